@@ -1,0 +1,16 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#include <pybind11/pybind11.h>
+
+namespace kiseki::bindings {
+void bind_core(pybind11::module_& m);
+void bind_grid(pybind11::module_& m);
+void bind_mapping(pybind11::module_& m);
+}  // namespace kiseki::bindings
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "kiseki's C++ core (private: use the kiseki package)";
+  kiseki::bindings::bind_core(m);
+  kiseki::bindings::bind_grid(m);
+  kiseki::bindings::bind_mapping(m);
+}

@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+// numpy <-> C++ helpers shared by the binding files: shape and value checks that raise
+// ValueError (std::invalid_argument) with the argument's name.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "kiseki/core/pose.hpp"
+
+namespace kiseki::bindings {
+
+namespace py = pybind11;
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+
+inline std::string shape_string(const py::array& a) {
+  std::string s = "(";
+  for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+/// Checks a numeric array's dimensionality and, where cols >= 0, its last dimension.
+template <typename Array>
+void require_shape(const Array& a, const char* name, int ndim, py::ssize_t cols = -1) {
+  if (a.ndim() != ndim || (cols >= 0 && a.shape(ndim - 1) != cols)) {
+    std::string want = ndim == 1 ? "(n,)" : (cols >= 0 ? "(n, " + std::to_string(cols) + ")" : "(n, m)");
+    throw std::invalid_argument(std::string(name) + ": expected an array of shape " + want +
+                                ", got shape " + shape_string(a));
+  }
+}
+
+template <typename Array>
+void require_finite(const Array& a, const char* name) {
+  const auto* p = a.data();
+  for (py::ssize_t i = 0; i < a.size(); ++i) {
+    if (!std::isfinite(p[i])) {
+      throw std::invalid_argument(std::string(name) + ": contains NaN or infinite values");
+    }
+  }
+}
+
+/// Converts any numeric input to a C-contiguous array of T (no copy when it already is one),
+/// rejecting non-numeric dtypes (strings, objects) with a ValueError naming the argument.
+template <typename T>
+py::array_t<T, py::array::c_style | py::array::forcecast> as_numeric(const py::handle& obj,
+                                                                      const char* name) {
+  py::array raw = py::array::ensure(obj);
+  if (!raw) throw std::invalid_argument(std::string(name) + ": expected a numeric array");
+  const char kind = raw.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b') {
+    throw std::invalid_argument(std::string(name) + ": expected a numeric array, got dtype " +
+                                std::string(py::str(raw.dtype())));
+  }
+  return py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(raw);
+}
+
+inline DoubleArray as_doubles(const py::handle& obj, const char* name) {
+  return as_numeric<double>(obj, name);
+}
+inline FloatArray as_floats(const py::handle& obj, const char* name) {
+  return as_numeric<float>(obj, name);
+}
+
+inline Pose2 pose_from_row(const double* row) { return {row[0], row[1], row[2]}; }
+
+}  // namespace kiseki::bindings

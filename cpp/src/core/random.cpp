@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#include "kiseki/core/random.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace kiseki {
+
+std::uint64_t derive_seed(std::uint64_t seed, std::uint64_t stream) {
+  std::uint64_t z = seed + 0x9E3779B97F4A7C15ULL * (stream + 1);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+Random::Random(std::uint64_t seed) : seed_(seed), engine_(seed) {}
+
+double Random::uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
+
+double Random::uniform(double low, double high) { return low + (high - low) * uniform(); }
+
+double Random::normal(double mean, double stddev) {
+  if (has_spare_) {
+    has_spare_ = false;
+    return mean + stddev * spare_;
+  }
+  double u = 0.0, v = 0.0, s = 0.0;
+  do {
+    u = 2.0 * uniform() - 1.0;
+    v = 2.0 * uniform() - 1.0;
+    s = u * u + v * v;
+  } while (s >= 1.0 || s == 0.0);
+  const double factor = std::sqrt(-2.0 * std::log(s) / s);
+  spare_ = v * factor;
+  has_spare_ = true;
+  return mean + stddev * u * factor;
+}
+
+std::uint64_t Random::below(std::uint64_t n) {
+  if (n == 0) throw std::invalid_argument("Random::below: n must be positive");
+  const std::uint64_t limit = ~std::uint64_t{0} - (~std::uint64_t{0} % n);
+  std::uint64_t r = engine_();
+  while (r >= limit) r = engine_();
+  return r % n;
+}
+
+}  // namespace kiseki

@@ -1,0 +1,35 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""kiseki: mobile-robot localization and navigation toolkit (C++17 core, Python front).
+
+The public API lives in the submodules (``kiseki.core``, ``kiseki.grid``, ``kiseki.map_io``,
+``kiseki.mapping``, ``kiseki.datasets``); the most used names are re-exported here.
+"""
+
+from __future__ import annotations
+
+from kiseki.core import Pose2, Pose3, Random, derive_seed, library_versions, normalize_angle
+from kiseki.errors import KisekiError, LogFormatError, MapFormatError
+from kiseki.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from kiseki.map_io import load_map, save_map
+
+__version__ = library_versions()["kiseki"]
+
+__all__ = [
+    "FREE",
+    "OCCUPIED",
+    "UNKNOWN",
+    "KisekiError",
+    "LogFormatError",
+    "MapFormatError",
+    "OccupancyGrid",
+    "Pose2",
+    "Pose3",
+    "Random",
+    "__version__",
+    "derive_seed",
+    "library_versions",
+    "load_map",
+    "normalize_angle",
+    "save_map",
+]

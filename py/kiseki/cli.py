@@ -1,0 +1,172 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The ``kiseki`` command line: one command with subcommands.
+
+Errors in what the user gave (a missing or corrupt file, a bad value) print one line
+``kiseki: error: ...`` on stderr and exit with status 1.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from kiseki.errors import KisekiError
+
+app = typer.Typer(
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+    help="kiseki: mobile-robot localization and navigation toolkit.",
+)
+map_app = typer.Typer(no_args_is_help=True, help="Occupancy-grid maps: build, render, inspect.")
+app.add_typer(map_app, name="map")
+console = Console()
+
+
+def _version_callback(value: bool) -> None:
+    if value:
+        from kiseki.core import library_versions
+
+        versions = library_versions()
+        others = ", ".join(f"{k} {v}" for k, v in sorted(versions.items()) if k != "kiseki")
+        typer.echo(f"kiseki {versions['kiseki']} ({others})")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(
+        False, "--version", callback=_version_callback, is_eager=True, help="Show the version."
+    ),
+) -> None:
+    """kiseki: mobile-robot localization and navigation toolkit."""
+
+
+def _positive(name: str, value: float) -> float:
+    if not np.isfinite(value) or value <= 0:
+        raise ValueError(f"{name} must be a positive number, got {value}")
+    return value
+
+
+@map_app.command("from-log")
+def map_from_log(
+    log: Path = typer.Argument(..., help="CARMEN log (.log or .log.gz) with poses and scans."),
+    output: Path = typer.Option(..., "-o", "--output", help="Map YAML to write (image beside)."),
+    resolution: float = typer.Option(0.05, help="Cell size in metres."),
+    usable_range: float = typer.Option(30.0, help="Free space is marked at most this far (m)."),
+    render: Path | None = typer.Option(None, help="Also draw the map and trajectory to this PNG."),
+) -> None:
+    """Build an occupancy grid from a log's poses and scans and save it as a ROS map."""
+    from kiseki.datasets import read_carmen_log
+    from kiseki.map_io import load_map, save_map
+    from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
+    from kiseki.plots import render_map
+
+    config = MapBuildConfig(
+        resolution=_positive("--resolution", resolution),
+        usable_range=_positive("--usable-range", usable_range),
+    )
+    start = time.perf_counter()
+    scans = read_carmen_log(log).scans
+    grid = build_map(scans.poses, scans.ranges, scans.angles, scans.max_range, config, True)
+    seconds = time.perf_counter() - start
+    saved = load_map(save_map(grid, output))
+    share = endpoint_agreement(saved, scans.poses, scans.ranges, scans.angles, scans.max_range)
+    if render is not None:
+        render_map(saved, render, trajectory=scans.poses, title=f"{log.name}")
+    console.print(
+        f"{output}: {grid.width} x {grid.height} cells at {grid.resolution} m from "
+        f"{len(scans)} scans in {seconds:.2f} s; {100 * share:.1f} % of scan endpoints on or "
+        "next to occupied cells"
+    )
+
+
+def _read_trajectory(path: Path) -> np.ndarray:
+    """x, y[, theta] rows from a CSV with a header naming x and y, or poses of a CARMEN log."""
+    if path.name.endswith((".log", ".log.gz")):
+        from kiseki.datasets import read_carmen_log
+
+        return read_carmen_log(path).scans.poses
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: trajectory file not found")
+    header = path.open(encoding="utf-8").readline().strip().split(",")
+    if "x" not in header or "y" not in header:
+        raise ValueError(f"{path}: a trajectory CSV needs a header with columns x and y")
+    try:
+        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except ValueError as err:
+        raise ValueError(f"{path}: not a numeric CSV ({err})") from err
+    if data.shape[1] != len(header) or not np.isfinite(data).all():
+        raise ValueError(f"{path}: rows must have {len(header)} finite numbers")
+    return data[:, [header.index("x"), header.index("y")]]
+
+
+@map_app.command("render")
+def map_render(
+    map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat map."),
+    output: Path = typer.Option(..., "-o", "--output", help="PNG to write."),
+    trajectory: Path | None = typer.Option(
+        None, help="Trajectory to overlay: CSV with x,y columns, or a CARMEN log."
+    ),
+) -> None:
+    """Draw a map (and a trajectory over it) to a PNG."""
+    from kiseki.map_io import load_map
+    from kiseki.plots import render_map
+
+    grid = load_map(map_file)
+    path = _read_trajectory(trajectory) if trajectory is not None else None
+    render_map(grid, output, trajectory=path, title=map_file.name)
+    console.print(f"{output}: {grid.width} x {grid.height} map drawn")
+
+
+@map_app.command("info")
+def map_info(
+    map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat map."),
+) -> None:
+    """Print a map's size, resolution, origin and cell counts."""
+    from kiseki.grid import grid_summary
+    from kiseki.map_io import load_map
+
+    summary = grid_summary(load_map(map_file))
+    table = Table(title=str(map_file))
+    table.add_column("field")
+    table.add_column("value", justify="right")
+    for key, value in summary.items():
+        table.add_row(key, f"{value:.4g}" if isinstance(value, float) else str(value))
+    console.print(table)
+
+
+@app.command("demo")
+def demo(
+    out: Path = typer.Option(Path("results/demo"), help="Folder for the figures and summary."),
+    map_file: Path = typer.Option(
+        Path("data/maps/factory_corridor.yaml"), "--map", help="Map to drive through."
+    ),
+    seed: int = typer.Option(0, help="Seed of the simulated laser noise."),
+) -> None:
+    """The main job until teaching and playback land: drive a simulated laser along the
+    factory corridor map kept in data/, rebuild the map from its scans, draw everything."""
+    from kiseki.demo import run_demo
+
+    run_demo(map_file, out, seed, console)
+
+
+def main() -> None:
+    """Entry point: runs the app and turns input errors into one line and exit status 1."""
+    try:
+        app()
+    except (KisekiError, ValueError, OSError, RuntimeError, IndexError) as err:
+        message = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        typer.echo(f"kiseki: error: {message}", err=True)
+        sys.exit(1)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,14 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Core types: planar and 3-D poses, angle normalisation, the seeded random generator.
+
+``Random`` is the one generator every stochastic part of kiseki uses: the engine is
+mt19937_64 and the distributions are kiseki's own, so a seed gives the same numbers on every
+platform. ``derive_seed(seed, k)`` gives stream ``k`` of a seed (per trial, robot or sensor).
+"""
+
+from __future__ import annotations
+
+from kiseki._core import Pose2, Pose3, Random, derive_seed, library_versions, normalize_angle
+
+__all__ = ["Pose2", "Pose3", "Random", "derive_seed", "library_versions", "normalize_angle"]

@@ -1,0 +1,49 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Occupancy grids in the ROS convention (int8 cells: 0 free, 100 occupied, -1 unknown).
+
+``OccupancyGrid`` is implemented in C++ (OpenCV storage). ``grid.cells`` is a writable numpy
+view of the cells without a copy, indexed ``[y, x]`` with row 0 at the map origin (as in the
+ROS message, not as in the image file). Ray casting (``cast_ray``, ``cells_on_ray``,
+``cast_scans``), the distance field and local windows are methods of the grid.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from kiseki._core import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+
+__all__ = ["FREE", "OCCUPIED", "UNKNOWN", "OccupancyGrid", "beam_angles", "grid_summary"]
+
+
+def beam_angles(count: int, field_of_view: float, start: float | None = None) -> np.ndarray:
+    """Evenly spaced beam angles (radians) covering ``field_of_view`` with both ends included,
+    starting at ``start`` (default ``-field_of_view / 2``)."""
+    if count < 1:
+        raise ValueError(f"beam count must be >= 1, got {count}")
+    if not np.isfinite(field_of_view) or field_of_view <= 0:
+        raise ValueError(f"field of view must be positive, got {field_of_view}")
+    first = -field_of_view / 2 if start is None else start
+    if count == 1:
+        return np.array([first])
+    return first + np.arange(count) * (field_of_view / (count - 1))
+
+
+def grid_summary(grid: OccupancyGrid) -> dict[str, float | int]:
+    """Size, extent and cell counts of a grid."""
+    cells = grid.cells
+    return {
+        "width": grid.width,
+        "height": grid.height,
+        "resolution": grid.resolution,
+        "origin_x": grid.origin.x,
+        "origin_y": grid.origin.y,
+        "origin_yaw": grid.origin.theta,
+        "size_x_m": grid.width * grid.resolution,
+        "size_y_m": grid.height * grid.resolution,
+        "free": int(np.count_nonzero(cells == FREE)),
+        "occupied": int(np.count_nonzero(cells == OCCUPIED)),
+        "unknown": int(np.count_nonzero(cells < 0)),
+        "intermediate": int(np.count_nonzero((cells > 0) & (cells < 100))),
+    }

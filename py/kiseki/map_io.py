@@ -1,0 +1,185 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Map files: the ROS map_server format (YAML + PGM/PNG image) and the CMU Wean Hall .dat map.
+
+Loading follows nav2's map_server rules for every field the format defines (``image``,
+``resolution``, ``origin``, ``negate``, ``occupied_thresh``, ``free_thresh``, ``mode`` trinary /
+scale / raw). Saving follows nav2's map_saver, except that ``free_thresh`` defaults to 0.196
+(the ROS 1 map_saver value) so that the 205-grey of unknown cells loads back as unknown; nav2's
+0.25 would turn it into free space. Files are written to a temporary name and renamed, so an
+interrupted save never leaves a half-written map behind.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+
+from kiseki import _core
+from kiseki._atomic import atomic_write
+from kiseki.core import Pose2
+from kiseki.errors import MapFormatError
+from kiseki.grid import OccupancyGrid
+
+__all__ = ["MapMetadata", "load_map", "read_map_metadata", "save_map"]
+
+MODES = ("trinary", "scale", "raw")
+
+
+@dataclass(frozen=True)
+class MapMetadata:
+    """The fields of a ROS map YAML file."""
+
+    image: Path
+    resolution: float
+    origin: tuple[float, float, float]
+    mode: str = "trinary"
+    negate: bool = False
+    occupied_thresh: float = 0.65
+    free_thresh: float = 0.196
+
+
+def _number(doc: dict, key: str, path: Path) -> float:
+    value = doc[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise MapFormatError(f"{path}: '{key}' must be a number, got {value!r}")
+    if not math.isfinite(value):
+        raise MapFormatError(f"{path}: '{key}' must be finite, got {value!r}")
+    return float(value)
+
+
+def _parse_yaml(path: Path) -> dict:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as err:
+        raise MapFormatError(f"{path}: not a text YAML file ({err})") from err
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as err:
+        raise MapFormatError(f"{path}: invalid YAML ({err})") from err
+    if not isinstance(doc, dict):
+        raise MapFormatError(f"{path}: expected a YAML mapping with image, resolution and origin")
+    missing = [k for k in ("image", "resolution", "origin") if k not in doc]
+    if missing:
+        raise MapFormatError(f"{path}: missing field(s) {', '.join(missing)}")
+    return doc
+
+
+def read_map_metadata(path: str | os.PathLike) -> MapMetadata:
+    """Reads and checks a ROS map YAML file (the image path is resolved next to it)."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: map YAML file not found")
+    doc = _parse_yaml(path)
+    resolution = _number(doc, "resolution", path)
+    if resolution <= 0:
+        raise MapFormatError(f"{path}: 'resolution' must be positive, got {resolution}")
+    origin = doc["origin"]
+    if not isinstance(origin, list) or len(origin) != 3:
+        raise MapFormatError(f"{path}: 'origin' must be a list [x, y, yaw], got {origin!r}")
+    origin_values = tuple(_number({"origin": v}, "origin", path) for v in origin)
+    mode = doc.get("mode", "trinary")
+    if mode not in MODES:
+        raise MapFormatError(f"{path}: 'mode' must be one of {', '.join(MODES)}, got {mode!r}")
+    negate = doc.get("negate", 0)
+    if negate not in (0, 1, True, False):
+        raise MapFormatError(f"{path}: 'negate' must be 0 or 1, got {negate!r}")
+    thresholds = {
+        key: _number(doc, key, path) if key in doc else default
+        for key, default in (("occupied_thresh", 0.65), ("free_thresh", 0.196))
+    }
+    for key, value in thresholds.items():
+        if not 0.0 <= value <= 1.0:
+            raise MapFormatError(f"{path}: '{key}' must lie in [0, 1], got {value}")
+    if thresholds["free_thresh"] > thresholds["occupied_thresh"]:
+        raise MapFormatError(f"{path}: 'free_thresh' exceeds 'occupied_thresh'")
+    if not isinstance(doc["image"], str) or not doc["image"]:
+        raise MapFormatError(f"{path}: 'image' must be a file name, got {doc['image']!r}")
+    image = Path(doc["image"])
+    return MapMetadata(
+        image=image if image.is_absolute() else path.parent / image,
+        resolution=resolution,
+        origin=origin_values,  # type: ignore[arg-type]
+        mode=mode,
+        negate=bool(negate),
+        **thresholds,
+    )
+
+
+def _load_ros_map(path: Path) -> OccupancyGrid:
+    meta = read_map_metadata(path)
+    if not meta.image.is_file():
+        raise FileNotFoundError(f"{path}: image file {meta.image} not found")
+    try:
+        image = _core.read_image(str(meta.image))
+    except RuntimeError as err:
+        raise MapFormatError(f"{path}: {err}") from err
+    return _core.occupancy_from_image(
+        image,
+        meta.resolution,
+        Pose2(*meta.origin),
+        mode=meta.mode,
+        negate=meta.negate,
+        occupied_thresh=meta.occupied_thresh,
+        free_thresh=meta.free_thresh,
+    )
+
+
+def load_map(path: str | os.PathLike) -> OccupancyGrid:
+    """Loads a map: a ROS map YAML (``.yaml``/``.yml``) or a CMU Wean ``.dat``/``.dat.gz``."""
+    path = Path(path)
+    name = path.name.lower()
+    if name.endswith((".dat", ".dat.gz")):
+        from kiseki.datasets.wean import read_wean_map
+
+        wean = read_wean_map(path)
+        return OccupancyGrid(wean.to_cells(), wean.resolution)
+    if not name.endswith((".yaml", ".yml")):
+        raise MapFormatError(f"{path}: unknown map format (expected .yaml, .yml, .dat or .dat.gz)")
+    return _load_ros_map(path)
+
+
+def save_map(
+    grid: OccupancyGrid,
+    path: str | os.PathLike,
+    mode: str = "trinary",
+    image_format: str | None = None,
+    occupied_thresh: float = 0.65,
+    free_thresh: float = 0.196,
+) -> Path:
+    """Saves a grid as ROS map YAML + image (``<stem>.pgm``, or ``.png`` in scale mode, which
+    needs an alpha channel). Returns the YAML path."""
+    path = Path(path)
+    if path.suffix.lower() not in (".yaml", ".yml"):
+        raise ValueError(f"{path}: a ROS map must be saved to a .yaml file")
+    if not path.parent.is_dir():
+        raise FileNotFoundError(f"{path}: directory {path.parent} does not exist")
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+    image_format = (image_format or ("png" if mode == "scale" else "pgm")).lower()
+    if image_format not in ("pgm", "png"):
+        raise ValueError(f"image_format must be 'pgm' or 'png', got {image_format!r}")
+    if mode == "scale" and image_format == "pgm":
+        raise ValueError("scale mode stores unknown cells in an alpha channel: use PNG")
+    image = _core.image_from_occupancy(
+        grid, mode=mode, occupied_thresh=occupied_thresh, free_thresh=free_thresh
+    )
+    image_path = path.with_suffix(f".{image_format}")
+    atomic_write(image_path, lambda tmp: _core.write_image(tmp, image))
+    origin = grid.origin
+    doc = {
+        "image": image_path.name,
+        "mode": mode,
+        "resolution": float(grid.resolution),
+        "origin": [float(origin.x), float(origin.y), float(origin.theta)],
+        "negate": 0,
+        "occupied_thresh": float(occupied_thresh),
+        "free_thresh": float(free_thresh),
+    }
+    text = yaml.safe_dump(doc, sort_keys=False, default_flow_style=None)
+    atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+    return path
