@@ -45,6 +45,7 @@ void bind_mapping(py::module_& m) {
       .def_readwrite("max_range", &LogOddsParams::max_range)
       .def_readwrite("usable_range", &LogOddsParams::usable_range)
       .def_readwrite("min_range", &LogOddsParams::min_range)
+      .def_readwrite("clear_on_no_return", &LogOddsParams::clear_on_no_return)
       .def_readwrite("prob_hit", &LogOddsParams::prob_hit)
       .def_readwrite("prob_miss", &LogOddsParams::prob_miss)
       .def_readwrite("clamp_min", &LogOddsParams::clamp_min)

@@ -71,19 +71,29 @@ def run_demo(map_file: Path, out: Path, seed: int, console: Console) -> dict:
     valid = ranges[at_p1] < config.max_range
     a = poses[at_p1, 2] + angles[valid]
     points = poses[at_p1, :2] + ranges[at_p1, valid, None] * np.column_stack([np.cos(a), np.sin(a)])
-    render_map(grid, out / "map_scan_at_P1.png", trajectory=poses, points=points,
-               title=f"{map_file.name}: path P0 -> P2 and the scan at P1")
+    render_map(
+        grid,
+        out / "map_scan_at_P1.png",
+        trajectory=poses,
+        points=points,
+        title=f"{map_file.name}: path P0 -> P2 and the scan at P1",
+    )
     render_distance_field(grid, out / "distance_field.png")
-    render_map(rebuilt, out / "rebuilt_map.png", trajectory=poses,
-               title="map rebuilt from the simulated scans")
+    render_map(
+        rebuilt,
+        out / "rebuilt_map.png",
+        trajectory=poses,
+        title="map rebuilt from the simulated scans",
+    )
     summary = {
         "map": str(map_file),
         "scans": len(poses),
         "beams_per_scan": config.beams,
         "scans_per_second": len(poses) / cast_seconds,
         "endpoints_on_true_map": endpoint_agreement(grid, poses, ranges, angles, config.max_range),
-        "endpoints_on_rebuilt_map": endpoint_agreement(rebuilt, poses, ranges, angles,
-                                                       config.max_range),
+        "endpoints_on_rebuilt_map": endpoint_agreement(
+            rebuilt, poses, ranges, angles, config.max_range
+        ),
         "true_map": grid_summary(grid),
         "rebuilt_map": grid_summary(rebuilt),
     }
@@ -99,11 +109,16 @@ def _print_summary(summary: dict, out: Path, console: Console) -> None:
     table.add_column("value", justify="right")
     table.add_row("scans cast (1081 beams, 30 m)", str(summary["scans"]))
     table.add_row("scans per second (one core)", f"{summary['scans_per_second']:.0f}")
-    table.add_row("endpoints on/next to occupied, true map",
-                  f"{100 * summary['endpoints_on_true_map']:.1f} %")
-    table.add_row("endpoints on/next to occupied, rebuilt map",
-                  f"{100 * summary['endpoints_on_rebuilt_map']:.1f} %")
-    table.add_row("rebuilt map size (cells)",
-                  f"{summary['rebuilt_map']['width']} x {summary['rebuilt_map']['height']}")
+    table.add_row(
+        "endpoints on/next to occupied, true map", f"{100 * summary['endpoints_on_true_map']:.1f} %"
+    )
+    table.add_row(
+        "endpoints on/next to occupied, rebuilt map",
+        f"{100 * summary['endpoints_on_rebuilt_map']:.1f} %",
+    )
+    table.add_row(
+        "rebuilt map size (cells)",
+        f"{summary['rebuilt_map']['width']} x {summary['rebuilt_map']['height']}",
+    )
     console.print(table)
     console.print(f"figures, rebuilt map and summary in {out}/")

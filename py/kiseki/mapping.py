@@ -26,6 +26,7 @@ class MapBuildConfig:
     resolution: float = 0.05
     usable_range: float = 30.0  # free space is marked at most this far along a beam
     min_range: float = 0.0
+    clear_on_no_return: bool = False  # do "no return" readings clear their beam? (see C++ doc)
     prob_hit: float = 0.7
     prob_miss: float = 0.4
     clamp_min: float = 0.12
@@ -43,7 +44,8 @@ class MapBuildConfig:
         unknown = sorted(set(values) - known)
         if unknown:
             raise ValueError(f"unknown map-building parameter(s): {', '.join(unknown)}")
-        return cls(**{k: float(v) for k, v in values.items()})
+        kinds = {f.name: f.type for f in fields(cls)}
+        return cls(**{k: (bool(v) if kinds[k] == "bool" else float(v)) for k, v in values.items()})
 
     def core_params(self, max_range: float) -> _core.LogOddsParams:
         p = _core.LogOddsParams()
@@ -51,6 +53,7 @@ class MapBuildConfig:
             "resolution",
             "usable_range",
             "min_range",
+            "clear_on_no_return",
             "prob_hit",
             "prob_miss",
             "clamp_min",

@@ -75,8 +75,15 @@ def render_map(
 ) -> Path:
     """Draws the grid, an optional trajectory (n, 2|3) and optional points (m, 2) to a PNG."""
     fig, ax = _figure(grid)
-    ax.imshow(map_shades(grid), cmap="gray", vmin=0, vmax=1, origin="lower",
-              extent=_extent(grid), interpolation="nearest")
+    ax.imshow(
+        map_shades(grid),
+        cmap="gray",
+        vmin=0,
+        vmax=1,
+        origin="lower",
+        extent=_extent(grid),
+        interpolation="nearest",
+    )
     if points is not None and len(points):
         xy = _world_xy(grid, points)
         ax.plot(xy[:, 0], xy[:, 1], ".", color="tab:red", markersize=1.5, label="scan points")
@@ -94,8 +101,9 @@ def render_distance_field(grid: OccupancyGrid, path: str | os.PathLike, clip: fl
     """Draws the distance to the nearest obstacle (metres, clipped at ``clip``)."""
     fig, ax = _figure(grid)
     field = np.minimum(grid.distance_field(), clip)
-    im = ax.imshow(field, cmap="viridis", origin="lower", extent=_extent(grid),
-                   interpolation="nearest")
+    im = ax.imshow(
+        field, cmap="viridis", origin="lower", extent=_extent(grid), interpolation="nearest"
+    )
     fig.colorbar(im, ax=ax, label="distance to nearest obstacle (m)", shrink=0.8)
     ax.set_title("distance field")
     return _save(fig, Path(path))

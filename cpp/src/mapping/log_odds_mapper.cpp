@@ -16,6 +16,11 @@ float logit(double p) { return static_cast<float>(std::log(p / (1.0 - p))); }
 
 bool usable(float r, const LogOddsParams& p) { return std::isfinite(r) && r > p.min_range; }
 
+// Whether a reading marks free space along its beam.
+bool clears(float r, const LogOddsParams& p) {
+  return usable(r, p) && (r < p.max_range || p.clear_on_no_return);
+}
+
 int checked_cells(double extent, double resolution) {
   const double n = std::ceil(extent / resolution);
   if (!(n >= 1.0) || n > 200000.0) {
@@ -70,10 +75,7 @@ void LogOddsMapper::integrate_scan(const Pose2& pose, const float* ranges, const
   float* l = log_odds_.ptr<float>(0);
   hit_cells_.clear();
   for (std::size_t i = 0; i < n; ++i) {  // pass 1: end cells of returns
-    if (!usable(ranges[i], params_) || ranges[i] >= params_.max_range ||
-        ranges[i] > params_.usable_range) {
-      continue;
-    }
+    if (!usable(ranges[i], params_) || ranges[i] >= params_.max_range) continue;
     const double a = pose.theta + angles[i];
     const CellIndex c = frame_.world_to_cell(
         {pose.x + ranges[i] * std::cos(a), pose.y + ranges[i] * std::sin(a)});
@@ -86,8 +88,8 @@ void LogOddsMapper::integrate_scan(const Pose2& pose, const float* ranges, const
   }
   RayCastOptions free_space;
   free_space.occupied_threshold = std::numeric_limits<std::int8_t>::max();  // never stop
-  for (std::size_t i = 0; i < n; ++i) {  // pass 2: free space along every beam
-    if (!usable(ranges[i], params_)) continue;
+  for (std::size_t i = 0; i < n; ++i) {  // pass 2: free space along the beams
+    if (!clears(ranges[i], params_)) continue;
     free_space.max_range = std::min<double>(ranges[i], params_.usable_range);
     for (const CellIndex& c : cells_on_ray(frame_, {pose.x, pose.y}, pose.theta + angles[i],
                                            free_space)) {
@@ -133,8 +135,8 @@ std::vector<double> LogOddsMapper::scan_bounds(const double* poses, const float*
     grow(x, y);
     for (std::size_t i = 0; i < n_beams; ++i) {
       const float r = ranges[s * n_beams + i];
-      if (!usable(r, p)) continue;
-      const double d = std::min<double>(r, p.usable_range);
+      if (!usable(r, p) || (r >= p.max_range && !p.clear_on_no_return)) continue;
+      const double d = r < p.max_range ? r : std::min<double>(r, p.usable_range);
       grow(x + d * std::cos(th + angles[i]), y + d * std::sin(th + angles[i]));
     }
   }

@@ -18,7 +18,13 @@ struct LogOddsParams {
   double resolution = 0.05;      ///< metres per cell
   double max_range = 80.0;       ///< readings >= max_range are "no return": free space only
   double usable_range = 30.0;    ///< free space is marked at most this far along a beam
+                                 ///< (returns beyond it still mark their end cell)
   double min_range = 0.0;        ///< readings <= min_range are ignored
+  /// Whether a "no return" reading (>= max_range) clears the cells along its beam up to
+  /// usable_range. Off by default: indoors a missing return is more often glass, a black or
+  /// specular surface, or an open door than truly empty space, and clearing along it erases
+  /// walls seen from elsewhere.
+  bool clear_on_no_return = false;
   double prob_hit = 0.7;
   double prob_miss = 0.4;
   double clamp_min = 0.12;
@@ -51,7 +57,8 @@ class LogOddsMapper {
   std::size_t scans_integrated() const { return scans_; }
 
   /// Axis-aligned bounds of everything a set of scans can touch: every sensor position and
-  /// every beam end (clipped to usable_range). poses is n_scans x 3 (x, y, theta), ranges
+  /// every return's end point (and, when no-return readings clear, their beams clipped to
+  /// usable_range). poses is n_scans x 3 (x, y, theta), ranges
   /// n_scans x n_beams, row-major. Returns {min_x, min_y, max_x, max_y}.
   static std::vector<double> scan_bounds(const double* poses, const float* ranges,
                                          const double* angles, std::size_t n_scans,

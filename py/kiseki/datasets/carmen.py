@@ -1,0 +1,312 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Reader for CARMEN laser logs (plain text or gzip), such as the Radish "-corrected" logs.
+
+Messages read, one per line (``#`` lines are comments)::
+
+    FLASER n r1..rn x y theta odom_x odom_y odom_theta timestamp hostname logger_timestamp
+    ROBOTLASER1 laser_type start_angle fov angular_resolution maximum_range accuracy
+        remission_mode n r1..rn k rem1..remk laser_x laser_y laser_theta robot_x robot_y
+        robot_theta tv rv forward_safety_dist side_safety_dist turn_axis timestamp hostname
+        logger_timestamp
+    ODOM x y theta tv rv accel timestamp hostname logger_timestamp
+    PARAM name value ...
+
+Laser scans come from the FLASER messages; only a log without FLASER uses its ROBOTLASER1
+messages. Everything else (RLASER rear laser, RAWLASER*, NEFF, SYNC, TRUEPOS, ...) is skipped.
+Remission values of ROBOTLASER1 are skipped too. A PARAM value is its first token. All laser
+messages used must have the same beam count (LogFormatError otherwise; no Radish log mixes them).
+
+FLASER beam angles follow CARMEN's own reader (``carmen_laser_guess_angle_increment``): the first
+beam is at -pi/2 (right) and beams go counter-clockwise with a step of pi/180 for 180 or 181
+beams, pi/360 for 360 or 361 and pi/720 for 400 or 401, otherwise pi/(n-1). So 181 and 361 beams
+span [-pi/2, pi/2], and 180 and 360 beams stop one step short of +pi/2. The ``laser_front_laser_*``
+PARAMs are not used, just as CARMEN ignores them for FLASER. ROBOTLASER1 messages carry their own
+``start_angle + i * angular_resolution``.
+
+Max range (readings >= ``max_range`` mean "no return"): the PARAM ``robot_front_laser_max`` if
+present, else the largest reading in the log, which is the no-return value the logger wrote (a
+log without any no-return reading would lose its single largest return this way). For
+ROBOTLASER1 it is the message's ``maximum_range`` field. The value is rounded to float32, like the
+ranges, so the comparison gives the same answer in float32 and float64. In the Radish logs:
+Intel has no PARAM and no returns are 81.83; ACES has no PARAM and readings are clipped at 50;
+CSAIL has ``robot_front_laser_max 50`` and no returns are 81.91 (largest return 35.12);
+Freiburg 079 has ``robot_front_laser_max 80.99`` and no returns are 81.91.
+
+Records are returned in file order and as written, with no sorting or filtering. Facts of the
+Radish "-corrected" logs (Intel, ACES, CSAIL, Freiburg 079) that users should know:
+
+* the FLASER ``odom_*`` fields equal the corrected ``x y theta`` fields, and the ODOM messages
+  follow the corrected path too, so none of them is raw odometry: make noisy odometry from the
+  increments of the corrected poses;
+* almost every FLASER is followed by an ODOM with timestamp 0 that repeats its pose, so ODOM
+  times are not sorted; a few Intel FLASER timestamps also step back (by up to 0.86 s);
+* the CSAIL log writes timestamps with 6 significant digits (``1.13486e+09``): 10 s steps.
+"""
+
+from __future__ import annotations
+
+import gzip
+import os
+import zlib
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from kiseki.errors import LogFormatError
+
+__all__ = [
+    "CarmenLog",
+    "LaserScans",
+    "OdometryRecords",
+    "flaser_angles",
+    "read_carmen_log",
+]
+
+_GZIP_MAGIC = b"\x1f\x8b"
+_MAX_RANGE_PARAM = "robot_front_laser_max"
+# Step of CARMEN's FLASER guess for the usual SICK beam counts.
+_FLASER_STEPS = {
+    180: np.pi / 180,
+    181: np.pi / 180,
+    360: np.pi / 360,
+    361: np.pi / 360,
+    400: np.pi / 720,
+    401: np.pi / 720,
+}
+
+_Row = tuple[int, list[str]]  # (1-based line number, whitespace-separated tokens)
+
+
+@dataclass(frozen=True, eq=False)
+class LaserScans:
+    """Laser scans of one log, in file order."""
+
+    times: np.ndarray  # (N,) float64 message timestamp, seconds
+    poses: np.ndarray  # (N, 3) float64 laser pose in the log (x, y, theta; corrected logs)
+    odometry: np.ndarray  # (N, 3) float64 odometry pose as logged (see the module docstring)
+    ranges: np.ndarray  # (N, B) float32 metres, C-contiguous
+    angles: np.ndarray  # (B,) float64 beam angles in the laser frame, radians
+    max_range: float  # readings >= max_range mean no return
+
+    def __len__(self) -> int:
+        return int(self.times.shape[0])
+
+
+@dataclass(frozen=True, eq=False)
+class OdometryRecords:
+    """ODOM messages of one log, in file order."""
+
+    times: np.ndarray  # (M,) float64 seconds
+    poses: np.ndarray  # (M, 3) float64 x, y, theta
+    velocities: np.ndarray  # (M, 2) float64 tv (m/s), rv (rad/s)
+
+    def __len__(self) -> int:
+        return int(self.times.shape[0])
+
+
+@dataclass(frozen=True, eq=False)
+class CarmenLog:
+    """Everything kiseki reads from one CARMEN log."""
+
+    path: Path
+    scans: LaserScans
+    odometry: OdometryRecords
+    params: dict[str, str]
+
+
+def flaser_angles(num_beams: int) -> np.ndarray:
+    """Beam angles (radians, laser frame) CARMEN assumes for a FLASER with ``num_beams``."""
+    if num_beams < 2:
+        raise ValueError(f"a FLASER needs at least 2 beams, got {num_beams}")
+    step = _FLASER_STEPS.get(num_beams, np.pi / (num_beams - 1))
+    return -np.pi / 2 + step * np.arange(num_beams, dtype=np.float64)
+
+
+def read_carmen_log(path: str | os.PathLike) -> CarmenLog:
+    """Read a CARMEN log (gzip if the file starts with the gzip magic bytes)."""
+    path = Path(path)
+    rows, params = _split_messages(path, _read_text(path))
+    if rows["FLASER"]:
+        scans = _parse_flaser(path, rows["FLASER"], params)
+    elif rows["ROBOTLASER1"]:
+        scans = _parse_robotlaser(path, rows["ROBOTLASER1"])
+    else:
+        raise LogFormatError(f"{path}: no FLASER or ROBOTLASER1 messages")
+    odometry = _parse_odom(path, rows["ODOM"])
+    return CarmenLog(path=path, scans=scans, odometry=odometry, params=params)
+
+
+def _read_text(path: Path) -> str:
+    data = path.read_bytes()
+    if data.startswith(_GZIP_MAGIC):
+        try:
+            data = gzip.decompress(data)
+        except (EOFError, OSError, zlib.error) as exc:
+            raise LogFormatError(f"{path}: truncated or corrupt gzip stream ({exc})") from exc
+    if not data.strip():
+        raise LogFormatError(f"{path}: empty log")
+    return data.decode("latin-1")
+
+
+def _split_messages(path: Path, text: str) -> tuple[dict[str, list[_Row]], dict[str, str]]:
+    rows: dict[str, list[_Row]] = {"FLASER": [], "ROBOTLASER1": [], "ODOM": []}
+    params: dict[str, str] = {}
+    for lineno, line in enumerate(text.split("\n"), start=1):
+        tokens = line.split()
+        if not tokens or tokens[0].startswith("#"):
+            continue
+        kind = tokens[0]
+        if kind in rows:
+            rows[kind].append((lineno, tokens))
+        elif kind == "PARAM":
+            if len(tokens) < 3:
+                raise LogFormatError(f"{path}:{lineno}: PARAM needs a name and a value")
+            params[tokens[1]] = tokens[2]
+    return rows, params
+
+
+def _int_field(path: Path, lineno: int, token: str, what: str) -> int:
+    try:
+        value = int(token)
+    except ValueError:
+        raise LogFormatError(f"{path}:{lineno}: {what} {token!r} is not an integer") from None
+    if value < 0:
+        raise LogFormatError(f"{path}:{lineno}: {what} {value} is negative")
+    return value
+
+
+def _to_float(path: Path, rows: Sequence[_Row], fields: list[list[str]], kind: str) -> np.ndarray:
+    """Convert equal-length token lists to a float64 array; errors name the line."""
+    try:
+        values = np.array(fields, dtype=np.float64)
+    except ValueError:
+        for (lineno, _), tokens in zip(rows, fields, strict=True):
+            for token in tokens:
+                try:
+                    float(token)
+                except ValueError:
+                    msg = f"{path}:{lineno}: non-numeric value {token!r} in {kind}"
+                    raise LogFormatError(msg) from None
+        raise LogFormatError(f"{path}: unreadable numbers in {kind}") from None
+    bad = ~np.isfinite(values).all(axis=1)
+    if bad.any():
+        lineno = rows[int(np.argmax(bad))][0]
+        raise LogFormatError(f"{path}:{lineno}: non-finite value (NaN or inf) in {kind}")
+    return values
+
+
+def _check_count(path: Path, lineno: int, tokens: list[str], expected: int, kind: str) -> None:
+    if len(tokens) != expected:
+        msg = f"{path}:{lineno}: {kind} has {len(tokens)} fields, expected {expected}"
+        raise LogFormatError(msg)
+
+
+def _check_min_count(path: Path, lineno: int, tokens: list[str], minimum: int, kind: str) -> None:
+    if len(tokens) < minimum:
+        msg = f"{path}:{lineno}: {kind} has {len(tokens)} fields, expected at least {minimum}"
+        raise LogFormatError(msg)
+
+
+def _check_ranges(path: Path, rows: Sequence[_Row], ranges: np.ndarray, kind: str) -> None:
+    negative = (ranges < 0).any(axis=1)
+    if negative.any():
+        lineno = rows[int(np.argmax(negative))][0]
+        raise LogFormatError(f"{path}:{lineno}: negative range reading in {kind}")
+
+
+def _parse_flaser(path: Path, rows: list[_Row], params: dict[str, str]) -> LaserScans:
+    first_line, first = rows[0]
+    _check_min_count(path, first_line, first, 2, "FLASER")
+    n = _int_field(path, first_line, first[1], "FLASER beam count")
+    if n < 2:
+        raise LogFormatError(f"{path}:{first_line}: FLASER beam count {n} is below 2")
+    fields = []
+    for lineno, tokens in rows:
+        _check_min_count(path, lineno, tokens, 2, "FLASER")
+        if tokens[1] != first[1] and _int_field(path, lineno, tokens[1], "beam count") != n:
+            msg = f"{path}:{lineno}: FLASER has {tokens[1]} beams, line {first_line} has {n}"
+            raise LogFormatError(msg)
+        _check_count(path, lineno, tokens, n + 11, "FLASER")
+        fields.append(tokens[2 : n + 9] + tokens[n + 10 :])  # skip count and hostname
+    values = _to_float(path, rows, fields, "FLASER")
+    ranges = np.ascontiguousarray(values[:, :n], dtype=np.float32)
+    _check_ranges(path, rows, ranges, "FLASER")
+    return LaserScans(
+        times=values[:, n + 6].copy(),
+        poses=values[:, n : n + 3].copy(),
+        odometry=values[:, n + 3 : n + 6].copy(),
+        ranges=ranges,
+        angles=flaser_angles(n),
+        max_range=_flaser_max_range(path, params, ranges),
+    )
+
+
+def _flaser_max_range(path: Path, params: dict[str, str], ranges: np.ndarray) -> float:
+    text = params.get(_MAX_RANGE_PARAM)
+    if text is None:
+        return float(ranges.max())
+    try:
+        value = float(np.float32(text))
+    except ValueError:
+        raise LogFormatError(f"{path}: PARAM {_MAX_RANGE_PARAM} {text!r} is not a number") from None
+    if not np.isfinite(value) or value <= 0:
+        raise LogFormatError(f"{path}: PARAM {_MAX_RANGE_PARAM} {text!r} is not positive")
+    return value
+
+
+def _robotlaser_fields(path: Path, lineno: int, tokens: list[str]) -> list[str]:
+    """Numeric fields of one ROBOTLASER1: config(4), ranges(n), poses(6), timestamp."""
+    kind = "ROBOTLASER1"
+    _check_min_count(path, lineno, tokens, 24, kind)
+    n = _int_field(path, lineno, tokens[8], "ROBOTLASER1 beam count")
+    _check_min_count(path, lineno, tokens, n + 24, kind)
+    k = _int_field(path, lineno, tokens[9 + n], "ROBOTLASER1 remission count")
+    _check_count(path, lineno, tokens, n + k + 24, kind)
+    base = 10 + n + k
+    return tokens[2:6] + tokens[9 : 9 + n] + tokens[base : base + 6] + [tokens[base + 11]]
+
+
+def _parse_robotlaser(path: Path, rows: list[_Row]) -> LaserScans:
+    fields = [_robotlaser_fields(path, lineno, tokens) for lineno, tokens in rows]
+    n = len(fields[0]) - 11
+    for (lineno, _), row in zip(rows, fields, strict=True):
+        if len(row) - 11 != n:
+            msg = f"{path}:{lineno}: ROBOTLASER1 has {len(row) - 11} beams, the first has {n}"
+            raise LogFormatError(msg)
+    values = _to_float(path, rows, fields, "ROBOTLASER1")
+    config = values[:, :4]  # start_angle, fov, angular_resolution, maximum_range
+    changed = (config != config[0]).any(axis=1)
+    if changed.any():
+        lineno = rows[int(np.argmax(changed))][0]
+        raise LogFormatError(f"{path}:{lineno}: ROBOTLASER1 laser configuration changes")
+    start, _, step, max_range = config[0]
+    if n == 0 or max_range <= 0:
+        raise LogFormatError(f"{path}:{rows[0][0]}: ROBOTLASER1 with no beams or max range <= 0")
+    ranges = np.ascontiguousarray(values[:, 4 : 4 + n], dtype=np.float32)
+    _check_ranges(path, rows, ranges, "ROBOTLASER1")
+    return LaserScans(
+        times=values[:, n + 10].copy(),
+        poses=values[:, n + 4 : n + 7].copy(),
+        odometry=values[:, n + 7 : n + 10].copy(),
+        ranges=ranges,
+        angles=start + step * np.arange(n, dtype=np.float64),
+        max_range=float(np.float32(max_range)),
+    )
+
+
+def _parse_odom(path: Path, rows: list[_Row]) -> OdometryRecords:
+    if not rows:
+        empty = np.empty((0, 3))
+        return OdometryRecords(times=np.empty(0), poses=empty, velocities=np.empty((0, 2)))
+    for lineno, tokens in rows:
+        _check_count(path, lineno, tokens, 10, "ODOM")
+    fields = [tokens[1:8] + tokens[9:] for _, tokens in rows]  # skip hostname
+    values = _to_float(path, rows, fields, "ODOM")
+    return OdometryRecords(
+        times=values[:, 6].copy(),
+        poses=values[:, 0:3].copy(),
+        velocities=values[:, 3:5].copy(),
+    )

@@ -1,0 +1,154 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Reader for the CMU Wean Hall map (BeeSoft ``.dat`` format, plain text or gzip).
+
+Format: header lines ``robot_specifications->name value`` (``resolution`` in cm per cell), then
+``global_map[0]: size_y size_x``, then ``size_x * size_y`` numbers, x the outer loop (each text
+line is one x, as in the original reader ``bee-map.c``, which fills ``prob[x][y]``). A stored value
+``v`` in [0, 1] is known, a negative one unknown (the file uses -1).
+
+Value convention: ``v`` is the probability that the cell is FREE, so occupancy = 1 - v, although
+``instruct.txt`` calls it "a probability for occupancy". Evidence from ``wean.dat.gz``:
+
+* 72.8 % of the cells are unknown; of the known ones 78 % have v >= 0.6 and 18 % are exactly
+  1.0, but only 5.7 % exactly 0.0. The seen part of a building is mostly free space, walls thin;
+* drawn with white = high v, the map reproduces ``wean.gif`` (white corridors, thin black walls):
+  of the cells read here as occupied (> 0.65), 85 % fall on dark gif pixels; of the free ones
+  (< 0.196), 95 % on bright pixels; with occupancy = v instead, 2 % and 8 %;
+* BeeSoft/Rhino tools write this format as ``1 - prob`` and read it back as ``1.0 - temp``; the
+  CMU 16-831 starter code also uses 1 - v.
+
+Orientation: ``occupancy[y, x]``, row 0 at y = 0. Shown with row 0 at the bottom it matches
+``wean.gif``: cropped to the known area and resampled onto the gif, the known cells overlap the
+gif's non-background pixels with IoU 0.99; drawn upside down (row 0 on top) the IoU is 0.32, and
+mirrored left-right 0.50. The header's ``autoshifted_x/y`` offsets (0 in Wean) are not applied.
+"""
+
+from __future__ import annotations
+
+import gzip
+import os
+import re
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from kiseki.errors import MapFormatError
+
+__all__ = ["WeanMap", "read_wean_map"]
+
+_GZIP_MAGIC = b"\x1f\x8b"
+_HEADER_LINE = re.compile(r"robot_specifications->(\w+)\s+(\S+)")
+_SIZE_LINE = re.compile(r"global_map\[0\]:\s+(\d+)\s+(\d+)")
+
+
+@dataclass(frozen=True, eq=False)
+class WeanMap:
+    """Occupancy grid: ``occupancy[y, x]`` in [0, 1], NaN where unknown; row 0 at y = 0."""
+
+    occupancy: np.ndarray  # (H, W) float64
+    resolution: float  # metres per cell
+
+    def to_cells(self, occupied_thresh: float = 0.65, free_thresh: float = 0.196) -> np.ndarray:
+        """ROS-style int8 cells: 100 if p > occupied_thresh, 0 if p < free_thresh, else -1."""
+        if not 0.0 <= free_thresh <= occupied_thresh <= 1.0:
+            msg = f"need 0 <= free_thresh <= occupied_thresh <= 1, got {free_thresh}, "
+            raise ValueError(msg + f"{occupied_thresh}")
+        cells = np.full(self.occupancy.shape, -1, dtype=np.int8)
+        with np.errstate(invalid="ignore"):
+            cells[self.occupancy > occupied_thresh] = 100
+            cells[self.occupancy < free_thresh] = 0
+        return cells
+
+
+def read_wean_map(path: str | os.PathLike) -> WeanMap:
+    """Read a BeeSoft ``.dat`` map such as ``wean.dat.gz`` (gzip detected by magic bytes)."""
+    path = Path(path)
+    text = _read_text(path)
+    resolution_cm, size_y, size_x, body = _parse_header(path, text)
+    stored = _parse_values(path, body, size_x * size_y).reshape(size_x, size_y)  # [x, y]
+    occupancy = np.where(stored < 0, np.nan, 1.0 - stored).T
+    return WeanMap(occupancy=np.ascontiguousarray(occupancy), resolution=resolution_cm / 100.0)
+
+
+def _read_text(path: Path) -> str:
+    data = path.read_bytes()
+    if data.startswith(_GZIP_MAGIC):
+        try:
+            data = gzip.decompress(data)
+        except (EOFError, OSError, zlib.error) as exc:
+            raise MapFormatError(f"{path}: truncated or corrupt gzip stream ({exc})") from exc
+    return data.decode("latin-1")
+
+
+def _parse_header(path: Path, text: str) -> tuple[float, int, int, str]:
+    """Return (resolution in cm, size_y, size_x, text after the size line)."""
+    specs: dict[str, str] = {}
+    pos = 0
+    for lineno, line in enumerate(text.split("\n"), start=1):
+        end = pos + len(line) + 1
+        stripped = line.strip()
+        if stripped.startswith("global_map[0]"):
+            size = _SIZE_LINE.fullmatch(stripped)
+            if size is None or min(int(size[1]), int(size[2])) == 0:
+                raise MapFormatError(f"{path}:{lineno}: bad map size line {stripped!r}")
+            resolution = _header_resolution(path, specs, int(size[1]), int(size[2]))
+            return resolution, int(size[1]), int(size[2]), text[end:]
+        spec = _HEADER_LINE.fullmatch(stripped)
+        if stripped and spec is None:
+            raise MapFormatError(f"{path}:{lineno}: unexpected header line {stripped[:60]!r}")
+        if spec is not None:
+            specs[spec[1]] = spec[2]
+        pos = end
+    raise MapFormatError(f"{path}: no 'global_map[0]: size_y size_x' line")
+
+
+def _spec_number(path: Path, specs: dict[str, str], name: str) -> float | None:
+    if name not in specs:
+        return None
+    try:
+        value = float(specs[name])
+    except ValueError:
+        value = float("nan")
+    if not np.isfinite(value):
+        raise MapFormatError(f"{path}: robot_specifications->{name} {specs[name]!r} is bad")
+    return value
+
+
+def _header_resolution(path: Path, specs: dict[str, str], size_y: int, size_x: int) -> float:
+    resolution = _spec_number(path, specs, "resolution")
+    if resolution is None or resolution <= 0:
+        raise MapFormatError(f"{path}: missing or non-positive robot_specifications->resolution")
+    for axis, cells in (("x", size_x), ("y", size_y)):
+        extent = _spec_number(path, specs, f"global_mapsize_{axis}")
+        if extent is not None and extent != cells * resolution:
+            msg = f"{path}: global_mapsize_{axis} {extent:g} cm != {cells} cells * {resolution:g}"
+            raise MapFormatError(msg)
+    return resolution
+
+
+def _parse_values(path: Path, body: str, count: int) -> np.ndarray:
+    tokens = body.split()
+    if len(tokens) != count:
+        raise MapFormatError(f"{path}: {len(tokens)} map values, the header promises {count}")
+    try:
+        values = np.array(tokens, dtype=np.float64)
+    except ValueError:
+        bad = next(t for t in tokens if not _is_float(t))
+        raise MapFormatError(f"{path}: non-numeric map value {bad!r}") from None
+    invalid = ~((values >= -1.0) & (values <= 1.0))  # also catches NaN
+    if invalid.any():
+        index = int(np.argmax(invalid))
+        msg = f"{path}: map value {tokens[index]!r} (number {index}) is outside [-1, 1]"
+        raise MapFormatError(msg)
+    return values
+
+
+def _is_float(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True

@@ -1,0 +1,37 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Fixtures: the project's own data/ and the recorded datasets in ../shared/data.
+
+Tests that need ../shared/data skip with a message when it is absent, except under CI
+(CI=true), where its absence is an error.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+PROJECT_ROOT = Path(__file__).resolve().parents[2]
+SHARED_DATA = PROJECT_ROOT.parent / "shared" / "data"
+
+
+@pytest.fixture(scope="session")
+def project_root() -> Path:
+    return PROJECT_ROOT
+
+
+@pytest.fixture(scope="session")
+def project_data() -> Path:
+    return PROJECT_ROOT / "data"
+
+
+@pytest.fixture(scope="session")
+def shared_data() -> Path:
+    if not SHARED_DATA.is_dir():
+        message = f"recorded datasets not found at {SHARED_DATA} (../shared/data)"
+        if os.environ.get("CI", "").lower() == "true":
+            pytest.fail(f"{message}: CI must provide them", pytrace=False)
+        pytest.skip(message)
+    return SHARED_DATA

@@ -1,0 +1,79 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The kiseki command line, run as a user would (a real subprocess)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import yaml
+
+import kiseki
+from kiseki import OccupancyGrid, Pose2, save_map
+
+
+def run(*args: str, cwd=None) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", *args], capture_output=True, text=True, cwd=cwd
+    )
+
+
+def test_version():
+    done = run("--version")
+    assert done.returncode == 0
+    assert done.stdout.startswith(f"kiseki {kiseki.__version__} (")
+    assert "octomap" in done.stdout and "pcl" in done.stdout
+
+
+def test_map_info_and_render(tmp_path):
+    cells = np.zeros((20, 30), dtype=np.int8)
+    cells[5, :] = 100
+    cells[15:, :3] = -1
+    path = save_map(OccupancyGrid(cells, 0.1, Pose2(1.0, 2.0, 0.0)), tmp_path / "m.yaml")
+    done = run("map", "info", str(path))
+    assert done.returncode == 0, done.stderr
+    assert "30" in done.stdout and "occupied" in done.stdout
+    occupied_row = [line for line in done.stdout.splitlines() if " occupied " in line]
+    assert occupied_row and occupied_row[0].split("│")[2].strip() == "30"
+    (tmp_path / "path.csv").write_text("t,x,y,theta\n0,1.5,2.5,0\n1,3.0,3.0,0.5\n")
+    png = tmp_path / "m.png"
+    done = run(
+        "map", "render", str(path), "-o", str(png), "--trajectory", str(tmp_path / "path.csv")
+    )
+    assert done.returncode == 0, done.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["map", "info", "missing.yaml"], "missing.yaml"),
+        (["map", "info", "bad.yaml"], "bad.yaml"),
+        (["map", "render", "good.yaml", "-o", "nodir/x.png"], "does not exist"),
+        (["map", "render", "good.yaml", "-o", "x.png", "--trajectory", "bad.csv"], "bad.csv"),
+        (["map", "from-log", "missing.log", "-o", "out.yaml"], "missing.log"),
+        (["map", "from-log", "empty.log", "-o", "out.yaml"], "empty.log"),
+        (["map", "from-log", "empty.log", "-o", "out.yaml", "--resolution", "-1"], "resolution"),
+    ],
+)
+def test_bad_input_prints_one_line_and_fails(tmp_path, args, needle):
+    (tmp_path / "bad.yaml").write_text(
+        yaml.safe_dump({"image": "x.pgm", "resolution": -1, "origin": [0, 0, 0]})
+    )
+    save_map(OccupancyGrid(4, 4, 0.1), tmp_path / "good.yaml")
+    (tmp_path / "bad.csv").write_text("a,b\n1,2\n")
+    (tmp_path / "empty.log").write_text("")
+    done = run(*args, cwd=tmp_path)
+    assert done.returncode == 1
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("kiseki: error: "), done.stderr
+    assert needle in lines[0]
+    assert "Traceback" not in done.stderr
+
+
+def test_unknown_command_fails():
+    done = run("teleport")
+    assert done.returncode != 0 and "teleport" in done.stderr
