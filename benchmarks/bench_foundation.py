@@ -13,6 +13,7 @@ Needs ../shared/data (the recorded datasets). Run: python benchmarks/bench_found
 
 from __future__ import annotations
 
+import os
 import platform
 import sys
 import time
@@ -45,6 +46,16 @@ def numpy_cast(grid: OccupancyGrid, poses: np.ndarray, angles: np.ndarray, max_r
     return out
 
 
+def cpu_name() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.machine()
+
+
 def best_of(fn, repeats: int = 3) -> tuple[float, object]:
     best, result = np.inf, None
     for _ in range(repeats):
@@ -58,9 +69,7 @@ def main() -> int:
     if not DATA.is_dir():
         print(f"recorded datasets not found at {DATA}: nothing to benchmark")
         return 1
-    print(
-        f"machine: {platform.processor() or platform.machine()}, Python {platform.python_version()}"
-    )
+    print(f"machine: {cpu_name()}, {os.cpu_count()} cores, Python {platform.python_version()}")
     start = time.perf_counter()
     log = read_carmen_log(DATA / "carmen" / "intel-corrected.log.gz")
     read_s = time.perf_counter() - start
