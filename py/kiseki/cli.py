@@ -27,6 +27,10 @@ app = typer.Typer(
 )
 map_app = typer.Typer(no_args_is_help=True, help="Occupancy-grid maps: build, render, inspect.")
 app.add_typer(map_app, name="map")
+experiment_app = typer.Typer(
+    no_args_is_help=True, help="Experiments: one command per paper table or figure."
+)
+app.add_typer(experiment_app, name="experiment")
 console = Console()
 
 
@@ -156,6 +160,52 @@ def demo(
     from kiseki.demo import run_demo
 
     run_demo(map_file, out, seed, console)
+
+
+@experiment_app.command("list")
+def experiment_list() -> None:
+    """List the registered experiments."""
+    from kiseki.experiments import all_experiments
+
+    table = Table(title="kiseki experiments")
+    for column in ("name", "paper", "table/figure", "description", "default trials"):
+        table.add_column(column)
+    for name, e in sorted(all_experiments().items()):
+        table.add_row(name, e.paper, e.artefact, e.description, str(e.default_runs))
+    console.print(table)
+
+
+@experiment_app.command("run")
+def experiment_run(
+    name: str = typer.Argument(..., help="Experiment name (see: kiseki experiment list)."),
+    runs: int | None = typer.Option(None, "--runs", help="Number of trials."),
+    seed: int | None = typer.Option(None, "--seed", help="Run seed (trial seeds derive from it)."),
+    overrides: list[str] = typer.Option([], "--set", help="Config override key=value (repeat)."),
+    workers: int | None = typer.Option(None, "--workers", help="Local Dask cluster of N workers."),
+    scheduler: str | None = typer.Option(None, "--scheduler", help="Dask scheduler tcp://H:P."),
+    out: Path | None = typer.Option(None, "--out", help="Results folder (default results/NAME/…)."),
+    resume: bool = typer.Option(False, "--resume", help="Run only the missing trials of a run."),
+) -> None:
+    """Run an experiment's trials and write its results folder."""
+    from kiseki.experiments import run_experiment
+
+    result = run_experiment(name, runs, seed, overrides, workers, scheduler, out, resume)
+    console.print(
+        f"{result.run_dir}: {result.runs} trials ({result.executed} run now, "
+        f"{result.failed} failed) in {result.wall_seconds:.1f} s"
+    )
+
+
+@app.command("report")
+def report(
+    results: Path = typer.Option(Path("results"), help="Results folder of the experiments."),
+    output: Path = typer.Option(Path("REPRODUCTION.md"), "-o", "--output", help="File to write."),
+) -> None:
+    """Gather the latest result of every experiment into REPRODUCTION.md."""
+    from kiseki.experiments import write_reproduction
+
+    total, held, missing = write_reproduction(results, output)
+    console.print(f"{output}: {total} claims, {held} hold; {len(missing)} experiments missing")
 
 
 def main() -> None:

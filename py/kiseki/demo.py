@@ -42,10 +42,13 @@ class DemoConfig:
     goal_x: float = 13.0
 
 
-def simulate_scans(grid, config: DemoConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Poses (n, 3), noisy ranges (n, b) and beam angles (b,) along the corridor."""
+def simulate_scans(
+    grid, config: DemoConfig, lateral_offset: float = 0.0
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Poses (n, 3), noisy ranges (n, b) and beam angles (b,) along the corridor, on the line
+    y = lateral_offset."""
     xs = np.arange(0.0, config.goal_x + 1e-9, config.scan_spacing)
-    poses = np.column_stack([xs, np.zeros_like(xs), np.zeros_like(xs)])
+    poses = np.column_stack([xs, np.full_like(xs, lateral_offset), np.zeros_like(xs)])
     angles = beam_angles(config.beams, np.deg2rad(config.field_of_view_deg))
     ranges = grid.cast_scans(poses, angles, max_range=config.max_range)
     noise = Random(config.seed).normal(0.0, config.range_noise_sd, ranges.size)

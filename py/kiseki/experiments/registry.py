@@ -1,0 +1,29 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The registry of experiments: an explicit dict, one entry per paper table or figure."""
+
+from __future__ import annotations
+
+from kiseki.errors import KisekiError
+from kiseki.experiments.base import Experiment
+
+__all__ = ["all_experiments", "get_experiment"]
+
+
+def _registry() -> dict[str, Experiment]:
+    from kiseki.experiments import carmen_maps, corridor_scans
+
+    experiments = [carmen_maps.EXPERIMENT, corridor_scans.EXPERIMENT]
+    return {e.name: e for e in experiments}
+
+
+def all_experiments() -> dict[str, Experiment]:
+    return _registry()
+
+
+def get_experiment(name: str) -> Experiment:
+    registry = _registry()
+    if name not in registry:
+        known = ", ".join(sorted(registry))
+        raise KisekiError(f"unknown experiment {name!r} (known: {known})")
+    return registry[name]

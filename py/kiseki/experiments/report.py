@@ -1,0 +1,136 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Writes a run's outputs (parquet, tables, figures, claims, report.md, manifest) and the
+project-wide REPRODUCTION.md that gathers the latest run of every experiment."""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+from rich.console import Console
+from rich.table import Table
+
+from kiseki._atomic import atomic_write
+from kiseki.experiments.base import CLAIM_COLUMNS, Analysis, Claim, Experiment
+from kiseki.experiments.registry import all_experiments
+
+__all__ = ["claims_table", "markdown_table", "write_outputs", "write_reproduction"]
+
+
+def _text(path: Path, text: str) -> None:
+    atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+
+
+def _cell(value: Any) -> str:
+    if isinstance(value, float):
+        return "" if math.isnan(value) else f"{value:.4g}"
+    return str(value).replace("|", "\\|").replace("\n", " ")
+
+
+def markdown_table(frame: pd.DataFrame) -> str:
+    head = "| " + " | ".join(map(str, frame.columns)) + " |"
+    rule = "|" + "---|" * len(frame.columns)
+    rows = ["| " + " | ".join(_cell(v) for v in row) + " |" for row in frame.itertuples(False)]
+    return "\n".join([head, rule, *rows])
+
+
+def _claims_frame(claims: Iterable[Claim]) -> pd.DataFrame:
+    rows = [[getattr(c, k) for k in CLAIM_COLUMNS] for c in claims]
+    return pd.DataFrame(rows, columns=CLAIM_COLUMNS)
+
+
+def _report(experiment: Experiment, analysis: Analysis, manifest: dict, claims: pd.DataFrame):
+    held = int(claims["holds"].sum())
+    lines = [
+        f"# {experiment.name}: {experiment.description}",
+        "",
+        f"Source: `{experiment.paper}`, {experiment.artefact}.  ",
+        f"Run: {manifest['finished']}, {manifest['trials']} trials "
+        f"({manifest['trials_failed']} failed), seed {manifest['seed']}, "
+        f"{manifest['execution']}, commit {manifest['git']['commit'] or 'unknown'}"
+        f"{' (with local changes)' if manifest['git']['dirty'] else ''}.",
+        "",
+        f"## Claims: {len(claims)} claims, {held} hold",
+        "",
+        markdown_table(claims),
+    ]
+    for name, table in analysis.tables.items():
+        lines += ["", f"## {name}", "", markdown_table(table)]
+    if analysis.figures:
+        lines += ["", "## Figures", ""]
+        lines += [f"![{p.stem}](figures/{p.name})" for p in analysis.figures]
+    if analysis.notes:
+        lines += ["", "## Notes", "", analysis.notes.strip()]
+    return "\n".join(lines) + "\n"
+
+
+def claims_table(title: str, claims: pd.DataFrame) -> Table:
+    table = Table(title=title)
+    for column in CLAIM_COLUMNS[:5]:
+        table.add_column(column, justify="right" if column.endswith("value") else "left")
+    for row in claims.itertuples(False):
+        mark = "[green]yes[/green]" if row.holds else "[red]no[/red]"
+        table.add_row(row.claim, str(row.paper_value), str(row.measured_value), row.unit, mark)
+    return table
+
+
+def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) -> pd.DataFrame:
+    trials.to_parquet(run_dir / ".trials.parquet.tmp", index=False)
+    (run_dir / ".trials.parquet.tmp").replace(run_dir / "trials.parquet")
+    timings.to_parquet(run_dir / ".timings.parquet.tmp", index=False)
+    (run_dir / ".timings.parquet.tmp").replace(run_dir / "timings.parquet")
+    (run_dir / "tables").mkdir(exist_ok=True)
+    (run_dir / "figures").mkdir(exist_ok=True)
+    analysis = experiment.analyze(config, trials, timings, run_dir / "figures")
+    for name, table in analysis.tables.items():
+        _text(run_dir / "tables" / f"{name}.csv", table.to_csv(index=False))
+    claims = _claims_frame(analysis.claims)
+    _text(run_dir / "claims.csv", claims.to_csv(index=False))
+    _text(run_dir / "report.md", _report(experiment, analysis, manifest, claims))
+    _text(run_dir / "manifest.json", json.dumps(manifest, indent=2))
+    Console().print(claims_table(f"{experiment.name}: claims ({run_dir})", claims))
+    if manifest["trials_failed"]:
+        Console().print(
+            f"[red]{manifest['trials_failed']} of {manifest['trials']} trials failed[/red]"
+        )
+    return claims
+
+
+def write_reproduction(results_root: Path, out: Path) -> tuple[int, int, list[str]]:
+    """Gathers the latest run of every registered experiment into one markdown file.
+    Returns (claims, claims that hold, missing experiment names)."""
+    by_paper: dict[str, list[str]] = {}
+    total = held = 0
+    missing: list[str] = []
+    for name, experiment in sorted(all_experiments().items()):
+        section = by_paper.setdefault(experiment.paper, [])
+        latest = results_root / name / "latest"
+        claims_path = latest / "claims.csv"
+        section += ["", f"### {name} ({experiment.artefact}): {experiment.description}", ""]
+        if not claims_path.is_file():
+            missing.append(name)
+            section.append(f"**missing**: no result yet; run `kiseki experiment run {name}`.")
+            continue
+        claims = pd.read_csv(claims_path, keep_default_na=False)
+        manifest = json.loads((latest / "manifest.json").read_text(encoding="utf-8"))
+        total += len(claims)
+        held += int(claims["holds"].astype(str).str.lower().eq("true").sum())
+        section += [
+            f"Result: `{latest.resolve().relative_to(results_root.resolve())}`, "
+            f"{manifest['trials']} trials, {manifest['trials_failed']} failed, "
+            f"commit {manifest['git']['commit'] or 'unknown'}.",
+            "",
+            markdown_table(claims),
+        ]
+    lines = ["# Reproduction report", "", f"{total} claims, {held} hold."]
+    if missing:
+        lines.append(f"Missing experiments ({len(missing)}): {', '.join(missing)}.")
+    for paper, section in by_paper.items():
+        lines += ["", f"## {paper}", *section]
+    _text(out, "\n".join(lines) + "\n")
+    return total, held, missing

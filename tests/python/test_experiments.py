@@ -1,0 +1,211 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The experiment harness: determinism across executors, resume after a real kill, failures
+recorded, results folder, reproduction report, and bad input."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+from kiseki.core import derive_seed
+from kiseki.experiments import base, registry, run_experiment, write_reproduction
+from kiseki.experiments.config import ConfigError, apply_overrides
+from kiseki.experiments.corridor_scans import CorridorScansConfig
+
+
+def cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", *args], cwd=cwd, capture_output=True, text=True
+    )
+
+
+def frame(run_dir: Path) -> pd.DataFrame:
+    return pd.read_parquet(run_dir / "trials.parquet")
+
+
+def test_serial_and_two_worker_local_cluster_give_identical_records(tmp_path):
+    args = ["experiment", "run", "corridor-scans", "--runs", "6", "--seed", "11"]
+    serial = cli(*args, "--out", "serial", cwd=tmp_path)
+    parallel = cli(*args, "--out", "dask", "--workers", "2", cwd=tmp_path)
+    assert serial.returncode == 0, serial.stderr
+    assert parallel.returncode == 0, parallel.stderr
+    a, b = frame(tmp_path / "serial"), frame(tmp_path / "dask")
+    pd.testing.assert_frame_equal(a, b)
+    assert (tmp_path / "serial" / "trials.parquet").read_bytes() == (
+        tmp_path / "dask" / "trials.parquet"
+    ).read_bytes()
+    assert list(a["seed"]) == [derive_seed(11, i) for i in range(6)]
+    assert a["lateral_offset"].nunique() == 6  # the seeds reach the trials
+    workers = pd.read_parquet(tmp_path / "dask" / "timings.parquet")["worker"].nunique()
+    assert workers == 2  # both workers of the LocalCluster took trials
+
+
+def test_carmen_maps_serial_equals_local_cluster(shared_data, tmp_path):
+    serial = cli("experiment", "run", "carmen-maps", "--out", "s", cwd=tmp_path)
+    parallel = cli("experiment", "run", "carmen-maps", "--workers", "2", "--out", "p", cwd=tmp_path)
+    assert serial.returncode == 0 and parallel.returncode == 0, serial.stderr + parallel.stderr
+    pd.testing.assert_frame_equal(frame(tmp_path / "s"), frame(tmp_path / "p"))
+    claims = pd.read_csv(tmp_path / "s" / "claims.csv")
+    intel = claims[claims["claim"].str.startswith("intel")].iloc[0]
+    assert intel["holds"] and float(intel["measured_value"]) >= 0.9
+
+
+def test_resume_after_kill_equals_an_uninterrupted_run(tmp_path):
+    args = [
+        sys.executable,
+        "-m",
+        "kiseki.cli",
+        "experiment",
+        "run",
+        "corridor-scans",
+        "--runs",
+        "6",
+        "--set",
+        "scan_spacing=0.01",
+    ]  # about a second per trial
+    proc = subprocess.Popen(
+        [*args, "--out", "killed"],
+        cwd=tmp_path,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    log = tmp_path / "killed" / "trials.jsonl"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        if log.exists() and len(log.read_bytes().splitlines()) >= 2:
+            break
+        time.sleep(0.02)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    finished = len(log.read_bytes().splitlines())
+    assert 2 <= finished < 6, "the kill must land mid-run"
+    assert not (tmp_path / "killed" / "trials.parquet").exists()
+    resumed = subprocess.run(
+        [*args[:4], "run", "corridor-scans", "--resume", "--out", "killed"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+    )
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"{6 - finished} run now" in resumed.stdout.replace("\n", " ")
+    full = subprocess.run([*args, "--out", "full"], cwd=tmp_path, capture_output=True, text=True)
+    assert full.returncode == 0, full.stderr
+    pd.testing.assert_frame_equal(frame(tmp_path / "killed"), frame(tmp_path / "full"))
+
+
+def _flaky_experiment() -> base.Experiment:
+    def trial(config, index, seed):
+        if index % 3 == 1:
+            raise RuntimeError(f"trial {index} broke")
+        return base.TrialOutput({"value": float(seed % 1000)})
+
+    def analyze(config, trials, timings, figures):
+        ok = trials[trials["error"].isna()]
+        claim = base.Claim("values recorded", "4", str(len(ok)), "trials", len(ok) == 4)
+        return base.Analysis(tables={"ok": ok}, claims=[claim])
+
+    return base.Experiment(
+        "flaky",
+        "test paper",
+        "Table 0",
+        "fails every third trial",
+        CorridorScansConfig,
+        trial,
+        analyze,
+        default_runs=6,
+    )
+
+
+def test_failing_trials_are_recorded_and_the_sweep_continues(tmp_path, monkeypatch):
+    real = registry._registry()
+    monkeypatch.setattr(registry, "_registry", lambda: {**real, "flaky": _flaky_experiment()})
+    result = run_experiment("flaky", out=tmp_path / "run", progress=False)
+    assert (result.runs, result.failed) == (6, 2)
+    trials = frame(tmp_path / "run")
+    assert trials["error"].notna().tolist() == [False, True, False, False, True, False]
+    assert "RuntimeError: trial 1 broke" in trials.loc[1, "error"]
+    assert "2 failed" in (tmp_path / "run" / "report.md").read_text()
+    manifest = yaml.safe_load((tmp_path / "run" / "manifest.json").read_text())
+    assert manifest["trials_failed"] == 2 and manifest["seed"] == 0
+
+
+def test_results_folder_latest_link_and_reproduction_report(tmp_path):
+    done = cli("experiment", "run", "corridor-scans", "--runs", "3", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    latest = tmp_path / "results" / "corridor-scans" / "latest"
+    assert latest.is_symlink()
+    for name in (
+        "config.yaml",
+        "manifest.json",
+        "trials.parquet",
+        "claims.csv",
+        "report.md",
+        "tables/summary.csv",
+        "figures/precision_vs_offset.png",
+    ):
+        assert (latest / name).is_file(), name
+    saved = yaml.safe_load((latest / "config.yaml").read_text())
+    assert saved["runs"] == 3 and saved["config"]["range_noise_sd"] == 0.01
+    claims = pd.read_csv(latest / "claims.csv")
+    assert list(claims.columns) == [
+        "claim",
+        "paper_value",
+        "measured_value",
+        "unit",
+        "holds",
+        "note",
+    ]
+    done = cli("report", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    text = (tmp_path / "REPRODUCTION.md").read_text()
+    assert "1 claims, 1 hold." in text
+    assert "Missing experiments (1): carmen-maps." in text
+    assert "every rebuilt occupied cell" in text
+
+
+def test_reproduction_report_with_carmen_maps(shared_data, tmp_path):
+    assert cli("experiment", "run", "carmen-maps", cwd=tmp_path).returncode == 0
+    total, held, missing = write_reproduction(tmp_path / "results", tmp_path / "R.md")
+    assert total == 4 and 1 <= held <= 4 and missing == ["corridor-scans"]
+    assert "intel-corrected: scan endpoints" in (tmp_path / "R.md").read_text()
+
+
+def test_overrides_are_typed():
+    c = apply_overrides(CorridorScansConfig(), ["range_noise_sd=0.02", "scan_spacing=0.2"])
+    assert (c.range_noise_sd, c.scan_spacing) == (0.02, 0.2)
+    with pytest.raises(ConfigError, match="unknown config key 'noise'"):
+        apply_overrides(CorridorScansConfig(), ["noise=1"])
+    with pytest.raises(ConfigError, match="range_noise_sd: expected float"):
+        apply_overrides(CorridorScansConfig(), ["range_noise_sd=loud"])
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["experiment", "run", "no-such-thing"], "unknown experiment 'no-such-thing'"),
+        (["experiment", "run", "corridor-scans", "--set", "noise=1"], "unknown config key"),
+        (["experiment", "run", "corridor-scans", "--set", "scan_spacing=wide"], "expected float"),
+        (["experiment", "run", "corridor-scans", "--set", "scan_spacing"], "key=value"),
+        (["experiment", "run", "corridor-scans", "--runs", "0"], "--runs"),
+        (
+            ["experiment", "run", "corridor-scans", "--scheduler", "tcp://127.0.0.1:9"],
+            "cannot reach the Dask scheduler at tcp://127.0.0.1:9",
+        ),
+        (["experiment", "run", "corridor-scans", "--scheduler", "localhost"], "tcp://HOST:PORT"),
+        (["experiment", "run", "corridor-scans", "--resume", "--out", "nothing"], "no config"),
+    ],
+)
+def test_bad_input_is_one_line_and_non_zero(tmp_path, args, needle):
+    done = cli(*args, cwd=tmp_path)
+    assert done.returncode == 1, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], done.stderr

@@ -1,0 +1,122 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""APE, RPE and alignment agree with evo (the reference implementation of the definitions)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from evo.core import metrics as evo_metrics
+from evo.core.trajectory import PoseTrajectory3D
+
+from kiseki.metrics import align_trajectory, ape, as_se3, rpe, stop_error, umeyama_alignment
+
+EVO_RELATION = {
+    "translation": evo_metrics.PoseRelation.translation_part,
+    "rotation_deg": evo_metrics.PoseRelation.rotation_angle_deg,
+    "full": evo_metrics.PoseRelation.full_transformation,
+}
+
+
+def trajectories(seed: int, n: int = 200):
+    """A wandering planar reference and an estimate with drift, noise and a frame offset."""
+    rng = np.random.default_rng(seed)
+    theta = np.cumsum(rng.normal(0, 0.05, n))
+    step = rng.uniform(0.05, 0.15, n)
+    ref = np.column_stack([np.cumsum(step * np.cos(theta)), np.cumsum(step * np.sin(theta)), theta])
+    est = (
+        ref
+        + rng.normal(0, [0.05, 0.05, 0.02], (n, 3))
+        + np.linspace(0, 1, n)[:, None]
+        * [
+            0.3,
+            -0.2,
+            0.05,
+        ]
+    )
+    c, s = np.cos(0.4), np.sin(0.4)
+    moved = est.copy()
+    moved[:, 0], moved[:, 1] = c * est[:, 0] - s * est[:, 1] + 2.0, s * est[:, 0] + c * est[:, 1]
+    moved[:, 2] += 0.4
+    return moved, ref
+
+
+def evo_traj(poses: np.ndarray) -> PoseTrajectory3D:
+    return PoseTrajectory3D(poses_se3=list(as_se3(poses)), timestamps=np.arange(len(poses)) * 0.1)
+
+
+@pytest.mark.parametrize("relation", ["translation", "rotation_deg", "full"])
+@pytest.mark.parametrize("alignment", ["none", "se3", "sim3", "origin"])
+def test_ape_matches_evo(relation, alignment):
+    est, ref = trajectories(1)
+    e, r = evo_traj(est), evo_traj(ref)
+    if alignment in ("se3", "sim3"):
+        e.align(r, correct_scale=alignment == "sim3")
+    elif alignment == "origin":
+        e.align_origin(r)
+    metric = evo_metrics.APE(EVO_RELATION[relation])
+    metric.process_data((r, e))
+    ours = ape(est, ref, relation, alignment)
+    np.testing.assert_allclose(ours.errors, metric.error, rtol=1e-9, atol=1e-9)
+    stats = metric.get_all_statistics()
+    for key in ("rmse", "mean", "median", "std", "min", "max", "sse"):
+        assert getattr(ours, key) == pytest.approx(stats[key], rel=1e-9, abs=1e-12)
+
+
+@pytest.mark.parametrize("relation", ["translation", "rotation_deg"])
+@pytest.mark.parametrize(("delta", "all_pairs"), [(1, False), (7, False), (7, True)])
+def test_rpe_matches_evo(relation, delta, all_pairs):
+    est, ref = trajectories(2)
+    metric = evo_metrics.RPE(
+        EVO_RELATION[relation],
+        delta=delta,
+        delta_unit=evo_metrics.Unit.frames,
+        all_pairs=all_pairs,
+    )
+    metric.process_data((evo_traj(ref), evo_traj(est)))
+    ours = rpe(est, ref, delta, relation, all_pairs)
+    np.testing.assert_allclose(ours.errors, metric.error, rtol=1e-9, atol=1e-9)
+
+
+def test_alignment_recovers_a_known_similarity():
+    rng = np.random.default_rng(3)
+    src = rng.normal(size=(50, 3))
+    angle = 0.7
+    c, s = np.cos(angle), np.sin(angle)
+    rot = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    dst = 2.5 * src @ rot.T + [1.0, -2.0, 0.5]
+    r, t, s = umeyama_alignment(src, dst, with_scale=True)
+    np.testing.assert_allclose(r, rot, atol=1e-12)
+    np.testing.assert_allclose(t, [1.0, -2.0, 0.5], atol=1e-12)
+    assert s == pytest.approx(2.5)
+    est, ref = trajectories(4)
+    aligned = align_trajectory(est, ref, "se3")
+    assert ape(aligned, ref).rmse < ape(est, ref).rmse / 5  # the 2 m / 0.4 rad offset is gone
+    assert ape(est, est, "rotation_deg").max == pytest.approx(0.0, abs=1e-6)
+
+
+def test_stop_error_in_goal_frame():
+    err = stop_error([13.05, 0.02, 0.01], [13.0, 0.0, 0.0])
+    assert (err.along, err.across) == pytest.approx((0.05, 0.02))
+    assert err.within(0.1) and not err.within(0.05)
+    err = stop_error([0.0, 1.1, 0.0], [0.0, 1.0, np.pi / 2])  # goal facing +y: 0.1 m overshoot
+    assert err.along == pytest.approx(0.1) and err.across == pytest.approx(0.0, abs=1e-12)
+    assert err.heading_deg == pytest.approx(-90.0)
+
+
+@pytest.mark.parametrize(
+    ("call", "match"),
+    [
+        (lambda: ape(np.zeros((3, 3)), np.zeros((4, 3))), "associate"),
+        (lambda: ape(np.zeros((3, 2)), np.zeros((3, 2))), "shape"),
+        (lambda: ape(np.full((3, 3), np.nan), np.zeros((3, 3))), "NaN"),
+        (lambda: ape(np.zeros((3, 3)), np.zeros((3, 3)), "speed"), "relation"),
+        (lambda: ape(np.zeros((3, 3)), np.zeros((3, 3)), alignment="affine"), "alignment"),
+        (lambda: rpe(np.zeros((3, 3)), np.zeros((3, 3)), delta=0), "delta"),
+        (lambda: rpe(np.zeros((3, 3)), np.zeros((3, 3)), delta=5), "no pose pairs"),
+        (lambda: stop_error([0, 0], [0, 0, 0]), "triples"),
+    ],
+)
+def test_bad_input(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
