@@ -6,6 +6,7 @@ namespace kiseki::bindings {
 void bind_core(pybind11::module_& m);
 void bind_grid(pybind11::module_& m);
 void bind_mapping(pybind11::module_& m);
+void bind_sim(pybind11::module_& m);
 }  // namespace kiseki::bindings
 
 PYBIND11_MODULE(_core, m) {
@@ -13,4 +14,5 @@ PYBIND11_MODULE(_core, m) {
   kiseki::bindings::bind_core(m);
   kiseki::bindings::bind_grid(m);
   kiseki::bindings::bind_mapping(m);
+  kiseki::bindings::bind_sim(m);
 }

@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#include "kiseki/sim/octree_world.hpp"
+
+#include <octomap/OcTree.h>
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+namespace kiseki {
+
+OctreeWorld::OctreeWorld(std::unique_ptr<octomap::OcTree> tree) : tree_(std::move(tree)) {}
+OctreeWorld::OctreeWorld(OctreeWorld&&) noexcept = default;
+OctreeWorld& OctreeWorld::operator=(OctreeWorld&&) noexcept = default;
+OctreeWorld::~OctreeWorld() = default;
+
+OctreeWorld OctreeWorld::read_binary(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open OctoMap file");
+  std::string header;
+  std::getline(in, header);
+  if (header.rfind("# Octomap OcTree binary file", 0) != 0) {
+    throw std::runtime_error(path + ": not an OctoMap binary tree (.bt) file");
+  }
+  in.seekg(0);
+  auto tree = std::make_unique<octomap::OcTree>(0.1);
+  if (!tree->readBinary(in) || tree->size() == 0) {
+    throw std::runtime_error(path + ": corrupt or truncated OctoMap binary file");
+  }
+  return OctreeWorld(std::move(tree));
+}
+
+OctreeWorld OctreeWorld::from_boxes(const BoxWorld& world, double resolution) {
+  if (!(resolution > 0.0) || !std::isfinite(resolution)) {
+    throw std::invalid_argument("OctreeWorld: resolution must be positive");
+  }
+  auto tree = std::make_unique<octomap::OcTree>(resolution);
+  // A voxel is occupied when its centre lies in the box grown by half a voxel: exactly the
+  // voxels a box overlaps when it is axis aligned, a slight over-fill when it is rotated, and
+  // never a hole in a thin slab.
+  const Eigen::Vector3d grow = Eigen::Vector3d::Constant(0.5 * resolution);
+  for (Box b : world.boxes()) {
+    b.half_size += grow;
+    const Eigen::AlignedBox3d bb = b.aabb();
+    octomap::OcTreeKey lo, hi;
+    if (!tree->coordToKeyChecked(bb.min().x(), bb.min().y(), bb.min().z(), lo) ||
+        !tree->coordToKeyChecked(bb.max().x(), bb.max().y(), bb.max().z(), hi)) {
+      throw std::invalid_argument("OctreeWorld: a box lies outside OctoMap's addressable range");
+    }
+    for (unsigned kx = lo[0]; kx <= hi[0]; ++kx)
+      for (unsigned ky = lo[1]; ky <= hi[1]; ++ky)
+        for (unsigned kz = lo[2]; kz <= hi[2]; ++kz) {
+          const octomap::OcTreeKey key(kx, ky, kz);
+          const octomap::point3d c = tree->keyToCoord(key);
+          if (b.contains({c.x(), c.y(), c.z()})) tree->updateNode(key, true, true);
+        }
+  }
+  tree->updateInnerOccupancy();
+  return OctreeWorld(std::move(tree));
+}
+
+double OctreeWorld::cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                         double max_range) const {
+  if (!origin.allFinite() || !direction.allFinite() || std::abs(direction.norm() - 1.0) > 1e-6) {
+    throw std::invalid_argument("OctreeWorld::cast: origin must be finite, direction a unit vector");
+  }
+  octomap::point3d end;
+  const octomap::point3d o(origin.x(), origin.y(), origin.z());
+  const octomap::point3d d(direction.x(), direction.y(), direction.z());
+  if (!tree_->castRay(o, d, end, true, max_range)) return max_range;
+  // castRay returns the hit voxel's centre: report the distance to its entry face along the ray.
+  const double h = 0.5 * tree_->getResolution();
+  const Eigen::Vector3d c(end.x(), end.y(), end.z());
+  double t0 = 0.0, t1 = max_range;
+  for (int k = 0; k < 3; ++k) {
+    if (direction[k] == 0.0) continue;
+    double ta = (c[k] - h - origin[k]) / direction[k], tb = (c[k] + h - origin[k]) / direction[k];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return std::min(t0, max_range);
+}
+
+Eigen::AlignedBox3d OctreeWorld::bounds() const {
+  double x0, y0, z0, x1, y1, z1;
+  tree_->getMetricMin(x0, y0, z0);
+  tree_->getMetricMax(x1, y1, z1);
+  return {Eigen::Vector3d(x0, y0, z0), Eigen::Vector3d(x1, y1, z1)};
+}
+
+double OctreeWorld::resolution() const { return tree_->getResolution(); }
+
+std::size_t OctreeWorld::occupied_leaves() const {
+  std::size_t n = 0;
+  for (auto it = tree_->begin_leafs(); it != tree_->end_leafs(); ++it) n += tree_->isNodeOccupied(*it);
+  return n;
+}
+
+void OctreeWorld::write_binary(const std::string& path) const {
+  if (!tree_->writeBinary(path)) throw std::runtime_error(path + ": cannot write OctoMap file");
+}
+
+void OctreeWorld::rasterize_band(double z_min, double z_max, OccupancyGrid& grid) const {
+  if (!(z_max > z_min)) throw std::invalid_argument("rasterize_band: need z_max > z_min");
+  grid.cells().setTo(kUnknown);
+  const Eigen::AlignedBox3d b = bounds();
+  const octomap::point3d lo(b.min().x(), b.min().y(), z_min), hi(b.max().x(), b.max().y(), z_max);
+  for (auto it = tree_->begin_leafs_bbx(lo, hi); it != tree_->end_leafs_bbx(); ++it) {
+    const double half = 0.5 * it.getSize();
+    const bool occ = tree_->isNodeOccupied(*it);
+    // A leaf may be a large pruned node: mark every grid cell its footprint covers.
+    const double step = std::min(grid.resolution(), it.getSize()) * 0.5;
+    for (double x = it.getX() - half + 0.5 * step; x < it.getX() + half; x += step)
+      for (double y = it.getY() - half + 0.5 * step; y < it.getY() + half; y += step) {
+        const CellIndex c = grid.world_to_cell({x, y});
+        if (!grid.contains(c)) continue;
+        std::int8_t& v = grid.cells().ptr<std::int8_t>(c.y)[c.x];
+        if (occ) v = kOccupied;
+        else if (v == kUnknown) v = kFree;
+      }
+  }
+}
+
+}  // namespace kiseki

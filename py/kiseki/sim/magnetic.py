@@ -1,0 +1,753 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Simulated magnetic field, a 3-axis magnetometer and a bearing sensor.
+
+The field model follows the facts of the magnetic-navigation thesis
+(``/work/shared/papers/002``, Japanese original, chapter 2, pp. 13-24; English digest in
+``DIGEST.md``):
+
+* the Earth's field, spatially uniform over a robot's workspace;
+* **steel** (beams, pipes, rebar, manholes) as permanent point dipoles (:class:`Dipole`) or
+  rows of them (:class:`DipoleLine`): the "local peak" disturbances of thesis Fig. 2.7;
+* a linear **gradient** about a reference point: the "cross-track gradient" disturbances of
+  thesis Fig. 2.8;
+* a slow **temperature drift**: the thesis (sec. 2.2, Figs. 2.1-2.4) finds that readings drift
+  with temperature and humidity but that the steel disturbances are much larger than the drift;
+* the robot's **own** motors, battery and PC as dipoles fixed in the body frame, whose effect the
+  thesis (sec. 2.3, Fig. 2.6) finds negligible beyond 10-15 cm for low-disturbance devices.
+
+Units: gauss (G; 1 G = 1e-4 T = 100 uT) for fields, metres, seconds, radians, A m^2 for dipole
+moments. Frames:
+
+* **world**: x east, y north, z up (ENU, as ROS REP-103); headings counter-clockwise from +x;
+* **body** of the robot: x forward, y left, z up, origin on the floor (the robot is planar and
+  level, pose ``(x, y, theta)``);
+* **sensor**: x forward, y right, z down, the thesis' convention for its MicroStrain 3DM-DH
+  (sec. 2.2 and sec. 3.3.1: "x = direction of travel, y = 90 deg to the right, z = towards the
+  ground"). The sensor frame is the body frame turned by the mounting yaw and then by pi about
+  its x axis, so y and z change sign.
+
+All randomness comes from :class:`kiseki.core.Random`; give each sensor its own stream with
+``kiseki.derive_seed(seed, k)``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from kiseki.core import Random, normalize_angle
+
+__all__ = [
+    "DEFAULT_DECLINATION_DEG",
+    "DEFAULT_DRIFT_AMPLITUDE",
+    "DEFAULT_DRIFT_PERIOD",
+    "DEFAULT_EARTH_TOTAL",
+    "DEFAULT_INCLINATION_DEG",
+    "DEFAULT_MOUNT",
+    "DEFAULT_NOISE_SD",
+    "MU0_OVER_4PI_GAUSS",
+    "ROBOT_SOURCE_MOMENT",
+    "BearingSensor",
+    "Dipole",
+    "DipoleLine",
+    "MagneticWorld",
+    "Magnetometer",
+    "default_earth_field",
+    "dipole_field",
+    "earth_field_from_angles",
+    "magnetic_azimuth",
+    "robot_self_sources",
+]
+
+#: mu0 / (4 pi) in G m / A: 1e-7 T m / A (exact in the pre-2019 SI, 1e-10 relative off since)
+#: times 1e4 G / T. A moment of m A m^2 at r metres gives fields of order 1e-3 m / r^3 G.
+MU0_OVER_4PI_GAUSS = 1e-3
+
+#: Total intensity of the Earth's field, G (46.5 uT). Assumption: the thesis' experiments were
+#: at Utsunomiya and Tsukuba (thesis ch. 5, Tsukuba Challenge), near the JMA Kakioka observatory
+#: (36.2 N, 140.2 E); IGRF values there in the 2010s are about 46-47 uT, rounded here.
+DEFAULT_EARTH_TOTAL = 0.465
+#: Inclination (dip), degrees, positive = field points down. Same source as the total; it lies
+#: between the ISEE stations Kagoshima (31.5 N, 45.1 deg) and Moshiri (44.4 N, 58.6 deg).
+DEFAULT_INCLINATION_DEG = 49.5
+#: Declination, degrees, positive east of true north: magnetic north is about 7.5 deg west
+#: of true north in Kanto (same source; ISEE stations: -6.1 to -9.5 deg).
+DEFAULT_DECLINATION_DEG = -7.5
+
+#: Temperature-drift amplitude, G. The thesis shows drift (Figs. 2.1-2.4, 10-30 deg C indoors,
+#: -3-12 deg C outdoors) but prints no number; it states the drift is much smaller than the
+#: steel disturbances. Assumption: of the order of the sensor noise (0.01 G, thesis ch. 6) and
+#: of the thesis' disturbance threshold (0.01 G, sec. 3.3.2), i.e. about 2 % of the field, what
+#: a magnetoresistive sensor's sensitivity temperature coefficient gives over ~10 deg C.
+#: The geomagnetic daily variation itself (~20-50 nT = 2e-4-5e-4 G) is negligible beside it.
+DEFAULT_DRIFT_AMPLITUDE = 0.01
+#: Drift period, s: one day (the daily temperature cycle). Assumption.
+DEFAULT_DRIFT_PERIOD = 86400.0
+
+#: Magnetometer noise SD per axis, G: "the sensor's SD is about 0.01 G" (thesis ch. 6,
+#: sec. 6.3.2, p. ~76, the 3DM-DH).
+DEFAULT_NOISE_SD = 0.01
+#: Mount of the magnetometer on the robot (body frame), m: the thesis' navigation robot carries
+#: its 3DM-DH 0.50 m above the floor over the centre of the drive axle (sec. 3.3.1, Fig. 3.5).
+DEFAULT_MOUNT = (0.0, 0.0, 0.5)
+
+#: Moment of each of the robot's own sources (motor, battery, PC), A m^2. Chosen so that a
+#: source changes the reading by more than the sensor noise (0.01 G) at 0.10 m in every
+#: direction (equatorial field 1e-3 * 0.012 / 0.1^3 = 0.012 G), by less than the noise at
+#: 0.15 m in every direction (axial 2e-3 * 0.012 / 0.15^3 = 0.0071 G) and by less than a tenth
+#: of the noise at 0.30 m (axial 8.9e-4 G): "negligible beyond 10-15 cm for low-disturbance
+#: devices" (thesis sec. 2.3, Fig. 2.6, p. 18). A dipole's field falls 27-fold from 0.1 to
+#: 0.3 m and varies 2-fold with direction, so the moment must lie in (0.0100, 0.0135).
+ROBOT_SOURCE_MOMENT = 0.012
+
+#: Default radius of the uniformly magnetised sphere a :class:`Dipole` stands for, m.
+DEFAULT_DIPOLE_RADIUS = 0.02
+
+_TWO_PI = 2.0 * math.pi
+
+
+# --------------------------------------------------------------------------------------------
+# input checks
+
+
+def _float_array(value: Any, name: str) -> np.ndarray:
+    try:
+        return np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
+
+
+def _finite_array(value: Any, shape: tuple[int | None, ...], name: str) -> np.ndarray:
+    """``value`` as a float array of ``shape`` (None = any length), finite, or ValueError."""
+    a = _float_array(value, name)
+    if a.ndim != len(shape) or any(
+        s is not None and s != d for s, d in zip(shape, a.shape, strict=True)
+    ):
+        want = "x".join("n" if s is None else str(s) for s in shape) or "a scalar"
+        raise ValueError(f"{name}: expected shape ({want}), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name}: must be finite, got {value!r}")
+    return a
+
+
+def _finite_scalar(
+    value: Any, name: str, *, minimum: float | None = None, strict: bool = False
+) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name}: expected a number, got {value!r}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{name}: must be finite, got {value!r}")
+    if minimum is not None and (v <= minimum if strict else v < minimum):
+        rel = ">" if strict else ">="
+        raise ValueError(f"{name}: must be {rel} {minimum}, got {value!r}")
+    return v
+
+
+def _seed(seed: Any, name: str) -> int:
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"{name}: expected a non-negative integer seed, got {seed!r}")
+    return int(seed)
+
+
+def _points(points: Any, name: str = "points") -> tuple[np.ndarray, bool]:
+    """Points as (n, 3) and whether a single (3,) point was given."""
+    a = _float_array(points, name)
+    single = a.shape == (3,)
+    a = _finite_array(a.reshape(1, 3) if single else a, (None, 3), name)
+    return a, single
+
+
+def _poses(poses: Any, name: str = "poses") -> tuple[np.ndarray, bool]:
+    """Planar poses as (n, 3) rows (x, y, theta) and whether a single pose was given."""
+    if hasattr(poses, "to_array") and not isinstance(poses, np.ndarray):
+        poses = poses.to_array()  # kiseki.core.Pose2
+    a = _float_array(poses, name)
+    single = a.shape == (3,)
+    a = _finite_array(a.reshape(1, 3) if single else a, (None, 3), name)
+    return a, single
+
+
+def _times(times: Any, n: int, name: str = "times") -> np.ndarray:
+    t = _float_array(times, name)
+    if t.ndim == 0:
+        t = np.full(n, float(t))
+    t = _finite_array(t, (n,), name)
+    return t
+
+
+# --------------------------------------------------------------------------------------------
+# dipoles
+
+
+def dipole_field(points: Any, positions: Any, moments: Any, radii: Any) -> np.ndarray:
+    """Field in G at ``points`` (n, 3) of dipoles at ``positions`` (k, 3) with ``moments``
+    (k, 3) A m^2, summed over the dipoles.
+
+    Outside radius ``radii[j]`` of dipole j this is the closed form
+    ``B = mu0/(4 pi) (3 (m . r_hat) r_hat - m) / |r|^3`` (Jackson, Classical Electrodynamics,
+    eq. 5.56). Inside it, the source is taken to be a uniformly magnetised sphere of that radius
+    (whose outside field is exactly the dipole field), so the field there is the sphere's uniform
+    interior field ``mu0/(4 pi) 2 m / R^3`` (Jackson eq. 5.104): bounded, and equal to the
+    on-axis outside field at the surface. This guards the 1/r^3 singularity.
+    """
+    p, _ = _points(points)
+    q = np.asarray(positions, dtype=float).reshape(-1, 3)
+    m = np.asarray(moments, dtype=float).reshape(-1, 3)
+    rad = np.broadcast_to(np.asarray(radii, dtype=float), (q.shape[0],))
+    out = np.zeros_like(p)
+    k = q.shape[0]
+    if k == 0 or p.shape[0] == 0:
+        return out
+    block = max(1, 500_000 // k)  # bounds the (block, k, 3) temporaries to ~12 MB each
+    inside_field = 2.0 * m / rad[:, None] ** 3  # (k, 3)
+    for start in range(0, p.shape[0], block):
+        r = p[start : start + block, None, :] - q[None, :, :]  # (b, k, 3)
+        d2 = np.einsum("bkc,bkc->bk", r, r)
+        d = np.sqrt(d2)
+        inside = d < rad[None, :]
+        safe = np.where(inside, 1.0, d)
+        mr = np.einsum("bkc,kc->bk", r, m)
+        outside_field = (3.0 * mr / safe**5)[..., None] * r - m[None] / (safe**3)[..., None]
+        b = np.where(inside[..., None], inside_field[None], outside_field)
+        out[start : start + block] = b.sum(axis=1)
+    return MU0_OVER_4PI_GAUSS * out
+
+
+@dataclass(frozen=True, eq=False)
+class Dipole:
+    """A permanent point dipole: a piece of steel, a motor, a battery.
+
+    ``position`` (3,) m and ``moment`` (3,) A m^2 in the frame of whoever holds it (the world
+    for :class:`MagneticWorld`, the body for a :class:`Magnetometer`'s self-sources).
+    ``radius`` m: inside it the source is a uniformly magnetised sphere (see
+    :func:`dipole_field`); default 0.02 m, an assumption (the size of a small motor).
+    """
+
+    position: np.ndarray
+    moment: np.ndarray
+    radius: float = DEFAULT_DIPOLE_RADIUS
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "position", _finite_array(self.position, (3,), "position"))
+        object.__setattr__(self, "moment", _finite_array(self.moment, (3,), "moment"))
+        r = _finite_scalar(self.radius, "radius", minimum=0.0, strict=True)
+        object.__setattr__(self, "radius", r)
+
+    def field_at(self, points: Any) -> np.ndarray:
+        """Field in G at (n, 3) points (or one (3,) point) in the holder's frame."""
+        p, single = _points(points)
+        b = dipole_field(p, self.position, self.moment, self.radius)
+        return b[0] if single else b
+
+
+@dataclass(frozen=True, eq=False)
+class DipoleLine:
+    """A steel beam, pipe or rebar from ``start`` to ``end`` (m) as a row of point dipoles.
+
+    The segment is cut into ``N = max(1, round(L / spacing))`` equal pieces; piece i is a dipole
+    at its midpoint ``start + (i + 1/2) (end - start) / N`` with moment
+    ``moment_per_metre * L / N`` (A m^2), so the total moment is ``moment_per_metre * L``
+    (midpoint rule for a uniformly magnetised line). Sensors more than about one ``spacing``
+    away see a smooth line; closer they see the individual dipoles. ``radius`` (default
+    ``spacing / 2``, neighbouring spheres touching) guards each dipole's singularity.
+    """
+
+    start: np.ndarray
+    end: np.ndarray
+    moment_per_metre: np.ndarray
+    spacing: float = 0.1
+    radius: float | None = None
+    positions: np.ndarray = field(init=False, repr=False)
+    moments: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        a = _finite_array(self.start, (3,), "start")
+        b = _finite_array(self.end, (3,), "end")
+        mpm = _finite_array(self.moment_per_metre, (3,), "moment_per_metre")
+        spacing = _finite_scalar(self.spacing, "spacing", minimum=0.0, strict=True)
+        length = float(np.linalg.norm(b - a))
+        if length == 0.0:
+            raise ValueError("DipoleLine: start and end coincide (zero length)")
+        radius = spacing / 2 if self.radius is None else self.radius
+        radius = _finite_scalar(radius, "radius", minimum=0.0, strict=True)
+        n = max(1, round(length / spacing))
+        frac = (np.arange(n) + 0.5) / n
+        object.__setattr__(self, "start", a)
+        object.__setattr__(self, "end", b)
+        object.__setattr__(self, "moment_per_metre", mpm)
+        object.__setattr__(self, "spacing", spacing)
+        object.__setattr__(self, "radius", radius)
+        object.__setattr__(self, "positions", a + frac[:, None] * (b - a))
+        object.__setattr__(self, "moments", np.tile(mpm * (length / n), (n, 1)))
+
+    @property
+    def length(self) -> float:
+        return float(np.linalg.norm(self.end - self.start))
+
+    def dipoles(self) -> list[Dipole]:
+        """The line's point dipoles."""
+        return [
+            Dipole(p, m, self.radius) for p, m in zip(self.positions, self.moments, strict=True)
+        ]
+
+    def field_at(self, points: Any) -> np.ndarray:
+        """Field in G at (n, 3) points (or one (3,) point)."""
+        p, single = _points(points)
+        b = dipole_field(p, self.positions, self.moments, self.radius)
+        return b[0] if single else b
+
+
+def robot_self_sources(moment: float = ROBOT_SOURCE_MOMENT) -> list[Dipole]:
+    """The robot's own motors, battery and PC as body-frame dipoles of strength ``moment``.
+
+    Layout (an assumption; thesis Fig. 3.6 shows the parts but its drawing is not in the text):
+    drive motors on the axle 0.2 m left and right at 0.1 m height (moments along the motor
+    shafts, +-y), battery 0.15 m behind the axle at 0.15 m (moment along x), PC 0.1 m behind at
+    0.3 m (moment up). With the default sensor mount (0, 0, 0.5) every source is at least 0.2 m
+    from the sensor, as the thesis' robot keeps its sensor 20 cm from all electronics
+    (sec. 3.3.1).
+    """
+    return [
+        Dipole((0.0, 0.2, 0.1), (0.0, moment, 0.0)),
+        Dipole((0.0, -0.2, 0.1), (0.0, -moment, 0.0)),
+        Dipole((-0.15, 0.0, 0.15), (moment, 0.0, 0.0)),
+        Dipole((-0.1, 0.0, 0.3), (0.0, 0.0, moment)),
+    ]
+
+
+# --------------------------------------------------------------------------------------------
+# the world's field
+
+
+def earth_field_from_angles(
+    total: float, inclination_deg: float, declination_deg: float
+) -> np.ndarray:
+    """The Earth's field (3,) in G in the world frame (x east, y north, z up).
+
+    ``total`` G; ``inclination_deg`` positive when the field points down (northern
+    hemisphere); ``declination_deg`` positive when magnetic north is east of true north.
+    """
+    f = _finite_scalar(total, "total", minimum=0.0)
+    inc = math.radians(_finite_scalar(inclination_deg, "inclination_deg"))
+    dec = math.radians(_finite_scalar(declination_deg, "declination_deg"))
+    if abs(inc) > math.pi / 2:
+        raise ValueError(f"inclination_deg: must be within [-90, 90], got {inclination_deg!r}")
+    h = f * math.cos(inc)
+    return np.array([h * math.sin(dec), h * math.cos(dec), -f * math.sin(inc)])
+
+
+def default_earth_field() -> np.ndarray:
+    """The default Earth field: 0.465 G, inclination 49.5 deg down, declination -7.5 deg."""
+    return earth_field_from_angles(
+        DEFAULT_EARTH_TOTAL, DEFAULT_INCLINATION_DEG, DEFAULT_DECLINATION_DEG
+    )
+
+
+class MagneticWorld:
+    """The magnetic field of a scene, in G in the world frame (x east, y north, z up).
+
+    ``B(p, t) = earth_field + G (p - gradient_origin) + sum of dipoles and lines + drift(t)``
+
+    * ``earth_field`` (3,) G; default :func:`default_earth_field`.
+    * ``dipoles``, ``lines``: steel. Scale: a moment of m A m^2 at r m gives 1e-3 m / r^3 to
+      2e-3 m / r^3 G, so a disturbance that stands well above the thesis' 0.01 G threshold at
+      0.5-1 m (a buried pipe is at least 0.2 m from the sensor, sec. 2.4) needs m of order
+      1-10 A m^2.
+    * ``gradient`` (3, 3) G/m, ``gradient[i, j] = dB_i / dx_j``, about ``gradient_origin``:
+      the slow cross-track slopes of thesis Fig. 2.8. A source-free static field has a
+      symmetric, traceless gradient; that is not enforced, so a scene may use a one-component
+      slope (e.g. only dBz/dy) as the thesis' figures show.
+    * drift: ``drift_amplitude * sin(2 pi t / drift_period + drift_phase) * u``, uniform in
+      space, with ``u`` the Earth field's direction (a temperature-dependent change of the
+      sensor's scale factor acts along the field it measures). Deterministic, bounded by
+      ``drift_amplitude`` and slow: its rate is at most ``2 pi A / P`` (7e-7 G/s with the
+      defaults 0.01 G and one day, see :data:`DEFAULT_DRIFT_AMPLITUDE`).
+    """
+
+    def __init__(
+        self,
+        earth_field: Any = None,
+        dipoles: Iterable[Dipole] = (),
+        lines: Iterable[DipoleLine] = (),
+        gradient: Any = None,
+        gradient_origin: Any = (0.0, 0.0, 0.0),
+        drift_amplitude: float = DEFAULT_DRIFT_AMPLITUDE,
+        drift_period: float = DEFAULT_DRIFT_PERIOD,
+        drift_phase: float = 0.0,
+    ) -> None:
+        self.earth_field = (
+            default_earth_field()
+            if earth_field is None
+            else _finite_array(earth_field, (3,), "earth_field")
+        )
+        self.dipoles: tuple[Dipole, ...] = tuple(dipoles)
+        self.lines: tuple[DipoleLine, ...] = tuple(lines)
+        for d in self.dipoles:
+            if not isinstance(d, Dipole):
+                raise ValueError(f"dipoles: expected Dipole objects, got {d!r}")
+        for line in self.lines:
+            if not isinstance(line, DipoleLine):
+                raise ValueError(f"lines: expected DipoleLine objects, got {line!r}")
+        self.gradient = (
+            np.zeros((3, 3)) if gradient is None else _finite_array(gradient, (3, 3), "gradient")
+        )
+        self.gradient_origin = _finite_array(gradient_origin, (3,), "gradient_origin")
+        self.drift_amplitude = _finite_scalar(drift_amplitude, "drift_amplitude", minimum=0.0)
+        self.drift_period = _finite_scalar(drift_period, "drift_period", minimum=0.0, strict=True)
+        self.drift_phase = _finite_scalar(drift_phase, "drift_phase")
+        norm = float(np.linalg.norm(self.earth_field))
+        self.drift_direction = self.earth_field / norm if norm > 0 else np.array([0.0, 0.0, -1.0])
+        pos = [d.position[None] for d in self.dipoles] + [ln.positions for ln in self.lines]
+        mom = [d.moment[None] for d in self.dipoles] + [ln.moments for ln in self.lines]
+        rad = [np.array([d.radius]) for d in self.dipoles] + [
+            np.full(len(ln.positions), ln.radius) for ln in self.lines
+        ]
+        self._positions = np.concatenate(pos) if pos else np.zeros((0, 3))
+        self._moments = np.concatenate(mom) if mom else np.zeros((0, 3))
+        self._radii = np.concatenate(rad) if rad else np.zeros(0)
+
+    def drift(self, t: Any) -> np.ndarray:
+        """Drift (3,) G at time ``t`` s, or (n, 3) for (n,) times."""
+        ts = np.asarray(t, dtype=float)
+        if not np.all(np.isfinite(ts)):
+            raise ValueError(f"t: must be finite, got {t!r}")
+        s = self.drift_amplitude * np.sin(_TWO_PI * ts / self.drift_period + self.drift_phase)
+        return s[..., None] * self.drift_direction
+
+    def static_field_at(self, points: Any) -> np.ndarray:
+        """Field without the drift, (n, 3) G at (n, 3) points (or (3,) at one point)."""
+        p, single = _points(points)
+        b = self.earth_field + (p - self.gradient_origin) @ self.gradient.T
+        b = b + dipole_field(p, self._positions, self._moments, self._radii)
+        return b[0] if single else b
+
+    def field_at(self, points: Any, t: Any = 0.0) -> np.ndarray:
+        """Field (n, 3) G at (n, 3) world points and time ``t`` s (scalar or (n,)).
+
+        One (3,) point gives one (3,) field.
+        """
+        p, single = _points(points)
+        ts = _times(t, p.shape[0], "t")
+        b = self.static_field_at(p) + self.drift(ts)
+        return b[0] if single else b
+
+    def to_dict(self) -> dict[str, Any]:
+        """The scene mapping :meth:`from_dict` reads back."""
+        return {
+            "earth_field": self.earth_field.tolist(),
+            "dipoles": [
+                {"position": d.position.tolist(), "moment": d.moment.tolist(), "radius": d.radius}
+                for d in self.dipoles
+            ],
+            "lines": [
+                {
+                    "start": ln.start.tolist(),
+                    "end": ln.end.tolist(),
+                    "moment_per_metre": ln.moment_per_metre.tolist(),
+                    "spacing": ln.spacing,
+                    "radius": ln.radius,
+                }
+                for ln in self.lines
+            ],
+            "gradient": self.gradient.tolist(),
+            "gradient_origin": self.gradient_origin.tolist(),
+            "drift": {
+                "amplitude": self.drift_amplitude,
+                "period": self.drift_period,
+                "phase": self.drift_phase,
+            },
+        }
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any], source: str = "<scene>") -> MagneticWorld:
+        """Build from a scene-YAML mapping; every key is optional (defaults as the constructor).
+
+        ``earth_field``: ``[x, y, z]`` G, or ``{total, inclination_deg, declination_deg}``;
+        ``dipoles``: ``[{position, moment, radius?}]``; ``lines``:
+        ``[{start, end, moment_per_metre, spacing?, radius?}]``; ``gradient``: 3x3 G/m;
+        ``gradient_origin``: ``[x, y, z]``; ``drift``: ``{amplitude?, period?, phase?}``.
+        Unknown keys, wrong shapes, non-numbers, NaN or out-of-range values raise ValueError
+        naming ``source`` and the key.
+        """
+
+        def fail(key: str, message: str) -> ValueError:
+            return ValueError(f"{source}: {key}: {message}")
+
+        def mapping(value: Any, key: str, allowed: Sequence[str]) -> Mapping[str, Any]:
+            if not isinstance(value, Mapping):
+                got = f"expected a mapping, got {type(value).__name__}"
+                raise fail(key, got) if key else ValueError(f"{source}: {got}")
+            for k in value:
+                if k not in allowed:
+                    where = f"{key}.{k}" if key else str(k)
+                    raise fail(where, f"unknown key (allowed: {', '.join(allowed)})")
+            return value
+
+        def required(m: Mapping[str, Any], k: str, key: str) -> Any:
+            if k not in m:
+                raise fail(f"{key}.{k}", "missing")
+            return m[k]
+
+        def vector(value: Any, key: str, shape: tuple[int, ...]) -> np.ndarray:
+            if isinstance(value, (str, bytes, bool)) or _has_bool(value):
+                raise fail(key, f"expected numbers, got {value!r}")
+            try:
+                return _finite_array(value, shape, "value")
+            except ValueError as exc:
+                raise fail(key, str(exc).removeprefix("value: ")) from None
+
+        def scalar(value: Any, key: str, **limits: Any) -> float:
+            try:
+                return _finite_scalar(value, "value", **limits)
+            except ValueError as exc:
+                raise fail(key, str(exc).removeprefix("value: ")) from None
+
+        def sequence(value: Any, key: str) -> list[Any]:
+            if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Sequence):
+                raise fail(key, f"expected a list, got {type(value).__name__}")
+            return list(value)
+
+        top = mapping(
+            d, "", ("earth_field", "dipoles", "lines", "gradient", "gradient_origin", "drift")
+        )
+        kwargs: dict[str, Any] = {}
+        if "earth_field" in top:
+            ef = top["earth_field"]
+            if isinstance(ef, Mapping):
+                ef = mapping(ef, "earth_field", ("total", "inclination_deg", "declination_deg"))
+                total = scalar(
+                    required(ef, "total", "earth_field"), "earth_field.total", minimum=0.0
+                )
+                inc = scalar(
+                    required(ef, "inclination_deg", "earth_field"), "earth_field.inclination_deg"
+                )
+                if abs(inc) > 90:
+                    raise fail(
+                        "earth_field.inclination_deg", f"must be within [-90, 90], got {inc!r}"
+                    )
+                dec = scalar(ef.get("declination_deg", 0.0), "earth_field.declination_deg")
+                kwargs["earth_field"] = earth_field_from_angles(total, inc, dec)
+            else:
+                kwargs["earth_field"] = vector(ef, "earth_field", (3,))
+        dipoles = []
+        for i, item in enumerate(sequence(top.get("dipoles", []), "dipoles")):
+            key = f"dipoles[{i}]"
+            item = mapping(item, key, ("position", "moment", "radius"))
+            radius = scalar(
+                item.get("radius", DEFAULT_DIPOLE_RADIUS), f"{key}.radius", minimum=0.0, strict=True
+            )
+            dipoles.append(
+                Dipole(
+                    vector(required(item, "position", key), f"{key}.position", (3,)),
+                    vector(required(item, "moment", key), f"{key}.moment", (3,)),
+                    radius,
+                )
+            )
+        lines = []
+        for i, item in enumerate(sequence(top.get("lines", []), "lines")):
+            key = f"lines[{i}]"
+            item = mapping(item, key, ("start", "end", "moment_per_metre", "spacing", "radius"))
+            start = vector(required(item, "start", key), f"{key}.start", (3,))
+            end = vector(required(item, "end", key), f"{key}.end", (3,))
+            if np.array_equal(start, end):
+                raise fail(f"{key}.end", "equals start (zero-length line)")
+            spacing = scalar(item.get("spacing", 0.1), f"{key}.spacing", minimum=0.0, strict=True)
+            radius = item.get("radius")
+            if radius is not None:
+                radius = scalar(radius, f"{key}.radius", minimum=0.0, strict=True)
+            mpm = vector(required(item, "moment_per_metre", key), f"{key}.moment_per_metre", (3,))
+            lines.append(DipoleLine(start, end, mpm, spacing, radius))
+        kwargs["dipoles"] = dipoles
+        kwargs["lines"] = lines
+        if "gradient" in top:
+            kwargs["gradient"] = vector(top["gradient"], "gradient", (3, 3))
+        if "gradient_origin" in top:
+            kwargs["gradient_origin"] = vector(top["gradient_origin"], "gradient_origin", (3,))
+        if "drift" in top:
+            dr = mapping(top["drift"], "drift", ("amplitude", "period", "phase"))
+            if "amplitude" in dr:
+                kwargs["drift_amplitude"] = scalar(dr["amplitude"], "drift.amplitude", minimum=0.0)
+            if "period" in dr:
+                kwargs["drift_period"] = scalar(
+                    dr["period"], "drift.period", minimum=0.0, strict=True
+                )
+            if "phase" in dr:
+                kwargs["drift_phase"] = scalar(dr["phase"], "drift.phase")
+        return cls(**kwargs)
+
+
+def _has_bool(value: Any) -> bool:
+    if isinstance(value, bool):
+        return True
+    if isinstance(value, (list, tuple)):
+        return any(_has_bool(v) for v in value)
+    return False
+
+
+# --------------------------------------------------------------------------------------------
+# sensors
+
+
+class Magnetometer:
+    """A 3-axis magnetometer on a planar, level robot; readings in G in the SENSOR frame
+    (x forward, y right, z down).
+
+    ``world``: the :class:`MagneticWorld`. ``mount``: sensor position in the body frame
+    (x forward, y left, z up), m; default (0, 0, 0.5) (thesis sec. 3.3.1). ``yaw``: rotation of
+    the sensor's x axis from the body's x axis, counter-clockwise seen from above, rad.
+    ``noise_sd``: per-axis Gaussian noise SD, G; default 0.01 G (thesis ch. 6). ``seed``:
+    seed of the sensor's own :class:`kiseki.core.Random` stream. ``self_sources``: the robot's
+    own magnetic parts as body-frame :class:`Dipole` objects; None gives
+    :func:`robot_self_sources`, ``[]`` none. They move and turn with the robot, so they add a
+    constant offset in the sensor frame (a "hard-iron" bias).
+
+    A reading is ``F Rz(yaw)^T (Rz(theta)^T B_world(p, t) + B_self) + noise`` with
+    ``F = diag(1, -1, -1)`` and ``p`` the sensor's world position.
+    """
+
+    def __init__(
+        self,
+        world: MagneticWorld,
+        mount: Any = DEFAULT_MOUNT,
+        yaw: float = 0.0,
+        noise_sd: float = DEFAULT_NOISE_SD,
+        seed: int = 0,
+        self_sources: Iterable[Dipole] | None = None,
+    ) -> None:
+        if not isinstance(world, MagneticWorld):
+            raise ValueError(f"world: expected a MagneticWorld, got {type(world).__name__}")
+        self.world = world
+        self.mount = _finite_array(mount, (3,), "mount")
+        self.yaw = _finite_scalar(yaw, "yaw")
+        self.noise_sd = _finite_scalar(noise_sd, "noise_sd", minimum=0.0)
+        self.seed = _seed(seed, "seed")
+        self.self_sources: tuple[Dipole, ...] = tuple(
+            robot_self_sources() if self_sources is None else self_sources
+        )
+        for s in self.self_sources:
+            if not isinstance(s, Dipole):
+                raise ValueError(f"self_sources: expected Dipole objects, got {s!r}")
+        self._rng = Random(self.seed)
+        self.self_field = np.zeros(3)  # body frame, G
+        for s in self.self_sources:
+            self.self_field = self.self_field + s.field_at(self.mount)
+
+    def sensor_positions(self, poses: Any) -> np.ndarray:
+        """World positions (n, 3) of the sensor for (n, 3) robot poses."""
+        p, _ = _poses(poses)
+        c, s = np.cos(p[:, 2]), np.sin(p[:, 2])
+        mx, my, mz = self.mount
+        return np.column_stack(
+            [p[:, 0] + c * mx - s * my, p[:, 1] + s * mx + c * my, np.full(len(p), mz)]
+        )
+
+    def expected_many(self, poses: Any, times: Any = 0.0) -> np.ndarray:
+        """Noiseless readings (n, 3) G, sensor frame, for (n, 3) poses at (n,) times."""
+        p, _ = _poses(poses)
+        t = _times(times, p.shape[0])
+        b = self.world.field_at(self.sensor_positions(p), t)
+        c, s = np.cos(p[:, 2]), np.sin(p[:, 2])
+        bx = c * b[:, 0] + s * b[:, 1] + self.self_field[0]  # world -> body
+        by = -s * b[:, 0] + c * b[:, 1] + self.self_field[1]
+        bz = b[:, 2] + self.self_field[2]
+        cy, sy = math.cos(self.yaw), math.sin(self.yaw)
+        # body -> yawed sensor axes, then flip y (left -> right) and z (up -> down)
+        return np.column_stack([cy * bx + sy * by, -(-sy * bx + cy * by), -bz])
+
+    def expected(self, robot_pose: Any, t: float = 0.0) -> np.ndarray:
+        """Noiseless reading (3,) G for one pose (x, y, theta) (or a Pose2) at time ``t``."""
+        p, single = _poses(robot_pose, "robot_pose")
+        if not single:
+            raise ValueError(f"robot_pose: expected (x, y, theta), got shape {p.shape}")
+        return self.expected_many(p, t)[0]
+
+    def read_many(self, poses: Any, times: Any = 0.0) -> np.ndarray:
+        """Noisy readings (n, 3) G. Draws 3 n normals in row order, so it gives the same
+        numbers as n successive :meth:`read` calls."""
+        b = self.expected_many(poses, times)
+        if self.noise_sd > 0 and b.size:
+            b = b + self._rng.normal(0.0, self.noise_sd, b.size).reshape(b.shape)
+        return b
+
+    def read(self, robot_pose: Any, t: float = 0.0) -> np.ndarray:
+        """Noisy reading (3,) G in the sensor frame for one pose (x, y, theta) at time ``t``."""
+        p, single = _poses(robot_pose, "robot_pose")
+        if not single:
+            raise ValueError(f"robot_pose: expected (x, y, theta), got shape {p.shape}")
+        return self.read_many(p, t)[0]
+
+
+def magnetic_azimuth(reading: Any) -> float | np.ndarray:
+    """Azimuth ``m_theta = atan2(m_y, m_x)`` of the horizontal field in the sensor frame, rad,
+    wrapped to [-pi, pi): the angle from the sensor's x axis to magnetic north, positive
+    towards the sensor's +y (to the right, clockwise seen from above).
+
+    This is the thesis' yaw-plane magnetic azimuth (sec. 2.5, ch. 4-5) for a level sensor. With
+    it, the world heading (counter-clockwise from east) of the sensor's x axis is
+    ``alpha_N + m_theta``, where ``alpha_N`` is the world direction of the local horizontal
+    field; so ``theta - m_theta`` depends on the place only, which is what the thesis stores in
+    its map (``theta_m = theta - m_theta``, ch. 4-5). ``-m_theta`` is the compass heading
+    (clockwise from magnetic north). (3,) gives a float, (n, 3) an (n,) array; a zero
+    horizontal field gives 0.
+    """
+    a = _float_array(reading, "reading")
+    single = a.shape == (3,)
+    a = _finite_array(a.reshape(1, 3) if single else a, (None, 3), "reading")
+    az = np.asarray(normalize_angle(np.arctan2(a[:, 1], a[:, 0])), dtype=float)
+    return float(az[0]) if single else az
+
+
+class BearingSensor:
+    """Bearing (direction) from one robot to another, for cooperative positioning (paper 001:
+    angle noise N(0, 0.1 deg)).
+
+    ``noise_sd_deg``: SD of the additive Gaussian noise, degrees (default 0.1, paper 001's
+    simulation). ``seed``: seed of the sensor's own :class:`kiseki.core.Random` stream.
+    """
+
+    def __init__(self, noise_sd_deg: float = 0.1, seed: int = 0) -> None:
+        self.noise_sd_deg = _finite_scalar(noise_sd_deg, "noise_sd_deg", minimum=0.0)
+        self.noise_sd = math.radians(self.noise_sd_deg)
+        self.seed = _seed(seed, "seed")
+        self._rng = Random(self.seed)
+
+    @staticmethod
+    def true_bearings(observer_poses: Any, targets_xy: Any) -> np.ndarray:
+        """Noiseless bearings (n,) rad in the observers' frames, wrapped to [-pi, pi)."""
+        obs, tgt = _bearing_inputs(observer_poses, targets_xy)
+        dx, dy = tgt[:, 0] - obs[:, 0], tgt[:, 1] - obs[:, 1]
+        if np.any((dx == 0) & (dy == 0)):
+            raise ValueError("targets_xy: a target coincides with its observer (no bearing)")
+        return np.asarray(normalize_angle(np.arctan2(dy, dx) - obs[:, 2]), dtype=float)
+
+    def measure_many(self, observer_poses: Any, targets_xy: Any) -> np.ndarray:
+        """Noisy bearings (n,) rad, counter-clockwise from the observer's x axis, wrapped to
+        [-pi, pi). ``observer_poses`` (n, 3) or (3,), ``targets_xy`` (n, 2) or (2,)."""
+        b = self.true_bearings(observer_poses, targets_xy)
+        if self.noise_sd > 0 and b.size:
+            b = np.asarray(normalize_angle(b + self._rng.normal(0.0, self.noise_sd, b.size)))
+        return b
+
+    def measure(self, observer_pose: Any, target_xy: Any) -> float:
+        """One noisy bearing, rad, in the observer's frame, wrapped to [-pi, pi)."""
+        obs, _ = _poses(observer_pose, "observer_pose")
+        tgt = _finite_array(target_xy, (2,), "target_xy")
+        if obs.shape[0] != 1:
+            raise ValueError(f"observer_pose: expected (x, y, theta), got shape {obs.shape}")
+        return float(self.measure_many(obs, tgt[None])[0])
+
+
+def _bearing_inputs(observer_poses: Any, targets_xy: Any) -> tuple[np.ndarray, np.ndarray]:
+    obs, _ = _poses(observer_poses, "observer_poses")
+    t = _float_array(targets_xy, "targets_xy")
+    t = _finite_array(t.reshape(1, 2) if t.shape == (2,) else t, (None, 2), "targets_xy")
+    n = max(obs.shape[0], t.shape[0])
+    if obs.shape[0] not in (1, n) or t.shape[0] not in (1, n):
+        raise ValueError(f"observer_poses {obs.shape} and targets_xy {t.shape}: row counts differ")
+    return np.broadcast_to(obs, (n, 3)), np.broadcast_to(t, (n, 2))
