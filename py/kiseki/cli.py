@@ -31,6 +31,8 @@ experiment_app = typer.Typer(
     no_args_is_help=True, help="Experiments: one command per paper table or figure."
 )
 app.add_typer(experiment_app, name="experiment")
+sim_app = typer.Typer(no_args_is_help=True, help="Simulation: scenes, runs logged to MCAP.")
+app.add_typer(sim_app, name="sim")
 console = Console()
 
 
@@ -194,6 +196,78 @@ def experiment_run(
         f"{result.run_dir}: {result.runs} trials ({result.executed} run now, "
         f"{result.failed} failed) in {result.wall_seconds:.1f} s"
     )
+
+
+@sim_app.command("run")
+def sim_run(
+    scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML (data/worlds/...)."),
+    output: Path = typer.Option(..., "-o", "--output", help="MCAP file to write."),
+    controller: str = typer.Option("route", help="'route' (pure pursuit) or 'commands'."),
+    commands: Path | None = typer.Option(None, help="CSV t,v,w or t,vx,vy,w for 'commands'."),
+    duration: float | None = typer.Option(None, help="Seconds to simulate (default: to goal)."),
+    seed: int = typer.Option(0, help="Seed of every noise source of the run."),
+    variant: str = typer.Option("teach", help="Scene variant: teach or playback."),
+    overwrite: bool = typer.Option(False, help="Replace an existing output file."),
+) -> None:
+    """Simulate a scene and log the run (ground truth, odometry, sensors) to MCAP."""
+    from kiseki.sim.run import SimConfig, read_commands, simulate
+    from kiseki.sim.scene import load_scene
+
+    if controller not in ("route", "commands"):
+        raise ValueError(f"--controller must be route or commands, got {controller!r}")
+    if (controller == "commands") != (commands is not None):
+        raise ValueError("--commands FILE goes with --controller commands, and only with it")
+    script = read_commands(commands) if commands is not None else None
+    scene = load_scene(scene_file, variant)
+    summary = simulate(scene, output, SimConfig(duration=duration, seed=seed), script, overwrite)
+    x, y, th = summary.final_pose
+    console.print(
+        f"{output}: {summary.sim_seconds:.1f} s simulated in {summary.wall_seconds:.1f} s "
+        f"({summary.sim_seconds / max(summary.wall_seconds, 1e-9):.1f}x real time), "
+        f"final pose ({x:.3f}, {y:.3f}, {th:.3f}), goal reached: {summary.reached_goal}; "
+        + ", ".join(f"{k} {v}" for k, v in summary.messages.items())
+    )
+
+
+@sim_app.command("render")
+def sim_render(
+    run_file: Path = typer.Argument(..., metavar="RUN", help="MCAP file of a run."),
+    output: Path = typer.Option(..., "-o", "--output", help="GIF to write."),
+    scene_file: Path | None = typer.Option(None, "--scene", help="Scene (default: from run)."),
+) -> None:
+    """Animate a recorded run over its scene (GIF)."""
+    from kiseki.sim.mcap_log import read_run
+    from kiseki.sim.render import render_run
+    from kiseki.sim.scene import load_scene
+
+    run = read_run(run_file)
+    path = scene_file or Path(run.metadata.get("scene_file", ""))
+    if not str(path) or not path.is_file():
+        raise FileNotFoundError(f"{run_file}: its scene file {path} is not found: give --scene")
+    render_run(load_scene(path), run, output)
+    console.print(f"{output}: animation written")
+
+
+@sim_app.command("show")
+def sim_show(
+    scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML."),
+    output: Path = typer.Option(..., "-o", "--output", help="PNG to write."),
+    octree: Path | None = typer.Option(None, help="Also export the world as an OctoMap .bt."),
+    resolution: float = typer.Option(0.05, help="Voxel size of the .bt export (m)."),
+) -> None:
+    """Draw a scene from above (and export its OctoMap)."""
+    from kiseki import _core
+    from kiseki.sim.render import render_scene
+    from kiseki.sim.scene import load_scene
+
+    scene = load_scene(scene_file)
+    render_scene(scene, output)
+    if octree is not None:
+        if not isinstance(scene.world, _core.BoxWorld):
+            raise ValueError(f"{scene_file}: the world is already an OctoMap")
+        tree = _core.OctreeWorld.from_boxes(scene.world, _positive("--resolution", resolution))
+        tree.write_binary(str(octree))
+    console.print(f"{output}: scene drawn" + (f"; {octree} written" if octree else ""))
 
 
 @app.command("report")

@@ -44,6 +44,7 @@ from kiseki.core import Random, normalize_angle
 
 __all__ = [
     "DEFAULT_DECLINATION_DEG",
+    "DEFAULT_DIPOLE_RADIUS",
     "DEFAULT_DRIFT_AMPLITUDE",
     "DEFAULT_DRIFT_PERIOD",
     "DEFAULT_EARTH_TOTAL",

@@ -1,0 +1,163 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Top-down pictures of scenes and runs: the world in height bands, the robot, its route, scans
+and trajectories (PNG), and an animation of a run (GIF)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
+from matplotlib.colors import ListedColormap  # noqa: E402
+
+from kiseki._atomic import atomic_write  # noqa: E402
+from kiseki.sim.scene import Scene  # noqa: E402
+
+__all__ = ["render_run", "render_scene"]
+
+# Height bands drawn from the top down, so lower obstacles show where they exist.
+BANDS = [
+    ((1.0, None), "high (1.0 m to under the ceiling)"),
+    ((0.6, 1.0), "table tops (0.6-1.0 m)"),
+    ((0.05, 0.6), "low (0.05-0.6 m): legs, walls"),
+]
+COLOURS = ["white", "#b0b0b0", "#e69f00", "black"]
+
+
+def _layers(scene: Scene) -> tuple[np.ndarray, object]:
+    layers = None
+    grid = None
+    top = float(scene.bounds[1][2]) - 0.15  # leave out a ceiling at the scene's top
+    for k, ((lo, hi), _) in enumerate(BANDS):
+        grid = scene.ground_truth(lo, hi if hi is not None else max(top, lo + 0.1))
+        occ = grid.cells == 100
+        if layers is None:
+            layers = np.zeros(occ.shape, dtype=np.int8)
+        layers[occ] = k + 1
+    return layers, grid
+
+
+def _axes(grid, title: str):
+    aspect = grid.height / grid.width
+    width = 12.0 if aspect < 1 else 12.0 / aspect
+    fig, ax = plt.subplots(figsize=(width, max(3.0, width * aspect)), dpi=110)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(title)
+    return fig, ax
+
+
+def _extent(grid) -> list[float]:
+    o, r = grid.origin, grid.resolution
+    return [o.x, o.x + grid.width * r, o.y, o.y + grid.height * r]
+
+
+def _save(fig, path) -> Path:
+    try:
+        return atomic_write(Path(path), lambda tmp: fig.savefig(tmp, bbox_inches="tight"))
+    finally:
+        plt.close(fig)
+
+
+def render_scene(scene: Scene, path: str | os.PathLike) -> Path:
+    """The scene from above: obstacles by height band, robot start, route and waypoints."""
+    layers, grid = _layers(scene)
+    fig, ax = _axes(grid, f"{scene.name}: {scene.description}")
+    ax.imshow(
+        layers,
+        origin="lower",
+        extent=_extent(grid),
+        cmap=ListedColormap(COLOURS),
+        vmin=0,
+        vmax=3,
+        interpolation="nearest",
+    )
+    for k, (_, label) in enumerate(BANDS):
+        ax.plot([], [], "s", color=COLOURS[k + 1], label=label)
+    route = np.asarray(scene.route.get("waypoints", []), dtype=float).reshape(-1, 2)
+    if len(route):
+        ax.plot(route[:, 0], route[:, 1], "--o", color="tab:blue", markersize=4, label="route")
+        for name, (x, y) in zip(scene.route.get("names", []), route, strict=False):
+            ax.annotate(name, (x, y), textcoords="offset points", xytext=(4, 6), fontsize=8)
+    start = scene.robot.get("start")
+    if start is not None:
+        x, y, yaw = float(start[0]), float(start[1]), np.radians(float(start[2]))
+        ax.arrow(
+            x,
+            y,
+            0.6 * np.cos(yaw),
+            0.6 * np.sin(yaw),
+            width=0.08,
+            color="tab:green",
+            label="robot start",
+        )
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
+    return _save(fig, path)
+
+
+def render_run(
+    scene: Scene, run, path: str | os.PathLike, scan_topic: str = "/scan", frames: int = 40
+) -> Path:
+    """An animation of a recorded run (kiseki.sim.mcap_log.SimRun): trajectory, odometry and
+    the laser scan, over the scene's map. GIF via Pillow."""
+    truth = np.array(
+        [
+            [m["pose"]["position"]["x"], m["pose"]["position"]["y"]]
+            for _, m in run.messages("/ground_truth")
+        ]
+    )
+    odom = (
+        np.array([[m["x"], m["y"]] for _, m in run.messages("/odom")])
+        if "/odom" in run.topics()
+        else None
+    )
+    scans = run.messages(scan_topic) if scan_topic in run.topics() else []
+    layers, grid = _layers(scene)
+    fig, ax = _axes(grid, f"{scene.name}: simulated run")
+    ax.imshow(
+        layers,
+        origin="lower",
+        extent=_extent(grid),
+        cmap=ListedColormap(COLOURS),
+        vmin=0,
+        vmax=3,
+        interpolation="nearest",
+    )
+    (true_line,) = ax.plot([], [], "-", color="tab:blue", label="ground truth")
+    (odom_line,) = ax.plot([], [], "-", color="tab:red", label="odometry")
+    (points,) = ax.plot([], [], ".", color="tab:green", markersize=2, label="scan")
+    ax.legend(loc="upper right", fontsize=7)
+    n = max(1, len(truth))
+    picks = np.unique(np.linspace(0, n - 1, min(frames, n)).astype(int))
+
+    def draw(i):
+        true_line.set_data(truth[: i + 1, 0], truth[: i + 1, 1])
+        if odom is not None and len(odom):
+            j = min(len(odom) - 1, int(i * len(odom) / n))
+            odom_line.set_data(odom[: j + 1, 0], odom[: j + 1, 1])
+        if scans:
+            s = scans[min(len(scans) - 1, int(i * len(scans) / n))][1]
+            r = np.asarray(s["ranges"], dtype=float)
+            a = s["start_angle"] + np.arange(len(r)) * (s["end_angle"] - s["start_angle"]) / max(
+                1, len(r) - 1
+            )
+            q = s["pose"]
+            yaw = 2 * np.arctan2(q["orientation"]["z"], q["orientation"]["w"])
+            ok = np.isfinite(r) & (r < np.nanmax(r))
+            points.set_data(
+                q["position"]["x"] + r[ok] * np.cos(yaw + a[ok]),
+                q["position"]["y"] + r[ok] * np.sin(yaw + a[ok]),
+            )
+        return true_line, odom_line, points
+
+    anim = FuncAnimation(fig, draw, frames=picks, blit=True)
+    try:
+        return atomic_write(Path(path), lambda tmp: anim.save(tmp, writer=PillowWriter(fps=10)))
+    finally:
+        plt.close(fig)

@@ -1,0 +1,316 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The simulation loop: a fixed time step moves the robot by a controller (pure pursuit along
+the scene's route) or by a script of velocity commands, records ground truth, odometry and
+every sensor, and writes the run to MCAP as it goes."""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from kiseki.sim.mcap_log import RunWriter
+from kiseki.sim.scene import Scene
+from kiseki.sim.setup import RobotSetup, SensorSetup, build_robot, build_sensors
+
+__all__ = ["PurePursuit", "RunSummary", "SimConfig", "read_commands", "simulate"]
+
+MAG_SCHEMA = {
+    "type": "object",
+    "title": "kiseki.MagneticField",
+    "properties": {"x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"}},
+}
+TILT_SCHEMA = {
+    "type": "object",
+    "title": "kiseki.TiltScan",
+    "properties": {
+        "tilt_deg": {"type": "array"},
+        "scan_deg": {"type": "array"},
+        "ranges": {"type": "array", "description": "row-major (tilt, scan); 0 = no return"},
+        "gyro_rpy": {"type": "array"},
+        "sensor_pose": {"type": "array"},
+    },
+}
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    dt: float = 0.1  # s, the thesis' 10 Hz control loop
+    duration: float | None = None  # s; None: until the route's goal is reached
+    max_duration: float = 900.0  # s, a safety stop for controllers
+    seed: int = 0
+    lookahead: float = 0.6  # m, pure pursuit
+    goal_tolerance: float = 0.1  # m, the thesis' stop rule
+
+    def __post_init__(self) -> None:
+        if not (self.dt > 0 and math.isfinite(self.dt)):
+            raise ValueError(f"dt must be positive, got {self.dt}")
+        if self.duration is not None and not (self.duration > 0 and math.isfinite(self.duration)):
+            raise ValueError(f"duration must be positive, got {self.duration}")
+        if not (self.lookahead > 0 and self.goal_tolerance > 0):
+            raise ValueError("lookahead and goal_tolerance must be positive")
+
+
+class PurePursuit:
+    """Follows a polyline: aims at the point `lookahead` metres ahead along the path, slows to
+    stop at the last waypoint within its deceleration limit, and reports when it is there."""
+
+    def __init__(
+        self, waypoints, speed: float, lookahead: float, tolerance: float, max_accel: float
+    ) -> None:
+        pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
+        if len(pts) < 2 or not np.isfinite(pts).all():
+            raise ValueError("a route needs at least two finite waypoints")
+        if not speed > 0:
+            raise ValueError("route speed must be positive")
+        seg = np.diff(pts, axis=0)
+        self.lengths = np.hypot(seg[:, 0], seg[:, 1])
+        if (self.lengths <= 0).any():
+            raise ValueError("consecutive route waypoints must differ")
+        self.points, self.cum = pts, np.concatenate([[0.0], np.cumsum(self.lengths)])
+        self.speed, self.lookahead, self.tolerance, self.max_accel = (
+            speed,
+            lookahead,
+            tolerance,
+            max_accel,
+        )
+        self.progress = 0.0
+        self.done = False
+
+    def _point_at(self, s: float) -> np.ndarray:
+        s = min(max(s, 0.0), self.cum[-1])
+        i = min(int(np.searchsorted(self.cum, s, side="right")) - 1, len(self.lengths) - 1)
+        f = (s - self.cum[i]) / self.lengths[i]
+        return self.points[i] + f * (self.points[i + 1] - self.points[i])
+
+    def _project(self, xy: np.ndarray) -> float:
+        best, best_s = np.inf, self.progress
+        for i in range(len(self.lengths)):
+            a, b = self.points[i], self.points[i + 1]
+            f = np.clip(np.dot(xy - a, b - a) / self.lengths[i] ** 2, 0.0, 1.0)
+            s = self.cum[i] + f * self.lengths[i]
+            d = np.hypot(*(a + f * (b - a) - xy))
+            if d < best and s >= self.progress - 0.5:  # never jump back along the path
+                best, best_s = d, s
+        return max(self.progress, best_s)
+
+    def command(self, pose) -> tuple[float, float, float]:
+        """(v_forward, v_left, yaw_rate) in the body frame."""
+        x, y, th = (float(v) for v in pose)
+        xy = np.array([x, y])
+        goal = self.points[-1]
+        dist_goal = float(np.hypot(*(goal - xy)))
+        self.progress = self._project(xy)
+        if self.done or (dist_goal < self.tolerance and self.cum[-1] - self.progress < 0.5):
+            self.done = True
+            return 0.0, 0.0, 0.0
+        target = self._point_at(self.progress + self.lookahead)
+        if self.cum[-1] - self.progress < self.lookahead:
+            target = goal
+        c, s = math.cos(th), math.sin(th)
+        dx, dy = target - xy
+        lx, ly = c * dx + s * dy, -s * dx + c * dy  # target in the body frame
+        speed = min(self.speed, math.sqrt(2 * self.max_accel * 0.8 * dist_goal))
+        curvature = 2.0 * ly / max(lx * lx + ly * ly, 1e-9)
+        if lx < 0:  # target behind: turn on the spot
+            return 0.0, 0.0, math.copysign(1.0, ly)
+        return speed, 0.0, speed * curvature
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    path: Path
+    steps: int
+    sim_seconds: float
+    wall_seconds: float
+    reached_goal: bool
+    final_pose: tuple[float, float, float]
+    final_odometry: tuple[float, float, float]
+    messages: dict[str, int]
+
+
+def read_commands(path: str | os.PathLike) -> np.ndarray:
+    """A velocity-command script: CSV with header t,v,w (diff drive) or t,vx,vy,w (omni); each
+    row holds from its time until the next row."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: command file not found")
+    header = path.read_text(encoding="utf-8").splitlines()[0].strip().split(",")
+    if header not in (["t", "v", "w"], ["t", "vx", "vy", "w"]):
+        raise ValueError(f"{path}: header must be t,v,w or t,vx,vy,w, got {','.join(header)}")
+    try:
+        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    except ValueError as err:
+        raise ValueError(f"{path}: not a numeric CSV ({err})") from err
+    if data.shape[1] != len(header) or not np.isfinite(data).all():
+        raise ValueError(f"{path}: every row needs {len(header)} finite numbers (no NaN)")
+    if (np.diff(data[:, 0]) < 0).any() or data[0, 0] < 0:
+        raise ValueError(f"{path}: times must start at >= 0 and not decrease")
+    if len(header) == 3:
+        data = np.column_stack([data[:, :2], np.zeros(len(data)), data[:, 2]])
+    return data
+
+
+def _step(setup: RobotSetup, command, dt: float) -> None:
+    vx, vy, w = command
+    if setup.kind == "diff_drive":
+        setup.odometry.update(setup.robot.step(vx, w, dt))
+    else:
+        setup.odometry.update(setup.robot.step(vx, vy, w, dt))
+
+
+def _pose(p) -> tuple[float, float, float]:
+    return (float(p.x), float(p.y), float(p.theta)) if hasattr(p, "x") else tuple(map(float, p))
+
+
+class _Recorder:
+    """Writes one time step of every due sensor."""
+
+    def __init__(self, writer: RunWriter, scene: Scene, sensors: list[SensorSetup]) -> None:
+        self.writer, self.scene, self.sensors = writer, scene, sensors
+        self.next_due = {s.name: 0.0 for s in sensors}
+        self.grids = {}
+        for s in sensors:
+            if s.kind == "laser":
+                z = s.mount.z
+                self.grids[s.name] = scene.ground_truth(z - 0.02, z + 0.02)
+
+    def record(self, t: float, pose, odom) -> None:
+        w = self.writer
+        w.write_pose("/ground_truth", t, pose)
+        w.write_transform(t, "world", "base_link", pose)
+        w.write_odometry("/odom", t, odom)
+        for s in self.sensors:
+            if t + 1e-9 < self.next_due[s.name]:
+                continue
+            self.next_due[s.name] = t + s.period
+            self._sensor(s, t, pose)
+
+    def _sensor(self, s: SensorSetup, t: float, pose) -> None:
+        w, topic = self.writer, f"/{s.name}"
+        if s.kind == "laser":
+            sensor_pose, ranges = s.device.scan(self.grids[s.name], pose)
+            w.write_laser_scan(
+                topic,
+                t,
+                sensor_pose,
+                s.device.params.angles,
+                ranges,
+                max_range=s.device.params.max_range,
+            )
+        elif s.kind == "depth_camera":
+            w.write_depth_image(topic, t, s.device.render(self.scene.world, pose), s.name)
+        elif s.kind == "magnetometer":
+            m = s.device.read(pose, t)
+            w.write_json(
+                topic,
+                t,
+                "kiseki.MagneticField",
+                {"x": float(m[0]), "y": float(m[1]), "z": float(m[2])},
+                MAG_SCHEMA,
+            )
+        elif s.kind == "tilting_laser":
+            sensor = s.mount.world(pose)
+            ranges, gyro = s.device.scan(self.scene.world, sensor)
+            tilt, scan = s.device.params.grid()
+            w.write_json(
+                topic,
+                t,
+                "kiseki.TiltScan",
+                {
+                    "tilt_deg": np.degrees(tilt).tolist(),
+                    "scan_deg": np.degrees(scan).tolist(),
+                    "ranges": np.nan_to_num(ranges, nan=0.0).ravel().tolist(),
+                    "gyro_rpy": gyro.tolist(),
+                    "sensor_pose": sensor.ravel().tolist(),
+                },
+                TILT_SCHEMA,
+            )
+
+
+def simulate(
+    scene: Scene,
+    out: str | os.PathLike,
+    config: SimConfig | None = None,
+    commands: np.ndarray | None = None,
+    overwrite: bool = False,
+    progress: bool = True,
+) -> RunSummary:
+    """Runs a scene and writes the run to an MCAP file; returns a summary."""
+    config = config or SimConfig()
+    setup = build_robot(scene, config.seed)
+    sensors = build_sensors(scene, setup, config.seed, config.dt)
+    controller = None
+    if commands is None:
+        route = scene.route
+        if "waypoints" not in route:
+            raise ValueError(f"{scene.path}: no route: give velocity commands instead")
+        accel = setup.robot.params.max_accel
+        controller = PurePursuit(
+            route["waypoints"],
+            float(route.get("speed", 0.5)),
+            config.lookahead,
+            config.goal_tolerance,
+            accel,
+        )
+    limit = config.duration or (
+        float(commands[-1, 0]) + config.dt if commands is not None else config.max_duration
+    )
+    steps = int(math.ceil(limit / config.dt - 1e-9))
+    meta = {
+        "scene": scene.name,
+        "scene_file": str(scene.path),
+        "seed": str(config.seed),
+        "dt": str(config.dt),
+        "robot": setup.kind,
+    }
+    start, t, k = time.perf_counter(), 0.0, 0
+    with RunWriter(out, meta, overwrite=overwrite) as writer:
+        writer.write_grid(
+            "/map", 0.0, next(iter(_laser_grids(scene, sensors)), scene.ground_truth(0.35, 0.45))
+        )
+        recorder = _Recorder(writer, scene, sensors)
+        total = steps if controller is None else None  # a route ends when its goal is reached
+        bar = tqdm(total=total, desc=scene.name, unit="step", disable=not progress, leave=False)
+        with bar:
+            for k in range(steps + 1):
+                t = k * config.dt
+                recorder.record(t, _pose(setup.robot.pose), _pose(setup.odometry.pose))
+                if k == steps or (controller is not None and controller.done):
+                    break
+                if controller is not None:
+                    command = controller.command(_pose(setup.robot.pose))
+                else:
+                    row = commands[max(0, int(np.searchsorted(commands[:, 0], t, "right")) - 1)]
+                    command = (row[1], row[2], row[3])
+                _step(setup, command, config.dt)
+                bar.update(1)
+    counts = {topic: n for topic, (_, n) in _topic_counts(out).items()}
+    return RunSummary(
+        Path(out),
+        k,
+        t,
+        time.perf_counter() - start,
+        bool(controller is not None and controller.done),
+        _pose(setup.robot.pose),
+        _pose(setup.odometry.pose),
+        counts,
+    )
+
+
+def _laser_grids(scene: Scene, sensors: list[SensorSetup]):
+    for s in sensors:
+        if s.kind == "laser":
+            yield scene.ground_truth(s.mount.z - 0.02, s.mount.z + 0.02)
+
+
+def _topic_counts(path) -> dict:
+    from kiseki.sim.mcap_log import read_run
+
+    return read_run(path).topics()

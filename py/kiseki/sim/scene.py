@@ -1,0 +1,165 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Scenes: a YAML description of a world (objects made of boxes, or a real OctoMap), its
+magnetic field, and a default robot, sensors and route, so that a scene file alone gives a
+meaningful run.
+
+Top-level keys: name, description, source, bounds {min: [x, y, z], max: [x, y, z]}, floor,
+octomap (a .bt file instead of, or beside, objects), objects (list of primitives, see
+kiseki.sim.primitives; an object may carry ``only_in: teach`` or ``only_in: playback``),
+grid_resolution, robot {type, start [x, y, yaw_deg], params, odometry_errors}, sensors (list),
+route {waypoints [[x, y], ...], speed}, magnetic (see kiseki.sim.magnetic).
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from kiseki import _core
+from kiseki.core import Pose2
+from kiseki.grid import OccupancyGrid
+from kiseki.sim.primitives import BoxList, expand
+
+__all__ = ["Scene", "load_scene"]
+
+TOP_KEYS = {
+    "name",
+    "description",
+    "source",
+    "bounds",
+    "floor",
+    "octomap",
+    "objects",
+    "grid_resolution",
+    "robot",
+    "sensors",
+    "route",
+    "magnetic",
+}
+VARIANTS = ("teach", "playback")
+
+
+@dataclass
+class Scene:
+    """A loaded scene: the 3-D world and everything a run needs from the file."""
+
+    name: str
+    path: Path
+    world: Any  # kiseki._core.BoxWorld or OctreeWorld
+    bounds: tuple[np.ndarray, np.ndarray]
+    grid_resolution: float
+    robot: dict = field(default_factory=dict)
+    sensors: list = field(default_factory=list)
+    route: dict = field(default_factory=dict)
+    magnetic: dict | None = None
+    description: str = ""
+    source: str = ""
+    boxes: BoxList | None = None
+
+    def ground_truth(self, z_min: float, z_max: float) -> OccupancyGrid:
+        """The 2-D ground-truth grid of a height band (metres above the floor)."""
+        lo, hi = self.bounds
+        res = self.grid_resolution
+        width = max(1, int(np.ceil((hi[0] - lo[0]) / res)))
+        height = max(1, int(np.ceil((hi[1] - lo[1]) / res)))
+        grid = OccupancyGrid(width, height, res, Pose2(float(lo[0]), float(lo[1]), 0.0))
+        self.world.rasterize_band(z_min, z_max, grid)
+        return grid
+
+
+def _bounds(doc: dict, where: str, world) -> tuple[np.ndarray, np.ndarray]:
+    if "bounds" not in doc:
+        lo, hi = world.bounds
+        return np.asarray(lo), np.asarray(hi)
+    b = doc["bounds"]
+    try:
+        lo, hi = np.asarray(b["min"], dtype=float), np.asarray(b["max"], dtype=float)
+    except (KeyError, TypeError, ValueError):
+        raise ValueError(f"{where}: 'bounds' needs min: [x, y, z] and max: [x, y, z]") from None
+    if lo.shape != (3,) or hi.shape != (3,) or not (hi > lo).all():
+        raise ValueError(f"{where}: 'bounds' max must exceed min in x, y and z")
+    return lo, hi
+
+
+def _objects(doc: dict, where: str, variant: str) -> BoxList:
+    boxes = BoxList.empty()
+    objects = doc.get("objects", [])
+    if not isinstance(objects, list):
+        raise ValueError(f"{where}: 'objects' must be a list")
+    for i, spec in enumerate(objects):
+        label = f"{where}: objects[{i}]"
+        only = spec.get("only_in") if isinstance(spec, dict) else None
+        if only is not None and only not in VARIANTS:
+            raise ValueError(f"{label}: only_in must be teach or playback, got {only!r}")
+        if only is None or only == variant:
+            boxes.extend(expand(spec, label))
+    return boxes
+
+
+def _floor(doc: dict, where: str, boxes: BoxList) -> None:
+    if not doc.get("floor", False):
+        return
+    if "bounds" not in doc:
+        raise ValueError(f"{where}: 'floor: true' needs 'bounds'")
+    lo, hi = (np.asarray(doc["bounds"][k], dtype=float) for k in ("min", "max"))
+    boxes.add(
+        [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, -0.05], [hi[0] - lo[0], hi[1] - lo[1], 0.1]
+    )
+
+
+def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
+    """Reads a scene file. ``variant`` selects objects marked ``only_in`` (a bicycle park that
+    changes between teaching and playback)."""
+    path = Path(path)
+    if variant not in VARIANTS:
+        raise ValueError(f"variant must be teach or playback, got {variant!r}")
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: scene file not found")
+    try:
+        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except yaml.YAMLError as err:
+        raise ValueError(f"{path}: invalid YAML ({err})") from err
+    if not isinstance(doc, dict):
+        raise ValueError(f"{path}: a scene file must be a YAML mapping")
+    unknown = sorted(set(doc) - TOP_KEYS)
+    if unknown:
+        raise ValueError(f"{path}: unknown key(s) {', '.join(unknown)}")
+    where = str(path)
+    boxes = _objects(doc, where, variant)
+    _floor(doc, where, boxes)
+    if "octomap" in doc:
+        bt = (path.parent / doc["octomap"]).resolve()
+        if not bt.is_file():
+            raise FileNotFoundError(f"{path}: octomap file {bt} not found")
+        try:
+            world = _core.OctreeWorld.read_binary(str(bt))
+        except RuntimeError as err:
+            raise ValueError(f"{path}: {err}") from err
+    else:
+        if not boxes.centers:
+            raise ValueError(f"{path}: a scene needs objects or an octomap")
+        world = _core.BoxWorld(*boxes.arrays())
+    res = doc.get("grid_resolution", 0.05)
+    if isinstance(res, bool) or not isinstance(res, int | float) or not res > 0:
+        raise ValueError(f"{path}: 'grid_resolution' must be a positive number")
+    scene = Scene(
+        name=str(doc.get("name", path.stem)),
+        path=path,
+        world=world,
+        bounds=_bounds(doc, where, world),
+        grid_resolution=float(res),
+        robot=dict(doc.get("robot") or {}),
+        sensors=list(doc.get("sensors") or []),
+        route=dict(doc.get("route") or {}),
+        magnetic=doc.get("magnetic"),
+        description=str(doc.get("description", "")),
+        source=str(doc.get("source", "")),
+        boxes=boxes,
+    )
+    return scene

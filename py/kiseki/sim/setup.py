@@ -1,0 +1,201 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Builds a scene's robot, odometry and sensors from its file, checking that the robot starts
+in free space and that every sensor sits on the robot."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from kiseki.core import derive_seed
+from kiseki.sim import robot as robots
+from kiseki.sim.magnetic import MagneticWorld, Magnetometer
+from kiseki.sim.scene import Scene
+from kiseki.sim.sensors import (
+    LASER_PRESETS,
+    DepthCamera,
+    DepthCameraParams,
+    Laser2D,
+    Mount,
+    TiltingLaser,
+    TiltingLaserParams,
+    with_overrides,
+)
+
+__all__ = ["RobotSetup", "SensorSetup", "build_robot", "build_sensors"]
+
+ROBOT_KEYS = {"type", "start", "params", "odometry_errors"}
+SENSOR_KEYS = {"type", "name", "mount", "preset", "params", "rate_hz", "width", "height", "pitch"}
+
+
+@dataclass
+class RobotSetup:
+    kind: str  # "diff_drive" or "omni"
+    robot: Any
+    odometry: Any
+    length: float
+    width: float
+    height: float
+
+
+@dataclass
+class SensorSetup:
+    kind: str
+    name: str
+    device: Any
+    period: float  # seconds between readings
+    mount: Mount
+
+
+def _start(scene: Scene) -> np.ndarray:
+    start = scene.robot.get("start", [0.0, 0.0, 0.0])
+    try:
+        x, y, yaw = (float(v) for v in start)
+    except (TypeError, ValueError):
+        raise ValueError(f"{scene.path}: robot.start must be [x, y, yaw_deg]") from None
+    if not all(math.isfinite(v) for v in (x, y, yaw)):
+        raise ValueError(f"{scene.path}: robot.start must be finite")
+    return np.array([x, y, math.radians(yaw)])
+
+
+def _check_free_start(scene: Scene, pose: np.ndarray, length: float, width: float, height: float):
+    grid = scene.ground_truth(0.05, min(height, float(scene.bounds[1][2]) - 0.05))
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    u, v = np.meshgrid(
+        np.linspace(-length / 2, length / 2, 15), np.linspace(-width / 2, width / 2, 9)
+    )
+    pts = np.column_stack(
+        [pose[0] + c * u.ravel() - s * v.ravel(), pose[1] + s * u.ravel() + c * v.ravel()]
+    )
+    cells = grid.world_to_cell(pts)
+    inside = (cells[:, 0] >= 0) & (cells[:, 0] < grid.width) & (cells[:, 1] >= 0)
+    inside &= cells[:, 1] < grid.height
+    if not inside.all():
+        raise ValueError(f"{scene.path}: the robot's start footprint leaves the scene's bounds")
+    if (grid.cells[cells[:, 1], cells[:, 0]] == 100).any():
+        raise ValueError(f"{scene.path}: the robot's start footprint overlaps an obstacle")
+
+
+def build_robot(scene: Scene, seed: int) -> RobotSetup:
+    spec = scene.robot
+    unknown = sorted(set(spec) - ROBOT_KEYS)
+    if unknown:
+        raise ValueError(f"{scene.path}: robot: unknown key(s) {', '.join(unknown)}")
+    kind = spec.get("type", "diff_drive")
+    pose = _start(scene)
+    where = f"{scene.path}: robot"
+    odo_seed = derive_seed(seed, 1000)
+    if kind == "diff_drive":
+        params = robots.DiffDriveParams.from_dict(spec.get("params") or {}, where)
+        errors = robots.OdometryErrorParams.from_dict(spec.get("odometry_errors") or {}, where)
+        setup = RobotSetup(
+            kind,
+            robots.DiffDriveRobot(params, pose),
+            robots.WheelOdometry(params, errors, odo_seed, pose),
+            params.length,
+            params.width,
+            params.height,
+        )
+    elif kind == "omni":
+        params = robots.OmniParams.from_dict(spec.get("params") or {}, where)
+        errors = robots.OmniOdometryErrorParams.from_dict(spec.get("odometry_errors") or {}, where)
+        setup = RobotSetup(
+            kind,
+            robots.OmniRobot(params, pose),
+            robots.OmniOdometry(errors, odo_seed, pose),
+            params.length,
+            params.width,
+            1.2,
+        )
+    else:
+        raise ValueError(f"{where}: type must be diff_drive or omni, got {kind!r}")
+    _check_free_start(scene, pose, setup.length, setup.width, setup.height)
+    return setup
+
+
+def _mount(spec: dict, where: str, robot: RobotSetup) -> Mount:
+    m = spec.get("mount", [0.0, 0.0, 0.5])
+    try:
+        values = [float(v) for v in m]
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}: mount must be [x, y, z] or [x, y, z, yaw_deg]") from None
+    if len(values) not in (3, 4) or not all(math.isfinite(v) for v in values):
+        raise ValueError(f"{where}: mount must be 3 or 4 finite numbers")
+    mount = Mount(
+        *values[:3], values[3] if len(values) == 4 else 0.0, float(spec.get("pitch", 0.0))
+    )
+    margin = 0.1
+    if (
+        abs(mount.x) > robot.length / 2 + margin
+        or abs(mount.y) > robot.width / 2 + margin
+        or not 0.0 <= mount.z <= robot.height + 0.5
+    ):
+        raise ValueError(
+            f"{where}: mount ({mount.x}, {mount.y}, {mount.z}) lies outside the robot "
+            f"({robot.length} x {robot.width} x {robot.height} m)"
+        )
+    return mount
+
+
+def _period(spec: dict, default: float, where: str) -> float:
+    rate = spec.get("rate_hz")
+    if rate is None:
+        return default
+    if isinstance(rate, bool) or not isinstance(rate, int | float) or not rate > 0:
+        raise ValueError(f"{where}: rate_hz must be positive")
+    return 1.0 / float(rate)
+
+
+def build_sensors(scene: Scene, robot: RobotSetup, seed: int, dt: float) -> list[SensorSetup]:
+    out: list[SensorSetup] = []
+    magnetic = MagneticWorld.from_dict(scene.magnetic, str(scene.path)) if scene.magnetic else None
+    for i, spec in enumerate(scene.sensors):
+        where = f"{scene.path}: sensors[{i}]"
+        if not isinstance(spec, dict):
+            raise ValueError(f"{where}: each sensor must be a mapping")
+        unknown = sorted(set(spec) - SENSOR_KEYS)
+        if unknown:
+            raise ValueError(f"{where}: unknown key(s) {', '.join(unknown)}")
+        kind, name = spec.get("type"), str(spec.get("name", f"sensor{i}"))
+        mount = _mount(spec, where, robot)
+        s = derive_seed(seed, i)
+        overrides = dict(spec.get("params") or {})
+        if kind == "laser":
+            preset = spec.get("preset", "hokuyo_utm30lx")
+            if preset not in LASER_PRESETS:
+                raise ValueError(f"{where}: unknown preset {preset!r} ({', '.join(LASER_PRESETS)})")
+            params = with_overrides(LASER_PRESETS[preset], overrides, where)
+            device = Laser2D(params, mount, s)
+            period = _period(spec, max(dt, params.period), where)
+        elif kind == "depth_camera":
+            for key in ("width", "height"):
+                if key in spec:
+                    overrides[key] = spec[key]
+            params = with_overrides(DepthCameraParams(), overrides, where)
+            device = DepthCamera(params, mount, s)
+            period = _period(spec, max(dt, params.period), where)
+        elif kind == "magnetometer":
+            if magnetic is None:
+                raise ValueError(f"{where}: a magnetometer needs the scene's 'magnetic' section")
+            device = Magnetometer(
+                magnetic,
+                (mount.x, mount.y, mount.z),
+                math.radians(mount.yaw_deg),
+                seed=s,
+                **overrides,
+            )
+            period = _period(spec, dt, where)
+        elif kind == "tilting_laser":
+            device = TiltingLaser(with_overrides(TiltingLaserParams(), overrides, where), s)
+            period = _period(spec, 1e9, where)  # by default once, at the start
+        else:
+            raise ValueError(f"{where}: unknown sensor type {kind!r}")
+        out.append(SensorSetup(kind, name, device, period, mount))
+    names = [s.name for s in out]
+    if len(set(names)) != len(names):
+        raise ValueError(f"{scene.path}: sensor names must be unique, got {names}")
+    return out
