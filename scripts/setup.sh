@@ -16,7 +16,7 @@ KISEKI_PYTHON="${KISEKI_PYTHON:-python3}"
 APT_PACKAGES=(
   build-essential pkg-config git
   python3 python3-venv python3-dev
-  libeigen3-dev libpcl-dev liboctomap-dev libopencv-dev
+  libeigen3-dev libpcl-dev liboctomap-dev libopencv-dev octomap-tools
   libgtest-dev googletest
 )
 

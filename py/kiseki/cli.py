@@ -63,14 +63,14 @@ def _positive(name: str, value: float) -> float:
 
 @map_app.command("from-log")
 def map_from_log(
-    log: Path = typer.Argument(..., help="CARMEN log (.log or .log.gz) with poses and scans."),
+    log: Path = typer.Argument(..., help="CARMEN log (.log, .log.gz) or kiseki run (.mcap)."),
     output: Path = typer.Option(..., "-o", "--output", help="Map YAML to write (image beside)."),
     resolution: float = typer.Option(0.05, help="Cell size in metres."),
     usable_range: float = typer.Option(30.0, help="Free space is marked at most this far (m)."),
     render: Path | None = typer.Option(None, help="Also draw the map and trajectory to this PNG."),
 ) -> None:
     """Build an occupancy grid from a log's poses and scans and save it as a ROS map."""
-    from kiseki.datasets import read_carmen_log
+    from kiseki.datasets import open_scans
     from kiseki.map_io import load_map, save_map
     from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
     from kiseki.plots import render_map
@@ -80,7 +80,7 @@ def map_from_log(
         usable_range=_positive("--usable-range", usable_range),
     )
     start = time.perf_counter()
-    scans = read_carmen_log(log).scans
+    scans = open_scans(log)
     grid = build_map(scans.poses, scans.ranges, scans.angles, scans.max_range, config, True)
     seconds = time.perf_counter() - start
     saved = load_map(save_map(grid, output))

@@ -6,6 +6,7 @@ against their parameters, every scene of data/worlds loads, renders and runs."""
 from __future__ import annotations
 
 import math
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -15,7 +16,9 @@ import pytest
 import yaml
 from mcap.reader import make_reader
 
-from kiseki import _core
+from kiseki import _core, load_map
+from kiseki.datasets import open_scans
+from kiseki.mapping import endpoint_agreement
 from kiseki.sim.primitives import BoxList
 from kiseki.sim.render import render_scene
 from kiseki.sim.run import SimConfig, simulate
@@ -159,6 +162,9 @@ def test_octree_export_and_the_real_building(shared_data, tmp_path):
     tree.write_binary(str(tmp_path / "a.bt"))
     back = _core.OctreeWorld.read_binary(str(tmp_path / "a.bt"))
     assert back.occupied_leaves == tree.occupied_leaves > 10000
+    if shutil.which("bt2vrml"):  # octomap-tools (installed by the set-up) opens the export
+        done = subprocess.run(["bt2vrml", str(tmp_path / "a.bt")], capture_output=True, text=True)
+        assert f"Finished writing {tree.occupied_leaves} voxels" in done.stdout
     geb = tmp_path / "geb.yaml"
     geb.write_text(
         yaml.safe_dump({"name": "geb079", "octomap": str(shared_data / "octomap" / "geb079.bt")})
@@ -266,3 +272,30 @@ def test_cli_run_render_and_bad_commands(tmp_path):
         [*cmd, "run", str(scene), "-o", str(tmp_path / "r.mcap")], capture_output=True, text=True
     )
     assert done.returncode == 1 and "exists" in done.stderr  # nothing overwritten by accident
+
+
+def test_a_simulated_run_replays_through_the_dataset_interface(tmp_path):
+    scene = load_scene(WORLDS[[p.stem for p in WORLDS].index("factory_corridor")])
+    simulate(scene, tmp_path / "run.mcap", SimConfig(duration=6.0, seed=2), progress=False)
+    scans = open_scans(tmp_path / "run.mcap")
+    assert scans.ranges.shape == (61, 1081) and scans.max_range == 30.0
+    np.testing.assert_allclose(scans.poses[0], [0.45, 0.0, 0.0], atol=1e-9)  # laser 0.45 m ahead
+    assert np.abs(scans.odometry[-1, :2] - scans.poses[-1, :2]).max() < 0.5
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "kiseki.cli",
+            "map",
+            "from-log",
+            str(tmp_path / "run.mcap"),
+            "-o",
+            str(tmp_path / "m.yaml"),
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    grid = load_map(tmp_path / "m.yaml")
+    share = endpoint_agreement(grid, scans.poses, scans.ranges, scans.angles, scans.max_range)
+    assert share > 0.99
