@@ -46,15 +46,14 @@ Radish "-corrected" logs (Intel, ACES, CSAIL, Freiburg 079) that users should kn
 
 from __future__ import annotations
 
-import gzip
 import os
-import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from kiseki.datasets._files import read_maybe_gzipped
 from kiseki.errors import LogFormatError
 
 __all__ = [
@@ -65,7 +64,6 @@ __all__ = [
     "read_carmen_log",
 ]
 
-_GZIP_MAGIC = b"\x1f\x8b"
 _MAX_RANGE_PARAM = "robot_front_laser_max"
 # Step of CARMEN's FLASER guess for the usual SICK beam counts.
 _FLASER_STEPS = {
@@ -140,15 +138,10 @@ def read_carmen_log(path: str | os.PathLike) -> CarmenLog:
 
 
 def _read_text(path: Path) -> str:
-    data = path.read_bytes()
-    if data.startswith(_GZIP_MAGIC):
-        try:
-            data = gzip.decompress(data)
-        except (EOFError, OSError, zlib.error) as exc:
-            raise LogFormatError(f"{path}: truncated or corrupt gzip stream ({exc})") from exc
-    if not data.strip():
+    text = read_maybe_gzipped(path, LogFormatError)
+    if not text.strip():
         raise LogFormatError(f"{path}: empty log")
-    return data.decode("latin-1")
+    return text
 
 
 def _split_messages(path: Path, text: str) -> tuple[dict[str, list[_Row]], dict[str, str]]:

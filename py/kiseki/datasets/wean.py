@@ -26,20 +26,18 @@ mirrored left-right 0.50. The header's ``autoshifted_x/y`` offsets (0 in Wean) a
 
 from __future__ import annotations
 
-import gzip
 import os
 import re
-import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from kiseki.datasets._files import read_maybe_gzipped
 from kiseki.errors import MapFormatError
 
 __all__ = ["WeanMap", "read_wean_map"]
 
-_GZIP_MAGIC = b"\x1f\x8b"
 _HEADER_LINE = re.compile(r"robot_specifications->(\w+)\s+(\S+)")
 _SIZE_LINE = re.compile(r"global_map\[0\]:\s+(\d+)\s+(\d+)")
 
@@ -74,13 +72,7 @@ def read_wean_map(path: str | os.PathLike) -> WeanMap:
 
 
 def _read_text(path: Path) -> str:
-    data = path.read_bytes()
-    if data.startswith(_GZIP_MAGIC):
-        try:
-            data = gzip.decompress(data)
-        except (EOFError, OSError, zlib.error) as exc:
-            raise MapFormatError(f"{path}: truncated or corrupt gzip stream ({exc})") from exc
-    return data.decode("latin-1")
+    return read_maybe_gzipped(path, MapFormatError)
 
 
 def _parse_header(path: Path, text: str) -> tuple[float, int, int, str]:

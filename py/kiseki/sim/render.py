@@ -53,6 +53,22 @@ def _axes(grid, title: str):
     return fig, ax
 
 
+def _scene_axes(scene: Scene, title: str):
+    """A figure with the scene's obstacles drawn by height band."""
+    layers, grid = _layers(scene)
+    fig, ax = _axes(grid, title)
+    ax.imshow(
+        layers,
+        origin="lower",
+        extent=_extent(grid),
+        cmap=ListedColormap(COLOURS),
+        vmin=0,
+        vmax=3,
+        interpolation="nearest",
+    )
+    return fig, ax
+
+
 def _extent(grid) -> list[float]:
     o, r = grid.origin, grid.resolution
     return [o.x, o.x + grid.width * r, o.y, o.y + grid.height * r]
@@ -67,17 +83,7 @@ def _save(fig, path) -> Path:
 
 def render_scene(scene: Scene, path: str | os.PathLike) -> Path:
     """The scene from above: obstacles by height band, robot start, route and waypoints."""
-    layers, grid = _layers(scene)
-    fig, ax = _axes(grid, f"{scene.name}: {scene.description}")
-    ax.imshow(
-        layers,
-        origin="lower",
-        extent=_extent(grid),
-        cmap=ListedColormap(COLOURS),
-        vmin=0,
-        vmax=3,
-        interpolation="nearest",
-    )
+    fig, ax = _scene_axes(scene, f"{scene.name}: {scene.description}")
     for k, (_, label) in enumerate(BANDS):
         ax.plot([], [], "s", color=COLOURS[k + 1], label=label)
     route = np.asarray(scene.route.get("waypoints", []), dtype=float).reshape(-1, 2)
@@ -118,17 +124,7 @@ def render_run(
         else None
     )
     scans = run.messages(scan_topic) if scan_topic in run.topics() else []
-    layers, grid = _layers(scene)
-    fig, ax = _axes(grid, f"{scene.name}: simulated run")
-    ax.imshow(
-        layers,
-        origin="lower",
-        extent=_extent(grid),
-        cmap=ListedColormap(COLOURS),
-        vmin=0,
-        vmax=3,
-        interpolation="nearest",
-    )
+    fig, ax = _scene_axes(scene, f"{scene.name}: simulated run")
     (true_line,) = ax.plot([], [], "-", color="tab:blue", label="ground truth")
     (odom_line,) = ax.plot([], [], "-", color="tab:red", label="odometry")
     (points,) = ax.plot([], [], ".", color="tab:green", markersize=2, label="scan")
