@@ -39,29 +39,39 @@ def best_of(fn, repeats: int = 3) -> tuple[float, object]:
 def main() -> None:
     factory = load_scene(WORLDS / "factory_corridor.yaml")
     with tempfile.TemporaryDirectory() as tmp:
-        runs = [simulate(factory, Path(tmp) / f"r{i}.mcap", SimConfig(seed=i), progress=False)
-                for i in range(3)]
+        runs = [
+            simulate(factory, Path(tmp) / f"r{i}.mcap", SimConfig(seed=i), progress=False)
+            for i in range(3)
+        ]
     factor = max(r.sim_seconds / r.wall_seconds for r in runs)
-    print(f"factory corridor run to P2 (two 160x120 depth cameras + 1081-beam laser, 10 Hz, "
-          f"MCAP): {runs[0].sim_seconds:.1f} s simulated, {factor:.1f}x real time (goal 5x)")
+    print(
+        f"factory corridor run to P2 (two 160x120 depth cameras + 1081-beam laser, 10 Hz, "
+        f"MCAP): {runs[0].sim_seconds:.1f} s simulated, {factor:.1f}x real time (goal 5x)"
+    )
 
     grid = factory.ground_truth(0.38, 0.42)
     angles = LASER_PRESETS["hokuyo_utm30lx"].angles
     poses = np.column_stack([np.linspace(0, 13, 2000), np.zeros(2000), np.zeros(2000)])
     seconds, _ = best_of(lambda: grid.cast_scans(poses, angles, max_range=30.0))
-    print(f"2-D laser, factory, 1081 beams, 30 m, 0.05 m grid: {len(poses) / seconds:,.0f} "
-          "scans/s (goal 1,000)")
+    print(
+        f"2-D laser, factory, 1081 beams, 30 m, 0.05 m grid: {len(poses) / seconds:,.0f} "
+        "scans/s (goal 1,000)"
+    )
 
     camera = DepthCamera(DepthCameraParams(), Mount(0.0, 0.29, 0.4, 90.0), seed=0)
     seconds, _ = best_of(lambda: camera.render(factory.world, (4.0, 0.0, 0.0), noise=False), 20)
     noisy, _ = best_of(lambda: camera.render(factory.world, (4.0, 0.0, 0.0)), 20)
-    print(f"depth frame 160x120: {1000 * seconds:.2f} ms geometry, {1000 * noisy:.2f} ms with "
-          "the disparity noise (goal < 10 ms)")
+    print(
+        f"depth frame 160x120: {1000 * seconds:.2f} ms geometry, {1000 * noisy:.2f} ms with "
+        "the disparity noise (goal < 10 ms)"
+    )
 
     rubble = load_scene(WORLDS / "rubble_a.yaml")
     seconds, tree = best_of(lambda: _core.OctreeWorld.from_boxes(rubble.world, 0.02), 2)
-    print(f"OcTree of rubble environment A at 0.02 m: {seconds:.2f} s, "
-          f"{tree.occupied_leaves:,} occupied leaves (goal < 2 s)")
+    print(
+        f"OcTree of rubble environment A at 0.02 m: {seconds:.2f} s, "
+        f"{tree.occupied_leaves:,} occupied leaves (goal < 2 s)"
+    )
 
 
 if __name__ == "__main__":

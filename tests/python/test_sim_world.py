@@ -19,6 +19,7 @@ from mcap.reader import make_reader
 from kiseki import _core, load_map
 from kiseki.datasets import open_scans
 from kiseki.mapping import endpoint_agreement
+from kiseki.sim.mcap_log import read_run
 from kiseki.sim.primitives import BoxList
 from kiseki.sim.render import render_scene
 from kiseki.sim.run import SimConfig, simulate
@@ -60,11 +61,15 @@ def test_every_scene_loads_renders_and_runs(path, tmp_path):
         channels = reader.get_summary().channels
         for _, channel, _ in reader.iter_messages():
             counts[channel.topic] += 1
-    assert counts["/ground_truth"] == counts["/odom"] == 11 and counts["/map"] == 1
-    for sensor in scene.sensors:
-        topic = f"/{sensor['name']}"
-        expected = 1 if sensor["type"] == "tilting_laser" else 11
-        assert counts[topic] == expected, topic
+    assert counts["/map"] == 1
+    several = len(scene.robot_specs) > 1
+    for spec in scene.robot_specs:
+        prefix = f"/{spec['name']}" if several else ""
+        assert counts[f"{prefix}/ground_truth"] == counts[f"{prefix}/odom"] == 11
+        for sensor in spec["sensors"]:
+            topic = f"{prefix}/{sensor['name']}"
+            expected = 1 if sensor["type"] == "tilting_laser" else 11
+            assert counts[topic] == expected, topic
     assert {c.message_encoding for c in channels.values()} == {"json"}
 
 
@@ -203,6 +208,8 @@ def test_octree_export_and_the_real_building(shared_data, tmp_path):
             "beams",
         ),
         ({"robot": {"type": "tank"}}, "diff_drive or omni"),
+        ({"robots": [{"name": "a", "start": [2, 2, 0]}]}, "not both"),
+        ({"sensors": [{"type": "bearing", "name": "b", "targets": ["ghost"]}]}, "other robots"),
     ],
 )
 def test_bad_scenes_are_rejected_with_the_file_named(tmp_path, patch, match):
@@ -299,3 +306,24 @@ def test_a_simulated_run_replays_through_the_dataset_interface(tmp_path):
     grid = load_map(tmp_path / "m.yaml")
     share = endpoint_agreement(grid, scans.poses, scans.ranges, scans.angles, scans.max_range)
     assert share > 0.99
+
+
+def test_mutual_bearings_of_three_robots_match_the_geometry(tmp_path):
+    scene = load_scene(WORLDS[[p.stem for p in WORLDS].index("coop_three_robots")])
+    simulate(scene, tmp_path / "coop.mcap", SimConfig(seed=7), progress=False)
+    run = read_run(tmp_path / "coop.mcap")
+    truth = {n: run.messages(f"/{n}/ground_truth") for n in ("r1", "r2", "r3")}
+    errors = []
+    for observer in ("r1", "r2", "r3"):
+        for i, (_, msg) in enumerate(run.messages(f"/{observer}/bearings")):
+            me = truth[observer][i][1]["pose"]
+            x, y = me["position"]["x"], me["position"]["y"]
+            yaw = 2 * math.atan2(me["orientation"]["z"], me["orientation"]["w"])
+            for target, measured in zip(msg["targets"], msg["bearings"], strict=True):
+                other = truth[target][i][1]["pose"]["position"]
+                expected = math.atan2(other["y"] - y, other["x"] - x) - yaw
+                errors.append(math.remainder(measured - expected, 2 * math.pi))
+    errors = np.degrees(errors)
+    assert len(errors) > 300
+    assert abs(errors.std() - 0.1) < 0.1 * 4 / math.sqrt(2 * len(errors)) + 0.005
+    assert abs(errors.mean()) < 4 * 0.1 / math.sqrt(len(errors))

@@ -86,12 +86,27 @@ def render_scene(scene: Scene, path: str | os.PathLike) -> Path:
     fig, ax = _scene_axes(scene, f"{scene.name}: {scene.description}")
     for k, (_, label) in enumerate(BANDS):
         ax.plot([], [], "s", color=COLOURS[k + 1], label=label)
-    route = np.asarray(scene.route.get("waypoints", []), dtype=float).reshape(-1, 2)
+    for k, spec in enumerate(scene.robot_specs):
+        label = spec["name"] if len(scene.robot_specs) > 1 else ""
+        _draw_robot(ax, spec, label, f"C{k}")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
+    return _save(fig, path)
+
+
+def _draw_robot(ax, spec: dict, label: str, colour: str) -> None:
+    route = np.asarray(spec["route"].get("waypoints", []), dtype=float).reshape(-1, 2)
     if len(route):
-        ax.plot(route[:, 0], route[:, 1], "--o", color="tab:blue", markersize=4, label="route")
-        for name, (x, y) in zip(scene.route.get("names", []), route, strict=False):
+        ax.plot(
+            route[:, 0],
+            route[:, 1],
+            "--o",
+            color=colour,
+            markersize=4,
+            label=f"route {label}".strip(),
+        )
+        for name, (x, y) in zip(spec["route"].get("names", []), route, strict=False):
             ax.annotate(name, (x, y), textcoords="offset points", xytext=(4, 6), fontsize=8)
-    start = scene.robot.get("start")
+    start = spec["robot"].get("start")
     if start is not None:
         x, y, yaw = float(start[0]), float(start[1]), np.radians(float(start[2]))
         ax.arrow(
@@ -101,56 +116,70 @@ def render_scene(scene: Scene, path: str | os.PathLike) -> Path:
             0.6 * np.sin(yaw),
             width=0.08,
             color="tab:green",
-            label="robot start",
+            label=f"start {label}".strip(),
         )
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
-    return _save(fig, path)
+        if label:
+            ax.annotate(label, (x, y), textcoords="offset points", xytext=(-10, -12), fontsize=8)
+
+
+def _track(run, topic: str) -> np.ndarray:
+    msgs = run.messages(topic)
+    if not msgs:
+        return np.zeros((0, 2))
+    if "pose" in msgs[0][1]:
+        return np.array([[m["pose"]["position"]["x"], m["pose"]["position"]["y"]] for _, m in msgs])
+    return np.array([[m["x"], m["y"]] for _, m in msgs])
+
+
+def _scan_points(message: dict) -> np.ndarray:
+    r = np.asarray(message["ranges"], dtype=float)
+    step = (message["end_angle"] - message["start_angle"]) / max(1, len(r) - 1)
+    a = message["start_angle"] + np.arange(len(r)) * step
+    q = message["pose"]
+    yaw = 2 * np.arctan2(q["orientation"]["z"], q["orientation"]["w"])
+    ok = np.isfinite(r) & (r < np.nanmax(r))
+    return np.column_stack(
+        [
+            q["position"]["x"] + r[ok] * np.cos(yaw + a[ok]),
+            q["position"]["y"] + r[ok] * np.sin(yaw + a[ok]),
+        ]
+    )
 
 
 def render_run(
     scene: Scene, run, path: str | os.PathLike, scan_topic: str = "/scan", frames: int = 40
 ) -> Path:
-    """An animation of a recorded run (kiseki.sim.mcap_log.SimRun): trajectory, odometry and
-    the laser scan, over the scene's map. GIF via Pillow."""
-    truth = np.array(
-        [
-            [m["pose"]["position"]["x"], m["pose"]["position"]["y"]]
-            for _, m in run.messages("/ground_truth")
-        ]
-    )
-    odom = (
-        np.array([[m["x"], m["y"]] for _, m in run.messages("/odom")])
-        if "/odom" in run.topics()
-        else None
-    )
-    scans = run.messages(scan_topic) if scan_topic in run.topics() else []
+    """An animation of a recorded run (kiseki.sim.mcap_log.SimRun): every robot's ground truth
+    and odometry, and the laser scan, over the scene. GIF via Pillow."""
+    topics = run.topics()
+    prefixes = sorted(t[: -len("/ground_truth")] for t in topics if t.endswith("/ground_truth"))
+    if not prefixes:
+        raise ValueError(f"{run.path}: no ground-truth topic to animate")
+    truths = [_track(run, f"{p}/ground_truth") for p in prefixes]
+    odoms = [
+        _track(run, f"{p}/odom") if f"{p}/odom" in topics else np.zeros((0, 2)) for p in prefixes
+    ]
+    scans = run.messages(scan_topic) if scan_topic in topics else []
     fig, ax = _scene_axes(scene, f"{scene.name}: simulated run")
-    (true_line,) = ax.plot([], [], "-", color="tab:blue", label="ground truth")
-    (odom_line,) = ax.plot([], [], "-", color="tab:red", label="odometry")
+    lines = []
+    for k, p in enumerate(prefixes):
+        name = p.strip("/") or "robot"
+        lines.append(ax.plot([], [], "-", color=f"C{k}", label=f"{name} ground truth")[0])
+        lines.append(ax.plot([], [], ":", color=f"C{k}", label=f"{name} odometry")[0])
     (points,) = ax.plot([], [], ".", color="tab:green", markersize=2, label="scan")
-    ax.legend(loc="upper right", fontsize=7)
-    n = max(1, len(truth))
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
+    n = max(len(t) for t in truths)
     picks = np.unique(np.linspace(0, n - 1, min(frames, n)).astype(int))
 
     def draw(i):
-        true_line.set_data(truth[: i + 1, 0], truth[: i + 1, 1])
-        if odom is not None and len(odom):
-            j = min(len(odom) - 1, int(i * len(odom) / n))
-            odom_line.set_data(odom[: j + 1, 0], odom[: j + 1, 1])
+        for k in range(len(prefixes)):
+            for line, track in ((lines[2 * k], truths[k]), (lines[2 * k + 1], odoms[k])):
+                j = min(len(track), int((i + 1) * len(track) / n))
+                line.set_data(track[:j, 0], track[:j, 1])
         if scans:
-            s = scans[min(len(scans) - 1, int(i * len(scans) / n))][1]
-            r = np.asarray(s["ranges"], dtype=float)
-            a = s["start_angle"] + np.arange(len(r)) * (s["end_angle"] - s["start_angle"]) / max(
-                1, len(r) - 1
-            )
-            q = s["pose"]
-            yaw = 2 * np.arctan2(q["orientation"]["z"], q["orientation"]["w"])
-            ok = np.isfinite(r) & (r < np.nanmax(r))
-            points.set_data(
-                q["position"]["x"] + r[ok] * np.cos(yaw + a[ok]),
-                q["position"]["y"] + r[ok] * np.sin(yaw + a[ok]),
-            )
-        return true_line, odom_line, points
+            xy = _scan_points(scans[min(len(scans) - 1, int(i * len(scans) / n))][1])
+            points.set_data(xy[:, 0], xy[:, 1])
+        return (*lines, points)
 
     anim = FuncAnimation(fig, draw, frames=picks, blit=True)
     try:

@@ -169,11 +169,29 @@ def _pose(p) -> tuple[float, float, float]:
     return (float(p.x), float(p.y), float(p.theta)) if hasattr(p, "x") else tuple(map(float, p))
 
 
-class _Recorder:
-    """Writes one time step of every due sensor."""
+BEARING_SCHEMA = {
+    "type": "object",
+    "title": "kiseki.Bearings",
+    "properties": {
+        "targets": {"type": "array", "items": {"type": "string"}},
+        "bearings": {"type": "array", "description": "rad, counter-clockwise in the robot frame"},
+    },
+}
 
-    def __init__(self, writer: RunWriter, scene: Scene, sensors: list[SensorSetup]) -> None:
-        self.writer, self.scene, self.sensors = writer, scene, sensors
+
+class _Recorder:
+    """Writes one time step of a robot's ground truth, odometry and every due sensor."""
+
+    def __init__(
+        self,
+        writer: RunWriter,
+        scene: Scene,
+        robot: RobotSetup,
+        sensors: list[SensorSetup],
+        prefix: str,
+    ) -> None:
+        self.writer, self.scene, self.robot, self.sensors = writer, scene, robot, sensors
+        self.prefix = prefix
         self.next_due = {s.name: 0.0 for s in sensors}
         self.grids = {}
         for s in sensors:
@@ -181,19 +199,22 @@ class _Recorder:
                 z = s.mount.z
                 self.grids[s.name] = scene.ground_truth(z - 0.02, z + 0.02)
 
-    def record(self, t: float, pose, odom) -> None:
-        w = self.writer
-        w.write_pose("/ground_truth", t, pose)
-        w.write_transform(t, "world", "base_link", pose)
-        w.write_odometry("/odom", t, odom)
+    def record(self, t: float, positions: dict[str, tuple[float, float, float]]) -> None:
+        w, p = self.writer, self.prefix
+        pose, odom = _pose(self.robot.robot.pose), _pose(self.robot.odometry.pose)
+        w.write_pose(f"{p}/ground_truth", t, pose)
+        w.write_transform(
+            t, "world", f"{p.strip('/')}/base_link" if p else "base_link", pose, topic=f"{p}/tf"
+        )
+        w.write_odometry(f"{p}/odom", t, odom)
         for s in self.sensors:
             if t + 1e-9 < self.next_due[s.name]:
                 continue
             self.next_due[s.name] = t + s.period
-            self._sensor(s, t, pose)
+            self._sensor(s, t, pose, positions)
 
-    def _sensor(self, s: SensorSetup, t: float, pose) -> None:
-        w, topic = self.writer, f"/{s.name}"
+    def _sensor(self, s: SensorSetup, t: float, pose, positions) -> None:
+        w, topic = self.writer, f"{self.prefix}/{s.name}"
         if s.kind == "laser":
             sensor_pose, ranges = s.device.scan(self.grids[s.name], pose)
             w.write_laser_scan(
@@ -215,6 +236,16 @@ class _Recorder:
                 {"x": float(m[0]), "y": float(m[1]), "z": float(m[2])},
                 MAG_SCHEMA,
             )
+        elif s.kind == "bearing":
+            targets = np.array([positions[name][:2] for name in s.targets])
+            bearings = s.device.measure_many(np.asarray(pose), targets)
+            w.write_json(
+                topic,
+                t,
+                "kiseki.Bearings",
+                {"targets": list(s.targets), "bearings": [float(b) for b in bearings]},
+                BEARING_SCHEMA,
+            )
         elif s.kind == "tilting_laser":
             sensor = s.mount.world(pose)
             ranges, gyro = s.device.scan(self.scene.world, sensor)
@@ -234,6 +265,35 @@ class _Recorder:
             )
 
 
+@dataclass
+class _Agent:
+    setup: RobotSetup
+    sensors: list[SensorSetup]
+    controller: PurePursuit | None
+
+
+def _agents(scene: Scene, config: SimConfig, commands) -> list[_Agent]:
+    agents = []
+    for index, spec in enumerate(scene.robot_specs):
+        setup = build_robot(scene, config.seed, index)
+        sensors = build_sensors(scene, setup, config.seed, config.dt, index)
+        route, controller = spec["route"], None
+        if commands is None and "waypoints" in route:
+            controller = PurePursuit(
+                route["waypoints"],
+                float(route.get("speed", 0.5)),
+                config.lookahead,
+                config.goal_tolerance,
+                setup.robot.params.max_accel,
+            )
+        agents.append(_Agent(setup, sensors, controller))
+    if commands is None and not any(a.controller for a in agents):
+        raise ValueError(f"{scene.path}: no route: give velocity commands instead")
+    if commands is not None and len(agents) > 1:
+        raise ValueError(f"{scene.path}: command scripts drive one robot; this scene has several")
+    return agents
+
+
 def simulate(
     scene: Scene,
     out: str | os.PathLike,
@@ -242,23 +302,11 @@ def simulate(
     overwrite: bool = False,
     progress: bool = True,
 ) -> RunSummary:
-    """Runs a scene and writes the run to an MCAP file; returns a summary."""
+    """Runs a scene and writes the run to an MCAP file; returns a summary. With one robot the
+    topics are /ground_truth, /odom, /tf and /<sensor>; with several, /<robot>/... ."""
     config = config or SimConfig()
-    setup = build_robot(scene, config.seed)
-    sensors = build_sensors(scene, setup, config.seed, config.dt)
-    controller = None
-    if commands is None:
-        route = scene.route
-        if "waypoints" not in route:
-            raise ValueError(f"{scene.path}: no route: give velocity commands instead")
-        accel = setup.robot.params.max_accel
-        controller = PurePursuit(
-            route["waypoints"],
-            float(route.get("speed", 0.5)),
-            config.lookahead,
-            config.goal_tolerance,
-            accel,
-        )
+    agents = _agents(scene, config, commands)
+    routed = [a for a in agents if a.controller is not None]
     limit = config.duration or (
         float(commands[-1, 0]) + config.dt if commands is not None else config.max_duration
     )
@@ -268,40 +316,51 @@ def simulate(
         "scene_file": str(scene.path),
         "seed": str(config.seed),
         "dt": str(config.dt),
-        "robot": setup.kind,
+        "robots": ",".join(a.setup.name for a in agents),
     }
     start, t, k = time.perf_counter(), 0.0, 0
+    single = len(agents) == 1
     with RunWriter(out, meta, overwrite=overwrite) as writer:
-        writer.write_grid(
-            "/map", 0.0, next(iter(_laser_grids(scene, sensors)), scene.ground_truth(0.35, 0.45))
-        )
-        recorder = _Recorder(writer, scene, sensors)
-        total = steps if controller is None else None  # a route ends when its goal is reached
+        laser_grid = next((g for a in agents for g in _laser_grids(scene, a.sensors)), None)
+        writer.write_grid("/map", 0.0, laser_grid or scene.ground_truth(0.35, 0.45))
+        recorders = [
+            _Recorder(writer, scene, a.setup, a.sensors, "" if single else f"/{a.setup.name}")
+            for a in agents
+        ]
+        total = steps if not routed else None  # a route ends when its goal is reached
         bar = tqdm(total=total, desc=scene.name, unit="step", disable=not progress, leave=False)
         with bar:
             for k in range(steps + 1):
                 t = k * config.dt
-                recorder.record(t, _pose(setup.robot.pose), _pose(setup.odometry.pose))
-                if k == steps or (controller is not None and controller.done):
+                positions = {a.setup.name: _pose(a.setup.robot.pose) for a in agents}
+                for recorder in recorders:
+                    recorder.record(t, positions)
+                if k == steps or (routed and all(a.controller.done for a in routed)):
                     break
-                if controller is not None:
-                    command = controller.command(_pose(setup.robot.pose))
-                else:
-                    row = commands[max(0, int(np.searchsorted(commands[:, 0], t, "right")) - 1)]
-                    command = (row[1], row[2], row[3])
-                _step(setup, command, config.dt)
+                for a in agents:
+                    _step(a.setup, _command(a, commands, t), config.dt)
                 bar.update(1)
     counts = {topic: n for topic, (_, n) in _topic_counts(out).items()}
+    first = agents[0].setup
     return RunSummary(
         Path(out),
         k,
         t,
         time.perf_counter() - start,
-        bool(controller is not None and controller.done),
-        _pose(setup.robot.pose),
-        _pose(setup.odometry.pose),
+        bool(routed) and all(a.controller.done for a in routed),
+        _pose(first.robot.pose),
+        _pose(first.odometry.pose),
         counts,
     )
+
+
+def _command(agent: _Agent, commands, t: float) -> tuple[float, float, float]:
+    if agent.controller is not None:
+        return agent.controller.command(_pose(agent.setup.robot.pose))
+    if commands is None:
+        return 0.0, 0.0, 0.0  # a robot without a route stands still
+    row = commands[max(0, int(np.searchsorted(commands[:, 0], t, "right")) - 1)]
+    return row[1], row[2], row[3]
 
 
 def _laser_grids(scene: Scene, sensors: list[SensorSetup]):

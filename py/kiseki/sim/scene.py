@@ -8,7 +8,9 @@ Top-level keys: name, description, source, bounds {min: [x, y, z], max: [x, y, z
 octomap (a .bt file instead of, or beside, objects), objects (list of primitives, see
 kiseki.sim.primitives; an object may carry ``only_in: teach`` or ``only_in: playback``),
 grid_resolution, robot {type, start [x, y, yaw_deg], params, odometry_errors}, sensors (list),
-route {waypoints [[x, y], ...], speed}, magnetic (see kiseki.sim.magnetic).
+route {waypoints [[x, y], ...], speed}, magnetic (see kiseki.sim.magnetic). Several robots:
+``robots`` (a list of {name, type, start, params, odometry_errors, sensors, route}) instead of
+robot, sensors and route.
 """
 
 from __future__ import annotations
@@ -41,7 +43,9 @@ TOP_KEYS = {
     "sensors",
     "route",
     "magnetic",
+    "robots",
 }
+ROBOT_ENTRY_KEYS = {"name", "type", "start", "params", "odometry_errors", "sensors", "route"}
 VARIANTS = ("teach", "playback")
 
 
@@ -61,6 +65,7 @@ class Scene:
     description: str = ""
     source: str = ""
     boxes: BoxList | None = None
+    robot_specs: list = field(default_factory=list)  # [{name, robot, sensors, route}]
 
     def ground_truth(self, z_min: float, z_max: float) -> OccupancyGrid:
         """The 2-D ground-truth grid of a height band (metres above the floor)."""
@@ -148,18 +153,58 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
     res = doc.get("grid_resolution", 0.05)
     if isinstance(res, bool) or not isinstance(res, int | float) or not res > 0:
         raise ValueError(f"{path}: 'grid_resolution' must be a positive number")
+    specs = _robot_specs(doc, where)
     scene = Scene(
         name=str(doc.get("name", path.stem)),
         path=path,
         world=world,
         bounds=_bounds(doc, where, world),
         grid_resolution=float(res),
-        robot=dict(doc.get("robot") or {}),
-        sensors=list(doc.get("sensors") or []),
-        route=dict(doc.get("route") or {}),
+        robot=specs[0]["robot"],
+        sensors=specs[0]["sensors"],
+        route=specs[0]["route"],
         magnetic=doc.get("magnetic"),
         description=str(doc.get("description", "")),
         source=str(doc.get("source", "")),
         boxes=boxes,
+        robot_specs=specs,
     )
     return scene
+
+
+def _robot_specs(doc: dict, where: str) -> list[dict]:
+    """One entry per robot: {name, robot (type/start/params/errors), sensors, route}."""
+    if "robots" not in doc:
+        return [
+            {
+                "name": "robot",
+                "robot": dict(doc.get("robot") or {}),
+                "sensors": list(doc.get("sensors") or []),
+                "route": dict(doc.get("route") or {}),
+            }
+        ]
+    if any(k in doc for k in ("robot", "sensors", "route")):
+        raise ValueError(f"{where}: give 'robots' or 'robot'/'sensors'/'route', not both")
+    robots = doc["robots"]
+    if not isinstance(robots, list) or not robots:
+        raise ValueError(f"{where}: 'robots' must be a non-empty list")
+    specs = []
+    for i, entry in enumerate(robots):
+        if not isinstance(entry, dict) or "name" not in entry:
+            raise ValueError(f"{where}: robots[{i}] must be a mapping with a name")
+        unknown = sorted(set(entry) - ROBOT_ENTRY_KEYS)
+        if unknown:
+            raise ValueError(f"{where}: robots[{i}]: unknown key(s) {', '.join(unknown)}")
+        robot = {k: entry[k] for k in ("type", "start", "params", "odometry_errors") if k in entry}
+        specs.append(
+            {
+                "name": str(entry["name"]),
+                "robot": robot,
+                "sensors": list(entry.get("sensors") or []),
+                "route": dict(entry.get("route") or {}),
+            }
+        )
+    names = [s["name"] for s in specs]
+    if len(set(names)) != len(names):
+        raise ValueError(f"{where}: robot names must be unique, got {names}")
+    return specs

@@ -13,7 +13,7 @@ import numpy as np
 
 from kiseki.core import derive_seed
 from kiseki.sim import robot as robots
-from kiseki.sim.magnetic import MagneticWorld, Magnetometer
+from kiseki.sim.magnetic import BearingSensor, MagneticWorld, Magnetometer
 from kiseki.sim.scene import Scene
 from kiseki.sim.sensors import (
     LASER_PRESETS,
@@ -29,11 +29,23 @@ from kiseki.sim.sensors import (
 __all__ = ["RobotSetup", "SensorSetup", "build_robot", "build_sensors"]
 
 ROBOT_KEYS = {"type", "start", "params", "odometry_errors"}
-SENSOR_KEYS = {"type", "name", "mount", "preset", "params", "rate_hz", "width", "height", "pitch"}
+SENSOR_KEYS = {
+    "type",
+    "name",
+    "mount",
+    "preset",
+    "params",
+    "rate_hz",
+    "width",
+    "height",
+    "pitch",
+    "targets",
+}
 
 
 @dataclass
 class RobotSetup:
+    name: str
     kind: str  # "diff_drive" or "omni"
     robot: Any
     odometry: Any
@@ -49,10 +61,11 @@ class SensorSetup:
     device: Any
     period: float  # seconds between readings
     mount: Mount
+    targets: tuple[str, ...] = ()  # bearing sensors: the robots they measure
 
 
-def _start(scene: Scene) -> np.ndarray:
-    start = scene.robot.get("start", [0.0, 0.0, 0.0])
+def _start(scene: Scene, spec: dict) -> np.ndarray:
+    start = spec.get("start", [0.0, 0.0, 0.0])
     try:
         x, y, yaw = (float(v) for v in start)
     except (TypeError, ValueError):
@@ -80,19 +93,21 @@ def _check_free_start(scene: Scene, pose: np.ndarray, length: float, width: floa
         raise ValueError(f"{scene.path}: the robot's start footprint overlaps an obstacle")
 
 
-def build_robot(scene: Scene, seed: int) -> RobotSetup:
-    spec = scene.robot
+def build_robot(scene: Scene, seed: int, index: int = 0) -> RobotSetup:
+    """The robot `index` of the scene (its true motion and its odometry)."""
+    name, spec = scene.robot_specs[index]["name"], scene.robot_specs[index]["robot"]
+    where = f"{scene.path}: robot" + (f" {name}" if len(scene.robot_specs) > 1 else "")
     unknown = sorted(set(spec) - ROBOT_KEYS)
     if unknown:
-        raise ValueError(f"{scene.path}: robot: unknown key(s) {', '.join(unknown)}")
+        raise ValueError(f"{where}: unknown key(s) {', '.join(unknown)}")
     kind = spec.get("type", "diff_drive")
-    pose = _start(scene)
-    where = f"{scene.path}: robot"
-    odo_seed = derive_seed(seed, 1000)
+    pose = _start(scene, spec)
+    odo_seed = derive_seed(seed, 1000 + index)
     if kind == "diff_drive":
         params = robots.DiffDriveParams.from_dict(spec.get("params") or {}, where)
         errors = robots.OdometryErrorParams.from_dict(spec.get("odometry_errors") or {}, where)
         setup = RobotSetup(
+            name,
             kind,
             robots.DiffDriveRobot(params, pose),
             robots.WheelOdometry(params, errors, odo_seed, pose),
@@ -104,6 +119,7 @@ def build_robot(scene: Scene, seed: int) -> RobotSetup:
         params = robots.OmniParams.from_dict(spec.get("params") or {}, where)
         errors = robots.OmniOdometryErrorParams.from_dict(spec.get("odometry_errors") or {}, where)
         setup = RobotSetup(
+            name,
             kind,
             robots.OmniRobot(params, pose),
             robots.OmniOdometry(errors, odo_seed, pose),
@@ -150,11 +166,17 @@ def _period(spec: dict, default: float, where: str) -> float:
     return 1.0 / float(rate)
 
 
-def build_sensors(scene: Scene, robot: RobotSetup, seed: int, dt: float) -> list[SensorSetup]:
+def build_sensors(
+    scene: Scene, robot: RobotSetup, seed: int, dt: float, index: int = 0
+) -> list[SensorSetup]:
+    """The sensors of robot `index`; each gets its own seeded stream."""
     out: list[SensorSetup] = []
     magnetic = MagneticWorld.from_dict(scene.magnetic, str(scene.path)) if scene.magnetic else None
-    for i, spec in enumerate(scene.sensors):
-        where = f"{scene.path}: sensors[{i}]"
+    others = {s["name"] for s in scene.robot_specs} - {robot.name}
+    for i, spec in enumerate(scene.robot_specs[index]["sensors"]):
+        where = f"{scene.path}: sensors[{i}]" + (
+            f" of {robot.name}" if len(scene.robot_specs) > 1 else ""
+        )
         if not isinstance(spec, dict):
             raise ValueError(f"{where}: each sensor must be a mapping")
         unknown = sorted(set(spec) - SENSOR_KEYS)
@@ -162,7 +184,8 @@ def build_sensors(scene: Scene, robot: RobotSetup, seed: int, dt: float) -> list
             raise ValueError(f"{where}: unknown key(s) {', '.join(unknown)}")
         kind, name = spec.get("type"), str(spec.get("name", f"sensor{i}"))
         mount = _mount(spec, where, robot)
-        s = derive_seed(seed, i)
+        s = derive_seed(seed, 100 * index + i)
+        targets: tuple[str, ...] = ()
         overrides = dict(spec.get("params") or {})
         if kind == "laser":
             preset = spec.get("preset", "hokuyo_utm30lx")
@@ -189,12 +212,23 @@ def build_sensors(scene: Scene, robot: RobotSetup, seed: int, dt: float) -> list
                 **overrides,
             )
             period = _period(spec, dt, where)
+        elif kind == "bearing":
+            targets = tuple(str(t) for t in spec.get("targets") or sorted(others))
+            if not targets or not set(targets) <= others:
+                raise ValueError(
+                    f"{where}: bearing targets must be other robots of the scene "
+                    f"({', '.join(sorted(others)) or 'none'}), got {list(targets)}"
+                )
+            device = BearingSensor(seed=s, **overrides)
+            period = _period(spec, dt, where)
         elif kind == "tilting_laser":
             device = TiltingLaser(with_overrides(TiltingLaserParams(), overrides, where), s)
             period = _period(spec, 1e9, where)  # by default once, at the start
         else:
             raise ValueError(f"{where}: unknown sensor type {kind!r}")
-        out.append(SensorSetup(kind, name, device, period, mount))
+        if "targets" in spec and kind != "bearing":
+            raise ValueError(f"{where}: only bearing sensors take targets")
+        out.append(SensorSetup(kind, name, device, period, mount, targets))
     names = [s.name for s in out]
     if len(set(names)) != len(names):
         raise ValueError(f"{scene.path}: sensor names must be unique, got {names}")
