@@ -151,17 +151,17 @@ def map_info(
 
 @app.command("demo")
 def demo(
-    out: Path = typer.Option(Path("results/demo"), help="Folder for the figures and summary."),
-    map_file: Path = typer.Option(
-        Path("data/maps/factory_corridor.yaml"), "--map", help="Map to drive through."
+    out: Path = typer.Option(Path("results/demo"), help="Folder for the run, maps and figures."),
+    scene: Path = typer.Option(
+        Path("data/worlds/factory_corridor.yaml"), "--scene", help="Scene to run."
     ),
-    seed: int = typer.Option(0, help="Seed of the simulated laser noise."),
+    seed: int = typer.Option(0, help="Seed of every noise source of the run."),
 ) -> None:
-    """The main job until teaching and playback land: drive a simulated laser along the
-    factory corridor map kept in data/, rebuild the map from its scans, draw everything."""
+    """The main job until teaching and playback land: the thesis' corridor run in the
+    simulated factory, odometry drift, and maps taught from the true and the odometry path."""
     from kiseki.demo import run_demo
 
-    run_demo(map_file, out, seed, console)
+    run_demo(scene, out, seed, console)
 
 
 @experiment_app.command("list")

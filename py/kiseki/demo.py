@@ -1,18 +1,17 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The main job until teaching and playback land: a simulated laser driven along the factory
-corridor map kept in ``data/``, the map rebuilt from its scans, everything drawn to PNG.
-
-Laser: a Hokuyo UTM-30LX (270 deg, 1081 beams, 30 m; datasheet accuracy +-30 mm, taken as
-3 sigma, so Gaussian range noise with sigma 0.01 m), mounted at the robot's centre.
-Path: P0 (0, 0) -> P1 (7.4, 0) -> P2 (13.0, 0) of the thesis' corridor experiment, one scan
-every 0.1 m. Noise comes from kiseki's seeded generator: the same seed, the same result.
+"""The main job until teaching and playback land: the thesis' corridor run (P0 -> P1 -> P2) in
+the simulated factory (data/worlds/factory_corridor.yaml). The AGV follows the route with a
+Hokuyo laser and two sideways depth cameras, its wheel odometry drifting as real odometry does;
+the run is logged to MCAP; maps are built from the laser along the true path and along the
+odometry path, showing how odometry alone bends a taught map; the odometry error at P1 and P2
+is set beside the thesis' Tables 4.1-4.4. Uses only files in the repository.
 """
 
 from __future__ import annotations
 
 import json
-import time
+import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -22,83 +21,98 @@ from rich.console import Console
 from rich.table import Table
 
 from kiseki._atomic import atomic_write
-from kiseki.core import Random
-from kiseki.grid import beam_angles, grid_summary
-from kiseki.map_io import load_map, save_map
-from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
-from kiseki.plots import render_distance_field, render_map
+from kiseki.grid import grid_summary
+from kiseki.map_io import save_map
+from kiseki.mapping import build_map, endpoint_agreement
+from kiseki.plots import render_map
+from kiseki.sim.mcap_log import read_run
+from kiseki.sim.render import render_scene
+from kiseki.sim.run import SimConfig, simulate
+from kiseki.sim.scene import load_scene
 
 __all__ = ["DemoConfig", "run_demo"]
+
+# The thesis' odometry error (odometry - truth) at P1 and P2, means of 11 runs (Tables 4.1-4.4).
+THESIS_ODOMETRY_ERROR = {"P1": (None, -0.07), "P2": (0.01, -0.20)}
 
 
 @dataclass(frozen=True)
 class DemoConfig:
+    scene: str = "data/worlds/factory_corridor.yaml"
     seed: int = 0
-    beams: int = 1081
-    field_of_view_deg: float = 270.0
-    max_range: float = 30.0
-    range_noise_sd: float = 0.01
-    scan_spacing: float = 0.1
-    goal_x: float = 13.0
-
-
-def simulate_scans(
-    grid, config: DemoConfig, lateral_offset: float = 0.0
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Poses (n, 3), noisy ranges (n, b) and beam angles (b,) along the corridor, on the line
-    y = lateral_offset."""
-    xs = np.arange(0.0, config.goal_x + 1e-9, config.scan_spacing)
-    poses = np.column_stack([xs, np.full_like(xs, lateral_offset), np.zeros_like(xs)])
-    angles = beam_angles(config.beams, np.deg2rad(config.field_of_view_deg))
-    ranges = grid.cast_scans(poses, angles, max_range=config.max_range)
-    noise = Random(config.seed).normal(0.0, config.range_noise_sd, ranges.size)
-    hit = ranges < config.max_range
-    ranges[hit] += noise.reshape(ranges.shape)[hit]
-    return poses, ranges.astype(np.float32), angles
 
 
 def _write_text(path: Path, text: str) -> None:
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
+def _odometry_sensor_poses(odometry: np.ndarray, mount_x: float) -> np.ndarray:
+    """The laser's pose if the robot were where its odometry says (laser mount_x ahead)."""
+    c, s = np.cos(odometry[:, 2]), np.sin(odometry[:, 2])
+    return np.column_stack(
+        [odometry[:, 0] + mount_x * c, odometry[:, 1] + mount_x * s, odometry[:, 2]]
+    )
+
+
+def _errors_at(truth: np.ndarray, odometry: np.ndarray, waypoints: dict) -> dict:
+    """Odometry - truth (x, y) when the robot passes each waypoint's x (the stop for the last)."""
+    out = {}
+    for name, (x, _) in waypoints.items():
+        passed = np.nonzero(truth[:, 0] >= x - 0.05)[0]
+        i = int(passed[0]) if len(passed) else len(truth) - 1
+        out[name] = (odometry[i, :2] - truth[i, :2]).tolist()
+    return out
+
+
 def run_demo(map_file: Path, out: Path, seed: int, console: Console) -> dict:
-    config = DemoConfig(seed=seed)
+    config = DemoConfig(scene=str(map_file), seed=seed)
     out.mkdir(parents=True, exist_ok=True)
-    grid = load_map(map_file)
-    start = time.perf_counter()
-    poses, ranges, angles = simulate_scans(grid, config)
-    cast_seconds = time.perf_counter() - start
-    rebuilt = build_map(poses, ranges, angles, config.max_range, MapBuildConfig())
-    save_map(rebuilt, out / "rebuilt_map.yaml")
-    at_p1 = int(np.argmin(np.abs(poses[:, 0] - 7.4)))
-    valid = ranges[at_p1] < config.max_range
-    a = poses[at_p1, 2] + angles[valid]
-    points = poses[at_p1, :2] + ranges[at_p1, valid, None] * np.column_stack([np.cos(a), np.sin(a)])
+    scene = load_scene(map_file)
+    render_scene(scene, out / "scene.png")
+    run = simulate(scene, out / "run.mcap", SimConfig(seed=seed), overwrite=True, progress=True)
+    log = read_run(run.path)
+    scans = log.laser_scans()
+    mount_x = float(np.hypot(*(scans.poses[0, :2] - _track(log)[0, :2])))
+    truth = _track(log)
+    odom_sensor = _odometry_sensor_poses(scans.odometry, mount_x)
+    maps = {
+        "true_path": build_map(scans.poses, scans.ranges, scans.angles, scans.max_range),
+        "odometry_path": build_map(odom_sensor, scans.ranges, scans.angles, scans.max_range),
+    }
+    for name, grid in maps.items():
+        save_map(grid, out / f"map_{name}.yaml")
     render_map(
-        grid,
-        out / "map_scan_at_P1.png",
-        trajectory=poses,
-        points=points,
-        title=f"{map_file.name}: path P0 -> P2 and the scan at P1",
+        maps["true_path"],
+        out / "map_true_path.png",
+        trajectory=scans.poses,
+        title="map from the laser along the true path",
     )
-    render_distance_field(grid, out / "distance_field.png")
     render_map(
-        rebuilt,
-        out / "rebuilt_map.png",
-        trajectory=poses,
-        title="map rebuilt from the simulated scans",
+        maps["odometry_path"],
+        out / "map_odometry_path.png",
+        trajectory=odom_sensor,
+        title="map from the laser along the odometry path (what odometry alone teaches)",
     )
+    route = dict(zip(scene.route.get("names", []), scene.route["waypoints"], strict=False))
+    x, y, _ = run.final_pose
+    goal = scene.route["waypoints"][-1]
     summary = {
-        "map": str(map_file),
-        "scans": len(poses),
-        "beams_per_scan": config.beams,
-        "scans_per_second": len(poses) / cast_seconds,
-        "endpoints_on_true_map": endpoint_agreement(grid, poses, ranges, angles, config.max_range),
-        "endpoints_on_rebuilt_map": endpoint_agreement(
-            rebuilt, poses, ranges, angles, config.max_range
+        "scene": str(map_file),
+        "simulated_seconds": run.sim_seconds,
+        "real_time_factor": run.sim_seconds / run.wall_seconds,
+        "messages": run.messages,
+        "stop_error_m": math.hypot(x - goal[0], y - goal[1]),
+        "reached_goal": run.reached_goal,
+        "odometry_error_m": _errors_at(
+            truth, scans.odometry, {k: v for k, v in route.items() if k != "P0"}
         ),
-        "true_map": grid_summary(grid),
-        "rebuilt_map": grid_summary(rebuilt),
+        "endpoints_true_path_map": endpoint_agreement(
+            maps["true_path"], scans.poses, scans.ranges, scans.angles, scans.max_range
+        ),
+        "endpoints_odometry_path_map": endpoint_agreement(
+            maps["odometry_path"], odom_sensor, scans.ranges, scans.angles, scans.max_range
+        ),
+        "map_true_path": grid_summary(maps["true_path"]),
     }
     _write_text(out / "config.yaml", yaml.safe_dump(asdict(config), sort_keys=False))
     _write_text(out / "summary.json", json.dumps(summary, indent=2))
@@ -106,22 +120,41 @@ def run_demo(map_file: Path, out: Path, seed: int, console: Console) -> dict:
     return summary
 
 
+def _track(log) -> np.ndarray:
+    msgs = log.messages("/ground_truth")
+    return np.array([[m["pose"]["position"]["x"], m["pose"]["position"]["y"]] for _, m in msgs])
+
+
 def _print_summary(summary: dict, out: Path, console: Console) -> None:
-    table = Table(title="kiseki demo: simulated laser in the factory corridor")
+    table = Table(title="kiseki demo: the thesis' corridor run P0 -> P1 -> P2, simulated")
     table.add_column("quantity")
-    table.add_column("value", justify="right")
-    table.add_row("scans cast (1081 beams, 30 m)", str(summary["scans"]))
-    table.add_row("scans per second (one core)", f"{summary['scans_per_second']:.0f}")
+    table.add_column("thesis", justify="right")
+    table.add_column("kiseki", justify="right")
     table.add_row(
-        "endpoints on/next to occupied, true map", f"{100 * summary['endpoints_on_true_map']:.1f} %"
+        "simulated time (s), speed vs real time",
+        "",
+        f"{summary['simulated_seconds']:.1f} s, {summary['real_time_factor']:.1f}x",
     )
     table.add_row(
-        "endpoints on/next to occupied, rebuilt map",
-        f"{100 * summary['endpoints_on_rebuilt_map']:.1f} %",
+        "stop distance from P2 (m), controller on ground truth",
+        "<= 0.1",
+        f"{summary['stop_error_m']:.3f}",
+    )
+    for name, (dx, dy) in summary["odometry_error_m"].items():
+        tx, ty = THESIS_ODOMETRY_ERROR.get(name, (None, None))
+        thesis = f"({'-' if tx is None else f'{tx:+.2f}'}, {ty:+.2f})" if ty is not None else ""
+        table.add_row(
+            f"odometry error at {name} (x, y) m, one run", thesis, f"({dx:+.3f}, {dy:+.3f})"
+        )
+    table.add_row(
+        "scan endpoints on the map, true path",
+        "",
+        f"{100 * summary['endpoints_true_path_map']:.1f} %",
     )
     table.add_row(
-        "rebuilt map size (cells)",
-        f"{summary['rebuilt_map']['width']} x {summary['rebuilt_map']['height']}",
+        "scan endpoints on the map, odometry path",
+        "",
+        f"{100 * summary['endpoints_odometry_path_map']:.1f} %",
     )
     console.print(table)
-    console.print(f"figures, rebuilt map and summary in {out}/")
+    console.print(f"run (MCAP), maps (ROS YAML + PGM), figures and summary in {out}/")

@@ -18,12 +18,41 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from kiseki.core import Random  # noqa: E402
-from kiseki.demo import DemoConfig, simulate_scans  # noqa: E402
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput  # noqa: E402
+from kiseki.grid import beam_angles  # noqa: E402
 from kiseki.map_io import load_map  # noqa: E402
 from kiseki.mapping import build_map, endpoint_agreement  # noqa: E402
 
 MAP = Path(__file__).resolve().parents[3] / "data" / "maps" / "factory_corridor.yaml"
+
+
+@dataclass(frozen=True)
+class CorridorLaser:
+    """The laser of this check: a Hokuyo UTM-30LX (270 deg, 1081 beams, 30 m; datasheet
+    accuracy +-30 mm taken as 3 sigma) at the robot's centre, one scan every `scan_spacing` m
+    along the corridor from P0 (x = 0) to P2 (x = 13.0 m)."""
+
+    seed: int = 0
+    beams: int = 1081
+    field_of_view_deg: float = 270.0
+    max_range: float = 30.0
+    range_noise_sd: float = 0.01
+    scan_spacing: float = 0.1
+    goal_x: float = 13.0
+
+
+def simulate_scans(
+    grid, laser: CorridorLaser, lateral_offset: float = 0.0
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Poses (n, 3), noisy ranges (n, b) and beam angles (b,) along y = lateral_offset."""
+    xs = np.arange(0.0, laser.goal_x + 1e-9, laser.scan_spacing)
+    poses = np.column_stack([xs, np.full_like(xs, lateral_offset), np.zeros_like(xs)])
+    angles = beam_angles(laser.beams, np.deg2rad(laser.field_of_view_deg))
+    ranges = grid.cast_scans(poses, angles, max_range=laser.max_range)
+    noise = Random(laser.seed).normal(0.0, laser.range_noise_sd, ranges.size)
+    hit = ranges < laser.max_range
+    ranges[hit] += noise.reshape(ranges.shape)[hit]
+    return poses, ranges.astype(np.float32), angles
 
 
 @dataclass(frozen=True)
@@ -46,7 +75,7 @@ def trial(config: CorridorScansConfig, index: int, seed: int) -> TrialOutput:
     del index
     truth = load_map(config.map_file)
     offset = Random(seed).uniform(-config.max_lateral_offset, config.max_lateral_offset, 1)[0]
-    demo = DemoConfig(
+    demo = CorridorLaser(
         seed=seed, range_noise_sd=config.range_noise_sd, scan_spacing=config.scan_spacing
     )
     poses, ranges, angles = simulate_scans(truth, demo, lateral_offset=offset)
