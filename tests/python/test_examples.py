@@ -18,7 +18,7 @@ def test_scan_in_corridor(project_root, tmp_path):
     )
     assert done.returncode == 0, done.stderr
     ahead, left, right = map(float, re.findall(r"([\d.]+) m", done.stdout))
-    # P1 = (7.4, 0): the east wall's inner face is at x = 14.5; north wall at y = 1.5;
-    # a shelf (8.5..10.5, y >= 0.9) does not cover x = 7.4; south wall at y = -1.5
-    assert abs(ahead - 7.1) < 0.03 and abs(left - 1.5) < 0.03 and abs(right - 1.5) < 0.03
+    # P1 = (7.4, 0) in data/worlds/factory_corridor.yaml: the east wall's inner face is at
+    # x = 14.9, the north and south walls' at y = +-1.5; nothing else stands on those lines
+    assert abs(ahead - 7.5) < 0.03 and abs(left - 1.5) < 0.03 and abs(right - 1.5) < 0.03
     assert out.read_bytes()[:4] == b"\x89PNG"

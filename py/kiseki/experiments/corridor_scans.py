@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""corridor-scans: a self-check of the simulator-to-map chain on the factory corridor kept in
-data/maps. Each trial drives the laser of the demo (Hokuyo UTM-30LX, sigma 0.01 m) along the
-corridor on a line offset sideways by a seeded random amount, rebuilds the map from the noisy
-scans and measures it against the true map. Needs nothing outside the repository."""
+"""corridor-scans: a self-check of the simulator-to-map chain on the factory corridor map kept
+in data/maps (the 0.4 m band of data/worlds/factory_corridor.yaml). Each trial drives a laser
+(Hokuyo UTM-30LX, sigma 0.01 m) along the corridor on a line offset sideways by a seeded random
+amount, rebuilds the map from the noisy scans and measures it against the true map. Needs
+nothing outside the repository."""
 
 from __future__ import annotations
 
