@@ -7,6 +7,7 @@ void bind_core(pybind11::module_& m);
 void bind_grid(pybind11::module_& m);
 void bind_mapping(pybind11::module_& m);
 void bind_sim(pybind11::module_& m);
+void bind_models(pybind11::module_& m);
 }  // namespace kiseki::bindings
 
 PYBIND11_MODULE(_core, m) {
@@ -15,4 +16,5 @@ PYBIND11_MODULE(_core, m) {
   kiseki::bindings::bind_grid(m);
   kiseki::bindings::bind_mapping(m);
   kiseki::bindings::bind_sim(m);
+  kiseki::bindings::bind_models(m);
 }

@@ -1,0 +1,96 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#include <pybind11/eigen.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+
+#include "kiseki/models/local_map.hpp"
+#include "kiseki/models/space_observation.hpp"
+#include "numpy_helpers.hpp"
+
+namespace kiseki::bindings {
+
+using namespace pybind11::literals;
+
+namespace {
+
+Pose3 pose3_from_matrix(const Eigen::Matrix4d& m) {
+  const Eigen::Matrix3d r = m.block<3, 3>(0, 0);
+  if (!m.allFinite() || !(r * r.transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-6) ||
+      r.determinant() < 0) {
+    throw std::invalid_argument("pose: expected a finite 4x4 rigid transform");
+  }
+  return {m.block<3, 1>(0, 3), Eigen::Quaterniond(r)};
+}
+
+void add_scan(LocalMapBuilder& b, const Pose2& sensor, const py::handle& a_in,
+              const py::handle& r_in, double max_range) {
+  const auto a = as_doubles(a_in, "angles");
+  const auto r = as_floats(r_in, "ranges");
+  require_shape(a, "angles", 1);
+  require_shape(r, "ranges", 1);
+  if (a.shape(0) != r.shape(0)) throw std::invalid_argument("angles and ranges differ in length");
+  b.add_scan(sensor, a.data(), r.data(), static_cast<std::size_t>(a.shape(0)), max_range);
+}
+
+}  // namespace
+
+void bind_models(py::module_& m) {
+  py::class_<LocalMapBuilder>(m, "LocalMapBuilder")
+      .def(py::init([](double size, double resolution) {
+             return LocalMapBuilder(LocalMapParams{size, resolution});
+           }),
+           "size"_a = 8.0, "resolution"_a = 0.1)
+      .def("add_scan", &add_scan, "sensor"_a, "angles"_a, "ranges"_a, "max_range"_a)
+      .def(
+          "add_depth_band",
+          [](LocalMapBuilder& b, const py::array& depth_in, const Eigen::Matrix4d& optical,
+             double fx, double fy, double cx, double cy, double min_range, double max_range,
+             double z_min, double z_max) {
+            const auto d = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(depth_in);
+            if (!d || d.ndim() != 2) throw std::invalid_argument("depth: expected a 2-D float32 image");
+            const PinholeCamera cam{static_cast<int>(d.shape(1)), static_cast<int>(d.shape(0)),
+                                    fx, fy, cx, cy, min_range, max_range};
+            const cv::Mat view(cam.height, cam.width, CV_32FC1, const_cast<float*>(d.data()));
+            b.add_depth_band(view, cam, pose3_from_matrix(optical), z_min, z_max);
+          },
+          "depth"_a, "optical_in_robot"_a, "fx"_a, "fy"_a, "cx"_a, "cy"_a, "min_range"_a,
+          "max_range"_a, "z_min"_a, "z_max"_a)
+      .def("build", &LocalMapBuilder::build);
+
+  py::class_<SpaceObservationModel>(m, "SpaceObservationModel")
+      .def(py::init([](const OccupancyGrid& map, double sp, double si, double step) {
+             SpaceObservationParams p;
+             p.sigma_penetration = sp;
+             p.sigma_intrusion = si;
+             p.heading_step_deg = step;
+             return std::make_unique<SpaceObservationModel>(map, p);
+           }),
+           "map"_a, "sigma_penetration"_a = 10.0, "sigma_intrusion"_a = 130.0,
+           "heading_step_deg"_a = 1.0)
+      .def("set_local_map", &SpaceObservationModel::set_local_map, "local_map"_a)
+      .def("counts",
+           [](const SpaceObservationModel& s, const Pose2& pose) {
+             const auto c = s.counts(pose);
+             return py::make_tuple(c.penetrating, c.map_occupied, c.intruding, c.map_free);
+           }, "pose"_a, "(penetrating, map_occupied, intruding, map_free) in view")
+      .def("likelihoods",
+           [](const SpaceObservationModel& s, const py::handle& poses_in) {
+             const auto p = as_doubles(poses_in, "poses");
+             require_shape(p, "poses", 2, 3);
+             require_finite(p, "poses");
+             py::array_t<double> out(p.shape(0));
+             double* dst = out.mutable_data();
+             {
+               py::gil_scoped_release release;
+               s.likelihoods(p.data(), static_cast<std::size_t>(p.shape(0)), dst);
+             }
+             return out;
+           }, "poses"_a, "Likelihoods of particles (n, 3); releases the GIL.")
+      .def("rotated_local_map", &SpaceObservationModel::rotated_local_map, "bin"_a)
+      .def("bin_of", &SpaceObservationModel::bin_of, "heading"_a)
+      .def_property_readonly("bins", &SpaceObservationModel::bins);
+}
+
+}  // namespace kiseki::bindings

@@ -1,0 +1,211 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#include "kiseki/models/space_observation.hpp"
+
+#include <cmath>
+#include <mutex>
+#include <stdexcept>
+
+#include "kiseki/core/angle.hpp"
+
+namespace kiseki {
+namespace {
+
+using Word = std::uint64_t;
+
+// Rows of bits: row y holds cells x = 0..cols-1 in words_per_row words (bit x % 64).
+struct BitRows {
+  int rows = 0, cols = 0, words = 0;
+  std::vector<Word> bits;
+  BitRows() = default;
+  BitRows(int r, int c) : rows(r), cols(c), words((c + 63) / 64), bits(static_cast<std::size_t>(r) * ((c + 63) / 64), 0) {}
+  void set(int x, int y) { bits[static_cast<std::size_t>(y) * words + x / 64] |= Word{1} << (x % 64); }
+  const Word* row(int y) const { return bits.data() + static_cast<std::size_t>(y) * words; }
+};
+
+// Bits [x0, x0 + n) of a row (cells outside 0..cols-1 read as 0), into out[0 .. (n+63)/64).
+void extract(const Word* row, int cols, int x0, int n, Word* out) {
+  const int out_words = (n + 63) / 64;
+  for (int k = 0; k < out_words; ++k) {
+    Word w = 0;
+    const int start = x0 + 64 * k;  // first source bit of this output word
+    for (int part = 0; part < 2; ++part) {
+      const int src_word = (start >= 0 ? start / 64 : (start - 63) / 64) + part;
+      if (src_word < 0 || src_word * 64 >= cols) continue;
+      const int shift = start - src_word * 64;  // in [-63, 63]
+      const Word v = row[src_word];
+      if (shift >= 0) w |= v >> shift;
+      else if (shift > -64) w |= v << (-shift);
+    }
+    const int valid_to = cols - start;  // bits at or past the map's last column are 0
+    if (valid_to < 64) w &= valid_to <= 0 ? 0 : (Word{1} << valid_to) - 1;
+    if (64 * (k + 1) > n) w &= (Word{1} << (n - 64 * k)) - 1;
+    out[k] = w;
+  }
+}
+
+struct Rotated {
+  BitRows free, occupied;  // in view = free | occupied
+};
+
+}  // namespace
+
+double SpaceObservationCounts::penetration_ratio() const {
+  return map_occupied > 0 ? 100.0 * penetrating / map_occupied : 0.0;
+}
+
+double SpaceObservationCounts::intrusion_ratio() const {
+  return map_free > 0 ? 100.0 * intruding / map_free : 0.0;
+}
+
+void SpaceObservationParams::validate() const {
+  if (!(sigma_penetration > 0.0) || !(sigma_intrusion > 0.0) || !(heading_step_deg > 0.0) ||
+      heading_step_deg > 45.0 || free_max < 0 || occupied_threshold <= free_max) {
+    throw std::invalid_argument(
+        "space observation: sigmas and heading step must be positive (step <= 45 deg), "
+        "0 <= free_max < occupied_threshold");
+  }
+}
+
+struct SpaceObservationModel::Impl {
+  SpaceObservationParams params;
+  OccupancyGrid map;
+  BitRows map_free, map_occupied;
+  OccupancyGrid local{1, 1, 1.0};
+  bool has_local = false;
+  int span = 0;  // rotated local maps are span x span map cells, centred on the robot's cell
+  mutable std::vector<Rotated> cache;
+  mutable std::vector<std::once_flag> once;  // thread-safe lazy rotation per bin
+
+  Impl(const OccupancyGrid& m, const SpaceObservationParams& p) : params(p), map(m.clone()) {
+    map_free = BitRows(m.height(), m.width());
+    map_occupied = BitRows(m.height(), m.width());
+    for (int y = 0; y < m.height(); ++y)
+      for (int x = 0; x < m.width(); ++x) {
+        const std::int8_t v = m.value(x, y);
+        if (v >= p.occupied_threshold) map_occupied.set(x, y);
+        else if (v >= 0 && v <= p.free_max) map_free.set(x, y);
+      }
+  }
+
+  int bins() const { return static_cast<int>(std::lround(360.0 / params.heading_step_deg)); }
+
+  void rotate(int bin, Rotated& out) const {
+    const double theta = bin * params.heading_step_deg * kPi / 180.0;
+    const double c = std::cos(theta), s = std::sin(theta), res = map.resolution();
+    out.free = BitRows(span, span);
+    out.occupied = BitRows(span, span);
+    const double half = 0.5 * local.width() * local.resolution();
+    for (int j = 0; j < span; ++j) {
+      for (int i = 0; i < span; ++i) {
+        // Centre of rotated cell (i, j) relative to the robot's cell centre, in the map axes.
+        const double dx = (i - span / 2) * res, dy = (j - span / 2) * res;
+        const double lx = c * dx + s * dy + half, ly = -s * dx + c * dy + half;  // robot frame
+        const int cx = static_cast<int>(std::floor(lx / local.resolution()));
+        const int cy = static_cast<int>(std::floor(ly / local.resolution()));
+        if (!local.contains(cx, cy)) continue;
+        const std::int8_t v = local.value(cx, cy);
+        if (v == kFree) out.free.set(i, j);
+        else if (v >= params.occupied_threshold) out.occupied.set(i, j);
+      }
+    }
+  }
+
+  const Rotated& rotated(int bin) const {
+    std::call_once(once[bin], [&] { rotate(bin, cache[bin]); });
+    return cache[bin];
+  }
+};
+
+SpaceObservationModel::SpaceObservationModel(const OccupancyGrid& map,
+                                             const SpaceObservationParams& params) {
+  params.validate();
+  impl_ = std::make_unique<Impl>(map, params);
+}
+
+SpaceObservationModel::~SpaceObservationModel() = default;
+SpaceObservationModel::SpaceObservationModel(SpaceObservationModel&&) noexcept = default;
+SpaceObservationModel& SpaceObservationModel::operator=(SpaceObservationModel&&) noexcept = default;
+
+void SpaceObservationModel::set_local_map(const OccupancyGrid& local) {
+  if (local.width() != local.height()) throw std::invalid_argument("local map must be square");
+  Impl& m = *impl_;
+  m.local = local.clone();
+  m.has_local = true;
+  const double extent = local.width() * local.resolution() * std::sqrt(2.0);
+  m.span = static_cast<int>(std::ceil(extent / m.map.resolution())) | 1;  // odd: a centre cell
+  if (m.span > 64 * 64) {
+    throw std::invalid_argument("space observation: the local map spans more than 4096 map cells");
+  }
+  m.cache = std::vector<Rotated>(static_cast<std::size_t>(m.bins()));
+  m.once = std::vector<std::once_flag>(static_cast<std::size_t>(m.bins()));
+}
+
+int SpaceObservationModel::bins() const { return impl_->bins(); }
+
+int SpaceObservationModel::bin_of(double heading) const {
+  if (!std::isfinite(heading)) throw std::invalid_argument("space observation: heading is not finite");
+  const double deg = normalize_angle(heading) * 180.0 / kPi;
+  const int n = impl_->bins();
+  return ((static_cast<int>(std::lround(deg / impl_->params.heading_step_deg)) % n) + n) % n;
+}
+
+SpaceObservationCounts SpaceObservationModel::counts(const Pose2& pose) const {
+  const Impl& m = *impl_;
+  if (!m.has_local) throw std::logic_error("space observation: set a local map first");
+  if (!std::isfinite(pose.x) || !std::isfinite(pose.y)) {
+    throw std::invalid_argument("space observation: particle pose is not finite");
+  }
+  const Rotated& l = m.rotated(bin_of(pose.theta));
+  const CellIndex centre = m.map.world_to_cell({pose.x, pose.y});
+  const int x0 = centre.x - m.span / 2, y0 = centre.y - m.span / 2;
+  SpaceObservationCounts c;
+  Word occ[64], fre[64];  // up to 4096 cells a row
+  const int words = l.free.words;
+  for (int j = 0; j < m.span; ++j) {
+    const int y = y0 + j;
+    if (y < 0 || y >= m.map.height()) continue;
+    extract(m.map_occupied.row(y), m.map.width(), x0, m.span, occ);
+    extract(m.map_free.row(y), m.map.width(), x0, m.span, fre);
+    const Word* lf = l.free.row(j);
+    const Word* lo = l.occupied.row(j);
+    for (int k = 0; k < words; ++k) {
+      const Word view = lf[k] | lo[k];
+      c.penetrating += __builtin_popcountll(lf[k] & occ[k]);
+      c.map_occupied += __builtin_popcountll(view & occ[k]);
+      c.intruding += __builtin_popcountll(lo[k] & fre[k]);
+      c.map_free += __builtin_popcountll(view & fre[k]);
+    }
+  }
+  return c;
+}
+
+double SpaceObservationModel::likelihood(const Pose2& pose) const {
+  const SpaceObservationCounts c = counts(pose);
+  const double p = c.penetration_ratio() / impl_->params.sigma_penetration;
+  const double i = c.intrusion_ratio() / impl_->params.sigma_intrusion;
+  return std::exp(-0.5 * (p * p + i * i));
+}
+
+void SpaceObservationModel::likelihoods(const double* poses, std::size_t n, double* out) const {
+  for (std::size_t k = 0; k < n; ++k) {
+    out[k] = likelihood(Pose2(poses[3 * k], poses[3 * k + 1], poses[3 * k + 2]));
+  }
+}
+
+OccupancyGrid SpaceObservationModel::rotated_local_map(int bin) const {
+  const Impl& m = *impl_;
+  if (!m.has_local) throw std::logic_error("space observation: set a local map first");
+  if (bin < 0 || bin >= m.bins()) throw std::out_of_range("space observation: no such heading bin");
+  const Rotated& l = m.rotated(bin);
+  OccupancyGrid out(m.span, m.span, m.map.resolution(), Pose2(), kUnknown);
+  for (int j = 0; j < m.span; ++j)
+    for (int i = 0; i < m.span; ++i) {
+      const Word bit = Word{1} << (i % 64);
+      if (l.free.row(j)[i / 64] & bit) out.set(i, j, kFree);
+      else if (l.occupied.row(j)[i / 64] & bit) out.set(i, j, kOccupied);
+    }
+  return out;
+}
+
+}  // namespace kiseki

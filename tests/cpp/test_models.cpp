@@ -1,0 +1,139 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "kiseki/core/angle.hpp"
+#include "kiseki/core/random.hpp"
+#include "kiseki/grid/ray_casting.hpp"
+#include "kiseki/models/local_map.hpp"
+#include "kiseki/models/space_observation.hpp"
+#include "kiseki/sim/box_world.hpp"
+
+using namespace kiseki;
+
+namespace {
+
+std::vector<double> fan(int n, double fov) {
+  std::vector<double> a(n);
+  for (int i = 0; i < n; ++i) a[i] = -fov / 2 + fov * i / (n - 1);
+  return a;
+}
+
+// A 12 m x 6 m room at 0.1 m with a few pillars.
+OccupancyGrid room() {
+  OccupancyGrid g(120, 60, 0.1, Pose2(-2.0, -3.0, 0.0), kFree);
+  for (int x = 0; x < 120; ++x) g.set(x, 0, kOccupied), g.set(x, 59, kOccupied);
+  for (int y = 0; y < 60; ++y) g.set(0, y, kOccupied), g.set(119, y, kOccupied);
+  for (int k = 0; k < 5; ++k) g.set(20 + 18 * k, 20 + 7 * k, kOccupied);
+  return g;
+}
+
+OccupancyGrid local_from(const OccupancyGrid& map, const Pose2& robot) {
+  const auto angles = fan(541, 270.0 * kPi / 180.0);
+  std::vector<double> r(angles.size());
+  RayCastOptions o;
+  o.max_range = 30.0;
+  cast_scan(map, robot, angles.data(), angles.size(), o, r.data());
+  std::vector<float> rf(r.begin(), r.end());
+  LocalMapBuilder b;
+  b.add_scan(Pose2(), angles.data(), rf.data(), rf.size(), 30.0);
+  return b.build();
+}
+
+}  // namespace
+
+TEST(LocalMap, WallAheadIsFreeThenOccupiedAndBehindIsOutOfView) {
+  const auto angles = fan(181, kPi);
+  std::vector<float> ranges(angles.size());
+  for (std::size_t i = 0; i < angles.size(); ++i) {
+    ranges[i] = std::abs(std::cos(angles[i])) > 1e-6 ? static_cast<float>(std::min(2.0 / std::cos(angles[i]), 30.0)) : 30.0f;
+  }
+  LocalMapBuilder b;
+  b.add_scan(Pose2(), angles.data(), ranges.data(), ranges.size(), 30.0);
+  const OccupancyGrid l = b.build();
+  ASSERT_EQ(l.width(), 80);
+  const auto at = [&](double x, double y) {
+    const CellIndex c = l.world_to_cell({x, y});
+    return l.value(c.x, c.y);
+  };
+  EXPECT_EQ(at(1.0, 0.05), kFree);        // between the robot and the wall at x = 2
+  EXPECT_EQ(at(2.05, 0.05), kOccupied);   // the wall
+  EXPECT_EQ(at(3.5, 0.05), kOccupied);    // behind it: unseen, counted occupied
+  EXPECT_EQ(at(-2.0, 0.05), kUnknown);    // behind the robot: outside the 180 deg view
+  EXPECT_EQ(at(0.5, 3.5), kFree);         // to the side, before the wall plane
+}
+
+TEST(LocalMap, DepthBandSeesTableTopsThatAPlaneAtLegHeightMisses) {
+  Box top, leg;
+  top.center = {2.0, 0.0, 0.85};
+  top.half_size = {0.3, 1.0, 0.02};
+  leg.center = {2.25, 0.75, 0.4};
+  leg.half_size = {0.025, 0.025, 0.4};
+  const BoxWorld world({top, leg});
+  const auto cam = PinholeCamera::from_fov(160, 120, 58 * kPi / 180, 45 * kPi / 180, 0.5, 10.0);
+  Eigen::Matrix3d r;
+  r << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // optical axes looking along robot +x
+  const Pose3 optical(Eigen::Vector3d(0, 0, 0.4), Eigen::Quaterniond(r));
+  const cv::Mat depth = render_depth(world, optical, cam);
+  LocalMapBuilder band, plane;
+  band.add_depth_band(depth, cam, optical, 0.4, 1.0);
+  plane.add_depth_band(depth, cam, optical, 0.39, 0.41);
+  const OccupancyGrid lb = band.build(), lp = plane.build();
+  const CellIndex front = lb.world_to_cell({1.75, 0.0});  // the table top's near edge
+  EXPECT_EQ(lb.value(front.x, front.y), kOccupied);
+  EXPECT_EQ(lp.value(front.x, front.y), kFree);  // the plane passes under the top
+  const cv::Mat wrong(10, 10, CV_32FC1, cv::Scalar(1.0f));
+  EXPECT_THROW(band.add_depth_band(wrong, cam, optical, 0.4, 1.0), std::invalid_argument);
+}
+
+TEST(SpaceObservation, BitCountsEqualPlainLoopsOverTheRotatedLocalMap) {
+  const OccupancyGrid map = room();
+  SpaceObservationModel model(map);
+  model.set_local_map(local_from(map, Pose2(3.0, 0.2, 0.4)));
+  Random rng(3);
+  for (int k = 0; k < 200; ++k) {
+    const Pose2 p(rng.uniform(-3, 11), rng.uniform(-4, 4), rng.uniform(-kPi, kPi));
+    const OccupancyGrid l = model.rotated_local_map(model.bin_of(p.theta));
+    const CellIndex c = map.world_to_cell({p.x, p.y});
+    SpaceObservationCounts ref;
+    for (int j = 0; j < l.height(); ++j)
+      for (int i = 0; i < l.width(); ++i) {
+        const int mx = c.x - l.width() / 2 + i, my = c.y - l.height() / 2 + j;
+        const std::int8_t lv = l.value(i, j);
+        if (lv < 0 || !map.contains(mx, my)) continue;
+        const std::int8_t mv = map.value(mx, my);
+        const bool m_occ = mv >= 65, m_free = mv >= 0 && mv <= 19;
+        ref.map_occupied += m_occ;
+        ref.map_free += m_free;
+        ref.penetrating += (lv == kFree) && m_occ;
+        ref.intruding += (lv == kOccupied) && m_free;
+      }
+    const SpaceObservationCounts got = model.counts(p);
+    ASSERT_EQ(got.penetrating, ref.penetrating);
+    ASSERT_EQ(got.map_occupied, ref.map_occupied);
+    ASSERT_EQ(got.intruding, ref.intruding);
+    ASSERT_EQ(got.map_free, ref.map_free);
+  }
+}
+
+TEST(SpaceObservation, LikelihoodPeaksAtTheTruePose) {
+  const OccupancyGrid map = room();
+  const Pose2 truth(3.0, 0.2, 0.4);
+  SpaceObservationModel model(map);
+  model.set_local_map(local_from(map, truth));
+  const double best = model.likelihood(truth);
+  EXPECT_GT(best, 0.9);
+  for (const Pose2& off : {Pose2(0.3, 0, 0), Pose2(0, 0.3, 0), Pose2(0, 0, 0.1), Pose2(-0.3, 0.2, 0)}) {
+    EXPECT_LT(model.likelihood(truth.compose(off)), best);
+  }
+  const auto c = model.counts(truth);
+  EXPECT_LT(c.penetration_ratio(), 2.0);  // percent
+  SpaceObservationParams bad;
+  bad.sigma_penetration = 0.0;
+  EXPECT_THROW(SpaceObservationModel(map, bad), std::invalid_argument);
+  SpaceObservationModel empty(map);
+  EXPECT_THROW(empty.counts(truth), std::logic_error);
+}
