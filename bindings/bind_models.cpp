@@ -46,16 +46,17 @@ void bind_models(py::module_& m) {
       .def(
           "add_depth_band",
           [](LocalMapBuilder& b, const py::array& depth_in, const Eigen::Matrix4d& optical,
-             double fx, double fy, double cx, double cy, double min_range, double max_range,
-             double z_min, double z_max) {
+             int width, int height, double fx, double fy, double cx, double cy, double min_range,
+             double max_range, double z_min, double z_max) {
             const auto d = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(depth_in);
             if (!d || d.ndim() != 2) throw std::invalid_argument("depth: expected a 2-D float32 image");
-            const PinholeCamera cam{static_cast<int>(d.shape(1)), static_cast<int>(d.shape(0)),
-                                    fx, fy, cx, cy, min_range, max_range};
-            const cv::Mat view(cam.height, cam.width, CV_32FC1, const_cast<float*>(d.data()));
+            const PinholeCamera cam{width, height, fx, fy, cx, cy, min_range, max_range};
+            const cv::Mat view(static_cast<int>(d.shape(0)), static_cast<int>(d.shape(1)), CV_32FC1,
+                               const_cast<float*>(d.data()));
             b.add_depth_band(view, cam, pose3_from_matrix(optical), z_min, z_max);
           },
-          "depth"_a, "optical_in_robot"_a, "fx"_a, "fy"_a, "cx"_a, "cy"_a, "min_range"_a,
+          "depth"_a, "optical_in_robot"_a, "width"_a, "height"_a, "fx"_a, "fy"_a, "cx"_a, "cy"_a,
+          "min_range"_a,
           "max_range"_a, "z_min"_a, "z_max"_a)
       .def("build", &LocalMapBuilder::build);
 

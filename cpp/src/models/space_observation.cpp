@@ -2,6 +2,7 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/models/space_observation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <mutex>
 #include <stdexcept>
@@ -23,29 +24,39 @@ struct BitRows {
   const Word* row(int y) const { return bits.data() + static_cast<std::size_t>(y) * words; }
 };
 
-// Bits [x0, x0 + n) of a row (cells outside 0..cols-1 read as 0), into out[0 .. (n+63)/64).
-void extract(const Word* row, int cols, int x0, int n, Word* out) {
-  const int out_words = (n + 63) / 64;
-  for (int k = 0; k < out_words; ++k) {
-    Word w = 0;
-    const int start = x0 + 64 * k;  // first source bit of this output word
-    for (int part = 0; part < 2; ++part) {
-      const int src_word = (start >= 0 ? start / 64 : (start - 63) / 64) + part;
-      if (src_word < 0 || src_word * 64 >= cols) continue;
-      const int shift = start - src_word * 64;  // in [-63, 63]
-      const Word v = row[src_word];
-      if (shift >= 0) w |= v >> shift;
-      else if (shift > -64) w |= v << (-shift);
-    }
-    const int valid_to = cols - start;  // bits at or past the map's last column are 0
-    if (valid_to < 64) w &= valid_to <= 0 ? 0 : (Word{1} << valid_to) - 1;
-    if (64 * (k + 1) > n) w &= (Word{1} << (n - 64 * k)) - 1;
-    out[k] = w;
-  }
-}
-
 struct Rotated {
   BitRows free, occupied;  // in view = free | occupied
+  int first_row = 0, last_row = -1;  // rows holding any cell in view
+};
+
+// A map's bit rows pre-shifted for every alignment: shifted(s).row(y)[pad + w] holds map cells
+// [64 w + s, 64 w + s + 64) of row y (0 outside the map), so a window starting at any column
+// reads whole words. `pad` words of zeros on each side let windows hang over the map's edges.
+struct ShiftedRows {
+  int pad = 0, words = 0, rows = 0;
+  std::vector<Word> bits;  // [shift][row][pad + words + pad]
+  ShiftedRows() = default;
+  ShiftedRows(const BitRows& src, int pad_words) : pad(pad_words), words(src.words), rows(src.rows) {
+    const int stride = words + 2 * pad;
+    bits.assign(static_cast<std::size_t>(64) * rows * stride, 0);
+    for (int sh = 0; sh < 64; ++sh)
+      for (int y = 0; y < rows; ++y) {
+        const Word* in = src.row(y);
+        Word* out = bits.data() + (static_cast<std::size_t>(sh) * rows + y) * stride + pad;
+        for (int w = -pad; w < words + pad; ++w) {
+          const Word lo = (w >= 0 && w < words) ? in[w] : 0;
+          const Word hi = (w + 1 >= 0 && w + 1 < words) ? in[w + 1] : 0;
+          out[w] = sh == 0 ? lo : (lo >> sh) | (hi << (64 - sh));
+        }
+      }
+  }
+  // Word k of the window of row y starting at column x0.
+  const Word* window(int y, int x0) const {
+    const int sh = ((x0 % 64) + 64) % 64;
+    const int q = (x0 - sh) / 64;
+    const int stride = words + 2 * pad;
+    return bits.data() + (static_cast<std::size_t>(sh) * rows + y) * stride + pad + q;
+  }
 };
 
 }  // namespace
@@ -71,6 +82,7 @@ struct SpaceObservationModel::Impl {
   SpaceObservationParams params;
   OccupancyGrid map;
   BitRows map_free, map_occupied;
+  ShiftedRows shifted_free, shifted_occupied;
   OccupancyGrid local{1, 1, 1.0};
   bool has_local = false;
   int span = 0;  // rotated local maps are span x span map cells, centred on the robot's cell
@@ -107,6 +119,9 @@ struct SpaceObservationModel::Impl {
         const std::int8_t v = local.value(cx, cy);
         if (v == kFree) out.free.set(i, j);
         else if (v >= params.occupied_threshold) out.occupied.set(i, j);
+        else continue;
+        if (out.last_row < out.first_row) out.first_row = j;
+        out.last_row = j;
       }
     }
   }
@@ -137,6 +152,11 @@ void SpaceObservationModel::set_local_map(const OccupancyGrid& local) {
   if (m.span > 64 * 64) {
     throw std::invalid_argument("space observation: the local map spans more than 4096 map cells");
   }
+  const int pad = (m.span + 63) / 64 + 1;  // words a window may hang over either edge
+  if (m.shifted_free.pad < pad) {
+    m.shifted_free = ShiftedRows(m.map_free, pad);
+    m.shifted_occupied = ShiftedRows(m.map_occupied, pad);
+  }
   m.cache = std::vector<Rotated>(static_cast<std::size_t>(m.bins()));
   m.once = std::vector<std::once_flag>(static_cast<std::size_t>(m.bins()));
 }
@@ -160,13 +180,13 @@ SpaceObservationCounts SpaceObservationModel::counts(const Pose2& pose) const {
   const CellIndex centre = m.map.world_to_cell({pose.x, pose.y});
   const int x0 = centre.x - m.span / 2, y0 = centre.y - m.span / 2;
   SpaceObservationCounts c;
-  Word occ[64], fre[64];  // up to 4096 cells a row
   const int words = l.free.words;
-  for (int j = 0; j < m.span; ++j) {
-    const int y = y0 + j;
-    if (y < 0 || y >= m.map.height()) continue;
-    extract(m.map_occupied.row(y), m.map.width(), x0, m.span, occ);
-    extract(m.map_free.row(y), m.map.width(), x0, m.span, fre);
+  // A window further than the padding off the map sees no map cell at all.
+  if (x0 + m.span <= 0 || x0 >= m.map.width()) return c;
+  const int first = std::max(l.first_row, -y0), last = std::min(l.last_row, m.map.height() - 1 - y0);
+  for (int j = first; j <= last; ++j) {
+    const Word* occ = m.shifted_occupied.window(y0 + j, x0);
+    const Word* fre = m.shifted_free.window(y0 + j, x0);
     const Word* lf = l.free.row(j);
     const Word* lo = l.occupied.row(j);
     for (int k = 0; k < words; ++k) {

@@ -1,0 +1,94 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The space observation model against its numpy reference, and its local-map rotation against
+an independent numpy resampling."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kiseki import Pose2
+from kiseki.grid import beam_angles
+from kiseki.models import (
+    LocalMapBuilder,
+    SpaceObservationModel,
+    counts_reference,
+    likelihood_reference,
+)
+from kiseki.sim.scene import load_scene
+
+
+@pytest.fixture(scope="module")
+def corridor(project_root):
+    scene = load_scene(project_root / "data" / "worlds" / "factory_corridor.yaml")
+    grid = scene.ground_truth(0.35, 0.45)
+    angles = beam_angles(1081, np.radians(270))
+    ranges = grid.cast_scans(np.array([[7.4, 0.0, 0.0]]), angles, max_range=30.0)[0]
+    builder = LocalMapBuilder(8.0, 0.1)
+    builder.add_scan(Pose2(), angles, ranges.astype(np.float32), 30.0)
+    model = SpaceObservationModel(grid)
+    model.set_local_map(builder.build())
+    return grid, model
+
+
+def test_cpp_equals_the_numpy_reference(corridor):
+    grid, model = corridor
+    rng = np.random.default_rng(0)
+    poses = np.column_stack(
+        [rng.uniform(-1, 15, 300), rng.uniform(-2, 2, 300), rng.uniform(-np.pi, np.pi, 300)]
+    )
+    for pose in poses[:60]:  # the counts are identical...
+        assert model.counts(Pose2(*pose)) == counts_reference(model, grid, pose)
+    # ...and so the likelihoods, up to the last bit of exp()
+    np.testing.assert_allclose(
+        model.likelihoods(poses), likelihood_reference(model, grid, poses), rtol=1e-13, atol=0
+    )
+
+
+def test_rotation_matches_an_independent_resampling(corridor):
+    grid, model = corridor
+    local = LocalMapBuilder(8.0, 0.1)  # the same local map, rebuilt for its cells
+    angles = beam_angles(1081, np.radians(270))
+    ranges = grid.cast_scans(np.array([[7.4, 0.0, 0.0]]), angles, max_range=30.0)[0]
+    local.add_scan(Pose2(), angles, ranges.astype(np.float32), 30.0)
+    cells = local.build().cells
+    for bin_ in (0, 37, 90, 200, 333):
+        rotated = model.rotated_local_map(bin_).cells
+        span = rotated.shape[0]
+        theta = np.radians(bin_)
+        jj, ii = np.mgrid[0:span, 0:span]
+        dx, dy = (ii - span // 2) * grid.resolution, (jj - span // 2) * grid.resolution
+        lx = np.cos(theta) * dx + np.sin(theta) * dy + 4.0
+        ly = -np.sin(theta) * dx + np.cos(theta) * dy + 4.0
+        cx, cy = np.floor(lx / 0.1).astype(int), np.floor(ly / 0.1).astype(int)
+        inside = (cx >= 0) & (cx < 80) & (cy >= 0) & (cy < 80)
+        expected = np.full((span, span), -1, dtype=np.int8)
+        expected[inside] = cells[cy[inside], cx[inside]]
+        assert np.mean(expected == rotated) > 0.999
+
+
+def test_likelihood_prefers_the_true_pose_and_errors_run_along_the_corridor(corridor):
+    _, model = corridor
+    xs = np.linspace(-0.5, 0.5, 21)
+    along = model.likelihoods(np.column_stack([7.4 + xs, np.zeros(21), np.zeros(21)]))
+    across = model.likelihoods(np.column_stack([np.full(21, 7.4), xs, np.zeros(21)]))
+    assert np.argmax(along) == 10 and np.argmax(across) == 10
+    # sideways offsets are punished far harder than offsets along the corridor
+    assert across[[0, 20]].max() < 0.01 < along[[0, 20]].min()
+
+
+def test_bad_input(corridor):
+    grid, model = corridor
+    with pytest.raises(ValueError, match="poses"):
+        model.likelihoods(np.zeros((3, 2)))
+    with pytest.raises(ValueError, match="NaN"):
+        model.likelihoods(np.array([[np.nan, 0.0, 0.0]]))
+    with pytest.raises(ValueError):
+        SpaceObservationModel(grid, sigma_penetration=-1.0)
+    with pytest.raises(RuntimeError, match="local map first"):
+        SpaceObservationModel(grid).counts(Pose2())
+    with pytest.raises(ValueError, match="float32 of the camera"):
+        LocalMapBuilder().add_depth_band(
+            np.ones((5, 5), np.float32), np.eye(4), 160, 120, 100, 100, 80, 60, 0.5, 10.0, 0.4, 1.0
+        )
