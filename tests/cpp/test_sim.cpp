@@ -48,17 +48,23 @@ TEST(Box, IntersectionAgreesWithMarchingAndContains) {
       const Eigen::Vector3d o = b.center + Eigen::Vector3d(r.uniform(-2, 2), r.uniform(-2, 2), r.uniform(-2, 2));
       const Eigen::Vector3d d = random_direction(r);
       const double t = b.intersect(o, d);
+      // Reference: march in 1 cm steps to the first point inside, then bisect the entry.
       double march = std::numeric_limits<double>::infinity();
-      for (double s = 0.0; s < 5.0; s += 1e-4) {
-        if (b.contains(o + s * d)) {
-          march = s;
-          break;
+      for (double s = 0.0; s < 5.0; s += 1e-2) {
+        if (!b.contains(o + s * d)) continue;
+        double lo = std::max(0.0, s - 1e-2), hi = s;
+        if (b.contains(o + lo * d)) hi = lo;  // the ray starts inside
+        for (int k = 0; k < 60 && hi > lo; ++k) {
+          const double mid = 0.5 * (lo + hi);
+          (b.contains(o + mid * d) ? hi : lo) = mid;
         }
+        march = hi;
+        break;
       }
       if (std::isinf(march)) {
         EXPECT_TRUE(std::isinf(t) || t > 5.0 - 1e-3 || !b.contains(o + (t + 1e-6) * d));
       } else {
-        ASSERT_NEAR(t, march, 2e-4);
+        ASSERT_NEAR(t, march, 1e-9);
       }
     }
   }
