@@ -61,15 +61,19 @@ void bind_models(py::module_& m) {
       .def("build", &LocalMapBuilder::build);
 
   py::class_<SpaceObservationModel>(m, "SpaceObservationModel")
-      .def(py::init([](const OccupancyGrid& map, double sp, double si, double step) {
+      .def(py::init([](const OccupancyGrid& map, double sp, double si, double step, bool occ) {
              SpaceObservationParams p;
              p.sigma_penetration = sp;
              p.sigma_intrusion = si;
              p.heading_step_deg = step;
+             p.occlusion_aware = occ;
              return std::make_unique<SpaceObservationModel>(map, p);
            }),
            "map"_a, "sigma_penetration"_a = 10.0, "sigma_intrusion"_a = 130.0,
-           "heading_step_deg"_a = 1.0)
+           "heading_step_deg"_a = 1.0, "occlusion_aware"_a = false)
+      .def("visible_from",
+           [](const SpaceObservationModel& s, const Pose2& pose) { return s.visibility(pose); },
+           "pose"_a, "Cells of the particle's window its cell sees (1) or not (0), int8.")
       .def("set_local_map", &SpaceObservationModel::set_local_map, "local_map"_a)
       .def("counts",
            [](const SpaceObservationModel& s, const Pose2& pose) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <mutex>
+#include <unordered_map>
 #include <stdexcept>
 
 #include "kiseki/core/angle.hpp"
@@ -87,6 +88,8 @@ struct SpaceObservationModel::Impl {
   bool has_local = false;
   int span = 0;  // rotated local maps are span x span map cells, centred on the robot's cell
   mutable std::vector<Rotated> cache;
+  mutable std::mutex visibility_mutex;
+  mutable std::unordered_map<long long, std::shared_ptr<const BitRows>> visibility;
   mutable std::vector<std::once_flag> once;  // thread-safe lazy rotation per bin
 
   Impl(const OccupancyGrid& m, const SpaceObservationParams& p) : params(p), map(m.clone()) {
@@ -126,6 +129,33 @@ struct SpaceObservationModel::Impl {
     }
   }
 
+  // Cells of the span x span window centred on map cell (cx, cy) that the centre sees: a fan of
+  // rays from the centre cell's centre, each ending at (and including) the first occupied cell.
+  std::shared_ptr<const BitRows> visible_from(int cx, int cy) const {
+    const long long key = static_cast<long long>(cy) * (1LL << 32) + cx;
+    {
+      std::lock_guard<std::mutex> lock(visibility_mutex);
+      const auto it = visibility.find(key);
+      if (it != visibility.end()) return it->second;
+    }
+    auto out = std::make_shared<BitRows>(span, span);
+    const int half = span / 2, rays = 8 * span;
+    for (int r = 0; r < rays; ++r) {
+      const double a = 2.0 * kPi * r / rays, dx = std::cos(a), dy = std::sin(a);
+      for (double t = 0.0; t <= half * std::sqrt(2.0) + 1.0; t += 0.5) {
+        const int i = half + static_cast<int>(std::lround(t * dx));
+        const int j = half + static_cast<int>(std::lround(t * dy));
+        if (i < 0 || j < 0 || i >= span || j >= span) break;
+        out->set(i, j);
+        const int mx = cx - half + i, my = cy - half + j;
+        if (map.contains(mx, my) && map.value(mx, my) >= params.occupied_threshold) break;
+      }
+    }
+    std::lock_guard<std::mutex> lock(visibility_mutex);
+    if (visibility.size() > 200000) visibility.clear();  // bound the memory on long runs
+    return visibility.emplace(key, std::move(out)).first->second;
+  }
+
   const Rotated& rotated(int bin) const {
     std::call_once(once[bin], [&] { rotate(bin, cache[bin]); });
     return cache[bin];
@@ -148,7 +178,12 @@ void SpaceObservationModel::set_local_map(const OccupancyGrid& local) {
   m.local = local.clone();
   m.has_local = true;
   const double extent = local.width() * local.resolution() * std::sqrt(2.0);
-  m.span = static_cast<int>(std::ceil(extent / m.map.resolution())) | 1;  // odd: a centre cell
+  const int span = static_cast<int>(std::ceil(extent / m.map.resolution())) | 1;  // odd: a centre
+  if (span != m.span) {
+    std::lock_guard<std::mutex> lock(m.visibility_mutex);
+    m.visibility.clear();  // windows of another size
+  }
+  m.span = span;
   if (m.span > 64 * 64) {
     throw std::invalid_argument("space observation: the local map spans more than 4096 map cells");
   }
@@ -184,17 +219,27 @@ SpaceObservationCounts SpaceObservationModel::counts(const Pose2& pose) const {
   // A window further than the padding off the map sees no map cell at all.
   if (x0 + m.span <= 0 || x0 >= m.map.width()) return c;
   const int first = std::max(l.first_row, -y0), last = std::min(l.last_row, m.map.height() - 1 - y0);
+  std::shared_ptr<const BitRows> seen;
+  if (m.params.occlusion_aware) seen = m.visible_from(centre.x, centre.y);
+  Word hidden_free[64];
   for (int j = first; j <= last; ++j) {
     const Word* occ = m.shifted_occupied.window(y0 + j, x0);
     const Word* fre = m.shifted_free.window(y0 + j, x0);
     const Word* lf = l.free.row(j);
     const Word* lo = l.occupied.row(j);
+    const Word* vis = seen ? seen->row(j) : nullptr;
     for (int k = 0; k < words; ++k) {
+      // The expected map: a free cell the sensor cannot see is expected occupied.
+      hidden_free[k] = vis ? fre[k] & ~vis[k] : 0;
+    }
+    for (int k = 0; k < words; ++k) {
+      const Word exp_occ = occ[k] | hidden_free[k];
+      const Word exp_free = fre[k] & ~hidden_free[k];
       const Word view = lf[k] | lo[k];
-      c.penetrating += __builtin_popcountll(lf[k] & occ[k]);
-      c.map_occupied += __builtin_popcountll(view & occ[k]);
-      c.intruding += __builtin_popcountll(lo[k] & fre[k]);
-      c.map_free += __builtin_popcountll(view & fre[k]);
+      c.penetrating += __builtin_popcountll(lf[k] & exp_occ);
+      c.map_occupied += __builtin_popcountll(view & exp_occ);
+      c.intruding += __builtin_popcountll(lo[k] & exp_free);
+      c.map_free += __builtin_popcountll(view & exp_free);
     }
   }
   return c;
@@ -225,6 +270,22 @@ OccupancyGrid SpaceObservationModel::rotated_local_map(int bin) const {
       if (l.free.row(j)[i / 64] & bit) out.set(i, j, kFree);
       else if (l.occupied.row(j)[i / 64] & bit) out.set(i, j, kOccupied);
     }
+  return out;
+}
+
+}  // namespace kiseki
+
+namespace kiseki {
+
+OccupancyGrid SpaceObservationModel::visibility(const Pose2& pose) const {
+  const Impl& m = *impl_;
+  if (!m.has_local) throw std::logic_error("space observation: set a local map first");
+  const CellIndex c = m.map.world_to_cell({pose.x, pose.y});
+  const auto seen = m.visible_from(c.x, c.y);
+  OccupancyGrid out(m.span, m.span, m.map.resolution(), Pose2(), 0);
+  for (int j = 0; j < m.span; ++j)
+    for (int i = 0; i < m.span; ++i)
+      if (seen->row(j)[i / 64] & (Word{1} << (i % 64))) out.set(i, j, 1);
   return out;
 }
 

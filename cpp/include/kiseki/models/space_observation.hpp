@@ -26,6 +26,9 @@ struct SpaceObservationParams {
   double heading_step_deg = 1.0;    ///< bin width of the pre-rotated local maps
   std::int8_t occupied_threshold = 65;  ///< map cells >= this are occupied; 0..free_max free
   std::int8_t free_max = 19;
+  /// Proposal 1 of the thesis: compare L with the map the particle should observe, in which
+  /// every map cell hidden from the sensor behind an occupied cell counts as occupied.
+  bool occlusion_aware = false;
   void validate() const;
 };
 
@@ -41,6 +44,9 @@ struct SpaceObservationParams {
 /// stored as bit rows; a particle then costs a few AND + popcount per row against the map's bit
 /// rows at an integer cell offset. Discretisation: heading to the nearest bin, position to the
 /// map cell containing the particle; each rotated cell takes the L cell under its centre.
+/// Occlusion-aware (proposal 1): visibility from the particle's cell is found by a fan of rays
+/// through the map (8 per cell of the window's side) that stop at the first occupied cell; it
+/// depends on the cell only, so it is cached per cell and shared by the particles in it.
 class SpaceObservationModel {
  public:
   SpaceObservationModel(const OccupancyGrid& map, const SpaceObservationParams& params = {});
@@ -59,6 +65,9 @@ class SpaceObservationModel {
   /// -1 outside view), for tests and the numpy reference.
   OccupancyGrid rotated_local_map(int bin) const;
   int bin_of(double heading) const;
+  /// The window of map cells around the particle's cell, 1 where visible from it, else 0
+  /// (occlusion-aware model only; for tests and the numpy reference).
+  OccupancyGrid visibility(const Pose2& pose) const;
   int bins() const;
 
  private:
