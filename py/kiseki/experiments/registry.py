@@ -11,9 +11,9 @@ __all__ = ["all_experiments", "get_experiment"]
 
 
 def _registry() -> dict[str, Experiment]:
-    from kiseki.experiments import carmen_maps, corridor_scans
+    from kiseki.experiments import carmen_maps, corridor_scans, fig_3_14
 
-    experiments = [carmen_maps.EXPERIMENT, corridor_scans.EXPERIMENT]
+    experiments = [carmen_maps.EXPERIMENT, corridor_scans.EXPERIMENT, fig_3_14.EXPERIMENT]
     return {e.name: e for e in experiments}
 
 

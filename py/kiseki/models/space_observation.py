@@ -16,15 +16,19 @@ from __future__ import annotations
 import numpy as np
 
 from kiseki._core import LocalMapBuilder, SpaceObservationModel
+from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
 
 __all__ = ["LocalMapBuilder", "SpaceObservationModel", "counts_reference", "likelihood_reference"]
 
 
-def counts_reference(model: SpaceObservationModel, grid: OccupancyGrid, pose) -> tuple:
+def counts_reference(
+    model: SpaceObservationModel, grid: OccupancyGrid, pose, occlusion_aware: bool = False
+) -> tuple:
     """(penetrating, map_occupied, intruding, map_free) for one particle, in plain numpy: the
     local map rotated to the particle's heading bin (``model.rotated_local_map``) laid over the
-    map at the particle's cell."""
+    map at the particle's cell; occlusion-aware, free map cells the particle's cell cannot see
+    (``model.visible_from``) count as occupied."""
     x, y, theta = (float(v) for v in pose)
     local = model.rotated_local_map(model.bin_of(theta)).cells
     span = local.shape[0]
@@ -36,8 +40,12 @@ def counts_reference(model: SpaceObservationModel, grid: OccupancyGrid, pose) ->
     if xs1 > xs0 and ys1 > ys0:
         window[ys0 - y0 : ys1 - y0, xs0 - x0 : xs1 - x0] = grid.cells[ys0:ys1, xs0:xs1]
     view = local >= 0
-    m_occ = (window >= 65) & view
-    m_free = (window >= 0) & (window <= 19) & view
+    occupied, free = window >= 65, (window >= 0) & (window <= 19)
+    if occlusion_aware:
+        hidden = free & (model.visible_from(Pose2(x, y, theta)).cells == 0)
+        occupied, free = occupied | hidden, free & ~hidden
+    m_occ = occupied & view
+    m_free = free & view
     return (
         int(np.count_nonzero((local == 0) & m_occ)),
         int(m_occ.sum()),
