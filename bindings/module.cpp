@@ -8,6 +8,7 @@ void bind_grid(pybind11::module_& m);
 void bind_mapping(pybind11::module_& m);
 void bind_sim(pybind11::module_& m);
 void bind_models(pybind11::module_& m);
+void bind_filters(pybind11::module_& m);
 }  // namespace kiseki::bindings
 
 PYBIND11_MODULE(_core, m) {
@@ -17,4 +18,5 @@ PYBIND11_MODULE(_core, m) {
   kiseki::bindings::bind_mapping(m);
   kiseki::bindings::bind_sim(m);
   kiseki::bindings::bind_models(m);
+  kiseki::bindings::bind_filters(m);
 }
