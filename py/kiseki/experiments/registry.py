@@ -11,9 +11,16 @@ __all__ = ["all_experiments", "get_experiment"]
 
 
 def _registry() -> dict[str, Experiment]:
-    from kiseki.experiments import carmen_maps, corridor_scans, fig_3_14
+    from kiseki.experiments import carmen_maps, corridor_scans, fig_3_14, teach_playback
 
-    experiments = [carmen_maps.EXPERIMENT, corridor_scans.EXPERIMENT, fig_3_14.EXPERIMENT]
+    experiments = [
+        carmen_maps.EXPERIMENT,
+        corridor_scans.EXPERIMENT,
+        fig_3_14.EXPERIMENT,
+        teach_playback.EXP1,
+        teach_playback.EXP2,
+        teach_playback.EXP3,
+    ]
     return {e.name: e for e in experiments}
 
 
