@@ -270,6 +270,66 @@ def sim_show(
     console.print(f"{output}: scene drawn" + (f"; {octree} written" if octree else ""))
 
 
+@app.command("teach")
+def teach_command(
+    scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML with a route."),
+    out: Path = typer.Option(..., "-o", "--out", help="Folder for maps, waypoints and the log."),
+    seed: int = typer.Option(0, help="Seed of the run's noise."),
+    resume: bool = typer.Option(False, help="Rebuild maps and waypoints from OUT/teach.mcap."),
+    overwrite: bool = typer.Option(False, help="Replace an existing teaching log."),
+) -> None:
+    """Teach a route: push the robot along the scene's route (simulated), build the environment
+    maps with the thesis' merge rules, record the waypoints; the run is logged as it goes."""
+    from kiseki.sim.scene import load_scene
+    from kiseki.teach.teaching import recover, teach
+
+    scene = load_scene(scene_file)
+    if resume:
+        log = out / "teach.mcap"
+        if not log.is_file():
+            raise FileNotFoundError(f"{log}: no teaching log to resume from")
+        result = recover(scene, log, out)
+    else:
+        result = teach(scene, out, seed, overwrite=overwrite)
+    names = ", ".join(m["name"] for m in result.marks)
+    console.print(
+        f"{out}: {result.steps} steps, waypoints {names or 'none'}; maps "
+        + ", ".join(str(p) for p in result.maps.values())
+    )
+
+
+@app.command("playback")
+def playback_command(
+    scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML (playback variant)."),
+    taught: Path = typer.Option(..., help="Folder written by kiseki teach."),
+    route: str = typer.Option(..., help="Waypoint names, start to goal: P0,P1,P2."),
+    method: str = typer.Option("proposal2", help="conventional, proposal1, proposal2 or both."),
+    seed: int = typer.Option(0, help="Seed of the run's noise."),
+) -> None:
+    """Play a taught route back on the particle filter's estimate; stop within 0.1 m of the goal."""
+    import math
+
+    from kiseki.map_io import load_map
+    from kiseki.sim.scene import load_scene
+    from kiseki.teach import PlaybackConfig, playback
+    from kiseki.teach.local_maps import METHODS
+    from kiseki.teach.teaching import load_taught
+
+    config = PlaybackConfig(method=method, seed=seed)
+    band, _ = METHODS[method]
+    map_path, marks = load_taught(taught, band, [n.strip() for n in route.split(",")])
+    result = playback(load_scene(scene_file, "playback"), load_map(map_path), marks, config)
+    goal = marks[-1]
+    tx, ty, _ = result.stop_true
+    ex, ey, _ = result.stop_estimate
+    console.print(
+        f"{method}: stopped after {result.steps} steps; estimated stop ({ex:.3f}, {ey:.3f}) in the "
+        f"map, {math.hypot(ex - goal['x'], ey - goal['y']):.3f} m from {goal['name']}; true stop "
+        f"({tx:.3f}, {ty:.3f}), {math.hypot(tx - goal['truth'][0], ty - goal['truth'][1]):.3f} m "
+        f"from where {goal['name']} was taught; goal reached: {result.reached}"
+    )
+
+
 @app.command("report")
 def report(
     results: Path = typer.Option(Path("results"), help="Results folder of the experiments."),

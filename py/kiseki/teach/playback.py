@@ -7,6 +7,7 @@ odometry and weighs particles with the space observation model on the chosen met
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field
 
@@ -70,6 +71,14 @@ def playback(
     if len(waypoints) < 2:
         raise ValueError("a route needs a start and a goal waypoint")
     band, occlusion = METHODS[config.method]
+    if "truth" in waypoints[0]:  # in simulation the robot starts where the start was taught
+        x, y, th = waypoints[0]["truth"]
+        scene = copy.copy(scene)
+        scene.robot_specs = [dict(scene.robot_specs[0])]
+        scene.robot_specs[0]["robot"] = {
+            **scene.robot_specs[0]["robot"],
+            "start": [x, y, math.degrees(th)],
+        }
     setup = build_robot(scene, derive_seed(config.seed, 1))
     cameras = [
         s.device

@@ -30,7 +30,7 @@ from kiseki.sim.scene import Scene
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.local_maps import BANDS, LocalMapMaker
 
-__all__ = ["TeachResult", "recover", "teach", "waypoints_file_hash"]
+__all__ = ["TeachResult", "load_taught", "recover", "teach", "waypoints_file_hash"]
 
 MARK_SCHEMA = {
     "type": "object",
@@ -185,3 +185,31 @@ def recover(scene: Scene, log: str | os.PathLike, out: str | os.PathLike) -> Tea
             steps += 1
     marks = [m for _, m in run.messages("/waypoints")] if "/waypoints" in topics else []
     return _write_outputs(Path(out), maps, marks, Path(log), steps)
+
+
+def load_taught(folder: str | os.PathLike, band: str, route: list[str]) -> tuple[Path, list[dict]]:
+    """The map of a local-map band and the route's waypoints from a teaching folder, checking
+    that the map is the one the waypoints were taught with."""
+    folder = Path(folder)
+    path = folder / "waypoints.yaml"
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no waypoint file (run kiseki teach first)")
+    doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    if not isinstance(doc, dict) or "waypoints" not in doc or "maps" not in doc:
+        raise ValueError(f"{path}: not a kiseki waypoint file")
+    if band not in doc["maps"]:
+        raise ValueError(f"{path}: no {band!r} map was taught")
+    map_path = folder / doc["maps"][band]["file"]
+    if not map_path.is_file():
+        raise FileNotFoundError(f"{map_path}: the taught map is missing")
+    if waypoints_file_hash(map_path) != doc["maps"][band]["image_sha1"]:
+        raise ValueError(f"{map_path}: this map is not the one {path} was taught with")
+    by_name = {w["name"]: w for w in doc["waypoints"]}
+    unknown = [n for n in route if n not in by_name]
+    if unknown:
+        raise ValueError(
+            f"{path}: no waypoint named {', '.join(unknown)} (known: {', '.join(by_name)})"
+        )
+    if len(route) < 2 or len(set(route)) != len(route):
+        raise ValueError("a route needs at least two different waypoints")
+    return map_path, [by_name[n] for n in route]
