@@ -153,15 +153,16 @@ def map_info(
 def demo(
     out: Path = typer.Option(Path("results/demo"), help="Folder for the run, maps and figures."),
     scene: Path = typer.Option(
-        Path("data/worlds/factory_corridor.yaml"), "--scene", help="Scene to run."
+        Path("data/worlds/factory_turn.yaml"), "--scene", help="Scene with a taught route."
     ),
     seed: int = typer.Option(0, help="Seed of every noise source of the run."),
+    particles: int = typer.Option(1000, help="Particles of the localization filter."),
 ) -> None:
-    """The main job until teaching and playback land: the thesis' corridor run in the
-    simulated factory, odometry drift, and maps taught from the true and the odometry path."""
+    """The main job: teach the factory route with a turn, play it back with each method, and
+    print the thesis' Table 4.5-style comparison."""
     from kiseki.demo import run_demo
 
-    run_demo(scene, out, seed, console)
+    run_demo(scene, out, seed, console, particles)
 
 
 @experiment_app.command("list")
@@ -290,7 +291,7 @@ def teach_command(
             raise FileNotFoundError(f"{log}: no teaching log to resume from")
         result = recover(scene, log, out)
     else:
-        result = teach(scene, out, seed, overwrite=overwrite)
+        result = teach(scene, out, seed, overwrite=overwrite, progress=True)
     names = ", ".join(m["name"] for m in result.marks)
     console.print(
         f"{out}: {result.steps} steps, waypoints {names or 'none'}; maps "

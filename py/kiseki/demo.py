@@ -1,11 +1,12 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The main job until teaching and playback land: the thesis' corridor run (P0 -> P1 -> P2) in
-the simulated factory (data/worlds/factory_corridor.yaml). The AGV follows the route with a
-Hokuyo laser and two sideways depth cameras, its wheel odometry drifting as real odometry does;
-the run is logged to MCAP; maps are built from the laser along the true path and along the
-odometry path, showing how odometry alone bends a taught map; the odometry error at P1 and P2
-is set beside the thesis' Tables 4.1-4.4. Uses only files in the repository.
+"""The main job: the factory demo of the teaching-and-playback thesis, in the simulated factory
+(data/worlds/factory_turn.yaml, the route with a turn of Exp. 2). The AGV is pushed once along
+the route (teaching: environment maps from its two sideways depth cameras placed by odometry,
+waypoints P0, T1, T2, G, the run logged to MCAP), then plays the route back with each method
+(conventional, proposal 1, proposal 2, both) and stops when its estimate is within 0.1 m of G.
+The Table 4.5-style comparison is printed beside the thesis' numbers (one run per method here;
+`kiseki experiment run exp2-turn` repeats it). Uses only files in the repository.
 """
 
 from __future__ import annotations
@@ -21,140 +22,108 @@ from rich.console import Console
 from rich.table import Table
 
 from kiseki._atomic import atomic_write
-from kiseki.grid import grid_summary
-from kiseki.map_io import save_map
-from kiseki.mapping import build_map, endpoint_agreement
+from kiseki.core import derive_seed
+from kiseki.map_io import load_map
 from kiseki.plots import render_map
-from kiseki.sim.mcap_log import read_run
 from kiseki.sim.render import render_scene
-from kiseki.sim.run import SimConfig, simulate
 from kiseki.sim.scene import load_scene
+from kiseki.teach import PlaybackConfig, playback, teach
+from kiseki.teach.local_maps import METHODS
 
 __all__ = ["DemoConfig", "run_demo"]
 
-# The thesis' odometry error (odometry - truth) at P1 and P2, means of 11 runs (Tables 4.1-4.4).
-THESIS_ODOMETRY_ERROR = {"P1": (None, -0.07), "P2": (0.01, -0.20)}
+# Thesis Table 4.5 (5 runs each): stop error mean (m), estimate error mean (m), stops within 0.1 m
+THESIS = {
+    "conventional": (0.13, 0.13, "0/5"),
+    "proposal1": (0.09, 0.08, "4/5"),
+    "proposal2": (0.07, 0.05, "5/5"),
+    "both": (None, None, "not tried"),
+}
 
 
 @dataclass(frozen=True)
 class DemoConfig:
-    scene: str = "data/worlds/factory_corridor.yaml"
+    scene: str = "data/worlds/factory_turn.yaml"
     seed: int = 0
+    particles: int = 1000
 
 
 def _write_text(path: Path, text: str) -> None:
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
-def _odometry_sensor_poses(odometry: np.ndarray, mount_x: float) -> np.ndarray:
-    """The laser's pose if the robot were where its odometry says (laser mount_x ahead)."""
-    c, s = np.cos(odometry[:, 2]), np.sin(odometry[:, 2])
-    return np.column_stack(
-        [odometry[:, 0] + mount_x * c, odometry[:, 1] + mount_x * s, odometry[:, 2]]
-    )
-
-
-def _errors_at(truth: np.ndarray, odometry: np.ndarray, waypoints: dict) -> dict:
-    """Odometry - truth (x, y) when the robot passes each waypoint's x (the stop for the last)."""
-    out = {}
-    for name, (x, _) in waypoints.items():
-        passed = np.nonzero(truth[:, 0] >= x - 0.05)[0]
-        i = int(passed[0]) if len(passed) else len(truth) - 1
-        out[name] = (odometry[i, :2] - truth[i, :2]).tolist()
-    return out
-
-
-def run_demo(map_file: Path, out: Path, seed: int, console: Console) -> dict:
-    config = DemoConfig(scene=str(map_file), seed=seed)
+def run_demo(
+    scene_file: Path, out: Path, seed: int, console: Console, particles: int = 1000
+) -> dict:
+    config = DemoConfig(scene=str(scene_file), seed=seed, particles=particles)
     out.mkdir(parents=True, exist_ok=True)
-    scene = load_scene(map_file)
+    scene = load_scene(scene_file)
     render_scene(scene, out / "scene.png")
-    run = simulate(scene, out / "run.mcap", SimConfig(seed=seed), overwrite=True, progress=True)
-    log = read_run(run.path)
-    scans = log.laser_scans()
-    mount_x = float(np.hypot(*(scans.poses[0, :2] - _track(log)[0, :2])))
-    truth = _track(log)
-    odom_sensor = _odometry_sensor_poses(scans.odometry, mount_x)
-    maps = {
-        "true_path": build_map(scans.poses, scans.ranges, scans.angles, scans.max_range),
-        "odometry_path": build_map(odom_sensor, scans.ranges, scans.angles, scans.max_range),
-    }
-    for name, grid in maps.items():
-        save_map(grid, out / f"map_{name}.yaml")
+    console.print("teaching: pushing the AGV along the route ...")
+    taught = teach(scene, out / "teach", seed=derive_seed(seed, 1), overwrite=True)
+    goal = taught.marks[-1]
+    maps = {band: load_map(path) for band, path in taught.maps.items()}
+    marks_xy = np.array([[m["x"], m["y"]] for m in taught.marks])
     render_map(
-        maps["true_path"],
-        out / "map_true_path.png",
-        trajectory=scans.poses,
-        title="map from the laser along the true path",
+        maps["band"],
+        out / "taught_map_band.png",
+        trajectory=marks_xy,
+        title="taught map (depth height band) and waypoints, odometry frame",
     )
-    render_map(
-        maps["odometry_path"],
-        out / "map_odometry_path.png",
-        trajectory=odom_sensor,
-        title="map from the laser along the odometry path (what odometry alone teaches)",
-    )
-    route = dict(zip(scene.route.get("names", []), scene.route["waypoints"], strict=False))
-    x, y, _ = run.final_pose
-    goal = scene.route["waypoints"][-1]
+    play_scene = load_scene(scene_file, "playback")
+    results = {}
+    for method in METHODS:
+        console.print(f"playback: {method} ...")
+        band, _ = METHODS[method]
+        r = playback(
+            play_scene,
+            maps[band],
+            taught.marks,
+            PlaybackConfig(method=method, particles=particles, seed=derive_seed(seed, 2)),
+        )
+        tx, ty = r.stop_true[0] - goal["truth"][0], r.stop_true[1] - goal["truth"][1]
+        ex, ey = r.stop_estimate[0] - goal["x"], r.stop_estimate[1] - goal["y"]
+        results[method] = {
+            "stop_error_m": math.hypot(tx, ty),
+            "estimate_error_m": math.hypot(ex - tx, ey - ty),
+            "stop_offset_m": [tx, ty],
+            "reached": r.reached,
+            "steps": r.steps,
+        }
     summary = {
-        "scene": str(map_file),
-        "simulated_seconds": run.sim_seconds,
-        "real_time_factor": run.sim_seconds / run.wall_seconds,
-        "messages": run.messages,
-        "stop_error_m": math.hypot(x - goal[0], y - goal[1]),
-        "reached_goal": run.reached_goal,
-        "odometry_error_m": _errors_at(
-            truth, scans.odometry, {k: v for k, v in route.items() if k != "P0"}
-        ),
-        "endpoints_true_path_map": endpoint_agreement(
-            maps["true_path"], scans.poses, scans.ranges, scans.angles, scans.max_range
-        ),
-        "endpoints_odometry_path_map": endpoint_agreement(
-            maps["odometry_path"], odom_sensor, scans.ranges, scans.angles, scans.max_range
-        ),
-        "map_true_path": grid_summary(maps["true_path"]),
+        "scene": str(scene_file),
+        "teaching_steps": taught.steps,
+        "waypoints": [m["name"] for m in taught.marks],
+        "playback": results,
     }
     _write_text(out / "config.yaml", yaml.safe_dump(asdict(config), sort_keys=False))
     _write_text(out / "summary.json", json.dumps(summary, indent=2))
-    _print_summary(summary, out, console)
+    _print(results, out, console)
     return summary
 
 
-def _track(log) -> np.ndarray:
-    msgs = log.messages("/ground_truth")
-    return np.array([[m["pose"]["position"]["x"], m["pose"]["position"]["y"]] for _, m in msgs])
-
-
-def _print_summary(summary: dict, out: Path, console: Console) -> None:
-    table = Table(title="kiseki demo: the thesis' corridor run P0 -> P1 -> P2, simulated")
-    table.add_column("quantity")
-    table.add_column("thesis", justify="right")
-    table.add_column("kiseki", justify="right")
-    table.add_row(
-        "simulated time (s), speed vs real time",
-        "",
-        f"{summary['simulated_seconds']:.1f} s, {summary['real_time_factor']:.1f}x",
-    )
-    table.add_row(
-        "stop distance from P2 (m), controller on ground truth",
-        "<= 0.1",
-        f"{summary['stop_error_m']:.3f}",
-    )
-    for name, (dx, dy) in summary["odometry_error_m"].items():
-        tx, ty = THESIS_ODOMETRY_ERROR.get(name, (None, None))
-        thesis = f"({'-' if tx is None else f'{tx:+.2f}'}, {ty:+.2f})" if ty is not None else ""
+def _print(results: dict, out: Path, console: Console) -> None:
+    table = Table(title="Route with a turn (thesis Exp. 2, Table 4.5): one run per method")
+    for column in (
+        "method",
+        "stop error m (thesis)",
+        "kiseki",
+        "estimate error m (thesis)",
+        "kiseki",
+        "within 0.1 m (thesis)",
+        "kiseki",
+    ):
+        table.add_column(column, justify="left" if column == "method" else "right")
+    for method, r in results.items():
+        stop, est, within = THESIS[method]
         table.add_row(
-            f"odometry error at {name} (x, y) m, one run", thesis, f"({dx:+.3f}, {dy:+.3f})"
+            method,
+            "-" if stop is None else f"{stop:.2f}",
+            f"{r['stop_error_m']:.3f}",
+            "-" if est is None else f"{est:.2f}",
+            f"{r['estimate_error_m']:.3f}",
+            within,
+            "yes" if r["stop_error_m"] <= 0.1 else "no",
         )
-    table.add_row(
-        "scan endpoints on the map, true path",
-        "",
-        f"{100 * summary['endpoints_true_path_map']:.1f} %",
-    )
-    table.add_row(
-        "scan endpoints on the map, odometry path",
-        "",
-        f"{100 * summary['endpoints_odometry_path_map']:.1f} %",
-    )
     console.print(table)
-    console.print(f"run (MCAP), maps (ROS YAML + PGM), figures and summary in {out}/")
+    console.print(f"teaching log, taught maps, waypoints, figures and summary in {out}/")

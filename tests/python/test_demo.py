@@ -1,11 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The main job's demo: uses only the repository's data, is deterministic, stops at P2, and
-shows odometry drift in the map taught along the odometry path."""
+"""The main job's demo: uses only the repository's data, teaches, plays back every method, and
+is deterministic for a seed."""
 
 from __future__ import annotations
-
-import json
 
 import numpy as np
 from rich.console import Console
@@ -15,30 +13,26 @@ from kiseki.demo import run_demo
 from kiseki.experiments.corridor_scans import CorridorLaser, simulate_scans
 
 
-def test_demo_runs_the_corridor_and_writes_everything(tmp_path, project_root):
-    scene = project_root / "data" / "worlds" / "factory_corridor.yaml"
-    summary = run_demo(scene, tmp_path / "a", seed=3, console=Console(quiet=True))
+def test_demo_teaches_and_plays_back_every_method(tmp_path, project_root):
+    scene = project_root / "data" / "worlds" / "factory_turn.yaml"
+    summary = run_demo(scene, tmp_path / "a", seed=3, console=Console(quiet=True), particles=300)
     for name in (
         "scene.png",
-        "map_true_path.png",
-        "map_odometry_path.png",
-        "run.mcap",
-        "map_true_path.yaml",
-        "map_odometry_path.pgm",
+        "taught_map_band.png",
+        "teach/teach.mcap",
+        "teach/map_band.yaml",
+        "teach/map_plane.pgm",
+        "teach/waypoints.yaml",
         "config.yaml",
         "summary.json",
     ):
         assert (tmp_path / "a" / name).stat().st_size > 0, name
-    assert summary["reached_goal"] and summary["stop_error_m"] <= 0.1
-    assert summary["endpoints_true_path_map"] > 0.99
-    dx, dy = summary["odometry_error_m"]["P2"]
-    assert 0.005 < abs(dy) < 1.0 and abs(dx) < 0.1  # drift is mostly sideways, as in the thesis
-    truth_map = load_map(tmp_path / "a" / "map_true_path.yaml")
-    assert truth_map.resolution == 0.05
-    again = run_demo(scene, tmp_path / "b", seed=3, console=Console(quiet=True))
-    assert again["odometry_error_m"] == summary["odometry_error_m"]  # same seed, same run
-    other = json.loads(json.dumps(run_demo(scene, tmp_path / "c", 4, Console(quiet=True))))
-    assert other["odometry_error_m"] != summary["odometry_error_m"]
+    assert summary["waypoints"] == ["P0", "T1", "T2", "G"]
+    assert set(summary["playback"]) == {"conventional", "proposal1", "proposal2", "both"}
+    for result in summary["playback"].values():
+        assert result["reached"] and result["stop_error_m"] < 0.5  # localized, not lost
+    again = run_demo(scene, tmp_path / "b", seed=3, console=Console(quiet=True), particles=300)
+    assert again["playback"] == summary["playback"]  # same seed, same runs
 
 
 def test_corridor_laser_noise_is_seeded_and_has_its_sd(project_data):

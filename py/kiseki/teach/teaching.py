@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 import yaml
+from tqdm import tqdm
 
 from kiseki import _core
 from kiseki._atomic import atomic_write
@@ -87,7 +88,12 @@ def _write_outputs(
 
 
 def teach(
-    scene: Scene, out: str | os.PathLike, seed: int = 0, dt: float = 0.1, overwrite: bool = False
+    scene: Scene,
+    out: str | os.PathLike,
+    seed: int = 0,
+    dt: float = 0.1,
+    overwrite: bool = False,
+    progress: bool = False,
 ) -> TeachResult:
     """Pushes the robot along the scene's route (pure pursuit stands in for the operator),
     marks each named route point as a waypoint, and builds one environment map per local-map
@@ -112,6 +118,7 @@ def teach(
         {"scene_file": str(scene.path), "seed": str(seed), "dt": str(dt), "names": ",".join(names)},
         overwrite=overwrite,
     ) as writer:
+        bar = tqdm(desc="teaching", unit="step", disable=not progress, mininterval=0.1)
         for k in range(int(900 / dt)):
             t = k * dt
             truth = _pose(setup.robot.pose)
@@ -123,10 +130,12 @@ def teach(
                 writer.write_depth_image(f"/{c.name}", t, image, c.name)
             _integrate(maps, makers, images, odom)
             _mark(writer, marks, names, controller, truth, odom, t)
+            bar.update(1)  # this step is written
             if controller.done:
                 break
             v, _, w = controller.command(truth)
             setup.odometry.update(setup.robot.step(v, w, dt))
+        bar.close()
     return _write_outputs(out, maps, marks, log, k + 1)
 
 
@@ -184,6 +193,7 @@ def recover(scene: Scene, log: str | os.PathLike, out: str | os.PathLike) -> Tea
             )
             steps += 1
     marks = [m for _, m in run.messages("/waypoints")] if "/waypoints" in topics else []
+    Path(out).mkdir(parents=True, exist_ok=True)
     return _write_outputs(Path(out), maps, marks, Path(log), steps)
 
 

@@ -1,0 +1,144 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Teaching and playback: merge rules, recovery after a real kill, waypoint files tied to their
+maps, the particle filter, and bad input."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+import yaml
+
+from kiseki import _core, load_map
+from kiseki.core import Pose2
+from kiseki.grid import OccupancyGrid
+from kiseki.sim.scene import load_scene
+from kiseki.teach import LocalMapMaker, PlaybackConfig, playback, teach
+from kiseki.teach.teaching import load_taught, recover
+
+
+def test_merge_rules_of_the_thesis():
+    env = OccupancyGrid(np.full((1, 4), -1, np.int8), 1.0)
+    env.cells[0] = [-1, 100, 0, 100]
+    local = OccupancyGrid(np.array([[100, 0, 100, -1]], np.int8), 1.0, Pose2(-0.5, -0.5, 0.0))
+    # local cell i sits on environment cell i (the pose shifts L's centre onto cell 0's centre)
+    changed = _core.merge_local_map(env, local, Pose2(0.5, 0.5, 0.0))
+    # unknown -> local; free over occupied -> free; occupied over free -> stays free; -1 skipped
+    assert env.cells[0].tolist() == [100, 0, 0, 100] and changed == 2
+
+
+def test_particle_filter_tracks_odometry_and_resamples():
+    pf = _core.ParticleFilter(500, seed=4)
+    pf.initialize(Pose2(0.0, 0.0, 0.0), 0.01, 0.01, 0.001)
+    pf.predict(Pose2(0.0, 0.0, 0.0), Pose2(1.0, 0.0, 0.0))
+    est = pf.estimate()
+    assert abs(est.x - 1.0) < 0.05 and abs(est.y) < 0.05
+    spread = pf.poses[:, 0].std()
+    assert 0.05 < spread < 0.5  # translation noise alpha3 = 0.05: sd = sqrt(0.05) * 1 m = 0.22
+    likelihood = np.exp(-0.5 * ((pf.poses[:, 0] - 1.1) / 0.02) ** 2)
+    pf.weight(likelihood)
+    assert pf.effective_sample_size < 250 and pf.resample_if_needed()
+    assert abs(pf.estimate().x - 1.1) < 0.03 and pf.effective_sample_size == pytest.approx(500)
+    with pytest.raises(ValueError):
+        pf.weight(np.ones(3))
+    a = _core.ParticleFilter(50, seed=9)
+    b = _core.ParticleFilter(50, seed=9)
+    for f in (a, b):
+        f.initialize(Pose2(), 0.1, 0.1, 0.1)
+        f.predict(Pose2(), Pose2(0.5, 0.1, 0.2))
+    assert np.array_equal(a.poses, b.poses)
+
+
+def test_teach_recover_and_playback(tmp_path, project_root):
+    scene_file = project_root / "data" / "worlds" / "factory_corridor.yaml"
+    taught = teach(load_scene(scene_file), tmp_path / "t", seed=5)
+    assert [m["name"] for m in taught.marks] == ["P0", "P1", "P2"]
+    online = {band: load_map(p).cells.copy() for band, p in taught.maps.items()}
+    again = recover(load_scene(scene_file), taught.log, tmp_path / "r")
+    assert again.steps == taught.steps and again.marks == taught.marks
+    for band, path in again.maps.items():
+        np.testing.assert_array_equal(load_map(path).cells, online[band])
+    map_path, marks = load_taught(tmp_path / "t", "band", ["P0", "P1", "P2"])
+    result = playback(
+        load_scene(scene_file, "playback"),
+        load_map(map_path),
+        marks,
+        PlaybackConfig(particles=300, seed=1),
+    )
+    goal = marks[-1]["truth"]
+    assert (
+        result.reached
+        and np.hypot(result.stop_true[0] - goal[0], result.stop_true[1] - goal[1]) <= 0.1
+    )
+
+
+def test_a_killed_teaching_run_is_recovered_losing_under_a_second(tmp_path, project_root):
+    scene = project_root / "data" / "worlds" / "factory_corridor.yaml"
+    cli = [sys.executable, "-m", "kiseki.cli", "teach", str(scene), "-o", str(tmp_path / "t")]
+    progress = (tmp_path / "progress.txt").open("w")
+    proc = subprocess.Popen(cli, stdout=subprocess.DEVNULL, stderr=progress)
+    log = tmp_path / "t" / "teach.mcap"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and (not log.exists() or log.stat().st_size < 3_000_000):
+        time.sleep(0.05)
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    progress.close()
+    # the progress bar counts a step once it is written; it refreshes every 0.1 s
+    shown = [int(n) for n in re.findall(r"(\d+)step", (tmp_path / "progress.txt").read_text())]
+    assert shown, "the teaching run showed no progress before the kill"
+    done = subprocess.run([*cli, "--resume"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    steps = int(re.search(r"(\d+) steps", done.stdout.replace("\n", " ")).group(1))
+    assert 0 < steps < 266  # killed mid-run
+    assert steps >= max(shown) - 10  # at most the last second (10 steps at 10 Hz) is lost
+    assert (tmp_path / "t" / "map_band.yaml").is_file()
+    counts = yaml.safe_load((tmp_path / "t" / "waypoints.yaml").read_text())
+    assert counts["waypoints"][0]["name"] == "P0"
+
+
+def test_bad_input(tmp_path, project_root):
+    scene_file = project_root / "data" / "worlds" / "factory_corridor.yaml"
+    taught = teach(load_scene(scene_file), tmp_path / "t", seed=1)
+    with pytest.raises(ValueError, match="no waypoint named P7"):
+        load_taught(tmp_path / "t", "band", ["P0", "P7"])
+    # a map from another run beside this waypoint file
+    other = teach(load_scene(scene_file), tmp_path / "o", seed=2)
+    (tmp_path / "t" / "map_band.pgm").write_bytes((tmp_path / "o" / "map_band.pgm").read_bytes())
+    with pytest.raises(ValueError, match="not the one"):
+        load_taught(tmp_path / "t", "band", ["P0", "P2"])
+    del taught, other
+    with pytest.raises(ValueError, match="method"):
+        PlaybackConfig(method="magic")
+    scene = load_scene(scene_file)
+    from kiseki.sim.setup import build_robot, build_sensors
+
+    cams = [
+        s.device
+        for s in build_sensors(scene, build_robot(scene, 0), 0, 0.1)
+        if s.kind == "depth_camera"
+    ]
+    with pytest.raises(ValueError, match="160 x 120"):
+        LocalMapMaker(cams, "band").make([np.zeros((10, 10), np.float32)] * 2)
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "kiseki.cli",
+            "teach",
+            str(scene_file),
+            "-o",
+            str(tmp_path / "none"),
+            "--resume",
+        ],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 1 and "no teaching log" in done.stderr
