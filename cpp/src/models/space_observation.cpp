@@ -51,12 +51,12 @@ struct ShiftedRows {
         }
       }
   }
-  // Word k of the window of row y starting at column x0.
+  int stride() const { return words + 2 * pad; }
+  // Word k of the window of row y starting at column x0; the next row is stride() words on.
   const Word* window(int y, int x0) const {
     const int sh = ((x0 % 64) + 64) % 64;
     const int q = (x0 - sh) / 64;
-    const int stride = words + 2 * pad;
-    return bits.data() + (static_cast<std::size_t>(sh) * rows + y) * stride + pad + q;
+    return bits.data() + (static_cast<std::size_t>(sh) * rows + y) * stride() + pad + q;
   }
 };
 
@@ -222,9 +222,11 @@ SpaceObservationCounts SpaceObservationModel::counts(const Pose2& pose) const {
   std::shared_ptr<const BitRows> seen;
   if (m.params.occlusion_aware) seen = m.visible_from(centre.x, centre.y);
   Word hidden_free[64];
-  for (int j = first; j <= last; ++j) {
-    const Word* occ = m.shifted_occupied.window(y0 + j, x0);
-    const Word* fre = m.shifted_free.window(y0 + j, x0);
+  if (first > last) return c;
+  const int stride = m.shifted_free.stride();
+  const Word* occ = m.shifted_occupied.window(y0 + first, x0);
+  const Word* fre = m.shifted_free.window(y0 + first, x0);
+  for (int j = first; j <= last; ++j, occ += stride, fre += stride) {
     const Word* lf = l.free.row(j);
     const Word* lo = l.occupied.row(j);
     const Word* vis = seen ? seen->row(j) : nullptr;
