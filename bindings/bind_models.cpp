@@ -5,6 +5,7 @@
 
 #include <cstring>
 
+#include "kiseki/models/likelihood_field.hpp"
 #include "kiseki/models/local_map.hpp"
 #include "kiseki/models/space_observation.hpp"
 #include "numpy_helpers.hpp"
@@ -59,6 +60,38 @@ void bind_models(py::module_& m) {
           "min_range"_a,
           "max_range"_a, "z_min"_a, "z_max"_a)
       .def("build", &LocalMapBuilder::build);
+
+  py::class_<LikelihoodFieldModel>(m, "LikelihoodFieldModel")
+      .def(py::init([](const OccupancyGrid& map, double sigma, double z_hit, double z_rand,
+                       int stride) {
+             LikelihoodFieldParams p;
+             p.sigma_hit = sigma, p.z_hit = z_hit, p.z_rand = z_rand, p.beam_stride = stride;
+             return std::make_unique<LikelihoodFieldModel>(map, p);
+           }),
+           "map"_a, "sigma_hit"_a = 0.2, "z_hit"_a = 0.95, "z_rand"_a = 0.05, "beam_stride"_a = 1)
+      .def("set_scan",
+           [](LikelihoodFieldModel& lf, const py::handle& a_in, const py::handle& r_in,
+              double max_range) {
+             const auto a = as_doubles(a_in, "angles");
+             const auto r = as_floats(r_in, "ranges");
+             require_shape(a, "angles", 1);
+             require_shape(r, "ranges", 1);
+             if (a.shape(0) != r.shape(0)) throw std::invalid_argument("angles and ranges differ in length");
+             lf.set_scan(a.data(), r.data(), static_cast<std::size_t>(a.shape(0)), max_range);
+           }, "angles"_a, "ranges"_a, "max_range"_a)
+      .def("log_likelihoods",
+           [](const LikelihoodFieldModel& lf, const py::handle& poses_in) {
+             const auto p = as_doubles(poses_in, "poses");
+             require_shape(p, "poses", 2, 3);
+             require_finite(p, "poses");
+             py::array_t<double> out(p.shape(0));
+             double* dst = out.mutable_data();
+             {
+               py::gil_scoped_release release;
+               lf.log_likelihoods(p.data(), static_cast<std::size_t>(p.shape(0)), dst);
+             }
+             return out;
+           }, "poses"_a, "Log-likelihoods of sensor poses (n, 3); releases the GIL.");
 
   py::class_<SpaceObservationModel>(m, "SpaceObservationModel")
       .def(py::init([](const OccupancyGrid& map, double sp, double si, double step, bool occ) {
