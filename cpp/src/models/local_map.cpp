@@ -45,7 +45,6 @@ void LocalMapBuilder::add_scan(const Pose2& sensor, const double* angles, const 
   RayCastOptions through;  // an empty frame: walk every cell to the edge of L
   through.occupied_threshold = std::numeric_limits<std::int8_t>::max();
   through.max_range = 2.0 * params_.size;
-  const double res = params_.resolution;
   for (std::size_t i = 0; i < n; ++i) {
     const double r = ranges[i];
     if (!std::isfinite(r) || r < 0.0 || !std::isfinite(angles[i])) continue;
@@ -53,19 +52,20 @@ void LocalMapBuilder::add_scan(const Pose2& sensor, const double* angles, const 
     const double heading = sensor.theta + angles[i];
     const Eigen::Vector2d start(sensor.x, sensor.y);
     const Eigen::Vector2d dir(std::cos(heading), std::sin(heading));
+    // The cell holding the beam's end is the hit (as in map building); the cells the beam
+    // crosses before it are free; the cells after it along the ray are hidden (occupied).
+    const CellIndex end = frame_.world_to_cell(start + std::min(r, 2.0 * params_.size) * dir);
+    bool behind = false;
     for (const CellIndex& c : cells_on_ray(frame_, start, heading, through)) {
-      // Distance along the beam to the cell centre's projection decides its side of the end.
-      const Eigen::Vector2d centre = frame_.cell_to_world(c.x, c.y);
-      const double along = (centre - start).dot(dir);
       if (!hit) {
-        if (along > max_range) break;
+        const Eigen::Vector2d centre = frame_.cell_to_world(c.x, c.y);
+        if ((centre - start).dot(dir) > max_range) break;
         mark(c, kPassed);
-      } else if (std::abs(along - r) <= 0.5 * res) {
+      } else if (c == end) {
         mark(c, kHit);
-      } else if (along < r) {
-        mark(c, kPassed);
+        behind = true;
       } else {
-        mark(c, kShadow);
+        mark(c, behind ? kShadow : kPassed);
       }
     }
   }
