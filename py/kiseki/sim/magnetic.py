@@ -3,7 +3,7 @@
 """Simulated magnetic field, a 3-axis magnetometer and a bearing sensor.
 
 The field model follows the facts of the magnetic-navigation thesis
-(``/work/shared/papers/002``, Japanese original, chapter 2, pp. 13-24; English digest in
+(``002_74cea16d239c028f.txt``, Japanese original, chapter 2, pp. 13-24; English digest in
 ``DIGEST.md``):
 
 * the Earth's field, spatially uniform over a robot's workspace;
