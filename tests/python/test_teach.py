@@ -115,6 +115,14 @@ def test_bad_input(tmp_path, project_root):
     with pytest.raises(ValueError, match="not the one"):
         load_taught(tmp_path / "t", "band", ["P0", "P2"])
     del taught, other
+    # a route through a wall: a waypoint taught beyond the corridor's north wall
+    env = load_map(tmp_path / "o" / "map_band.yaml")
+    marks = [
+        {"name": "A", "x": 2.0, "y": 0.0, "theta": 0.0},
+        {"name": "B", "x": 2.0, "y": 3.0, "theta": 0.0},
+    ]
+    with pytest.raises(ValueError, match="A -> B crosses occupied space"):
+        playback(load_scene(scene_file, "playback"), env, marks, PlaybackConfig(particles=10))
     with pytest.raises(ValueError, match="method"):
         PlaybackConfig(method="magic")
     scene = load_scene(scene_file)

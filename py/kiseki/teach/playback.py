@@ -21,7 +21,24 @@ from kiseki.sim.scene import Scene
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.local_maps import METHODS, LocalMapMaker
 
-__all__ = ["PlaybackConfig", "PlaybackResult", "playback"]
+__all__ = ["PlaybackConfig", "PlaybackResult", "check_route", "playback"]
+
+
+def check_route(environment: OccupancyGrid, waypoints: list[dict]) -> None:
+    """Raises ValueError when a straight leg between consecutive waypoints crosses occupied
+    cells of the taught map (the robot follows the legs, so such a route is unreachable)."""
+    for a, b in zip(waypoints, waypoints[1:], strict=False):
+        length = math.hypot(b["x"] - a["x"], b["y"] - a["y"])
+        if length == 0:
+            continue
+        heading = math.atan2(b["y"] - a["y"], b["x"] - a["x"])
+        rng, hit, cell = environment.cast_ray(a["x"], a["y"], heading, max_range=length)
+        if hit and rng < length - environment.resolution:
+            x, y = environment.cell_to_world(np.array([cell], dtype=float))[0]
+            raise ValueError(
+                f"the route leg {a['name']} -> {b['name']} crosses occupied space "
+                f"at ({x:.2f}, {y:.2f}) m of the taught map"
+            )
 
 
 @dataclass(frozen=True)
@@ -70,6 +87,7 @@ def playback(
     config = config or PlaybackConfig()
     if len(waypoints) < 2:
         raise ValueError("a route needs a start and a goal waypoint")
+    check_route(environment, waypoints)
     band, occlusion = METHODS[config.method]
     if "truth" in waypoints[0]:  # in simulation the robot starts where the start was taught
         x, y, th = waypoints[0]["truth"]
