@@ -25,13 +25,34 @@ Pose3 pose3_from_matrix(const Eigen::Matrix4d& m) {
   return {m.block<3, 1>(0, 3), Eigen::Quaterniond(r)};
 }
 
-void add_scan(LocalMapBuilder& b, const Pose2& sensor, const py::handle& a_in,
-              const py::handle& r_in, double max_range) {
-  const auto a = as_doubles(a_in, "angles");
-  const auto r = as_floats(r_in, "ranges");
+// A scan's checked beam angles (n,) and ranges (n,).
+std::pair<DoubleArray, FloatArray> beams(const py::handle& a_in, const py::handle& r_in) {
+  auto a = as_doubles(a_in, "angles");
+  auto r = as_floats(r_in, "ranges");
   require_shape(a, "angles", 1);
   require_shape(r, "ranges", 1);
   if (a.shape(0) != r.shape(0)) throw std::invalid_argument("angles and ranges differ in length");
+  return {a, r};
+}
+
+// One value per pose of a checked (n, 3) pose array, computed by fn(poses, n, out) without the GIL.
+template <typename Fn>
+py::array_t<double> per_pose(const py::handle& poses_in, Fn&& fn) {
+  const auto p = as_doubles(poses_in, "poses");
+  require_shape(p, "poses", 2, 3);
+  require_finite(p, "poses");
+  py::array_t<double> out(p.shape(0));
+  double* dst = out.mutable_data();
+  {
+    py::gil_scoped_release release;
+    fn(p.data(), static_cast<std::size_t>(p.shape(0)), dst);
+  }
+  return out;
+}
+
+void add_scan(LocalMapBuilder& b, const Pose2& sensor, const py::handle& a_in,
+              const py::handle& r_in, double max_range) {
+  const auto [a, r] = beams(a_in, r_in);
   b.add_scan(sensor, a.data(), r.data(), static_cast<std::size_t>(a.shape(0)), max_range);
 }
 
@@ -72,25 +93,14 @@ void bind_models(py::module_& m) {
       .def("set_scan",
            [](LikelihoodFieldModel& lf, const py::handle& a_in, const py::handle& r_in,
               double max_range) {
-             const auto a = as_doubles(a_in, "angles");
-             const auto r = as_floats(r_in, "ranges");
-             require_shape(a, "angles", 1);
-             require_shape(r, "ranges", 1);
-             if (a.shape(0) != r.shape(0)) throw std::invalid_argument("angles and ranges differ in length");
+             const auto [a, r] = beams(a_in, r_in);
              lf.set_scan(a.data(), r.data(), static_cast<std::size_t>(a.shape(0)), max_range);
            }, "angles"_a, "ranges"_a, "max_range"_a)
       .def("log_likelihoods",
-           [](const LikelihoodFieldModel& lf, const py::handle& poses_in) {
-             const auto p = as_doubles(poses_in, "poses");
-             require_shape(p, "poses", 2, 3);
-             require_finite(p, "poses");
-             py::array_t<double> out(p.shape(0));
-             double* dst = out.mutable_data();
-             {
-               py::gil_scoped_release release;
-               lf.log_likelihoods(p.data(), static_cast<std::size_t>(p.shape(0)), dst);
-             }
-             return out;
+           [](const LikelihoodFieldModel& lf, const py::handle& poses) {
+             return per_pose(poses, [&](const double* p, std::size_t n, double* out) {
+               lf.log_likelihoods(p, n, out);
+             });
            }, "poses"_a, "Log-likelihoods of sensor poses (n, 3); releases the GIL.");
 
   py::class_<SpaceObservationModel>(m, "SpaceObservationModel")
@@ -114,17 +124,10 @@ void bind_models(py::module_& m) {
              return py::make_tuple(c.penetrating, c.map_occupied, c.intruding, c.map_free);
            }, "pose"_a, "(penetrating, map_occupied, intruding, map_free) in view")
       .def("likelihoods",
-           [](const SpaceObservationModel& s, const py::handle& poses_in) {
-             const auto p = as_doubles(poses_in, "poses");
-             require_shape(p, "poses", 2, 3);
-             require_finite(p, "poses");
-             py::array_t<double> out(p.shape(0));
-             double* dst = out.mutable_data();
-             {
-               py::gil_scoped_release release;
-               s.likelihoods(p.data(), static_cast<std::size_t>(p.shape(0)), dst);
-             }
-             return out;
+           [](const SpaceObservationModel& s, const py::handle& poses) {
+             return per_pose(poses, [&](const double* p, std::size_t n, double* out) {
+               s.likelihoods(p, n, out);
+             });
            }, "poses"_a, "Likelihoods of particles (n, 3); releases the GIL.")
       .def("rotated_local_map", &SpaceObservationModel::rotated_local_map, "bin"_a)
       .def("bin_of", &SpaceObservationModel::bin_of, "heading"_a)
