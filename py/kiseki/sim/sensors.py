@@ -183,20 +183,13 @@ class DepthCamera:
 
     def render(self, world, robot_pose, noise: bool = True) -> np.ndarray:
         """z-depth image (float32 metres, 0 = no measurement)."""
-        p = self.params
-        fx, fy, cx, cy = self.intrinsics()
-        depth = world.render_depth(
-            self.optical_pose(robot_pose),
-            p.width,
-            p.height,
-            fx,
-            fy,
-            cx,
-            cy,
-            p.min_range,
-            p.max_range,
-        )
+        depth = world.render_depth(self.optical_pose(robot_pose), *self.camera_args())
         return self.add_noise(depth) if noise else depth
+
+    def camera_args(self) -> tuple:
+        """(width, height, fx, fy, cx, cy, min_range, max_range), as the C++ core takes them."""
+        p = self.params
+        return (p.width, p.height, *self.intrinsics(), p.min_range, p.max_range)
 
     def add_noise(self, depth: np.ndarray) -> np.ndarray:
         p = self.params

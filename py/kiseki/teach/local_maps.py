@@ -55,20 +55,6 @@ class LocalMapMaker:
                     f"depth image is {depth.shape[1]} x {depth.shape[0]}, the camera "
                     f"gives {p.width} x {p.height}"
                 )
-            fx, fy, cx, cy = camera.intrinsics()
             optical = camera.optical_pose((0.0, 0.0, 0.0))  # in the robot frame
-            builder.add_depth_band(
-                depth,
-                optical,
-                p.width,
-                p.height,
-                fx,
-                fy,
-                cx,
-                cy,
-                p.min_range,
-                p.max_range,
-                z_min,
-                z_max,
-            )
+            builder.add_depth_band(depth, optical, *camera.camera_args(), z_min, z_max)
         return builder.build()
