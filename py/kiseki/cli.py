@@ -68,20 +68,32 @@ def map_from_log(
     resolution: float = typer.Option(0.05, help="Cell size in metres."),
     usable_range: float = typer.Option(30.0, help="Free space is marked at most this far (m)."),
     render: Path | None = typer.Option(None, help="Also draw the map and trajectory to this PNG."),
+    rules: str = typer.Option(
+        "log-odds",
+        help="log-odds (occupancy probabilities) or teaching (the thesis' merge rules: the map "
+        "the space observation model expects; use --resolution 0.1).",
+    ),
 ) -> None:
     """Build an occupancy grid from a log's poses and scans and save it as a ROS map."""
     from kiseki.datasets import open_scans
     from kiseki.map_io import load_map, save_map
-    from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
+    from kiseki.mapping import MapBuildConfig, build_map, build_teaching_map, endpoint_agreement
     from kiseki.plots import render_map
 
+    if rules not in ("log-odds", "teaching"):
+        raise typer.BadParameter(f"--rules must be log-odds or teaching, got {rules!r}")
     config = MapBuildConfig(
         resolution=_positive("--resolution", resolution),
         usable_range=_positive("--usable-range", usable_range),
     )
     start = time.perf_counter()
     scans = open_scans(log)
-    grid = build_map(scans.poses, scans.ranges, scans.angles, scans.max_range, config, True)
+    if rules == "teaching":
+        grid = build_teaching_map(
+            scans.poses, scans.ranges, scans.angles, scans.max_range, resolution, progress=True
+        )
+    else:
+        grid = build_map(scans.poses, scans.ranges, scans.angles, scans.max_range, config, True)
     seconds = time.perf_counter() - start
     saved = load_map(save_map(grid, output))
     share = endpoint_agreement(saved, scans.poses, scans.ranges, scans.angles, scans.max_range)

@@ -17,6 +17,7 @@ from kiseki import _core
 from kiseki.core import Pose2, Random, derive_seed
 from kiseki.datasets.carmen import LaserScans
 from kiseki.grid import OccupancyGrid
+from kiseki.mapping import scan_local_map
 
 __all__ = ["LOCALIZATION_METHODS", "LocalizeConfig", "localize", "noisy_odometry"]
 
@@ -81,9 +82,7 @@ def localize(
             pf.predict(Pose2(*odom[k - 1]), Pose2(*odom[k]))
         ranges = scans.ranges[k]
         if config.method == "space-observation":
-            builder = _core.LocalMapBuilder(8.0, 0.1)
-            builder.add_scan(Pose2(), scans.angles, ranges, scans.max_range)
-            model.set_local_map(builder.build())
+            model.set_local_map(scan_local_map(scans.angles, ranges, scans.max_range))
             pf.weight(model.likelihoods(pf.poses))
         else:
             model.set_scan(scans.angles, ranges, scans.max_range)
