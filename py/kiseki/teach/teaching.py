@@ -31,7 +31,7 @@ from kiseki.sim.scene import Scene
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.local_maps import BANDS, LocalMapMaker
 
-__all__ = ["TeachResult", "load_taught", "recover", "teach", "waypoints_file_hash"]
+__all__ = ["TeachResult", "TeachingRun", "load_taught", "recover", "teach", "waypoints_file_hash"]
 
 MARK_SCHEMA = {
     "type": "object",
@@ -87,6 +87,114 @@ def _write_outputs(
     return TeachResult(paths, out / "waypoints.yaml", log, steps, marks)
 
 
+class TeachingRun:
+    """The state of one teaching run and its one step, shared by scripted and keyboard
+    teaching: the robot, its depth cameras, the environment maps being merged, the waypoint
+    marks and the MCAP log. Opening the run logs step 0 at the start pose; each :meth:`step`
+    moves the robot by a velocity command for ``dt``, then logs the new true pose, odometry and
+    depth images and merges the local maps placed by odometry; :meth:`mark` records a waypoint
+    at the current odometry pose. Use it as a context manager (the log is closed on exit, also
+    on an exception, so that :func:`recover` can rebuild the run)."""
+
+    def __init__(
+        self,
+        scene: Scene,
+        out: str | os.PathLike,
+        seed: int = 0,
+        dt: float = 0.1,
+        overwrite: bool = False,
+        metadata: dict[str, str] | None = None,
+    ) -> None:
+        if not (math.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt must be a positive number of seconds, got {dt}")
+        self.scene, self.dt = scene, float(dt)
+        self.out = Path(out)
+        self.setup = build_robot(scene, seed)
+        if self.setup.kind != "diff_drive":
+            raise ValueError(f"{scene.path}: teaching pushes a diff_drive robot")
+        self.cameras = [
+            s for s in build_sensors(scene, self.setup, seed, dt) if s.kind == "depth_camera"
+        ]
+        if not self.cameras:
+            raise ValueError(f"{scene.path}: teaching needs the robot's depth cameras")
+        self.makers = {b: LocalMapMaker([c.device for c in self.cameras], b) for b in BANDS}
+        self.maps = {b: _environment(scene) for b in BANDS}
+        self.marks: list[dict] = []
+        self.steps = 0  # steps logged
+        self.out.mkdir(parents=True, exist_ok=True)
+        self.log = self.out / "teach.mcap"
+        meta = {"scene_file": str(scene.path), "seed": str(seed), "dt": str(dt)}
+        self._writer = RunWriter(self.log, {**meta, **(metadata or {})}, overwrite=overwrite)
+        try:
+            self._record()
+        except BaseException:
+            self._writer.close()
+            raise
+
+    @property
+    def t(self) -> float:
+        """Time of the last logged step (s)."""
+        return (self.steps - 1) * self.dt
+
+    @property
+    def truth(self) -> tuple[float, float, float]:
+        return _pose(self.setup.robot.pose)
+
+    @property
+    def odom(self) -> tuple[float, float, float]:
+        return _pose(self.setup.odometry.pose)
+
+    @property
+    def limits(self) -> tuple[float, float]:
+        """The robot's (max_speed m/s, max_yaw_rate rad/s)."""
+        p = self.setup.robot.params
+        return float(p.max_speed), float(p.max_yaw_rate)
+
+    def step(self, v: float, w: float) -> None:
+        """Moves the robot by (v m/s, w rad/s) for dt (within its limits) and logs the step."""
+        self.setup.odometry.update(self.setup.robot.step(v, w, self.dt))
+        self._record()
+
+    def _record(self) -> None:
+        t, truth, odom = self.steps * self.dt, self.truth, self.odom
+        self._writer.write_pose("/ground_truth", t, truth)
+        self._writer.write_odometry("/odom", t, odom)
+        images = [c.device.render(self.scene.world, truth) for c in self.cameras]
+        for c, image in zip(self.cameras, images, strict=True):
+            self._writer.write_depth_image(f"/{c.name}", t, image, c.name)
+        _integrate(self.maps, self.makers, images, odom)
+        self.steps += 1
+
+    def mark(self, name: str) -> dict:
+        """Records waypoint `name` at the current odometry pose (and logs the mark)."""
+        odom = self.odom
+        mark = {
+            "id": len(self.marks),
+            "name": str(name),
+            "x": odom[0],
+            "y": odom[1],
+            "theta": odom[2],
+            "truth": [float(v) for v in self.truth],
+        }
+        self.marks.append(mark)
+        self._writer.write_json("/waypoints", self.t, "kiseki.WaypointMark", mark, MARK_SCHEMA)
+        return mark
+
+    def close(self) -> None:
+        self._writer.close()
+
+    def finish(self) -> TeachResult:
+        """Closes the log and writes the maps and the waypoint file."""
+        self.close()
+        return _write_outputs(self.out, self.maps, self.marks, self.log, self.steps)
+
+    def __enter__(self) -> TeachingRun:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
 def teach(
     scene: Scene,
     out: str | os.PathLike,
@@ -98,45 +206,28 @@ def teach(
     """Pushes the robot along the scene's route (pure pursuit stands in for the operator),
     marks each named route point as a waypoint, and builds one environment map per local-map
     band ("plane" and "band")."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    setup = build_robot(scene, seed)
-    cameras = [s for s in build_sensors(scene, setup, seed, dt) if s.kind == "depth_camera"]
-    if not cameras:
-        raise ValueError(f"{scene.path}: teaching needs the robot's depth cameras")
     route = scene.route
+    if not route.get("waypoints"):
+        raise ValueError(f"{scene.path}: scripted teaching needs a route (or use the keyboard)")
     names = list(route.get("names") or [f"W{i}" for i in range(len(route["waypoints"]))])
-    controller = PurePursuit(
-        route["waypoints"], float(route.get("speed", 0.5)), 0.6, 0.1, setup.robot.params.max_accel
-    )
-    makers = {b: LocalMapMaker([c.device for c in cameras], b) for b in BANDS}
-    maps = {b: _environment(scene) for b in BANDS}
-    marks: list[dict] = []
-    log = out / "teach.mcap"
-    with RunWriter(
-        log,
-        {"scene_file": str(scene.path), "seed": str(seed), "dt": str(dt), "names": ",".join(names)},
-        overwrite=overwrite,
-    ) as writer:
+    with TeachingRun(scene, out, seed, dt, overwrite, {"names": ",".join(names)}) as run:
+        controller = PurePursuit(
+            route["waypoints"],
+            float(route.get("speed", 0.5)),
+            0.6,
+            0.1,
+            run.setup.robot.params.max_accel,
+        )
         bar = tqdm(desc="teaching", unit="step", disable=not progress, mininterval=0.1)
-        for k in range(int(900 / dt)):
-            t = k * dt
-            truth = _pose(setup.robot.pose)
-            odom = _pose(setup.odometry.pose)
-            writer.write_pose("/ground_truth", t, truth)
-            writer.write_odometry("/odom", t, odom)
-            images = [c.device.render(scene.world, truth) for c in cameras]
-            for c, image in zip(cameras, images, strict=True):
-                writer.write_depth_image(f"/{c.name}", t, image, c.name)
-            _integrate(maps, makers, images, odom)
-            _mark(writer, marks, names, controller, truth, odom, t)
+        while True:
+            _mark(run, names, controller)
             bar.update(1)  # this step is written
-            if controller.done:
+            if controller.done or run.steps >= int(900 / dt):
                 break
-            v, _, w = controller.command(truth)
-            setup.odometry.update(setup.robot.step(v, w, dt))
+            v, _, w = controller.command(run.truth)
+            run.step(v, w)
         bar.close()
-    return _write_outputs(out, maps, marks, log, k + 1)
+        return run.finish()
 
 
 def _pose(p) -> tuple[float, float, float]:
@@ -149,10 +240,10 @@ def _integrate(maps, makers, images, odom) -> None:
         _core.merge_local_map(maps[band], maker.make(images), pose)
 
 
-def _mark(writer, marks, names, controller: PurePursuit, truth, odom, t) -> None:
+def _mark(run: TeachingRun, names, controller: PurePursuit) -> None:
     """The operator marks the next route point when the robot reaches it along the route (the
     goal when the robot stops there)."""
-    i = len(marks)
+    i = len(run.marks)
     if i >= len(names):
         return
     last = i == len(names) - 1
@@ -160,16 +251,7 @@ def _mark(writer, marks, names, controller: PurePursuit, truth, odom, t) -> None
         not last and controller.progress < controller.cum[i] - 0.05
     ):
         return
-    mark = {
-        "id": i,
-        "name": str(names[i]),
-        "x": odom[0],
-        "y": odom[1],
-        "theta": odom[2],
-        "truth": [float(v) for v in truth],
-    }
-    marks.append(mark)
-    writer.write_json("/waypoints", t, "kiseki.WaypointMark", mark, MARK_SCHEMA)
+    run.mark(names[i])
 
 
 def recover(scene: Scene, log: str | os.PathLike, out: str | os.PathLike) -> TeachResult:
