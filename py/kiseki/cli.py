@@ -285,23 +285,55 @@ def sim_show(
 
 @app.command("teach")
 def teach_command(
-    scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML with a route."),
+    scene_file: Path = typer.Argument(
+        ..., metavar="SCENE", help="Scene YAML (with a route unless --keyboard)."
+    ),
     out: Path = typer.Option(..., "-o", "--out", help="Folder for maps, waypoints and the log."),
     seed: int = typer.Option(0, help="Seed of the run's noise."),
     resume: bool = typer.Option(False, help="Rebuild maps and waypoints from OUT/teach.mcap."),
     overwrite: bool = typer.Option(False, help="Replace an existing teaching log."),
+    keyboard: bool = typer.Option(
+        False,
+        help="Push the robot from the terminal instead of along the route: w/s or Up/Down "
+        "speed +-0.1 m/s, a/d or Left/Right turn +-0.1 rad/s, space stop, m mark waypoint "
+        "P0, P1, ..., q finish.",
+    ),
+    keys: Path | None = typer.Option(
+        None,
+        help="With --keyboard: read timed keys from this file (lines TIME KEY [KEY ...], TIME "
+        "in simulated seconds, ending with q) instead of the terminal.",
+    ),
 ) -> None:
-    """Teach a route: push the robot along the scene's route (simulated), build the environment
-    maps with the thesis' merge rules, record the waypoints; the run is logged as it goes."""
+    """Teach a route: push the robot along the scene's route (simulated) or from the keyboard,
+    build the environment maps with the thesis' merge rules, record the waypoints; the run is
+    logged as it goes."""
     from kiseki.sim.scene import load_scene
     from kiseki.teach.teaching import recover, teach
 
+    if keys is not None and not keyboard:
+        raise ValueError("--keys FILE goes with --keyboard")
+    if keyboard and keys is None and not resume and not sys.stdin.isatty():
+        raise ValueError("--keyboard needs a terminal on stdin (or --keys FILE of timed keys)")
     scene = load_scene(scene_file)
     if resume:
         log = out / "teach.mcap"
         if not log.is_file():
             raise FileNotFoundError(f"{log}: no teaching log to resume from")
         result = recover(scene, log, out)
+    elif keyboard:
+        from kiseki.teach.keyboard import KeyScript, TerminalKeys, teach_keyboard
+
+        source = KeyScript(keys) if keys is not None else TerminalKeys(sys.stdin.fileno(), 0.1)
+        try:
+            with source:
+                result = teach_keyboard(scene, out, source, seed, overwrite=overwrite)
+        except KeyboardInterrupt:
+            typer.echo(
+                f"\nkiseki: interrupted; {out / 'teach.mcap'} is kept: add --resume to build "
+                "the maps and waypoints from it",
+                err=True,
+            )
+            raise typer.Exit(130) from None
     else:
         result = teach(scene, out, seed, overwrite=overwrite, progress=True)
     names = ", ".join(m["name"] for m in result.marks)

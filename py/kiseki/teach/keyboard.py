@@ -1,0 +1,269 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Keyboard teaching: the operator pushes the simulated robot from a terminal and marks the
+waypoints, at the simulation rate (10 Hz), with the same steps, log and outputs as scripted
+teaching (:class:`~kiseki.teach.teaching.TeachingRun`), so ``kiseki teach --resume`` rebuilds
+a killed keyboard run too.
+
+Keys (like ``teleop_twist_keyboard``, but each press changes the command by one step):
+w / Up and s / Down raise and lower the forward speed by 0.1 m/s, a / Left and d / Right the
+turn rate (counter-clockwise positive) by 0.1 rad/s, both within the robot's limits; space
+stops; m marks a waypoint at the odometry pose, named P0, P1, ...; q finishes and writes the
+maps and the waypoint file.
+
+Keys come from the terminal (cbreak mode, no Enter needed; the terminal's mode is restored on
+exit, also on an exception, Ctrl-C or SIGTERM) or from a key script for tests and demos: lines
+``TIME KEY [KEY ...]`` with TIME the simulated seconds at which the keys are pressed, KEY one
+of w a s d m q or up down left right space, ``#`` comments; the script must end with q and runs
+as fast as the simulation can.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import select
+import signal
+import sys
+import time
+from pathlib import Path
+from typing import TextIO
+
+from kiseki.sim.scene import Scene
+from kiseki.teach.teaching import TeachingRun, TeachResult
+
+__all__ = [
+    "HELP",
+    "KeyScript",
+    "Teleop",
+    "TerminalKeys",
+    "decode_keys",
+    "teach_keyboard",
+]
+
+LINEAR_STEP = 0.1  # m/s per key press
+ANGULAR_STEP = 0.1  # rad/s per key press
+KEYS = ("w", "a", "s", "d", "up", "down", "left", "right", "space", "m", "q")
+HELP = (
+    f"keyboard teaching: w/Up s/Down speed +-{LINEAR_STEP} m/s, a/Left d/Right turn "
+    f"+-{ANGULAR_STEP} rad/s,\n"
+    "  space stop, m mark a waypoint (P0, P1, ...), q finish and write the maps\n"
+)
+_ESCAPES = {b"A": "up", b"B": "down", b"C": "right", b"D": "left"}
+_CHARS = {b" ": "space", **{k.encode(): k for k in "wasdmq"}}
+
+
+def decode_keys(data: bytes) -> tuple[list[str], bytes]:
+    """Key names from terminal bytes (letters, space, arrow escape sequences ESC [ X and
+    ESC O X; upper-case letters count as lower-case) and the undecoded tail (an escape
+    sequence cut by the read). Other bytes are ignored."""
+    keys: list[str] = []
+    i = 0
+    while i < len(data):
+        b = data[i : i + 1]
+        if b == b"\x1b":
+            if i + 2 >= len(data):
+                return keys, data[i:]  # maybe the start of an arrow: wait for the rest
+            if data[i + 1 : i + 2] in (b"[", b"O") and data[i + 2 : i + 3] in _ESCAPES:
+                keys.append(_ESCAPES[data[i + 2 : i + 3]])
+                i += 3
+                continue
+            i += 1
+            continue
+        key = _CHARS.get(b.lower())
+        if key is not None:
+            keys.append(key)
+        i += 1
+    return keys, b""
+
+
+class Teleop:
+    """The velocity command the keys set: each press changes it by one step, within the
+    robot's limits (max_speed m/s, max_yaw_rate rad/s)."""
+
+    def __init__(self, max_speed: float, max_yaw_rate: float) -> None:
+        if not (max_speed > 0 and max_yaw_rate > 0):
+            raise ValueError("the robot's speed limits must be positive")
+        self.max_speed, self.max_yaw_rate = float(max_speed), float(max_yaw_rate)
+        self.v = 0.0
+        self.w = 0.0
+
+    def press(self, key: str) -> str | None:
+        """Applies a key; returns "mark" or "quit" for those keys, else None."""
+        if key in ("w", "up", "s", "down"):
+            step = LINEAR_STEP if key in ("w", "up") else -LINEAR_STEP
+            self.v = round(min(max(self.v + step, -self.max_speed), self.max_speed), 6)
+        elif key in ("a", "left", "d", "right"):
+            step = ANGULAR_STEP if key in ("a", "left") else -ANGULAR_STEP
+            self.w = round(min(max(self.w + step, -self.max_yaw_rate), self.max_yaw_rate), 6)
+        elif key == "space":
+            self.v = self.w = 0.0
+        elif key == "m":
+            return "mark"
+        elif key == "q":
+            return "quit"
+        else:
+            raise ValueError(f"unknown key {key!r} (known: {', '.join(KEYS)})")
+        return None
+
+
+class KeyScript:
+    """Timed keys from a file (see the module docstring); :meth:`wait` hands out the keys due
+    at a simulated time at once, without waiting for the wall clock."""
+
+    interactive = False
+
+    def __init__(self, path: str | os.PathLike) -> None:
+        path = Path(path)
+        if not path.is_file():
+            raise FileNotFoundError(f"{path}: key script not found")
+        self._events: list[tuple[float, str]] = []
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            fields = line.split("#", 1)[0].split()
+            if not fields:
+                continue
+            where = f"{path}:{number}"
+            try:
+                t = float(fields[0])
+            except ValueError:
+                raise ValueError(f"{where}: a line is TIME KEY [KEY ...], got {line!r}") from None
+            if not (math.isfinite(t) and t >= 0) or len(fields) < 2:
+                raise ValueError(f"{where}: a line is TIME KEY [KEY ...] with TIME >= 0 seconds")
+            if self._events and t < self._events[-1][0]:
+                raise ValueError(f"{where}: times must not decrease")
+            for key in fields[1:]:
+                if key.lower() not in KEYS:
+                    raise ValueError(f"{where}: unknown key {key!r} (known: {', '.join(KEYS)})")
+                self._events.append((t, key.lower()))
+        if not self._events or self._events[-1][1] != "q":
+            raise ValueError(f"{path}: a key script must end with q (finish)")
+        self._next = 0
+
+    def wait(self, t: float) -> list[str]:
+        """The keys pressed at simulated times up to t (half a millisecond of slack)."""
+        keys = []
+        while self._next < len(self._events) and self._events[self._next][0] <= t + 5e-4:
+            keys.append(self._events[self._next][1])
+            self._next += 1
+        return keys
+
+    def __enter__(self) -> KeyScript:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        pass
+
+
+class TerminalKeys:
+    """Keys from a terminal in cbreak mode (no Enter, no echo; Ctrl-C still interrupts).
+    :meth:`wait` paces the loop: it returns the keys pressed until one period after the last
+    call (at once if the simulation fell behind). The terminal's mode is restored on exit."""
+
+    interactive = True
+
+    def __init__(self, fd: int, period: float) -> None:
+        try:
+            import termios
+            import tty
+        except ImportError:
+            raise RuntimeError("keyboard teaching needs a POSIX terminal (termios)") from None
+        if not os.isatty(fd):
+            raise ValueError("keyboard teaching needs a terminal on stdin")
+        self._termios, self._tty = termios, tty
+        self.fd, self.period = fd, float(period)
+        self._saved = None
+        self._old_term = None
+        self._deadline = 0.0
+        self._pending = b""
+
+    def __enter__(self) -> TerminalKeys:
+        self._saved = self._termios.tcgetattr(self.fd)
+        try:  # SIGTERM unwinds like Ctrl-C, so the terminal is restored
+            self._old_term = signal.signal(signal.SIGTERM, _terminate)
+        except ValueError:  # not the main thread
+            self._old_term = None
+        self._tty.setcbreak(self.fd, self._termios.TCSANOW)
+        self._deadline = time.monotonic()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._saved is not None:
+            self._termios.tcsetattr(self.fd, self._termios.TCSADRAIN, self._saved)
+            self._saved = None
+        if self._old_term is not None:
+            signal.signal(signal.SIGTERM, self._old_term)
+            self._old_term = None
+
+    def wait(self, t: float) -> list[str]:
+        del t  # the wall clock paces the terminal
+        now = time.monotonic()
+        self._deadline = max(self._deadline + self.period, now)
+        keys: list[str] = []
+        while True:
+            timeout = self._deadline - time.monotonic()
+            ready, _, _ = select.select([self.fd], [], [], max(timeout, 0.0))
+            if ready:
+                data = os.read(self.fd, 64)
+                if not data:
+                    raise EOFError("the terminal closed")
+                got, self._pending = decode_keys(self._pending + data)
+                keys += got
+            if timeout <= 0:
+                return keys
+
+
+def _terminate(signum, frame) -> None:
+    raise SystemExit(128 + signum)
+
+
+def _status(run: TeachingRun, teleop: Teleop) -> str:
+    x, y, th = run.odom
+    last = f" ({run.marks[-1]['name']})" if run.marks else ""
+    return (
+        f"step {run.steps - 1} | odom {x:.2f} {y:.2f} {math.degrees(th):.1f} deg | "
+        f"v {teleop.v:+.1f} w {teleop.w:+.1f} | waypoints {len(run.marks)}{last}"
+    )
+
+
+def teach_keyboard(
+    scene: Scene,
+    out: str | os.PathLike,
+    keys: KeyScript | TerminalKeys,
+    seed: int = 0,
+    dt: float = 0.1,
+    overwrite: bool = False,
+    stream: TextIO | None = None,
+) -> TeachResult:
+    """Teaches from keys (see the module docstring): one :meth:`TeachingRun.step` per period
+    with the velocity command the keys set, a waypoint P<n> at each m, until q. A status line
+    (step, odometry pose, command, waypoints) goes to `stream`: refreshed in place on a
+    terminal, one line a second otherwise."""
+    stream = stream if stream is not None else sys.stdout
+    in_place = stream.isatty()
+    with TeachingRun(scene, out, seed, dt, overwrite, {"mode": "keyboard"}) as run:
+        teleop = Teleop(*run.limits)
+        stream.write(HELP)
+        stream.flush()
+        while True:
+            pressed, done = False, False
+            for key in keys.wait(run.t):
+                pressed = True
+                action = teleop.press(key)
+                if action == "mark":
+                    run.mark(f"P{len(run.marks)}")
+                elif action == "quit":
+                    done = True
+                    break
+            # the status counts a step once it is logged
+            if in_place:
+                stream.write("\r" + _status(run, teleop) + "\x1b[K")
+                stream.flush()
+            elif (run.steps - 1) % 10 == 0 or pressed:
+                stream.write(_status(run, teleop) + "\n")
+                stream.flush()
+            if done:
+                break
+            run.step(teleop.v, teleop.w)
+        if in_place:
+            stream.write("\n")
+        return run.finish()
