@@ -315,11 +315,15 @@ def teach_command(
     if keyboard and keys is None and not resume and not sys.stdin.isatty():
         raise ValueError("--keyboard needs a terminal on stdin (or --keys FILE of timed keys)")
     scene = load_scene(scene_file)
+    log = out / "teach.mcap"
     if resume:
-        log = out / "teach.mcap"
         if not log.is_file():
             raise FileNotFoundError(f"{log}: no teaching log to resume from")
         result = recover(scene, log, out)
+    elif log.exists() and not overwrite:
+        raise FileExistsError(
+            f"{log}: a teaching log exists; --resume rebuilds from it, --overwrite replaces it"
+        )
     elif keyboard:
         from kiseki.teach.keyboard import KeyScript, TerminalKeys, teach_keyboard
 
@@ -327,13 +331,13 @@ def teach_command(
         try:
             with source:
                 result = teach_keyboard(scene, out, source, seed, overwrite=overwrite)
-        except KeyboardInterrupt:
+        except (KeyboardInterrupt, SystemExit) as stop:  # Ctrl-C; SIGTERM exits 143
             typer.echo(
-                f"\nkiseki: interrupted; {out / 'teach.mcap'} is kept: add --resume to build "
-                "the maps and waypoints from it",
+                f"\nkiseki: interrupted; {log} is kept: add --resume to build the maps and "
+                "waypoints from it",
                 err=True,
             )
-            raise typer.Exit(130) from None
+            raise typer.Exit(stop.code if isinstance(stop, SystemExit) else 130) from None
     else:
         result = teach(scene, out, seed, overwrite=overwrite, progress=True)
     names = ", ".join(m["name"] for m in result.marks)

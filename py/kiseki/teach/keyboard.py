@@ -205,7 +205,7 @@ class TerminalKeys:
             if ready:
                 data = os.read(self.fd, 64)
                 if not data:
-                    raise EOFError("the terminal closed")
+                    raise RuntimeError("the terminal closed")
                 got, self._pending = decode_keys(self._pending + data)
                 keys += got
             if timeout <= 0:
