@@ -236,18 +236,22 @@ def test_keyboard_teaching_in_a_terminal(tmp_path, project_root):
     assert p1["truth"][1] - p0["truth"][1] > 0.15 and p1["truth"][0] > p0["truth"][0]
 
 
-def test_ctrl_c_restores_the_terminal_and_keeps_the_log(tmp_path, project_root):
+@pytest.mark.parametrize("stop", ["ctrl-c", "sigterm"])
+def test_an_interrupt_restores_the_terminal_and_keeps_the_log(tmp_path, project_root, stop):
     scene = project_root / "data" / "worlds" / "factory_turn.yaml"
     out = tmp_path / "t"
     term = _Terminal(["teach", str(scene), "--keyboard", "-o", str(out)])
     try:
-        term.wait_for_step(0)
+        now = term.wait_for_step(0)
         term.press(b"ww")
-        term.wait_for_step(10)
+        now = term.wait_for_step(now + 10)
         term.press(b"m")
-        term.wait_for_step(25)
-        term.press(b"\x03")  # Ctrl-C: SIGINT from the terminal
-        assert term.finish() == 130
+        term.wait_for_step(now + 15)
+        if stop == "ctrl-c":
+            term.press(b"\x03")  # SIGINT from the terminal (cbreak mode keeps ISIG)
+        else:
+            term.proc.send_signal(signal.SIGTERM)
+        assert term.finish() == (130 if stop == "ctrl-c" else 143)
         after = termios.tcgetattr(term.slave)
     finally:
         term.close()
@@ -260,6 +264,9 @@ def test_ctrl_c_restores_the_terminal_and_keeps_the_log(tmp_path, project_root):
         text=True,
     )
     assert done.returncode == 0, done.stderr
+    # the log was closed on the way out: every step shown is in it
+    steps = int(re.search(r"(\d+) steps", done.stdout.replace("\n", " ")).group(1))
+    assert steps >= term.step() + 1
     assert [
         w["name"] for w in yaml.safe_load((out / "waypoints.yaml").read_text())["waypoints"]
     ] == ["P0"]
@@ -283,6 +290,12 @@ def test_keyboard_needs_a_terminal_or_a_key_script(tmp_path, project_root):
     keys.write_text("0 w\n1 fly\n2 q\n")
     done = subprocess.run([*cli, "--keyboard", "--keys", str(keys)], capture_output=True, text=True)
     assert done.returncode == 1 and "keys.txt:2: unknown key 'fly'" in done.stderr
+    (tmp_path / "t").mkdir()
+    (tmp_path / "t" / "teach.mcap").write_bytes(b"")  # an earlier run's log is not replaced
+    keys.write_text("0 w\n1 q\n")
+    done = subprocess.run([*cli, "--keyboard", "--keys", str(keys)], capture_output=True, text=True)
+    assert done.returncode == 1 and "a teaching log exists; --resume" in done.stderr
+    assert (tmp_path / "t" / "teach.mcap").read_bytes() == b""
 
 
 def test_a_killed_keyboard_run_is_recovered(tmp_path, project_root):
