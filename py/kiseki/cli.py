@@ -333,7 +333,7 @@ def teach_command(
                 result = teach_keyboard(scene, out, source, seed, overwrite=overwrite)
         except (KeyboardInterrupt, SystemExit) as stop:  # Ctrl-C; SIGTERM exits 143
             typer.echo(
-                f"\nkiseki: interrupted; {log} is kept: add --resume to build the maps and "
+                f"kiseki: interrupted; {log} is kept: add --resume to build the maps and "
                 "waypoints from it",
                 err=True,
             )

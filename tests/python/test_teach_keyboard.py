@@ -99,6 +99,20 @@ def test_a_key_script_teaches_like_the_operator(tmp_path, project_root):
         np.testing.assert_array_equal(load_map(path).cells, load_map(result.maps[band]).cells)
 
 
+def test_the_readme_key_script_runs(tmp_path, project_root):
+    readme = (project_root / "README.md").read_text(encoding="utf-8")
+    section = readme[readme.index("### Teaching from the keyboard") :]
+    script = section[
+        section.index("```text\n") + 8 : section.index("```\n", 8 + section.index("```text"))
+    ]
+    (tmp_path / "keys.txt").write_text(script)
+    scene = load_scene(project_root / "data" / "worlds" / "factory_turn.yaml")
+    with KeyScript(tmp_path / "keys.txt") as keys:
+        result = teach_keyboard(scene, tmp_path / "t", keys, stream=io.StringIO())
+    assert [m["name"] for m in result.marks] == ["P0", "P1"] and result.steps == 91
+    assert result.marks[1]["truth"][2] > 0.5  # it turned left in place at 0.2 rad/s for 4 s
+
+
 # --------------------------------------------------------------------------------------------
 # The real CLI in a pseudo-terminal
 # --------------------------------------------------------------------------------------------

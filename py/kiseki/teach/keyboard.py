@@ -111,8 +111,6 @@ class KeyScript:
     """Timed keys from a file (see the module docstring); :meth:`wait` hands out the keys due
     at a simulated time at once, without waiting for the wall clock."""
 
-    interactive = False
-
     def __init__(self, path: str | os.PathLike) -> None:
         path = Path(path)
         if not path.is_file():
@@ -156,10 +154,9 @@ class KeyScript:
 
 class TerminalKeys:
     """Keys from a terminal in cbreak mode (no Enter, no echo; Ctrl-C still interrupts).
-    :meth:`wait` paces the loop: it returns the keys pressed until one period after the last
-    call (at once if the simulation fell behind). The terminal's mode is restored on exit."""
-
-    interactive = True
+    :meth:`wait` paces the loop: it returns the keys pressed until one period (the run's dt)
+    after the last call (at once if the simulation fell behind). The terminal's mode is
+    restored on exit."""
 
     def __init__(self, fd: int, period: float) -> None:
         try:
@@ -169,6 +166,8 @@ class TerminalKeys:
             raise RuntimeError("keyboard teaching needs a POSIX terminal (termios)") from None
         if not os.isatty(fd):
             raise ValueError("keyboard teaching needs a terminal on stdin")
+        if not (math.isfinite(period) and period > 0):
+            raise ValueError(f"the period must be a positive number of seconds, got {period}")
         self._termios, self._tty = termios, tty
         self.fd, self.period = fd, float(period)
         self._saved = None
@@ -237,33 +236,40 @@ def teach_keyboard(
     """Teaches from keys (see the module docstring): one :meth:`TeachingRun.step` per period
     with the velocity command the keys set, a waypoint P<n> at each m, until q. A status line
     (step, odometry pose, command, waypoints) goes to `stream`: refreshed in place on a
-    terminal, one line a second otherwise."""
+    terminal, one line a second and at each key otherwise."""
     stream = stream if stream is not None else sys.stdout
     in_place = stream.isatty()
     with TeachingRun(scene, out, seed, dt, overwrite, {"mode": "keyboard"}) as run:
-        teleop = Teleop(*run.limits)
         stream.write(HELP)
         stream.flush()
-        while True:
-            pressed, done = False, False
-            for key in keys.wait(run.t):
-                pressed = True
-                action = teleop.press(key)
-                if action == "mark":
-                    run.mark(f"P{len(run.marks)}")
-                elif action == "quit":
-                    done = True
-                    break
-            # the status counts a step once it is logged
-            if in_place:
-                stream.write("\r" + _status(run, teleop) + "\x1b[K")
+        try:
+            _drive(run, keys, Teleop(*run.limits), stream, in_place)
+        finally:
+            if in_place:  # whatever comes next starts on a line of its own
+                stream.write("\n")
                 stream.flush()
-            elif (run.steps - 1) % 10 == 0 or pressed:
-                stream.write(_status(run, teleop) + "\n")
-                stream.flush()
-            if done:
-                break
-            run.step(teleop.v, teleop.w)
-        if in_place:
-            stream.write("\n")
         return run.finish()
+
+
+def _drive(run: TeachingRun, keys, teleop: Teleop, stream: TextIO, in_place: bool) -> None:
+    """The loop: the keys due, the status of the logged step, then one step, until q."""
+    while True:
+        pressed, done = False, False
+        for key in keys.wait(run.t):
+            pressed = True
+            action = teleop.press(key)
+            if action == "mark":
+                run.mark(f"P{len(run.marks)}")
+            elif action == "quit":
+                done = True
+                break
+        # the status counts a step once it is logged
+        if in_place:
+            stream.write("\r" + _status(run, teleop) + "\x1b[K")
+            stream.flush()
+        elif (run.steps - 1) % 10 == 0 or pressed:
+            stream.write(_status(run, teleop) + "\n")
+            stream.flush()
+        if done:
+            return
+        run.step(teleop.v, teleop.w)
