@@ -102,9 +102,7 @@ def test_a_key_script_teaches_like_the_operator(tmp_path, project_root):
 def test_the_readme_key_script_runs(tmp_path, project_root):
     readme = (project_root / "README.md").read_text(encoding="utf-8")
     section = readme[readme.index("### Teaching from the keyboard") :]
-    script = section[
-        section.index("```text\n") + 8 : section.index("```\n", 8 + section.index("```text"))
-    ]
+    script = re.search(r"```text\n(.*?)```", section, re.S).group(1)
     (tmp_path / "keys.txt").write_text(script)
     scene = load_scene(project_root / "data" / "worlds" / "factory_turn.yaml")
     with KeyScript(tmp_path / "keys.txt") as keys:
