@@ -83,7 +83,7 @@ class LaserScans:
     """Laser scans of one log, in file order."""
 
     times: np.ndarray  # (N,) float64 message timestamp, seconds
-    poses: np.ndarray  # (N, 3) float64 laser pose in the log (x, y, theta; corrected logs)
+    poses: np.ndarray  # (N, 3) float64 laser pose in the log (x, y, theta); NaN if it has none
     odometry: np.ndarray  # (N, 3) float64 odometry pose as logged (see the module docstring)
     ranges: np.ndarray  # (N, B) float32 metres, C-contiguous
     angles: np.ndarray  # (B,) float64 beam angles in the laser frame, radians
@@ -91,6 +91,11 @@ class LaserScans:
 
     def __len__(self) -> int:
         return int(self.times.shape[0])
+
+    @property
+    def has_reference_poses(self) -> bool:
+        """False for logs without reference poses (e.g. the Wean Hall logs: ``poses`` all NaN)."""
+        return bool(np.isfinite(self.poses).all())
 
 
 @dataclass(frozen=True, eq=False)
