@@ -23,6 +23,15 @@ void bind_filters(py::module_& m) {
            "particles"_a = 1000, "alpha1"_a = 0.05, "alpha2"_a = 0.01, "alpha3"_a = 0.05,
            "alpha4"_a = 0.01, "resample_threshold"_a = 0.5, "seed"_a = 0)
       .def("initialize", &ParticleFilter::initialize, "mean"_a, "sd_x"_a, "sd_y"_a, "sd_theta"_a)
+      .def("set_particles",
+           [](ParticleFilter& f, const py::handle& poses_in) {
+             const auto p = as_doubles(poses_in, "poses");
+             require_shape(p, "poses", 2, 3);
+             std::vector<Pose2> particles(static_cast<std::size_t>(p.shape(0)));
+             for (std::size_t i = 0; i < particles.size(); ++i) particles[i] = pose_from_row(p.data() + 3 * i);
+             f.set_particles(particles);
+           }, "poses"_a,
+           "Replaces the particles by poses (n, 3), any n >= 1, with uniform weights.")
       .def("predict", &ParticleFilter::predict, "odom_before"_a, "odom_after"_a)
       .def("weight",
            [](ParticleFilter& f, const py::handle& lk_in) {
