@@ -381,38 +381,89 @@ def playback_command(
 
 @app.command("localize")
 def localize_command(
-    log: Path = typer.Argument(..., help="CARMEN log (.log, .log.gz) or kiseki run (.mcap)."),
-    map_file: Path = typer.Option(..., "--map", help="ROS map YAML of the log's building."),
+    log: Path = typer.Argument(
+        ..., help="CARMEN log (.log, .log.gz), kiseki run (.mcap) or CMU Wean robotdata log."
+    ),
+    map_file: Path = typer.Option(
+        ..., "--map", help="ROS map YAML of the log's building, or a CMU .dat(.gz) map."
+    ),
     method: str = typer.Option(
         "likelihood-field", help="odometry, space-observation or likelihood-field."
     ),
     seed: int = typer.Option(0, help="Seed of the filter and of the odometry noise."),
     odometry_noise: float = typer.Option(0.0, help="Odometry noise SD, fraction of each step."),
-    particles: int = typer.Option(500, help="Particles of the filter."),
+    particles: int | None = typer.Option(
+        None, help="Particles of the filter (default 500; 50000 at the start with --global)."
+    ),
+    global_start: bool = typer.Option(
+        False,
+        "--global",
+        help="Global localization: start uniformly over the map's free cells (no initial pose).",
+    ),
+    tracking_particles: int = typer.Option(
+        1000, help="With --global: particles kept once the cloud has converged."
+    ),
+    plot: Path | None = typer.Option(
+        None, help="With --global: draw the map, the estimates and where they converged (PNG)."
+    ),
     output: Path = typer.Option(..., "-o", "--output", help="CSV t,x,y,theta to write."),
 ) -> None:
-    """Localize along a log (position tracking from its first pose) and print the absolute pose
-    error against the log's reference poses."""
+    """Localize along a log: position tracking from its first reference pose, or with --global
+    from a uniform start. Prints the absolute pose error against the log's reference poses when
+    it has them; with --global also the convergence report (written to OUTPUT.json too)."""
     from kiseki._atomic import atomic_write
     from kiseki.datasets import open_scans
-    from kiseki.localization import LocalizeConfig, localize
     from kiseki.map_io import load_map
     from kiseki.metrics import ape
 
-    config = LocalizeConfig(
-        method=method, seed=seed, odometry_noise=odometry_noise, particles=particles
-    )
     scans = open_scans(log)
-    trajectory = localize(scans, load_map(map_file), config, progress=True)
+    grid = load_map(map_file)
+    if global_start:
+        from kiseki.global_localization import GlobalConfig, global_localize
+
+        if odometry_noise != 0.0:
+            raise ValueError("--odometry-noise is for logs with reference poses, not --global")
+        gconfig = GlobalConfig(
+            method=method,
+            seed=seed,
+            particles=50_000 if particles is None else particles,
+            tracking_particles=tracking_particles,
+        )
+        result = global_localize(scans, grid, gconfig, progress=True)
+        trajectory = result.estimates
+    else:
+        from kiseki.localization import LocalizeConfig, localize
+
+        if not scans.has_reference_poses:
+            raise ValueError(f"{log}: the log has no reference poses to start from: use --global")
+        config = LocalizeConfig(
+            method=method,
+            seed=seed,
+            odometry_noise=odometry_noise,
+            particles=500 if particles is None else particles,
+        )
+        trajectory = localize(scans, grid, config, progress=True)
     rows = np.column_stack([scans.times, trajectory])
     text = "t,x,y,theta\n" + "\n".join(",".join(f"{v:.6f}" for v in row) for row in rows) + "\n"
     atomic_write(output, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-    position = ape(trajectory, scans.poses)
-    heading = ape(trajectory, scans.poses, "rotation_deg")
-    console.print(
-        f"{output}: {len(scans)} poses; {method}: position RMSE {position.rmse:.3f} m "
-        f"(max {position.max:.3f} m), heading RMSE {heading.rmse:.2f} deg"
-    )
+    if scans.has_reference_poses:
+        position = ape(trajectory, scans.poses)
+        heading = ape(trajectory, scans.poses, "rotation_deg")
+        console.print(
+            f"{output}: {len(scans)} poses; {method}: position RMSE {position.rmse:.3f} m "
+            f"(max {position.max:.3f} m), heading RMSE {heading.rmse:.2f} deg"
+        )
+    else:
+        console.print(f"{output}: {len(scans)} poses; the log has no reference poses")
+    if global_start:
+        from kiseki.global_localization import describe, write_report
+
+        report_path = write_report(result, output.with_suffix(".json"))
+        console.print(describe(result.report) + f" (report: {report_path})")
+        if plot is not None:
+            from kiseki.global_localization import render_global
+
+            render_global(grid, result, plot, title=f"{log.name}: global {method}")
 
 
 @app.command("report")

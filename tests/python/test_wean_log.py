@@ -59,7 +59,10 @@ def test_tiny_log_units_and_layout(tmp_path: Path, compress: bool) -> None:
 def test_malformed_lines_name_file_and_line(tmp_path: Path) -> None:
     good = tiny_log(tmp_path / "good.log").read_text().splitlines()
     cases = {
-        "short": (good[:3] + [good[3].rsplit(" ", 2)[0]], r"short\.log:4: L line has 186 fields, expected 188"),
+        "short": (
+            good[:3] + [good[3].rsplit(" ", 2)[0]],
+            r"short\.log:4: L line has 186 fields, expected 188",
+        ),
         "text": (good[:2] + ["O 1 2 x 4"], r"text\.log:3: non-numeric value 'x'"),
         "kind": (good[:1] + ["Q 1 2 3"], r"kind\.log:2: unknown line type 'Q'"),
         "neg": (
