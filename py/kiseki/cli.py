@@ -88,6 +88,8 @@ def map_from_log(
     )
     start = time.perf_counter()
     scans = open_scans(log)
+    if not scans.has_reference_poses:
+        raise ValueError(f"{log}: the log has no reference poses to build a map from")
     if rules == "teaching":
         grid = build_teaching_map(
             scans.poses, scans.ranges, scans.angles, scans.max_range, resolution, progress=True
@@ -142,6 +144,24 @@ def map_render(
     path = _read_trajectory(trajectory) if trajectory is not None else None
     render_map(grid, output, trajectory=path, title=map_file.name)
     console.print(f"{output}: {grid.width} x {grid.height} map drawn")
+
+
+@map_app.command("convert")
+def map_convert(
+    map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat(.gz) map."),
+    output: Path = typer.Option(..., "-o", "--output", help="ROS map YAML to write (PGM beside)."),
+) -> None:
+    """Save a map (e.g. the CMU Wean .dat.gz) as a ROS map YAML + PGM (trinary)."""
+    from kiseki.grid import grid_summary
+    from kiseki.map_io import load_map, save_map
+
+    grid = load_map(map_file)
+    save_map(grid, output)
+    summary = grid_summary(grid)
+    console.print(
+        f"{output}: {grid.width} x {grid.height} cells at {grid.resolution} m; "
+        f"{summary['free']} free, {summary['occupied']} occupied, {summary['unknown']} unknown"
+    )
 
 
 @map_app.command("info")

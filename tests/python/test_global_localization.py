@@ -172,3 +172,14 @@ def test_cli_malformed_log_names_the_line(tmp_path: Path) -> None:
     )
     assert done.returncode == 1
     assert "robotdata.log:2: L line has 9 fields, expected 188" in done.stderr
+
+
+def test_cli_map_convert_and_no_map_from_wean_log(wean: tuple[Path, Path], tmp_path: Path) -> None:
+    log, map_file = wean
+    yaml_path = tmp_path / "wean.yaml"
+    done = run_cli("map", "convert", str(map_file), "-o", str(yaml_path))
+    assert done.returncode == 0, done.stderr
+    assert "48332 free" in done.stdout
+    np.testing.assert_array_equal(load_map(yaml_path).cells, load_map(map_file).cells)
+    done = run_cli("map", "from-log", str(log), "-o", str(tmp_path / "x.yaml"))
+    assert done.returncode == 1 and "no reference poses" in done.stderr
