@@ -441,6 +441,8 @@ def localize_command(
     if global_start:
         from kiseki.global_localization import GlobalConfig, global_localize
 
+        if output.suffix.lower() == ".json":
+            raise ValueError(f"{output}: the report goes to OUTPUT.json: give a .csv output")
         if odometry_noise != 0.0:
             raise ValueError("--odometry-noise is for logs with reference poses, not --global")
         gconfig = GlobalConfig(
