@@ -183,3 +183,17 @@ def test_cli_map_convert_and_no_map_from_wean_log(wean: tuple[Path, Path], tmp_p
     np.testing.assert_array_equal(load_map(yaml_path).cells, load_map(map_file).cells)
     done = run_cli("map", "from-log", str(log), "-o", str(tmp_path / "x.yaml"))
     assert done.returncode == 1 and "no reference poses" in done.stderr
+
+
+def test_particle_filter_set_particles() -> None:
+    from kiseki import _core
+
+    pf = _core.ParticleFilter(100, seed=1)
+    poses = np.array([[0.0, 1.0, 0.1], [2.0, 3.0, -0.2], [4.0, 5.0, 3.0]])
+    pf.set_particles(poses)
+    np.testing.assert_allclose(pf.poses, poses)
+    np.testing.assert_allclose(pf.weights, np.full(3, 1 / 3))
+    with pytest.raises(ValueError, match="poses"):
+        pf.set_particles(np.zeros((3, 2)))
+    with pytest.raises(ValueError, match="finite"):
+        pf.set_particles(np.array([[0.0, np.nan, 0.0]]))
