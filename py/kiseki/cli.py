@@ -423,6 +423,12 @@ def localize_command(
     tracking_particles: int = typer.Option(
         1000, help="With --global: particles kept once the cloud has converged."
     ),
+    recovery: bool = typer.Option(
+        False,
+        "--recovery",
+        help="With --global: Augmented MCL while tracking (uniform poses injected when the "
+        "scans fit worse than usual).",
+    ),
     plot: Path | None = typer.Option(
         None, help="With --global: draw the map, the estimates and where they converged (PNG)."
     ),
@@ -450,6 +456,7 @@ def localize_command(
             seed=seed,
             particles=50_000 if particles is None else particles,
             tracking_particles=tracking_particles,
+            recovery=recovery,
         )
         result = global_localize(scans, grid, gconfig, progress=True)
         trajectory = result.estimates

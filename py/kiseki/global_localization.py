@@ -17,9 +17,14 @@
   holds 90 % of the weight below ``shrink_radius``) for ``shrink_after`` updates, it is
   resampled (low variance) down to ``tracking_particles``: a converged cloud needs far fewer
   particles than the uniform start. This is a simple fixed rule instead of KLD-sampling
-  (Fox 2003), which adapts the count at every step; both sizes are the user's choice. There
-  is no random injection (Augmented MCL): a cloud converged on a wrong place stays there, and
-  the fit figures of the report are what tells.
+  (Fox 2003), which adapts the count at every step; both sizes are the user's choice.
+* Recovery (``recovery``, off by default): Augmented MCL (Probabilistic Robotics, Table 8.3)
+  while tracking, with ROS AMCL's suggested ``alpha_slow`` 0.001 and ``alpha_fast`` 0.1. The
+  average likelihood is the weighted mean over particles of the per-beam (geometric mean) scan
+  likelihood, so that it does not depend on how many beams returned. At every update a share
+  ``1 - w_fast / w_slow`` of the cloud is replaced by uniform poses over the free cells.
+  Without it, a cloud converged on a wrong place or lost stays so, and the fit figures of the
+  report are what tells.
 
 Convergence report (:class:`ConvergenceReport`): after every scan the 90 %-weight radius
 (``spread``); the filter is *converged* from the first scan after which the spread stays below
@@ -33,6 +38,7 @@ endpoints inside the map to the nearest occupied cell. The same figures for the 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import os
 import time
@@ -109,6 +115,9 @@ class GlobalConfig:
     weight_share: float = 0.9  # share of the weight inside the spread radius
     likelihood_power: float = 0.1  # until the cut to tracking_particles
     shrink_after: int = 10  # consecutive measurement updates with the spread below shrink_radius
+    recovery: bool = False  # Augmented MCL while tracking (random poses when the fit drops)
+    alpha_slow: float = 0.001
+    alpha_fast: float = 0.1
 
     def __post_init__(self) -> None:
         if self.method not in ("likelihood-field", "space-observation"):
@@ -129,6 +138,8 @@ class GlobalConfig:
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ValueError(f"{name} must be >= 0, got {value}")
+        if not (0 < self.alpha_slow < self.alpha_fast <= 1):
+            raise ValueError("need 0 < alpha_slow < alpha_fast <= 1")
         if self.shrink_after < 1:
             raise ValueError(f"shrink_after must be >= 1, got {self.shrink_after}")
         if not 0 < self.weight_share <= 1:
@@ -161,6 +172,7 @@ class ConvergenceReport:
     seconds: float
     # share of endpoints within 1 cell, per block of 100 scans from the first (None: no return)
     fit_by_block: list[float | None] = field(default_factory=list)
+    injected: int = 0  # uniform poses injected by the recovery (Augmented MCL)
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -257,6 +269,24 @@ def scan_fit(
     )
 
 
+def _per_beam_average(
+    log_l: np.ndarray,
+    weights: np.ndarray,
+    ranges: np.ndarray,
+    max_range: float,
+    config: GlobalConfig,
+) -> float:
+    """The weighted mean over particles of the per-beam (geometric mean) likelihood: the scale
+    does not depend on how many beams of the scan returned, unlike the product."""
+    used = ranges[:: config.beam_stride]
+    beams = int(np.count_nonzero(np.isfinite(used) & (used > 0) & (used < max_range)))
+    if beams == 0:
+        return float("nan")
+    per_beam = log_l / beams
+    top = per_beam.max()
+    return float(np.exp(top) * np.dot(weights, np.exp(per_beam - top)))
+
+
 def _moved(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
     step = Pose2(*a).between(Pose2(*b))
     return float(np.hypot(step.x, step.y)), abs(float(step.theta))
@@ -299,6 +329,9 @@ def global_localize(
     updates = 0
     shrunk_at: int | None = None
     tight_updates = 0
+    w_slow: float | None = None
+    w_fast: float | None = None
+    injected = 0
     for k in tqdm(range(n), desc="global " + config.method, unit="scan", disable=not progress):
         moved_d, moved_a = (np.inf, np.inf) if last_update is None else _moved(last_update, odom[k])
         if not (moved_d >= config.update_min_d or moved_a >= config.update_min_a):
@@ -320,6 +353,11 @@ def global_localize(
             log_l = lf_model.log_likelihoods(pf.poses)
             if shrunk_at is None:
                 log_l *= config.likelihood_power
+            elif config.recovery and np.isfinite(
+                w_avg := _per_beam_average(log_l, pf.weights, ranges, scans.max_range, config)
+            ):
+                w_slow = w_avg if w_slow is None else w_slow + config.alpha_slow * (w_avg - w_slow)
+                w_fast = w_avg if w_fast is None else w_fast + config.alpha_fast * (w_avg - w_fast)
             pf.weight(np.exp(log_l - log_l.max()))
         poses, weights = pf.poses, pf.weights
         estimates[k] = last_estimate = pf.estimate().to_array()
@@ -331,10 +369,19 @@ def global_localize(
                 keep = _systematic_resample(poses, weights, config.tracking_particles, rng)
                 pf.set_particles(keep)
             shrunk_at = k
+        elif w_slow is not None and w_fast is not None and w_fast < w_slow:
+            # Augmented MCL: resample with a share 1 - w_fast / w_slow of uniform poses.
+            inject = rng.binomial(len(poses), 1.0 - w_fast / w_slow)
+            keep = _systematic_resample(poses, weights, len(poses) - inject, rng)
+            if inject > 0:
+                keep = np.vstack([keep, uniform_free_poses(grid, inject, rng)])
+            pf.set_particles(keep)
+            injected += inject
         else:
             pf.resample_if_needed()
     seconds = time.perf_counter() - start
     report = _report(scans, grid, config, estimates, spread, updates, shrunk_at, seconds)
+    report = dataclasses.replace(report, injected=injected)
     return GlobalResult(estimates, spread, counts, report, config)
 
 
@@ -407,6 +454,8 @@ def describe(report: ConvergenceReport) -> str:
     )
     if report.shrunk_at is not None:
         text += f" (cloud cut to the tracking size at scan {report.shrunk_at})"
+    if report.injected:
+        text += f"; {report.injected} uniform poses injected while tracking"
     fit, shifted, rotated = report.fit, report.fit_shifted_1m, report.fit_rotated_10deg
     if fit is not None and shifted is not None and rotated is not None:
         text += (

@@ -197,3 +197,22 @@ def test_particle_filter_set_particles() -> None:
         pf.set_particles(np.zeros((3, 2)))
     with pytest.raises(ValueError, match="finite"):
         pf.set_particles(np.array([[0.0, np.nan, 0.0]]))
+
+
+def test_wean_recovery_injects_and_stays_deterministic(wean: tuple[Path, Path]) -> None:
+    log, map_file = wean
+    full = open_scans(log)
+    n = 300
+    scans = LaserScans(
+        full.times[:n], full.poses[:n], full.odometry[:n], full.ranges[:n], full.angles,
+        full.max_range,
+    )  # fmt: skip
+    grid = load_map(map_file)
+    config = GlobalConfig(seed=0, recovery=True)
+    first = global_localize(scans, grid, config)
+    assert first.report.shrunk_at is not None and first.report.injected > 0
+    assert first.particle_counts[-1] == config.tracking_particles
+    again = global_localize(scans, grid, config)
+    np.testing.assert_array_equal(first.estimates, again.estimates)
+    with pytest.raises(ValueError, match="alpha_slow"):
+        GlobalConfig(alpha_slow=0.2, alpha_fast=0.1)
