@@ -2,6 +2,7 @@
 // Copyright (c) 2026 the kiseki authors
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -136,4 +137,39 @@ TEST(SpaceObservation, LikelihoodPeaksAtTheTruePose) {
   EXPECT_THROW(SpaceObservationModel(map, bad), std::invalid_argument);
   SpaceObservationModel empty(map);
   EXPECT_THROW(empty.counts(truth), std::logic_error);
+}
+
+TEST(SpaceObservation, VisibilityReachesEveryCellOfAnOpenWindowAndStopsAtWalls) {
+  OccupancyGrid open(200, 200, 0.1, Pose2(), kFree);
+  SpaceObservationParams p;
+  p.occlusion_aware = true;
+  SpaceObservationModel model(open, p);
+  model.set_local_map(LocalMapBuilder().build());  // 8 m: a window of 115 x 115 cells
+  const OccupancyGrid all = model.visibility(Pose2(10.05, 10.05, 0.0));
+  ASSERT_EQ(all.width(), 115);
+  int seen = 0;
+  for (int j = 0; j < all.height(); ++j)
+    for (int i = 0; i < all.width(); ++i) seen += all.value(i, j);
+  EXPECT_EQ(seen, 115 * 115);  // the border segments pass through every cell
+
+  // A closed box of walls around the centre cell (100, 100), 5 x 5 cells inside: the walls are
+  // seen, nothing beyond them, nor the box's corner cells (hidden behind the walls beside them,
+  // the diagonal segment is stopped at their corners); inside a wall, only that cell is seen.
+  OccupancyGrid boxed = open.clone();
+  for (int k = -3; k <= 3; ++k) {
+    boxed.set(100 + k, 97, kOccupied), boxed.set(100 + k, 103, kOccupied);
+    boxed.set(97, 100 + k, kOccupied), boxed.set(103, 100 + k, kOccupied);
+  }
+  SpaceObservationModel walled(boxed, p);
+  walled.set_local_map(LocalMapBuilder().build());
+  const OccupancyGrid box = walled.visibility(Pose2(10.05, 10.05, 0.0));
+  for (int j = 0; j < box.height(); ++j)
+    for (int i = 0; i < box.width(); ++i) {
+      const int dx = std::abs(i - 57), dy = std::abs(j - 57);
+      const bool inside = std::max(dx, dy) <= 3 && !(dx == 3 && dy == 3);
+      ASSERT_EQ(box.value(i, j), inside ? 1 : 0) << i << ", " << j;
+    }
+  const OccupancyGrid wall = walled.visibility(Pose2(9.75, 10.05, 0.0));  // cell (97, 100)
+  for (int j = 0; j < wall.height(); ++j)
+    for (int i = 0; i < wall.width(); ++i) ASSERT_EQ(wall.value(i, j), i == 57 && j == 57 ? 1 : 0);
 }

@@ -10,12 +10,13 @@ import pandas as pd
 import pytest
 
 from kiseki import Pose2
-from kiseki.grid import beam_angles
+from kiseki.grid import OccupancyGrid, beam_angles
 from kiseki.models import (
     LocalMapBuilder,
     SpaceObservationModel,
     counts_reference,
     likelihood_reference,
+    visibility_reference,
 )
 from kiseki.sim.scene import load_scene
 
@@ -110,6 +111,46 @@ def test_occlusion_aware_counts_equal_the_reference_and_hide_behind_walls(corrid
     assert seen[span // 2, span // 2] == 1  # its own cell
     assert seen[span // 2, span // 2 + 40] == 1  # 2 m along the corridor (0.05 m cells)
     assert seen[span // 2 + 45, span // 2] == 0  # 2.25 m to the left, behind the north wall
+
+
+def walled_rooms():
+    """12 m x 8 m at 0.1 m: outer walls, a partition with a doorway, a diagonal wall whose cells
+    touch only at corners, pillars, and a patch of unknown cells."""
+    cells = np.zeros((80, 120), dtype=np.int8)
+    cells[[0, -1], :] = 100
+    cells[:, [0, -1]] = 100
+    cells[:, 60] = 100  # the partition...
+    cells[30:38, 60] = 0  # ...and its doorway
+    for k in range(25):  # a staircase wall, 8-connected only
+        cells[50 + k, 15 + k] = 100
+    cells[20, 30] = cells[21, 31] = cells[60, 90] = 100  # a diagonal pair, a lone pillar
+    cells[10:14, 80:84] = 100
+    cells[65:70, 100:110] = -1
+    return OccupancyGrid(cells, 0.1, Pose2(0.0, 0.0, 0.0))
+
+
+def test_visibility_equals_the_reference_cell_for_cell():
+    grid = walled_rooms()
+    model = SpaceObservationModel(grid, occlusion_aware=True)
+    model.set_local_map(LocalMapBuilder(4.0, 0.1).build())  # a window of 57 x 57 cells
+    rng = np.random.default_rng(2)
+    cells = [(35, 33), (59, 34), (61, 20), (20, 70), (30, 20), (1, 1), (118, 78), (60, 5)]
+    cells += [tuple(c) for c in rng.integers([-5, -5], [125, 85], (40, 2))]
+    for cx, cy in cells:
+        seen = model.visible_from(Pose2((cx + 0.5) * 0.1, (cy + 0.5) * 0.1, 0.3)).cells
+        assert seen.shape == (57, 57)
+        np.testing.assert_array_equal(seen, visibility_reference(grid, (cx, cy), 57))
+    # and what it means: from (50, 34), in the left room's doorway row
+    seen = model.visible_from(Pose2(5.05, 3.45, 0.0)).cells  # [row, column], centre (28, 28)
+    assert seen[28, 28 + 10] == 1  # the partition cell itself is seen...
+    assert seen[28, 28 + 15] == 1  # ...and the next room, through the doorway
+    assert seen[28 - 20, 28 + 15] == 0  # but not behind the partition
+    seen = model.visible_from(Pose2(2.05, 7.05, 0.0)).cells  # (20, 70), above the staircase
+    assert seen[28 - 20, 28 + 20] == 0  # below it, behind cells touching only at corners
+    seen = model.visible_from(Pose2(2.75, 2.45, 0.0)).cells  # (27, 24), below the diagonal pair
+    assert seen[28 - 4, 28 + 3] == 1 and seen[28 - 3, 28 + 4] == 1  # sees the pair
+    assert seen[28 - 2, 28 + 2] == 1  # and the cell before the corner they share,
+    assert seen[28 - 4, 28 + 4] == 0  # but not through it
 
 
 def plain_local(grid):

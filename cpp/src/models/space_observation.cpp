@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <mutex>
 #include <unordered_map>
 #include <stdexcept>
@@ -129,8 +130,14 @@ struct SpaceObservationModel::Impl {
     }
   }
 
-  // Cells of the span x span window centred on map cell (cx, cy) that the centre sees: a fan of
-  // rays from the centre cell's centre, each ending at (and including) the first occupied cell.
+  // Cells of the span x span window centred on map cell (cx, cy) that the centre sees: from the
+  // centre cell's centre, one segment to the centre of every cell on the window's border, each
+  // seeing the cells it passes through up to and including the first occupied one (see the
+  // header). The walk is exact, in integers: with (di, dj) the border cell's offset, the segment
+  // crosses column boundaries at t = (2m + 1) / (2|di|) and row boundaries at t = (2n + 1) /
+  // (2|dj|); scaled by 2 |di| |dj| these are ex = (2m + 1) |dj| and ey = (2n + 1) |di|, so each
+  // step compares two integers and a tie is a corner. Along a row (dj = 0) ex stays 0 < ey, and
+  // along a column ey stays 0 < ex, so those walk straight.
   std::shared_ptr<const BitRows> visible_from(int cx, int cy) const {
     const long long key = static_cast<long long>(cy) * (1LL << 32) + cx;
     {
@@ -138,19 +145,48 @@ struct SpaceObservationModel::Impl {
       const auto it = visibility.find(key);
       if (it != visibility.end()) return it->second;
     }
-    auto out = std::make_shared<BitRows>(span, span);
-    const int half = span / 2, rays = 8 * span;
-    for (int r = 0; r < rays; ++r) {
-      const double a = 2.0 * kPi * r / rays, dx = std::cos(a), dy = std::sin(a);
-      for (double t = 0.0; t <= half * std::sqrt(2.0) + 1.0; t += 0.5) {
-        const int i = half + static_cast<int>(std::lround(t * dx));
-        const int j = half + static_cast<int>(std::lround(t * dy));
-        if (i < 0 || j < 0 || i >= span || j >= span) break;
-        out->set(i, j);
-        const int mx = cx - half + i, my = cy - half + j;
-        if (map.contains(mx, my) && map.value(mx, my) >= params.occupied_threshold) break;
+    const int half = span / 2;
+    const std::size_t cells = static_cast<std::size_t>(span) * span;
+    // The window's occupied cells (none outside the map) and the cells seen, one byte each.
+    std::vector<std::uint8_t> occupied(cells, 0), seen(cells, 0);
+    const int x0 = cx - half, y0 = cy - half;
+    for (int j = std::max(0, -y0); j < std::min(span, map.height() - y0); ++j)
+      for (int i = std::max(0, -x0); i < std::min(span, map.width() - x0); ++i)
+        occupied[static_cast<std::size_t>(j) * span + i] =
+            map.value(x0 + i, y0 + j) >= params.occupied_threshold;
+    const int centre = half * span + half;
+    seen[centre] = 1;
+    if (!occupied[centre]) {
+      auto walk = [&](int di, int dj) {
+        const int ai = std::abs(di), aj = std::abs(dj);
+        const int sx = di > 0 ? 1 : -1, sy = dj > 0 ? span : -span;  // index steps
+        long long ex = aj, ey = ai;  // next column / row crossing, scaled
+        int at = centre;
+        for (int left = ai + aj; left > 0;) {
+          if (ex < ey) {
+            at += sx, ex += 2LL * aj, --left;
+          } else if (ey < ex) {
+            at += sy, ey += 2LL * ai, --left;
+          } else {  // through a corner: both cells touching it are seen; both occupied seal it
+            seen[at + sx] = seen[at + sy] = 1;
+            if (occupied[at + sx] && occupied[at + sy]) return;
+            at += sx + sy, ex += 2LL * aj, ey += 2LL * ai, left -= 2;
+          }
+          seen[at] = 1;
+          if (occupied[at]) return;
+        }
+      };
+      for (int d = -half; d < half; ++d) {  // the border, each cell once
+        walk(d, -half);
+        walk(half, d);
+        walk(-d, half);
+        walk(-half, -d);
       }
     }
+    auto out = std::make_shared<BitRows>(span, span);
+    for (int j = 0; j < span; ++j)
+      for (int i = 0; i < span; ++i)
+        if (seen[static_cast<std::size_t>(j) * span + i]) out->set(i, j);
     std::lock_guard<std::mutex> lock(visibility_mutex);
     if (visibility.size() > 200000) visibility.clear();  // bound the memory on long runs
     return visibility.emplace(key, std::move(out)).first->second;

@@ -9,6 +9,13 @@ from kiseki.models.space_observation import (
     SpaceObservationModel,
     counts_reference,
     likelihood_reference,
+    visibility_reference,
 )
 
-__all__ = ["LocalMapBuilder", "SpaceObservationModel", "counts_reference", "likelihood_reference"]
+__all__ = [
+    "LocalMapBuilder",
+    "SpaceObservationModel",
+    "counts_reference",
+    "likelihood_reference",
+    "visibility_reference",
+]

@@ -9,17 +9,90 @@ Penetration ratio = 100 |free in L and occupied in m_i| / |occupied in m_i|, int
 likelihood = exp(-pen^2 / (2 * 10^2)) * exp(-intr^2 / (2 * 130^2)). The thesis gives the ratios
 without a unit; sigma 10 vs 130 only makes sense in percent (penetration costly, intrusion, which
 unknown obstacles cause, cheap), so percent it is.
+
+Occlusion-aware (proposal 1 of the thesis), the map the particle should observe: free map cells
+its cell cannot see count as occupied. Visibility (``visibility_reference``, the C++ model's
+``visible_from``): from the centre of the particle's cell, one straight segment to the centre of
+every cell on the border of the span x span window around it. A segment sees the cells it passes
+through, in order, up to and including the first occupied one. Where it passes exactly through a
+cell corner it also sees the two cells touching that corner on either side, and it stops there
+if both of them are occupied (a diagonal wall seals; one grazed corner does not). Cells outside
+the map are never occupied.
 """
 
 from __future__ import annotations
 
+from itertools import groupby
+
 import numpy as np
 
 from kiseki._core import LocalMapBuilder, SpaceObservationModel
-from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
 
-__all__ = ["LocalMapBuilder", "SpaceObservationModel", "counts_reference", "likelihood_reference"]
+__all__ = [
+    "LocalMapBuilder",
+    "SpaceObservationModel",
+    "counts_reference",
+    "likelihood_reference",
+    "visibility_reference",
+]
+
+
+def visibility_reference(
+    grid: OccupancyGrid, cell, span: int, occupied_threshold: int = 65
+) -> np.ndarray:
+    """The span x span window of map cells centred on ``cell`` (x, y), 1 where the centre cell
+    sees it, else 0 (int8, [row, column]); the definition is in the module's docstring.
+
+    Each segment is walked by its boundary crossings in order: with (di, dj) the border cell's
+    offset, it crosses column boundaries at t = (2m + 1) / (2|di|), m < |di|, and row boundaries
+    at t = (2n + 1) / (2|dj|), n < |dj| (t = 1 at the border cell's centre); a column and a row
+    crossing at the same t are a corner. Exact in integers: times 2 |di| |dj| (a factor 0 taken
+    as 1, for a segment along a row or a column), t is (2m + 1) |dj| and (2n + 1) |di|."""
+    cx, cy = (int(v) for v in cell)
+    half = span // 2
+    occupied = np.zeros((span, span), dtype=bool)
+    x0, y0 = cx - half, cy - half
+    xs0, ys0 = max(x0, 0), max(y0, 0)
+    xs1, ys1 = min(x0 + span, grid.width), min(y0 + span, grid.height)
+    if xs1 > xs0 and ys1 > ys0:
+        cells = grid.cells[ys0:ys1, xs0:xs1]
+        occupied[ys0 - y0 : ys1 - y0, xs0 - x0 : xs1 - x0] = cells >= occupied_threshold
+    seen = np.zeros((span, span), dtype=np.int8)
+    seen[half, half] = 1
+    if occupied[half, half]:
+        return seen
+    border = [
+        (di, dj)
+        for dj in range(-half, half + 1)
+        for di in range(-half, half + 1)
+        if max(abs(di), abs(dj)) == half
+    ]
+    for di, dj in border:
+        ai, aj = abs(di), abs(dj)
+        sx, sy = (1 if di > 0 else -1), (1 if dj > 0 else -1)
+        crossings = sorted(
+            [((2 * m + 1) * max(aj, 1), "column") for m in range(ai)]
+            + [((2 * n + 1) * max(ai, 1), "row") for n in range(aj)]
+        )
+        i = j = half
+        for _, group in groupby(crossings, key=lambda c: c[0]):
+            kinds = {kind for _, kind in group}
+            if kinds == {"column", "row"}:  # through a corner
+                sides = ((j, i + sx), (j + sy, i))
+                for side in sides:
+                    seen[side] = 1
+                if all(occupied[side] for side in sides):
+                    break
+                i, j = i + sx, j + sy
+            elif kinds == {"column"}:
+                i += sx
+            else:
+                j += sy
+            seen[j, i] = 1
+            if occupied[j, i]:
+                break
+    return seen
 
 
 def counts_reference(
@@ -28,7 +101,7 @@ def counts_reference(
     """(penetrating, map_occupied, intruding, map_free) for one particle, in plain numpy: the
     local map rotated to the particle's heading bin (``model.rotated_local_map``) laid over the
     map at the particle's cell; occlusion-aware, free map cells the particle's cell cannot see
-    (``model.visible_from``) count as occupied."""
+    (``visibility_reference``) count as occupied."""
     x, y, theta = (float(v) for v in pose)
     local = model.rotated_local_map(model.bin_of(theta)).cells
     span = local.shape[0]
@@ -42,7 +115,7 @@ def counts_reference(
     view = local >= 0
     occupied, free = window >= 65, (window >= 0) & (window <= 19)
     if occlusion_aware:
-        hidden = free & (model.visible_from(Pose2(x, y, theta)).cells == 0)
+        hidden = free & (visibility_reference(grid, (cx, cy), span) == 0)
         occupied, free = occupied | hidden, free & ~hidden
     m_occ = occupied & view
     m_free = free & view

@@ -44,9 +44,17 @@ struct SpaceObservationParams {
 /// stored as bit rows; a particle then costs a few AND + popcount per row against the map's bit
 /// rows at an integer cell offset. Discretisation: heading to the nearest bin, position to the
 /// map cell containing the particle; each rotated cell takes the L cell under its centre.
-/// Occlusion-aware (proposal 1): visibility from the particle's cell is found by a fan of rays
-/// through the map (8 per cell of the window's side) that stop at the first occupied cell; it
-/// depends on the cell only, so it is cached per cell and shared by the particles in it.
+/// Occlusion-aware (proposal 1): the window of map cells around the particle's cell is seen
+/// from that cell's centre along one straight segment to the centre of every cell on the
+/// window's border (4 (span - 1) segments, which together pass through every cell of the
+/// window). A segment sees the cells it passes through, in order, up to and including the first
+/// occupied one; where it passes exactly through a cell corner it also sees the two cells
+/// touching that corner on either side, and stops there if both are occupied (a wall whose
+/// cells touch only at corners still hides what is behind it). Cells outside the map are never
+/// occupied. Each segment is walked cell by cell (Amanatides-Woo) with its boundary crossings
+/// compared exactly in integers, so corners are found without rounding. Visibility depends on
+/// the cell only, so it is cached per cell (bounded in size, thread-safe) and shared by the
+/// particles in it. The numpy reference is kiseki.models.visibility_reference.
 class SpaceObservationModel {
  public:
   SpaceObservationModel(const OccupancyGrid& map, const SpaceObservationParams& params = {});
