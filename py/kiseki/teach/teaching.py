@@ -129,9 +129,11 @@ def teach(
             for c, image in zip(cameras, images, strict=True):
                 writer.write_depth_image(f"/{c.name}", t, image, c.name)
             _integrate(maps, makers, images, odom)
-            _mark(writer, marks, names, controller, truth, odom, t)
+            # the operator stops pushing at the goal and marks it once the cart is at rest
+            resting = controller.done and not any(setup.robot.velocity)
+            _mark(writer, marks, names, controller, truth, odom, t, resting)
             bar.update(1)  # this step is written
-            if controller.done:
+            if resting:
                 break
             v, _, w = controller.command(truth)
             setup.odometry.update(setup.robot.step(v, w, dt))
@@ -149,16 +151,14 @@ def _integrate(maps, makers, images, odom) -> None:
         _core.merge_local_map(maps[band], maker.make(images), pose)
 
 
-def _mark(writer, marks, names, controller: PurePursuit, truth, odom, t) -> None:
+def _mark(writer, marks, names, controller: PurePursuit, truth, odom, t, resting) -> None:
     """The operator marks the next route point when the robot reaches it along the route (the
-    goal when the robot stops there)."""
+    goal once the robot has come to rest there)."""
     i = len(marks)
     if i >= len(names):
         return
     last = i == len(names) - 1
-    if (last and not controller.done) or (
-        not last and controller.progress < controller.cum[i] - 0.05
-    ):
+    if (last and not resting) or (not last and controller.progress < controller.cum[i] - 0.05):
         return
     mark = {
         "id": i,
