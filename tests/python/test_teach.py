@@ -158,3 +158,15 @@ def test_bad_input(tmp_path, project_root):
         text=True,
     )
     assert done.returncode == 1 and "no teaching log" in done.stderr
+
+
+def test_experiment_trial_records_the_goal_likelihood_profile():
+    from kiseki.experiments.teach_playback import PROFILE_OFFSETS, Exp2Config, trial
+
+    record = trial(Exp2Config(methods=["proposal1"], particles=100), 0, 0).record
+    along = [record[f"proposal1_goal_like_along_{o:+.2f}"] for o in PROFILE_OFFSETS]
+    side = [record[f"proposal1_goal_like_side_{o:+.2f}"] for o in PROFILE_OFFSETS]
+    assert all(0 < v <= 1 for v in along + side)
+    assert abs(record["proposal1_goal_peak_along"]) <= 0.4
+    assert abs(record["proposal1_goal_peak_side"]) <= 0.4
+    assert record["proposal1_reached"]
