@@ -98,7 +98,9 @@ TEST(SpaceObservation, BitCountsEqualPlainLoopsOverTheRotatedLocalMap) {
   for (int k = 0; k < 200; ++k) {
     const Pose2 p(rng.uniform(-3, 11), rng.uniform(-4, 4), rng.uniform(-kPi, kPi));
     const OccupancyGrid l = model.rotated_local_map(model.bin_of(p.theta));
-    const CellIndex c = map.world_to_cell({p.x, p.y});
+    // the window cell: the one whose lower-left corner is the grid corner nearest the particle
+    const Eigen::Vector2d g = map.world_to_grid({p.x, p.y});
+    const CellIndex c{static_cast<int>(std::floor(g.x() + 0.5)), static_cast<int>(std::floor(g.y() + 0.5))};
     SpaceObservationCounts ref;
     for (int j = 0; j < l.height(); ++j)
       for (int i = 0; i < l.width(); ++i) {

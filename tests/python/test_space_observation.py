@@ -60,7 +60,8 @@ def test_rotation_matches_an_independent_resampling(corridor):
         span = rotated.shape[0]
         theta = np.radians(bin_)
         jj, ii = np.mgrid[0:span, 0:span]
-        dx, dy = (ii - span // 2) * grid.resolution, (jj - span // 2) * grid.resolution
+        # cell centres relative to the window's corner, where the particle is
+        dx, dy = (ii - span // 2 + 0.5) * grid.resolution, (jj - span // 2 + 0.5) * grid.resolution
         lx = np.cos(theta) * dx + np.sin(theta) * dy + 4.0
         ly = -np.sin(theta) * dx + np.cos(theta) * dy + 4.0
         cx, cy = np.floor(lx / 0.1).astype(int), np.floor(ly / 0.1).astype(int)
@@ -78,6 +79,38 @@ def test_likelihood_prefers_the_true_pose_and_errors_run_along_the_corridor(corr
     assert np.argmax(along) == 10 and np.argmax(across) == 10
     # sideways offsets are punished far harder than offsets along the corridor
     assert across[[0, 20]].max() < 0.01 < along[[0, 20]].min()
+
+
+@pytest.mark.parametrize("heading_deg", [0.0, 90.0, 180.0, -90.0])
+def test_no_half_cell_bias(heading_deg):
+    """True poses spread evenly over a map cell, particles on a 1 cm lattice around each: the
+    centroid of the best-scoring particles is the truth on average. L has the robot on a cell
+    corner; the window was anchored on the map cell containing the particle, which treated every
+    particle as sitting on its cell's lower-left corner: for axis-aligned headings the estimate
+    ran half a cell (0.05 m) forward and to the left of the truth."""
+    rng = np.random.default_rng(3)
+    cells = np.where(rng.random((120, 120)) < 0.08, 100, 0).astype(np.int8)
+    cells[[0, -1], :] = cells[:, [0, -1]] = 100
+    grid = OccupancyGrid(cells, 0.1, Pose2(-6.0, -6.0, 0.0))
+    theta = np.radians(heading_deg)
+    angles = beam_angles(2000, 2 * np.pi)
+    model = SpaceObservationModel(grid)
+    offsets = np.arange(-0.2, 0.2001, 0.01)
+    ox, oy = (a.ravel() for a in np.meshgrid(offsets, offsets))
+    sub = [-0.03, -0.01, 0.01, 0.03]  # true positions within the cell, symmetric about its corner
+    bias = []
+    for tx, ty in [(a, b) for a in sub for b in sub]:
+        ranges = grid.cast_scans(np.array([[tx, ty, theta]]), angles, max_range=4.0)[0]
+        builder = LocalMapBuilder(8.0, 0.1)
+        builder.add_scan(Pose2(), angles, ranges.astype(np.float32), 4.0)
+        model.set_local_map(builder.build())
+        like = model.likelihoods(np.column_stack([tx + ox, ty + oy, np.full(ox.size, theta)]))
+        best = like >= like.max() * (1 - 1e-9)
+        bias.append((ox[best].mean(), oy[best].mean()))
+    forward, left = np.array(bias).mean(axis=0) @ np.array(
+        [[np.cos(theta), -np.sin(theta)], [np.sin(theta), np.cos(theta)]]
+    )
+    assert abs(forward) < 0.01 and abs(left) < 0.01, (forward, left)
 
 
 def test_bad_input(corridor):

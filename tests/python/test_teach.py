@@ -19,6 +19,7 @@ import yaml
 from kiseki import _core, load_map
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
+from kiseki.sim.mcap_log import read_run
 from kiseki.sim.scene import load_scene
 from kiseki.teach import LocalMapMaker, PlaybackConfig, playback, teach
 from kiseki.teach.teaching import load_taught, recover
@@ -77,6 +78,13 @@ def test_teach_recover_and_playback(tmp_path, project_root):
         result.reached
         and np.hypot(result.stop_true[0] - goal[0], result.stop_true[1] - goal[1]) <= 0.1
     )
+    # the goal is marked and the stop is measured where the robot has come to rest (it was
+    # taken one step after the stop command, still rolling at 0.2 m/s, 0.06 m short of rest)
+    assert np.array_equal(result.truth[-1], result.truth[-2])
+    log = read_run(taught.log)
+    last = [m["pose"]["position"] for _, m in log.messages("/ground_truth")][-2:]
+    assert last[0] == last[1]
+    assert marks[-1]["truth"][:2] == pytest.approx([last[1]["x"], last[1]["y"]], abs=1e-9)
 
 
 def test_a_killed_teaching_run_is_recovered_losing_under_a_second(tmp_path, project_root):
@@ -150,3 +158,15 @@ def test_bad_input(tmp_path, project_root):
         text=True,
     )
     assert done.returncode == 1 and "no teaching log" in done.stderr
+
+
+def test_experiment_trial_records_the_goal_likelihood_profile():
+    from kiseki.experiments.teach_playback import PROFILE_OFFSETS, Exp2Config, trial
+
+    record = trial(Exp2Config(methods=["proposal1"], particles=100), 0, 0).record
+    along = [record[f"proposal1_goal_like_along_{o:+.2f}"] for o in PROFILE_OFFSETS]
+    side = [record[f"proposal1_goal_like_side_{o:+.2f}"] for o in PROFILE_OFFSETS]
+    assert all(0 < v <= 1 for v in along + side)
+    assert abs(record["proposal1_goal_peak_along"]) <= 0.4
+    assert abs(record["proposal1_goal_peak_side"]) <= 0.4
+    assert record["proposal1_reached"]

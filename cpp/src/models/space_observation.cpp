@@ -87,7 +87,7 @@ struct SpaceObservationModel::Impl {
   ShiftedRows shifted_free, shifted_occupied;
   OccupancyGrid local{1, 1, 1.0};
   bool has_local = false;
-  int span = 0;  // rotated local maps are span x span map cells, centred on the robot's cell
+  int span = 0;  // rotated local maps are span x span map cells, centred on the window cell
   mutable std::vector<Rotated> cache;
   mutable std::mutex visibility_mutex;
   mutable std::unordered_map<long long, std::shared_ptr<const BitRows>> visibility;
@@ -106,6 +106,19 @@ struct SpaceObservationModel::Impl {
 
   int bins() const { return static_cast<int>(std::lround(360.0 / params.heading_step_deg)); }
 
+  // The window of a particle: the map cell whose lower-left corner is the grid corner nearest
+  // the particle. The local map L has the robot on a cell corner (its origin is at -size/2), so
+  // anchoring the window on a corner lines L's cells up with the map's for axis-aligned
+  // headings; the particle's snap to that corner is within half a cell either way, zero on
+  // average. (Anchoring on the cell that contains the particle treated every particle as
+  // sitting on its cell's lower-left corner: a bias of half a cell forward and to the left.)
+  CellIndex window_cell(const Pose2& pose) const {
+    const Eigen::Vector2d g = map.world_to_grid({pose.x, pose.y});
+    const double lim = 1e9;
+    return {static_cast<int>(std::floor(std::clamp(g.x() + 0.5, -lim, lim))),
+            static_cast<int>(std::floor(std::clamp(g.y() + 0.5, -lim, lim)))};
+  }
+
   void rotate(int bin, Rotated& out) const {
     const double theta = bin * params.heading_step_deg * kPi / 180.0;
     const double c = std::cos(theta), s = std::sin(theta), res = map.resolution();
@@ -114,8 +127,8 @@ struct SpaceObservationModel::Impl {
     const double half = 0.5 * local.width() * local.resolution();
     for (int j = 0; j < span; ++j) {
       for (int i = 0; i < span; ++i) {
-        // Centre of rotated cell (i, j) relative to the robot's cell centre, in the map axes.
-        const double dx = (i - span / 2) * res, dy = (j - span / 2) * res;
+        // Centre of rotated cell (i, j) relative to the window's corner (the robot), map axes.
+        const double dx = (i - span / 2 + 0.5) * res, dy = (j - span / 2 + 0.5) * res;
         const double lx = c * dx + s * dy + half, ly = -s * dx + c * dy + half;  // robot frame
         const int cx = static_cast<int>(std::floor(lx / local.resolution()));
         const int cy = static_cast<int>(std::floor(ly / local.resolution()));
@@ -248,7 +261,7 @@ SpaceObservationCounts SpaceObservationModel::counts(const Pose2& pose) const {
     throw std::invalid_argument("space observation: particle pose is not finite");
   }
   const Rotated& l = m.rotated(bin_of(pose.theta));
-  const CellIndex centre = m.map.world_to_cell({pose.x, pose.y});
+  const CellIndex centre = m.window_cell(pose);
   const int x0 = centre.x - m.span / 2, y0 = centre.y - m.span / 2;
   SpaceObservationCounts c;
   const int words = l.free.words;
@@ -318,7 +331,7 @@ namespace kiseki {
 OccupancyGrid SpaceObservationModel::visibility(const Pose2& pose) const {
   const Impl& m = *impl_;
   if (!m.has_local) throw std::logic_error("space observation: set a local map first");
-  const CellIndex c = m.map.world_to_cell({pose.x, pose.y});
+  const CellIndex c = m.window_cell(pose);
   const auto seen = m.visible_from(c.x, c.y);
   OccupancyGrid out(m.span, m.span, m.map.resolution(), Pose2(), 0);
   for (int j = 0; j < m.span; ++j)

@@ -105,7 +105,8 @@ def counts_reference(
     x, y, theta = (float(v) for v in pose)
     local = model.rotated_local_map(model.bin_of(theta)).cells
     span = local.shape[0]
-    cx, cy = grid.world_to_cell(np.array([[x, y]]))[0]
+    # the window cell: the one whose lower-left corner is the grid corner nearest the particle
+    cx, cy = grid.world_to_cell(np.array([[x, y]]) + 0.5 * grid.resolution)[0]
     x0, y0 = cx - span // 2, cy - span // 2
     window = np.full((span, span), -1, dtype=np.int8)
     xs0, ys0 = max(x0, 0), max(y0, 0)

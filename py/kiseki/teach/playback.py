@@ -1,8 +1,10 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """Playback (thesis sec. 3.5): the robot follows the taught waypoints on the particle filter's
-estimate and stops when the estimate is within 0.1 m of the goal. The filter predicts from
-odometry and weighs particles with the space observation model on the chosen method's local map.
+estimate and stops when the estimate is within 0.1 m of the goal; it then decelerates at its
+acceleration limit (the filter still running) and its stop pose is where it comes to rest. The
+filter predicts from odometry and weighs particles with the space observation model on the
+chosen method's local map.
 """
 
 from __future__ import annotations
@@ -126,8 +128,8 @@ def playback(
         truth_log.append(truth)
         est_log.append(estimate)
         _record_passes(passes, waypoints, controller, truth, estimate, _pose(setup.odometry.pose))
-        if controller.done:
-            break
+        if controller.done and not any(setup.robot.velocity):
+            break  # the stop pose is where the robot comes to rest, not where it was told to stop
         v, _, w = controller.command(estimate)
         setup.odometry.update(setup.robot.step(v, w, config.dt))
         odom_after = setup.odometry.pose

@@ -220,9 +220,11 @@ def teach(
         )
         bar = tqdm(desc="teaching", unit="step", disable=not progress, mininterval=0.1)
         while True:
-            _mark(run, names, controller)
+            # the operator stops pushing at the goal and marks it once the cart is at rest
+            resting = controller.done and not any(run.setup.robot.velocity)
+            _mark(run, names, controller, resting)
             bar.update(1)  # this step is written
-            if controller.done or run.steps >= int(900 / dt):
+            if resting or run.steps >= int(900 / dt):
                 break
             v, _, w = controller.command(run.truth)
             run.step(v, w)
@@ -240,16 +242,14 @@ def _integrate(maps, makers, images, odom) -> None:
         _core.merge_local_map(maps[band], maker.make(images), pose)
 
 
-def _mark(run: TeachingRun, names, controller: PurePursuit) -> None:
+def _mark(run: TeachingRun, names, controller: PurePursuit, resting: bool) -> None:
     """The operator marks the next route point when the robot reaches it along the route (the
-    goal when the robot stops there)."""
+    goal once the robot has come to rest there)."""
     i = len(run.marks)
     if i >= len(names):
         return
     last = i == len(names) - 1
-    if (last and not controller.done) or (
-        not last and controller.progress < controller.cum[i] - 0.05
-    ):
+    if (last and not resting) or (not last and controller.progress < controller.cum[i] - 0.05):
         return
     run.mark(names[i])
 
