@@ -147,7 +147,8 @@ TEST(SpaceObservation, VisibilityReachesEveryCellOfAnOpenWindowAndStopsAtWalls) 
   p.occlusion_aware = true;
   SpaceObservationModel model(open, p);
   model.set_local_map(LocalMapBuilder().build());  // 8 m: a window of 115 x 115 cells
-  const OccupancyGrid all = model.visibility(Pose2(10.05, 10.05, 0.0));
+  // The window is anchored on the cell whose lower-left corner is nearest the pose.
+  const OccupancyGrid all = model.visibility(Pose2(10.02, 9.97, 0.0));
   ASSERT_EQ(all.width(), 115);
   int seen = 0;
   for (int j = 0; j < all.height(); ++j)
@@ -164,14 +165,14 @@ TEST(SpaceObservation, VisibilityReachesEveryCellOfAnOpenWindowAndStopsAtWalls) 
   }
   SpaceObservationModel walled(boxed, p);
   walled.set_local_map(LocalMapBuilder().build());
-  const OccupancyGrid box = walled.visibility(Pose2(10.05, 10.05, 0.0));
+  const OccupancyGrid box = walled.visibility(Pose2(10.0, 10.0, 0.0));
   for (int j = 0; j < box.height(); ++j)
     for (int i = 0; i < box.width(); ++i) {
       const int dx = std::abs(i - 57), dy = std::abs(j - 57);
       const bool inside = std::max(dx, dy) <= 3 && !(dx == 3 && dy == 3);
       ASSERT_EQ(box.value(i, j), inside ? 1 : 0) << i << ", " << j;
     }
-  const OccupancyGrid wall = walled.visibility(Pose2(9.75, 10.05, 0.0));  // cell (97, 100)
+  const OccupancyGrid wall = walled.visibility(Pose2(9.7, 10.0, 0.0));  // cell (97, 100)
   for (int j = 0; j < wall.height(); ++j)
     for (int i = 0; i < wall.width(); ++i) ASSERT_EQ(wall.value(i, j), i == 57 && j == 57 ? 1 : 0);
 }

@@ -170,17 +170,18 @@ def test_visibility_equals_the_reference_cell_for_cell():
     cells = [(35, 33), (59, 34), (61, 20), (20, 70), (30, 20), (1, 1), (118, 78), (60, 5)]
     cells += [tuple(c) for c in rng.integers([-5, -5], [125, 85], (40, 2))]
     for cx, cy in cells:
-        seen = model.visible_from(Pose2((cx + 0.5) * 0.1, (cy + 0.5) * 0.1, 0.3)).cells
+        # the window is anchored on the map cell whose lower-left corner is nearest the pose
+        seen = model.visible_from(Pose2(cx * 0.1 + 0.02, cy * 0.1 - 0.03, 0.3)).cells
         assert seen.shape == (57, 57)
         np.testing.assert_array_equal(seen, visibility_reference(grid, (cx, cy), 57))
     # and what it means: from (50, 34), in the left room's doorway row
-    seen = model.visible_from(Pose2(5.05, 3.45, 0.0)).cells  # [row, column], centre (28, 28)
+    seen = model.visible_from(Pose2(5.0, 3.4, 0.0)).cells  # [row, column], centre (28, 28)
     assert seen[28, 28 + 10] == 1  # the partition cell itself is seen...
     assert seen[28, 28 + 15] == 1  # ...and the next room, through the doorway
     assert seen[28 - 20, 28 + 15] == 0  # but not behind the partition
-    seen = model.visible_from(Pose2(2.05, 7.05, 0.0)).cells  # (20, 70), above the staircase
+    seen = model.visible_from(Pose2(2.0, 7.0, 0.0)).cells  # (20, 70), above the staircase
     assert seen[28 - 20, 28 + 20] == 0  # below it, behind cells touching only at corners
-    seen = model.visible_from(Pose2(2.75, 2.45, 0.0)).cells  # (27, 24), below the diagonal pair
+    seen = model.visible_from(Pose2(2.7, 2.4, 0.0)).cells  # (27, 24), below the diagonal pair
     assert seen[28 - 4, 28 + 3] == 1 and seen[28 - 3, 28 + 4] == 1  # sees the pair
     assert seen[28 - 2, 28 + 2] == 1  # and the cell before the corner they share,
     assert seen[28 - 4, 28 + 4] == 0  # but not through it

@@ -52,8 +52,19 @@ class PlaybackConfig:
     speed: float = 0.5  # m/s
     goal_tolerance: float = 0.1  # m, the thesis' stop rule
     initial_sd: tuple[float, float, float] = (0.05, 0.05, math.radians(1.0))
-    # odometry motion model noise (Probabilistic Robotics Table 5.6), the same for every method
-    alphas: tuple[float, float, float, float] = (0.02, 0.005, 0.02, 0.005)
+    # Odometry motion model noise (Probabilistic Robotics Table 5.6), the same for every method,
+    # set so that its 1-sigma spread covers the simulated AGV's odometry error (sim.robot's
+    # OdometryErrorParams) at 10 Hz and 0.5 m/s (0.05 m, up to about 0.05 rad per step):
+    #   alpha1 (rot -> rot): track width +0.5 % over a 90 deg turn of about 30 steps needs
+    #     0.005^2 * 30 = 7.5e-4, turning slip 5e-5 rad/rad adds 5e-5 / 0.05 = 1e-3 -> 0.002;
+    #   alpha2 (trans -> rot, rad^2/m^2): the 0.1 % wheel-radius difference over the 0.5 m track
+    #     turns 0.002 rad/m, over a 10 m leg of 200 steps (0.002 * 10)^2 / 200 / 0.05^2 = 8e-4;
+    #     wheel slip 4e-6 m/m per wheel adds 2 * 4e-6 / 0.5^2 / 0.05 = 6.4e-4 -> 0.002;
+    #   alpha3 (trans -> trans): mean wheel radius -0.1 % over 200 steps 0.001^2 * 200 = 2e-4,
+    #     slip 2e-6 / 0.05 = 4e-5 -> 5e-4;
+    #   alpha4 (rot -> trans, m^2/rad^2): no modelled source; a floor of 5e-4.
+    # (Each sum rounded up to 1, 2 or 5 times a power of ten.)
+    alphas: tuple[float, float, float, float] = (0.002, 0.002, 0.0005, 0.0005)
     max_duration: float = 300.0
 
     def __post_init__(self) -> None:
