@@ -53,6 +53,7 @@ from kiseki._atomic import atomic_write
 from kiseki.core import Pose2, derive_seed
 from kiseki.datasets.carmen import LaserScans
 from kiseki.grid import FREE, OccupancyGrid
+from kiseki.localization import REAL_ODOMETRY_ALPHAS
 
 __all__ = [
     "GlobalConfig",
@@ -91,8 +92,9 @@ class GlobalConfig:
     * ``shrink_radius`` 0.5 m held for ``shrink_after`` 10 measurement updates (about 2 m of
       travel) before the cut, so that a cloud that is tight for a moment on a wrong place
       keeps its particles.
-    * ``alphas``: the odometry noise of ``LocalizeConfig`` (same filter, same defaults),
-      applied once per measurement update to the odometry since the last one, as AMCL does.
+    * ``alphas``: ``REAL_ODOMETRY_ALPHAS`` of kiseki.localization (the log's real odometry,
+      of unknown error), applied once per measurement update to the odometry since the last
+      one, as AMCL does.
     * ``beam_stride`` 3: 60 of 180 beams, nav2 AMCL's default ``max_beams`` 60.
     * ``sigma_hit`` 0.2 m: nav2 AMCL's default.
     * ``update_min_d`` 0.2 m, ``update_min_a`` 0.5 rad: ROS 1 AMCL's defaults (``update_min_a``
@@ -105,7 +107,7 @@ class GlobalConfig:
     seed: int = 0
     particles: int = 50_000
     tracking_particles: int = 1000
-    alphas: tuple[float, float, float, float] = (0.05, 0.01, 0.05, 0.01)
+    alphas: tuple[float, float, float, float] = REAL_ODOMETRY_ALPHAS
     beam_stride: int = 3
     sigma_hit: float = 0.2
     update_min_d: float = 0.2

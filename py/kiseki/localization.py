@@ -19,9 +19,18 @@ from kiseki.datasets.carmen import LaserScans
 from kiseki.grid import OccupancyGrid
 from kiseki.mapping import scan_local_map
 
-__all__ = ["LOCALIZATION_METHODS", "LocalizeConfig", "localize", "noisy_odometry"]
+__all__ = [
+    "LOCALIZATION_METHODS",
+    "REAL_ODOMETRY_ALPHAS",
+    "LocalizeConfig",
+    "localize",
+    "motion_alphas",
+    "noisy_odometry",
+]
 
 LOCALIZATION_METHODS = ("odometry", "space-observation", "likelihood-field")
+# The motion noise for a log's own odometry, whose error is unknown: wide, AMCL-like values.
+REAL_ODOMETRY_ALPHAS = (0.05, 0.01, 0.05, 0.01)
 
 
 @dataclass(frozen=True)
@@ -31,7 +40,8 @@ class LocalizeConfig:
     odometry_noise: float = 0.0  # SD as a fraction of each odometry increment's component
     particles: int = 500
     initial_sd: tuple[float, float, float] = (0.1, 0.1, np.radians(3.0))
-    alphas: tuple[float, float, float, float] = (0.05, 0.01, 0.05, 0.01)
+    # Odometry motion model noise (Probabilistic Robotics Table 5.6); None: `motion_alphas`
+    alphas: tuple[float, float, float, float] | None = None
     beam_stride: int = 2  # likelihood field: every other beam (AMCL-like)
 
     def __post_init__(self) -> None:
@@ -43,6 +53,32 @@ class LocalizeConfig:
             raise ValueError(f"odometry noise must be >= 0, got {self.odometry_noise}")
         if self.particles < 1:
             raise ValueError("particles must be >= 1")
+        if self.alphas is not None and (
+            len(self.alphas) != 4 or not all(a >= 0 and np.isfinite(a) for a in self.alphas)
+        ):
+            raise ValueError(f"alphas must be four finite numbers >= 0, got {self.alphas}")
+
+
+def motion_alphas(config: LocalizeConfig, scans: LaserScans) -> tuple[float, ...]:
+    """The filter's motion noise: `config.alphas` if given, else the noise the odometry has.
+
+    That is the log's own odometry error plus the noise `noisy_odometry` adds. The log's own:
+    none when its odometry equals its reference poses (the CARMEN "corrected" logs), else
+    unknown, and then `REAL_ODOMETRY_ALPHAS`. The added noise has SD F |component| on each
+    increment, so in the motion model's terms a rotation SD of F |rotation| and a translation
+    SD of F |translation|: alpha1 = alpha3 = F^2; the cross terms (translation turning the
+    heading, rotation moving the robot) get a tenth of that. A filter told of more noise than
+    the odometry has spreads its particles further than one scan can pull them back, which the
+    weakly peaked space observation model does not survive on long corridors."""
+    if config.alphas is not None:
+        return tuple(config.alphas)
+    exact = scans.odometry.shape == scans.poses.shape and np.allclose(
+        scans.odometry, scans.poses, atol=1e-6
+    )
+    base = (0.0, 0.0, 0.0, 0.0) if exact else REAL_ODOMETRY_ALPHAS
+    f2 = config.odometry_noise**2
+    added = (f2, 0.1 * f2, f2, 0.1 * f2)
+    return tuple(max(b + a, 1e-6) for b, a in zip(base, added, strict=True))
 
 
 def noisy_odometry(poses: np.ndarray, fraction: float, seed: int) -> np.ndarray:
@@ -69,7 +105,7 @@ def localize(
     odom = noisy_odometry(scans.odometry, config.odometry_noise, derive_seed(config.seed, 1))
     if config.method == "odometry":
         return odom
-    a1, a2, a3, a4 = config.alphas
+    a1, a2, a3, a4 = motion_alphas(config, scans)
     pf = _core.ParticleFilter(config.particles, a1, a2, a3, a4, 0.5, derive_seed(config.seed, 2))
     pf.initialize(Pose2(*scans.poses[0]), *config.initial_sd)
     if config.method == "space-observation":
