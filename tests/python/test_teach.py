@@ -57,6 +57,28 @@ def test_particle_filter_tracks_odometry_and_resamples():
     assert np.array_equal(a.poses, b.poses)
 
 
+def test_motion_model_turns_on_the_spot_and_reverses_without_spurious_spread():
+    alphas = dict(alpha1=0.002, alpha2=0.002, alpha3=0.0005, alpha4=0.0005)
+    # A turn on the spot of 0.05 rad with 0.1 mm of slip sideways-backward: the heading spreads
+    # by sqrt(alpha1) * 0.05 = 2.2 mrad (plus a negligible alpha2 term), not as if the slip's
+    # direction (about -pi here) were turned there and back.
+    pf = _core.ParticleFilter(4000, seed=3, **alphas)
+    pf.initialize(Pose2(), 0.0, 0.0, 0.0)
+    pf.predict(Pose2(), Pose2(-1e-4, -1e-5, 0.05))
+    heading = pf.poses[:, 2]
+    assert heading.std() == pytest.approx(np.sqrt(0.002) * 0.05, rel=0.1)
+    assert abs(heading.mean() - 0.05) < 1e-3
+    # Straight back 0.1 m: the noise of a forward 0.1 m (heading sd sqrt(2 alpha2) 0.1 from
+    # rot1 and rot2, position sd sqrt(alpha3) 0.1 along the track), not of two half-turns.
+    for step in (0.1, -0.1):
+        pf = _core.ParticleFilter(4000, seed=3, **alphas)
+        pf.initialize(Pose2(), 0.0, 0.0, 0.0)
+        pf.predict(Pose2(), Pose2(step, 0.0, 0.0))
+        assert pf.poses[:, 2].std() == pytest.approx(np.sqrt(2 * 0.002) * 0.1, rel=0.1)
+        assert pf.poses[:, 0].std() == pytest.approx(np.sqrt(0.0005) * 0.1, rel=0.1)
+        assert abs(pf.poses[:, 0].mean() - step) < 1e-3
+
+
 def test_teach_recover_and_playback(tmp_path, project_root):
     scene_file = project_root / "data" / "worlds" / "factory_corridor.yaml"
     taught = teach(load_scene(scene_file), tmp_path / "t", seed=5)
@@ -85,6 +107,20 @@ def test_teach_recover_and_playback(tmp_path, project_root):
     last = [m["pose"]["position"] for _, m in log.messages("/ground_truth")][-2:]
     assert last[0] == last[1]
     assert marks[-1]["truth"][:2] == pytest.approx([last[1]["x"], last[1]["y"]], abs=1e-9)
+    # Returning to the start is a route too: it begins with a turn on the spot, which lost the
+    # track (a 180 deg heading flip in a corridor that looks alike both ways) while the motion
+    # model took the direction of the turn's wheel slip for a rotation of up to pi.
+    home, back = load_taught(tmp_path / "t", "plane", ["P2", "P1", "P0"])
+    result = playback(
+        load_scene(scene_file, "playback"),
+        load_map(home),
+        back,
+        PlaybackConfig(method="proposal1", particles=300, seed=1),
+    )
+    start = back[-1]["truth"]
+    flip = np.abs(np.angle(np.exp(1j * (result.estimates[:, 2] - result.truth[:, 2]))))
+    assert result.reached and flip.max() < np.radians(10), np.degrees(flip.max())
+    assert np.hypot(result.stop_true[0] - start[0], result.stop_true[1] - start[1]) <= 0.2
 
 
 def test_a_killed_teaching_run_is_recovered_losing_under_a_second(tmp_path, project_root):

@@ -2,6 +2,7 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/filters/particle_filter.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -47,16 +48,28 @@ void ParticleFilter::set_particles(const std::vector<Pose2>& particles) {
   weights_.assign(particles_.size(), 1.0 / particles_.size());
 }
 
+namespace {
+constexpr double kTurnOnTheSpot = 0.01;  // m
+}  // namespace
+
 void ParticleFilter::predict(const Pose2& a, const Pose2& b) {
   // Probabilistic Robotics, Table 5.6: decompose the odometry increment.
   const double dx = b.x - a.x, dy = b.y - a.y;
   const double trans = std::hypot(dx, dy);
-  const double rot1 = trans < 1e-6 ? 0.0 : angle_difference(std::atan2(dy, dx), a.theta);
+  // Below kTurnOnTheSpot the increment is a turn on the spot (ROS AMCL's rule): the direction
+  // of a millimetre of wheel slip says nothing, and taking it for rot1 (anything up to pi)
+  // would spread the heading as if the robot had turned twice as far.
+  const double rot1 =
+      trans < kTurnOnTheSpot ? 0.0 : angle_difference(std::atan2(dy, dx), a.theta);
   const double rot2 = angle_difference(angle_difference(b.theta, a.theta), rot1);
+  // Reversing is not turning: the noise of a backward move is that of a forward one, so the
+  // rotations enter the noise folded to [0, pi/2] (rot1 = pi means straight back).
+  const auto folded = [](double r) { return std::min(std::abs(r), kPi - std::abs(r)); };
+  const double n1 = folded(rot1), n2 = folded(rot2);
   const auto& p = params_;
-  const double sd_rot1 = std::sqrt(p.alpha1 * rot1 * rot1 + p.alpha2 * trans * trans);
-  const double sd_trans = std::sqrt(p.alpha3 * trans * trans + p.alpha4 * (rot1 * rot1 + rot2 * rot2));
-  const double sd_rot2 = std::sqrt(p.alpha1 * rot2 * rot2 + p.alpha2 * trans * trans);
+  const double sd_rot1 = std::sqrt(p.alpha1 * n1 * n1 + p.alpha2 * trans * trans);
+  const double sd_trans = std::sqrt(p.alpha3 * trans * trans + p.alpha4 * (n1 * n1 + n2 * n2));
+  const double sd_rot2 = std::sqrt(p.alpha1 * n2 * n2 + p.alpha2 * trans * trans);
   for (auto& q : particles_) {
     const double r1 = rot1 - rng_.normal(0.0, sd_rot1);
     const double t = trans - rng_.normal(0.0, sd_trans);

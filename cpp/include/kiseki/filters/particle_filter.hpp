@@ -32,6 +32,8 @@ class ParticleFilter {
   void initialize(const Pose2& mean, double sd_x, double sd_y, double sd_theta);
   void set_particles(const std::vector<Pose2>& particles);
   /// Moves every particle by the odometry increment between two odometry poses, with noise.
+  /// An increment under 1 cm is a turn on the spot (no rot1), and a backward move has the
+  /// noise of a forward one (rotations near pi enter the noise as their distance from pi).
   void predict(const Pose2& odom_before, const Pose2& odom_after);
   /// Multiplies the weights by likelihoods (one per particle) and normalises. If every
   /// likelihood is zero the weights are left uniform and false is returned.
