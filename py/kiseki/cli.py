@@ -370,23 +370,38 @@ def teach_command(
 @app.command("playback")
 def playback_command(
     scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML (playback variant)."),
-    taught: Path = typer.Option(..., help="Folder written by kiseki teach."),
-    route: str = typer.Option(..., help="Waypoint names, start to goal: P0,P1,P2."),
+    route: str = typer.Option(..., help="Waypoint names, start, via, goal: P0,P1,P2."),
+    taught: Path | None = typer.Option(None, help="Folder written by kiseki teach."),
+    map_file: Path | None = typer.Option(
+        None, "--map", help="Taught map YAML (instead of --taught; with --waypoints)."
+    ),
+    waypoints: Path | None = typer.Option(
+        None, help="Waypoint YAML written by kiseki teach (instead of --taught)."
+    ),
     method: str = typer.Option("proposal2", help="conventional, proposal1, proposal2 or both."),
     seed: int = typer.Option(0, help="Seed of the run's noise."),
 ) -> None:
-    """Play a taught route back on the particle filter's estimate; stop within 0.1 m of the goal."""
+    """Play a taught route back on the particle filter's estimate; stop within 0.1 m of the goal.
+    Give the teaching folder (--taught) or its waypoint file (--waypoints, and --map for a map
+    other than the one named there)."""
     import math
 
     from kiseki.map_io import load_map
     from kiseki.sim.scene import load_scene
     from kiseki.teach import PlaybackConfig, playback
     from kiseki.teach.local_maps import METHODS
-    from kiseki.teach.teaching import load_taught
+    from kiseki.teach.teaching import load_route
 
+    if (taught is None) == (waypoints is None):
+        raise ValueError("give either --taught FOLDER or --waypoints FILE (with --map MAP.yaml)")
+    if taught is not None and map_file is not None:
+        raise ValueError("--map goes with --waypoints, not with --taught")
     config = PlaybackConfig(method=method, seed=seed)
     band, _ = METHODS[method]
-    map_path, marks = load_taught(taught, band, [n.strip() for n in route.split(",")])
+    names = [n.strip() for n in route.split(",")]
+    if taught is not None:
+        waypoints = taught / "waypoints.yaml"
+    map_path, marks = load_route(waypoints, band, names, map_file)
     result = playback(load_scene(scene_file, "playback"), load_map(map_path), marks, config)
     goal = marks[-1]
     tx, ty, _ = result.stop_true

@@ -22,7 +22,7 @@ from kiseki.grid import OccupancyGrid
 from kiseki.sim.mcap_log import read_run
 from kiseki.sim.scene import load_scene
 from kiseki.teach import LocalMapMaker, PlaybackConfig, playback, teach
-from kiseki.teach.teaching import load_taught, recover
+from kiseki.teach.teaching import load_route, load_taught, recover
 
 
 def test_merge_rules_of_the_thesis():
@@ -159,6 +159,21 @@ def test_bad_input(tmp_path, project_root):
     with pytest.raises(ValueError, match="not the one"):
         load_taught(tmp_path / "t", "band", ["P0", "P2"])
     del taught, other
+    # playback from a waypoint file and an explicit map: the right map, another run's, the
+    # wrong band's
+    waypoints = tmp_path / "o" / "waypoints.yaml"
+    path, route = load_route(waypoints, "band", ["P0", "P2"], tmp_path / "o" / "map_band.yaml")
+    assert path == tmp_path / "o" / "map_band.yaml" and [w["name"] for w in route] == ["P0", "P2"]
+    with pytest.raises(ValueError, match="not the one"):
+        load_route(tmp_path / "t" / "waypoints.yaml", "band", ["P0", "P2"], path)
+    with pytest.raises(ValueError, match="the 'plane' map of .* needs the 'band' map"):
+        load_route(waypoints, "band", ["P0", "P2"], tmp_path / "o" / "map_plane.yaml")
+    with pytest.raises(ValueError, match="not a ROS map YAML"):
+        load_route(waypoints, "band", ["P0", "P2"], waypoints)
+    cli = [sys.executable, "-m", "kiseki.cli", "playback", str(scene_file), "--route", "P0,P2"]
+    done = subprocess.run(cli, capture_output=True, text=True)
+    assert done.returncode == 1 and "either --taught FOLDER or --waypoints FILE" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
     # a route through a wall: a waypoint taught beyond the corridor's north wall
     env = load_map(tmp_path / "o" / "map_band.yaml")
     marks = [

@@ -31,7 +31,15 @@ from kiseki.sim.scene import Scene
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.local_maps import BANDS, LocalMapMaker
 
-__all__ = ["TeachResult", "TeachingRun", "load_taught", "recover", "teach", "waypoints_file_hash"]
+__all__ = [
+    "TeachResult",
+    "TeachingRun",
+    "load_route",
+    "load_taught",
+    "recover",
+    "teach",
+    "waypoints_file_hash",
+]
 
 MARK_SCHEMA = {
     "type": "object",
@@ -282,8 +290,19 @@ def recover(scene: Scene, log: str | os.PathLike, out: str | os.PathLike) -> Tea
 def load_taught(folder: str | os.PathLike, band: str, route: list[str]) -> tuple[Path, list[dict]]:
     """The map of a local-map band and the route's waypoints from a teaching folder, checking
     that the map is the one the waypoints were taught with."""
-    folder = Path(folder)
-    path = folder / "waypoints.yaml"
+    return load_route(Path(folder) / "waypoints.yaml", band, route)
+
+
+def load_route(
+    waypoints: str | os.PathLike,
+    band: str,
+    route: list[str],
+    map_file: str | os.PathLike | None = None,
+) -> tuple[Path, list[dict]]:
+    """The route's waypoints from a waypoint file and the map to play it back on: `map_file`,
+    or the `band` map named in the waypoint file. The map must be the one the waypoints were
+    taught with (its image's SHA-1 is in the waypoint file), and of the method's band."""
+    path = Path(waypoints)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no waypoint file (run kiseki teach first)")
     doc = yaml.safe_load(path.read_text(encoding="utf-8"))
@@ -291,10 +310,20 @@ def load_taught(folder: str | os.PathLike, band: str, route: list[str]) -> tuple
         raise ValueError(f"{path}: not a kiseki waypoint file")
     if band not in doc["maps"]:
         raise ValueError(f"{path}: no {band!r} map was taught")
-    map_path = folder / doc["maps"][band]["file"]
+    map_path = path.parent / doc["maps"][band]["file"] if map_file is None else Path(map_file)
     if not map_path.is_file():
         raise FileNotFoundError(f"{map_path}: the taught map is missing")
-    if waypoints_file_hash(map_path) != doc["maps"][band]["image_sha1"]:
+    try:
+        digest = waypoints_file_hash(map_path)
+    except (OSError, yaml.YAMLError, KeyError, TypeError) as e:
+        raise ValueError(f"{map_path}: not a ROS map YAML with its image beside it ({e})") from e
+    if digest != doc["maps"][band]["image_sha1"]:
+        others = [b for b, m in doc["maps"].items() if m.get("image_sha1") == digest]
+        if others:
+            raise ValueError(
+                f"{map_path}: this is the {others[0]!r} map of {path}; the method needs the "
+                f"{band!r} map"
+            )
         raise ValueError(f"{map_path}: this map is not the one {path} was taught with")
     by_name = {w["name"]: w for w in doc["waypoints"]}
     unknown = [n for n in route if n not in by_name]
