@@ -171,16 +171,22 @@ class TerminalKeys:
         self._termios, self._tty = termios, tty
         self.fd, self.period = fd, float(period)
         self._saved = None
-        self._old_term = None
+        self._old_handlers: dict[int, object] = {}
+        self._received: int | None = None
         self._deadline = 0.0
         self._pending = b""
 
     def __enter__(self) -> TerminalKeys:
         self._saved = self._termios.tcgetattr(self.fd)
-        try:  # SIGTERM unwinds like Ctrl-C, so the terminal is restored
-            self._old_term = signal.signal(signal.SIGTERM, _terminate)
-        except ValueError:  # not the main thread
-            self._old_term = None
+        # Ctrl-C (SIGINT) and SIGTERM only set a flag, which `wait` turns into
+        # KeyboardInterrupt / SystemExit(143) at a safe point: an exception raised by the
+        # handler itself may surface inside a C extension that clears it (a pybind11 argument
+        # conversion does), and the interrupt would be lost.
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            try:
+                self._old_handlers[signum] = signal.signal(signum, self._receive)
+            except ValueError:  # not the main thread: leave the defaults
+                break
         self._tty.setcbreak(self.fd, self._termios.TCSANOW)
         self._deadline = time.monotonic()
         return self
@@ -189,9 +195,18 @@ class TerminalKeys:
         if self._saved is not None:
             self._termios.tcsetattr(self.fd, self._termios.TCSADRAIN, self._saved)
             self._saved = None
-        if self._old_term is not None:
-            signal.signal(signal.SIGTERM, self._old_term)
-            self._old_term = None
+        for signum, handler in self._old_handlers.items():
+            signal.signal(signum, handler)
+        self._old_handlers = {}
+
+    def _receive(self, signum, frame) -> None:
+        self._received = signum
+
+    def _raise_if_signalled(self) -> None:
+        if self._received == signal.SIGINT:
+            raise KeyboardInterrupt
+        if self._received is not None:
+            raise SystemExit(128 + self._received)
 
     def wait(self, t: float) -> list[str]:
         del t  # the wall clock paces the terminal
@@ -199,8 +214,10 @@ class TerminalKeys:
         self._deadline = max(self._deadline + self.period, now)
         keys: list[str] = []
         while True:
+            self._raise_if_signalled()
             timeout = self._deadline - time.monotonic()
             ready, _, _ = select.select([self.fd], [], [], max(timeout, 0.0))
+            self._raise_if_signalled()
             if ready:
                 data = os.read(self.fd, 64)
                 if not data:
@@ -209,10 +226,6 @@ class TerminalKeys:
                 keys += got
             if timeout <= 0:
                 return keys
-
-
-def _terminate(signum, frame) -> None:
-    raise SystemExit(128 + signum)
 
 
 def _status(run: TeachingRun, teleop: Teleop) -> str:
