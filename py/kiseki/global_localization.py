@@ -488,18 +488,10 @@ def render_global(
 ) -> Path:
     """The map with the estimates after convergence (blue), before it (faint) and the
     convergence point (red)."""
-    from kiseki.plots import _extent, _figure, _save, _world_xy, map_shades
+    from kiseki.plots import _figure, _save, _world_xy, draw_map
 
     fig, ax = _figure(grid)
-    ax.imshow(
-        map_shades(grid),
-        cmap="gray",
-        vmin=0,
-        vmax=1,
-        origin="lower",
-        extent=_extent(grid),
-        interpolation="nearest",
-    )
+    draw_map(ax, grid)
     k = result.report.converged_scan
     xy = _world_xy(grid, result.estimates)
     if k is None:

@@ -16,7 +16,7 @@ import numpy as np  # noqa: E402
 from kiseki._atomic import atomic_write  # noqa: E402
 from kiseki.grid import OccupancyGrid  # noqa: E402
 
-__all__ = ["map_shades", "render_distance_field", "render_map", "to_map_frame"]
+__all__ = ["draw_map", "map_shades", "render_distance_field", "render_map", "to_map_frame"]
 
 
 def map_shades(grid: OccupancyGrid) -> np.ndarray:
@@ -66,15 +66,8 @@ def _world_xy(grid: OccupancyGrid, points: np.ndarray) -> np.ndarray:
     return pts[:, :2] if grid.origin.theta == 0.0 else to_map_frame(grid, pts)
 
 
-def render_map(
-    grid: OccupancyGrid,
-    path: str | os.PathLike,
-    trajectory: np.ndarray | None = None,
-    points: np.ndarray | None = None,
-    title: str | None = None,
-) -> Path:
-    """Draws the grid, an optional trajectory (n, 2|3) and optional points (m, 2) to a PNG."""
-    fig, ax = _figure(grid)
+def draw_map(ax, grid: OccupancyGrid) -> None:
+    """The grid in grey shades (free white, occupied black, unknown grey) in world metres."""
     ax.imshow(
         map_shades(grid),
         cmap="gray",
@@ -84,6 +77,18 @@ def render_map(
         extent=_extent(grid),
         interpolation="nearest",
     )
+
+
+def render_map(
+    grid: OccupancyGrid,
+    path: str | os.PathLike,
+    trajectory: np.ndarray | None = None,
+    points: np.ndarray | None = None,
+    title: str | None = None,
+) -> Path:
+    """Draws the grid, an optional trajectory (n, 2|3) and optional points (m, 2) to a PNG."""
+    fig, ax = _figure(grid)
+    draw_map(ax, grid)
     if points is not None and len(points):
         xy = _world_xy(grid, points)
         ax.plot(xy[:, 0], xy[:, 1], ".", color="tab:red", markersize=1.5, label="scan points")
