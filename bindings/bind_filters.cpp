@@ -3,7 +3,6 @@
 #include <pybind11/stl.h>
 
 #include "kiseki/filters/particle_filter.hpp"
-#include "kiseki/teach/map_merge.hpp"
 #include "numpy_helpers.hpp"
 
 namespace kiseki::bindings {
@@ -55,8 +54,6 @@ void bind_filters(py::module_& m) {
       .def_property_readonly("weights", [](const ParticleFilter& f) {
         return py::array_t<double>(static_cast<py::ssize_t>(f.weights().size()), f.weights().data());
       });
-  m.def("merge_local_map", &merge_local_map, "environment"_a, "local"_a, "pose"_a,
-        "Places a local map in the environment map with the thesis' merge rules.");
 }
 
 }  // namespace kiseki::bindings

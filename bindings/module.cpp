@@ -9,6 +9,7 @@ void bind_mapping(pybind11::module_& m);
 void bind_sim(pybind11::module_& m);
 void bind_models(pybind11::module_& m);
 void bind_filters(pybind11::module_& m);
+void bind_teach(pybind11::module_& m);
 }  // namespace kiseki::bindings
 
 PYBIND11_MODULE(_core, m) {
@@ -19,4 +20,5 @@ PYBIND11_MODULE(_core, m) {
   kiseki::bindings::bind_sim(m);
   kiseki::bindings::bind_models(m);
   kiseki::bindings::bind_filters(m);
+  kiseki::bindings::bind_teach(m);
 }

@@ -70,18 +70,20 @@ def map_from_log(
     render: Path | None = typer.Option(None, help="Also draw the map and trajectory to this PNG."),
     rules: str = typer.Option(
         "log-odds",
-        help="log-odds (occupancy probabilities) or teaching (the thesis' merge rules: the map "
-        "the space observation model expects; use --resolution 0.1).",
+        help="log-odds (occupancy probabilities), teaching (the thesis' merge rules: the map "
+        "the space observation model expects; use --resolution 0.1) or evidence (a teaching map "
+        "whose cells turn free only when their free observations outweigh their hits).",
     ),
 ) -> None:
     """Build an occupancy grid from a log's poses and scans and save it as a ROS map."""
     from kiseki.datasets import open_scans
     from kiseki.map_io import load_map, save_map
-    from kiseki.mapping import MapBuildConfig, build_map, build_teaching_map, endpoint_agreement
+    from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
     from kiseki.plots import render_map
+    from kiseki.teach.environment_map import build_teaching_map
 
-    if rules not in ("log-odds", "teaching"):
-        raise typer.BadParameter(f"--rules must be log-odds or teaching, got {rules!r}")
+    if rules not in ("log-odds", "teaching", "evidence"):
+        raise typer.BadParameter(f"--rules must be log-odds, teaching or evidence, got {rules!r}")
     config = MapBuildConfig(
         resolution=_positive("--resolution", resolution),
         usable_range=_positive("--usable-range", usable_range),
@@ -90,9 +92,15 @@ def map_from_log(
     scans = open_scans(log)
     if not scans.has_reference_poses:
         raise ValueError(f"{log}: the log has no reference poses to build a map from")
-    if rules == "teaching":
+    if rules in ("teaching", "evidence"):
         grid = build_teaching_map(
-            scans.poses, scans.ranges, scans.angles, scans.max_range, resolution, progress=True
+            scans.poses,
+            scans.ranges,
+            scans.angles,
+            scans.max_range,
+            resolution,
+            rule="thesis" if rules == "teaching" else "evidence",
+            progress=True,
         )
     else:
         grid = build_map(scans.poses, scans.ranges, scans.angles, scans.max_range, config, True)
@@ -189,12 +197,19 @@ def demo(
     ),
     seed: int = typer.Option(0, help="Seed of every noise source of the run."),
     particles: int = typer.Option(1000, help="Particles of the localization filter."),
+    merge: str = typer.Option(
+        "thesis", help="Merge rule of the taught maps: thesis or evidence (see kiseki teach)."
+    ),
 ) -> None:
-    """The main job: teach the factory route with a turn, play it back with each method, and
-    print the thesis' Table 4.5-style comparison."""
+    """The main job: teach the factory route with a turn, measure the taught maps against the
+    scene's truth, play the route back with each method, and print the thesis' Table 4.5-style
+    comparison."""
     from kiseki.demo import run_demo
+    from kiseki.teach.environment_map import MERGE_RULES
 
-    run_demo(scene, out, seed, console, particles)
+    if merge not in MERGE_RULES:
+        raise typer.BadParameter(f"--merge must be {' or '.join(MERGE_RULES)}, got {merge!r}")
+    run_demo(scene, out, seed, console, particles, merge)
 
 
 @experiment_app.command("list")
@@ -323,13 +338,23 @@ def teach_command(
         help="With --keyboard: read timed keys from this file (lines TIME KEY [KEY ...], TIME "
         "in simulated seconds, ending with q) instead of the terminal.",
     ),
+    merge: str | None = typer.Option(
+        None,
+        help="Merge rule of the environment maps: thesis (L free over M occupied -> free; the "
+        "default) or evidence (a cell turns free only when its free observations outweigh its "
+        "hits). With --resume: the rule the log was taught with, unless given.",
+    ),
 ) -> None:
     """Teach a route: push the robot along the scene's route (simulated) or from the keyboard,
-    build the environment maps with the thesis' merge rules, record the waypoints; the run is
+    build the environment maps with the thesis' merge rules (or --merge evidence), record the
+    waypoints and measure the maps against the scene's truth (map_truth.json); the run is
     logged as it goes."""
     from kiseki.sim.scene import load_scene
+    from kiseki.teach.environment_map import MERGE_RULES
     from kiseki.teach.teaching import recover, teach
 
+    if merge is not None and merge not in MERGE_RULES:
+        raise typer.BadParameter(f"--merge must be {' or '.join(MERGE_RULES)}, got {merge!r}")
     if keys is not None and not keyboard:
         raise ValueError("--keys FILE goes with --keyboard")
     if keyboard and keys is None and not resume and not sys.stdin.isatty():
@@ -339,7 +364,7 @@ def teach_command(
     if resume:
         if not log.is_file():
             raise FileNotFoundError(f"{log}: no teaching log to resume from")
-        result = recover(scene, log, out)
+        result = recover(scene, log, out, merge)
     elif log.exists() and not overwrite:
         raise FileExistsError(
             f"{log}: a teaching log exists; --resume rebuilds from it, --overwrite replaces it"
@@ -350,7 +375,9 @@ def teach_command(
         source = KeyScript(keys) if keys is not None else TerminalKeys(sys.stdin.fileno(), 0.1)
         try:
             with source:
-                result = teach_keyboard(scene, out, source, seed, overwrite=overwrite)
+                result = teach_keyboard(
+                    scene, out, source, seed, overwrite=overwrite, merge=merge or "thesis"
+                )
         except (KeyboardInterrupt, SystemExit) as stop:  # Ctrl-C; SIGTERM exits 143
             typer.echo(
                 f"kiseki: interrupted; {log} is kept: add --resume to build the maps and "
@@ -359,12 +386,22 @@ def teach_command(
             )
             raise typer.Exit(stop.code if isinstance(stop, SystemExit) else 130) from None
     else:
-        result = teach(scene, out, seed, overwrite=overwrite, progress=True)
+        result = teach(
+            scene, out, seed, overwrite=overwrite, progress=True, merge=merge or "thesis"
+        )
     names = ", ".join(m["name"] for m in result.marks)
     console.print(
         f"{out}: {result.steps} steps, waypoints {names or 'none'}; maps "
         + ", ".join(str(p) for p in result.maps.values())
+        + f" ({result.merge} merge)"
     )
+    for band, t in (result.truth or {}).items():
+        console.print(
+            f"  {band} map against the scene's truth: {100 * t['erased_share']:.1f} % of "
+            f"{t['obstacle_cells']} obstacle cells in reach erased, "
+            f"{100 * t['false_occupied_share']:.1f} % of {t['visible_free_cells']} visible "
+            "free cells occupied"
+        )
 
 
 @app.command("playback")

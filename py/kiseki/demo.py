@@ -46,6 +46,7 @@ class DemoConfig:
     scene: str = "data/worlds/factory_turn.yaml"
     seed: int = 0
     particles: int = 1000
+    merge: str = "thesis"  # the environment maps' merge rule (kiseki.teach.environment_map)
 
 
 def _write_text(path: Path, text: str) -> None:
@@ -53,14 +54,19 @@ def _write_text(path: Path, text: str) -> None:
 
 
 def run_demo(
-    scene_file: Path, out: Path, seed: int, console: Console, particles: int = 1000
+    scene_file: Path,
+    out: Path,
+    seed: int,
+    console: Console,
+    particles: int = 1000,
+    merge: str = "thesis",
 ) -> dict:
-    config = DemoConfig(scene=str(scene_file), seed=seed, particles=particles)
+    config = DemoConfig(scene=str(scene_file), seed=seed, particles=particles, merge=merge)
     out.mkdir(parents=True, exist_ok=True)
     scene = load_scene(scene_file)
     render_scene(scene, out / "scene.png")
     console.print("teaching: pushing the AGV along the route ...")
-    taught = teach(scene, out / "teach", seed=derive_seed(seed, 1), overwrite=True)
+    taught = teach(scene, out / "teach", seed=derive_seed(seed, 1), overwrite=True, merge=merge)
     goal = taught.marks[-1]
     maps = {band: load_map(path) for band, path in taught.maps.items()}
     marks_xy = np.array([[m["x"], m["y"]] for m in taught.marks])
@@ -94,12 +100,33 @@ def run_demo(
         "scene": str(scene_file),
         "teaching_steps": taught.steps,
         "waypoints": [m["name"] for m in taught.marks],
+        "merge": taught.merge,
+        "taught_map_truth": {
+            band: {k: t[k] for k in ("erased_share", "false_occupied_share")}
+            for band, t in taught.truth.items()
+        },
         "playback": results,
     }
     _write_text(out / "config.yaml", yaml.safe_dump(asdict(config), sort_keys=False))
     _write_text(out / "summary.json", json.dumps(summary, indent=2))
+    _print_truth(taught.truth, taught.merge, console)
     _print(results, out, console)
     return summary
+
+
+def _print_truth(truth: dict, merge: str, console: Console) -> None:
+    table = Table(title=f"Taught maps against the scene's truth ({merge} merge)")
+    for column in ("map", "obstacle cells in reach", "erased", "visible free cells", "occupied"):
+        table.add_column(column, justify="left" if column == "map" else "right")
+    for band, t in truth.items():
+        table.add_row(
+            band,
+            str(t["obstacle_cells"]),
+            f"{100 * t['erased_share']:.1f} %",
+            str(t["visible_free_cells"]),
+            f"{100 * t['false_occupied_share']:.1f} %",
+        )
+    console.print(table)
 
 
 def _print(results: dict, out: Path, console: Console) -> None:

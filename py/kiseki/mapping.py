@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """Occupancy-grid mapping from scans taken at known poses: the log-odds inverse sensor model
-(`build_map`), and the teaching-and-playback thesis' environment map (`build_teaching_map`), in
-which local maps are merged by the thesis' rules and the space behind every obstacle is occupied."""
+(`build_map`), and the thesis' local map L of one scan (`scan_local_map`). The teaching map built
+from logs by the thesis' merge rules is `kiseki.teach.environment_map.build_teaching_map`."""
 
 from __future__ import annotations
 
@@ -17,8 +17,8 @@ from kiseki.grid import OccupancyGrid
 __all__ = [
     "MapBuildConfig",
     "build_map",
-    "build_teaching_map",
     "endpoint_agreement",
+    "scan_local_builder",
     "scan_local_map",
 ]
 
@@ -103,6 +103,24 @@ def build_map(
     return mapper.to_occupancy()
 
 
+def scan_local_builder(
+    angles: np.ndarray,
+    ranges: np.ndarray,
+    max_range: float,
+    size: float = 8.0,
+    resolution: float = 0.1,
+) -> _core.LocalMapBuilder:
+    """The builder of the thesis' local map L (robot frame, sensor at its centre) filled with
+    one 2-D scan; readings >= max_range ("no return": glass, black surfaces, open space) are
+    left out, as in `build_map`: a missing echo says nothing certain about the space along the
+    beam. Its `build()` is L, its `hits()` the cells a beam ended in."""
+    ranges = np.array(ranges, dtype=np.float32)  # a copy: the caller's scan stays as it was
+    ranges[ranges >= max_range] = np.nan
+    builder = _core.LocalMapBuilder(size, resolution)
+    builder.add_scan(_core.Pose2(), angles, ranges, max_range)
+    return builder
+
+
 def scan_local_map(
     angles: np.ndarray,
     ranges: np.ndarray,
@@ -110,47 +128,8 @@ def scan_local_map(
     size: float = 8.0,
     resolution: float = 0.1,
 ) -> OccupancyGrid:
-    """The thesis' local map L (robot frame, sensor at its centre) from one 2-D scan. Readings
-    >= max_range ("no return": glass, black surfaces, open space) are left out, as in
-    `build_map`: a missing echo says nothing certain about the space along the beam."""
-    ranges = np.array(ranges, dtype=np.float32)  # a copy: the caller's scan stays as it was
-    ranges[ranges >= max_range] = np.nan
-    builder = _core.LocalMapBuilder(size, resolution)
-    builder.add_scan(_core.Pose2(), angles, ranges, max_range)
-    return builder.build()
-
-
-def build_teaching_map(
-    poses: np.ndarray,
-    ranges: np.ndarray,
-    angles: np.ndarray,
-    max_range: float,
-    resolution: float = 0.1,
-    local_size: float = 8.0,
-    progress: bool = False,
-) -> OccupancyGrid:
-    """The environment map the space observation model is defined against (thesis sec. 3.4),
-    from scans at known poses: each scan's local map (`scan_local_map`) placed at its pose and
-    merged by the thesis' rules (unknown -> local value; local free over occupied -> free;
-    local occupied over free -> stays free). Walls are as thin as single scans see them and
-    the space behind them is occupied, unlike `build_map`'s log-odds map."""
-    poses = np.ascontiguousarray(poses, dtype=np.float64)
-    ranges = np.asarray(ranges)
-    if poses.ndim != 2 or poses.shape[1] != 3 or poses.shape[0] == 0:
-        raise ValueError(f"poses: expected a non-empty (n, 3) array, got shape {poses.shape}")
-    if ranges.ndim != 2 or ranges.shape[0] != poses.shape[0]:
-        raise ValueError(f"ranges: expected ({poses.shape[0]}, beams), got shape {ranges.shape}")
-    if not np.isfinite(poses).all():
-        raise ValueError("poses: every pose must be finite")
-    reach = local_size / np.sqrt(2.0) + resolution  # half the diagonal of a local map
-    lo = poses[:, :2].min(axis=0) - reach
-    hi = poses[:, :2].max(axis=0) + reach
-    width, height = np.ceil((hi - lo) / resolution).astype(int)
-    grid = _core.OccupancyGrid(int(width), int(height), resolution, _core.Pose2(lo[0], lo[1], 0))
-    for k in tqdm(range(len(poses)), desc="teaching map", disable=not progress, leave=False):
-        local = scan_local_map(angles, ranges[k], max_range, local_size, resolution)
-        _core.merge_local_map(grid, local, _core.Pose2(*poses[k]))
-    return grid
+    """The thesis' local map L from one 2-D scan (see `scan_local_builder`)."""
+    return scan_local_builder(angles, ranges, max_range, size, resolution).build()
 
 
 def endpoint_agreement(

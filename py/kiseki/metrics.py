@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """Trajectory metrics with evo's definitions (Grupp, evo, 2017): absolute pose error (APE),
-relative pose error (RPE), trajectory alignment (Umeyama 1991), and the stop-position error
-of a route's goal.
+relative pose error (RPE), trajectory alignment (Umeyama 1991), the stop-position error
+of a route's goal, and a taught map's departure from the ground truth (`taught_map_truth`).
 
 Poses are (n, 3) planar rows (x, y, theta) or (n, 4, 4) homogeneous matrices; planar poses are
 lifted to SE(3) with z = 0. Error statistics are those evo prints (rmse, mean, median, std with
@@ -17,12 +17,14 @@ import numpy as np
 
 __all__ = [
     "ErrorStatistics",
+    "MapTruth",
     "StopError",
     "align_trajectory",
     "ape",
     "as_se3",
     "rpe",
     "stop_error",
+    "taught_map_truth",
     "umeyama_alignment",
 ]
 
@@ -201,3 +203,105 @@ def stop_error(stop, goal) -> StopError:
     c, si = np.cos(g[2]), np.sin(g[2])
     heading = np.degrees(np.arctan2(np.sin(s[2] - g[2]), np.cos(s[2] - g[2])))
     return StopError(c * dx + si * dy, -si * dx + c * dy, float(np.hypot(dx, dy)), float(heading))
+
+
+@dataclass(frozen=True)
+class MapTruth:
+    """A taught map measured against the ground truth (`taught_map_truth`)."""
+
+    erased_share: float  # obstacle cells in reach that the map marks free (with 8 neighbours)
+    false_occupied_share: float  # visible free cells the map marks occupied (with 8 neighbours)
+    obstacle_cells: int
+    erased_cells: int
+    visible_free_cells: int
+    false_occupied_cells: int
+
+    def as_dict(self) -> dict:
+        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+
+
+def _all_nine(mask: np.ndarray) -> np.ndarray:
+    """True where a cell and its 8 neighbours are all True (False at the border)."""
+    padded = np.pad(mask, 1, constant_values=False)
+    out = np.ones_like(mask)
+    h, w = mask.shape
+    for dy in (0, 1, 2):
+        for dx in (0, 1, 2):
+            out &= padded[dy : dy + h, dx : dx + w]
+    return out
+
+
+def taught_map_truth(
+    taught,
+    truth,
+    sensor_poses: np.ndarray,
+    hfov: float,
+    reach: float,
+    min_range: float = 0.0,
+) -> MapTruth:
+    """How far a taught map (free 0 / occupied 100 / unknown -1) departs from the truth grid
+    of the same height band, over the cells the sensors could reach along the route.
+
+    A truth cell is in reach when its centre lies within `reach` metres and +-hfov/2 of the
+    heading of some sensor pose (n, 3: x, y, yaw in the world), at least `min_range` ahead of
+    it along the heading (a depth camera measures nothing nearer than its minimum depth); it is
+    visible when, besides, nothing occupied in the truth lies between that sensor and it (ray
+    cast in the truth).
+    - erased share: of the truth's occupied cells in reach (seen or hidden), those that the
+      taught map marks free together with all 8 neighbours of the taught cell under them;
+    - false-occupied share: of the truth's free cells visible from the route, those that the
+      taught map marks occupied together with all 8 neighbours.
+    The 8 neighbours keep a one-cell shift (odometry, a thin leg beside a beam) from counting:
+    what counts is free space where a wall is, or a wall where open space is.
+    """
+    poses = np.asarray(sensor_poses, dtype=np.float64)
+    if poses.ndim != 2 or poses.shape[1] != 3 or len(poses) == 0 or not np.isfinite(poses).all():
+        raise ValueError("sensor_poses: expected a non-empty finite (n, 3) array")
+    if not (0 < hfov < 2 * np.pi) or not (reach > 0 and np.isfinite(reach)):
+        raise ValueError(f"need 0 < hfov < 2 pi and a positive reach, got {hfov}, {reach}")
+    cells = np.asarray(truth.cells)
+    res = truth.resolution
+    ys, xs = np.mgrid[0 : truth.height, 0 : truth.width]
+    cx = truth.origin.x + (xs.ravel() + 0.5) * res
+    cy = truth.origin.y + (ys.ravel() + 0.5) * res
+    occupied = cells.ravel() >= 65
+    free = cells.ravel() == 0
+    step = 0.25 * res / reach  # rays a quarter cell apart at the reach
+    angles = np.arange(-hfov / 2, hfov / 2 + step, step)
+    ranges = truth.cast_scans(poses, angles, max_range=reach + res)
+    in_reach = np.zeros(cx.size, bool)
+    visible = np.zeros(cx.size, bool)
+    for pose, beams in zip(poses, ranges, strict=True):
+        dx, dy = cx - pose[0], cy - pose[1]
+        dist = np.hypot(dx, dy)
+        bearing = np.arctan2(dy, dx) - pose[2]
+        bearing = (bearing + np.pi) % (2 * np.pi) - np.pi
+        ahead = dist * np.cos(bearing)  # depth along the sensor's axis
+        near = (dist <= reach) & (np.abs(bearing) <= hfov / 2) & (ahead >= min_range)
+        in_reach |= near
+        k = np.clip(np.rint((bearing[near] + hfov / 2) / step).astype(int), 0, len(angles) - 1)
+        seen = np.zeros(cx.size, bool)
+        seen[near] = dist[near] < beams[k] - 0.5 * res
+        visible |= seen
+    taught_cells = np.asarray(taught.cells)
+    ti = np.floor((cx - taught.origin.x) / taught.resolution).astype(int)
+    tj = np.floor((cy - taught.origin.y) / taught.resolution).astype(int)
+    inside = (ti >= 0) & (ti < taught.width) & (tj >= 0) & (tj < taught.height)
+    free9 = np.zeros(cx.size, bool)
+    occupied9 = np.zeros(cx.size, bool)
+    f9, o9 = _all_nine(taught_cells == 0), _all_nine(taught_cells >= 65)
+    free9[inside] = f9[tj[inside], ti[inside]]
+    occupied9[inside] = o9[tj[inside], ti[inside]]
+    obstacles = occupied & in_reach
+    open_cells = free & visible
+    erased = int((obstacles & free9).sum())
+    false_occ = int((open_cells & occupied9).sum())
+    n_obst, n_open = int(obstacles.sum()), int(open_cells.sum())
+    return MapTruth(
+        erased / n_obst if n_obst else 0.0,
+        false_occ / n_open if n_open else 0.0,
+        n_obst,
+        erased,
+        n_open,
+        false_occ,
+    )

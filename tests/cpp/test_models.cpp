@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Copyright (c) 2026 the kiseki authors
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "kiseki/core/angle.hpp"
@@ -30,6 +32,22 @@ OccupancyGrid room() {
   for (int y = 0; y < 60; ++y) g.set(0, y, kOccupied), g.set(119, y, kOccupied);
   for (int k = 0; k < 5; ++k) g.set(20 + 18 * k, 20 + 7 * k, kOccupied);
   return g;
+}
+
+PinholeCamera xtion() {
+  return PinholeCamera::from_fov(160, 120, 58 * kPi / 180, 45 * kPi / 180, 0.5, 10.0);
+}
+
+// An optical frame at height z looking along robot +x.
+Pose3 level_camera(double z) {
+  Eigen::Matrix3d r;
+  r << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  return Pose3(Eigen::Vector3d(0, 0, z), Eigen::Quaterniond(r));
+}
+
+std::int8_t value_at(const OccupancyGrid& l, double x, double y) {
+  const CellIndex c = l.world_to_cell({x, y});
+  return l.value(c.x, c.y);
 }
 
 OccupancyGrid local_from(const OccupancyGrid& map, const Pose2& robot) {
@@ -73,11 +91,12 @@ TEST(LocalMap, DepthBandSeesTableTopsThatAPlaneAtLegHeightMisses) {
   top.half_size = {0.3, 1.0, 0.02};
   leg.center = {2.25, 0.75, 0.4};
   leg.half_size = {0.025, 0.025, 0.4};
-  const BoxWorld world({top, leg});
-  const auto cam = PinholeCamera::from_fov(160, 120, 58 * kPi / 180, 45 * kPi / 180, 0.5, 10.0);
-  Eigen::Matrix3d r;
-  r << 0, 0, 1, -1, 0, 0, 0, -1, 0;  // optical axes looking along robot +x
-  const Pose3 optical(Eigen::Vector3d(0, 0, 0.4), Eigen::Quaterniond(r));
+  Box back;  // a wall behind the table: the plane's rows need something to read
+  back.center = {5.0, 0.0, 1.0};
+  back.half_size = {0.05, 5.0, 1.0};
+  const BoxWorld world({top, leg, back});
+  const auto cam = xtion();
+  const Pose3 optical = level_camera(0.4);
   const cv::Mat depth = render_depth(world, optical, cam);
   LocalMapBuilder band, plane;
   band.add_depth_band(depth, cam, optical, 0.4, 1.0);
@@ -88,6 +107,90 @@ TEST(LocalMap, DepthBandSeesTableTopsThatAPlaneAtLegHeightMisses) {
   EXPECT_EQ(lp.value(front.x, front.y), kFree);  // the plane passes under the top
   const cv::Mat wrong(10, 10, CV_32FC1, cv::Scalar(1.0f));
   EXPECT_THROW(band.add_depth_band(wrong, cam, optical, 0.4, 1.0), std::invalid_argument);
+}
+
+TEST(LocalMap, ScanReadingsThatAreNoReadingAddNothing) {
+  const std::vector<double> angles = {0.0, 0.5, 1.0, 1.5, -0.5};
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<float> ranges = {0.0f, nan, inf, -inf, -1.0f};
+  LocalMapBuilder b;
+  b.add_scan(Pose2(), angles.data(), ranges.data(), ranges.size(), 30.0);
+  const OccupancyGrid l = b.build();
+  for (int y = 0; y < l.height(); ++y) {
+    for (int x = 0; x < l.width(); ++x) ASSERT_EQ(l.value(x, y), kUnknown) << x << "," << y;
+  }
+}
+
+// The regression of the wall-erasing column rule: a bench 0.3 m in front of the camera, under
+// its 0.5 m minimum range, reads 0 in its columns; those columns must not become free rays
+// through the wall behind it to the camera's maximum range.
+TEST(LocalMap, ColumnsWithoutAReadingAddNoCellNotAFreeRayThroughTheWall) {
+  Box bench, wall, floor;
+  bench.center = {0.35, 0.0, 0.5};  // faces the camera at x = 0.3 m, 0.16 m wide
+  bench.half_size = {0.05, 0.08, 0.5};
+  wall.center = {3.05, 0.0, 1.25};
+  wall.half_size = {0.05, 6.0, 1.25};
+  floor.center = {0.0, 0.0, -0.05};
+  floor.half_size = {10.0, 10.0, 0.05};
+  const BoxWorld world({bench, wall, floor});
+  const auto cam = xtion();
+  const Pose3 optical = level_camera(0.4);
+  const cv::Mat depth = render_depth(world, optical, cam);
+  for (const auto& band : {std::pair{0.39, 0.41}, std::pair{0.4, 1.0}}) {
+    LocalMapBuilder b;
+    b.add_depth_band(depth, cam, optical, band.first, band.second);
+    const OccupancyGrid l = b.build();
+    // behind the bench, straight ahead: the wall at x = 3.0-3.1 and beyond it, never free
+    for (double x = 0.55; x < 4.0; x += 0.1) {
+      EXPECT_NE(value_at(l, x, 0.0), kFree) << "x = " << x << ", band " << band.first;
+    }
+    // the wall beside the bench's shadow is seen and the space before it free
+    EXPECT_EQ(value_at(l, 3.05, 1.2), kOccupied);
+    EXPECT_EQ(value_at(l, 2.0, 1.0), kFree);
+    EXPECT_NE(value_at(l, 3.55, 1.2), kFree);  // behind the wall
+  }
+}
+
+TEST(LocalMap, ReadingsOutsideThePlaneFreeItOnlyWhileTheirRaysRunInsideIt) {
+  Box floor;  // nothing but the floor: the level rows read nothing within 10 m
+  floor.center = {0.0, 0.0, -0.05};
+  floor.half_size = {20.0, 20.0, 0.05};
+  const auto cam = xtion();
+  const Pose3 optical = level_camera(0.4);
+  const cv::Mat depth = render_depth(BoxWorld({floor}), optical, cam);
+  LocalMapBuilder plane;
+  plane.add_depth_band(depth, cam, optical, 0.39, 0.41);
+  const OccupancyGrid l = plane.build();
+  int free = 0, occupied = 0;
+  for (int y = 0; y < l.height(); ++y) {
+    for (int x = 0; x < l.width(); ++x) {
+      const Eigen::Vector2d c = l.cell_to_world(x, y);
+      free += l.value(x, y) == kFree && c.norm() > 0.5;
+      occupied += l.value(x, y) == kOccupied;
+    }
+  }
+  // the floor rows leave the 0.39-0.41 m plane within 0.25 m of the camera
+  EXPECT_EQ(free, 0);
+  EXPECT_EQ(occupied, 0);
+}
+
+TEST(LocalMap, APixelReportedAsNothingWithinRangeIsFreeToMaxRange) {
+  const auto cam = xtion();
+  const Pose3 optical = level_camera(0.4);
+  cv::Mat depth(cam.height, cam.width, CV_32FC1, cv::Scalar(0.0f));
+  depth.row(59).setTo(std::numeric_limits<float>::infinity());  // REP 117: no return
+  LocalMapBuilder b;
+  b.add_depth_band(depth, cam, optical, 0.39, 0.41);
+  const OccupancyGrid l = b.build();
+  EXPECT_EQ(value_at(l, 3.85, 0.0), kFree);  // to the edge of the 8 m local map
+  EXPECT_EQ(value_at(l, 3.85, 1.0), kFree);
+  EXPECT_EQ(value_at(l, 1.0, 1.5), kUnknown);  // outside the 58 deg view
+  depth.setTo(0.0f);
+  LocalMapBuilder none;
+  none.add_depth_band(depth, cam, optical, 0.4, 1.0);
+  const OccupancyGrid empty = none.build();
+  EXPECT_EQ(cv::countNonZero(empty.cells() != kUnknown), 0);  // all no reading: no cell
 }
 
 TEST(SpaceObservation, BitCountsEqualPlainLoopsOverTheRotatedLocalMap) {

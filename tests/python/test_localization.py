@@ -21,9 +21,10 @@ from kiseki.localization import (
     motion_alphas,
     noisy_odometry,
 )
-from kiseki.mapping import MapBuildConfig, build_map, build_teaching_map, scan_local_map
+from kiseki.mapping import MapBuildConfig, build_map, scan_local_map
 from kiseki.metrics import ape
 from kiseki.models import SpaceObservationModel
+from kiseki.teach.environment_map import build_teaching_map
 
 
 def test_noisy_odometry_has_the_requested_spread():

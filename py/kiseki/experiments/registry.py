@@ -11,12 +11,19 @@ __all__ = ["all_experiments", "get_experiment"]
 
 
 def _registry() -> dict[str, Experiment]:
-    from kiseki.experiments import carmen_maps, corridor_scans, fig_3_14, teach_playback
+    from kiseki.experiments import (
+        carmen_maps,
+        corridor_scans,
+        fig_3_14,
+        merge_rules,
+        teach_playback,
+    )
 
     experiments = [
         carmen_maps.EXPERIMENT,
         corridor_scans.EXPERIMENT,
         fig_3_14.EXPERIMENT,
+        merge_rules.EXPERIMENT,
         teach_playback.EXP1,
         teach_playback.EXP2,
         teach_playback.EXP3,

@@ -40,6 +40,7 @@ from kiseki.map_io import load_map  # noqa: E402
 from kiseki.sim.scene import load_scene  # noqa: E402
 from kiseki.sim.setup import build_robot, build_sensors  # noqa: E402
 from kiseki.teach import PlaybackConfig, playback, teach  # noqa: E402
+from kiseki.teach.environment_map import MERGE_RULES  # noqa: E402
 from kiseki.teach.local_maps import METHODS, LocalMapMaker  # noqa: E402
 
 WORLDS = Path(__file__).resolve().parents[3] / "data" / "worlds"
@@ -51,6 +52,7 @@ class Exp1Config:
     methods: list[str] = field(default_factory=lambda: ["proposal2"])
     particles: int = 1000
     boxes: int = 0  # unknown boxes placed at random for playback (Exp. 3)
+    merge: str = "thesis"  # the taught maps' merge rule: thesis or evidence
 
 
 @dataclass(frozen=True)
@@ -61,6 +63,7 @@ class Exp2Config:
     )
     particles: int = 1000
     boxes: int = 0
+    merge: str = "thesis"
 
 
 @dataclass(frozen=True)
@@ -69,6 +72,7 @@ class Exp3Config:
     methods: list[str] = field(default_factory=lambda: ["proposal2"])
     particles: int = 1000
     boxes: int = 3
+    merge: str = "thesis"
 
 
 def _errors(result, goal: dict) -> dict:
@@ -184,7 +188,15 @@ def trial(config: Exp1Config, index: int, seed: int) -> TrialOutput:
     methods = config.methods
     record = {}
     with tempfile.TemporaryDirectory() as tmp:
-        taught = teach(load_scene(scene_file), Path(tmp) / "teach", seed=derive_seed(seed, 1))
+        taught = teach(
+            load_scene(scene_file),
+            Path(tmp) / "teach",
+            seed=derive_seed(seed, 1),
+            merge=config.merge,
+        )
+        for band, t in taught.truth.items():
+            record[f"taught_{band}_erased_share"] = t["erased_share"]
+            record[f"taught_{band}_false_occupied_share"] = t["false_occupied_share"]
         play_file = scene_file
         if config.boxes:
             play_file = _with_boxes(scene_file, config.boxes, derive_seed(seed, 3), Path(tmp))
@@ -244,6 +256,29 @@ def _stop_table(config, trials: pd.DataFrame) -> pd.DataFrame:
                 "along_track_share": float(
                     (trials[f"{method}_stop_dx"].abs() > trials[f"{method}_stop_dy"].abs()).mean()
                 ),
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def _taught_table(config, trials: pd.DataFrame) -> pd.DataFrame:
+    """The taught maps against the scene's truth (kiseki.metrics.taught_map_truth), per band:
+    mean and worst share of obstacle cells in reach erased, and of visible free cells marked
+    occupied, over the trials (each teaches its own map)."""
+    rows = []
+    for band in ("plane", "band"):
+        erased = trials.get(f"taught_{band}_erased_share")
+        if erased is None:
+            continue
+        occupied = trials[f"taught_{band}_false_occupied_share"]
+        rows.append(
+            {
+                "map": band,
+                "merge": config.merge,
+                "erased_share_mean": erased.mean(),
+                "erased_share_max": erased.max(),
+                "false_occupied_share_mean": occupied.mean(),
+                "false_occupied_share_max": occupied.max(),
             }
         )
     return pd.DataFrame(rows)
@@ -397,7 +432,12 @@ def analyze_exp1(config, trials, timings, figures) -> Analysis:
     )
     diag = _diagnostics(config, ok)
     return Analysis(
-        tables={"errors_at_waypoints": errors, "stops": stops, "diagnostics": diag},
+        tables={
+            "errors_at_waypoints": errors,
+            "stops": stops,
+            "diagnostics": diag,
+            "taught_maps": _taught_table(config, ok),
+        },
         figures=[_stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
         claims=claims,
         notes=notes + "\n\n" + _diagnosis(diag, turn_route=False),
@@ -451,7 +491,7 @@ def analyze_exp2(config, trials, timings, figures) -> Analysis:
         )
     diag = _diagnostics(config, ok)
     return Analysis(
-        tables={"stops": stops, "diagnostics": diag},
+        tables={"stops": stops, "diagnostics": diag, "taught_maps": _taught_table(config, ok)},
         figures=[_stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
         claims=claims,
         notes="Thesis Tables 4.5/4.6: 5 runs per method; 'both' is not in the thesis.\n\n"
@@ -499,7 +539,12 @@ def analyze_exp3(config, trials, timings, figures) -> Analysis:
         "final leg, change the stop much less.\n\n" + _diagnosis(diag)
     )
     return Analysis(
-        tables={"stops": stops, "diagnostics": diag, "boxes_final_leg": boxes},
+        tables={
+            "stops": stops,
+            "diagnostics": diag,
+            "boxes_final_leg": boxes,
+            "taught_maps": _taught_table(config, ok),
+        },
         figures=[_stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
         claims=claims,
         notes=notes,
@@ -512,6 +557,8 @@ def _preflight(config: Exp1Config) -> None:
     for m in config.methods or []:
         if m not in METHODS:
             raise ValueError(f"unknown method {m!r} (known: {', '.join(METHODS)})")
+    if config.merge not in MERGE_RULES:
+        raise ValueError(f"unknown merge rule {config.merge!r} (known: {', '.join(MERGE_RULES)})")
 
 
 EXP1 = Experiment(

@@ -67,10 +67,15 @@ class Scene:
     boxes: BoxList | None = None
     robot_specs: list = field(default_factory=list)  # [{name, robot, sensors, route}]
 
-    def ground_truth(self, z_min: float, z_max: float) -> OccupancyGrid:
-        """The 2-D ground-truth grid of a height band (metres above the floor)."""
+    def ground_truth(
+        self, z_min: float, z_max: float, resolution: float | None = None
+    ) -> OccupancyGrid:
+        """The 2-D ground-truth grid of a height band (metres above the floor), at the scene's
+        grid resolution or at `resolution`."""
         lo, hi = self.bounds
-        res = self.grid_resolution
+        res = self.grid_resolution if resolution is None else float(resolution)
+        if not (np.isfinite(res) and res > 0):
+            raise ValueError(f"resolution must be a positive number of metres, got {resolution}")
         width = max(1, int(np.ceil((hi[0] - lo[0]) / res)))
         height = max(1, int(np.ceil((hi[1] - lo[1]) / res)))
         grid = OccupancyGrid(width, height, res, Pose2(float(lo[0]), float(lo[1]), 0.0))

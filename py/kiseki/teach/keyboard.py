@@ -245,6 +245,7 @@ def teach_keyboard(
     dt: float = 0.1,
     overwrite: bool = False,
     stream: TextIO | None = None,
+    merge: str = "thesis",
 ) -> TeachResult:
     """Teaches from keys (see the module docstring): one :meth:`TeachingRun.step` per period
     with the velocity command the keys set, a waypoint P<n> at each m, until q. A status line
@@ -252,7 +253,7 @@ def teach_keyboard(
     terminal, one line a second and at each key otherwise."""
     stream = stream if stream is not None else sys.stdout
     in_place = stream.isatty()
-    with TeachingRun(scene, out, seed, dt, overwrite, {"mode": "keyboard"}) as run:
+    with TeachingRun(scene, out, seed, dt, overwrite, {"mode": "keyboard"}, merge) as run:
         stream.write(HELP)
         stream.flush()
         try:

@@ -44,6 +44,12 @@ class LocalMapMaker:
             raise ValueError("local maps need at least one depth camera")
 
     def make(self, images: list[np.ndarray]):
+        """The local map L of one set of depth images (one per camera)."""
+        return self.builder(images).build()
+
+    def builder(self, images: list[np.ndarray]) -> _core.LocalMapBuilder:
+        """The builder filled with one set of depth images: `build()` is L, `hits()` the cells
+        a beam ended in (for the evidence merge)."""
         if len(images) != len(self.cameras):
             raise ValueError(f"expected {len(self.cameras)} depth images, got {len(images)}")
         builder = _core.LocalMapBuilder(self.size, self.resolution)
@@ -57,4 +63,4 @@ class LocalMapMaker:
                 )
             optical = camera.optical_pose((0.0, 0.0, 0.0))  # in the robot frame
             builder.add_depth_band(depth, optical, *camera.camera_args(), z_min, z_max)
-        return builder.build()
+        return builder

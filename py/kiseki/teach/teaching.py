@@ -11,6 +11,7 @@ under a second at 10 Hz).
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 import os
 from dataclasses import dataclass
@@ -20,15 +21,16 @@ import numpy as np
 import yaml
 from tqdm import tqdm
 
-from kiseki import _core
 from kiseki._atomic import atomic_write
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
 from kiseki.map_io import save_map
+from kiseki.metrics import taught_map_truth
 from kiseki.sim.mcap_log import RunWriter, read_run
 from kiseki.sim.run import PurePursuit
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import build_robot, build_sensors
+from kiseki.teach.environment_map import MERGE_RULES, EnvironmentMap
 from kiseki.teach.local_maps import BANDS, LocalMapMaker
 
 __all__ = [
@@ -62,6 +64,8 @@ class TeachResult:
     log: Path
     steps: int
     marks: list[dict]
+    merge: str = "thesis"  # the merge rule the maps were built with
+    truth: dict | None = None  # band -> the map against the scene's truth (map_truth.json)
 
 
 def _environment(scene: Scene, resolution: float = 0.1, margin: float = 4.0) -> OccupancyGrid:
@@ -78,12 +82,60 @@ def waypoints_file_hash(map_yaml: Path) -> str:
     return hashlib.sha1((Path(map_yaml).parent / meta["image"]).read_bytes()).hexdigest()
 
 
+def measure_taught_maps(
+    scene: Scene, maps: dict[str, OccupancyGrid], truths: np.ndarray, cameras: list
+) -> dict:
+    """Each taught map against the scene's ground truth at its own band's heights (and its
+    resolution), over what the cameras could reach from the true poses of the run: see
+    `kiseki.metrics.taught_map_truth`. The reach is the local map's half size less the mount's
+    offset from the robot's centre (so every cell in reach lies inside L), within max range,
+    and no nearer than the camera's minimum depth (a bench under it is invisible)."""
+    truths = np.asarray(truths, dtype=np.float64).reshape(-1, 3)
+    out = {}
+    for band, grid in maps.items():
+        truth = scene.ground_truth(*BANDS[band], resolution=grid.resolution)
+        measured = []
+        for camera in cameras:
+            device = camera.device
+            mount = device.mount
+            reach = min(device.params.max_range, 4.0 - math.hypot(mount.x, mount.y))
+            poses = np.array([mount.planar(p) for p in truths])
+            hfov = math.radians(device.params.hfov_deg)
+            measured.append(
+                taught_map_truth(grid, truth, poses, hfov, reach, device.params.min_range)
+            )
+        # the cameras look at different sides: add their cells (a cell seen by both counts
+        # once in each camera's share; the sideways cameras of the AGV share none)
+        total = {k: sum(getattr(m, k) for m in measured) for k in measured[0].as_dict()}
+        out[band] = {
+            "erased_share": total["erased_cells"] / max(1, total["obstacle_cells"]),
+            "false_occupied_share": total["false_occupied_cells"]
+            / max(1, total["visible_free_cells"]),
+            "obstacle_cells": total["obstacle_cells"],
+            "erased_cells": total["erased_cells"],
+            "visible_free_cells": total["visible_free_cells"],
+            "false_occupied_cells": total["false_occupied_cells"],
+            "truth_band_m": list(BANDS[band]),
+        }
+    return out
+
+
 def _write_outputs(
-    out: Path, maps: dict[str, OccupancyGrid], marks: list[dict], log: Path, steps: int
+    out: Path,
+    maps: dict[str, OccupancyGrid],
+    marks: list[dict],
+    log: Path,
+    steps: int,
+    merge: str,
+    truth: dict | None,
 ) -> TeachResult:
     paths = {band: save_map(grid, out / f"map_{band}.yaml") for band, grid in maps.items()}
+    if truth is not None:
+        text = json.dumps({"merge": merge, "maps": truth}, indent=2)
+        atomic_write(out / "map_truth.json", lambda tmp: Path(tmp).write_text(text, "utf-8"))
     doc = {
         "log": log.name,
+        "merge": merge,
         "maps": {
             band: {"file": p.name, "image_sha1": waypoints_file_hash(p)}
             for band, p in paths.items()
@@ -92,7 +144,7 @@ def _write_outputs(
     }
     text = yaml.safe_dump(doc, sort_keys=False)
     atomic_write(out / "waypoints.yaml", lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-    return TeachResult(paths, out / "waypoints.yaml", log, steps, marks)
+    return TeachResult(paths, out / "waypoints.yaml", log, steps, marks, merge, truth)
 
 
 class TeachingRun:
@@ -102,7 +154,8 @@ class TeachingRun:
     moves the robot by a velocity command for ``dt``, then logs the new true pose, odometry and
     depth images and merges the local maps placed by odometry; :meth:`mark` records a waypoint
     at the current odometry pose. Use it as a context manager (the log is closed on exit, also
-    on an exception, so that :func:`recover` can rebuild the run)."""
+    on an exception, so that :func:`recover` can rebuild the run). `merge` is the environment
+    maps' merge rule (`kiseki.teach.environment_map`)."""
 
     def __init__(
         self,
@@ -112,9 +165,13 @@ class TeachingRun:
         dt: float = 0.1,
         overwrite: bool = False,
         metadata: dict[str, str] | None = None,
+        merge: str = "thesis",
     ) -> None:
         if not (math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt must be a positive number of seconds, got {dt}")
+        if merge not in MERGE_RULES:
+            raise ValueError(f"merge rule must be one of {', '.join(MERGE_RULES)}, got {merge!r}")
+        self.merge = merge
         self.scene, self.dt = scene, float(dt)
         self.out = Path(out)
         self.setup = build_robot(scene, seed)
@@ -126,12 +183,13 @@ class TeachingRun:
         if not self.cameras:
             raise ValueError(f"{scene.path}: teaching needs the robot's depth cameras")
         self.makers = {b: LocalMapMaker([c.device for c in self.cameras], b) for b in BANDS}
-        self.maps = {b: _environment(scene) for b in BANDS}
+        self.maps = {b: EnvironmentMap(_environment(scene), merge) for b in BANDS}
         self.marks: list[dict] = []
+        self.truths: list[tuple[float, float, float]] = []  # true pose of every logged step
         self.steps = 0  # steps logged
         self.out.mkdir(parents=True, exist_ok=True)
         self.log = self.out / "teach.mcap"
-        meta = {"scene_file": str(scene.path), "seed": str(seed), "dt": str(dt)}
+        meta = {"scene_file": str(scene.path), "seed": str(seed), "dt": str(dt), "merge": merge}
         self._writer = RunWriter(self.log, {**meta, **(metadata or {})}, overwrite=overwrite)
         try:
             self._record()
@@ -171,6 +229,7 @@ class TeachingRun:
         for c, image in zip(self.cameras, images, strict=True):
             self._writer.write_depth_image(f"/{c.name}", t, image, c.name)
         _integrate(self.maps, self.makers, images, odom)
+        self.truths.append(truth)
         self.steps += 1
 
     def mark(self, name: str) -> dict:
@@ -192,9 +251,12 @@ class TeachingRun:
         self._writer.close()
 
     def finish(self) -> TeachResult:
-        """Closes the log and writes the maps and the waypoint file."""
+        """Closes the log and writes the maps, the waypoint file and the maps measured
+        against the scene's truth (map_truth.json)."""
         self.close()
-        return _write_outputs(self.out, self.maps, self.marks, self.log, self.steps)
+        maps = {b: m.map() for b, m in self.maps.items()}
+        truth = measure_taught_maps(self.scene, maps, np.array(self.truths), self.cameras)
+        return _write_outputs(self.out, maps, self.marks, self.log, self.steps, self.merge, truth)
 
     def __enter__(self) -> TeachingRun:
         return self
@@ -210,15 +272,16 @@ def teach(
     dt: float = 0.1,
     overwrite: bool = False,
     progress: bool = False,
+    merge: str = "thesis",
 ) -> TeachResult:
     """Pushes the robot along the scene's route (pure pursuit stands in for the operator),
     marks each named route point as a waypoint, and builds one environment map per local-map
-    band ("plane" and "band")."""
+    band ("plane" and "band") with the merge rule `merge`."""
     route = scene.route
     if not route.get("waypoints"):
         raise ValueError(f"{scene.path}: scripted teaching needs a route (or use the keyboard)")
     names = list(route.get("names") or [f"W{i}" for i in range(len(route["waypoints"]))])
-    with TeachingRun(scene, out, seed, dt, overwrite, {"names": ",".join(names)}) as run:
+    with TeachingRun(scene, out, seed, dt, overwrite, {"names": ",".join(names)}, merge) as run:
         controller = PurePursuit(
             route["waypoints"],
             float(route.get("speed", 0.5)),
@@ -247,7 +310,7 @@ def _pose(p) -> tuple[float, float, float]:
 def _integrate(maps, makers, images, odom) -> None:
     pose = Pose2(*odom)
     for band, maker in makers.items():
-        _core.merge_local_map(maps[band], maker.make(images), pose)
+        maps[band].merge(maker.builder(images), pose)
 
 
 def _mark(run: TeachingRun, names, controller: PurePursuit, resting: bool) -> None:
@@ -262,29 +325,43 @@ def _mark(run: TeachingRun, names, controller: PurePursuit, resting: bool) -> No
     run.mark(names[i])
 
 
-def recover(scene: Scene, log: str | os.PathLike, out: str | os.PathLike) -> TeachResult:
-    """Rebuilds the maps and waypoints of a teaching run from its MCAP log (after a crash)."""
+def recover(
+    scene: Scene, log: str | os.PathLike, out: str | os.PathLike, merge: str | None = None
+) -> TeachResult:
+    """Rebuilds the maps and waypoints of a teaching run from its MCAP log (after a crash),
+    with the merge rule the run was taught with (or `merge`)."""
     run = read_run(log)
     topics = run.topics()
+    merge = merge or run.metadata.get("merge", "thesis")
+    if merge not in MERGE_RULES:
+        raise ValueError(f"{log}: unknown merge rule {merge!r} (known: {', '.join(MERGE_RULES)})")
     setup = build_robot(scene, 0)
     cameras = [s for s in build_sensors(scene, setup, 0, 0.1) if s.kind == "depth_camera"]
     missing = [c.name for c in cameras if f"/{c.name}" not in topics]
     if missing or "/odom" not in topics:
         raise ValueError(f"{log}: not a teaching log of {scene.path} (missing topics)")
     odom = {round(t, 6): (m["x"], m["y"], m["theta"]) for t, m in run.messages("/odom")}
+    truth = {}
+    if "/ground_truth" in topics:
+        times, poses = run.poses("/ground_truth")
+        truth = {round(float(t), 6): tuple(p) for t, p in zip(times, poses, strict=True)}
     images = [dict((round(t, 6), d) for t, d in run.depth_images(f"/{c.name}")) for c in cameras]
     makers = {b: LocalMapMaker([c.device for c in cameras], b) for b in BANDS}
-    maps = {b: _environment(scene) for b in BANDS}
-    steps = 0
+    maps = {b: EnvironmentMap(_environment(scene), merge) for b in BANDS}
+    steps, truths = 0, []
     for t in sorted(odom):
         if all(t in im for im in images):
             _integrate(
                 maps, makers, [np.asarray(im[t], dtype=np.float32) for im in images], odom[t]
             )
             steps += 1
+            if t in truth:
+                truths.append(truth[t])
     marks = [m for _, m in run.messages("/waypoints")] if "/waypoints" in topics else []
     Path(out).mkdir(parents=True, exist_ok=True)
-    return _write_outputs(Path(out), maps, marks, Path(log), steps)
+    grids = {b: m.map() for b, m in maps.items()}
+    measured = measure_taught_maps(scene, grids, np.array(truths), cameras) if truths else None
+    return _write_outputs(Path(out), grids, marks, Path(log), steps, merge, measured)
 
 
 def load_taught(folder: str | os.PathLike, band: str, route: list[str]) -> tuple[Path, list[dict]]:
