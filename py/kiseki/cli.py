@@ -83,7 +83,7 @@ def map_from_log(
     from kiseki.teach.environment_map import build_teaching_map
 
     if rules not in ("log-odds", "teaching", "evidence"):
-        raise typer.BadParameter(f"--rules must be log-odds, teaching or evidence, got {rules!r}")
+        raise ValueError(f"--rules must be log-odds, teaching or evidence, got {rules!r}")
     config = MapBuildConfig(
         resolution=_positive("--resolution", resolution),
         usable_range=_positive("--usable-range", usable_range),
@@ -208,7 +208,7 @@ def demo(
     from kiseki.teach.environment_map import MERGE_RULES
 
     if merge not in MERGE_RULES:
-        raise typer.BadParameter(f"--merge must be {' or '.join(MERGE_RULES)}, got {merge!r}")
+        raise ValueError(f"--merge must be {' or '.join(MERGE_RULES)}, got {merge!r}")
     run_demo(scene, out, seed, console, particles, merge)
 
 
@@ -354,7 +354,7 @@ def teach_command(
     from kiseki.teach.teaching import recover, teach
 
     if merge is not None and merge not in MERGE_RULES:
-        raise typer.BadParameter(f"--merge must be {' or '.join(MERGE_RULES)}, got {merge!r}")
+        raise ValueError(f"--merge must be {' or '.join(MERGE_RULES)}, got {merge!r}")
     if keys is not None and not keyboard:
         raise ValueError("--keys FILE goes with --keyboard")
     if keyboard and keys is None and not resume and not sys.stdin.isatty():

@@ -57,6 +57,9 @@ def test_map_info_and_render(tmp_path):
         (["map", "from-log", "missing.log", "-o", "out.yaml"], "missing.log"),
         (["map", "from-log", "empty.log", "-o", "out.yaml"], "empty.log"),
         (["map", "from-log", "empty.log", "-o", "out.yaml", "--resolution", "-1"], "resolution"),
+        (["map", "from-log", "empty.log", "-o", "out.yaml", "--rules", "bayes"], "--rules"),
+        (["teach", "scene.yaml", "-o", "t", "--merge", "bayes"], "--merge"),
+        (["demo", "--out", "d", "--merge", "bayes"], "--merge"),
     ],
 )
 def test_bad_input_prints_one_line_and_fails(tmp_path, args, needle):

@@ -29,6 +29,12 @@ def test_demo_teaches_and_plays_back_every_method(tmp_path, project_root):
         assert (tmp_path / "a" / name).stat().st_size > 0, name
     assert summary["waypoints"] == ["P0", "T1", "T2", "G"]
     assert set(summary["playback"]) == {"conventional", "proposal1", "proposal2", "both"}
+    # the taught maps against the scene's truth, per band (see test_taught_maps for the bound)
+    assert summary["merge"] == "thesis"
+    for band in ("plane", "band"):
+        shares = summary["taught_map_truth"][band]
+        assert set(shares) == {"erased_share", "false_occupied_share"}
+        assert 0.0 <= shares["erased_share"] < 0.1 and 0.0 <= shares["false_occupied_share"] < 0.1
     for result in summary["playback"].values():
         assert result["reached"] and result["stop_error_m"] < 0.5  # localized, not lost
     again = run_demo(scene, tmp_path / "b", seed=3, console=Console(quiet=True), particles=300)

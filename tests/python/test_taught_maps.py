@@ -10,6 +10,7 @@ import json
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from kiseki import _core
@@ -238,3 +239,47 @@ def test_teaching_writes_its_maps_against_the_truth(tmp_path, project_data):
     assert result.truth == doc["maps"]
     with pytest.raises(ValueError, match="merge rule"):
         teach(scene, tmp_path / "u", merge="bayes")
+
+
+def test_merge_rules_experiment_on_the_intel_log(shared_data, tmp_path):
+    """Real scans: the thesis' rule lets stray beams free wall cells, evidence counting keeps
+    more of the endpoints on the map; both maps still track the log (a short prefix here;
+    `kiseki experiment run merge-rules` runs the four logs whole)."""
+    from kiseki.experiments import run_experiment
+
+    run = run_experiment(
+        "merge-rules",
+        runs=1,
+        overrides=[f"data_dir={shared_data / 'carmen'}", "logs=intel-corrected", "max_scans=150"],
+        out=tmp_path / "mr",
+        progress=False,
+    )
+    table = pd.read_csv(run.run_dir / "tables" / "per_log.csv").iloc[0]
+    assert table["scans"] == 150
+    assert table["endpoints_evidence"] > table["endpoints_thesis"] + 0.02
+    assert table["endpoints_log_odds"] > table["endpoints_thesis"]
+    for rule in ("thesis", "evidence"):
+        assert table[f"position_rmse_{rule}_m"] < 0.6, rule  # odometry alone: metres off
+
+
+def test_map_from_log_with_evidence_rules_is_the_evidence_teaching_map(shared_data, tmp_path):
+    import subprocess
+    import sys
+
+    from kiseki import load_map
+    from kiseki.datasets import read_carmen_log
+
+    log = shared_data / "carmen" / "aces-corrected.log.gz"
+    out = tmp_path / "aces.yaml"
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "map", "from-log", str(log), "-o", str(out)]
+        + ["--rules", "evidence", "--resolution", "0.1"],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    scans = read_carmen_log(log).scans
+    expected = build_teaching_map(
+        scans.poses, scans.ranges, scans.angles, scans.max_range, 0.1, rule="evidence"
+    )
+    np.testing.assert_array_equal(np.asarray(load_map(out).cells), np.asarray(expected.cells))
