@@ -237,6 +237,20 @@ def test_teaching_writes_its_maps_against_the_truth(tmp_path, project_data):
         assert 0.0 <= m["erased_share"] < 0.2 and 0.0 <= m["false_occupied_share"] < 0.2, band
         assert m["erased_cells"] == round(m["erased_share"] * m["obstacle_cells"])
     assert result.truth == doc["maps"]
+    # rebuilt from the log (as after a crash): the same rule, the same maps and measures
+    from kiseki.teach.teaching import recover
+
+    again = recover(scene, result.log, tmp_path / "r")
+    assert again.merge == "evidence" and again.truth == result.truth
+    for band in BANDS:
+        assert (tmp_path / "r" / f"map_{band}.pgm").read_bytes() == (
+            tmp_path / "t" / f"map_{band}.pgm"
+        ).read_bytes()
+    thesis = recover(scene, result.log, tmp_path / "r2", merge="thesis")
+    assert thesis.merge == "thesis"
+    assert (tmp_path / "r2" / "map_band.pgm").read_bytes() != (
+        tmp_path / "t" / "map_band.pgm"
+    ).read_bytes()
     with pytest.raises(ValueError, match="merge rule"):
         teach(scene, tmp_path / "u", merge="bayes")
 
