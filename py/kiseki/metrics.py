@@ -235,9 +235,9 @@ def taught_map_truth(
     taught,
     truth,
     sensor_poses: np.ndarray,
-    hfov: float,
-    reach: float,
-    min_range: float = 0.0,
+    hfov,
+    reach,
+    min_range=0.0,
 ) -> MapTruth:
     """How far a taught map (free 0 / occupied 100 / unknown -1) departs from the truth grid
     of the same height band, over the cells the sensors could reach along the route.
@@ -246,7 +246,8 @@ def taught_map_truth(
     heading of some sensor pose (n, 3: x, y, yaw in the world), at least `min_range` ahead of
     it along the heading (a depth camera measures nothing nearer than its minimum depth); it is
     visible when, besides, nothing occupied in the truth lies between that sensor and it (ray
-    cast in the truth).
+    cast in the truth). `hfov`, `reach` and `min_range` are numbers or one value per pose
+    (several sensors' poses measured together: a cell any of them reaches counts once).
     - erased share: of the truth's occupied cells in reach (seen or hidden), those that the
       taught map marks free together with all 8 neighbours of the taught cell under them;
     - false-occupied share: of the truth's free cells visible from the route, those that the
@@ -257,8 +258,17 @@ def taught_map_truth(
     poses = np.asarray(sensor_poses, dtype=np.float64)
     if poses.ndim != 2 or poses.shape[1] != 3 or len(poses) == 0 or not np.isfinite(poses).all():
         raise ValueError("sensor_poses: expected a non-empty finite (n, 3) array")
-    if not (0 < hfov < 2 * np.pi) or not (reach > 0 and np.isfinite(reach)):
-        raise ValueError(f"need 0 < hfov < 2 pi and a positive reach, got {hfov}, {reach}")
+    n = len(poses)
+    try:
+        hfov, reach, min_range = (
+            np.broadcast_to(np.asarray(v, dtype=np.float64), (n,)) for v in (hfov, reach, min_range)
+        )
+    except ValueError:
+        raise ValueError("hfov, reach and min_range: a number or one value per pose") from None
+    if not ((hfov > 0) & (hfov < 2 * np.pi)).all() or not (np.isfinite(reach) & (reach > 0)).all():
+        raise ValueError("need 0 < hfov < 2 pi and a positive finite reach for every pose")
+    if not (np.isfinite(min_range) & (min_range >= 0)).all():
+        raise ValueError("min_range must be >= 0 and finite")
     cells = np.asarray(truth.cells)
     res = truth.resolution
     ys, xs = np.mgrid[0 : truth.height, 0 : truth.width]
@@ -266,20 +276,23 @@ def taught_map_truth(
     cy = truth.origin.y + (ys.ravel() + 0.5) * res
     occupied = cells.ravel() >= 65
     free = cells.ravel() == 0
-    step = 0.25 * res / reach  # rays a quarter cell apart at the reach
-    angles = np.arange(-hfov / 2, hfov / 2 + step, step)
-    ranges = truth.cast_scans(poses, angles, max_range=reach + res)
+    step = 0.25 * res / reach.max()  # rays a quarter cell apart at the farthest reach
+    half = hfov.max() / 2
+    angles = np.arange(-half, half + step, step)
+    ranges = truth.cast_scans(poses, angles, max_range=float(reach.max() + res))
     in_reach = np.zeros(cx.size, bool)
     visible = np.zeros(cx.size, bool)
-    for pose, beams in zip(poses, ranges, strict=True):
+    for pose, beams, fov, far, near_limit in zip(
+        poses, ranges, hfov, reach, min_range, strict=True
+    ):
         dx, dy = cx - pose[0], cy - pose[1]
         dist = np.hypot(dx, dy)
         bearing = np.arctan2(dy, dx) - pose[2]
         bearing = (bearing + np.pi) % (2 * np.pi) - np.pi
         ahead = dist * np.cos(bearing)  # depth along the sensor's axis
-        near = (dist <= reach) & (np.abs(bearing) <= hfov / 2) & (ahead >= min_range)
+        near = (dist <= far) & (np.abs(bearing) <= fov / 2) & (ahead >= near_limit)
         in_reach |= near
-        k = np.clip(np.rint((bearing[near] + hfov / 2) / step).astype(int), 0, len(angles) - 1)
+        k = np.clip(np.rint((bearing[near] + half) / step).astype(int), 0, len(angles) - 1)
         seen = np.zeros(cx.size, bool)
         seen[near] = dist[near] < beams[k] - 0.5 * res
         visible |= seen

@@ -366,7 +366,7 @@ def _diagnosis(diag: pd.DataFrame, turn_route: bool = True) -> str:
         "a depth column without a reading (a bench under the cameras' 0.5 m minimum range) "
         "became a free ray to 10 m, and the thesis' merge made it permanent: with perfect "
         "poses and noise-free images 23.7 % of the obstacle cells in reach were erased in the "
-        "plane map and 9.6 % in the band map (now 2.5 % and 1.7 %, table `taught_maps` for "
+        "plane map and 9.6 % in the band map (now 2.6 % and 1.7 %, table `taught_maps` for "
         "these runs with odometry). Those holes were the cells 'that L marks occupied behind "
         "walls but the map knows as free' that drew the raw-cut-out methods forward; the "
         "earlier explanation of the ordering rested on them. (3) Why the fixed plane does as "

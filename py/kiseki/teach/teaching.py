@@ -83,40 +83,34 @@ def waypoints_file_hash(map_yaml: Path) -> str:
 
 
 def measure_taught_maps(
-    scene: Scene, maps: dict[str, OccupancyGrid], truths: np.ndarray, cameras: list
+    scene: Scene,
+    maps: dict[str, OccupancyGrid],
+    truths: np.ndarray,
+    cameras: list,
+    local_size: float = 8.0,
 ) -> dict:
     """Each taught map against the scene's ground truth at its own band's heights (and its
     resolution), over what the cameras could reach from the true poses of the run: see
-    `kiseki.metrics.taught_map_truth`. The reach is the local map's half size less the mount's
-    offset from the robot's centre (so every cell in reach lies inside L), within max range,
-    and no nearer than the camera's minimum depth (a bench under it is invisible)."""
+    `kiseki.metrics.taught_map_truth` (every camera's poses together: a cell that several
+    reach counts once). A camera's reach is half the local map's size less the mount's offset
+    from the robot's centre (so every cell in reach lies inside L), within its max range, and
+    no nearer than its minimum depth (a bench under it is invisible)."""
     truths = np.asarray(truths, dtype=np.float64).reshape(-1, 3)
+    poses, hfov, reach, min_range = [], [], [], []
+    for camera in cameras:
+        device, mount = camera.device, camera.device.mount
+        poses.append(np.array([mount.planar(p) for p in truths]).reshape(-1, 3))
+        n = len(truths)
+        hfov.append(np.full(n, math.radians(device.params.hfov_deg)))
+        far = min(device.params.max_range, 0.5 * local_size - math.hypot(mount.x, mount.y))
+        reach.append(np.full(n, far))
+        min_range.append(np.full(n, device.params.min_range))
+    poses, hfov, reach, min_range = (np.concatenate(v) for v in (poses, hfov, reach, min_range))
     out = {}
     for band, grid in maps.items():
         truth = scene.ground_truth(*BANDS[band], resolution=grid.resolution)
-        measured = []
-        for camera in cameras:
-            device = camera.device
-            mount = device.mount
-            reach = min(device.params.max_range, 4.0 - math.hypot(mount.x, mount.y))
-            poses = np.array([mount.planar(p) for p in truths])
-            hfov = math.radians(device.params.hfov_deg)
-            measured.append(
-                taught_map_truth(grid, truth, poses, hfov, reach, device.params.min_range)
-            )
-        # the cameras look at different sides: add their cells (a cell seen by both counts
-        # once in each camera's share; the sideways cameras of the AGV share none)
-        total = {k: sum(getattr(m, k) for m in measured) for k in measured[0].as_dict()}
-        out[band] = {
-            "erased_share": total["erased_cells"] / max(1, total["obstacle_cells"]),
-            "false_occupied_share": total["false_occupied_cells"]
-            / max(1, total["visible_free_cells"]),
-            "obstacle_cells": total["obstacle_cells"],
-            "erased_cells": total["erased_cells"],
-            "visible_free_cells": total["visible_free_cells"],
-            "false_occupied_cells": total["false_occupied_cells"],
-            "truth_band_m": list(BANDS[band]),
-        }
+        measured = taught_map_truth(grid, truth, poses, hfov, reach, min_range)
+        out[band] = {**measured.as_dict(), "truth_band_m": list(BANDS[band])}
     return out
 
 
