@@ -110,11 +110,16 @@ void LocalMapBuilder::add_depth_band(const cv::Mat& depth, const PinholeCamera& 
     throw std::invalid_argument("local map: the camera pose must be finite");
   }
   const Eigen::Vector2d start(t.x(), t.y());
+  // A pixel's ray for image coordinates (gx, gy) is r (gx, gy, 1): per column the part that
+  // does not depend on the row is computed once, and a point at depth d is t + d * ray.
+  std::vector<double> gy(static_cast<std::size_t>(cam.height) + 1);  // at row edges v = 0..H
+  for (int v = 0; v <= cam.height; ++v) gy[v] = (v - cam.cy) / cam.fy;
+  const Eigen::Vector3d down = r.col(1);
   for (int u = 0; u < cam.width; ++u) {
     // The column's heading in the robot frame: its optical ray at the principal row.
     const double gx = (u + 0.5 - cam.cx) / cam.fx;
-    const Eigen::Vector3d axis = r * Eigen::Vector3d(gx, 0.0, 1.0);
-    const double heading = std::atan2(axis.y(), axis.x());
+    const Eigen::Vector3d base = r.col(0) * gx + r.col(2);
+    const double heading = std::atan2(base.y(), base.x());
     double hit = std::numeric_limits<double>::infinity();  // nearest in-band reading
     double free_from = std::numeric_limits<double>::infinity(), free_to = 0.0;
     for (int v = 0; v < cam.height; ++v) {
@@ -125,16 +130,15 @@ void LocalMapBuilder::add_depth_band(const cv::Mat& depth, const PinholeCamera& 
       const bool no_return = std::isinf(d) && d > 0.0f;
       if (!no_return && !(d >= cam.min_range && d < cam.max_range)) continue;
       const double z = no_return ? cam.max_range : static_cast<double>(d);
-      const auto point = [&](double row) {
-        return Eigen::Vector3d(r * Eigen::Vector3d(gx * z, (row - cam.cy) / cam.fy * z, z) + t);
-      };
-      const Eigen::Vector3d p = point(v + 0.5), top = point(v), bottom = point(v + 1.0);
-      const double along = std::hypot(p.x() - t.x(), p.y() - t.y());
+      const double centre = 0.5 * (gy[v] + gy[v + 1]);
+      const double ax = base.x() + down.x() * centre, ay = base.y() + down.y() * centre;
+      const double along = z * std::sqrt(ax * ax + ay * ay);  // horizontal distance
       // The pixel sees the band where its footprint (between its top and bottom edge rays)
       // overlaps [z_min, z_max]; at a fraction f of the way to the reading the footprint spans
       // t.z + f (z_edge - t.z), linear in f, so that part of the ray is an interval of f.
-      const double low = std::min(top.z(), bottom.z()) - t.z();
-      const double high = std::max(top.z(), bottom.z()) - t.z();
+      const double top = z * (base.z() + down.z() * gy[v]);
+      const double bottom = z * (base.z() + down.z() * gy[v + 1]);
+      const double low = std::min(top, bottom), high = std::max(top, bottom);
       double f_lo = 0.0, f_hi = 1.0;
       clip_linear_le(t.z(), low, z_max, f_lo, f_hi);     // the lower edge below the top
       clip_linear_le(-t.z(), -high, -z_min, f_lo, f_hi);  // the upper edge above the bottom
