@@ -41,29 +41,6 @@ py::array mat_view(cv::Mat& mat, py::handle owner) {
                         mat.ptr<T>(0), owner);
 }
 
-// Hands a freshly made cv::Mat to numpy without copying: a capsule keeps the Mat alive.
-py::array mat_to_numpy(cv::Mat mat) {
-  auto* owned = new cv::Mat(std::move(mat));
-  py::capsule keep(owned, [](void* p) { delete static_cast<cv::Mat*>(p); });
-  const auto elem = static_cast<py::ssize_t>(owned->elemSize1());
-  std::vector<py::ssize_t> shape = {owned->rows, owned->cols};
-  std::vector<py::ssize_t> strides = {static_cast<py::ssize_t>(owned->step[0]),
-                                      static_cast<py::ssize_t>(owned->elemSize())};
-  if (owned->channels() > 1) {
-    shape.push_back(owned->channels());
-    strides.push_back(elem);
-  }
-  py::dtype dt;
-  switch (owned->depth()) {
-    case CV_8U: dt = py::dtype::of<std::uint8_t>(); break;
-    case CV_8S: dt = py::dtype::of<std::int8_t>(); break;
-    case CV_16U: dt = py::dtype::of<std::uint16_t>(); break;
-    case CV_32F: dt = py::dtype::of<float>(); break;
-    default: throw std::runtime_error("unsupported matrix depth");
-  }
-  return py::array(dt, shape, strides, owned->data, keep);
-}
-
 cv::Mat numpy_to_image(const py::array& image) {
   const auto kind = image.dtype().kind();
   const auto size = image.itemsize();

@@ -81,12 +81,8 @@ void bind_models(py::module_& m) {
           "min_range"_a,
           "max_range"_a, "z_min"_a, "z_max"_a)
       .def("build", &LocalMapBuilder::build)
-      .def("hits", [](const LocalMapBuilder& b) {
-        const cv::Mat h = b.hits();
-        py::array_t<std::uint8_t> out({h.rows, h.cols});
-        std::memcpy(out.mutable_data(), h.data, h.total());
-        return out;
-      }, "The cells a beam ended in (uint8 mask, 1 = hit), of build()'s size.");
+      .def("hits", [](const LocalMapBuilder& b) { return mat_to_numpy(b.hits()); },
+           "The cells a beam ended in (uint8 mask, 1 = hit), of build()'s size.");
 
   py::class_<LikelihoodFieldModel>(m, "LikelihoodFieldModel")
       .def(py::init([](const OccupancyGrid& map, double sigma, double z_hit, double z_rand,

@@ -8,8 +8,10 @@
 #include <pybind11/pybind11.h>
 
 #include <cmath>
+#include <opencv2/core/mat.hpp>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "kiseki/core/pose.hpp"
 
@@ -68,5 +70,30 @@ inline FloatArray as_floats(const py::handle& obj, const char* name) {
 }
 
 inline Pose2 pose_from_row(const double* row) { return {row[0], row[1], row[2]}; }
+
+/// Hands a cv::Mat to numpy without copying: a capsule keeps the Mat (and so its buffer)
+/// alive. The array shares the Mat's buffer: pass a clone of anything still in use in C++.
+inline py::array mat_to_numpy(cv::Mat mat) {
+  auto* owned = new cv::Mat(std::move(mat));
+  py::capsule keep(owned, [](void* p) { delete static_cast<cv::Mat*>(p); });
+  const auto elem = static_cast<py::ssize_t>(owned->elemSize1());
+  std::vector<py::ssize_t> shape = {owned->rows, owned->cols};
+  std::vector<py::ssize_t> strides = {static_cast<py::ssize_t>(owned->step[0]),
+                                      static_cast<py::ssize_t>(owned->elemSize())};
+  if (owned->channels() > 1) {
+    shape.push_back(owned->channels());
+    strides.push_back(elem);
+  }
+  py::dtype dt;
+  switch (owned->depth()) {
+    case CV_8U: dt = py::dtype::of<std::uint8_t>(); break;
+    case CV_8S: dt = py::dtype::of<std::int8_t>(); break;
+    case CV_16U: dt = py::dtype::of<std::uint16_t>(); break;
+    case CV_32S: dt = py::dtype::of<std::int32_t>(); break;
+    case CV_32F: dt = py::dtype::of<float>(); break;
+    default: throw std::runtime_error("unsupported matrix depth");
+  }
+  return py::array(dt, shape, strides, owned->data, keep);
+}
 
 }  // namespace kiseki::bindings

@@ -61,6 +61,15 @@ def _positive(name: str, value: float) -> float:
     return value
 
 
+def _merge_rule(value: str) -> str:
+    """A checked --merge value (the taught maps' merge rule)."""
+    from kiseki.teach.environment_map import MERGE_RULES
+
+    if value not in MERGE_RULES:
+        raise ValueError(f"--merge must be {' or '.join(MERGE_RULES)}, got {value!r}")
+    return value
+
+
 @map_app.command("from-log")
 def map_from_log(
     log: Path = typer.Argument(..., help="CARMEN log (.log, .log.gz) or kiseki run (.mcap)."),
@@ -205,11 +214,8 @@ def demo(
     scene's truth, play the route back with each method, and print the thesis' Table 4.5-style
     comparison."""
     from kiseki.demo import run_demo
-    from kiseki.teach.environment_map import MERGE_RULES
 
-    if merge not in MERGE_RULES:
-        raise ValueError(f"--merge must be {' or '.join(MERGE_RULES)}, got {merge!r}")
-    run_demo(scene, out, seed, console, particles, merge)
+    run_demo(scene, out, seed, console, particles, _merge_rule(merge))
 
 
 @experiment_app.command("list")
@@ -350,11 +356,10 @@ def teach_command(
     waypoints and measure the maps against the scene's truth (map_truth.json); the run is
     logged as it goes."""
     from kiseki.sim.scene import load_scene
-    from kiseki.teach.environment_map import MERGE_RULES
     from kiseki.teach.teaching import recover, teach
 
-    if merge is not None and merge not in MERGE_RULES:
-        raise ValueError(f"--merge must be {' or '.join(MERGE_RULES)}, got {merge!r}")
+    if merge is not None:
+        _merge_rule(merge)
     if keys is not None and not keyboard:
         raise ValueError("--keys FILE goes with --keyboard")
     if keyboard and keys is None and not resume and not sys.stdin.isatty():

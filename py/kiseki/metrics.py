@@ -271,37 +271,39 @@ def taught_map_truth(
         raise ValueError("min_range must be >= 0 and finite")
     cells = np.asarray(truth.cells)
     res = truth.resolution
-    ys, xs = np.mgrid[0 : truth.height, 0 : truth.width]
-    cx = truth.origin.x + (xs.ravel() + 0.5) * res
-    cy = truth.origin.y + (ys.ravel() + 0.5) * res
-    occupied = cells.ravel() >= 65
-    free = cells.ravel() == 0
+    xs = truth.origin.x + (np.arange(truth.width) + 0.5) * res  # cell centres
+    ys = truth.origin.y + (np.arange(truth.height) + 0.5) * res
+    occupied, free = cells >= 65, cells == 0
     step = 0.25 * res / reach.max()  # rays a quarter cell apart at the farthest reach
     half = hfov.max() / 2
     angles = np.arange(-half, half + step, step)
     ranges = truth.cast_scans(poses, angles, max_range=float(reach.max() + res))
-    in_reach = np.zeros(cx.size, bool)
-    visible = np.zeros(cx.size, bool)
+    in_reach = np.zeros(cells.shape, bool)
+    visible = np.zeros(cells.shape, bool)
     for pose, beams, fov, far, near_limit in zip(
         poses, ranges, hfov, reach, min_range, strict=True
     ):
-        dx, dy = cx - pose[0], cy - pose[1]
+        # only the cells of the square around the sensor that holds its reach
+        i0, i1 = np.searchsorted(xs, [pose[0] - far, pose[0] + far])
+        j0, j1 = np.searchsorted(ys, [pose[1] - far, pose[1] + far])
+        if i0 >= i1 or j0 >= j1:
+            continue
+        dx, dy = xs[None, i0:i1] - pose[0], ys[j0:j1, None] - pose[1]
         dist = np.hypot(dx, dy)
-        bearing = np.arctan2(dy, dx) - pose[2]
-        bearing = (bearing + np.pi) % (2 * np.pi) - np.pi
+        bearing = (np.arctan2(dy, dx) - pose[2] + np.pi) % (2 * np.pi) - np.pi
         ahead = dist * np.cos(bearing)  # depth along the sensor's axis
         near = (dist <= far) & (np.abs(bearing) <= fov / 2) & (ahead >= near_limit)
-        in_reach |= near
+        in_reach[j0:j1, i0:i1] |= near
         k = np.clip(np.rint((bearing[near] + half) / step).astype(int), 0, len(angles) - 1)
-        seen = np.zeros(cx.size, bool)
-        seen[near] = dist[near] < beams[k] - 0.5 * res
-        visible |= seen
+        window = visible[j0:j1, i0:i1]
+        window[near] |= dist[near] < beams[k] - 0.5 * res
     taught_cells = np.asarray(taught.cells)
-    ti = np.floor((cx - taught.origin.x) / taught.resolution).astype(int)
-    tj = np.floor((cy - taught.origin.y) / taught.resolution).astype(int)
+    ti = np.floor((xs - taught.origin.x) / taught.resolution).astype(int)[None, :]
+    tj = np.floor((ys - taught.origin.y) / taught.resolution).astype(int)[:, None]
+    ti, tj = np.broadcast_arrays(ti, tj)
     inside = (ti >= 0) & (ti < taught.width) & (tj >= 0) & (tj < taught.height)
-    free9 = np.zeros(cx.size, bool)
-    occupied9 = np.zeros(cx.size, bool)
+    free9 = np.zeros(cells.shape, bool)
+    occupied9 = np.zeros(cells.shape, bool)
     f9, o9 = _all_nine(taught_cells == 0), _all_nine(taught_cells >= 65)
     free9[inside] = f9[tj[inside], ti[inside]]
     occupied9[inside] = o9[tj[inside], ti[inside]]

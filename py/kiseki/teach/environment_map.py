@@ -48,15 +48,11 @@ class EnvironmentMap:
         number of M cells whose state changed."""
         if self.rule == "thesis":
             return _core.merge_local_map(self._grid, local.build(), pose)
-        return self._evidence.merge(local.build(), local.hits(), pose)
+        return self._evidence.merge(local, pose)
 
     def map(self) -> OccupancyGrid:
         """M in the thesis' three states (a copy)."""
-        if self.rule == "thesis":
-            return _core.OccupancyGrid(
-                np.array(self._grid.cells), self._grid.resolution, self._grid.origin
-            )
-        return self._evidence.map()
+        return self._grid.copy() if self.rule == "thesis" else self._evidence.map()
 
 
 def build_teaching_map(
@@ -74,8 +70,6 @@ def build_teaching_map(
     `kiseki.mapping.scan_local_map`) placed at its pose and merged by `rule`. Walls are as thin
     as single scans see them and the space behind them is occupied, unlike the log-odds map of
     `kiseki.mapping.build_map`."""
-    if rule not in MERGE_RULES:
-        raise ValueError(f"merge rule must be one of {', '.join(MERGE_RULES)}, got {rule!r}")
     poses = np.ascontiguousarray(poses, dtype=np.float64)
     ranges = np.asarray(ranges)
     if poses.ndim != 2 or poses.shape[1] != 3 or poses.shape[0] == 0:
