@@ -1,22 +1,47 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Pictures: maps with trajectories and scan points, distance fields (PNG, written atomically)."""
+"""Pictures: maps with trajectories and scan points, distance fields (PNG, written atomically).
+
+Figures are :class:`matplotlib.figure.Figure` objects drawn by the Agg canvas and made without
+pyplot (:func:`new_figure`): importing kiseki or drawing with it never selects a matplotlib
+backend, so a user's backend choice stands, and the figures are not kept by pyplot (there is
+nothing to close)."""
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
-import matplotlib
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from kiseki._atomic import atomic_write
+from kiseki.grid import OccupancyGrid
 
-from kiseki._atomic import atomic_write  # noqa: E402
-from kiseki.grid import OccupancyGrid  # noqa: E402
+__all__ = [
+    "draw_map",
+    "figure_for_grid",
+    "map_shades",
+    "new_figure",
+    "render_distance_field",
+    "render_map",
+    "save_figure",
+    "to_map_frame",
+    "world_xy",
+]
 
-__all__ = ["draw_map", "map_shades", "render_distance_field", "render_map", "to_map_frame"]
+
+def new_figure(**kwargs: Any) -> Figure:
+    """A matplotlib figure (``Figure(**kwargs)``: figsize, dpi, ...) with an Agg canvas, made
+    without pyplot: no backend is selected and pyplot does not keep it. Add axes with
+    ``fig.subplots(...)``; ``fig.savefig`` picks the canvas of the file's format (Agg for
+    PNG)."""
+    fig = Figure(**kwargs)
+    FigureCanvasAgg(fig)
+    return fig
 
 
 def map_shades(grid: OccupancyGrid) -> np.ndarray:
@@ -35,17 +60,20 @@ def to_map_frame(grid: OccupancyGrid, points: np.ndarray) -> np.ndarray:
     return pts @ np.array([[c, -s], [s, c]])
 
 
-def _save(fig: plt.Figure, path: Path) -> Path:
-    try:
-        return atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=fig.dpi, bbox_inches="tight"))
-    finally:
-        plt.close(fig)
+def save_figure(fig: Figure, path: str | os.PathLike) -> Path:
+    """Writes the figure to `path` atomically (format from the suffix) at the figure's dpi,
+    cropped to what is drawn; returns the path."""
+    return atomic_write(Path(path), lambda tmp: fig.savefig(tmp, dpi=fig.dpi, bbox_inches="tight"))
 
 
-def _figure(grid: OccupancyGrid, max_inches: float = 12.0) -> tuple[plt.Figure, plt.Axes]:
+def figure_for_grid(grid: OccupancyGrid, max_inches: float = 12.0) -> tuple[Figure, Axes]:
+    """A figure (:func:`new_figure`, 120 dpi) and its axes shaped like the grid: its longer
+    side `max_inches` long (the height at least 2.5 in); axes labelled in metres. Draw the grid
+    with :func:`draw_map` and points with :func:`world_xy`."""
     aspect = grid.height / grid.width
     width = max_inches if aspect <= 1 else max_inches / aspect
-    fig, ax = plt.subplots(figsize=(width, max(2.5, width * aspect)), dpi=120)
+    fig = new_figure(figsize=(width, max(2.5, width * aspect)), dpi=120)
+    ax = fig.subplots()
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     return fig, ax
@@ -59,7 +87,9 @@ def _extent(grid: OccupancyGrid) -> list[float]:
     return [x0, x0 + grid.width * grid.resolution, y0, y0 + grid.height * grid.resolution]
 
 
-def _world_xy(grid: OccupancyGrid, points: np.ndarray) -> np.ndarray:
+def world_xy(grid: OccupancyGrid, points: np.ndarray) -> np.ndarray:
+    """World points (n, 2+) -> the (n, 2) coordinates :func:`draw_map` draws them at: world x, y
+    for a map without yaw, else the map's own frame (:func:`to_map_frame`)."""
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] < 2:
         raise ValueError(f"points must have shape (n, 2) or (n, 3), got {pts.shape}")
@@ -87,28 +117,28 @@ def render_map(
     title: str | None = None,
 ) -> Path:
     """Draws the grid, an optional trajectory (n, 2|3) and optional points (m, 2) to a PNG."""
-    fig, ax = _figure(grid)
+    fig, ax = figure_for_grid(grid)
     draw_map(ax, grid)
     if points is not None and len(points):
-        xy = _world_xy(grid, points)
+        xy = world_xy(grid, points)
         ax.plot(xy[:, 0], xy[:, 1], ".", color="tab:red", markersize=1.5, label="scan points")
     if trajectory is not None and len(trajectory):
-        xy = _world_xy(grid, trajectory)
+        xy = world_xy(grid, trajectory)
         ax.plot(xy[:, 0], xy[:, 1], "-", color="tab:blue", linewidth=1.2, label="trajectory")
         ax.plot(xy[0, 0], xy[0, 1], "o", color="tab:green", markersize=5, label="start")
     if trajectory is not None or points is not None:
         ax.legend(loc="upper right", fontsize=8)
     ax.set_title(title or f"{grid.width} x {grid.height} cells, {grid.resolution} m")
-    return _save(fig, Path(path))
+    return save_figure(fig, path)
 
 
 def render_distance_field(grid: OccupancyGrid, path: str | os.PathLike, clip: float = 2.0) -> Path:
     """Draws the distance to the nearest obstacle (metres, clipped at ``clip``)."""
-    fig, ax = _figure(grid)
+    fig, ax = figure_for_grid(grid)
     field = np.minimum(grid.distance_field(), clip)
     im = ax.imshow(
         field, cmap="viridis", origin="lower", extent=_extent(grid), interpolation="nearest"
     )
     fig.colorbar(im, ax=ax, label="distance to nearest obstacle (m)", shrink=0.8)
     ax.set_title("distance field")
-    return _save(fig, Path(path))
+    return save_figure(fig, path)

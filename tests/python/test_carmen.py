@@ -11,8 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from kiseki.datasets.carmen import LaserScans, flaser_angles, read_carmen_log
+from kiseki.datasets.carmen import flaser_angles, read_carmen_log
 from kiseki.errors import LogFormatError
+from kiseki.scans import LaserScans
 
 RANGES = [[1.5, 2.25, 3.0, 81.91], [0.5, 81.91, 7.125, 4.0]]
 POSES = [[1.0, 2.0, 0.5], [1.25, 2.5, -3.0]]

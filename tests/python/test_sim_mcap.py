@@ -23,8 +23,8 @@ from mcap.records import Chunk, ChunkIndex, Message
 from mcap.stream_reader import ReadDataStream, breakup_chunk
 
 import kiseki
-from kiseki.datasets.carmen import LaserScans
 from kiseki.errors import LogFormatError
+from kiseki.scans import LaserScans
 from kiseki.sim.mcap_log import (
     FOXGLOVE_SCHEMAS,
     ODOMETRY_SCHEMA_NAME,

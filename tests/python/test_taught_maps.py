@@ -14,9 +14,9 @@ import pandas as pd
 import pytest
 
 from kiseki import _core
+from kiseki.control import PurePursuit
 from kiseki.core import Pose2
 from kiseki.metrics import taught_map_truth
-from kiseki.sim.run import PurePursuit
 from kiseki.sim.scene import load_scene
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import EnvironmentMap, build_teaching_map

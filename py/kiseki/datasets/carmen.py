@@ -55,10 +55,10 @@ import numpy as np
 
 from kiseki.datasets._files import read_maybe_gzipped
 from kiseki.errors import LogFormatError
+from kiseki.scans import LaserScans
 
 __all__ = [
     "CarmenLog",
-    "LaserScans",
     "OdometryRecords",
     "flaser_angles",
     "read_carmen_log",
@@ -76,26 +76,6 @@ _FLASER_STEPS = {
 }
 
 _Row = tuple[int, list[str]]  # (1-based line number, whitespace-separated tokens)
-
-
-@dataclass(frozen=True, eq=False)
-class LaserScans:
-    """Laser scans of one log, in file order."""
-
-    times: np.ndarray  # (N,) float64 message timestamp, seconds
-    poses: np.ndarray  # (N, 3) float64 laser pose in the log (x, y, theta); NaN if it has none
-    odometry: np.ndarray  # (N, 3) float64 odometry pose as logged (see the module docstring)
-    ranges: np.ndarray  # (N, B) float32 metres, C-contiguous
-    angles: np.ndarray  # (B,) float64 beam angles in the laser frame, radians
-    max_range: float  # readings >= max_range mean no return
-
-    def __len__(self) -> int:
-        return int(self.times.shape[0])
-
-    @property
-    def has_reference_poses(self) -> bool:
-        """False for logs without reference poses (e.g. the Wean Hall logs: ``poses`` all NaN)."""
-        return bool(np.isfinite(self.poses).all())
 
 
 @dataclass(frozen=True, eq=False)

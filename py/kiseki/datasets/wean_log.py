@@ -8,7 +8,7 @@ Lines, units centimetres and radians, as described by the data set's ``instruct.
     L x y theta xl yl thetal r1 .. r180 ts        a laser scan: robot and laser pose in the
                                                   odometry frame (interpolated), 180 ranges
 
-The scans become a :class:`~kiseki.datasets.carmen.LaserScans` in metres:
+The scans become a :class:`~kiseki.scans.LaserScans` in metres:
 
 * ``odometry`` is the *laser* pose ``xl yl thetal`` of each ``L`` line (the laser sits 25 cm ahead
   of the robot centre), because the particle filters of kiseki track sensor poses;
@@ -35,8 +35,9 @@ from pathlib import Path
 import numpy as np
 
 from kiseki.datasets._files import GZIP_MAGIC, read_maybe_gzipped
-from kiseki.datasets.carmen import LaserScans, flaser_angles
+from kiseki.datasets.carmen import flaser_angles
 from kiseki.errors import LogFormatError
+from kiseki.scans import LaserScans
 
 __all__ = ["WeanLog", "is_wean_log", "read_wean_log"]
 

@@ -11,16 +11,13 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from kiseki.datasets import read_carmen_log  # noqa: E402
-from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput  # noqa: E402
-from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement  # noqa: E402
+from kiseki.datasets import read_carmen_log
+from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
+from kiseki.plots import new_figure
 
 RANGE_BANDS = [(0.0, 5.0), (5.0, 15.0), (15.0, 100.0)]  # metres
 LOGS = ["intel-corrected", "aces-corrected", "csail-corrected", "freiburg-079-corrected"]
@@ -127,7 +124,8 @@ def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) 
         )
         for row in per_log.itertuples()
     ]
-    fig, ax = plt.subplots(figsize=(7, 3.5), dpi=120)
+    fig = new_figure(figsize=(7, 3.5), dpi=120)
+    ax = fig.subplots()
     ax.bar(per_log["log"], per_log["endpoint_share"], color="tab:blue")
     ax.axhline(config.threshold, color="tab:red", linestyle="--", label="threshold")
     ax.set_ylim(0.8, 1.0)
@@ -136,7 +134,6 @@ def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) 
     fig.autofmt_xdate(rotation=20)
     path = figures / "endpoint_share.png"
     fig.savefig(path, bbox_inches="tight")
-    plt.close(fig)
     notes = (
         f"Maps at {config.resolution} m from the logs' corrected poses; a cell counts as "
         "occupied above p = 0.65. Build times are medians over the trials of each log. "

@@ -11,18 +11,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from kiseki.core import Random  # noqa: E402
-from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput  # noqa: E402
-from kiseki.grid import beam_angles  # noqa: E402
-from kiseki.map_io import load_map  # noqa: E402
-from kiseki.mapping import build_map, endpoint_agreement  # noqa: E402
+from kiseki.core import Random
+from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.grid import beam_angles
+from kiseki.map_io import load_map
+from kiseki.mapping import build_map, endpoint_agreement
+from kiseki.plots import new_figure
 
 MAP = Path(__file__).resolve().parents[3] / "data" / "maps" / "factory_corridor.yaml"
 
@@ -113,13 +110,13 @@ def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) 
             note="self-check: ray casting, noise model, mapping and map files agree",
         )
     ]
-    fig, ax = plt.subplots(figsize=(6, 3.5), dpi=120)
+    fig = new_figure(figsize=(6, 3.5), dpi=120)
+    ax = fig.subplots()
     ax.scatter(ok["lateral_offset"], ok["occupied_precision"], s=12)
     ax.set_xlabel("lateral offset of the path (m)")
     ax.set_ylabel("occupied-cell precision")
     path = figures / "precision_vs_offset.png"
     fig.savefig(path, bbox_inches="tight")
-    plt.close(fig)
     return Analysis(tables={"summary": summary}, figures=[path], claims=claims)
 
 

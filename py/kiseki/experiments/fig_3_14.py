@@ -18,17 +18,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from kiseki import _core  # noqa: E402
-from kiseki.core import Pose2, Random  # noqa: E402
-from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput  # noqa: E402
-from kiseki.grid import OccupancyGrid  # noqa: E402
+from kiseki import _core
+from kiseki.core import Pose2, Random
+from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.grid import OccupancyGrid
+from kiseki.plots import new_figure
 
 
 @dataclass(frozen=True)
@@ -117,7 +114,8 @@ def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) 
         ),
     ]
     del centre
-    fig, ax = plt.subplots(figsize=(6.5, 3.5), dpi=120)
+    fig = new_figure(figsize=(6.5, 3.5), dpi=120)
+    ax = fig.subplots()
     ax.plot(offsets, curves["raw"], "-o", markersize=3, label="conventional (raw map)")
     ax.plot(offsets, curves["occlusion"], "-s", markersize=3, label="proposal 1 (occlusion-aware)")
     ax.axvline(0.0, color="grey", linewidth=0.8)
@@ -126,7 +124,6 @@ def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) 
     ax.legend(fontsize=8)
     path = figures / "likelihood_vs_offset.png"
     fig.savefig(path, bbox_inches="tight")
-    plt.close(fig)
     notes = (
         "Thesis Fig. 3.14 plots the same two curves (its exact geometry is not given). Here the "
         "flat side is where the displaced particle only adds intrusions (local-map occupied over "

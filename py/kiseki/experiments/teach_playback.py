@@ -25,23 +25,21 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
+import yaml
+from matplotlib.patches import Circle
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-import yaml  # noqa: E402
-
-from kiseki import _core  # noqa: E402
-from kiseki.core import Random, derive_seed  # noqa: E402
-from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput  # noqa: E402
-from kiseki.map_io import load_map  # noqa: E402
-from kiseki.sim.scene import load_scene  # noqa: E402
-from kiseki.sim.setup import build_robot, build_sensors  # noqa: E402
-from kiseki.teach import PlaybackConfig, playback, teach  # noqa: E402
-from kiseki.teach.environment_map import MERGE_RULES  # noqa: E402
-from kiseki.teach.local_maps import METHODS, LocalMapMaker  # noqa: E402
+from kiseki import _core
+from kiseki.core import Random, derive_seed
+from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.map_io import load_map
+from kiseki.plots import new_figure
+from kiseki.sim.scene import load_scene
+from kiseki.sim.setup import build_robot, build_sensors
+from kiseki.teach import PlaybackConfig, playback, teach
+from kiseki.teach.environment_map import MERGE_RULES
+from kiseki.teach.local_maps import METHODS, LocalMapMaker
 
 WORLDS = Path(__file__).resolve().parents[3] / "data" / "worlds"
 
@@ -149,7 +147,8 @@ def _goal_profile(scene, environment, goal: dict, method: str) -> dict:
 
 
 def _profile_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.5), dpi=120, sharey=True)
+    fig = new_figure(figsize=(9, 3.5), dpi=120)
+    axes = fig.subplots(1, 2, sharey=True)
     for ax, axis in zip(axes, ("along", "side"), strict=True):
         for method in config.methods:
             cols = [f"{method}_goal_like_{axis}_{o:+.2f}" for o in PROFILE_OFFSETS]
@@ -161,7 +160,6 @@ def _profile_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
     fig.suptitle("around the true goal pose: taught map, noise-free local map", fontsize=9)
     path = figures / "goal_likelihood_profiles.png"
     fig.savefig(path, bbox_inches="tight")
-    plt.close(fig)
     return path
 
 
@@ -285,10 +283,11 @@ def _taught_table(config, trials: pd.DataFrame) -> pd.DataFrame:
 
 
 def _stop_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
-    fig, ax = plt.subplots(figsize=(5, 5), dpi=120)
+    fig = new_figure(figsize=(5, 5), dpi=120)
+    ax = fig.subplots()
     for method in config.methods:
         ax.plot(trials[f"{method}_stop_dx"], trials[f"{method}_stop_dy"], "o", label=method)
-    circle = plt.Circle((0, 0), 0.1, fill=False, linestyle="--", color="grey")
+    circle = Circle((0, 0), 0.1, fill=False, linestyle="--", color="grey")
     ax.add_patch(circle)
     ax.set_aspect("equal")
     ax.set_xlabel("stop error x (m)")
@@ -296,7 +295,6 @@ def _stop_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
     ax.legend(fontsize=8)
     path = figures / "stop_positions.png"
     fig.savefig(path, bbox_inches="tight")
-    plt.close(fig)
     return path
 
 

@@ -40,7 +40,7 @@ Reading (:func:`read_run`)
     Header record, or whose complete records do not parse (bad CRC, bad JSON, ...) raises
     :class:`~kiseki.errors.LogFormatError` naming the file.
 
-    :meth:`SimRun.laser_scans` returns the same :class:`~kiseki.datasets.carmen.LaserScans` as
+    :meth:`SimRun.laser_scans` returns the same :class:`~kiseki.scans.LaserScans` as
     the CARMEN reader, so simulated runs replay through the interface of real logs.
 """
 
@@ -68,9 +68,9 @@ from mcap.stream_reader import StreamReader
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
 from kiseki.core import Pose2
-from kiseki.datasets.carmen import LaserScans
 from kiseki.errors import LogFormatError
 from kiseki.grid import OccupancyGrid
+from kiseki.scans import LaserScans
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
@@ -903,7 +903,7 @@ class SimRun:
         truth_topic: str | None = "/ground_truth",
         odom_topic: str | None = "/odom",
     ) -> LaserScans:
-        """The scans as a CARMEN-like :class:`~kiseki.datasets.carmen.LaserScans`, by time.
+        """The scans as a CARMEN-like :class:`~kiseki.scans.LaserScans`, by time.
 
         * ``poses``: the sensor pose in the world, the pose written in each LaserScan message
           (the laser pose of a CARMEN log). A scan whose ``frame_id`` is not the frame of the

@@ -8,16 +8,13 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.animation import FuncAnimation, PillowWriter
+from matplotlib.colors import ListedColormap
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.animation import FuncAnimation, PillowWriter  # noqa: E402
-from matplotlib.colors import ListedColormap  # noqa: E402
-
-from kiseki._atomic import atomic_write  # noqa: E402
-from kiseki.sim.scene import Scene  # noqa: E402
+from kiseki._atomic import atomic_write
+from kiseki.plots import new_figure
+from kiseki.sim.scene import Scene
 
 __all__ = ["render_run", "render_scene"]
 
@@ -46,7 +43,8 @@ def _layers(scene: Scene) -> tuple[np.ndarray, object]:
 def _axes(grid, title: str):
     aspect = grid.height / grid.width
     width = 12.0 if aspect < 1 else 12.0 / aspect
-    fig, ax = plt.subplots(figsize=(width, max(3.0, width * aspect)), dpi=110)
+    fig = new_figure(figsize=(width, max(3.0, width * aspect)), dpi=110)
+    ax = fig.subplots()
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_title(title)
@@ -75,10 +73,7 @@ def _extent(grid) -> list[float]:
 
 
 def _save(fig, path) -> Path:
-    try:
-        return atomic_write(Path(path), lambda tmp: fig.savefig(tmp, bbox_inches="tight"))
-    finally:
-        plt.close(fig)
+    return atomic_write(Path(path), lambda tmp: fig.savefig(tmp, bbox_inches="tight"))
 
 
 def render_scene(scene: Scene, path: str | os.PathLike) -> Path:
@@ -182,7 +177,4 @@ def render_run(
         return (*lines, points)
 
     anim = FuncAnimation(fig, draw, frames=picks, blit=True)
-    try:
-        return atomic_write(Path(path), lambda tmp: anim.save(tmp, writer=PillowWriter(fps=10)))
-    finally:
-        plt.close(fig)
+    return atomic_write(Path(path), lambda tmp: anim.save(tmp, writer=PillowWriter(fps=10)))

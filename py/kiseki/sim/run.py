@@ -15,11 +15,12 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from kiseki.sim.mcap_log import RunWriter
+from kiseki.control import PurePursuit
+from kiseki.sim.mcap_log import RunWriter, read_run
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import RobotSetup, SensorSetup, build_robot, build_sensors
 
-__all__ = ["PurePursuit", "RunSummary", "SimConfig", "read_commands", "simulate"]
+__all__ = ["RunSummary", "SimConfig", "read_commands", "simulate"]
 
 MAG_SCHEMA = {
     "type": "object",
@@ -55,72 +56,6 @@ class SimConfig:
             raise ValueError(f"duration must be positive, got {self.duration}")
         if not (self.lookahead > 0 and self.goal_tolerance > 0):
             raise ValueError("lookahead and goal_tolerance must be positive")
-
-
-class PurePursuit:
-    """Follows a polyline: aims at the point `lookahead` metres ahead along the path, slows to
-    stop at the last waypoint within its deceleration limit, and reports when it is there."""
-
-    def __init__(
-        self, waypoints, speed: float, lookahead: float, tolerance: float, max_accel: float
-    ) -> None:
-        pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
-        if len(pts) < 2 or not np.isfinite(pts).all():
-            raise ValueError("a route needs at least two finite waypoints")
-        if not speed > 0:
-            raise ValueError("route speed must be positive")
-        seg = np.diff(pts, axis=0)
-        self.lengths = np.hypot(seg[:, 0], seg[:, 1])
-        if (self.lengths <= 0).any():
-            raise ValueError("consecutive route waypoints must differ")
-        self.points, self.cum = pts, np.concatenate([[0.0], np.cumsum(self.lengths)])
-        self.speed, self.lookahead, self.tolerance, self.max_accel = (
-            speed,
-            lookahead,
-            tolerance,
-            max_accel,
-        )
-        self.progress = 0.0
-        self.done = False
-
-    def _point_at(self, s: float) -> np.ndarray:
-        s = min(max(s, 0.0), self.cum[-1])
-        i = min(int(np.searchsorted(self.cum, s, side="right")) - 1, len(self.lengths) - 1)
-        f = (s - self.cum[i]) / self.lengths[i]
-        return self.points[i] + f * (self.points[i + 1] - self.points[i])
-
-    def _project(self, xy: np.ndarray) -> float:
-        best, best_s = np.inf, self.progress
-        for i in range(len(self.lengths)):
-            a, b = self.points[i], self.points[i + 1]
-            f = np.clip(np.dot(xy - a, b - a) / self.lengths[i] ** 2, 0.0, 1.0)
-            s = self.cum[i] + f * self.lengths[i]
-            d = np.hypot(*(a + f * (b - a) - xy))
-            if d < best and s >= self.progress - 0.5:  # never jump back along the path
-                best, best_s = d, s
-        return max(self.progress, best_s)
-
-    def command(self, pose) -> tuple[float, float, float]:
-        """(v_forward, v_left, yaw_rate) in the body frame."""
-        x, y, th = (float(v) for v in pose)
-        xy = np.array([x, y])
-        goal = self.points[-1]
-        dist_goal = float(np.hypot(*(goal - xy)))
-        self.progress = self._project(xy)
-        if self.done or (dist_goal < self.tolerance and self.cum[-1] - self.progress < 0.5):
-            self.done = True
-            return 0.0, 0.0, 0.0
-        target = self._point_at(self.progress + self.lookahead)
-        if self.cum[-1] - self.progress < self.lookahead:
-            target = goal
-        c, s = math.cos(th), math.sin(th)
-        dx, dy = target - xy
-        lx, ly = c * dx + s * dy, -s * dx + c * dy  # target in the body frame
-        speed = min(self.speed, math.sqrt(2 * self.max_accel * 0.8 * dist_goal))
-        curvature = 2.0 * ly / max(lx * lx + ly * ly, 1e-9)
-        if lx < 0:  # target behind: turn on the spot
-            return 0.0, 0.0, math.copysign(1.0, ly)
-        return speed, 0.0, speed * curvature
 
 
 @dataclass(frozen=True)
@@ -370,6 +305,4 @@ def _laser_grids(scene: Scene, sensors: list[SensorSetup]):
 
 
 def _topic_counts(path) -> dict:
-    from kiseki.sim.mcap_log import read_run
-
     return read_run(path).topics()

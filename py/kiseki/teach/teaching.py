@@ -22,12 +22,12 @@ import yaml
 from tqdm import tqdm
 
 from kiseki._atomic import atomic_write
+from kiseki.control import PurePursuit
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
 from kiseki.map_io import save_map
 from kiseki.metrics import taught_map_truth
 from kiseki.sim.mcap_log import RunWriter, read_run
-from kiseki.sim.run import PurePursuit
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import MERGE_RULES, EnvironmentMap

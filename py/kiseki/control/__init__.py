@@ -1,0 +1,10 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Control: following a path. Teaching, playback and the simulator drive their robots with the
+same follower; control imports nothing of the methods above it nor of the simulator."""
+
+from __future__ import annotations
+
+from kiseki.control.pure_pursuit import PurePursuit
+
+__all__ = ["PurePursuit"]
