@@ -1,39 +1,59 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Readers for recorded robot data: CARMEN logs, kiseki's simulated runs (MCAP), and the CMU
-Wean Hall map. ``open_scans`` gives the laser scans of any supported log through one interface."""
+"""Readers for recorded robot data: CARMEN logs, ROS 1 and ROS 2 bags, kiseki's simulated runs
+(MCAP), and the CMU Wean Hall map. ``open_scans`` gives the laser scans of any supported log
+through one interface."""
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
 
-from kiseki.datasets.carmen import CarmenLog, LaserScans, OdometryRecords, read_carmen_log
+from kiseki.datasets.carmen import CarmenLog, OdometryRecords, read_carmen_log
+from kiseki.datasets.rosbag import BAG_KINDS, is_ros_bag, read_bag_scans, write_bag
 from kiseki.datasets.wean import WeanMap, read_wean_map
 from kiseki.datasets.wean_log import WeanLog, is_wean_log, read_wean_log
+from kiseki.scans import LaserScans
+from kiseki.sim.mcap_log import read_run
 
 __all__ = [
     "open_scans",
+    "BAG_KINDS",
     "CarmenLog",
     "LaserScans",
     "OdometryRecords",
     "WeanLog",
     "WeanMap",
+    "is_ros_bag",
     "is_wean_log",
+    "read_bag_scans",
     "read_carmen_log",
     "read_wean_log",
     "read_wean_map",
+    "write_bag",
 ]
 
 
-def open_scans(path: str | os.PathLike) -> LaserScans:
-    """The laser scans of a log: a CARMEN log (.log, .log.gz, .clf), a kiseki run (.mcap,
-    scans of /scan paired with /ground_truth and /odom) or a CMU Wean Hall robotdata log
-    (recognised by its content: ``O``/``L`` lines; no reference poses)."""
+def open_scans(
+    path: str | os.PathLike,
+    scan_topic: str = "/scan",
+    odom_topic: str = "/odom",
+    reference_topic: str | None = None,
+) -> LaserScans:
+    """The laser scans of a log: a ROS 1 bag (.bag) or ROS 2 bag (folder, .db3, or .mcap with
+    CDR messages; see :func:`read_bag_scans` for the topics), a CARMEN log (.log, .log.gz, .clf),
+    a kiseki run (.mcap, scans of /scan paired with /ground_truth and /odom) or a CMU Wean Hall
+    robotdata log (recognised by its content: ``O``/``L`` lines; no reference poses). The topic
+    arguments are for bags only: other logs name their own topics or have none."""
     path = Path(path)
+    if is_ros_bag(path) or path.suffix.lower() in (".bag", ".db3"):
+        return read_bag_scans(path, scan_topic, odom_topic, reference_topic)
+    if (scan_topic, odom_topic, reference_topic) != ("/scan", "/odom", None):
+        raise ValueError(
+            f"{path}: not a ROS bag: the scan, odometry and reference topics can only be "
+            "chosen for ROS bags"
+        )
     if path.suffix.lower() == ".mcap":
-        from kiseki.sim.mcap_log import read_run
-
         return read_run(path).laser_scans()
     if is_wean_log(path):
         return read_wean_log(path).scans

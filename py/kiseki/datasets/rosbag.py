@@ -1,0 +1,638 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""ROS 1 bags and ROS 2 bags (sqlite3 or MCAP storage) as laser scans, read and written with the
+pure-Python ``rosbags`` library, so no ROS installation is needed.
+
+Reading (:func:`read_bag_scans`) returns the same :class:`~kiseki.scans.LaserScans` as
+the CARMEN reader, in the laser frame, as kiseki's filters expect:
+
+* scans: ``sensor_msgs/msg/LaserScan`` (ROS 1 ``sensor_msgs/LaserScan``) on ``scan_topic``,
+  ordered by their ``header.stamp``, which gives ``times``. Beam ``i`` is at
+  ``angle_min + i * angle_increment`` (float32 fields in the message); ``max_range`` is the
+  ``range_max`` of the first scan. Every scan must have the first scan's beam count, angles and
+  ``header.frame_id`` (the laser frame). Ranges stay float32 as recorded, NaN and inf included
+  (the filters take them as invalid / no return).
+* odometry: ``nav_msgs/msg/Odometry`` on ``odom_topic`` (odometry frame = its ``header.frame_id``,
+  base frame = its ``child_frame_id``); when the bag has no such topic, the ``/tf`` transform that
+  moves the laser frame or the first of its ``/tf_static`` parents (the base frame) relative to
+  its ``/tf`` parent (the odometry frame). Poses are interpolated to each scan's stamp (linear in
+  x and y, shortest arc in the heading) and composed with the laser's mount.
+* mount: the base -> laser frame transform, composed from ``/tf_static`` (several hops are
+  followed, e.g. ``base_footprint -> base_link -> laser``); identity when the laser frame is the
+  base frame. A missing transform is a :class:`~kiseki.errors.LogFormatError`.
+* poses (reference): with ``reference_topic``, the ``nav_msgs/msg/Odometry`` poses on that topic
+  (e.g. a simulator's ground truth), interpolated and composed with the mount of their
+  ``child_frame_id`` like the odometry; all NaN without a ``reference_topic``.
+
+Everything is planar: x, y and the yaw of each pose and transform (roll, pitch and z dropped).
+Scans stamped before the first or after the last odometry pose are dropped, since odometry is not
+extrapolated; with a ``reference_topic`` the same holds for the reference poses. Frame names are
+compared without a leading ``/`` (ROS 1 style ``/base_link`` is ``base_link``).
+
+Writing (:func:`write_bag`) converts a :class:`LaserScans` (e.g. a CARMEN log) into a bag with
+``rosbags``' own writers: LaserScan messages, the odometry of ``base_link`` in ``odom``, the mount
+on ``/tf_static`` and, when the scans have reference poses, ``base_link`` in ``map`` on the
+reference topic. Each message is stamped (and logged) at its scan's time.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from kiseki.errors import LogFormatError
+from kiseki.scans import LaserScans
+
+__all__ = ["BAG_KINDS", "is_ros_bag", "read_bag_scans", "write_bag"]
+
+BAG_KINDS = ("ros1", "ros2-sqlite3", "ros2-mcap")
+
+LASER_SCAN = "sensor_msgs/msg/LaserScan"
+ODOMETRY = "nav_msgs/msg/Odometry"
+TF_MESSAGES = ("tf2_msgs/msg/TFMessage", "tf/msg/tfMessage")  # ROS 2 / ROS 1, same layout
+TF_TOPIC = "/tf"
+TF_STATIC_TOPIC = "/tf_static"
+
+ODOM_FRAME = "odom"
+BASE_FRAME = "base_link"
+MAP_FRAME = "map"
+
+_NS_PER_S = 1_000_000_000
+_ROS1_MAGIC = b"#ROSBAG V2.0\n"
+_SQLITE_MAGIC = b"SQLite format 3\x00"
+_MCAP_MAGIC = b"\x89MCAP0\r\n"
+_TF_MESSAGE_MSG = "geometry_msgs/TransformStamped[] transforms\n"
+
+
+# --- recognising bags ---
+
+
+def is_ros_bag(path: str | os.PathLike) -> bool:
+    """Whether ``path`` is a ROS 1 ``.bag`` file, a ROS 2 bag folder (with ``metadata.yaml``) or a
+    ROS 2 storage file (``.db3``, or ``.mcap`` with CDR messages: kiseki's own simulated runs are
+    MCAP too, with JSON messages). Reads only the head (and the MCAP summary) of a file."""
+    path = Path(path)
+    if path.is_dir():
+        return (path / "metadata.yaml").is_file()
+    suffix = path.suffix.lower()
+    if suffix not in (".bag", ".db3", ".mcap"):
+        return False
+    try:
+        with path.open("rb") as f:
+            head = f.read(len(_SQLITE_MAGIC))
+    except OSError:
+        return False
+    if suffix == ".bag":
+        return head.startswith(_ROS1_MAGIC)
+    if suffix == ".db3":
+        return head == _SQLITE_MAGIC
+    return head.startswith(_MCAP_MAGIC) and _is_ros2_mcap(path)
+
+
+def _is_ros2_mcap(path: Path) -> bool:
+    """A ROS 2 MCAP: its channels' message encoding is ``cdr``; without channels (an empty bag),
+    its header profile is ``ros2``."""
+    from mcap.exceptions import McapError
+    from mcap.reader import make_reader
+    from mcap.records import Channel, Header
+    from mcap.stream_reader import StreamReader
+
+    try:
+        with path.open("rb") as f:
+            reader = make_reader(f)
+            summary = reader.get_summary()
+            if summary is not None and summary.channels:
+                return any(c.message_encoding == "cdr" for c in summary.channels.values())
+            profile = reader.get_header().profile
+    except (McapError, OSError, ValueError, EOFError):
+        profile = None
+    # No summary (a cut file): the first channel record, streamed from the start.
+    try:
+        with path.open("rb") as f:
+            for record in StreamReader(f, skip_magic=False).records:
+                if isinstance(record, Channel):
+                    return record.message_encoding == "cdr"
+                if isinstance(record, Header):
+                    profile = record.profile
+    except Exception:  # a corrupt tail ends the search, whatever the mcap reader raises
+        pass
+    return profile == "ros2"
+
+
+# --- reading ---
+
+
+@dataclass
+class _Track:
+    """Timed planar poses of one frame (``child``) in another (``parent``), by stamp."""
+
+    parent: str
+    child: str
+    ns: list[int]
+    poses: list[tuple[float, float, float]]
+
+
+def read_bag_scans(
+    path: str | os.PathLike,
+    scan_topic: str = "/scan",
+    odom_topic: str = "/odom",
+    reference_topic: str | None = None,
+) -> LaserScans:
+    """The laser scans of a ROS 1 or ROS 2 bag, with laser-frame odometry and, with
+    ``reference_topic``, laser-frame reference poses (see the module docstring)."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: no such bag")
+    if not is_ros_bag(path):
+        raise LogFormatError(
+            f"{path}: not a ROS bag (a ROS 1 .bag file, or a ROS 2 bag folder with metadata.yaml"
+            " or its .db3 / .mcap file with CDR messages)"
+        )
+    with _open_bag(path) as reader:
+        topics = {name: info.msgtype for name, info in reader.topics.items()}
+        if reader.message_count == 0:
+            raise LogFormatError(f"{path}: empty bag (no messages)")
+        if scan_topic not in topics:
+            raise LogFormatError(
+                f"{path}: no scan topic {scan_topic!r}; topics: {_describe(topics)}"
+            )
+        _check_type(path, topics, scan_topic, (LASER_SCAN,))
+        use_tf = odom_topic not in topics
+        if use_tf and TF_TOPIC not in topics:
+            raise LogFormatError(
+                f"{path}: no odometry: neither {odom_topic!r} nor {TF_TOPIC!r}; topics: "
+                f"{_describe(topics)}"
+            )
+        wanted = [scan_topic, TF_TOPIC if use_tf else odom_topic]
+        if reference_topic is not None:
+            if reference_topic not in topics:
+                raise LogFormatError(
+                    f"{path}: no reference topic {reference_topic!r}; topics: {_describe(topics)}"
+                )
+            _check_type(path, topics, reference_topic, (ODOMETRY,))
+            wanted.append(reference_topic)
+        if not use_tf:
+            _check_type(path, topics, odom_topic, (ODOMETRY,))
+        for tf_topic in (TF_TOPIC, TF_STATIC_TOPIC):
+            if tf_topic in topics:
+                _check_type(path, topics, tf_topic, TF_MESSAGES)
+                wanted.append(tf_topic)
+        messages: dict[str, list[Any]] = {topic: [] for topic in wanted}
+        connections = [c for c in reader.connections if c.topic in messages]
+        try:
+            for connection, _, raw in reader.messages(connections=connections):
+                msg = reader.deserialize(raw, connection.msgtype)
+                messages[connection.topic].append(msg)
+        except Exception as exc:  # rosbags raises its own errors for corrupt data
+            raise LogFormatError(f"{path}: unreadable messages ({exc})") from exc
+
+    scans = messages[scan_topic]
+    if not scans:
+        raise LogFormatError(f"{path}: no messages on the scan topic {scan_topic!r}")
+    laser, ns, ranges, angles, max_range = _scan_arrays(path, scan_topic, scans)
+    static = _static_transforms(messages.get(TF_STATIC_TOPIC, []))
+    if use_tf:
+        odom = _tf_odometry(path, messages[TF_TOPIC], static, laser, odom_topic)
+    else:
+        odom = _odometry_track(path, odom_topic, messages[odom_topic])
+    tracks = [odom]
+    if reference_topic is not None:
+        tracks.append(_odometry_track(path, reference_topic, messages[reference_topic]))
+    keep = np.ones(len(ns), dtype=bool)
+    for track in tracks:
+        keep &= (ns >= track.ns[0]) & (ns <= track.ns[-1])
+    if not keep.any():
+        raise LogFormatError(
+            f"{path}: no scan on {scan_topic!r} lies within the time span of the odometry"
+            + (" and the reference poses" if reference_topic is not None else "")
+        )
+    ns = ns[keep]
+    laser_poses = []
+    for track in tracks:
+        mount = _mount(path, static, track.child, laser)
+        laser_poses.append(_compose(_interpolate(track, ns), mount))
+    poses = laser_poses[1] if reference_topic is not None else np.full((len(ns), 3), np.nan)
+    return LaserScans(
+        times=np.array([int(t) / _NS_PER_S for t in ns], dtype=np.float64),
+        poses=poses,
+        odometry=laser_poses[0],
+        ranges=np.ascontiguousarray(ranges[keep]),
+        angles=angles,
+        max_range=max_range,
+    )
+
+
+@contextmanager
+def _open_bag(path: Path) -> Iterator[Any]:
+    """An open ``rosbags`` AnyReader; its errors become LogFormatError naming the bag."""
+    from rosbags.highlevel import AnyReader, AnyReaderError
+    from rosbags.typesys import Stores, get_typestore
+
+    is_ros1 = path.is_file() and path.suffix.lower() == ".bag"
+    store = get_typestore(Stores.ROS1_NOETIC if is_ros1 else Stores.ROS2_HUMBLE)
+    try:
+        reader = AnyReader([path], default_typestore=store)
+        reader.open()
+    except AnyReaderError as exc:
+        raise LogFormatError(f"{path}: unreadable ROS bag ({exc})") from exc
+    try:
+        yield reader
+    finally:
+        reader.close()
+
+
+def _describe(topics: dict[str, str | None]) -> str:
+    return ", ".join(f"{name} ({kind})" for name, kind in sorted(topics.items())) or "none"
+
+
+def _check_type(
+    path: Path, topics: dict[str, str | None], topic: str, kinds: Sequence[str]
+) -> None:
+    if topics[topic] not in kinds:
+        raise LogFormatError(
+            f"{path}: topic {topic!r} has type {topics[topic]}, expected {' or '.join(kinds)}"
+        )
+
+
+def _frame(name: str) -> str:
+    return name.lstrip("/")
+
+
+def _stamp_ns(header: Any) -> int:
+    return int(header.stamp.sec) * _NS_PER_S + int(header.stamp.nanosec)
+
+
+def _yaw(q: Any) -> float:
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def _scan_arrays(
+    path: Path, topic: str, scans: list[Any]
+) -> tuple[str, np.ndarray, np.ndarray, np.ndarray, float]:
+    """Laser frame, stamps (ns), ranges, beam angles and max range of the scans, by stamp."""
+    first = scans[0]
+    beams = len(first.ranges)
+    if beams < 1:
+        raise LogFormatError(f"{path}: the first scan on {topic!r} has no beams")
+    laser = _frame(first.header.frame_id)
+    for index, scan in enumerate(scans):
+        if (
+            len(scan.ranges) != beams
+            or scan.angle_min != first.angle_min
+            or scan.angle_increment != first.angle_increment
+        ):
+            raise LogFormatError(
+                f"{path}: scan {index} on {topic!r} has other beams than the first scan "
+                f"({len(scan.ranges)} from {scan.angle_min} step {scan.angle_increment} rad, "
+                f"not {beams} from {first.angle_min} step {first.angle_increment} rad)"
+            )
+        if _frame(scan.header.frame_id) != laser:
+            raise LogFormatError(
+                f"{path}: scan {index} on {topic!r} is in frame {scan.header.frame_id!r}, the "
+                f"first scan in {laser!r}"
+            )
+    ns = np.array([_stamp_ns(scan.header) for scan in scans], dtype=np.int64)
+    order = np.argsort(ns, kind="stable")
+    ranges = np.empty((len(scans), beams), dtype=np.float32)
+    for row, index in enumerate(order):
+        ranges[row] = scans[index].ranges
+    angle_min = float(first.angle_min)
+    angles = angle_min + float(first.angle_increment) * np.arange(beams, dtype=np.float64)
+    return laser, ns[order], ranges, angles, float(np.float32(first.range_max))
+
+
+def _odometry_track(path: Path, topic: str, messages: list[Any]) -> _Track:
+    if not messages:
+        raise LogFormatError(f"{path}: no messages on {topic!r}")
+    parent = _frame(messages[0].header.frame_id)
+    child = _frame(messages[0].child_frame_id)
+    track = _Track(parent, child, [], [])
+    for index, msg in enumerate(messages):
+        if (_frame(msg.header.frame_id), _frame(msg.child_frame_id)) != (parent, child):
+            raise LogFormatError(
+                f"{path}: message {index} on {topic!r} is {msg.child_frame_id!r} in "
+                f"{msg.header.frame_id!r}, the first one {child!r} in {parent!r}"
+            )
+        pose = msg.pose.pose
+        track.ns.append(_stamp_ns(msg.header))
+        track.poses.append((float(pose.position.x), float(pose.position.y), _yaw(pose.orientation)))
+    return _sorted(track)
+
+
+def _sorted(track: _Track) -> _Track:
+    order = sorted(range(len(track.ns)), key=track.ns.__getitem__)
+    return _Track(
+        track.parent,
+        track.child,
+        [track.ns[i] for i in order],
+        [track.poses[i] for i in order],
+    )
+
+
+def _transform_pose(transform: Any) -> tuple[float, float, float]:
+    t = transform.transform
+    return (float(t.translation.x), float(t.translation.y), _yaw(t.rotation))
+
+
+def _static_transforms(messages: list[Any]) -> dict[str, tuple[str, tuple[float, float, float]]]:
+    """child frame -> (parent frame, planar pose of the child in the parent); the last wins."""
+    static: dict[str, tuple[str, tuple[float, float, float]]] = {}
+    for msg in messages:
+        for transform in msg.transforms:
+            static[_frame(transform.child_frame_id)] = (
+                _frame(transform.header.frame_id),
+                _transform_pose(transform),
+            )
+    return static
+
+
+def _tf_odometry(
+    path: Path,
+    messages: list[Any],
+    static: dict[str, tuple[str, tuple[float, float, float]]],
+    laser: str,
+    odom_topic: str,
+) -> _Track:
+    """The /tf track of the base frame: the laser frame or its first /tf_static parent that
+    /tf moves."""
+    tracks: dict[tuple[str, str], _Track] = {}
+    for msg in messages:
+        for transform in msg.transforms:
+            parent, child = _frame(transform.header.frame_id), _frame(transform.child_frame_id)
+            track = tracks.setdefault((parent, child), _Track(parent, child, [], []))
+            track.ns.append(_stamp_ns(transform.header))
+            track.poses.append(_transform_pose(transform))
+    moved: dict[str, list[_Track]] = {}
+    for track in tracks.values():
+        moved.setdefault(track.child, []).append(track)
+    frame, seen = laser, set()
+    while frame not in moved:
+        seen.add(frame)
+        if frame not in static or static[frame][0] in seen:
+            raise LogFormatError(
+                f"{path}: no odometry: no topic {odom_topic!r}, and {TF_TOPIC!r} moves neither "
+                f"the laser frame {laser!r} nor one of its {TF_STATIC_TOPIC} parents"
+            )
+        frame = static[frame][0]
+    if len(moved[frame]) > 1:
+        parents = sorted(t.parent for t in moved[frame])
+        raise LogFormatError(f"{path}: {TF_TOPIC!r} moves {frame!r} in several frames {parents}")
+    return _sorted(moved[frame][0])
+
+
+def _mount(
+    path: Path, static: dict[str, tuple[str, tuple[float, float, float]]], base: str, laser: str
+) -> np.ndarray:
+    """Planar pose of the laser frame in the base frame, composed along /tf_static."""
+    mount = np.zeros(3)
+    frame, seen = laser, set()
+    while frame != base:
+        seen.add(frame)
+        if frame not in static or static[frame][0] in seen:
+            raise LogFormatError(
+                f"{path}: no transform from {base!r} to the laser frame {laser!r} on "
+                f"{TF_STATIC_TOPIC}"
+            )
+        parent, pose = static[frame]
+        mount = _compose(np.array([pose]), mount)[0]
+        frame = parent
+    return mount
+
+
+def _interpolate(track: _Track, ns: np.ndarray) -> np.ndarray:
+    """Poses of ``track`` at the stamps ``ns`` (within its span): linear in x and y,
+    shortest arc in the heading."""
+    times = np.array(track.ns, dtype=np.int64)
+    poses = np.array(track.poses, dtype=np.float64)
+    if len(times) == 1:
+        return np.repeat(poses, len(ns), axis=0)
+    i0 = (np.searchsorted(times, ns, side="right") - 1).clip(0, len(times) - 2)
+    t0, t1 = times[i0], times[i0 + 1]
+    span = (t1 - t0).astype(np.float64)
+    a = np.where(span > 0, (ns - t0).astype(np.float64) / np.where(span > 0, span, 1.0), 1.0)
+    p0, p1 = poses[i0], poses[i0 + 1]
+    out = np.empty((len(ns), 3))
+    out[:, :2] = p0[:, :2] + a[:, None] * (p1[:, :2] - p0[:, :2])
+    out[:, 2] = _wrap(p0[:, 2] + a * _wrap(p1[:, 2] - p0[:, 2]))
+    return out
+
+
+def _wrap(theta: np.ndarray) -> np.ndarray:
+    return np.remainder(theta + np.pi, 2 * np.pi) - np.pi
+
+
+def _compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a ∘ b`` for planar poses (rows of x, y, theta; ``b`` may be one pose)."""
+    b = np.broadcast_to(b, a.shape)
+    c, s = np.cos(a[:, 2]), np.sin(a[:, 2])
+    return np.column_stack(
+        [
+            a[:, 0] + c * b[:, 0] - s * b[:, 1],
+            a[:, 1] + s * b[:, 0] + c * b[:, 1],
+            _wrap(a[:, 2] + b[:, 2]),
+        ]
+    )
+
+
+def _inverse(pose: np.ndarray) -> np.ndarray:
+    x, y, theta = pose
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([-c * x - s * y, s * x - c * y, -theta])
+
+
+# --- writing ---
+
+
+def write_bag(
+    scans: LaserScans,
+    path: str | os.PathLike,
+    kind: str = "ros1",
+    scan_topic: str = "/scan",
+    odom_topic: str = "/odom",
+    reference_topic: str = "/ground_truth",
+    laser_frame: str = "laser",
+    mount: Sequence[float] = (0.0, 0.0, 0.0),
+) -> Path:
+    """Write ``scans`` as a bag: ``kind`` ``ros1`` (a ``.bag`` file), ``ros2-sqlite3`` or
+    ``ros2-mcap`` (a bag folder). ``mount`` is the laser's planar pose (x, y, yaw) in
+    ``base_link``; the odometry (and reference poses) of ``base_link`` are the laser's composed
+    with its inverse. The bag is written beside ``path`` under a temporary name and renamed when
+    complete; an existing ``path`` is refused. Scan times that step back or repeat (some CARMEN
+    logs) are written as they are, but the reader orders scans and poses by stamp."""
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    path = Path(path)
+    if kind not in BAG_KINDS:
+        raise ValueError(f"bag kind must be one of {', '.join(BAG_KINDS)}, got {kind!r}")
+    if path.exists():
+        raise FileExistsError(f"{path}: exists already, not overwriting")
+    if not path.parent.is_dir():
+        raise FileNotFoundError(f"{path}: directory {path.parent} does not exist")
+    mount = np.array(mount, dtype=np.float64)
+    if mount.shape != (3,) or not np.isfinite(mount).all():
+        raise ValueError(f"mount must be three finite numbers x, y, yaw, got {mount.tolist()}")
+    laser_frame = _frame(laser_frame)
+    if laser_frame == BASE_FRAME and mount.any():
+        raise ValueError(f"a laser frame {BASE_FRAME!r} is the base frame: its mount must be 0")
+    if len(scans) == 0:
+        raise ValueError(f"{path}: no scans to write")
+    if not np.isfinite(scans.odometry).all():
+        raise ValueError(f"{path}: the scans' odometry has NaN or inf poses")
+    if not np.isfinite(scans.times).all() or (scans.times < 0).any():
+        raise ValueError(f"{path}: scan times must be finite and >= 0")
+    angle_min, angle_increment = _beam_spacing(path, scans.angles)
+
+    ros1 = kind == "ros1"
+    store = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
+    if TF_MESSAGES[0] not in store.types:  # ROS1_NOETIC in rosbags has no tf2_msgs
+        store.register(get_types_from_msg(_TF_MESSAGE_MSG, TF_MESSAGES[0]))
+    types = store.types
+    ns = [round(Fraction(float(t)) * _NS_PER_S) for t in scans.times]
+    seq = iter(range(1, 2**32))
+
+    def header(stamp: int, frame: str) -> Any:
+        sec, nanosec = divmod(stamp, _NS_PER_S)
+        time = types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
+        if ros1:
+            return types["std_msgs/msg/Header"](seq=next(seq), stamp=time, frame_id=frame)
+        return types["std_msgs/msg/Header"](stamp=time, frame_id=frame)
+
+    def odometry(stamp: int, frame: str, pose: np.ndarray) -> Any:
+        geometry = "geometry_msgs/msg/"
+        q = types[geometry + "Quaternion"](*_yaw_quaternion(pose[2]))
+        where = types[geometry + "Pose"](
+            position=types[geometry + "Point"](x=pose[0], y=pose[1], z=0.0), orientation=q
+        )
+        zero = types[geometry + "Vector3"](x=0.0, y=0.0, z=0.0)
+        return types[ODOMETRY](
+            header=header(stamp, frame),
+            child_frame_id=BASE_FRAME,
+            pose=types[geometry + "PoseWithCovariance"](pose=where, covariance=np.zeros(36)),
+            twist=types[geometry + "TwistWithCovariance"](
+                twist=types[geometry + "Twist"](linear=zero, angular=zero),
+                covariance=np.zeros(36),
+            ),
+        )
+
+    def tf_static() -> Any:
+        geometry = "geometry_msgs/msg/"
+        transform = types[geometry + "TransformStamped"](
+            header=header(ns[0], BASE_FRAME),
+            child_frame_id=laser_frame,
+            transform=types[geometry + "Transform"](
+                translation=types[geometry + "Vector3"](x=mount[0], y=mount[1], z=0.0),
+                rotation=types[geometry + "Quaternion"](*_yaw_quaternion(mount[2])),
+            ),
+        )
+        return types[TF_MESSAGES[0]](transforms=[transform])
+
+    back = _inverse(mount)
+    base_odometry = _compose(scans.odometry, back)
+    base_reference = _compose(scans.poses, back) if scans.has_reference_poses else None
+    range_max = float(scans.max_range)
+    empty = np.zeros(0, dtype=np.float32)
+
+    def records() -> Iterator[tuple[str, int, Any]]:
+        if laser_frame != BASE_FRAME:
+            yield TF_STATIC_TOPIC, ns[0], tf_static()
+        for i, stamp in enumerate(ns):
+            yield odom_topic, stamp, odometry(stamp, ODOM_FRAME, base_odometry[i])
+            if base_reference is not None:
+                yield reference_topic, stamp, odometry(stamp, MAP_FRAME, base_reference[i])
+            beams = np.ascontiguousarray(scans.ranges[i], dtype=np.float32)
+            yield (
+                scan_topic,
+                stamp,
+                types[LASER_SCAN](
+                    header=header(stamp, laser_frame),
+                    angle_min=angle_min,
+                    angle_max=angle_min + (len(beams) - 1) * angle_increment,
+                    angle_increment=angle_increment,
+                    time_increment=0.0,
+                    scan_time=0.0,
+                    range_min=0.0,
+                    range_max=range_max,
+                    ranges=beams,
+                    intensities=empty,
+                ),
+            )
+
+    msgtypes = {scan_topic: LASER_SCAN, odom_topic: ODOMETRY, TF_STATIC_TOPIC: TF_MESSAGES[0]}
+    if base_reference is not None:
+        msgtypes[reference_topic] = ODOMETRY
+    if len(msgtypes) != 3 + (base_reference is not None):
+        raise ValueError(f"{path}: the scan, odometry and reference topics must differ")
+    work = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}."))
+    try:
+        staged = work / path.name
+        if ros1:
+            _write_ros1(staged, store, msgtypes, records())
+        else:
+            _write_ros2(staged, store, msgtypes, records(), kind.removeprefix("ros2-"))
+        if path.exists():
+            raise FileExistsError(f"{path}: appeared while the bag was written, not overwriting")
+        os.rename(staged, path)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return path
+
+
+def _beam_spacing(path: Path, angles: np.ndarray) -> tuple[float, float]:
+    """``angle_min`` and ``angle_increment`` of evenly spaced beam angles."""
+    angles = np.asarray(angles, dtype=np.float64)
+    if angles.ndim != 1 or len(angles) < 1 or not np.isfinite(angles).all():
+        raise ValueError(f"{path}: beam angles must be a non-empty 1-D array of finite numbers")
+    step = float((angles[-1] - angles[0]) / (len(angles) - 1)) if len(angles) > 1 else 0.0
+    spaced = angles[0] + step * np.arange(len(angles))
+    if np.abs(spaced - angles).max() > 1e-9:
+        raise ValueError(f"{path}: a LaserScan needs evenly spaced beam angles")
+    return float(angles[0]), step
+
+
+def _yaw_quaternion(theta: float) -> tuple[float, float, float, float]:
+    return (0.0, 0.0, math.sin(theta / 2), math.cos(theta / 2))
+
+
+def _write_ros1(
+    path: Path, store: Any, msgtypes: dict[str, str], records: Iterator[tuple[str, int, Any]]
+) -> None:
+    from rosbags.rosbag1 import Writer
+
+    with Writer(path) as writer:
+        connections = {
+            topic: writer.add_connection(
+                topic, msgtype, typestore=store, latching=1 if topic == TF_STATIC_TOPIC else None
+            )
+            for topic, msgtype in msgtypes.items()
+        }
+        for topic, stamp, msg in records:
+            writer.write(connections[topic], stamp, store.serialize_ros1(msg, msgtypes[topic]))
+
+
+def _write_ros2(
+    path: Path,
+    store: Any,
+    msgtypes: dict[str, str],
+    records: Iterator[tuple[str, int, Any]],
+    storage: str,
+) -> None:
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+    with Writer(path, version=Writer.VERSION_LATEST, storage_plugin=plugin) as writer:
+        connections = {
+            topic: writer.add_connection(topic, msgtype, typestore=store)
+            for topic, msgtype in msgtypes.items()
+        }
+        for topic, stamp, msg in records:
+            writer.write(connections[topic], stamp, store.serialize_cdr(msg, msgtypes[topic]))
