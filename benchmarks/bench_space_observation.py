@@ -18,6 +18,7 @@ import numpy as np
 
 from kiseki import Pose2
 from kiseki.grid import beam_angles
+from kiseki.localization import MclConfig, MonteCarloLocalizer
 from kiseki.models import LocalMapBuilder, SpaceObservationModel, likelihood_reference
 from kiseki.sim.scene import load_scene
 
@@ -81,7 +82,6 @@ def occlusion_rates(grid, local, poses) -> None:
 def filter_step() -> None:
     """One full step of the filter: two 160 x 120 depth images -> depth-band local map ->
     1000 likelihoods -> weights, estimate, resampling, prediction. Goal: < 10 ms."""
-    from kiseki import _core
     from kiseki.sim.setup import build_robot, build_sensors
     from kiseki.teach.local_maps import LocalMapMaker
 
@@ -96,15 +96,16 @@ def filter_step() -> None:
     images = [c.render(scene.world, (7.4, 0.0, 0.0)) for c in cameras]
     maker = LocalMapMaker(cameras, "band")
     model = SpaceObservationModel(grid)
-    pf = _core.ParticleFilter(1000, seed=0)
-    pf.initialize(Pose2(7.4, 0.0, 0.0), 0.05, 0.05, 0.02)
+    localizer = MonteCarloLocalizer(MclConfig(particles=1000), seed=0)
+    localizer.initialize((7.4, 0.0, 0.0), (0.05, 0.05, 0.02))
+
+    def observe():
+        model.set_local_map(maker.make(images))
+        return model
+
     steps, start = 50, time.perf_counter()
     for k in range(steps):
-        model.set_local_map(maker.make(images))
-        pf.weight(model.likelihoods(pf.poses))
-        pf.estimate()
-        pf.resample_if_needed()
-        pf.predict(Pose2(7.4 + 0.05 * k, 0, 0), Pose2(7.4 + 0.05 * (k + 1), 0, 0))
+        localizer.step((7.4 + 0.05 * k, 0.0, 0.0), observe)
     per_step = (time.perf_counter() - start) / steps
     print(
         f"filter step (1000 particles, depth-band local map from two 160x120 images): "

@@ -5,6 +5,7 @@
 
 #include <cstring>
 
+#include "kiseki/models/beam_model.hpp"
 #include "kiseki/models/likelihood_field.hpp"
 #include "kiseki/models/local_map.hpp"
 #include "kiseki/models/space_observation.hpp"
@@ -84,28 +85,69 @@ void bind_models(py::module_& m) {
       .def("hits", [](const LocalMapBuilder& b) { return mat_to_numpy(b.hits()); },
            "The cells a beam ended in (uint8 mask, 1 = hit), of build()'s size.");
 
-  py::class_<LikelihoodFieldModel>(m, "LikelihoodFieldModel")
+  py::class_<SensorModel>(m, "SensorModel",
+                          "A measurement model of the Monte Carlo engine: log p(z | x) per pose.")
+      .def("log_likelihoods",
+           [](const SensorModel& sm, const py::handle& poses) {
+             return per_pose(poses, [&](const double* p, std::size_t n, double* out) {
+               std::vector<Pose2> q(n);
+               for (std::size_t i = 0; i < n; ++i) q[i] = pose_from_row(p + 3 * i);
+               sm.log_likelihoods(q.data(), n, out);
+             });
+           }, "poses"_a, "Log-likelihoods of robot poses (n, 3) on one thread; releases the GIL.")
+      .def("agreement", &SensorModel::agreement, "pose"_a,
+           "Share of the measurement that agrees with the map from this pose (NaN: unknown).")
+      .def_property_readonly("readings", &SensorModel::readings);
+
+  py::enum_<BeamCombination>(m, "BeamCombination")
+      .value("product", BeamCombination::product)
+      .value("nav2", BeamCombination::nav2);
+
+  py::class_<LikelihoodFieldModel, SensorModel>(m, "LikelihoodFieldModel")
       .def(py::init([](const OccupancyGrid& map, double sigma, double z_hit, double z_rand,
-                       int stride) {
+                       int max_beams, double max_distance, BeamCombination combination,
+                       const Pose2& sensor, double tolerance) {
              LikelihoodFieldParams p;
-             p.sigma_hit = sigma, p.z_hit = z_hit, p.z_rand = z_rand, p.beam_stride = stride;
+             p.sigma_hit = sigma, p.z_hit = z_hit, p.z_rand = z_rand, p.max_beams = max_beams;
+             p.max_distance = max_distance, p.combination = combination, p.sensor = sensor;
+             p.agreement_tolerance = tolerance;
              return std::make_unique<LikelihoodFieldModel>(map, p);
            }),
-           "map"_a, "sigma_hit"_a = 0.2, "z_hit"_a = 0.95, "z_rand"_a = 0.05, "beam_stride"_a = 1)
+           "map"_a, "sigma_hit"_a = 0.2, "z_hit"_a = 0.95, "z_rand"_a = 0.05, "max_beams"_a = 0,
+           "max_distance"_a = 2.0, "combination"_a = BeamCombination::product,
+           "sensor"_a = Pose2(), "agreement_tolerance"_a = 0.2)
       .def("set_scan",
            [](LikelihoodFieldModel& lf, const py::handle& a_in, const py::handle& r_in,
               double max_range) {
              const auto [a, r] = beams(a_in, r_in);
              lf.set_scan(a.data(), r.data(), static_cast<std::size_t>(a.shape(0)), max_range);
            }, "angles"_a, "ranges"_a, "max_range"_a)
-      .def("log_likelihoods",
-           [](const LikelihoodFieldModel& lf, const py::handle& poses) {
-             return per_pose(poses, [&](const double* p, std::size_t n, double* out) {
-               lf.log_likelihoods(p, n, out);
-             });
-           }, "poses"_a, "Log-likelihoods of sensor poses (n, 3); releases the GIL.");
+      .def("table", [](const LikelihoodFieldModel& lf) { return mat_to_numpy(lf.table().clone()); },
+           "The per-cell term (log pz, or pz^3 for nav2) for the current max range.");
 
-  py::class_<SpaceObservationModel>(m, "SpaceObservationModel")
+  py::class_<BeamModel, SensorModel>(m, "BeamModel")
+      .def(py::init([](const OccupancyGrid& map, double z_hit, double z_short, double z_max,
+                       double z_rand, double sigma, double lambda_short, int max_beams,
+                       bool unknown_stops, BeamCombination combination, const Pose2& sensor,
+                       double tolerance) {
+             BeamModelParams p;
+             p.z_hit = z_hit, p.z_short = z_short, p.z_max = z_max, p.z_rand = z_rand;
+             p.sigma_hit = sigma, p.lambda_short = lambda_short, p.max_beams = max_beams;
+             p.unknown_stops = unknown_stops, p.combination = combination, p.sensor = sensor;
+             p.agreement_tolerance = tolerance;
+             return std::make_unique<BeamModel>(map, p);
+           }),
+           "map"_a, "z_hit"_a = 0.5, "z_short"_a = 0.05, "z_max"_a = 0.05, "z_rand"_a = 0.5,
+           "sigma_hit"_a = 0.2, "lambda_short"_a = 0.1, "max_beams"_a = 0,
+           "unknown_stops"_a = true, "combination"_a = BeamCombination::product,
+           "sensor"_a = Pose2(), "agreement_tolerance"_a = 0.2)
+      .def("set_scan",
+           [](BeamModel& bm, const py::handle& a_in, const py::handle& r_in, double max_range) {
+             const auto [a, r] = beams(a_in, r_in);
+             bm.set_scan(a.data(), r.data(), static_cast<std::size_t>(a.shape(0)), max_range);
+           }, "angles"_a, "ranges"_a, "max_range"_a);
+
+  py::class_<SpaceObservationModel, SensorModel>(m, "SpaceObservationModel")
       .def(py::init([](const OccupancyGrid& map, double sp, double si, double step, bool occ) {
              SpaceObservationParams p;
              p.sigma_penetration = sp;

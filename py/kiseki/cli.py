@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -72,7 +73,11 @@ def _merge_rule(value: str) -> str:
 
 @map_app.command("from-log")
 def map_from_log(
-    log: Path = typer.Argument(..., help="CARMEN log (.log, .log.gz) or kiseki run (.mcap)."),
+    log: Path = typer.Argument(
+        ...,
+        help="CARMEN log (.log, .log.gz), kiseki run (.mcap), ROS 1 bag (.bag) or ROS 2 bag "
+        "(folder, .db3 or .mcap).",
+    ),
     output: Path = typer.Option(..., "-o", "--output", help="Map YAML to write (image beside)."),
     resolution: float = typer.Option(0.05, help="Cell size in metres."),
     usable_range: float = typer.Option(30.0, help="Free space is marked at most this far (m)."),
@@ -82,6 +87,13 @@ def map_from_log(
         help="log-odds (occupancy probabilities), teaching (the thesis' merge rules: the map "
         "the space observation model expects; use --resolution 0.1) or evidence (a teaching map "
         "whose cells turn free only when their free observations outweigh their hits).",
+    ),
+    scan_topic: str = typer.Option("/scan", help="ROS bags: the sensor_msgs/LaserScan topic."),
+    odom_topic: str = typer.Option(
+        "/odom", help="ROS bags: the nav_msgs/Odometry topic (if absent: odom -> base on /tf)."
+    ),
+    reference_topic: str | None = typer.Option(
+        None, help="ROS bags: a nav_msgs/Odometry topic of reference poses, e.g. /ground_truth."
     ),
 ) -> None:
     """Build an occupancy grid from a log's poses and scans and save it as a ROS map."""
@@ -98,7 +110,7 @@ def map_from_log(
         usable_range=_positive("--usable-range", usable_range),
     )
     start = time.perf_counter()
-    scans = open_scans(log)
+    scans = open_scans(log, scan_topic, odom_topic, reference_topic)
     if not scans.has_reference_poses:
         raise ValueError(f"{log}: the log has no reference poses to build a map from")
     if rules in ("teaching", "evidence"):
@@ -459,79 +471,114 @@ def playback_command(
 @app.command("localize")
 def localize_command(
     log: Path = typer.Argument(
-        ..., help="CARMEN log (.log, .log.gz), kiseki run (.mcap) or CMU Wean robotdata log."
+        ...,
+        help="CARMEN log (.log, .log.gz), kiseki run (.mcap), CMU Wean robotdata log, ROS 1 bag "
+        "(.bag) or ROS 2 bag (folder, .db3 or .mcap).",
     ),
     map_file: Path = typer.Option(
         ..., "--map", help="ROS map YAML of the log's building, or a CMU .dat(.gz) map."
     ),
     method: str = typer.Option(
-        "likelihood-field", help="odometry, space-observation or likelihood-field."
+        "likelihood-field", help="beam, likelihood-field, space-observation or odometry."
     ),
     seed: int = typer.Option(0, help="Seed of the filter and of the odometry noise."),
     odometry_noise: float = typer.Option(0.0, help="Odometry noise SD, fraction of each step."),
     particles: int | None = typer.Option(
-        None, help="Particles of the filter (default 500; 50000 at the start with --global)."
+        None,
+        help="Particles (default 500; 50000 at the start with --global); with --kld the maximum.",
     ),
+    kld: bool = typer.Option(False, "--kld", help="Adapt the particle count by KLD sampling."),
+    beams: int | None = typer.Option(
+        None, help="Beams used per scan, nav2's max_beams (default 90; 60 with --global)."
+    ),
+    recovery: str = typer.Option(
+        "none",
+        help="none, augmented (Augmented MCL) or resetting (expansion, then sensor resetting); "
+        "with --global from the cloud's convergence on.",
+    ),
+    threads: int = typer.Option(0, help="Threads of the filter (0 = every core)."),
     global_start: bool = typer.Option(
         False,
         "--global",
         help="Global localization: start uniformly over the map's free cells (no initial pose).",
     ),
-    tracking_particles: int = typer.Option(
-        1000, help="With --global: particles kept once the cloud has converged."
-    ),
-    recovery: bool = typer.Option(
-        False,
-        "--recovery",
-        help="With --global: Augmented MCL while tracking (uniform poses injected when the "
-        "scans fit worse than usual).",
+    tracking_particles: int | None = typer.Option(
+        None, help="With --global: particles kept once the cloud has converged (default 1000)."
     ),
     plot: Path | None = typer.Option(
         None, help="With --global: draw the map, the estimates and where they converged (PNG)."
     ),
-    output: Path = typer.Option(..., "-o", "--output", help="CSV t,x,y,theta to write."),
+    output: Path = typer.Option(
+        ..., "-o", "--output", help="CSV t,x,y,theta,reliability to write."
+    ),
+    scan_topic: str = typer.Option("/scan", help="ROS bags: the sensor_msgs/LaserScan topic."),
+    odom_topic: str = typer.Option(
+        "/odom", help="ROS bags: the nav_msgs/Odometry topic (if absent: odom -> base on /tf)."
+    ),
+    reference_topic: str | None = typer.Option(
+        None, help="ROS bags: a nav_msgs/Odometry topic of reference poses, e.g. /ground_truth."
+    ),
 ) -> None:
     """Localize along a log: position tracking from its first reference pose, or with --global
     from a uniform start. Prints the absolute pose error against the log's reference poses when
-    it has them; with --global also the convergence report (written to OUTPUT.json too)."""
-    from kiseki._atomic import atomic_write
+    it has them; with --global also the convergence report (written to OUTPUT.json too). The
+    settings it ran with are written beside the output as OUTPUT-STEM.config.yaml."""
     from kiseki.datasets import open_scans
     from kiseki.map_io import load_map
     from kiseki.metrics import ape
 
-    scans = open_scans(log)
+    _check_output(output, [log, map_file])
+    if not global_start:
+        for name, value in (("--tracking-particles", tracking_particles), ("--plot", plot)):
+            if value is not None:
+                raise ValueError(f"{name} applies only with --global")
+    if global_start and output.suffix.lower() == ".json":
+        raise ValueError(f"{output}: the report goes to OUTPUT.json: give a .csv output")
+    if global_start and odometry_noise != 0.0:
+        raise ValueError("--odometry-noise is for logs with reference poses, not --global")
+    scans = open_scans(
+        log, scan_topic=scan_topic, odom_topic=odom_topic, reference_topic=reference_topic
+    )
     grid = load_map(map_file)
+    reliability = np.full(len(scans), np.nan)
     if global_start:
         from kiseki.global_localization import GlobalConfig, global_localize
 
-        if output.suffix.lower() == ".json":
-            raise ValueError(f"{output}: the report goes to OUTPUT.json: give a .csv output")
-        if odometry_noise != 0.0:
-            raise ValueError("--odometry-noise is for logs with reference poses, not --global")
         gconfig = GlobalConfig(
             method=method,
             seed=seed,
             particles=50_000 if particles is None else particles,
-            tracking_particles=tracking_particles,
+            tracking_particles=1000 if tracking_particles is None else tracking_particles,
             recovery=recovery,
+            kld=kld,
+            beams=60 if beams is None else beams,
+            threads=threads,
         )
+        saved_config = {"command": "localize --global", **asdict(gconfig)}
         result = global_localize(scans, grid, gconfig, progress=True)
-        trajectory = result.estimates
+        trajectory, reliability = result.estimates, result.reliability
     else:
         from kiseki.localization import LocalizeConfig, localize
 
-        if not scans.has_reference_poses:
-            raise ValueError(f"{log}: the log has no reference poses to start from: use --global")
         config = LocalizeConfig(
             method=method,
             seed=seed,
             odometry_noise=odometry_noise,
             particles=500 if particles is None else particles,
+            kld=kld,
+            beams=90 if beams is None else beams,
+            recovery=recovery,
+            threads=threads,
         )
-        trajectory = localize(scans, grid, config, progress=True)
-    rows = np.column_stack([scans.times, trajectory])
-    text = "t,x,y,theta\n" + "\n".join(",".join(f"{v:.6f}" for v in row) for row in rows) + "\n"
-    atomic_write(output, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+        if not scans.has_reference_poses:
+            raise ValueError(f"{log}: the log has no reference poses to start from: use --global")
+        saved_config = {"command": "localize", **config.to_dict()}
+        tracked = localize(scans, grid, config, progress=True)
+        trajectory, reliability = tracked.estimates, tracked.reliability
+    saved_config.update(log=str(log), map=str(map_file))
+    _write_trajectory(output, scans.times, trajectory, reliability)
+    config_path = output.with_name(output.stem + ".config.yaml")
+    _write_yaml(config_path, saved_config)
     if scans.has_reference_poses:
         position = ape(trajectory, scans.poses)
         heading = ape(trajectory, scans.poses, "rotation_deg")
@@ -550,6 +597,41 @@ def localize_command(
             from kiseki.global_localization import render_global
 
             render_global(grid, result, plot, title=f"{log.name}: global {method}")
+
+
+def _check_output(output: Path, inputs: list[Path]) -> None:
+    """Refuses an output that is one of the command's inputs (it would be overwritten)."""
+    for path in inputs:
+        if output.exists() and path.exists() and output.resolve() == path.resolve():
+            raise ValueError(f"{output}: the output would overwrite the input {path}")
+
+
+def _write_trajectory(
+    output: Path, times: np.ndarray, trajectory: np.ndarray, reliability: np.ndarray
+) -> None:
+    from kiseki._atomic import atomic_write
+
+    rows = np.column_stack([times, trajectory, reliability])
+    text = "t,x,y,theta,reliability\n" + "\n".join(
+        ",".join(f"{v:.6f}" for v in row) for row in rows
+    )
+    atomic_write(output, lambda tmp: Path(tmp).write_text(text + "\n", encoding="utf-8"))
+
+
+def _write_yaml(path: Path, doc: dict) -> None:
+    import yaml
+
+    from kiseki._atomic import atomic_write
+
+    def plain(value):
+        if isinstance(value, tuple | list):
+            return [plain(v) for v in value]
+        if isinstance(value, np.generic):
+            return value.item()
+        return value
+
+    text = yaml.safe_dump({k: plain(v) for k, v in doc.items()}, sort_keys=False)
+    atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
 @app.command("report")

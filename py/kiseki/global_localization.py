@@ -15,16 +15,15 @@
   likelihood-field scan likelihood is raised to ``likelihood_power`` (see GlobalConfig).
 * Shrinking: once the cloud has stayed converged (the radius around the weighted mean that
   holds 90 % of the weight below ``shrink_radius``) for ``shrink_after`` updates, it is
-  resampled (low variance) down to ``tracking_particles``: a converged cloud needs far fewer
-  particles than the uniform start. This is a simple fixed rule instead of KLD-sampling
-  (Fox 2003), which adapts the count at every step; both sizes are the user's choice.
-* Recovery (``recovery``, off by default): Augmented MCL (Probabilistic Robotics, Table 8.3)
-  while tracking, with ROS AMCL's suggested ``alpha_slow`` 0.001 and ``alpha_fast`` 0.1. The
-  average likelihood is the weighted mean over particles of the per-beam (geometric mean) scan
-  likelihood, so that it does not depend on how many beams returned. At every update a share
-  ``1 - w_fast / w_slow`` of the cloud is replaced by uniform poses over the free cells.
-  Without it, a cloud converged on a wrong place or lost stays so, and the fit figures of the
-  report are what tells.
+  resampled down to ``tracking_particles``: a converged cloud needs far fewer particles than the
+  uniform start. With ``kld`` the engine instead adapts the count at every resampling
+  (KLD sampling, Fox 2003), between ``tracking_particles`` and ``particles``.
+* Recovery (``recovery``, ``none`` by default) while tracking: ``augmented`` (Augmented MCL,
+  Probabilistic Robotics Table 8.3, nav2's alpha_slow 0.001 and alpha_fast 0.1) or
+  ``resetting`` (expansion, then sensor resetting); see :mod:`kiseki.localization`. Without it,
+  a cloud converged on a wrong place or lost stays so, and the fit figures of the report are
+  what tells.
+* Every step is the one engine of :mod:`kiseki.localization` (:class:`MonteCarloLocalizer`).
 
 Convergence report (:class:`ConvergenceReport`): after every scan the 90 %-weight radius
 (``spread``); the filter is *converged* from the first scan after which the spread stays below
@@ -50,10 +49,18 @@ from tqdm import tqdm
 
 from kiseki import _core
 from kiseki._atomic import atomic_write
-from kiseki.core import Pose2, derive_seed
-from kiseki.datasets.carmen import LaserScans
-from kiseki.grid import FREE, OccupancyGrid
-from kiseki.localization import REAL_ODOMETRY_ALPHAS
+from kiseki.core import derive_seed
+from kiseki.grid import OccupancyGrid
+from kiseki.localization import (
+    REAL_ODOMETRY_ALPHAS,
+    RECOVERY_MODES,
+    LocalizeConfig,
+    MclConfig,
+    MonteCarloLocalizer,
+    ScanSpaceObservation,
+    scan_model,
+)
+from kiseki.scans import LaserScans
 
 __all__ = [
     "GlobalConfig",
@@ -65,7 +72,6 @@ __all__ = [
     "render_global",
     "scan_fit",
     "spread_radius",
-    "uniform_free_poses",
     "write_report",
 ]
 
@@ -95,7 +101,7 @@ class GlobalConfig:
     * ``alphas``: ``REAL_ODOMETRY_ALPHAS`` of kiseki.localization (the log's real odometry,
       of unknown error), applied once per measurement update to the odometry since the last
       one, as AMCL does.
-    * ``beam_stride`` 3: 60 of 180 beams, nav2 AMCL's default ``max_beams`` 60.
+    * ``beams`` 60: nav2 AMCL's default ``max_beams``.
     * ``sigma_hit`` 0.2 m: nav2 AMCL's default.
     * ``update_min_d`` 0.2 m, ``update_min_a`` 0.5 rad: ROS 1 AMCL's defaults (``update_min_a``
       pi/6 ~ 0.52).
@@ -108,7 +114,7 @@ class GlobalConfig:
     particles: int = 50_000
     tracking_particles: int = 1000
     alphas: tuple[float, float, float, float] = REAL_ODOMETRY_ALPHAS
-    beam_stride: int = 3
+    beams: int = 60
     sigma_hit: float = 0.2
     update_min_d: float = 0.2
     update_min_a: float = 0.5
@@ -117,9 +123,9 @@ class GlobalConfig:
     weight_share: float = 0.9  # share of the weight inside the spread radius
     likelihood_power: float = 0.1  # until the cut to tracking_particles
     shrink_after: int = 10  # consecutive measurement updates with the spread below shrink_radius
-    recovery: bool = False  # Augmented MCL while tracking (random poses when the fit drops)
-    alpha_slow: float = 0.001
-    alpha_fast: float = 0.1
+    recovery: str = "none"  # while tracking: none, augmented or resetting
+    kld: bool = False  # adapt the count by KLD sampling instead of the fixed cut
+    threads: int = 0
 
     def __post_init__(self) -> None:
         if self.method not in ("likelihood-field", "space-observation"):
@@ -127,10 +133,19 @@ class GlobalConfig:
                 "global localization: method must be likelihood-field or space-observation, "
                 f"got {self.method!r}"
             )
+        if not (isinstance(self.seed, int) and 0 <= self.seed < 2**64):
+            raise ValueError(f"seed must be an integer in 0..2^64-1, got {self.seed!r}")
         if self.particles < 1 or self.tracking_particles < 1:
             raise ValueError("global localization: particle counts must be >= 1")
-        if self.beam_stride < 1:
-            raise ValueError(f"beam stride must be >= 1, got {self.beam_stride}")
+        if not (isinstance(self.beams, int) and self.beams >= 0):
+            raise ValueError(f"beams must be an integer >= 0 (0 = every beam), got {self.beams!r}")
+        if self.recovery not in RECOVERY_MODES:
+            raise ValueError(
+                f"recovery must be one of {', '.join(RECOVERY_MODES)}, got {self.recovery!r}"
+            )
+        if self.kld and self.tracking_particles > self.particles:
+            raise ValueError("with kld, tracking_particles (the minimum) must not exceed particles")
+        self.mcl()  # the engine's own checks
         positive = ("sigma_hit", "shrink_radius", "converged_radius", "likelihood_power")
         for name in positive:
             value = getattr(self, name)
@@ -140,12 +155,23 @@ class GlobalConfig:
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ValueError(f"{name} must be >= 0, got {value}")
-        if not (0 < self.alpha_slow < self.alpha_fast <= 1):
-            raise ValueError("need 0 < alpha_slow < alpha_fast <= 1")
         if self.shrink_after < 1:
             raise ValueError(f"shrink_after must be >= 1, got {self.shrink_after}")
         if not 0 < self.weight_share <= 1:
             raise ValueError(f"weight_share must lie in (0, 1], got {self.weight_share}")
+
+    def mcl(self) -> MclConfig:
+        """The engine's settings: the start's likelihood power, recovery off until the cut."""
+        return MclConfig(
+            particles=self.particles,
+            kld=self.kld,
+            min_particles=min(self.tracking_particles, self.particles),
+            alphas=tuple(self.alphas),
+            likelihood_power=self.likelihood_power,
+            update_min_d=self.update_min_d,
+            update_min_a=self.update_min_a,
+            threads=self.threads,
+        )
 
 
 @dataclass(frozen=True)
@@ -186,27 +212,8 @@ class GlobalResult:
     spread: np.ndarray  # (n,) radius (m) holding weight_share of the weight
     particle_counts: np.ndarray  # (n,)
     report: ConvergenceReport
+    reliability: np.ndarray  # (n,) the engine's reliability estimate after each scan
     config: GlobalConfig = field(repr=False)
-
-
-def uniform_free_poses(grid: OccupancyGrid, n: int, rng: np.random.Generator) -> np.ndarray:
-    """n poses (n, 3) uniform over the free cells of the grid (position uniform inside the
-    cell) with uniform heading in [-pi, pi)."""
-    if n < 1:
-        raise ValueError(f"need n >= 1 poses, got {n}")
-    free = np.flatnonzero(grid.cells.ravel() == FREE)
-    if free.size == 0:
-        raise ValueError("the map has no free cells: global localization has nowhere to start")
-    pick = free[rng.integers(0, free.size, size=n)]
-    gx = pick % grid.width + rng.random(n)
-    gy = pick // grid.width + rng.random(n)
-    o = grid.origin
-    c, s = np.cos(o.theta), np.sin(o.theta)
-    res = grid.resolution
-    x = o.x + res * (c * gx - s * gy)
-    y = o.y + res * (s * gx + c * gy)
-    theta = rng.uniform(-np.pi, np.pi, n)
-    return np.column_stack([x, y, theta])
 
 
 def spread_radius(poses: np.ndarray, weights: np.ndarray, share: float = 0.9) -> float:
@@ -219,16 +226,6 @@ def spread_radius(poses: np.ndarray, weights: np.ndarray, share: float = 0.9) ->
     cum = np.cumsum(w[order])
     k = min(int(np.searchsorted(cum, share)), len(d) - 1)
     return float(d[order[k]])
-
-
-def _systematic_resample(
-    poses: np.ndarray, weights: np.ndarray, n: int, rng: np.random.Generator
-) -> np.ndarray:
-    w = np.asarray(weights, dtype=float)
-    cum = np.cumsum(w / w.sum())
-    cum[-1] = 1.0
-    u = (rng.random() + np.arange(n)) / n
-    return poses[np.searchsorted(cum, u)]
 
 
 def scan_fit(
@@ -271,29 +268,6 @@ def scan_fit(
     )
 
 
-def _per_beam_average(
-    log_l: np.ndarray,
-    weights: np.ndarray,
-    ranges: np.ndarray,
-    max_range: float,
-    config: GlobalConfig,
-) -> float:
-    """The weighted mean over particles of the per-beam (geometric mean) likelihood: the scale
-    does not depend on how many beams of the scan returned, unlike the product."""
-    used = ranges[:: config.beam_stride]
-    beams = int(np.count_nonzero(np.isfinite(used) & (used > 0) & (used < max_range)))
-    if beams == 0:
-        return float("nan")
-    per_beam = log_l / beams
-    top = per_beam.max()
-    return float(np.exp(top) * np.dot(weights, np.exp(per_beam - top)))
-
-
-def _moved(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
-    step = Pose2(*a).between(Pose2(*b))
-    return float(np.hypot(step.x, step.y)), abs(float(step.theta))
-
-
 def _converged_from(spread: np.ndarray, threshold: float) -> int | None:
     above = np.flatnonzero(~(spread < threshold))
     if above.size == 0:
@@ -308,83 +282,54 @@ def global_localize(
     """Global localization along the scans' odometry from a uniform start over the map."""
     if len(scans) == 0:
         raise ValueError("global localization: the log has no scans")
+    if not np.isfinite(scans.odometry).all():
+        raise ValueError("global localization: the odometry has NaN or infinite poses")
     start = time.perf_counter()
-    rng = np.random.default_rng(derive_seed(config.seed, 3))
-    a1, a2, a3, a4 = config.alphas
-    pf = _core.ParticleFilter(config.particles, a1, a2, a3, a4, 0.5, derive_seed(config.seed, 2))
-    pf.set_particles(uniform_free_poses(grid, config.particles, rng))
-    if config.method == "space-observation":
-        from kiseki.mapping import scan_local_map
-
-        so_model = _core.SpaceObservationModel(grid)
-    else:
-        lf_model = _core.LikelihoodFieldModel(
-            grid, sigma_hit=config.sigma_hit, beam_stride=config.beam_stride
-        )
+    localizer = MonteCarloLocalizer(config.mcl(), derive_seed(config.seed, 2), grid)
+    localizer.initialize_global()
+    model = scan_model(
+        config.method,
+        grid,
+        LocalizeConfig(method=config.method, beams=config.beams, sigma_hit=config.sigma_hit),
+    )
+    engine_model = model.model if isinstance(model, ScanSpaceObservation) else model
     odom = np.asarray(scans.odometry, dtype=float)
     n = len(scans)
     estimates = np.empty((n, 3))
     spread = np.empty(n)
     counts = np.empty(n, dtype=np.int64)
-    last_update: np.ndarray | None = None
-    last_estimate = np.zeros(3)
-    updates = 0
+    reliability = np.empty(n)
     shrunk_at: int | None = None
     tight_updates = 0
-    w_slow: float | None = None
-    w_fast: float | None = None
     injected = 0
+
+    def prepare(k: int):
+        model.set_scan(scans.angles, scans.ranges[k], scans.max_range)
+        return engine_model
+
     for k in tqdm(range(n), desc="global " + config.method, unit="scan", disable=not progress):
-        moved_d, moved_a = (np.inf, np.inf) if last_update is None else _moved(last_update, odom[k])
-        if not (moved_d >= config.update_min_d or moved_a >= config.update_min_a):
-            # No update: the cloud stays; the estimate follows the odometry since the update.
-            step = Pose2(*last_update).between(Pose2(*odom[k]))
-            estimates[k] = (Pose2(*last_estimate) * step).to_array()
+        report = localizer.step(odom[k], lambda k=k: prepare(k))
+        estimates[k] = localizer.estimate
+        reliability[k] = localizer.reliability
+        if report is None:  # no update: the cloud stays, the estimate follows the odometry
             spread[k], counts[k] = spread[k - 1], counts[k - 1]
             continue
-        if last_update is not None:  # the motion model once per update, as in AMCL
-            pf.predict(Pose2(*last_update), Pose2(*odom[k]))
-        last_update = odom[k]
-        updates += 1
-        ranges = scans.ranges[k]
-        if config.method == "space-observation":
-            so_model.set_local_map(scan_local_map(scans.angles, ranges, scans.max_range))
-            pf.weight(so_model.likelihoods(pf.poses))
-        else:
-            lf_model.set_scan(scans.angles, ranges, scans.max_range)
-            log_l = lf_model.log_likelihoods(pf.poses)
-            if shrunk_at is None:
-                log_l *= config.likelihood_power
-            elif config.recovery and np.isfinite(
-                w_avg := _per_beam_average(log_l, pf.weights, ranges, scans.max_range, config)
-            ):
-                w_slow = w_avg if w_slow is None else w_slow + config.alpha_slow * (w_avg - w_slow)
-                w_fast = w_avg if w_fast is None else w_fast + config.alpha_fast * (w_avg - w_fast)
-            pf.weight(np.exp(log_l - log_l.max()))
-        poses, weights = pf.poses, pf.weights
-        estimates[k] = last_estimate = pf.estimate().to_array()
-        spread[k] = spread_radius(poses, weights, config.weight_share)
-        counts[k] = len(poses)
+        injected += report.injected
+        spread[k] = spread_radius(localizer.poses, localizer.weights, config.weight_share)
+        counts[k] = localizer.size
         tight_updates = tight_updates + 1 if spread[k] < config.shrink_radius else 0
         if shrunk_at is None and tight_updates >= config.shrink_after:
-            if config.tracking_particles < len(poses):
-                keep = _systematic_resample(poses, weights, config.tracking_particles, rng)
-                pf.set_particles(keep)
+            # Converged: cut to the tracking size (without KLD), use the plain likelihood and
+            # recover from now on.
+            if not config.kld and config.tracking_particles < localizer.size:
+                localizer.engine.resample_to(config.tracking_particles)
+            localizer.engine.set_likelihood_power(1.0)
+            localizer.engine.set_recovery(config.recovery)
             shrunk_at = k
-        elif w_slow is not None and w_fast is not None and w_fast < w_slow:
-            # Augmented MCL: resample with a share 1 - w_fast / w_slow of uniform poses.
-            inject = rng.binomial(len(poses), 1.0 - w_fast / w_slow)
-            keep = _systematic_resample(poses, weights, len(poses) - inject, rng)
-            if inject > 0:
-                keep = np.vstack([keep, uniform_free_poses(grid, inject, rng)])
-            pf.set_particles(keep)
-            injected += inject
-        else:
-            pf.resample_if_needed()
     seconds = time.perf_counter() - start
-    report = _report(scans, grid, config, estimates, spread, updates, shrunk_at, seconds)
+    report = _report(scans, grid, config, estimates, spread, localizer.updates, shrunk_at, seconds)
     report = dataclasses.replace(report, injected=injected)
-    return GlobalResult(estimates, spread, counts, report, config)
+    return GlobalResult(estimates, spread, counts, report, reliability, config)
 
 
 def _report(
@@ -488,12 +433,12 @@ def render_global(
 ) -> Path:
     """The map with the estimates after convergence (blue), before it (faint) and the
     convergence point (red)."""
-    from kiseki.plots import _figure, _save, _world_xy, draw_map
+    from kiseki.plots import draw_map, figure_for_grid, save_figure, world_xy
 
-    fig, ax = _figure(grid)
+    fig, ax = figure_for_grid(grid)
     draw_map(ax, grid)
     k = result.report.converged_scan
-    xy = _world_xy(grid, result.estimates)
+    xy = world_xy(grid, result.estimates)
     if k is None:
         ax.plot(xy[:, 0], xy[:, 1], "-", color="tab:orange", linewidth=0.8, label="not converged")
     else:
@@ -512,4 +457,4 @@ def render_global(
         )
     ax.legend(loc="upper right", fontsize=8)
     ax.set_title(title or "global localization")
-    return _save(fig, Path(path))
+    return save_figure(fig, path)

@@ -14,16 +14,16 @@ import pytest
 
 from kiseki import OccupancyGrid, Pose2
 from kiseki.datasets import open_scans
-from kiseki.datasets.carmen import LaserScans
 from kiseki.global_localization import (
     GlobalConfig,
     global_localize,
     scan_fit,
     spread_radius,
-    uniform_free_poses,
 )
 from kiseki.grid import FREE
+from kiseki.localization import MclConfig, MonteCarloLocalizer
 from kiseki.map_io import load_map
+from kiseki.scans import LaserScans
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess:
@@ -38,7 +38,7 @@ def test_uniform_free_poses_only_on_free_cells() -> None:
     cells[30:32, 40:50] = 0
     cells[12, 7] = 100
     grid = OccupancyGrid(cells, 0.1, Pose2(2.0, -1.0, 0.3))
-    poses = uniform_free_poses(grid, 5000, np.random.default_rng(1))
+    poses = MonteCarloLocalizer(MclConfig(), 1, grid).engine.uniform_poses(5000)
     assert poses.shape == (5000, 3)
     cell = grid.world_to_cell(poses[:, :2])
     assert (grid.cells[cell[:, 1], cell[:, 0]] == FREE).all()
@@ -46,14 +46,14 @@ def test_uniform_free_poses_only_on_free_cells() -> None:
     share = np.mean(cell[:, 1] >= 30)
     assert share == pytest.approx(20 / 119, abs=0.03)
     assert poses[:, 2].min() < -3.0 and poses[:, 2].max() > 3.0
-    again = uniform_free_poses(grid, 5000, np.random.default_rng(1))
+    again = MonteCarloLocalizer(MclConfig(), 1, grid).engine.uniform_poses(5000)
     np.testing.assert_array_equal(poses, again)
 
 
 def test_map_without_free_cells_is_refused() -> None:
     grid = OccupancyGrid(np.full((10, 10), 100, dtype=np.int8), 0.1)
-    with pytest.raises(ValueError, match="no free cells"):
-        uniform_free_poses(grid, 10, np.random.default_rng(0))
+    with pytest.raises(ValueError, match="no free cell"):
+        MonteCarloLocalizer(MclConfig(), 0, grid)
     scans = LaserScans(
         times=np.zeros(1),
         poses=np.full((1, 3), np.nan),
@@ -62,7 +62,7 @@ def test_map_without_free_cells_is_refused() -> None:
         angles=np.linspace(-1, 1, 4),
         max_range=10.0,
     )
-    with pytest.raises(ValueError, match="no free cells"):
+    with pytest.raises(ValueError, match="no free cell"):
         global_localize(scans, grid, GlobalConfig(particles=10))
 
 
@@ -130,7 +130,7 @@ def test_wean_run1_converges_and_fits_the_map(wean: tuple[Path, Path], tmp_path:
     assert doc["particles"][0] == 50_000 and doc["particles"][-1] == 1000
     assert (tmp_path / "run1.png").stat().st_size > 10_000
     trajectory = np.loadtxt(out, delimiter=",", skiprows=1)
-    assert trajectory.shape == (scans, 4)
+    assert trajectory.shape == (scans, 5)
     cells = load_map(map_file).world_to_cell(trajectory[report["converged_scan"] :, 1:3])
     assert (cells >= 0).all() and (cells < 800).all()
 
@@ -185,20 +185,6 @@ def test_cli_map_convert_and_no_map_from_wean_log(wean: tuple[Path, Path], tmp_p
     assert done.returncode == 1 and "no reference poses" in done.stderr
 
 
-def test_particle_filter_set_particles() -> None:
-    from kiseki import _core
-
-    pf = _core.ParticleFilter(100, seed=1)
-    poses = np.array([[0.0, 1.0, 0.1], [2.0, 3.0, -0.2], [4.0, 5.0, 3.0]])
-    pf.set_particles(poses)
-    np.testing.assert_allclose(pf.poses, poses)
-    np.testing.assert_allclose(pf.weights, np.full(3, 1 / 3))
-    with pytest.raises(ValueError, match="poses"):
-        pf.set_particles(np.zeros((3, 2)))
-    with pytest.raises(ValueError, match="finite"):
-        pf.set_particles(np.array([[0.0, np.nan, 0.0]]))
-
-
 def test_wean_recovery_injects_and_stays_deterministic(wean: tuple[Path, Path]) -> None:
     log, map_file = wean
     full = open_scans(log)
@@ -208,11 +194,11 @@ def test_wean_recovery_injects_and_stays_deterministic(wean: tuple[Path, Path]) 
         full.max_range,
     )  # fmt: skip
     grid = load_map(map_file)
-    config = GlobalConfig(seed=0, recovery=True)
+    config = GlobalConfig(seed=0, recovery="augmented")
     first = global_localize(scans, grid, config)
     assert first.report.shrunk_at is not None and first.report.injected > 0
     assert first.particle_counts[-1] == config.tracking_particles
     again = global_localize(scans, grid, config)
     np.testing.assert_array_equal(first.estimates, again.estimates)
-    with pytest.raises(ValueError, match="alpha_slow"):
-        GlobalConfig(alpha_slow=0.2, alpha_fast=0.1)
+    with pytest.raises(ValueError, match="recovery"):
+        GlobalConfig(recovery="pray")

@@ -40,11 +40,17 @@ def test_noisy_odometry_has_the_requested_spread():
 def test_likelihood_field_tracks_the_intel_log_far_better_than_odometry(shared_data):
     scans = read_carmen_log(shared_data / "carmen" / "intel-corrected.log.gz").scans
     grid = build_map(scans.poses, scans.ranges, scans.angles, scans.max_range)
-    odometry = localize(scans, grid, LocalizeConfig(method="odometry", odometry_noise=0.1))
-    tracked = localize(scans, grid, LocalizeConfig(method="likelihood-field", odometry_noise=0.1))
+    odometry = localize(
+        scans, grid, LocalizeConfig(method="odometry", odometry_noise=0.1)
+    ).estimates
+    tracked = localize(
+        scans, grid, LocalizeConfig(method="likelihood-field", odometry_noise=0.1)
+    ).estimates
     odo, lf = ape(odometry, scans.poses).rmse, ape(tracked, scans.poses).rmse
     assert lf < 0.2 and lf < odo / 10, (lf, odo)
-    again = localize(scans, grid, LocalizeConfig(method="likelihood-field", odometry_noise=0.1))
+    again = localize(
+        scans, grid, LocalizeConfig(method="likelihood-field", odometry_noise=0.1)
+    ).estimates
     assert np.array_equal(tracked, again)
 
 
@@ -102,8 +108,8 @@ def test_space_observation_tracks_the_logs_far_better_than_odometry(shared_data,
     # (alphas 0.05 / 0.01) the filter lost Intel in 2 of 5 seeds and ACES in every one.
     scans = read_carmen_log(shared_data / "carmen" / f"{log}-corrected.log.gz").scans
     grid = build_teaching_map(scans.poses, scans.ranges, scans.angles, scans.max_range)
-    odometry = localize(scans, grid, LocalizeConfig("odometry", odometry_noise=0.1))
-    tracked = localize(scans, grid, LocalizeConfig(odometry_noise=0.1))
+    odometry = localize(scans, grid, LocalizeConfig("odometry", odometry_noise=0.1)).estimates
+    tracked = localize(scans, grid, LocalizeConfig(odometry_noise=0.1)).estimates
     odo, so = ape(odometry, scans.poses).rmse, ape(tracked, scans.poses).rmse
     assert so < 0.6 and so < odo / 8, (so, odo)
 

@@ -35,50 +35,6 @@ def test_merge_rules_of_the_thesis():
     assert env.cells[0].tolist() == [100, 0, 0, 100] and changed == 2
 
 
-def test_particle_filter_tracks_odometry_and_resamples():
-    pf = _core.ParticleFilter(500, seed=4)
-    pf.initialize(Pose2(0.0, 0.0, 0.0), 0.01, 0.01, 0.001)
-    pf.predict(Pose2(0.0, 0.0, 0.0), Pose2(1.0, 0.0, 0.0))
-    est = pf.estimate()
-    assert abs(est.x - 1.0) < 0.05 and abs(est.y) < 0.05
-    spread = pf.poses[:, 0].std()
-    assert 0.05 < spread < 0.5  # translation noise alpha3 = 0.05: sd = sqrt(0.05) * 1 m = 0.22
-    likelihood = np.exp(-0.5 * ((pf.poses[:, 0] - 1.1) / 0.02) ** 2)
-    pf.weight(likelihood)
-    assert pf.effective_sample_size < 250 and pf.resample_if_needed()
-    assert abs(pf.estimate().x - 1.1) < 0.03 and pf.effective_sample_size == pytest.approx(500)
-    with pytest.raises(ValueError):
-        pf.weight(np.ones(3))
-    a = _core.ParticleFilter(50, seed=9)
-    b = _core.ParticleFilter(50, seed=9)
-    for f in (a, b):
-        f.initialize(Pose2(), 0.1, 0.1, 0.1)
-        f.predict(Pose2(), Pose2(0.5, 0.1, 0.2))
-    assert np.array_equal(a.poses, b.poses)
-
-
-def test_motion_model_turns_on_the_spot_and_reverses_without_spurious_spread():
-    alphas = dict(alpha1=0.002, alpha2=0.002, alpha3=0.0005, alpha4=0.0005)
-    # A turn on the spot of 0.05 rad with 0.1 mm of slip sideways-backward: the heading spreads
-    # by sqrt(alpha1) * 0.05 = 2.2 mrad (plus a negligible alpha2 term), not as if the slip's
-    # direction (about -pi here) were turned there and back.
-    pf = _core.ParticleFilter(4000, seed=3, **alphas)
-    pf.initialize(Pose2(), 0.0, 0.0, 0.0)
-    pf.predict(Pose2(), Pose2(-1e-4, -1e-5, 0.05))
-    heading = pf.poses[:, 2]
-    assert heading.std() == pytest.approx(np.sqrt(0.002) * 0.05, rel=0.1)
-    assert abs(heading.mean() - 0.05) < 1e-3
-    # Straight back 0.1 m: the noise of a forward 0.1 m (heading sd sqrt(2 alpha2) 0.1 from
-    # rot1 and rot2, position sd sqrt(alpha3) 0.1 along the track), not of two half-turns.
-    for step in (0.1, -0.1):
-        pf = _core.ParticleFilter(4000, seed=3, **alphas)
-        pf.initialize(Pose2(), 0.0, 0.0, 0.0)
-        pf.predict(Pose2(), Pose2(step, 0.0, 0.0))
-        assert pf.poses[:, 2].std() == pytest.approx(np.sqrt(2 * 0.002) * 0.1, rel=0.1)
-        assert pf.poses[:, 0].std() == pytest.approx(np.sqrt(0.0005) * 0.1, rel=0.1)
-        assert abs(pf.poses[:, 0].mean() - step) < 1e-3
-
-
 def test_teach_recover_and_playback(tmp_path, project_root):
     scene_file = project_root / "data" / "worlds" / "factory_corridor.yaml"
     taught = teach(load_scene(scene_file), tmp_path / "t", seed=5)

@@ -20,21 +20,34 @@ double Random::uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-
 
 double Random::uniform(double low, double high) { return low + (high - low) * uniform(); }
 
-double Random::normal(double mean, double stddev) {
-  if (has_spare_) {
-    has_spare_ = false;
-    return mean + stddev * spare_;
+namespace {
+// Marsaglia's polar method: two normal samples from a uniform point in the unit disc; the
+// second is kept for the next call.
+template <typename Generator>
+double polar_normal(Generator& g, bool& has_spare, double& spare) {
+  if (has_spare) {
+    has_spare = false;
+    return spare;
   }
   double u = 0.0, v = 0.0, s = 0.0;
   do {
-    u = 2.0 * uniform() - 1.0;
-    v = 2.0 * uniform() - 1.0;
+    u = 2.0 * g.uniform() - 1.0;
+    v = 2.0 * g.uniform() - 1.0;
     s = u * u + v * v;
   } while (s >= 1.0 || s == 0.0);
   const double factor = std::sqrt(-2.0 * std::log(s) / s);
-  spare_ = v * factor;
-  has_spare_ = true;
-  return mean + stddev * u * factor;
+  spare = v * factor;
+  has_spare = true;
+  return u * factor;
+}
+}  // namespace
+
+double Random::normal(double mean, double stddev) {
+  return mean + stddev * polar_normal(*this, has_spare_, spare_);
+}
+
+double StreamRandom::normal(double mean, double stddev) {
+  return mean + stddev * polar_normal(*this, has_spare_, spare_);
 }
 
 std::uint64_t Random::below(std::uint64_t n) {

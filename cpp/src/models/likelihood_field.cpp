@@ -2,6 +2,7 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/models/likelihood_field.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -11,47 +12,85 @@
 namespace kiseki {
 
 void LikelihoodFieldParams::validate() const {
-  if (!(sigma_hit > 0.0) || !(z_hit >= 0.0) || !(z_rand >= 0.0) || !(z_hit + z_rand > 0.0) ||
-      beam_stride < 1) {
-    throw std::invalid_argument("likelihood field: need sigma_hit > 0, z >= 0, beam_stride >= 1");
+  if (!(sigma_hit > 0.0) || !std::isfinite(sigma_hit) || !(z_hit >= 0.0) || !(z_rand >= 0.0) ||
+      !(z_hit + z_rand > 0.0) || !std::isfinite(z_hit + z_rand)) {
+    throw std::invalid_argument("likelihood field: need sigma_hit > 0, z_hit, z_rand >= 0 and not both 0");
+  }
+  if (max_beams < 0) throw std::invalid_argument("likelihood field: max_beams must be >= 0");
+  if (!(max_distance > 0.0) || !std::isfinite(max_distance)) {
+    throw std::invalid_argument("likelihood field: max_distance must be finite and > 0");
+  }
+  if (!(agreement_tolerance >= 0.0) || !std::isfinite(agreement_tolerance)) {
+    throw std::invalid_argument("likelihood field: agreement_tolerance must be >= 0");
   }
 }
 
 LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& map,
                                            const LikelihoodFieldParams& params)
-    : params_((params.validate(), params)), frame_(map.clone()), distance_(distance_field(map)) {}
+    : params_((params.validate(), params)),
+      frame_(map.clone()),
+      distance_(distance_field(map)),
+      occupied_(map, /*unknown_stops=*/false) {}
+
+double LikelihoodFieldModel::term(double d, double max_range) const {
+  const double s = params_.sigma_hit;
+  const double g = std::exp(-d * d / (2.0 * s * s));
+  const double rand = params_.z_rand / max_range;
+  if (params_.combination == BeamCombination::nav2) {
+    const double pz = params_.z_hit * g + rand;
+    return pz * pz * pz;
+  }
+  return std::log(params_.z_hit * g / (std::sqrt(2.0 * kPi) * s) + rand);
+}
+
+void LikelihoodFieldModel::tabulate(double max_range) {
+  if (max_range == table_range_) return;
+  table_.create(distance_.rows, distance_.cols, CV_32FC1);
+  for (int y = 0; y < distance_.rows; ++y) {
+    const float* d = distance_.ptr<float>(y);
+    float* t = table_.ptr<float>(y);
+    for (int x = 0; x < distance_.cols; ++x) {
+      t[x] = static_cast<float>(term(std::min<double>(d[x], params_.max_distance), max_range));
+    }
+  }
+  outside_ = static_cast<float>(term(params_.max_distance, max_range));
+  table_range_ = max_range;
+}
 
 void LikelihoodFieldModel::set_scan(const double* angles, const float* ranges, std::size_t n,
                                     double max_range) {
-  if (!(max_range > 0.0)) throw std::invalid_argument("likelihood field: max_range must be > 0");
-  cos_.clear(), sin_.clear(), range_.clear();
-  for (std::size_t i = 0; i < n; i += static_cast<std::size_t>(params_.beam_stride)) {
-    if (!std::isfinite(ranges[i]) || ranges[i] <= 0.0f || ranges[i] >= max_range) continue;
-    cos_.push_back(std::cos(angles[i]));
-    sin_.push_back(std::sin(angles[i]));
-    range_.push_back(ranges[i]);
-  }
-  max_range_ = max_range;
+  beams_.set(angles, ranges, n, max_range, params_.max_beams, /*keep_no_return=*/false);
+  tabulate(max_range);
 }
 
-void LikelihoodFieldModel::log_likelihoods(const double* poses, std::size_t n, double* out) const {
-  const double inv2s2 = 1.0 / (2.0 * params_.sigma_hit * params_.sigma_hit);
-  const double norm = params_.z_hit / (std::sqrt(2.0 * kPi) * params_.sigma_hit);
-  const double rand = params_.z_rand / max_range_;
-  const float far = static_cast<float>(3.0 * params_.sigma_hit + 1.0);
-  for (std::size_t k = 0; k < n; ++k) {
-    const double x = poses[3 * k], y = poses[3 * k + 1], th = poses[3 * k + 2];
-    const double c = std::cos(th), s = std::sin(th);
-    double log_l = 0.0;
-    for (std::size_t b = 0; b < range_.size(); ++b) {
-      const double bc = c * cos_[b] - s * sin_[b], bs = s * cos_[b] + c * sin_[b];
-      const Eigen::Vector2d g = frame_.world_to_grid({x + range_[b] * bc, y + range_[b] * bs});
-      const int cx = static_cast<int>(std::floor(g.x())), cy = static_cast<int>(std::floor(g.y()));
-      const float d = frame_.contains(cx, cy) ? distance_.ptr<float>(cy)[cx] : far;
-      log_l += std::log(norm * std::exp(-d * d * inv2s2) + rand);
-    }
-    out[k] = log_l;
+void LikelihoodFieldModel::log_likelihoods(const Pose2* poses, std::size_t n, double* out) const {
+  if (table_range_ < 0.0) throw std::logic_error("likelihood field: set a scan first");
+  // Everything in grid cells: a pose's sensor in the grid frame, then per beam one rotation.
+  const Pose2 to_grid = frame_.origin().inverse();
+  const double inv_res = 1.0 / frame_.resolution();
+  const int w = frame_.width(), h = frame_.height();
+  const std::size_t m = beams_.size();
+  std::vector<double> bx(m), by(m);
+  for (std::size_t b = 0; b < m; ++b) {
+    bx[b] = beams_.range[b] * beams_.cos[b] * inv_res;
+    by[b] = beams_.range[b] * beams_.sin[b] * inv_res;
   }
+  const bool nav2 = params_.combination == BeamCombination::nav2;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Pose2 s = to_grid.compose(poses[k].compose(params_.sensor));
+    const double px = s.x * inv_res, py = s.y * inv_res, c = std::cos(s.theta), sn = std::sin(s.theta);
+    double sum = 0.0;
+    for (std::size_t b = 0; b < m; ++b) {
+      const double gx = px + c * bx[b] - sn * by[b], gy = py + sn * bx[b] + c * by[b];
+      const int cx = static_cast<int>(std::floor(gx)), cy = static_cast<int>(std::floor(gy));
+      sum += (cx >= 0 && cy >= 0 && cx < w && cy < h) ? table_.ptr<float>(cy)[cx] : outside_;
+    }
+    out[k] = nav2 ? std::log1p(sum) : sum;
+  }
+}
+
+double LikelihoodFieldModel::agreement(const Pose2& pose) const {
+  return beams_.agreement(occupied_, pose.compose(params_.sensor), params_.agreement_tolerance);
 }
 
 }  // namespace kiseki

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdlib>
 #include <mutex>
 #include <unordered_map>
@@ -307,6 +308,19 @@ void SpaceObservationModel::likelihoods(const double* poses, std::size_t n, doub
   for (std::size_t k = 0; k < n; ++k) {
     out[k] = likelihood(Pose2(poses[3 * k], poses[3 * k + 1], poses[3 * k + 2]));
   }
+}
+
+double SpaceObservationModel::agreement(const Pose2& pose) const {
+  const Impl& m = *impl_;
+  const CellIndex at = m.map.world_to_cell({pose.x, pose.y});
+  if (!m.map.contains(at) || m.map.value(at.x, at.y) < 0 || m.map.value(at.x, at.y) > m.params.free_max) return 0.0;
+  const SpaceObservationCounts c = counts(pose);
+  if (c.map_occupied == 0) return std::numeric_limits<double>::quiet_NaN();
+  return 1.0 - std::min(1.0, static_cast<double>(c.penetrating) / c.map_occupied);
+}
+
+void SpaceObservationModel::log_likelihoods(const Pose2* poses, std::size_t n, double* out) const {
+  for (std::size_t k = 0; k < n; ++k) out[k] = std::log(likelihood(poses[k]));
 }
 
 OccupancyGrid SpaceObservationModel::rotated_local_map(int bin) const {

@@ -23,22 +23,19 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from kiseki.datasets import read_carmen_log  # noqa: E402
-from kiseki.datasets.carmen import LaserScans  # noqa: E402
-from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput  # noqa: E402
-from kiseki.experiments.carmen_maps import LOGS  # noqa: E402
-from kiseki.experiments.carmen_maps import data_dir as _carmen_dir  # noqa: E402
-from kiseki.localization import LocalizeConfig, localize  # noqa: E402
-from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement  # noqa: E402
-from kiseki.metrics import ape  # noqa: E402
-from kiseki.teach.environment_map import MERGE_RULES, build_teaching_map  # noqa: E402
+from kiseki.datasets import read_carmen_log
+from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.carmen_maps import LOGS
+from kiseki.experiments.carmen_maps import data_dir as _carmen_dir
+from kiseki.localization import LocalizeConfig, localize
+from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
+from kiseki.metrics import ape
+from kiseki.plots import new_figure
+from kiseki.scans import LaserScans
+from kiseki.teach.environment_map import MERGE_RULES, build_teaching_map
 
 
 @dataclass(frozen=True)
@@ -114,7 +111,7 @@ def trial(config: MergeRulesConfig, index: int, seed: int) -> TrialOutput:
         )
         timings[f"{rule}_build_seconds"] = time.perf_counter() - start
         start = time.perf_counter()
-        estimate = localize(scans, grid, localize_config)
+        estimate = localize(scans, grid, localize_config).estimates
         timings[f"{rule}_track_seconds"] = time.perf_counter() - start
         cells = np.asarray(grid.cells)
         record |= {
@@ -155,7 +152,8 @@ def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) 
         )
         for row in table.itertuples()
     ]
-    fig, axes = plt.subplots(1, 2, figsize=(10, 3.5), dpi=120)
+    fig = new_figure(figsize=(10, 3.5), dpi=120)
+    axes = fig.subplots(1, 2)
     x = np.arange(len(table))
     for k, (rule, colour) in enumerate((("thesis", "tab:orange"), ("evidence", "tab:blue"))):
         axes[0].bar(x + 0.3 * (k - 0.5), table[f"endpoints_{rule}"], 0.3, color=colour, label=rule)
@@ -171,7 +169,6 @@ def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) 
         ax.legend(fontsize=7)
     path = figures / "merge_rules.png"
     fig.savefig(path, bbox_inches="tight")
-    plt.close(fig)
     notes = (
         f"Teaching maps at {config.resolution} m from the corrected poses; endpoints count "
         "when they land on an occupied cell or one of its 8 neighbours. Tracking: the space "

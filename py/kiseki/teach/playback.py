@@ -3,8 +3,8 @@
 """Playback (thesis sec. 3.5): the robot follows the taught waypoints on the particle filter's
 estimate and stops when the estimate is within 0.1 m of the goal; it then decelerates at its
 acceleration limit (the filter still running) and its stop pose is where it comes to rest. The
-filter predicts from odometry and weighs particles with the space observation model on the
-chosen method's local map.
+filter (kiseki's Monte Carlo engine, :mod:`kiseki.localization`) predicts from odometry and
+weighs particles with the space observation model on the chosen method's local map.
 """
 
 from __future__ import annotations
@@ -16,9 +16,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from kiseki import _core
-from kiseki.core import Pose2, derive_seed
+from kiseki.control import PurePursuit
+from kiseki.core import derive_seed
 from kiseki.grid import OccupancyGrid
-from kiseki.sim.run import PurePursuit
+from kiseki.localization import MclConfig, MonteCarloLocalizer
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.local_maps import METHODS, LocalMapMaker
@@ -118,24 +119,28 @@ def playback(
     ]
     maker = LocalMapMaker(cameras, band)
     model = _core.SpaceObservationModel(environment, occlusion_aware=occlusion)
-    a1, a2, a3, a4 = config.alphas
-    pf = _core.ParticleFilter(config.particles, a1, a2, a3, a4, 0.5, derive_seed(config.seed, 2))
+    localizer = MonteCarloLocalizer(
+        MclConfig(particles=config.particles, alphas=tuple(config.alphas)),
+        derive_seed(config.seed, 2),
+    )
     start = waypoints[0]
-    pf.initialize(Pose2(start["x"], start["y"], start["theta"]), *config.initial_sd)
+    localizer.initialize((start["x"], start["y"], start["theta"]), config.initial_sd)
     points = [[w["x"], w["y"]] for w in waypoints]
     controller = PurePursuit(
         points, config.speed, 0.6, config.goal_tolerance, setup.robot.params.max_accel
     )
     passes: dict = {}
     truth_log, est_log = [], []
-    odom_before = setup.odometry.pose
-    for _ in range(int(config.max_duration / config.dt)):
-        truth = _pose(setup.robot.pose)
+
+    def observe():
         images = [c.render(scene.world, truth) for c in cameras]
         model.set_local_map(maker.make(images))
-        pf.weight(model.likelihoods(pf.poses))
-        estimate = _pose(pf.estimate())
-        pf.resample_if_needed()
+        return model
+
+    for _ in range(int(config.max_duration / config.dt)):
+        truth = _pose(setup.robot.pose)
+        localizer.step(_pose(setup.odometry.pose), observe)
+        estimate = tuple(float(v) for v in localizer.estimate)
         truth_log.append(truth)
         est_log.append(estimate)
         _record_passes(passes, waypoints, controller, truth, estimate, _pose(setup.odometry.pose))
@@ -143,9 +148,6 @@ def playback(
             break  # the stop pose is where the robot comes to rest, not where it was told to stop
         v, _, w = controller.command(estimate)
         setup.odometry.update(setup.robot.step(v, w, config.dt))
-        odom_after = setup.odometry.pose
-        pf.predict(odom_before, odom_after)
-        odom_before = odom_after
     return PlaybackResult(
         controller.done,
         len(truth_log),

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "kiseki/grid/occupancy_grid.hpp"
+#include "kiseki/models/sensor_model.hpp"
 
 namespace kiseki {
 
@@ -55,7 +56,7 @@ struct SpaceObservationParams {
 /// compared exactly in integers, so corners are found without rounding. Visibility depends on
 /// the cell only, so it is cached per cell (bounded in size, thread-safe) and shared by the
 /// particles in it. The numpy reference is kiseki.models.visibility_reference.
-class SpaceObservationModel {
+class SpaceObservationModel : public SensorModel {
  public:
   SpaceObservationModel(const OccupancyGrid& map, const SpaceObservationParams& params = {});
   ~SpaceObservationModel();
@@ -68,6 +69,12 @@ class SpaceObservationModel {
   double likelihood(const Pose2& pose) const;
   /// Likelihoods of n particles (poses row-major n x 3).
   void likelihoods(const double* poses, std::size_t n, double* out) const;
+  /// SensorModel: log of likelihood() per pose (-inf where it is 0).
+  void log_likelihoods(const Pose2* poses, std::size_t n, double* out) const override;
+  /// SensorModel: 1 - the share of the map's occupied cells in view that the local map sees as
+  /// free (1 - penetration ratio / 100, at least 0); 0 off the map's free cells; NaN when no
+  /// occupied map cell is in view.
+  double agreement(const Pose2& pose) const override;
 
   /// The local map rotated to heading bin k, as the map-aligned cells it would overlay (int8,
   /// -1 outside view), for tests and the numpy reference.

@@ -1,0 +1,157 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "kiseki/core/pose.hpp"
+#include "kiseki/core/random.hpp"
+#include "kiseki/filters/kld_sampling.hpp"
+#include "kiseki/filters/motion_model.hpp"
+#include "kiseki/filters/resampling.hpp"
+#include "kiseki/grid/occupancy_grid.hpp"
+#include "kiseki/models/sensor_model.hpp"
+
+namespace kiseki {
+
+/// What the filter does when the measurements stop agreeing with its particles.
+enum class Recovery {
+  none,
+  /// Augmented MCL (Probabilistic Robotics, Table 8.3): short- and long-term averages of the
+  /// per-reading likelihood, w_fast and w_slow; at each resampling a share max(0, 1 - w_fast /
+  /// w_slow) of the new particles is drawn uniformly over the free cells (nav2's recovery).
+  augmented,
+  /// Expansion resetting (Ueda et al., emcl / emcl2) then sensor resetting (Lenser and Veloso,
+  /// 2000): when the agreement of the measurement with the map seen from the particles (the
+  /// model's agreement(), for scans emcl2's non-penetration share) falls below reset_threshold,
+  /// every particle is moved by uniform noise (+-expansion_position, +-expansion_orientation) and
+  /// weighed again; after sensor_reset_after such updates in a row, a share sensor_reset_share of
+  /// the particles is drawn from sensor_reset_candidates uniform poses over the free cells in
+  /// proportion to their likelihood (the measurement proposes where the robot can be).
+  resetting,
+};
+Recovery recovery_from_name(const std::string& name);
+
+struct MclParams {
+  std::size_t particles = 1000;  ///< the count; with kld the maximum
+  bool kld = false;              ///< adapt the count by KLD sampling at each resampling
+  KldParams kld_params;          ///< (its max_particles is taken from `particles`)
+  MotionParams motion;
+  ResamplingMethod resampling = ResamplingMethod::systematic;
+  double resample_threshold = 0.5;  ///< resample when ESS < threshold * n; >= 1: every update
+  double likelihood_power = 1.0;    ///< log-likelihoods are multiplied by this (< 1 tempers)
+  Recovery recovery = Recovery::none;
+  double alpha_slow = 0.001, alpha_fast = 0.1;  ///< nav2's suggested recovery_alpha_*
+  double reset_threshold = 0.8;  ///< agreement below which the cloud counts as lost
+  double expansion_position = 0.2, expansion_orientation = 0.2;  ///< m, rad (half-widths)
+  int sensor_reset_after = 3;
+  double sensor_reset_share = 0.5;
+  std::size_t sensor_reset_candidates = 20000;
+  std::size_t agreement_samples = 16;  ///< particles (drawn by weight) the agreement averages
+  double reliability_rate = 0.1;       ///< smoothing of the reliability estimate per update
+  int threads = 0;                     ///< 0 = every core
+  void validate() const;
+};
+
+/// What one measurement update did.
+struct UpdateReport {
+  bool informative = false;        ///< the weights changed (some particle had a finite likelihood)
+  double effective_sample_size = 0.0;  ///< after weighting, before resampling
+  double average_likelihood = 0.0;  ///< weighted mean per-reading likelihood (Augmented MCL's w)
+  double agreement = 0.0;           ///< of the measurement with the map (NaN: model cannot tell)
+  bool resampled = false;
+  std::size_t injected = 0;         ///< uniform poses added (Augmented MCL)
+  std::string reset = "none";       ///< none, expansion or sensor
+  std::size_t particles = 0;        ///< after the update
+};
+
+/// Monte Carlo localization on SE(2): one engine for every particle filter over planar poses in
+/// kiseki (position tracking, global localization, the thesis' playback, magnetic models).
+/// Particles and weights can be read and set. Every per-particle loop (motion, likelihood)
+/// runs on `threads` threads; the random numbers of a particle come from its own stream, and
+/// sums run in one fixed order, so one seed gives one trajectory for any thread count.
+///
+/// Reliability estimate: r <- r + rate (s - r) after each update, where s is 1 when the
+/// measurement agrees with the map (agreement >= reset_threshold) and 0 when it does not; for
+/// models that cannot tell, s = min(1, w_fast / w_slow). So r is the recent share of updates
+/// that fit, and falls within a few updates when the filter is lost, where a confidence built
+/// from the particles' spread alone stays high on a tight cloud in the wrong place.
+class MonteCarloLocalization {
+ public:
+  MonteCarloLocalization(const MclParams& params, std::uint64_t seed);
+
+  /// The free cells (value 0..19) that uniform poses are drawn from: the global start,
+  /// Augmented MCL and sensor resetting need them. Throws if the map has no free cell.
+  void set_free_space(const OccupancyGrid& map);
+  bool has_free_space() const { return !free_cells_.empty(); }
+  std::vector<Pose2> uniform_poses(std::size_t n);
+
+  /// `particles` poses around a mean with the given SDs (m, m, rad); reliability 1.
+  void initialize_gaussian(const Pose2& mean, double sd_x, double sd_y, double sd_theta);
+  /// `particles` poses uniform over the free space; reliability 0.
+  void initialize_uniform();
+  /// Any n >= 1 poses, with weights (normalised here) or uniform weights when none are given.
+  void set_particles(const std::vector<Pose2>& poses, const std::vector<double>& weights = {});
+  /// New weights for the current particles (finite, >= 0, positive sum; normalised here).
+  void set_weights(const std::vector<double>& weights);
+
+  /// Moves the particles by an odometry increment. An increment longer than max_jump metres is
+  /// refused (an odometry jump is a fault of the log, not a motion).
+  void predict(const Pose2& odom_before, const Pose2& odom_after);
+  /// Weighs the particles with a model that holds the current measurement, then recovers and
+  /// resamples as configured.
+  UpdateReport update(const SensorModel& model);
+  /// The same with log-likelihoods computed elsewhere (one per particle), the number of
+  /// readings they hold and their agreement (NaN if unknown). Resetting then expands without
+  /// weighing again and never sensor-resets (that needs the model).
+  UpdateReport update(const std::vector<double>& log_likelihoods, std::size_t readings, double agreement);
+  /// Changes the likelihood power and the recovery between updates (global localization
+  /// tempers the likelihood and recovers only once its cloud has converged). Throws on values
+  /// MclParams::validate refuses. A new recovery starts Augmented MCL's averages afresh.
+  void set_likelihood_power(double power);
+  void set_recovery(Recovery recovery);
+  /// Resamples now to n particles (e.g. a converged global cloud cut to the tracking size).
+  void resample_to(std::size_t n);
+
+  Pose2 estimate() const;
+  /// Weighted covariance of (x, y, theta), the heading as its difference from the mean's.
+  Eigen::Matrix3d covariance() const;
+  double reliability() const { return reliability_; }
+  double effective_sample_size() const;
+  const std::vector<Pose2>& particles() const { return particles_; }
+  const std::vector<double>& weights() const { return weights_; }
+  const MclParams& params() const { return params_; }
+  double max_jump = 10.0;  ///< m per predict()
+
+ private:
+  UpdateReport update_impl(const std::vector<double>& log_l, std::size_t readings, double agreement,
+                           const SensorModel* model);
+  std::vector<double> evaluate(const SensorModel& model, const std::vector<Pose2>& poses) const;
+  double agreement_of(const SensorModel& model) const;
+  void resample(double inject_probability, UpdateReport& report);
+  void expansion_reset(const SensorModel* model);
+  void sensor_reset(const SensorModel& model);
+  void check_ready() const;
+
+  MclParams params_;
+  Random rng_;
+  std::vector<Pose2> particles_;
+  std::vector<double> weights_;
+  std::size_t target_ = 0;  // particle count without KLD
+  // free space for uniform poses
+  std::vector<std::int32_t> free_cells_;
+  int free_width_ = 0;
+  double free_resolution_ = 0.0;
+  Pose2 free_origin_;
+  // recovery state
+  double w_slow_ = 0.0, w_fast_ = 0.0;
+  int lost_updates_ = 0;
+  double reliability_ = 1.0;
+};
+
+}  // namespace kiseki

@@ -1,0 +1,55 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#pragma once
+
+#include <cstddef>
+
+#include "kiseki/grid/occupancy_grid.hpp"
+#include "kiseki/grid/range_caster.hpp"
+#include "kiseki/models/likelihood_field.hpp"
+#include "kiseki/models/scan_beams.hpp"
+#include "kiseki/models/sensor_model.hpp"
+
+namespace kiseki {
+
+/// The beam range-finder model (Probabilistic Robotics, Table 6.1; nav2 AMCL's "beam" model):
+/// each beam's reading z is compared with the range z* ray-cast in the map from the particle,
+/// pz = z_hit exp(-(z - z*)^2 / 2 sigma_hit^2)            (measurement noise)
+///    + z_short lambda_short exp(-lambda_short z)  if z < z* (unexpected objects)
+///    + z_max                                      if z is a no-return (at max range)
+///    + z_rand / max_range                         if z < max_range (random readings),
+/// the Gaussian divided by sqrt(2 pi) sigma_hit in the product combination. A ray stops at an
+/// occupied cell and, as in nav2, at an unknown one (unknown_stops). Readings of +inf or at or
+/// beyond max range are no-returns and score with z_max; NaN, zero and negative readings are
+/// skipped. Ray casting skips free space with a distance field (RangeCaster).
+struct BeamModelParams {
+  double z_hit = 0.5, z_short = 0.05, z_max = 0.05, z_rand = 0.5;  ///< nav2's defaults
+  double sigma_hit = 0.2;     ///< m
+  double lambda_short = 0.1;  ///< 1/m
+  int max_beams = 0;          ///< nav2's max_beams; 0 = every beam
+  bool unknown_stops = true;
+  BeamCombination combination = BeamCombination::product;
+  Pose2 sensor;  ///< the laser in the robot frame
+  double agreement_tolerance = 0.2;
+  void validate() const;
+};
+
+class BeamModel : public SensorModel {
+ public:
+  BeamModel(const OccupancyGrid& map, const BeamModelParams& params = {});
+  void set_scan(const double* angles, const float* ranges, std::size_t n, double max_range);
+  void log_likelihoods(const Pose2* poses, std::size_t n, double* out) const override;
+  std::size_t readings() const override { return beams_.size(); }
+  double agreement(const Pose2& pose) const override;
+  /// The mixture pz of one beam: reading z, expected range z_star.
+  double beam_probability(double z, double z_star, bool no_return) const;
+
+ private:
+  BeamModelParams params_;
+  ScanBeams beams_;
+  RangeCaster caster_;
+  RangeCaster occupied_;
+  bool has_scan_ = false;
+};
+
+}  // namespace kiseki

@@ -1,0 +1,359 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#include "kiseki/filters/monte_carlo_localization.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+#include "kiseki/core/angle.hpp"
+#include "kiseki/core/parallel.hpp"
+
+namespace kiseki {
+
+Recovery recovery_from_name(const std::string& name) {
+  if (name == "none") return Recovery::none;
+  if (name == "augmented") return Recovery::augmented;
+  if (name == "resetting") return Recovery::resetting;
+  throw std::invalid_argument("recovery: unknown '" + name + "' (none, augmented or resetting)");
+}
+
+void MclParams::validate() const {
+  if (particles < 1 || particles > 10'000'000) throw std::invalid_argument("MCL: particles must be in 1..10,000,000");
+  if (kld) {
+    KldParams k = kld_params;
+    k.max_particles = particles;
+    if (k.min_particles > particles) throw std::invalid_argument("MCL: KLD min_particles exceeds particles (the maximum)");
+    k.validate();
+  }
+  motion.validate();
+  const auto finite_nonneg = [](double v) { return v >= 0.0 && std::isfinite(v); };
+  if (!finite_nonneg(resample_threshold)) throw std::invalid_argument("MCL: resample_threshold must be >= 0");
+  if (!(likelihood_power > 0.0) || !std::isfinite(likelihood_power)) throw std::invalid_argument("MCL: likelihood_power must be > 0");
+  if (!(alpha_slow > 0.0 && alpha_slow <= 1.0 && alpha_fast > 0.0 && alpha_fast <= 1.0)) {
+    throw std::invalid_argument("MCL: alpha_slow and alpha_fast must lie in (0, 1]");
+  }
+  if (!(reset_threshold >= 0.0 && reset_threshold <= 1.0)) throw std::invalid_argument("MCL: reset_threshold must lie in [0, 1]");
+  if (!finite_nonneg(expansion_position) || !finite_nonneg(expansion_orientation)) {
+    throw std::invalid_argument("MCL: expansion radii must be finite and >= 0");
+  }
+  if (sensor_reset_after < 1) throw std::invalid_argument("MCL: sensor_reset_after must be >= 1");
+  if (!(sensor_reset_share >= 0.0 && sensor_reset_share <= 1.0)) throw std::invalid_argument("MCL: sensor_reset_share must lie in [0, 1]");
+  if (sensor_reset_candidates < 1 || sensor_reset_candidates > 10'000'000) {
+    throw std::invalid_argument("MCL: sensor_reset_candidates must be in 1..10,000,000");
+  }
+  if (agreement_samples < 1) throw std::invalid_argument("MCL: agreement_samples must be >= 1");
+  if (!(reliability_rate > 0.0 && reliability_rate <= 1.0)) throw std::invalid_argument("MCL: reliability_rate must lie in (0, 1]");
+  if (threads < 0) throw std::invalid_argument("MCL: threads must be >= 0 (0 = every core)");
+}
+
+MonteCarloLocalization::MonteCarloLocalization(const MclParams& params, std::uint64_t seed)
+    : params_((params.validate(), params)), rng_(seed), target_(params.particles) {
+  params_.kld_params.max_particles = params_.particles;
+}
+
+void MonteCarloLocalization::set_free_space(const OccupancyGrid& map) {
+  std::vector<std::int32_t> cells;
+  for (int y = 0; y < map.height(); ++y) {
+    for (int x = 0; x < map.width(); ++x) {
+      const std::int8_t v = map.value(x, y);
+      if (v >= 0 && v < 20) cells.push_back(y * map.width() + x);
+    }
+  }
+  if (cells.empty()) throw std::invalid_argument("MCL: the map has no free cell to draw poses from");
+  free_cells_ = std::move(cells);
+  free_width_ = map.width();
+  free_resolution_ = map.resolution();
+  free_origin_ = map.origin();
+}
+
+std::vector<Pose2> MonteCarloLocalization::uniform_poses(std::size_t n) {
+  if (free_cells_.empty()) throw std::logic_error("MCL: no free space set (set_free_space)");
+  std::vector<Pose2> out(n);
+  for (auto& p : out) {
+    const std::int32_t cell = free_cells_[rng_.below(free_cells_.size())];
+    const double gx = cell % free_width_ + rng_.uniform(), gy = cell / free_width_ + rng_.uniform();
+    const Eigen::Vector2d w = free_origin_.transform_point({gx * free_resolution_, gy * free_resolution_});
+    p = Pose2(w.x(), w.y(), rng_.uniform(-kPi, kPi));
+  }
+  return out;
+}
+
+void MonteCarloLocalization::initialize_gaussian(const Pose2& mean, double sd_x, double sd_y, double sd_theta) {
+  if (!(sd_x >= 0.0) || !(sd_y >= 0.0) || !(sd_theta >= 0.0) || !std::isfinite(sd_x + sd_y + sd_theta)) {
+    throw std::invalid_argument("MCL: standard deviations must be finite and >= 0");
+  }
+  if (!std::isfinite(mean.x) || !std::isfinite(mean.y) || !std::isfinite(mean.theta)) {
+    throw std::invalid_argument("MCL: the initial pose must be finite");
+  }
+  std::vector<Pose2> p(params_.particles);
+  for (auto& q : p) q = Pose2(rng_.normal(mean.x, sd_x), rng_.normal(mean.y, sd_y), rng_.normal(mean.theta, sd_theta));
+  set_particles(p);
+  reliability_ = 1.0;
+}
+
+void MonteCarloLocalization::initialize_uniform() {
+  set_particles(uniform_poses(params_.particles));
+  reliability_ = 0.0;
+}
+
+void MonteCarloLocalization::set_particles(const std::vector<Pose2>& poses, const std::vector<double>& weights) {
+  if (poses.empty()) throw std::invalid_argument("MCL: no particles");
+  if (poses.size() > 10'000'000) throw std::invalid_argument("MCL: more than 10,000,000 particles");
+  for (const auto& q : poses) {
+    if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.theta)) {
+      throw std::invalid_argument("MCL: particles must be finite");
+    }
+  }
+  if (!weights.empty() && weights.size() != poses.size()) {
+    throw std::invalid_argument("MCL: one weight per particle is needed");
+  }
+  particles_ = poses;
+  if (weights.empty()) {
+    weights_.assign(particles_.size(), 1.0 / static_cast<double>(particles_.size()));
+  } else {
+    set_weights(weights);
+  }
+}
+
+void MonteCarloLocalization::set_weights(const std::vector<double>& weights) {
+  if (weights.size() != particles_.size()) throw std::invalid_argument("MCL: one weight per particle is needed");
+  double total = 0.0;
+  for (double w : weights) {
+    if (!(w >= 0.0) || !std::isfinite(w)) throw std::invalid_argument("MCL: weights must be finite and >= 0");
+    total += w;
+  }
+  if (!(total > 0.0) || !std::isfinite(total)) throw std::invalid_argument("MCL: the weights sum to 0");
+  weights_.resize(weights.size());
+  for (std::size_t i = 0; i < weights.size(); ++i) weights_[i] = weights[i] / total;
+}
+
+void MonteCarloLocalization::check_ready() const {
+  if (particles_.empty()) throw std::logic_error("MCL: not initialised (no particles)");
+}
+
+void MonteCarloLocalization::predict(const Pose2& a, const Pose2& b) {
+  check_ready();
+  if (std::isfinite(a.x) && std::isfinite(b.x) && std::hypot(b.x - a.x, b.y - a.y) > max_jump) {
+    throw std::invalid_argument("MCL: odometry jumps " + std::to_string(std::hypot(b.x - a.x, b.y - a.y)) +
+                                " m between two updates (more than max_jump " + std::to_string(max_jump) + " m)");
+  }
+  const std::uint64_t step_seed = rng_.below(~std::uint64_t{0});
+  sample_motion(params_.motion, a, b, particles_.data(), particles_.size(), step_seed, params_.threads);
+}
+
+std::vector<double> MonteCarloLocalization::evaluate(const SensorModel& model, const std::vector<Pose2>& poses) const {
+  std::vector<double> out(poses.size());
+  parallel_for(poses.size(), params_.threads,
+               [&](std::size_t b, std::size_t e) { model.log_likelihoods(poses.data() + b, e - b, out.data() + b); }, 64);
+  return out;
+}
+
+double MonteCarloLocalization::agreement_of(const SensorModel& model) const {
+  // Particles drawn by weight at fixed pointers (m + 0.5) / k: no random numbers used.
+  const std::size_t k = std::min(params_.agreement_samples, particles_.size());
+  double sum = 0.0, c = weights_[0];
+  std::size_t i = 0, used = 0;
+  for (std::size_t m = 0; m < k; ++m) {
+    const double u = (static_cast<double>(m) + 0.5) / static_cast<double>(k);
+    while (u > c && i + 1 < particles_.size()) c += weights_[++i];
+    const double a = model.agreement(particles_[i]);
+    if (std::isnan(a)) return a;
+    sum += a;
+    ++used;
+  }
+  return sum / static_cast<double>(used);
+}
+
+UpdateReport MonteCarloLocalization::update(const SensorModel& model) {
+  check_ready();
+  const std::vector<double> log_l = evaluate(model, particles_);
+  return update_impl(log_l, model.readings(), std::numeric_limits<double>::quiet_NaN(), &model);
+}
+
+UpdateReport MonteCarloLocalization::update(const std::vector<double>& log_l, std::size_t readings, double agreement) {
+  check_ready();
+  if (!std::isnan(agreement) && !(agreement >= 0.0 && agreement <= 1.0)) {
+    throw std::invalid_argument("MCL: agreement must lie in [0, 1] (or be NaN)");
+  }
+  return update_impl(log_l, readings, agreement, nullptr);
+}
+
+UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_l, std::size_t readings,
+                                                 double agreement, const SensorModel* model) {
+  if (log_l.size() != particles_.size()) throw std::invalid_argument("MCL: one log-likelihood per particle is needed");
+  UpdateReport report;
+  // Augmented MCL's average likelihood: the weighted mean of the per-reading (geometric mean)
+  // likelihood, so that scans with more or fewer returns compare.
+  const double r = static_cast<double>(std::max<std::size_t>(readings, 1));
+  double top = -std::numeric_limits<double>::infinity();
+  for (double l : log_l) {
+    if (std::isnan(l)) throw std::invalid_argument("MCL: a log-likelihood is NaN");
+    top = std::max(top, l / r);
+  }
+  double w_avg = 0.0;
+  if (std::isfinite(top)) {
+    for (std::size_t i = 0; i < log_l.size(); ++i) w_avg += weights_[i] * std::exp(log_l[i] / r - top);
+    w_avg *= std::exp(top);
+  }
+  report.average_likelihood = w_avg;
+  report.informative = readings > 0 && apply_log_likelihoods(weights_, log_l, params_.likelihood_power);
+  report.effective_sample_size = kiseki::effective_sample_size(weights_);
+  if (report.informative && std::isfinite(w_avg)) {
+    if (w_slow_ == 0.0) w_slow_ = w_fast_ = w_avg;
+    w_slow_ += params_.alpha_slow * (w_avg - w_slow_);
+    w_fast_ += params_.alpha_fast * (w_avg - w_fast_);
+  }
+  const double ratio = w_slow_ > 0.0 ? w_fast_ / w_slow_ : 1.0;
+  if (model != nullptr) agreement = agreement_of(*model);
+  report.agreement = agreement;
+  const bool knows = !std::isnan(agreement);
+  const bool lost = knows ? agreement < params_.reset_threshold : ratio < 0.5;
+  const double signal = knows ? (lost ? 0.0 : 1.0) : std::min(1.0, ratio);
+  reliability_ += params_.reliability_rate * (signal - reliability_);
+
+  if (params_.recovery == Recovery::resetting && (lost || !report.informative)) {
+    ++lost_updates_;
+    if (model != nullptr && has_free_space() && lost_updates_ >= params_.sensor_reset_after) {
+      sensor_reset(*model);
+      report.reset = "sensor";
+      lost_updates_ = 0;
+    } else {
+      expansion_reset(model);
+      report.reset = "expansion";
+    }
+    report.resampled = true;
+    report.particles = particles_.size();
+    return report;
+  }
+  if (!lost) lost_updates_ = 0;
+  double inject = 0.0;
+  if (params_.recovery == Recovery::augmented && has_free_space()) inject = std::max(0.0, 1.0 - ratio);
+  if (inject > 0.0 || params_.resample_threshold >= 1.0 ||
+      report.effective_sample_size < params_.resample_threshold * static_cast<double>(particles_.size())) {
+    resample(inject, report);
+  }
+  report.particles = particles_.size();
+  return report;
+}
+
+void MonteCarloLocalization::resample(double inject, UpdateReport& report) {
+  std::size_t n = params_.kld ? params_.particles : target_;
+  std::vector<std::size_t> idx = resample_indices(weights_, n, params_.resampling, rng_);
+  std::vector<Pose2> out;
+  out.reserve(n);
+  if (params_.kld) {
+    // KLD sampling: the resampled set in random order, taken until the bound for the bins it
+    // has filled is met (Fox 2003, Table 1, with the draws made up front).
+    for (std::size_t i = n; i > 1; --i) std::swap(idx[i - 1], idx[rng_.below(i)]);
+    KldBins bins(params_.kld_params);
+    for (std::size_t i : idx) {
+      out.push_back(particles_[i]);
+      bins.add(particles_[i]);
+      if (bins.enough(out.size())) break;
+    }
+  } else {
+    for (std::size_t i : idx) out.push_back(particles_[i]);
+  }
+  if (inject > 0.0) {
+    std::size_t m = 0;
+    for (std::size_t i = 0; i < out.size(); ++i) m += rng_.uniform() < inject;
+    const std::vector<Pose2> fresh = uniform_poses(m);
+    for (std::size_t i = 0; i < m; ++i) out[out.size() - 1 - i] = fresh[i];
+    report.injected = m;
+  }
+  particles_.swap(out);
+  weights_.assign(particles_.size(), 1.0 / static_cast<double>(particles_.size()));
+  report.resampled = true;
+}
+
+void MonteCarloLocalization::set_likelihood_power(double power) {
+  MclParams p = params_;
+  p.likelihood_power = power;
+  p.validate();
+  params_ = p;
+}
+
+void MonteCarloLocalization::set_recovery(Recovery recovery) {
+  params_.recovery = recovery;
+  w_slow_ = w_fast_ = 0.0;  // the averages start again from the next update
+  lost_updates_ = 0;
+}
+
+void MonteCarloLocalization::resample_to(std::size_t n) {
+  check_ready();
+  if (n < 1 || n > 10'000'000) throw std::invalid_argument("MCL: resample_to needs 1..10,000,000 particles");
+  const std::vector<std::size_t> idx = resample_indices(weights_, n, params_.resampling, rng_);
+  std::vector<Pose2> out(n);
+  for (std::size_t i = 0; i < n; ++i) out[i] = particles_[idx[i]];
+  particles_.swap(out);
+  weights_.assign(n, 1.0 / static_cast<double>(n));
+  target_ = n;
+}
+
+void MonteCarloLocalization::expansion_reset(const SensorModel* model) {
+  const std::size_t n = particles_.size();
+  const std::vector<std::size_t> idx = resample_indices(weights_, n, params_.resampling, rng_);
+  std::vector<Pose2> out(n);
+  const std::uint64_t seed = rng_.below(~std::uint64_t{0});
+  const double rp = params_.expansion_position, ro = params_.expansion_orientation;
+  parallel_for(n, params_.threads, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      StreamRandom g(seed, i);
+      const Pose2& q = particles_[idx[i]];
+      const double dx = g.uniform(-rp, rp), dy = g.uniform(-rp, rp), dt = g.uniform(-ro, ro);
+      out[i] = Pose2(q.x + dx, q.y + dy, q.theta + dt);
+    }
+  }, 4096);
+  particles_.swap(out);
+  weights_.assign(n, 1.0 / static_cast<double>(n));
+  if (model != nullptr) apply_log_likelihoods(weights_, evaluate(*model, particles_), params_.likelihood_power);
+}
+
+void MonteCarloLocalization::sensor_reset(const SensorModel& model) {
+  const std::size_t n = particles_.size();
+  const auto from_sensor = static_cast<std::size_t>(std::llround(params_.sensor_reset_share * static_cast<double>(n)));
+  const std::vector<Pose2> candidates = uniform_poses(params_.sensor_reset_candidates);
+  std::vector<double> w(candidates.size(), 1.0);
+  std::vector<Pose2> out;
+  out.reserve(n);
+  if (from_sensor < n) {
+    for (std::size_t i : resample_indices(weights_, n - from_sensor, params_.resampling, rng_)) out.push_back(particles_[i]);
+  }
+  if (from_sensor > 0) {
+    const bool any = apply_log_likelihoods(w, evaluate(model, candidates), params_.likelihood_power);
+    if (!any) w.assign(w.size(), 1.0);
+    for (std::size_t i : resample_indices(w, from_sensor, params_.resampling, rng_)) out.push_back(candidates[i]);
+  }
+  particles_.swap(out);
+  weights_.assign(n, 1.0 / static_cast<double>(n));
+}
+
+Pose2 MonteCarloLocalization::estimate() const {
+  check_ready();
+  double x = 0, y = 0, c = 0, s = 0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const double w = weights_[i];
+    x += w * particles_[i].x;
+    y += w * particles_[i].y;
+    c += w * std::cos(particles_[i].theta);
+    s += w * std::sin(particles_[i].theta);
+  }
+  return {x, y, std::atan2(s, c)};
+}
+
+Eigen::Matrix3d MonteCarloLocalization::covariance() const {
+  const Pose2 m = estimate();
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const Eigen::Vector3d d(particles_[i].x - m.x, particles_[i].y - m.y, angle_difference(particles_[i].theta, m.theta));
+    cov += weights_[i] * d * d.transpose();
+  }
+  return cov;
+}
+
+double MonteCarloLocalization::effective_sample_size() const { return kiseki::effective_sample_size(weights_); }
+
+}  // namespace kiseki

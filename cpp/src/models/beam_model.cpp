@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#include "kiseki/models/beam_model.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "kiseki/core/angle.hpp"
+
+namespace kiseki {
+
+void BeamModelParams::validate() const {
+  for (double z : {z_hit, z_short, z_max, z_rand}) {
+    if (!(z >= 0.0) || !std::isfinite(z)) throw std::invalid_argument("beam model: z weights must be finite and >= 0");
+  }
+  if (!(z_hit + z_short + z_max + z_rand > 0.0)) throw std::invalid_argument("beam model: the z weights are all 0");
+  if (!(sigma_hit > 0.0) || !std::isfinite(sigma_hit)) throw std::invalid_argument("beam model: sigma_hit must be > 0");
+  if (!(lambda_short > 0.0) || !std::isfinite(lambda_short)) {
+    throw std::invalid_argument("beam model: lambda_short must be > 0");
+  }
+  if (max_beams < 0) throw std::invalid_argument("beam model: max_beams must be >= 0");
+  if (!(agreement_tolerance >= 0.0) || !std::isfinite(agreement_tolerance)) {
+    throw std::invalid_argument("beam model: agreement_tolerance must be >= 0");
+  }
+}
+
+BeamModel::BeamModel(const OccupancyGrid& map, const BeamModelParams& params)
+    : params_((params.validate(), params)),
+      caster_(map, params.unknown_stops),
+      occupied_(map, /*unknown_stops=*/false) {}
+
+void BeamModel::set_scan(const double* angles, const float* ranges, std::size_t n, double max_range) {
+  beams_.set(angles, ranges, n, max_range, params_.max_beams, /*keep_no_return=*/true);
+  has_scan_ = true;
+}
+
+double BeamModel::beam_probability(double z, double z_star, bool no_return) const {
+  const auto& p = params_;
+  const double e = z - z_star;
+  double g = std::exp(-e * e / (2.0 * p.sigma_hit * p.sigma_hit));
+  if (p.combination == BeamCombination::product) g /= std::sqrt(2.0 * kPi) * p.sigma_hit;
+  double pz = p.z_hit * g;
+  if (e < 0.0) pz += p.z_short * p.lambda_short * std::exp(-p.lambda_short * z);
+  if (no_return) pz += p.z_max;
+  else pz += p.z_rand / beams_.max_range;
+  return pz;
+}
+
+void BeamModel::log_likelihoods(const Pose2* poses, std::size_t n, double* out) const {
+  if (!has_scan_) throw std::logic_error("beam model: set a scan first");
+  const std::size_t m = beams_.size();
+  const bool nav2 = params_.combination == BeamCombination::nav2;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Pose2 s = poses[k].compose(params_.sensor);
+    double sum = 0.0;
+    for (std::size_t b = 0; b < m; ++b) {
+      const double heading = s.theta + beams_.angle[b];
+      const double z_star = caster_.range(s.x, s.y, heading, beams_.max_range);
+      const double pz = beam_probability(beams_.range[b], z_star, beams_.no_return[b]);
+      sum += nav2 ? pz * pz * pz : std::log(pz);
+    }
+    out[k] = nav2 ? std::log1p(sum) : sum;
+  }
+}
+
+double BeamModel::agreement(const Pose2& pose) const {
+  return beams_.agreement(occupied_, pose.compose(params_.sensor), params_.agreement_tolerance);
+}
+
+}  // namespace kiseki
