@@ -151,6 +151,8 @@ void bind_filters(py::module_& m) {
            [](MonteCarloLocalization& f, const std::string& r) { f.set_recovery(recovery_from_name(r)); },
            "recovery"_a)
       .def("estimate", &MonteCarloLocalization::estimate)
+      .def("posterior", &MonteCarloLocalization::posterior,
+           "The weighted mean after the last update's weighing, before its resampling.")
       .def("covariance", &MonteCarloLocalization::covariance)
       .def_property_readonly("reliability", &MonteCarloLocalization::reliability)
       .def_property_readonly("effective_sample_size", &MonteCarloLocalization::effective_sample_size)

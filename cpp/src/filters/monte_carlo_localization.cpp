@@ -91,11 +91,13 @@ void MonteCarloLocalization::initialize_gaussian(const Pose2& mean, double sd_x,
   std::vector<Pose2> p(params_.particles);
   for (auto& q : p) q = Pose2(rng_.normal(mean.x, sd_x), rng_.normal(mean.y, sd_y), rng_.normal(mean.theta, sd_theta));
   set_particles(p);
+  posterior_ = estimate();
   reliability_ = 1.0;
 }
 
 void MonteCarloLocalization::initialize_uniform() {
   set_particles(uniform_poses(params_.particles));
+  posterior_ = estimate();
   reliability_ = 0.0;
 }
 
@@ -224,13 +226,15 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
       expansion_reset(model);
       report.reset = "expansion";
     }
+    posterior_ = estimate();
     report.resampled = true;
     report.particles = particles_.size();
     return report;
   }
   if (!lost) lost_updates_ = 0;
+  posterior_ = estimate();  // before resampling: injected poses have no weight in it
   double inject = 0.0;
-  if (params_.recovery == Recovery::augmented && has_free_space()) inject = std::max(0.0, 1.0 - ratio);
+  if (params_.recovery != Recovery::none && has_free_space()) inject = std::max(0.0, 1.0 - ratio);
   if (inject > 0.0 || params_.resample_threshold >= 1.0 ||
       report.effective_sample_size < params_.resample_threshold * static_cast<double>(particles_.size())) {
     resample(inject, report);
@@ -329,6 +333,9 @@ void MonteCarloLocalization::sensor_reset(const SensorModel& model) {
   }
   particles_.swap(out);
   weights_.assign(n, 1.0 / static_cast<double>(n));
+  // Weigh the mixed set, so that the estimate is that of the better part, not the mean of two
+  // places.
+  apply_log_likelihoods(weights_, evaluate(model, particles_), params_.likelihood_power);
 }
 
 Pose2 MonteCarloLocalization::estimate() const {

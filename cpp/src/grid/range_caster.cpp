@@ -30,6 +30,12 @@ RangeCaster::RangeCaster(const OccupancyGrid& grid, bool unknown_stops, std::int
   }
 }
 
+double RangeCaster::clearance(double x, double y) const {
+  const CellIndex c = grid_.world_to_cell({x, y});
+  if (!grid_.contains(c)) return std::numeric_limits<double>::infinity();
+  return static_cast<double>(distance_.ptr<float>(c.y)[c.x]) * grid_.resolution();
+}
+
 bool RangeCaster::stops(int cx, int cy) const {
   const std::int8_t v = grid_.value(cx, cy);
   return v >= threshold_ || (unknown_stops_ && v < 0);

@@ -47,7 +47,10 @@ double ScanBeams::agreement(const RangeCaster& occupied, const Pose2& sensor, do
     const double heading = sensor.theta + angle[b];
     const double want = range[b] - tolerance;
     ++used;
-    if (want <= 0.0 || occupied.range(sensor.x, sensor.y, heading, want) >= want) ++reached;
+    const bool through = want > 0.0 && occupied.range(sensor.x, sensor.y, heading, want) < want;
+    if (through) continue;
+    const double ex = sensor.x + range[b] * std::cos(heading), ey = sensor.y + range[b] * std::sin(heading);
+    if (occupied.clearance(ex, ey) <= tolerance + g.resolution()) ++reached;
   }
   return used == 0 ? std::numeric_limits<double>::quiet_NaN() : static_cast<double>(reached) / used;
 }

@@ -15,6 +15,7 @@ def _registry() -> dict[str, Experiment]:
         carmen_maps,
         corridor_scans,
         fig_3_14,
+        mcl_kidnapping,
         merge_rules,
         teach_playback,
     )
@@ -23,6 +24,8 @@ def _registry() -> dict[str, Experiment]:
         carmen_maps.EXPERIMENT,
         corridor_scans.EXPERIMENT,
         fig_3_14.EXPERIMENT,
+        mcl_kidnapping.SIM,
+        mcl_kidnapping.CARMEN,
         merge_rules.EXPERIMENT,
         teach_playback.EXP1,
         teach_playback.EXP2,

@@ -26,13 +26,15 @@ enum class Recovery {
   /// per-reading likelihood, w_fast and w_slow; at each resampling a share max(0, 1 - w_fast /
   /// w_slow) of the new particles is drawn uniformly over the free cells (nav2's recovery).
   augmented,
-  /// Expansion resetting (Ueda et al., emcl / emcl2) then sensor resetting (Lenser and Veloso,
-  /// 2000): when the agreement of the measurement with the map seen from the particles (the
+  /// Augmented MCL's injection, and expansion resetting (Ueda et al., emcl / emcl2) then sensor
+  /// resetting (Lenser and Veloso, 2000): when the agreement of the measurement with the map seen from the particles (the
   /// model's agreement(), for scans emcl2's non-penetration share) falls below reset_threshold,
   /// every particle is moved by uniform noise (+-expansion_position, +-expansion_orientation) and
   /// weighed again; after sensor_reset_after such updates in a row, a share sensor_reset_share of
   /// the particles is drawn from sensor_reset_candidates uniform poses over the free cells in
-  /// proportion to their likelihood (the measurement proposes where the robot can be).
+  /// proportion to their likelihood (the measurement proposes where the robot can be), and the
+  /// set is weighed again. The resets catch a scan that contradicts the map; the injection
+  /// catches what they cannot, a place that looks alike (a pose carried along a corridor).
   resetting,
 };
 Recovery recovery_from_name(const std::string& name);
@@ -47,7 +49,7 @@ struct MclParams {
   double likelihood_power = 1.0;    ///< log-likelihoods are multiplied by this (< 1 tempers)
   Recovery recovery = Recovery::none;
   double alpha_slow = 0.001, alpha_fast = 0.1;  ///< nav2's suggested recovery_alpha_*
-  double reset_threshold = 0.8;  ///< agreement below which the cloud counts as lost
+  double reset_threshold = 0.6;  ///< agreement below which the cloud counts as lost
   double expansion_position = 0.2, expansion_orientation = 0.2;  ///< m, rad (half-widths)
   int sensor_reset_after = 3;
   double sensor_reset_share = 0.5;
@@ -118,7 +120,11 @@ class MonteCarloLocalization {
   /// Resamples now to n particles (e.g. a converged global cloud cut to the tracking size).
   void resample_to(std::size_t n);
 
+  /// Weighted mean of the current particles (circular mean of the headings).
   Pose2 estimate() const;
+  /// The weighted mean after the last update's weighing, before its resampling (so without
+  /// the uniform poses Augmented MCL injects, which have no weight yet): the filter's answer.
+  const Pose2& posterior() const { return posterior_; }
   /// Weighted covariance of (x, y, theta), the heading as its difference from the mean's.
   Eigen::Matrix3d covariance() const;
   double reliability() const { return reliability_; }
@@ -152,6 +158,7 @@ class MonteCarloLocalization {
   double w_slow_ = 0.0, w_fast_ = 0.0;
   int lost_updates_ = 0;
   double reliability_ = 1.0;
+  Pose2 posterior_;
 };
 
 }  // namespace kiseki

@@ -26,6 +26,9 @@ class RangeCaster {
   /// max_range.
   double range(double x, double y, double heading, double max_range) const;
   const OccupancyGrid& grid() const { return grid_; }
+  /// Distance (m) from a world point's cell centre to the nearest stopping cell's centre; +inf
+  /// outside the grid or when nothing stops a ray.
+  double clearance(double x, double y) const;
 
  private:
   bool stops(int cx, int cy) const;
