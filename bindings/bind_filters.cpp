@@ -97,6 +97,7 @@ void bind_filters(py::module_& m) {
                     [](MclParams& p, const std::string& v) { p.recovery = recovery_from_name(v); })
       .def_readwrite("alpha_slow", &MclParams::alpha_slow)
       .def_readwrite("alpha_fast", &MclParams::alpha_fast)
+      .def_readwrite("resetting_injects", &MclParams::resetting_injects)
       .def_readwrite("reset_threshold", &MclParams::reset_threshold)
       .def_readwrite("expansion_position", &MclParams::expansion_position)
       .def_readwrite("expansion_orientation", &MclParams::expansion_orientation)

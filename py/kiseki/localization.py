@@ -95,6 +95,7 @@ class MclConfig:
     recovery: str = "none"
     alpha_slow: float = 0.001
     alpha_fast: float = 0.1
+    resetting_injects: bool = True
     reset_threshold: float = 0.6
     expansion_position: float = 0.2
     expansion_orientation: float = 0.2
@@ -159,6 +160,7 @@ class MclConfig:
         p.recovery = self.recovery
         p.alpha_slow = self.alpha_slow
         p.alpha_fast = self.alpha_fast
+        p.resetting_injects = self.resetting_injects
         p.reset_threshold = self.reset_threshold
         p.expansion_position = self.expansion_position
         p.expansion_orientation = self.expansion_orientation
@@ -370,6 +372,8 @@ class LocalizeConfig:
             resample_threshold=self.resample_threshold,
             likelihood_power=self.likelihood_power,
             recovery=self.recovery,
+            # Uniform poses are no fair proposal for the space observation model (see MclParams)
+            resetting_injects=self.method != "space-observation",
             update_min_d=self.update_min_d,
             update_min_a=self.update_min_a,
             threads=self.threads,

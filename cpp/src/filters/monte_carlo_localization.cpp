@@ -234,7 +234,9 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
   if (!lost) lost_updates_ = 0;
   posterior_ = estimate();  // before resampling: injected poses have no weight in it
   double inject = 0.0;
-  if (params_.recovery != Recovery::none && has_free_space()) inject = std::max(0.0, 1.0 - ratio);
+  const bool injects = params_.recovery == Recovery::augmented ||
+                       (params_.recovery == Recovery::resetting && params_.resetting_injects);
+  if (injects && has_free_space()) inject = std::max(0.0, 1.0 - ratio);
   if (inject > 0.0 || params_.resample_threshold >= 1.0 ||
       report.effective_sample_size < params_.resample_threshold * static_cast<double>(particles_.size())) {
     resample(inject, report);

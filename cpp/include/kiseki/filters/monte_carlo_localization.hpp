@@ -49,6 +49,11 @@ struct MclParams {
   double likelihood_power = 1.0;    ///< log-likelihoods are multiplied by this (< 1 tempers)
   Recovery recovery = Recovery::none;
   double alpha_slow = 0.001, alpha_fast = 0.1;  ///< nav2's suggested recovery_alpha_*
+  /// Whether resetting also injects uniform poses as Augmented MCL does. Off for models that
+  /// score a random pose unfairly against the tracked cloud (the space observation model: its
+  /// ratios are normalised by what is in view, so a pose that sees little of the map can
+  /// outscore the true one).
+  bool resetting_injects = true;
   double reset_threshold = 0.6;  ///< agreement below which the cloud counts as lost
   double expansion_position = 0.2, expansion_orientation = 0.2;  ///< m, rad (half-widths)
   int sensor_reset_after = 3;
