@@ -77,8 +77,10 @@ class MclConfig:
     * ``recovery``: ``alpha_slow`` 0.001 and ``alpha_fast`` 0.1 (nav2's suggested values);
       resetting when the agreement falls below ``reset_threshold`` 0.6 (fewer than 60 % of the
       beams end near a wall without passing through one: a majority with a margin for people
-      and furniture the map does not hold), expansion by +-0.2 m and +-0.2 rad, a sensor reset after 3 such
-      updates in a row drawing half the particles from 20,000 uniform candidates.
+      and furniture the map does not hold), expansion by +-0.2 m and +-0.2 rad, a sensor reset
+      after 3 such updates in a row drawing half the particles from 20,000 uniform candidates,
+      and Augmented MCL's injection (``resetting_injects``; not for the space observation
+      model, which does not score uniform poses fairly).
     * ``update_min_d`` / ``update_min_a``: 0 (every scan is an update); nav2 uses 0.25 m / 0.2 rad.
     """
 
