@@ -26,7 +26,9 @@ def test_splice_carries_the_robot_and_keeps_the_odometry_smooth() -> None:
     assert len(out) == 15
     np.testing.assert_array_equal(out.ranges[:, 0], [*range(10, 20), *range(40, 45)])
     np.testing.assert_allclose(out.poses[10], poses[40])  # the truth jumps 2 m
-    steps = [Pose2(*a).between(Pose2(*b)).x for a, b in zip(out.odometry, out.odometry[1:], strict=False)]
+    steps = [
+        Pose2(*a).between(Pose2(*b)).x for a, b in zip(out.odometry, out.odometry[1:], strict=False)
+    ]
     np.testing.assert_allclose(steps, 0.1, atol=1e-12)  # the odometry does not see it
     assert np.all(np.diff(out.times) > 0)
 
