@@ -101,10 +101,10 @@ void bind_filters(py::module_& m) {
       .def_readwrite("reset_threshold", &MclParams::reset_threshold)
       .def_readwrite("expansion_position", &MclParams::expansion_position)
       .def_readwrite("expansion_orientation", &MclParams::expansion_orientation)
+      .def_readwrite("reset_after", &MclParams::reset_after)
       .def_readwrite("sensor_reset_after", &MclParams::sensor_reset_after)
       .def_readwrite("sensor_reset_share", &MclParams::sensor_reset_share)
       .def_readwrite("sensor_reset_candidates", &MclParams::sensor_reset_candidates)
-      .def_readwrite("agreement_samples", &MclParams::agreement_samples)
       .def_readwrite("reliability_rate", &MclParams::reliability_rate)
       .def_readwrite("threads", &MclParams::threads)
       .def("validate", &MclParams::validate);

@@ -77,10 +77,11 @@ class MclConfig:
     * ``recovery``: ``alpha_slow`` 0.001 and ``alpha_fast`` 0.1 (nav2's suggested values);
       resetting when the agreement falls below ``reset_threshold`` 0.6 (fewer than 60 % of the
       beams end near a wall without passing through one: a majority with a margin for people
-      and furniture the map does not hold), expansion by +-0.2 m and +-0.2 rad, a sensor reset
-      after 3 such updates in a row drawing half the particles from 20,000 uniform candidates,
-      and Augmented MCL's injection (``resetting_injects``; not for the space observation
-      model, which does not score uniform poses fairly).
+      and furniture the map does not hold) for 2 updates in a row, expansion by +-0.2 m and
+      +-0.2 rad, a sensor reset after 4 such updates in a row drawing half the particles from
+      20,000 uniform candidates (each reset kept only if it explains the scan better than the
+      cloud did); ``resetting_injects`` adds Augmented MCL's injection (off: on real logs an
+      injected pose that fits one odd scan better than the cloud pulls the estimate away).
     * ``update_min_d`` / ``update_min_a``: 0 (every scan is an update); nav2 uses 0.25 m / 0.2 rad.
     """
 
@@ -97,11 +98,12 @@ class MclConfig:
     recovery: str = "none"
     alpha_slow: float = 0.001
     alpha_fast: float = 0.1
-    resetting_injects: bool = True
+    resetting_injects: bool = False
     reset_threshold: float = 0.6
     expansion_position: float = 0.2
     expansion_orientation: float = 0.2
-    sensor_reset_after: int = 3
+    reset_after: int = 2
+    sensor_reset_after: int = 4
     sensor_reset_share: float = 0.5
     sensor_reset_candidates: int = 20_000
     update_min_d: float = 0.0
@@ -166,6 +168,7 @@ class MclConfig:
         p.reset_threshold = self.reset_threshold
         p.expansion_position = self.expansion_position
         p.expansion_orientation = self.expansion_orientation
+        p.reset_after = self.reset_after
         p.sensor_reset_after = self.sensor_reset_after
         p.sensor_reset_share = self.sensor_reset_share
         p.sensor_reset_candidates = self.sensor_reset_candidates
@@ -322,6 +325,7 @@ class LocalizeConfig:
     update_min_a: float = 0.0
     threads: int = 0
     global_start: bool = False  # start uniformly over the map (no initial pose)
+    resetting_injects: bool = False  # resetting adds Augmented MCL's injection (MclConfig)
     likelihood_power: float = 1.0
 
     def __post_init__(self) -> None:
@@ -374,8 +378,7 @@ class LocalizeConfig:
             resample_threshold=self.resample_threshold,
             likelihood_power=self.likelihood_power,
             recovery=self.recovery,
-            # Uniform poses are no fair proposal for the space observation model (see MclParams)
-            resetting_injects=self.method != "space-observation",
+            resetting_injects=self.resetting_injects,
             update_min_d=self.update_min_d,
             update_min_a=self.update_min_a,
             threads=self.threads,

@@ -39,12 +39,13 @@ void MclParams::validate() const {
   if (!finite_nonneg(expansion_position) || !finite_nonneg(expansion_orientation)) {
     throw std::invalid_argument("MCL: expansion radii must be finite and >= 0");
   }
-  if (sensor_reset_after < 1) throw std::invalid_argument("MCL: sensor_reset_after must be >= 1");
+  if (reset_after < 1 || sensor_reset_after < reset_after) {
+    throw std::invalid_argument("MCL: need 1 <= reset_after <= sensor_reset_after");
+  }
   if (!(sensor_reset_share >= 0.0 && sensor_reset_share <= 1.0)) throw std::invalid_argument("MCL: sensor_reset_share must lie in [0, 1]");
   if (sensor_reset_candidates < 1 || sensor_reset_candidates > 10'000'000) {
     throw std::invalid_argument("MCL: sensor_reset_candidates must be in 1..10,000,000");
   }
-  if (agreement_samples < 1) throw std::invalid_argument("MCL: agreement_samples must be >= 1");
   if (!(reliability_rate > 0.0 && reliability_rate <= 1.0)) throw std::invalid_argument("MCL: reliability_rate must lie in (0, 1]");
   if (threads < 0) throw std::invalid_argument("MCL: threads must be >= 0 (0 = every core)");
 }
@@ -154,19 +155,9 @@ std::vector<double> MonteCarloLocalization::evaluate(const SensorModel& model, c
 }
 
 double MonteCarloLocalization::agreement_of(const SensorModel& model) const {
-  // Particles drawn by weight at fixed pointers (m + 0.5) / k: no random numbers used.
-  const std::size_t k = std::min(params_.agreement_samples, particles_.size());
-  double sum = 0.0, c = weights_[0];
-  std::size_t i = 0, used = 0;
-  for (std::size_t m = 0; m < k; ++m) {
-    const double u = (static_cast<double>(m) + 0.5) / static_cast<double>(k);
-    while (u > c && i + 1 < particles_.size()) c += weights_[++i];
-    const double a = model.agreement(particles_[i]);
-    if (std::isnan(a)) return a;
-    sum += a;
-    ++used;
-  }
-  return sum / static_cast<double>(used);
+  // At the filter's answer, the weighted mean after weighing: a single particle of a tracking
+  // cloud is further off than the mean, and long beams turn its heading error into metres.
+  return model.agreement(estimate());
 }
 
 UpdateReport MonteCarloLocalization::update(const SensorModel& model) {
@@ -216,20 +207,25 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
   const double signal = knows ? (lost ? 0.0 : 1.0) : std::min(1.0, ratio);
   reliability_ += params_.reliability_rate * (signal - reliability_);
 
-  if (params_.recovery == Recovery::resetting && (lost || !report.informative)) {
-    ++lost_updates_;
+  if (params_.recovery == Recovery::resetting && (lost || !report.informative)) ++lost_updates_;
+  // Reset only when the disagreement persists (reset_after updates in a row): one scan through
+  // a glass door or into an unmapped room must not scatter a cloud that is right.
+  if (params_.recovery == Recovery::resetting && lost_updates_ >= params_.reset_after) {
+    double best = -std::numeric_limits<double>::infinity();
+    for (double l : log_l) best = std::max(best, l);
+    bool sensed = false;
     if (model != nullptr && has_free_space() && lost_updates_ >= params_.sensor_reset_after) {
-      sensor_reset(*model);
-      report.reset = "sensor";
-      lost_updates_ = 0;
-    } else {
-      expansion_reset(model);
-      report.reset = "expansion";
+      sensed = sensor_reset(*model, best);
+      if (sensed) lost_updates_ = 0;
     }
-    posterior_ = estimate();
-    report.resampled = true;
-    report.particles = particles_.size();
-    return report;
+    const bool expanded = !sensed && expansion_reset(model, best);
+    if (sensed || expanded) {
+      report.reset = sensed ? "sensor" : "expansion";
+      posterior_ = estimate();
+      report.resampled = true;
+      report.particles = particles_.size();
+      return report;
+    }
   }
   if (!lost) lost_updates_ = 0;
   posterior_ = estimate();  // before resampling: injected poses have no weight in it
@@ -299,7 +295,7 @@ void MonteCarloLocalization::resample_to(std::size_t n) {
   target_ = n;
 }
 
-void MonteCarloLocalization::expansion_reset(const SensorModel* model) {
+bool MonteCarloLocalization::expansion_reset(const SensorModel* model, double cloud_best) {
   const std::size_t n = particles_.size();
   const std::vector<std::size_t> idx = resample_indices(weights_, n, params_.resampling, rng_);
   std::vector<Pose2> out(n);
@@ -313,15 +309,29 @@ void MonteCarloLocalization::expansion_reset(const SensorModel* model) {
       out[i] = Pose2(q.x + dx, q.y + dy, q.theta + dt);
     }
   }, 4096);
+  if (model == nullptr) {  // log-likelihoods from elsewhere: cannot weigh again, so keep it
+    particles_.swap(out);
+    weights_.assign(n, 1.0 / static_cast<double>(n));
+    return true;
+  }
+  // Kept only if some expanded particle explains the measurement better than the best particle
+  // did: a cloud that is right but sees an odd scan is not scattered.
+  const std::vector<double> l = evaluate(*model, out);
+  if (!(*std::max_element(l.begin(), l.end()) > cloud_best)) return false;
   particles_.swap(out);
   weights_.assign(n, 1.0 / static_cast<double>(n));
-  if (model != nullptr) apply_log_likelihoods(weights_, evaluate(*model, particles_), params_.likelihood_power);
+  apply_log_likelihoods(weights_, l, params_.likelihood_power);
+  return true;
 }
 
-void MonteCarloLocalization::sensor_reset(const SensorModel& model) {
+bool MonteCarloLocalization::sensor_reset(const SensorModel& model, double cloud_best) {
   const std::size_t n = particles_.size();
   const auto from_sensor = static_cast<std::size_t>(std::llround(params_.sensor_reset_share * static_cast<double>(n)));
   const std::vector<Pose2> candidates = uniform_poses(params_.sensor_reset_candidates);
+  const std::vector<double> cand_l = evaluate(model, candidates);
+  // The measurement proposes another place only if some pose there explains it better than
+  // the best particle of the cloud does.
+  if (!(*std::max_element(cand_l.begin(), cand_l.end()) > cloud_best)) return false;
   std::vector<double> w(candidates.size(), 1.0);
   std::vector<Pose2> out;
   out.reserve(n);
@@ -329,7 +339,7 @@ void MonteCarloLocalization::sensor_reset(const SensorModel& model) {
     for (std::size_t i : resample_indices(weights_, n - from_sensor, params_.resampling, rng_)) out.push_back(particles_[i]);
   }
   if (from_sensor > 0) {
-    const bool any = apply_log_likelihoods(w, evaluate(model, candidates), params_.likelihood_power);
+    const bool any = apply_log_likelihoods(w, cand_l, params_.likelihood_power);
     if (!any) w.assign(w.size(), 1.0);
     for (std::size_t i : resample_indices(w, from_sensor, params_.resampling, rng_)) out.push_back(candidates[i]);
   }
@@ -338,6 +348,7 @@ void MonteCarloLocalization::sensor_reset(const SensorModel& model) {
   // Weigh the mixed set, so that the estimate is that of the better part, not the mean of two
   // places.
   apply_log_likelihoods(weights_, evaluate(model, particles_), params_.likelihood_power);
+  return true;
 }
 
 Pose2 MonteCarloLocalization::estimate() const {

@@ -3,6 +3,7 @@
 #include "kiseki/models/likelihood_field.hpp"
 
 #include <algorithm>
+#include <cstddef>
 #include <cmath>
 #include <stdexcept>
 
@@ -76,14 +77,17 @@ void LikelihoodFieldModel::log_likelihoods(const Pose2* poses, std::size_t n, do
     by[b] = beams_.range[b] * beams_.sin[b] * inv_res;
   }
   const bool nav2 = params_.combination == BeamCombination::nav2;
+  const float* table = table_.ptr<float>(0);  // continuous (created by tabulate)
+  const double width = w, height = h;
   for (std::size_t k = 0; k < n; ++k) {
     const Pose2 s = to_grid.compose(poses[k].compose(params_.sensor));
     const double px = s.x * inv_res, py = s.y * inv_res, c = std::cos(s.theta), sn = std::sin(s.theta);
     double sum = 0.0;
     for (std::size_t b = 0; b < m; ++b) {
       const double gx = px + c * bx[b] - sn * by[b], gy = py + sn * bx[b] + c * by[b];
-      const int cx = static_cast<int>(std::floor(gx)), cy = static_cast<int>(std::floor(gy));
-      sum += (cx >= 0 && cy >= 0 && cx < w && cy < h) ? table_.ptr<float>(cy)[cx] : outside_;
+      // Inside the grid the coordinates are >= 0, where truncation is floor.
+      const bool inside = gx >= 0.0 && gy >= 0.0 && gx < width && gy < height;
+      sum += inside ? table[static_cast<std::ptrdiff_t>(gy) * w + static_cast<std::ptrdiff_t>(gx)] : outside_;
     }
     out[k] = nav2 ? std::log1p(sum) : sum;
   }

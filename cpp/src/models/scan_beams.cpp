@@ -8,6 +8,10 @@
 
 namespace kiseki {
 
+namespace {
+constexpr double kHeadingTolerance = 0.02;  // rad (1.1 degrees) of heading error allowed
+}  // namespace
+
 void ScanBeams::set(const double* angles, const float* ranges, std::size_t n, double max_range_,
                     int max_beams, bool keep_no_return) {
   if (!(max_range_ > 0.0) || !std::isfinite(max_range_)) {
@@ -45,12 +49,15 @@ double ScanBeams::agreement(const RangeCaster& occupied, const Pose2& sensor, do
   for (std::size_t b = 0; b < range.size(); ++b) {
     if (no_return[b]) continue;
     const double heading = sensor.theta + angle[b];
-    const double want = range[b] - tolerance;
+    // The tolerance grows with the range by kHeadingTolerance: a heading error of a degree
+    // moves a 30 m beam's end by half a metre.
+    const double tol = tolerance + kHeadingTolerance * range[b];
+    const double want = range[b] - tol;
     ++used;
     const bool through = want > 0.0 && occupied.range(sensor.x, sensor.y, heading, want) < want;
     if (through) continue;
     const double ex = sensor.x + range[b] * std::cos(heading), ey = sensor.y + range[b] * std::sin(heading);
-    if (occupied.clearance(ex, ey) <= tolerance + g.resolution()) ++reached;
+    if (occupied.clearance(ex, ey) <= tol + g.resolution()) ++reached;
   }
   return used == 0 ? std::numeric_limits<double>::quiet_NaN() : static_cast<double>(reached) / used;
 }

@@ -2,7 +2,8 @@
 # Copyright (c) 2026 the kiseki authors
 """mcl-kidnapping: the kidnapped robot, in simulation and on real logs, for the three recovery
 settings of kiseki's Monte Carlo engine (none, Augmented MCL, expansion + sensor resetting),
-with the engine's reliability estimate before and after the jump.
+with the engine's reliability estimate before and after the jump; and resetting with Augmented
+MCL's injection added (``resetting+injection``).
 
 A trial makes one log and splices it: the scans up to the kidnapping (scan k) are followed by
 the scans from another place of the same run (scan j, at least ``min_jump`` metres away), while
@@ -51,7 +52,8 @@ class KidnapConfig:
     method: str = "likelihood-field"
     particles: int = 1000
     beams: int = 90
-    recoveries: list[str] = field(default_factory=lambda: list(RECOVERY_MODES))
+    # "resetting+injection": resetting with Augmented MCL's injection as well
+    recoveries: list[str] = field(default_factory=lambda: [*RECOVERY_MODES, "resetting+injection"])
     odometry_noise: float = 0.1  # CARMEN: added to the corrected poses' increments
     min_jump: float = 2.0  # m between the pose before and after the kidnapping
     before_scans: int = 200  # scans of tracking before the kidnapping (at most)
@@ -65,7 +67,7 @@ class KidnapConfig:
 
 def _check(config: KidnapConfig) -> None:
     for r in config.recoveries:
-        if r not in RECOVERY_MODES:
+        if r not in (*RECOVERY_MODES, "resetting+injection"):
             raise ValueError(f"kidnapping: unknown recovery {r!r} ({', '.join(RECOVERY_MODES)})")
     if not config.recoveries:
         raise ValueError("kidnapping: recoveries is empty")
@@ -154,7 +156,8 @@ def _trial(scans: LaserScans, grid, config: KidnapConfig, seed: int, name: str) 
             odometry_noise=config.odometry_noise if name != "sim" else 0.0,
             particles=config.particles,
             beams=config.beams,
-            recovery=recovery,
+            recovery=recovery.split("+")[0],
+            resetting_injects=recovery == "resetting+injection",
             threads=config.threads,
         )
         result = localize(spliced, grid, lc)
@@ -273,7 +276,8 @@ def analyze(config: KidnapConfig, trials: pd.DataFrame, timings: pd.DataFrame, f
         )
     fig = new_figure(figsize=(10, 3.6), dpi=120)
     axes = fig.subplots(1, 2)
-    for r, colour in zip(config.recoveries, ("tab:red", "tab:orange", "tab:blue"), strict=False):
+    colours = ("tab:red", "tab:orange", "tab:blue", "tab:green")
+    for r, colour in zip(config.recoveries, colours, strict=False):
         errors = [np.asarray(e) for e in ok[f"{r}_errors"]]
         rel = [np.asarray(e) for e in ok[f"{r}_reliability"]]
         if not errors:

@@ -28,9 +28,10 @@ struct ScanBeams {
   std::size_t size() const { return range.size(); }
 
   /// The share of returning beams that agree with the map seen from the sensor pose: the ray
-  /// reaches its reading (less `tolerance`) without entering an occupied cell (emcl2's
-  /// non-penetration; unknown cells do not stop it) and the reading ends within `tolerance`
-  /// (plus one cell, for the cell-centre distances) of an occupied cell. The second test
+  /// reaches its reading (less a tolerance) without entering an occupied cell (emcl2's
+  /// non-penetration; unknown cells do not stop it) and the reading ends within the tolerance
+  /// (plus one cell, for the cell-centre distances) of an occupied cell. The tolerance is
+  /// `tolerance` plus 0.02 x the range (a heading error of 1.1 degrees). The second test
   /// catches a pose in a wider space than the real one, whose beams end in the open and
   /// penetrate nothing. 0 when the sensor is not on a free cell (0..19) of the map; NaN when
   /// no beam returned.
