@@ -14,6 +14,7 @@ import pytest
 
 from kiseki.core import Pose2
 from kiseki.datasets import read_carmen_log
+from kiseki.grid import OccupancyGrid
 from kiseki.localization import (
     REAL_ODOMETRY_ALPHAS,
     LocalizeConfig,
@@ -139,3 +140,85 @@ def test_scan_local_map_leaves_out_no_return_beams():
     assert (local[centre + 2 :, centre] == -1).all()  # nothing marked along the no-return beam
     with pytest.raises(ValueError, match="ranges"):
         build_teaching_map(np.zeros((2, 3)), np.zeros((3, 2)), angles, 30.0)
+
+
+def _intel_prefix(shared_data, n=120):
+    from kiseki.experiments.merge_rules import _first
+
+    return _first(read_carmen_log(shared_data / "carmen" / "intel-corrected.log.gz").scans, n)
+
+
+def test_localize_command_writes_reliability_and_its_config(shared_data, tmp_path):
+    """The CSV has a reliability column, the config it ran with lies beside it, and every
+    method of the engine runs from the command line."""
+    import yaml
+
+    from kiseki.map_io import save_map
+
+    scans = _intel_prefix(shared_data, 2000)
+    grid = build_map(scans.poses, scans.ranges, scans.angles, scans.max_range)
+    save_map(grid, tmp_path / "intel.yaml")
+    log = shared_data / "carmen" / "intel-corrected.log.gz"
+    for method in ("beam", "likelihood-field"):
+        out = tmp_path / f"{method}.csv"
+        done = subprocess.run(
+            [sys.executable, "-m", "kiseki.cli", "localize", str(log), "--map",
+             str(tmp_path / "intel.yaml"), "--method", method, "--odometry-noise", "0.1",
+             "--recovery", "resetting", "--kld", "--particles", "800", "-o", str(out)],
+            capture_output=True, text=True,
+        )  # fmt: skip
+        assert done.returncode == 0, done.stderr
+        table = np.loadtxt(out, delimiter=",", skiprows=1)
+        assert out.read_text().splitlines()[0] == "t,x,y,theta,reliability"
+        assert table.shape == (len(scans), 5) and (table[:, 4] > 0.5).mean() > 0.9
+        config = yaml.safe_load((tmp_path / f"{method}.config.yaml").read_text())
+        assert config["method"] == method and config["recovery"] == "resetting"
+        assert config["kld"] is True and config["particles"] == 800
+        assert ape(table[:, 1:4], scans.poses).rmse < 0.2
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--recovery", "pray"], "recovery must be one of"),
+        (["--seed", "-1"], "seed must be"),
+        (["--threads", "-2"], "threads must be"),
+        (["--particles", "0"], "particles must be"),
+        (["--plot", "x.png"], "--plot applies only with --global"),
+        (["--method", "guess"], "method must be one of"),
+    ],
+)
+def test_localize_command_refuses_bad_options_in_one_line(shared_data, tmp_path, args, needle):
+    from kiseki.map_io import save_map
+
+    grid = OccupancyGrid(np.zeros((20, 20), np.int8), 0.1)
+    save_map(grid, tmp_path / "m.yaml")
+    log = shared_data / "carmen" / "intel-corrected.log.gz"
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "localize", str(log), "--map",
+         str(tmp_path / "m.yaml"), "-o", str(tmp_path / "t.csv"), *args],
+        capture_output=True, text=True, cwd=tmp_path,
+    )  # fmt: skip
+    assert done.returncode == 1
+    assert needle in done.stderr and len(done.stderr.strip().splitlines()) == 1, done.stderr
+
+
+def test_localize_refuses_its_own_inputs_as_output_and_maps_without_free_space(
+    shared_data, tmp_path
+):
+    from kiseki.map_io import save_map
+
+    scans = _intel_prefix(shared_data)
+    unknown = OccupancyGrid(np.full((30, 30), -1, np.int8), 0.1)
+    with pytest.raises(ValueError, match="no free cell"):
+        localize(scans, unknown, LocalizeConfig(method="likelihood-field"))
+    save_map(OccupancyGrid(np.zeros((20, 20), np.int8), 0.1), tmp_path / "m.yaml")
+    before = (tmp_path / "m.yaml").read_bytes()
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "localize",
+         str(shared_data / "carmen" / "intel-corrected.log.gz"), "--map", str(tmp_path / "m.yaml"),
+         "-o", str(tmp_path / "m.yaml")],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert done.returncode == 1 and "would overwrite the input" in done.stderr
+    assert (tmp_path / "m.yaml").read_bytes() == before
