@@ -242,23 +242,9 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
 }
 
 void MonteCarloLocalization::resample(double inject, UpdateReport& report) {
-  std::size_t n = params_.kld ? params_.particles : target_;
-  std::vector<std::size_t> idx = resample_indices(weights_, n, params_.resampling, rng_);
-  std::vector<Pose2> out;
-  out.reserve(n);
-  if (params_.kld) {
-    // KLD sampling: the resampled set in random order, taken until the bound for the bins it
-    // has filled is met (Fox 2003, Table 1, with the draws made up front).
-    for (std::size_t i = n; i > 1; --i) std::swap(idx[i - 1], idx[rng_.below(i)]);
-    KldBins bins(params_.kld_params);
-    for (std::size_t i : idx) {
-      out.push_back(particles_[i]);
-      bins.add(particles_[i]);
-      if (bins.enough(out.size())) break;
-    }
-  } else {
-    for (std::size_t i : idx) out.push_back(particles_[i]);
-  }
+  const std::size_t n = params_.kld ? params_.particles : target_;
+  std::vector<Pose2> out =
+      resample_states(particles_, weights_, n, params_.resampling, params_.kld, params_.kld_params, rng_);
   if (inject > 0.0) {
     std::size_t m = 0;
     for (std::size_t i = 0; i < out.size(); ++i) m += rng_.uniform() < inject;

@@ -81,21 +81,8 @@ bool TravelDistanceFilter::update(const std::vector<double>& log_l) {
   const bool changed = apply_log_likelihoods(weights_, log_l, params_.likelihood_power);
   const double n = static_cast<double>(particles_.size());
   if (params_.resample_threshold >= 1.0 || effective_sample_size() < params_.resample_threshold * n) {
-    const std::size_t count = params_.particles;
-    std::vector<std::size_t> idx = resample_indices(weights_, count, params_.resampling, rng_);
-    std::vector<double> out;
-    out.reserve(count);
-    if (params_.kld) {
-      for (std::size_t i = count; i > 1; --i) std::swap(idx[i - 1], idx[rng_.below(i)]);
-      KldBins bins(params_.kld_params);
-      for (std::size_t i : idx) {
-        out.push_back(particles_[i]);
-        bins.add(particles_[i]);
-        if (bins.enough(out.size())) break;
-      }
-    } else {
-      for (std::size_t i : idx) out.push_back(particles_[i]);
-    }
+    std::vector<double> out = resample_states(particles_, weights_, params_.particles, params_.resampling,
+                                              params_.kld, params_.kld_params, rng_);
     particles_.swap(out);
     weights_.assign(particles_.size(), 1.0 / static_cast<double>(particles_.size()));
   }

@@ -2,6 +2,7 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/models/beam_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -55,7 +56,11 @@ void BeamModel::log_likelihoods(const Pose2* poses, std::size_t n, double* out) 
     double sum = 0.0;
     for (std::size_t b = 0; b < m; ++b) {
       const double heading = s.theta + beams_.angle[b];
-      const double z_star = caster_.range(s.x, s.y, heading, beams_.max_range);
+      // Past reading + 8 sigma the Gaussian term is below exp(-32) of its peak, and every
+      // longer z* scores the same (the short term only asks z < z*): the ray stops there.
+      const double reach = beams_.no_return[b] ? beams_.max_range
+                                               : std::min(beams_.max_range, beams_.range[b] + 8.0 * params_.sigma_hit);
+      const double z_star = caster_.range(s.x, s.y, heading, reach);
       const double pz = beam_probability(beams_.range[b], z_star, beams_.no_return[b]);
       sum += nav2 ? pz * pz * pz : std::log(pz);
     }

@@ -5,8 +5,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <unordered_set>
+#include <vector>
 
 #include "kiseki/core/pose.hpp"
+#include "kiseki/core/random.hpp"
+#include "kiseki/filters/resampling.hpp"
 
 namespace kiseki {
 
@@ -46,5 +49,29 @@ class KldBins {
   KldParams params_;
   std::unordered_set<std::uint64_t> bins_;
 };
+
+/// Resampled states: n = params.max_particles indices drawn from the weights by `method`; with
+/// KLD sampling they are taken in random order until the bound for the bins filled so far is met
+/// (Fox 2003, Table 1, with the draws made up front), else all n. State is Pose2 or double.
+template <typename State>
+std::vector<State> resample_states(const std::vector<State>& states, const std::vector<double>& weights,
+                                   std::size_t n, ResamplingMethod method, bool kld,
+                                   const KldParams& params, Random& rng) {
+  std::vector<std::size_t> idx = resample_indices(weights, n, method, rng);
+  std::vector<State> out;
+  out.reserve(n);
+  if (!kld) {
+    for (std::size_t i : idx) out.push_back(states[i]);
+    return out;
+  }
+  for (std::size_t i = idx.size(); i > 1; --i) std::swap(idx[i - 1], idx[rng.below(i)]);
+  KldBins bins(params);
+  for (std::size_t i : idx) {
+    out.push_back(states[i]);
+    bins.add(states[i]);
+    if (bins.enough(out.size())) break;
+  }
+  return out;
+}
 
 }  // namespace kiseki

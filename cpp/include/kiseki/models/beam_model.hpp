@@ -21,7 +21,9 @@ namespace kiseki {
 /// the Gaussian divided by sqrt(2 pi) sigma_hit in the product combination. A ray stops at an
 /// occupied cell and, as in nav2, at an unknown one (unknown_stops). Readings of +inf or at or
 /// beyond max range are no-returns and score with z_max; NaN, zero and negative readings are
-/// skipped. Ray casting skips free space with a distance field (RangeCaster).
+/// skipped. Ray casting skips free space with a distance field (RangeCaster), and a ray stops
+/// 8 sigma_hit past its reading, where the Gaussian term has vanished and a longer z* scores the
+/// same.
 struct BeamModelParams {
   double z_hit = 0.5, z_short = 0.05, z_max = 0.05, z_rand = 0.5;  ///< nav2's defaults
   double sigma_hit = 0.2;     ///< m
