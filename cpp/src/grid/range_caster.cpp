@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -68,6 +69,8 @@ double RangeCaster::range(double x, double y, double heading, double max_range) 
   const int step_x = dx > 0 ? 1 : -1, step_y = dy > 0 ? 1 : -1;
   const double dt_x = dx != 0.0 ? std::abs(1.0 / dx) : inf, dt_y = dy != 0.0 ? std::abs(1.0 / dy) : inf;
   constexpr double kSqrt2 = 1.4142135623730951;
+  const float* dist = distance_.ptr<float>(0);  // continuous; 0 exactly at stopping cells
+  const int w = grid_.width(), h = grid_.height();
   double t = t0;  // where the ray is now (inside cell cx, cy)
   bool jumped = true;
   int cx = 0, cy = 0;
@@ -80,8 +83,9 @@ double RangeCaster::range(double x, double y, double heading, double max_range) 
       next_y = dy != 0.0 ? ((cy + (step_y > 0 ? 1 : 0)) - p.y()) / dy : inf;
       jumped = false;
     }
-    if (stops(cx, cy)) return t * res;
-    const double clear = static_cast<double>(distance_.ptr<float>(cy)[cx]) - kSqrt2;
+    const float d = dist[static_cast<std::ptrdiff_t>(cy) * w + cx];
+    if (d == 0.0f) return t * res;  // a stopping cell
+    const double clear = static_cast<double>(d) - kSqrt2;
     if (clear > 1.0) {  // free for `clear` cells from anywhere in this cell
       t += clear;
       if (t > t1) return max_range;
@@ -97,7 +101,7 @@ double RangeCaster::range(double x, double y, double heading, double max_range) 
       next_y += dt_y;
       cy += step_y;
     }
-    if (t > t1 || !grid_.contains(cx, cy)) return max_range;
+    if (t > t1 || cx < 0 || cy < 0 || cx >= w || cy >= h) return max_range;
   }
 }
 

@@ -21,10 +21,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kiseki import _core
 from kiseki.core import Pose2, Random
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.grid import OccupancyGrid
+from kiseki.models import LocalMapBuilder, SpaceObservationModel
 from kiseki.plots import new_figure
 
 
@@ -56,14 +56,14 @@ def trial(config: Fig314Config, index: int, seed: int) -> TrialOutput:
     ranges = grid.cast_scans(np.array([[0.0, 0.0, np.pi / 2]]), angles, max_range=10.0)[0]
     noise = Random(seed).normal(0.0, config.range_noise_sd, ranges.size)
     ranges = np.where(ranges < 10.0, ranges + noise, ranges).astype(np.float32)
-    builder = _core.LocalMapBuilder(8.0, 0.1)
+    builder = LocalMapBuilder(8.0, 0.1)
     builder.add_scan(Pose2(0.0, 0.0, np.pi / 2), angles, ranges, 10.0)
     local = builder.build()
     offsets = np.linspace(-config.max_offset, config.max_offset, config.offsets)
     poses = np.column_stack([offsets, np.zeros_like(offsets), np.zeros_like(offsets)])
     record = {}
     for name, occlusion in (("raw", False), ("occlusion", True)):
-        model = _core.SpaceObservationModel(grid, occlusion_aware=occlusion)
+        model = SpaceObservationModel(grid, occlusion_aware=occlusion)
         model.set_local_map(local)
         lk = model.likelihoods(poses)
         record.update({f"{name}_{k}": float(v) for k, v in enumerate(lk / lk.max())})

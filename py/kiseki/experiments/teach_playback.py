@@ -30,10 +30,10 @@ import pandas as pd
 import yaml
 from matplotlib.patches import Circle
 
-from kiseki import _core
 from kiseki.core import Random, derive_seed
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.map_io import load_map
+from kiseki.models import SpaceObservationModel
 from kiseki.plots import new_figure
 from kiseki.sim.scene import load_scene
 from kiseki.sim.setup import build_robot, build_sensors
@@ -125,7 +125,7 @@ def _goal_profile(scene, environment, goal: dict, method: str) -> dict:
     band, occlusion = METHODS[method]
     setup = build_robot(scene, 0)
     cameras = [s.device for s in build_sensors(scene, setup, 0, 0.1) if s.kind == "depth_camera"]
-    model = _core.SpaceObservationModel(environment, occlusion_aware=occlusion)
+    model = SpaceObservationModel(environment, occlusion_aware=occlusion)
     truth = tuple(goal["truth"])
     images = [c.render(scene.world, truth, noise=False) for c in cameras]
     model.set_local_map(LocalMapMaker(cameras, band).make(images))

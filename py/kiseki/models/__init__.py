@@ -1,9 +1,12 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Sensor models: the teaching-and-playback thesis' local maps and space observation model."""
+"""Sensor models: nav2's beam and likelihood-field range-finder models, the teaching-and-playback
+thesis' local maps and space observation model, and the interface they share with the Monte
+Carlo engine (``SensorModel``: log-likelihoods per pose, readings, agreement)."""
 
 from __future__ import annotations
 
+from kiseki._core import BeamCombination, BeamModel, LikelihoodFieldModel, SensorModel
 from kiseki.models.space_observation import (
     LocalMapBuilder,
     SpaceObservationModel,
@@ -13,7 +16,11 @@ from kiseki.models.space_observation import (
 )
 
 __all__ = [
+    "BeamCombination",
+    "BeamModel",
+    "LikelihoodFieldModel",
     "LocalMapBuilder",
+    "SensorModel",
     "SpaceObservationModel",
     "counts_reference",
     "likelihood_reference",
