@@ -35,6 +35,21 @@ class LaserScans:
     def __len__(self) -> int:
         return int(self.times.shape[0])
 
+    def first(self, n: int) -> LaserScans:
+        """The first n scans (all of them when n is 0 or at least the log's length)."""
+        if n < 0:
+            raise ValueError(f"first: n must be >= 0, got {n}")
+        if not n or n >= len(self):
+            return self
+        return LaserScans(
+            self.times[:n],
+            self.poses[:n],
+            self.odometry[:n],
+            np.ascontiguousarray(self.ranges[:n]),
+            self.angles,
+            self.max_range,
+        )
+
     @property
     def has_reference_poses(self) -> bool:
         """False for logs without reference poses (e.g. the Wean Hall logs: ``poses`` all NaN)."""

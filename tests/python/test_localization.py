@@ -143,9 +143,7 @@ def test_scan_local_map_leaves_out_no_return_beams():
 
 
 def _intel_prefix(shared_data, n=120):
-    from kiseki.experiments.merge_rules import _first
-
-    return _first(read_carmen_log(shared_data / "carmen" / "intel-corrected.log.gz").scans, n)
+    return read_carmen_log(shared_data / "carmen" / "intel-corrected.log.gz").scans.first(n)
 
 
 def test_localize_command_writes_reliability_and_its_config(shared_data, tmp_path):

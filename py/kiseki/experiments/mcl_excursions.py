@@ -71,12 +71,11 @@ def excursions(errors: np.ndarray, threshold: float) -> list[int]:
 
 def trial(config: ExcursionsConfig, index: int, seed: int) -> TrialOutput:
     from kiseki.datasets import read_carmen_log
-    from kiseki.experiments.merge_rules import _first
     from kiseki.mapping import MapBuildConfig, build_map
     from kiseki.teach.environment_map import build_teaching_map
 
     name = config.logs[index % len(config.logs)]
-    scans = _first(read_carmen_log(_carmen_dir(config) / f"{name}.log.gz").scans, config.max_scans)
+    scans = read_carmen_log(_carmen_dir(config) / f"{name}.log.gz").scans.first(config.max_scans)
     maps = {
         "space-observation": build_teaching_map(
             scans.poses, scans.ranges, scans.angles, scans.max_range, 0.1

@@ -34,7 +34,6 @@ from kiseki.localization import LocalizeConfig, localize
 from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
 from kiseki.metrics import ape
 from kiseki.plots import new_figure
-from kiseki.scans import LaserScans
 from kiseki.teach.environment_map import MERGE_RULES, build_teaching_map
 
 
@@ -65,24 +64,11 @@ def preflight(config: MergeRulesConfig) -> None:
         raise FileNotFoundError(f"merge-rules: {folder}: missing {', '.join(missing)}.log.gz")
 
 
-def _first(scans: LaserScans, n: int) -> LaserScans:
-    if not n or n >= len(scans):
-        return scans
-    return LaserScans(
-        scans.times[:n],
-        scans.poses[:n],
-        scans.odometry[:n],
-        np.ascontiguousarray(scans.ranges[:n]),
-        scans.angles,
-        scans.max_range,
-    )
-
-
 def trial(config: MergeRulesConfig, index: int, seed: int) -> TrialOutput:
     """Trial i: log i (modulo the number of logs), both rules, on the same odometry noise and
     filter seed."""
     name = config.logs[index % len(config.logs)]
-    scans = _first(read_carmen_log(_folder(config) / f"{name}.log.gz").scans, config.max_scans)
+    scans = read_carmen_log(_folder(config) / f"{name}.log.gz").scans.first(config.max_scans)
     reference = build_map(
         scans.poses,
         scans.ranges,
