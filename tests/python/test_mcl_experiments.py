@@ -69,3 +69,22 @@ def test_space_observation_excursions_return_on_a_real_log(shared_data, tmp_path
     assert so["longest_scans"] != -1 and so["longest_scans"] <= 20
     lf = table[table["method"] == "likelihood-field"].iloc[0]
     assert lf["rmse_mean_m"] < 0.1 < so["rmse_mean_m"] + 0.5  # both track; the field closer
+
+
+def test_kld_adapts_the_count_from_global_start_to_tracking(shared_data, tmp_path) -> None:
+    run = run_experiment(
+        "mcl-kld",
+        runs=1,
+        seed=0,
+        overrides=["logs=aces-corrected", "max_scans=250", "max_particles=20000"],
+        out=tmp_path / "kld",
+        progress=False,
+    )
+    assert run.failed == 0
+    table = pd.read_csv(run.run_dir / "tables" / "kld.csv").set_index("way")
+    trials = pd.read_parquet(run.run_dir / "trials.parquet")
+    counts = trials["kld_counts"].iloc[0]
+    assert counts[-1] == 1000  # a converged cloud fills few bins: the minimum
+    assert table.loc["fixed", "mean_particles"] == 20000
+    assert table.loc["kld", "mean_particles"] < 0.2 * table.loc["fixed", "mean_particles"]
+    assert table.loc["kld", "converged"] == table.loc["fixed", "converged"] == 1

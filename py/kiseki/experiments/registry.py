@@ -17,6 +17,7 @@ def _registry() -> dict[str, Experiment]:
         fig_3_14,
         mcl_excursions,
         mcl_kidnapping,
+        mcl_kld,
         merge_rules,
         teach_playback,
     )
@@ -28,6 +29,7 @@ def _registry() -> dict[str, Experiment]:
         mcl_excursions.EXPERIMENT,
         mcl_kidnapping.SIM,
         mcl_kidnapping.CARMEN,
+        mcl_kld.EXPERIMENT,
         merge_rules.EXPERIMENT,
         teach_playback.EXP1,
         teach_playback.EXP2,
