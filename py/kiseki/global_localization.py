@@ -57,8 +57,8 @@ from kiseki.localization import (
     LocalizeConfig,
     MclConfig,
     MonteCarloLocalizer,
-    ScanSpaceObservation,
     scan_model,
+    scan_preparer,
 )
 from kiseki.scans import LaserScans
 
@@ -292,7 +292,7 @@ def global_localize(
         grid,
         LocalizeConfig(method=config.method, beams=config.beams, sigma_hit=config.sigma_hit),
     )
-    engine_model = model.model if isinstance(model, ScanSpaceObservation) else model
+    prepare = scan_preparer(model, scans)
     odom = np.asarray(scans.odometry, dtype=float)
     n = len(scans)
     estimates = np.empty((n, 3))
@@ -302,10 +302,6 @@ def global_localize(
     shrunk_at: int | None = None
     tight_updates = 0
     injected = 0
-
-    def prepare(k: int):
-        model.set_scan(scans.angles, scans.ranges[k], scans.max_range)
-        return engine_model
 
     for k in tqdm(range(n), desc="global " + config.method, unit="scan", disable=not progress):
         report = localizer.step(odom[k], lambda k=k: prepare(k))

@@ -51,6 +51,7 @@ __all__ = [
     "motion_alphas",
     "noisy_odometry",
     "scan_model",
+    "scan_preparer",
 ]
 
 LOCALIZATION_METHODS = ("odometry", "space-observation", "likelihood-field", "beam")
@@ -222,13 +223,12 @@ class MonteCarloLocalizer:
         model ``prepare()`` returns (called only when an update is due), or, when none is due,
         moves the estimate with the odometry. Returns the update's report or None."""
         odometry = np.asarray(odometry, dtype=float)
-        if prepare is None or not self.due(odometry):
+        if prepare is None:
             self._follow(odometry)
             return None
-        if self._last_update is not None:
-            self.engine.predict(Pose2(*self._last_update), Pose2(*odometry))
-        report = self.engine.update(prepare())
-        return self._updated(odometry, report)
+        if not self._predict_if_due(odometry):
+            return None
+        return self._updated(odometry, self.engine.update(prepare()))
 
     def step_log_likelihoods(
         self,
@@ -240,14 +240,21 @@ class MonteCarloLocalizer:
         """As :meth:`step` for a model written elsewhere: ``log_likelihoods(poses)`` gives one
         log-likelihood per particle pose (n, 3)."""
         odometry = np.asarray(odometry, dtype=float)
-        if not self.due(odometry):
-            self._follow(odometry)
+        if not self._predict_if_due(odometry):
             return None
-        if self._last_update is not None:
-            self.engine.predict(Pose2(*self._last_update), Pose2(*odometry))
         log_l = np.asarray(log_likelihoods(self.engine.poses), dtype=float)
         report = self.engine.update_log_likelihoods(log_l, readings, agreement)
         return self._updated(odometry, report)
+
+    def _predict_if_due(self, odometry: np.ndarray) -> bool:
+        """AMCL's gate: if an update is due, moves the particles by the odometry since the last
+        one and returns True; else moves the estimate with the odometry."""
+        if not self.due(odometry):
+            self._follow(odometry)
+            return False
+        if self._last_update is not None:
+            self.engine.predict(Pose2(*self._last_update), Pose2(*odometry))
+        return True
 
     def _follow(self, odometry: np.ndarray) -> None:
         if self._last_update is None:
@@ -289,6 +296,18 @@ class ScanSpaceObservation:
         from kiseki.mapping import scan_local_map
 
         self.model.set_local_map(scan_local_map(angles, ranges, max_range))
+
+
+def scan_preparer(model, scans: LaserScans) -> Callable[[int], _core.SensorModel]:
+    """``prepare(k)`` for :meth:`MonteCarloLocalizer.step`: gives scan k to a model of
+    :func:`scan_model` and returns what the engine weighs with."""
+    engine_model = model.model if isinstance(model, ScanSpaceObservation) else model
+
+    def prepare(k: int) -> _core.SensorModel:
+        model.set_scan(scans.angles, scans.ranges[k], scans.max_range)
+        return engine_model
+
+    return prepare
 
 
 @dataclass(frozen=True)
@@ -513,18 +532,13 @@ def localize(
         localizer.initialize_global()
     else:
         localizer.initialize(scans.poses[0], config.initial_sd)
-    model = scan_model(config.method, grid, config)
-    engine_model = model.model if isinstance(model, ScanSpaceObservation) else model
+    prepare = scan_preparer(scan_model(config.method, grid, config), scans)
     estimates = np.empty((n, 3))
     reliability = np.empty(n)
     counts = np.empty(n, dtype=np.int64)
     updated = np.zeros(n, dtype=bool)
     resets = np.full(n, "none", dtype=object)
     seconds: list[float] = []
-
-    def prepare(k: int):
-        model.set_scan(scans.angles, scans.ranges[k], scans.max_range)
-        return engine_model
 
     for k in tqdm(range(n), desc=config.method, unit="scan", disable=not progress):
         start = time.perf_counter()

@@ -2,6 +2,8 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/grid/range_caster.hpp"
 
+#include "kiseki/grid/ray_casting.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -50,21 +52,8 @@ double RangeCaster::range(double x, double y, double heading, double max_range) 
   const Eigen::Vector2d p = grid_.world_to_grid({x, y});
   const double a = heading - grid_.origin().theta;
   const double dx = std::cos(a), dy = std::sin(a);
-  // Clip the ray to the grid's box [0, w] x [0, h] (slab method), in cell units.
   double t0 = 0.0, t1 = max_range / res;
-  const double lo[2] = {0.0, 0.0}, hi[2] = {double(grid_.width()), double(grid_.height())};
-  const double pp[2] = {p.x(), p.y()}, dd[2] = {dx, dy};
-  for (int k = 0; k < 2; ++k) {
-    if (dd[k] == 0.0) {
-      if (pp[k] < lo[k] || pp[k] > hi[k]) return max_range;
-      continue;
-    }
-    double ta = (lo[k] - pp[k]) / dd[k], tb = (hi[k] - pp[k]) / dd[k];
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-  }
-  if (t0 > t1) return max_range;
+  if (!clip_to_box(p, {dx, dy}, grid_.width(), grid_.height(), t0, t1)) return max_range;
   const double inf = std::numeric_limits<double>::infinity();
   const int step_x = dx > 0 ? 1 : -1, step_y = dy > 0 ? 1 : -1;
   const double dt_x = dx != 0.0 ? std::abs(1.0 / dx) : inf, dt_y = dy != 0.0 ? std::abs(1.0 / dy) : inf;

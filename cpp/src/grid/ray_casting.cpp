@@ -16,24 +16,6 @@ void check_options(const RayCastOptions& o) {
   }
 }
 
-// Clips the segment p + t d, t in [t0, t1], to the box [0, w] x [0, h] (slab method).
-// Returns false when the segment misses the box.
-bool clip_to_box(const Eigen::Vector2d& p, const Eigen::Vector2d& d, double w, double h,
-                 double& t0, double& t1) {
-  const double lo[2] = {0.0, 0.0}, hi[2] = {w, h};
-  for (int k = 0; k < 2; ++k) {
-    if (d[k] == 0.0) {
-      if (p[k] < lo[k] || p[k] > hi[k]) return false;
-      continue;
-    }
-    double ta = (lo[k] - p[k]) / d[k], tb = (hi[k] - p[k]) / d[k];
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-  }
-  return t0 <= t1;
-}
-
 // Walks the cells of the ray in grid units. visit(cell, t_enter) returns true to stop.
 template <typename Visit>
 void traverse(const OccupancyGrid& grid, const Eigen::Vector2d& start, double heading,
@@ -77,6 +59,22 @@ bool is_obstacle(std::int8_t v, const RayCastOptions& o) {
 }
 
 }  // namespace
+
+bool clip_to_box(const Eigen::Vector2d& p, const Eigen::Vector2d& d, double w, double h,
+                 double& t0, double& t1) {
+  const double lo[2] = {0.0, 0.0}, hi[2] = {w, h};
+  for (int k = 0; k < 2; ++k) {
+    if (d[k] == 0.0) {
+      if (p[k] < lo[k] || p[k] > hi[k]) return false;
+      continue;
+    }
+    double ta = (lo[k] - p[k]) / d[k], tb = (hi[k] - p[k]) / d[k];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return t0 <= t1;
+}
 
 RayHit cast_ray(const OccupancyGrid& grid, const Eigen::Vector2d& start, double heading,
                 const RayCastOptions& options) {

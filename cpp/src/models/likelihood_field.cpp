@@ -62,6 +62,13 @@ void LikelihoodFieldModel::set_scan(const double* angles, const float* ranges, s
                                     double max_range) {
   beams_.set(angles, ranges, n, max_range, params_.max_beams, /*keep_no_return=*/false);
   tabulate(max_range);
+  const double inv_res = 1.0 / frame_.resolution();
+  end_x_.resize(beams_.size());
+  end_y_.resize(beams_.size());
+  for (std::size_t b = 0; b < beams_.size(); ++b) {
+    end_x_[b] = beams_.range[b] * beams_.cos[b] * inv_res;
+    end_y_[b] = beams_.range[b] * beams_.sin[b] * inv_res;
+  }
 }
 
 void LikelihoodFieldModel::log_likelihoods(const Pose2* poses, std::size_t n, double* out) const {
@@ -71,11 +78,8 @@ void LikelihoodFieldModel::log_likelihoods(const Pose2* poses, std::size_t n, do
   const double inv_res = 1.0 / frame_.resolution();
   const int w = frame_.width(), h = frame_.height();
   const std::size_t m = beams_.size();
-  std::vector<double> bx(m), by(m);
-  for (std::size_t b = 0; b < m; ++b) {
-    bx[b] = beams_.range[b] * beams_.cos[b] * inv_res;
-    by[b] = beams_.range[b] * beams_.sin[b] * inv_res;
-  }
+  const double* bx = end_x_.data();
+  const double* by = end_y_.data();
   const bool nav2 = params_.combination == BeamCombination::nav2;
   const float* table = table_.ptr<float>(0);  // continuous (created by tabulate)
   const double width = w, height = h;

@@ -24,6 +24,11 @@ struct RayHit {
   CellIndex cell;  ///< the obstacle cell when hit
 };
 
+/// Clips the segment p + t d, t in [t0, t1], to the box [0, w] x [0, h] (slab method), in grid
+/// cell units; returns false when the segment misses the box. Shared by the ray casters.
+bool clip_to_box(const Eigen::Vector2d& p, const Eigen::Vector2d& d, double w, double h,
+                 double& t0, double& t1);
+
 /// Casts one ray from a world point along a world heading with the grid traversal of
 /// Amanatides and Woo (1987): the exact sequence of cells the ray crosses. The part of the ray
 /// outside the grid crosses no obstacle. A ray starting inside an obstacle has range 0.

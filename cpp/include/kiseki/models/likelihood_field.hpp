@@ -68,6 +68,7 @@ class LikelihoodFieldModel : public SensorModel {
   float outside_ = 0.0f;
   double table_range_ = -1.0;
   ScanBeams beams_;
+  std::vector<double> end_x_, end_y_;  // beam ends in the sensor frame, in cells
   RangeCaster occupied_;
 };
 
