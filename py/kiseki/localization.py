@@ -78,10 +78,12 @@ class MclConfig:
     * ``recovery``: ``alpha_slow`` 0.001 and ``alpha_fast`` 0.1 (nav2's suggested values);
       resetting when the agreement falls below ``reset_threshold`` 0.6 (fewer than 60 % of the
       beams end near a wall without passing through one: a majority with a margin for people
-      and furniture the map does not hold) for 2 updates in a row, expansion by +-0.2 m and
-      +-0.2 rad, a sensor reset after 4 such updates in a row drawing half the particles from
-      20,000 uniform candidates (each reset kept only if it explains the scan better than the
-      cloud did); ``resetting_injects`` adds Augmented MCL's injection (off: on real logs an
+      and furniture the map does not hold) or the likelihood drops below ``reset_likelihood_drop``
+      0.5 of its long-term average (w_fast / w_slow: a place that looks alike) for 2 updates in
+      a row, expansion by +-0.2 m and +-0.2 rad, a sensor reset after 4 such updates in a row
+      drawing half the particles from 20,000 uniform candidates (each reset kept only if it
+      explains the scan better than the cloud did by ``reset_evidence`` ln 10, a Bayes factor
+      of 10); ``resetting_injects`` adds Augmented MCL's injection (off: on real logs an
       injected pose that fits one odd scan better than the cloud pulls the estimate away).
     * ``update_min_d`` / ``update_min_a``: 0 (every scan is an update); nav2 uses 0.25 m / 0.2 rad.
     """
@@ -101,6 +103,8 @@ class MclConfig:
     alpha_fast: float = 0.1
     resetting_injects: bool = False
     reset_threshold: float = 0.6
+    reset_likelihood_drop: float = 0.5
+    reset_evidence: float = math.log(10.0)
     expansion_position: float = 0.2
     expansion_orientation: float = 0.2
     reset_after: int = 2
@@ -167,6 +171,8 @@ class MclConfig:
         p.alpha_fast = self.alpha_fast
         p.resetting_injects = self.resetting_injects
         p.reset_threshold = self.reset_threshold
+        p.reset_likelihood_drop = self.reset_likelihood_drop
+        p.reset_evidence = self.reset_evidence
         p.expansion_position = self.expansion_position
         p.expansion_orientation = self.expansion_orientation
         p.reset_after = self.reset_after

@@ -300,7 +300,6 @@ DriveLog drive(MclParams params, std::uint64_t seed, bool global, int steps, int
     const auto ranges = cast(g, truth, angles, 8.0);
     model.set_scan(angles.data(), ranges.data(), ranges.size(), 8.0);
     const UpdateReport rep = mcl.update(model);
-    if (std::getenv("KDEBUG")) std::printf("%d agree %.3f err %.3f n %zu reset %s\n", k, rep.agreement, error(mcl.estimate(), truth), mcl.particles().size(), rep.reset.c_str());
     run.estimates.push_back(mcl.estimate());
     run.counts.push_back(mcl.particles().size());
     run.reliability.push_back(mcl.reliability());
@@ -360,6 +359,90 @@ TEST(MonteCarloLocalization, ResettingRecoversFromAKidnappingAndTheReliabilityFa
   const DriveLog found = drive(p, 5, false, 100, 30, elsewhere);
   EXPECT_LT(error(found.estimates[found.estimates.size() - 2], found.estimates.back()), 0.2);
   EXPECT_GT(found.reliability.back(), 0.8);
+}
+
+// A measurement seen only through its likelihood: log p = -|pose - target|^2 / (2 0.3^2) (position
+// in m and heading in rad alike) plus `ripple` sin(3x) cos(2y), over 30 readings, with a fixed
+// agreement with the map.
+class TargetModel : public SensorModel {
+ public:
+  Pose2 target;
+  double peak = 1.0;  ///< 0: a flat likelihood (the ripple only)
+  double ripple = 0.0;
+  double agree = 1.0;
+  void log_likelihoods(const Pose2* poses, std::size_t n, double* out) const override {
+    for (std::size_t i = 0; i < n; ++i) {
+      const Pose2& q = poses[i];
+      const double d2 = std::pow(q.x - target.x, 2) + std::pow(q.y - target.y, 2) +
+                        std::pow(angle_difference(q.theta, target.theta), 2);
+      out[i] = -0.5 * peak * d2 / 0.09 + ripple * std::sin(3 * q.x) * std::cos(2 * q.y);
+    }
+  }
+  std::size_t readings() const override { return 30; }
+  double agreement(const Pose2&) const override { return agree; }
+};
+
+TEST(MonteCarloLocalization, ALikelihoodDropResetsACloudCarriedToAPlaceThatLooksAlike) {
+  // The scans go on agreeing with the map (agreement 1), but the robot is elsewhere: only the
+  // likelihood has dropped against its long-term average.
+  for (const double drop : {0.0, 0.5}) {
+    MclParams p;
+    p.particles = 1000;
+    p.recovery = Recovery::resetting;
+    p.reset_likelihood_drop = drop;
+    MonteCarloLocalization mcl(p, 11);
+    mcl.set_free_space(room());
+    TargetModel model;
+    model.target = Pose2(1.0, 4.5, 0.0);
+    mcl.initialize_gaussian(model.target, 0.1, 0.1, 0.05);
+    for (int k = 0; k < 20; ++k) mcl.update(model);
+    model.target = Pose2(7.5, 1.0, 2.0);
+    int sensor_resets = 0;
+    for (int k = 0; k < 30; ++k) sensor_resets += mcl.update(model).reset == "sensor";
+    if (drop == 0.0) {
+      EXPECT_EQ(sensor_resets, 0);
+      EXPECT_GT(error(mcl.estimate(), model.target), 3.0);  // agreement alone cannot see it
+    } else {
+      EXPECT_GE(sensor_resets, 1);
+      EXPECT_LT(error(mcl.estimate(), model.target), 0.3);
+    }
+  }
+}
+
+TEST(MonteCarloLocalization, AResetNeedsEvidenceWhereTheLikelihoodIsFlat) {
+  // Every scan disagrees with the map (agreement 0), but the likelihood is flat to within
+  // 0.8 nats everywhere: the best of 20,000 uniform candidates beats the cloud's best by
+  // chance. With the default margin (a Bayes factor of 10) no reset is kept and the cloud
+  // stays; without one, the resets scatter it over the room.
+  for (const double evidence : {0.0, MclParams{}.reset_evidence}) {
+    MclParams p;
+    p.particles = 1000;
+    p.recovery = Recovery::resetting;
+    p.reset_evidence = evidence;
+    MonteCarloLocalization mcl(p, 12);
+    mcl.set_free_space(room());
+    TargetModel model;
+    model.peak = 0.0;
+    model.ripple = 0.4;
+    model.agree = 0.0;
+    const Pose2 start(1.0, 4.5, 0.0);
+    mcl.initialize_gaussian(start, 0.1, 0.1, 0.05);
+    int resets = 0;
+    for (int k = 0; k < 30; ++k) resets += mcl.update(model).reset != "none";
+    if (evidence > 0.0) {
+      EXPECT_EQ(resets, 0);
+      EXPECT_LT(error(mcl.estimate(), start), 0.5);  // the ripple alone moves it a little
+    } else {
+      EXPECT_GT(resets, 0);
+      EXPECT_GT(error(mcl.estimate(), start), 1.0);
+    }
+  }
+  MclParams bad;
+  bad.reset_evidence = -1.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = MclParams{};
+  bad.reset_likelihood_drop = 1.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
 TEST(MonteCarloLocalization, WeightsCanBeSetAndBadInputIsRefused) {

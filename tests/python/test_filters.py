@@ -179,6 +179,10 @@ def test_update_gate_and_bad_input() -> None:
         MclConfig(recovery="hope")
     with pytest.raises(ValueError, match="threads"):
         MclConfig(threads=-1)
+    with pytest.raises(ValueError, match="reset_evidence"):
+        MclConfig(reset_evidence=float("nan"))
+    with pytest.raises(ValueError, match="reset_likelihood_drop"):
+        MclConfig(reset_likelihood_drop=1.0)
     with pytest.raises(ValueError, match="free cell"):
         MonteCarloLocalizer(MclConfig(), 0, OccupancyGrid(np.full((4, 4), -1, np.int8), 0.1))
     with pytest.raises(ValueError, match="differ in length"):

@@ -36,6 +36,10 @@ void MclParams::validate() const {
     throw std::invalid_argument("MCL: alpha_slow and alpha_fast must lie in (0, 1]");
   }
   if (!(reset_threshold >= 0.0 && reset_threshold <= 1.0)) throw std::invalid_argument("MCL: reset_threshold must lie in [0, 1]");
+  if (!(reset_evidence >= 0.0 && std::isfinite(reset_evidence))) throw std::invalid_argument("MCL: reset_evidence must be finite and >= 0");
+  if (!(reset_likelihood_drop >= 0.0 && reset_likelihood_drop < 1.0)) {
+    throw std::invalid_argument("MCL: reset_likelihood_drop must lie in [0, 1)");
+  }
   if (!finite_nonneg(expansion_position) || !finite_nonneg(expansion_orientation)) {
     throw std::invalid_argument("MCL: expansion radii must be finite and >= 0");
   }
@@ -206,8 +210,11 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
   const bool lost = knows ? agreement < params_.reset_threshold : ratio < 0.5;
   const double signal = knows ? (lost ? 0.0 : 1.0) : std::min(1.0, ratio);
   reliability_ += params_.reliability_rate * (signal - reliability_);
+  // emcl2's second trigger: the likelihood has dropped against its long-term average. It sees
+  // a cloud carried to a place that looks alike, whose scans still mostly agree with the map.
+  const bool dropped = ratio < params_.reset_likelihood_drop;
 
-  if (params_.recovery == Recovery::resetting && (lost || !report.informative)) ++lost_updates_;
+  if (params_.recovery == Recovery::resetting && (lost || dropped || !report.informative)) ++lost_updates_;
   // Reset only when the disagreement persists (reset_after updates in a row): one scan through
   // a glass door or into an unmapped room must not scatter a cloud that is right.
   if (params_.recovery == Recovery::resetting && lost_updates_ >= params_.reset_after) {
@@ -227,7 +234,7 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
       return report;
     }
   }
-  if (!lost) lost_updates_ = 0;
+  if (!lost && !dropped) lost_updates_ = 0;
   posterior_ = estimate();  // before resampling: injected poses have no weight in it
   double inject = 0.0;
   const bool injects = params_.recovery == Recovery::augmented ||
@@ -281,6 +288,13 @@ void MonteCarloLocalization::resample_to(std::size_t n) {
   target_ = n;
 }
 
+bool MonteCarloLocalization::explains_better(double proposed_best, double cloud_best) const {
+  // The best of many proposed poses beats the cloud's best by chance where the likelihood is
+  // flat (a scan of open space): the proposal must be better by a likelihood ratio of
+  // exp(reset_evidence), on the scale the weights use.
+  return params_.likelihood_power * (proposed_best - cloud_best) > params_.reset_evidence;
+}
+
 bool MonteCarloLocalization::expansion_reset(const SensorModel* model, double cloud_best) {
   const std::size_t n = particles_.size();
   const std::vector<std::size_t> idx = resample_indices(weights_, n, params_.resampling, rng_);
@@ -303,7 +317,7 @@ bool MonteCarloLocalization::expansion_reset(const SensorModel* model, double cl
   // Kept only if some expanded particle explains the measurement better than the best particle
   // did: a cloud that is right but sees an odd scan is not scattered.
   const std::vector<double> l = evaluate(*model, out);
-  if (!(*std::max_element(l.begin(), l.end()) > cloud_best)) return false;
+  if (!explains_better(*std::max_element(l.begin(), l.end()), cloud_best)) return false;
   particles_.swap(out);
   weights_.assign(n, 1.0 / static_cast<double>(n));
   apply_log_likelihoods(weights_, l, params_.likelihood_power);
@@ -317,7 +331,7 @@ bool MonteCarloLocalization::sensor_reset(const SensorModel& model, double cloud
   const std::vector<double> cand_l = evaluate(model, candidates);
   // The measurement proposes another place only if some pose there explains it better than
   // the best particle of the cloud does.
-  if (!(*std::max_element(cand_l.begin(), cand_l.end()) > cloud_best)) return false;
+  if (!explains_better(*std::max_element(cand_l.begin(), cand_l.end()), cloud_best)) return false;
   std::vector<double> w(candidates.size(), 1.0);
   std::vector<Pose2> out;
   out.reserve(n);

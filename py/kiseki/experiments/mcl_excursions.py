@@ -7,6 +7,12 @@ the likelihood field on its log-odds map (0.05 m) track from the first pose, eac
 recovery setting of ``recoveries``. An *excursion* is a run of scans whose position error
 exceeds ``excursion_distance`` (0.5 m); its length is the number of scans until the error is
 back below it (or to the end of the log: never back). Trial i is log i mod 4 with its own seed.
+
+For the excursions longer than ``max_return_scans``, ``long_seen_share`` is the share of their
+scans on which the truth explains the scan better than the estimate by the resets' evidence
+margin (a Bayes factor of 10). Near 0, the model itself cannot tell the estimate from the
+truth there (the space observation model penalises seeing through walls, not falling short of
+them, so it is blind along a corridor), and no recovery that weighs with it can act.
 """
 
 from __future__ import annotations
@@ -20,7 +26,14 @@ import pandas as pd
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.experiments.carmen_maps import LOGS
 from kiseki.experiments.carmen_maps import data_dir as _carmen_dir
-from kiseki.localization import RECOVERY_MODES, LocalizeConfig, localize
+from kiseki.localization import (
+    RECOVERY_MODES,
+    LocalizeConfig,
+    MclConfig,
+    localize,
+    scan_model,
+    scan_preparer,
+)
 from kiseki.metrics import ape
 from kiseki.plots import new_figure
 
@@ -69,6 +82,28 @@ def excursions(errors: np.ndarray, threshold: float) -> list[int]:
     return out
 
 
+def excursion_spans(errors: np.ndarray, threshold: float) -> list[tuple[int, int]]:
+    """(start, stop) scan indices of the runs of errors above threshold."""
+    above = np.concatenate([[False], errors > threshold, [False]])
+    edges = np.flatnonzero(np.diff(above.astype(np.int8)))
+    return list(zip(edges[0::2].tolist(), edges[1::2].tolist(), strict=True))
+
+
+def model_sees(scans, grid, lc: LocalizeConfig, estimates: np.ndarray, index: np.ndarray):
+    """Per scan of ``index``: does the truth explain the scan better than the estimate by the
+    resets' evidence margin (MclConfig.reset_evidence, tempered as the weights are)? Where it
+    does not, the model itself cannot tell the estimate from the truth, and no recovery that
+    weighs with it can prefer the truth."""
+    prepare = scan_preparer(scan_model(lc.method, grid, lc), scans)
+    margin = MclConfig().reset_evidence
+    out = np.zeros(len(index), dtype=bool)
+    for n, k in enumerate(index):
+        model = prepare(int(k))
+        ll = model.log_likelihoods(np.stack([scans.poses[k], estimates[k]]))
+        out[n] = lc.likelihood_power * (ll[0] - ll[1]) > margin
+    return out
+
+
 def trial(config: ExcursionsConfig, index: int, seed: int) -> TrialOutput:
     from kiseki.datasets import read_carmen_log
     from kiseki.mapping import MapBuildConfig, build_map
@@ -99,13 +134,23 @@ def trial(config: ExcursionsConfig, index: int, seed: int) -> TrialOutput:
             )
             result = localize(scans, maps[method], lc)
             d = result.estimates - scans.poses
-            runs = excursions(np.hypot(d[:, 0], d[:, 1]), config.excursion_distance)
+            errors = np.hypot(d[:, 0], d[:, 1])
+            runs = excursions(errors, config.excursion_distance)
+            long = [
+                np.arange(a, b)
+                for a, b in excursion_spans(errors, config.excursion_distance)
+                if b - a > config.max_return_scans
+            ]
+            long_index = np.concatenate(long) if long else np.zeros(0, dtype=np.int64)
+            sees = model_sees(scans, maps[method], lc, result.estimates, long_index)
             record |= {
                 f"{key}_rmse_m": ape(result.estimates, scans.poses).rmse,
                 f"{key}_heading_rmse_deg": ape(result.estimates, scans.poses, "rotation_deg").rmse,
                 f"{key}_excursions": len(runs),
                 f"{key}_longest": -1 if -1 in runs else max(runs, default=0),
                 f"{key}_resets": int(np.sum(result.resets != "none")),
+                f"{key}_long_scans": int(long_index.size),
+                f"{key}_long_seen": int(sees.sum()),
             }
             timings[f"{key}_ms_per_update"] = 1000.0 * float(np.mean(result.update_seconds))
     return TrialOutput(record, timings)
@@ -130,6 +175,12 @@ def analyze(config: ExcursionsConfig, trials: pd.DataFrame, timings: pd.DataFram
                         "excursions": int(group[f"{key}_excursions"].sum()),
                         "longest_scans": -1 if (longest == -1).any() else int(longest.max()),
                         "resets": int(group[f"{key}_resets"].sum()),
+                        "long_excursion_scans": int(group[f"{key}_long_scans"].sum()),
+                        "long_seen_share": (
+                            group[f"{key}_long_seen"].sum() / group[f"{key}_long_scans"].sum()
+                            if group[f"{key}_long_scans"].sum()
+                            else float("nan")
+                        ),
                         "ms_per_update": group[f"{key}_ms_per_update"].median(),
                     }
                 )
@@ -150,7 +201,16 @@ def analyze(config: ExcursionsConfig, trials: pd.DataFrame, timings: pd.DataFram
                 ),
                 unit="scans",
                 holds=bool(back),
-                note=f"{row.excursions} excursions over {row.seeds} seeds",
+                note=(
+                    f"{row.excursions} excursions over {row.seeds} seeds"
+                    + (
+                        f"; in the {row.long_excursion_scans} scans of the longer ones the "
+                        f"truth explains the scan better than the estimate by a Bayes factor "
+                        f"of 10 in {100 * row.long_seen_share:.0f} %"
+                        if row.long_excursion_scans
+                        else ""
+                    )
+                ),
             )
         )
     fig = new_figure(figsize=(8, 3.5), dpi=120)

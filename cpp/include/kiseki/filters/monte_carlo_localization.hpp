@@ -26,17 +26,21 @@ enum class Recovery {
   /// per-reading likelihood, w_fast and w_slow; at each resampling a share max(0, 1 - w_fast /
   /// w_slow) of the new particles is drawn uniformly over the free cells (nav2's recovery).
   augmented,
-  /// Augmented MCL's injection, and expansion resetting (Ueda et al., emcl / emcl2) then sensor
-  /// resetting (Lenser and Veloso, 2000): when the agreement of the measurement with the map seen from the particles (the
-  /// model's agreement(), for scans emcl2's non-penetration share) stays below reset_threshold
-  /// for reset_after updates in a row, every particle is moved by uniform noise
-  /// (+-expansion_position, +-expansion_orientation) and weighed again, kept only if some moved
-  /// particle explains the measurement better than the best one did; after sensor_reset_after
-  /// such updates in a row, a share sensor_reset_share of the particles is drawn from
+  /// Expansion resetting (Ueda et al., emcl / emcl2) then sensor resetting (Lenser and Veloso,
+  /// 2000). The cloud counts as lost on an update when the agreement of the measurement with
+  /// the map seen from the particles (the model's agreement(), for scans emcl2's
+  /// non-penetration share) is below reset_threshold, or, emcl2's other trigger, when the
+  /// likelihood has dropped (w_fast / w_slow below reset_likelihood_drop): a cloud carried to a
+  /// place that looks alike still mostly agrees with the map, but explains the scans worse than
+  /// it used to. After reset_after lost updates in a row every particle is moved by uniform
+  /// noise (+-expansion_position, +-expansion_orientation) and weighed again; after
+  /// sensor_reset_after, a share sensor_reset_share of the particles is drawn from
   /// sensor_reset_candidates uniform poses over the free cells in proportion to their
-  /// likelihood (the measurement proposes where the robot can be), if the best candidate
-  /// explains the measurement better than the best particle, and the set is weighed again. The resets catch a scan that contradicts the map; the injection
-  /// catches what they cannot, a place that looks alike (a pose carried along a corridor).
+  /// likelihood (the measurement proposes where the robot can be) and the set is weighed
+  /// again. Either reset is kept only if its best pose explains the measurement better than the
+  /// cloud's best by a likelihood ratio of exp(reset_evidence): a cloud that is right but sees
+  /// an odd scan is not scattered, nor one whose scans fit many places equally (open space).
+  /// With resetting_injects, Augmented MCL's injection is added as well.
   resetting,
 };
 Recovery recovery_from_name(const std::string& name);
@@ -57,6 +61,11 @@ struct MclParams {
   /// pulls the estimate away (ACES, Freiburg 079: RMSE 0.08 -> 2-7 m), so it is off by default.
   bool resetting_injects = false;
   double reset_threshold = 0.6;  ///< agreement below which the cloud counts as lost
+  /// ... or w_fast / w_slow below this (the likelihood has dropped); 0: agreement only
+  double reset_likelihood_drop = 0.5;
+  /// A reset is kept only if its best pose beats the cloud's best by this log-likelihood ratio
+  /// (tempered by likelihood_power): ln 10, a Bayes factor of 10 (Jeffreys' "strong").
+  double reset_evidence = 2.302585092994046;
   double expansion_position = 0.2, expansion_orientation = 0.2;  ///< m, rad (half-widths)
   int reset_after = 2;         ///< disagreeing updates in a row before the first reset
   int sensor_reset_after = 4;  ///< ... before a sensor reset (expansions until then)
@@ -147,6 +156,7 @@ class MonteCarloLocalization {
   std::vector<double> evaluate(const SensorModel& model, const std::vector<Pose2>& poses) const;
   double agreement_of(const SensorModel& model) const;
   void resample(double inject_probability, UpdateReport& report);
+  bool explains_better(double proposed_best, double cloud_best) const;
   bool expansion_reset(const SensorModel* model, double cloud_best);
   bool sensor_reset(const SensorModel& model, double cloud_best);
   void check_ready() const;
