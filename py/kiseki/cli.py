@@ -112,7 +112,13 @@ def map_from_log(
     start = time.perf_counter()
     scans = open_scans(log, scan_topic, odom_topic, reference_topic)
     if not scans.has_reference_poses:
-        raise ValueError(f"{log}: the log has no reference poses to build a map from")
+        hint = ""
+        if reference_topic is None:
+            from kiseki.datasets.rosbag import is_ros_bag
+
+            if is_ros_bag(log):
+                hint = " (a bag's reference poses come from --reference-topic, e.g. /ground_truth)"
+        raise ValueError(f"{log}: the log has no reference poses to build a map from{hint}")
     if rules in ("teaching", "evidence"):
         grid = build_teaching_map(
             scans.poses,

@@ -419,6 +419,17 @@ def test_cli_map_from_a_ros2_mcap_bag(bags: dict[str, Path], tmp_path: Path) -> 
     assert "on or" in done.output  # the endpoint agreement is printed
 
 
+def test_cli_map_from_a_bag_without_reference_names_the_option(
+    bags: dict[str, Path], tmp_path: Path
+) -> None:
+    out = tmp_path / "map.yaml"
+    done = CliRunner().invoke(app, ["map", "from-log", str(bags["ros2-mcap"]), "-o", str(out)])
+    assert done.exit_code != 0 and isinstance(done.exception, ValueError)
+    assert "no reference poses" in str(done.exception)
+    assert "--reference-topic" in str(done.exception)
+    assert not out.exists()
+
+
 def test_cli_wrong_scan_topic_is_one_line(
     bags: dict[str, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys
 ) -> None:
