@@ -10,6 +10,7 @@ void bind_sim(pybind11::module_& m);
 void bind_models(pybind11::module_& m);
 void bind_filters(pybind11::module_& m);
 void bind_teach(pybind11::module_& m);
+void bind_coop(pybind11::module_& m);
 }  // namespace kiseki::bindings
 
 PYBIND11_MODULE(_core, m) {
@@ -21,4 +22,5 @@ PYBIND11_MODULE(_core, m) {
   kiseki::bindings::bind_models(m);
   kiseki::bindings::bind_filters(m);
   kiseki::bindings::bind_teach(m);
+  kiseki::bindings::bind_coop(m);
 }
