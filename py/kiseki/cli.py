@@ -18,6 +18,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from kiseki._outputs import check_outputs
 from kiseki.errors import KisekiError
 
 app = typer.Typer(
@@ -105,6 +106,9 @@ def map_from_log(
 
     if rules not in ("log-odds", "teaching", "evidence"):
         raise ValueError(f"--rules must be log-odds, teaching or evidence, got {rules!r}")
+    check_outputs(
+        {"--output": [output, output.with_suffix(".pgm")], "--render": render}, {"LOG": log}
+    )
     config = MapBuildConfig(
         resolution=_positive("--resolution", resolution),
         usable_range=_positive("--usable-range", usable_range),
@@ -175,6 +179,7 @@ def map_render(
     from kiseki.map_io import load_map
     from kiseki.plots import render_map
 
+    check_outputs({"--output": output}, {"MAP": map_file, "--trajectory": trajectory})
     grid = load_map(map_file)
     path = _read_trajectory(trajectory) if trajectory is not None else None
     render_map(grid, output, trajectory=path, title=map_file.name)
@@ -190,6 +195,7 @@ def map_convert(
     from kiseki.grid import grid_summary
     from kiseki.map_io import load_map, save_map
 
+    check_outputs({"--output": [output, output.with_suffix(".pgm")]}, {"MAP": map_file})
     grid = load_map(map_file)
     save_map(grid, output)
     summary = grid_summary(grid)
@@ -289,6 +295,7 @@ def sim_run(
         raise ValueError(f"--controller must be route or commands, got {controller!r}")
     if (controller == "commands") != (commands is not None):
         raise ValueError("--commands FILE goes with --controller commands, and only with it")
+    check_outputs({"--output": output}, {"SCENE": scene_file, "--commands": commands})
     script = read_commands(commands) if commands is not None else None
     scene = load_scene(scene_file, variant)
     summary = simulate(scene, output, SimConfig(duration=duration, seed=seed), script, overwrite)
@@ -312,10 +319,12 @@ def sim_render(
     from kiseki.sim.render import render_run
     from kiseki.sim.scene import load_scene
 
+    check_outputs({"--output": output}, {"RUN": run_file, "--scene": scene_file})
     run = read_run(run_file)
     path = scene_file or Path(run.metadata.get("scene_file", ""))
     if not str(path) or not path.is_file():
         raise FileNotFoundError(f"{run_file}: its scene file {path} is not found: give --scene")
+    check_outputs({"--output": output}, {"the run's scene": path})
     render_run(load_scene(path), run, output)
     console.print(f"{output}: animation written")
 
@@ -332,6 +341,7 @@ def sim_show(
     from kiseki.sim.render import render_scene
     from kiseki.sim.scene import load_scene
 
+    check_outputs({"--output": output, "--octree": octree}, {"SCENE": scene_file})
     scene = load_scene(scene_file)
     render_scene(scene, output)
     if octree is not None:
@@ -533,7 +543,15 @@ def localize_command(
     from kiseki.map_io import load_map
     from kiseki.metrics import ape
 
-    _check_output(output, [log, map_file])
+    check_outputs(
+        {
+            "--output": output,
+            "its config": output.with_name(output.stem + ".config.yaml"),
+            "its report": output.with_suffix(".json") if global_start else None,
+            "--plot": plot,
+        },
+        {"LOG": log, "--map": map_file},
+    )
     if not global_start:
         for name, value in (("--tracking-particles", tracking_particles), ("--plot", plot)):
             if value is not None:
@@ -603,13 +621,6 @@ def localize_command(
             from kiseki.global_localization import render_global
 
             render_global(grid, result, plot, title=f"{log.name}: global {method}")
-
-
-def _check_output(output: Path, inputs: list[Path]) -> None:
-    """Refuses an output that is one of the command's inputs (it would be overwritten)."""
-    for path in inputs:
-        if output.exists() and path.exists() and output.resolve() == path.resolve():
-            raise ValueError(f"{output}: the output would overwrite the input {path}")
 
 
 def _write_trajectory(

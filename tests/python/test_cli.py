@@ -77,6 +77,46 @@ def test_bad_input_prints_one_line_and_fails(tmp_path, args, needle):
     assert "Traceback" not in done.stderr
 
 
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["map", "render", "good.yaml", "-o", "good.pgm"], "the input MAP's image"),
+        (["map", "render", "good.yaml", "-o", "link.png"], "the input MAP's image"),  # symlink
+        (["map", "render", "sub/../good.yaml", "-o", "./good.yaml"], "the input MAP"),
+        (["map", "convert", "good.yaml", "-o", "good.yaml"], "the input MAP"),
+        (["map", "convert", "good.yaml", "-o", "other.yaml"], ""),  # writes other.pgm: allowed
+        (["map", "from-log", "log.gz", "-o", "log.gz"], "the input LOG"),
+        (["map", "from-log", "log.gz", "-o", "m.yaml", "--render", "m.pgm"], "same file"),
+        (["map", "from-log", "log.gz", "-o", "m.yaml", "--render", "nodir/r.png"], "nodir"),
+        (["sim", "run", "scene.yaml", "-o", "scene.yaml", "--overwrite"], "the input SCENE"),
+        (["sim", "show", "scene.yaml", "-o", "x.png", "--octree", "scene.yaml"], "SCENE"),
+        (["localize", "log.gz", "--map", "good.yaml", "-o", "good.pgm"], "--map's image"),
+        (["localize", "log.gz", "--map", "good.yaml", "-o", "good.config.csv"], ""),
+        (["localize", "log.gz", "--map", "m.config.yaml", "-o", "m.csv"], "its config"),
+    ],
+)
+def test_outputs_never_overwrite_inputs(tmp_path, args, needle):
+    save_map(OccupancyGrid(4, 4, 0.1), tmp_path / "good.yaml")
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "link.png").symlink_to(tmp_path / "good.pgm")
+    (tmp_path / "log.gz").write_bytes(b"not a log")
+    (tmp_path / "scene.yaml").write_text("name: x\n")
+    save_map(OccupancyGrid(4, 4, 0.1), tmp_path / "m.config.yaml")  # a map named like a config
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()}
+    done = run(*args, cwd=tmp_path)
+    after = {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()}
+    for name, content in before.items():
+        if name != "other.pgm":
+            assert after[name] == content, f"{name} was changed"
+    if needle:
+        assert done.returncode == 1
+        lines = done.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("kiseki: error: "), done.stderr
+        assert needle in lines[0] and "Traceback" not in done.stderr
+    else:  # not an input: refused for another reason (the log) or written
+        assert "would overwrite" not in done.stderr
+
+
 def test_unknown_command_fails():
     done = run("teleport")
     assert done.returncode != 0 and "teleport" in done.stderr
