@@ -57,6 +57,31 @@ void bind_coop(py::module_& m) {
       },
       "standing_positions"_a, "bearings"_a, "elevations"_a, "bearing_sigma"_a = 0.0, "elevation_sigma"_a = 0.0,
       "min_intersection_angle"_a, "The same in 3-D, with n elevations.");
+  m.def(
+      "triangulate_pairs",
+      [](const py::handle& a, const py::handle& b, const py::handle& bearing_a, const py::handle& bearing_b,
+         double min_angle) {
+        const DoubleArray pa = as_doubles(a, "a"), pb = as_doubles(b, "b");
+        require_shape(pa, "a", 2, 2);
+        require_shape(pb, "b", 2, 2);
+        std::vector<Eigen::Vector2d> va, vb;
+        for (py::ssize_t i = 0; i < pa.shape(0); ++i) va.emplace_back(pa.at(i, 0), pa.at(i, 1));
+        for (py::ssize_t i = 0; i < pb.shape(0); ++i) vb.emplace_back(pb.at(i, 0), pb.at(i, 1));
+        const std::vector<double> ba = vector_of(bearing_a, "bearing_a"), bb = vector_of(bearing_b, "bearing_b");
+        TriangulationParams p;
+        p.min_intersection_angle = min_angle;
+        std::vector<Eigen::Vector2d> out;
+        {
+          py::gil_scoped_release release;
+          out = triangulate_pairs(va, vb, ba, bb, p);
+        }
+        py::array_t<double> result({static_cast<py::ssize_t>(out.size()), py::ssize_t{2}});
+        auto r = result.mutable_unchecked<2>();
+        for (std::size_t k = 0; k < out.size(); ++k) r(k, 0) = out[k].x(), r(k, 1) = out[k].y();
+        return result;
+      },
+      "a"_a, "b"_a, "bearing_a"_a, "bearing_b"_a, "min_intersection_angle"_a,
+      "(m, 2) intersections of the lines of sight from a[k] and b[k] (m x 2 each).");
   m.attr("TRIANGULATION_MIN_ANGLE") = TriangulationParams{}.min_intersection_angle;
 }
 

@@ -167,3 +167,30 @@ TEST(Triangulation, BadGeometryAndInputAreRefusedByName) {
   bad.bearing_sigma = -1;
   EXPECT_NE(message([&] { triangulate({{1, 0}, {-1, 0}}, {2.0, 1.0}, bad); }).find("bearing_sigma"), std::string::npos);
 }
+
+TEST(Triangulation, PairsMatchOneByOneAndNameTheBadRow) {
+  std::mt19937 gen(3);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  std::vector<Eigen::Vector2d> a, b;
+  std::vector<double> ba, bb;
+  for (int k = 0; k < 50; ++k) {
+    a.emplace_back(u(gen) - 5.0, u(gen));
+    b.emplace_back(u(gen) + 5.0, u(gen));
+    const Eigen::Vector2d target(u(gen), u(gen) + 6.0);
+    ba.push_back(bearing_to(a.back(), target));
+    bb.push_back(bearing_to(b.back(), target));
+  }
+  const auto out = triangulate_pairs(a, b, ba, bb);
+  for (int k = 0; k < 50; ++k) {
+    const Triangulation one = triangulate({a[k], b[k]}, {ba[k], bb[k]});
+    EXPECT_NEAR((out[k] - one.position).norm(), 0.0, 1e-12);
+  }
+  bb[17] = ba[17];  // parallel lines of sight in row 17
+  try {
+    triangulate_pairs(a, b, ba, bb);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("row 17: "), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(triangulate_pairs(a, b, ba, {1.0}), std::invalid_argument);
+}

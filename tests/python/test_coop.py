@@ -113,3 +113,140 @@ def test_bad_sigma_and_paper_angles() -> None:
         paper_position(1.0, 2.0, 1.5)
     with pytest.raises(ValueError, match="nearly parallel"):
         paper_position(1.0, 1e-4, 1e-4)
+
+
+# --- the positioning loop and the movement forms ---
+
+from kiseki.coop import GOAL, START, paper_angle, plan, simulate  # noqa: E402
+
+
+def _angle_at(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    u, v = a - p, b - p
+    return math.acos(np.clip(u @ v / np.linalg.norm(u) / np.linalg.norm(v), -1, 1))
+
+
+def test_form_1_measures_the_scout_symmetrically_and_takes_two_moves_per_unit() -> None:
+    angle = math.radians(55)
+    p = plan(1, 15, angle)
+    assert len(p.steps) == 15 and np.allclose(p.steps[-1].target, GOAL)
+    at = p.nominal_positions()
+    levels = []
+    for k, move in enumerate(p.steps[:-1]):
+        i, j = move.standing
+        before = at[k]
+        if k % 2 == 0:  # the scout: both standing robots see it at the angle (theta1 = theta2)
+            assert before[i, 1] == pytest.approx(before[j, 1])  # a lateral pair
+            assert _angle_at(before[i], before[j], move.target) == pytest.approx(angle)
+            assert _angle_at(before[j], before[i], move.target) == pytest.approx(angle)
+        else:  # the joiner lands level with the scout: the next pair
+            assert move.target[1] == pytest.approx(at[k + 1][p.steps[k - 1].robot][1])
+            levels.append(move.target[1])
+    rise = np.diff([0.0, *levels])  # the first over the start's baseline: w = 1 m
+    assert rise[0] == pytest.approx(math.tan(angle))
+    np.testing.assert_allclose(rise[1:], rise[1])  # then 2 moves per unit of forward travel
+    assert levels[-1] + rise[1] == pytest.approx(GOAL[1])
+
+
+def test_form_2_leapfrogs_one_unit_per_move_on_isosceles_triangles() -> None:
+    angle = math.radians(50)
+    p = plan(2, 9, angle)
+    at = p.nominal_positions()
+    ys = [m.target[1] for m in p.steps]
+    np.testing.assert_allclose(np.diff(ys), GOAL[1] / 9)  # 1 move per unit
+    for k, move in enumerate(p.steps[2:-1], start=2):
+        before = at[k]
+        assert move.robot == int(np.argmin(before[:, 1]))  # the rearmost jumps
+        far = max(move.standing, key=lambda r: np.hypot(*(before[r] - move.target)))
+        near = move.standing[0] if far == move.standing[1] else move.standing[1]
+        assert _angle_at(before[far], before[near], move.target) == pytest.approx(angle)
+
+
+def test_paper_angle_keeps_the_start_width() -> None:
+    for form, n in ((1, 9), (2, 7)):
+        p = plan(form, n)
+        assert p.angle == pytest.approx(paper_angle(form, n))
+        xs = np.abs(p.nominal_positions()[:, :, 0])
+        assert xs.max() == pytest.approx(2.0 if form == 1 else 1.0)  # widths follow the start's
+
+
+def test_simulation_is_seeded_and_its_error_scales_with_the_noise() -> None:
+    p = plan(2, 7)
+    a, b = simulate(p, 200, seed=4), simulate(p, 200, seed=4)
+    np.testing.assert_array_equal(a.goal_errors, b.goal_errors)
+    assert not np.array_equal(a.goal_errors, simulate(p, 200, seed=5).goal_errors)
+    assert simulate(p, 10, angle_sigma=0.0).goal_errors.max() < 1e-9  # exact without noise
+    # first order: ten times the noise, ten times the error (same draws)
+    small = simulate(p, 500, angle_sigma=math.radians(0.01), seed=9).goal_errors
+    large = simulate(p, 500, angle_sigma=math.radians(0.1), seed=9).goal_errors
+    assert large.mean() / small.mean() == pytest.approx(10.0, rel=0.01)
+
+
+def test_errors_accumulate_along_the_chain() -> None:
+    run = simulate(plan(2, 12), 400, seed=2)
+    spread = [
+        np.sqrt(np.trace(np.cov(run.estimates[:, k + 1, m.robot].T)))
+        for k, m in enumerate(run.plan.steps)
+    ]
+    assert spread[-1] > 2 * spread[0]
+    assert np.allclose(run.estimates[:, 0], START)  # the start is measured beforehand
+
+
+def test_bad_plans_are_refused() -> None:
+    with pytest.raises(ValueError, match="form must be 1 or 2"):
+        plan(3, 5, 0.9)
+    with pytest.raises(ValueError, match="odd number of moves"):
+        plan(1, 4, 0.9)
+    with pytest.raises(ValueError, match="5..85 deg"):
+        plan(2, 5, math.radians(89))
+    with pytest.raises(ValueError, match="ahead"):
+        plan(2, 5, 0.9, goal=(0.0, -5.0))
+    with pytest.raises(ValueError, match="runs"):
+        simulate(plan(2, 5), 0)
+    with pytest.raises(ValueError, match="seed"):
+        simulate(plan(2, 5), 5, seed=-1)
+
+
+def test_coop_experiment_claims_and_cli(tmp_path) -> None:
+    import subprocess
+    import sys
+
+    import pandas as pd
+
+    from kiseki.experiments import run_experiment
+
+    with pytest.raises(ValueError, match="9 settings"):
+        run_experiment(
+            "coop-forms",
+            runs=10,
+            overrides=["form1_moves=3,5,7,9", "form2_moves=5,7"],
+            out=tmp_path / "too_many",
+            progress=False,
+        )
+    run = run_experiment(
+        "coop-forms",
+        seed=0,
+        overrides=["form1_moves=3,5,7,9", "form2_moves=5,7", "dead_reckoning_runs=50"],
+        out=tmp_path / "c",
+        progress=False,
+    )
+    assert run.failed == 0
+    claims = pd.read_csv(run.run_dir / "claims.csv").set_index("claim")
+    lower = claims.filter(like="lower minimum", axis=0)
+    assert len(lower) == 1
+    table = pd.read_csv(run.run_dir / "tables" / "sweep.csv")
+    assert set(table["form"]) == {1, 2} and len(table) == 6
+    assert (table["mean_error_m"] > 0).all() and (table["mean_error_m"] < 1.0).all()
+    dead = pd.read_csv(run.run_dir / "tables" / "dead_reckoning.csv")
+    assert dead["mean_error_m"].iloc[0] > table["mean_error_m"].min()
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "coop", "simulate", "--form", "2", "--moves", "7",
+         "--runs", "50", "--plot", str(tmp_path / "g.png")],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "error at the goal mean" in done.stdout and (tmp_path / "g.png").stat().st_size > 5000
+    bad = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "coop", "simulate", "--form", "1", "--moves", "4"],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert bad.returncode == 1 and bad.stderr.startswith("kiseki: error: form 1 takes an odd")

@@ -178,4 +178,26 @@ Triangulation triangulate(const std::vector<Eigen::Vector3d>& standing, const st
   return solve(rays, 3, params);
 }
 
+std::vector<Eigen::Vector2d> triangulate_pairs(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b,
+                                               const std::vector<double>& bearing_a,
+                                               const std::vector<double>& bearing_b,
+                                               const TriangulationParams& params) {
+  const std::size_t m = a.size();
+  if (b.size() != m || bearing_a.size() != m || bearing_b.size() != m) {
+    throw std::invalid_argument("triangulate_pairs: the four inputs need the same number of rows");
+  }
+  TriangulationParams p = params;
+  p.bearing_sigma = 0.0;  // positions only
+  std::vector<Eigen::Vector2d> out(m);
+  for (std::size_t k = 0; k < m; ++k) {
+    try {
+      const Triangulation t = triangulate({a[k], b[k]}, {bearing_a[k], bearing_b[k]}, p);
+      out[k] = t.position.head<2>();
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("row " + std::to_string(k) + ": " + e.what());
+    }
+  }
+  return out;
+}
+
 }  // namespace kiseki

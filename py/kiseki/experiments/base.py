@@ -64,3 +64,6 @@ class Experiment:
     analyze: Callable[[Any, pd.DataFrame, pd.DataFrame, Path], Analysis]
     default_runs: int = 10
     preflight: Callable[[Any], None] | None = None
+    # For an experiment whose trials are the settings of its config (one trial per setting):
+    # the number of trials a config has; the default --runs, and the most it accepts.
+    trial_count: Callable[[Any], int] | None = None

@@ -13,6 +13,7 @@ __all__ = ["all_experiments", "get_experiment"]
 def _registry() -> dict[str, Experiment]:
     from kiseki.experiments import (
         carmen_maps,
+        coop_forms,
         corridor_scans,
         fig_3_14,
         mcl_excursions,
@@ -24,6 +25,7 @@ def _registry() -> dict[str, Experiment]:
 
     experiments = [
         carmen_maps.EXPERIMENT,
+        coop_forms.EXPERIMENT,
         corridor_scans.EXPERIMENT,
         fig_3_14.EXPERIMENT,
         mcl_excursions.EXPERIMENT,

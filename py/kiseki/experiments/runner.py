@@ -152,9 +152,14 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
         config = config_from_dict(experiment.config_type, saved["config"])
         return experiment, run_dir, config, saved["runs"], saved["seed"]
     config = apply_overrides(experiment.config_type(), list(overrides))
-    runs = experiment.default_runs if runs is None else runs
+    settings = experiment.trial_count(config) if experiment.trial_count else None
+    runs = (experiment.default_runs if settings is None else settings) if runs is None else runs
     if runs < 1:
         raise ConfigError(f"--runs must be at least 1, got {runs}")
+    if settings is not None and runs > settings:
+        raise ConfigError(
+            f"{name}: its config has {settings} settings (one trial each), not {runs}"
+        )
     seed = 0 if seed is None else seed
     if not 0 <= seed < 2**64:
         raise ConfigError(f"--seed must lie in [0, 2**64), got {seed}")

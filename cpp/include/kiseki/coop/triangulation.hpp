@@ -49,4 +49,12 @@ Triangulation triangulate(const std::vector<Eigen::Vector2d>& standing, const st
 Triangulation triangulate(const std::vector<Eigen::Vector3d>& standing, const std::vector<double>& bearings,
                           const std::vector<double>& elevations, const TriangulationParams& params = {});
 
+/// Many two-robot triangulations at once (a Monte Carlo sweep): row k intersects the line of
+/// sight from a[k] with bearing bearing_a[k] and the one from b[k] with bearing_b[k]. Throws
+/// std::invalid_argument naming the row, with the reason triangulate() gives.
+std::vector<Eigen::Vector2d> triangulate_pairs(const std::vector<Eigen::Vector2d>& a, const std::vector<Eigen::Vector2d>& b,
+                                               const std::vector<double>& bearing_a,
+                                               const std::vector<double>& bearing_b,
+                                               const TriangulationParams& params = {});
+
 }  // namespace kiseki

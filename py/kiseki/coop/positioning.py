@@ -1,0 +1,254 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The cooperative positioning loop of Hirose, Nagata and Kurazume (sec. 2, Fig. 1): three
+robots take turns; at each move one robot drives to a planned point while the other two stand,
+measure the angle between each other and it, and triangulate it from their own estimated
+positions. Errors build up as the group advances: each triangulation inherits the standing
+robots' errors.
+
+**Measurement.** Standing robot i measures theta_i, the angle between the directions to the
+other standing robot j and to the mover (the paper's theta_1, theta_2: no heading reference is
+needed), with Gaussian noise. Its line of sight in the world is then the direction of
+(estimate_j - estimate_i) turned by the measured theta_i, and the mover's estimate is where the
+two lines meet (kiseki.coop.triangulate). A robot drives exactly to its planned point (the
+paper models no motion error); the error at the goal is the distance between the estimate of the
+robot that moved to the goal and the goal.
+
+**The two movement forms.** The paper's drawings (Figs. 3, 4) are not in its text; it says only
+that advancing one unit along y takes 2 moves in form 1 and 1 in form 2, and that each form has
+a representative angle. kiseki's reading, with both forms starting from the paper's positions
+(robots at (-1, 0), (1, 0) and, behind them, (0, -1)) and ending with a move onto the goal:
+
+* **Form 1, pair and scout** (2 moves per unit). Two robots stand side by side, half-width w
+  apart from their centre; the third, behind them, moves to the apex ahead of them where both
+  see it at the representative angle theta from their baseline (theta_1 = theta_2 = theta, the
+  case of the paper's sec. 3.1; the unit is that apex height h = w tan(theta)). Then the pair
+  robot nearer to where it goes moves up beside the scout, 2 w to the side, so that the scout
+  and it form the next pair (the centre of the pair moving by w to one side and back the next
+  time); the pair robot left behind is the next scout. The first apex is over the start's
+  baseline (w = 1 m); the others are spaced evenly to reach the goal, with w = h / tan(theta).
+  An odd number of moves (A, B, ..., A): the last is the scout's, to the goal.
+* **Form 2, leapfrog** (1 move per unit). The robots stand on a zigzag of points on two rails
+  x = +-w, one unit s apart along y; at each move the rearmost robot jumps over the other two to
+  the next point ahead. Each measured triangle is isosceles: the standing robot on the mover's
+  rail, 2 s behind, sees the mover and the other standing robot at the representative angle
+  theta (tan(theta) = 2 w / s), and so does the mover. s = distance / n; the last point is the
+  goal.
+
+The number of moves n and the representative angle are independent in both forms: the
+formation's width follows from them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from kiseki import _core
+from kiseki.coop.triangulation import MIN_INTERSECTION_ANGLE
+
+#: The paper's simulation (sec. 4): start positions, goal, angle noise.
+START = np.array([[-1.0, 0.0], [1.0, 0.0], [0.0, -1.0]])
+GOAL = np.array([0.0, 10.0])
+ANGLE_SIGMA = math.radians(0.1)
+FORMS = (1, 2)
+
+
+@dataclass(frozen=True)
+class Move:
+    """One step: ``robot`` drives to ``target`` while ``standing`` (two robots) measure it."""
+
+    robot: int
+    target: np.ndarray
+    standing: tuple[int, int]
+
+
+@dataclass(frozen=True)
+class Plan:
+    form: int
+    moves: int
+    angle: float  # rad, the representative angle
+    start: np.ndarray = field(repr=False)
+    steps: list[Move] = field(repr=False)
+
+    def nominal_positions(self) -> np.ndarray:
+        """(moves + 1, 3, 2): every robot's planned position before the first move and after
+        each move."""
+        at = self.start.copy()
+        out = [at.copy()]
+        for m in self.steps:
+            at[m.robot] = m.target
+            out.append(at.copy())
+        return np.array(out)
+
+
+def paper_angle(form: int, moves: int, start=START, goal=GOAL) -> float:
+    """The representative angle (rad) when the formation keeps the start's width, as in the
+    paper's simulation, where the number of moves alone sets the geometry: form 1, tan(theta)
+    = h / w with h = distance / ((moves + 1) / 2); form 2, tan(theta) = 2 w / s with s =
+    distance / moves (w: half the start's baseline, 1 m)."""
+    start = np.asarray(start, dtype=float)
+    goal = np.asarray(goal, dtype=float)
+    if form not in FORMS:
+        raise ValueError(f"form must be 1 or 2, got {form!r}")
+    if not isinstance(moves, int) or isinstance(moves, bool) or moves < 1:
+        raise ValueError(f"moves must be an integer >= 1, got {moves!r}")
+    order = np.argsort(start[:, 1])
+    w = abs(start[order[1], 0] - start[order[2], 0]) / 2
+    if form == 1:
+        level = start[order[1:], 1].mean()
+        return math.atan((goal[1] - level) / ((moves + 1) // 2) / w)
+    return math.atan(2 * w / ((goal[1] - start[:, 1].max()) / moves))
+
+
+def _check(form: int, moves: int, angle: float) -> None:
+    if form not in FORMS:
+        raise ValueError(f"form must be 1 or 2, got {form!r}")
+    if not isinstance(moves, int) or isinstance(moves, bool) or not 1 <= moves <= 1000:
+        raise ValueError(f"moves must be an integer in 1..1000, got {moves!r}")
+    if form == 1 and moves % 2 == 0:
+        raise ValueError(
+            f"form 1 takes an odd number of moves (scout, pair, ..., scout), got {moves}"
+        )
+    if not (math.isfinite(angle) and math.radians(5) <= angle <= math.radians(85)):
+        raise ValueError(
+            f"the representative angle must lie in 5..85 deg, got {math.degrees(angle)}"
+        )
+
+
+def plan(form: int, moves: int, angle: float | None = None, start=START, goal=GOAL) -> Plan:
+    """The planned moves of a form (see the module) from ``start`` (3 x 2, the paper's by
+    default) to ``goal`` in ``moves`` moves at the representative ``angle`` (rad; None: the
+    formation keeps the start's width and the angle follows from ``moves``, ``paper_angle``)."""
+    if angle is None:
+        angle = paper_angle(form, moves, start, goal)
+    _check(form, moves, angle)
+    start = np.asarray(start, dtype=float)
+    goal = np.asarray(goal, dtype=float)
+    if start.shape != (3, 2) or not np.isfinite(start).all():
+        raise ValueError(f"start: expected 3 finite (x, y) rows, got shape {start.shape}")
+    if goal.shape != (2,) or not np.isfinite(goal).all():
+        raise ValueError(f"goal: expected a finite (x, y), got {goal!r}")
+    if not goal[1] > start[:, 1].max():
+        raise ValueError("the goal must lie ahead (greater y) of every start position")
+    steps = _form1(moves, angle, start, goal) if form == 1 else _form2(moves, angle, start, goal)
+    return Plan(form, moves, angle, start, steps)
+
+
+def _form1(moves: int, angle: float, start: np.ndarray, goal: np.ndarray) -> list[Move]:
+    pair = [int(i) for i in np.argsort(start[:, 1])[1:]]  # the two ahead; the third scouts
+    scout = int(np.argmin(start[:, 1]))
+    pos = start.copy()
+    level = float(pos[pair, 1].mean())
+    centre = float(pos[pair, 0].mean())  # the start's pair is centred on the goal's x
+    width = abs(pos[pair[0], 0] - pos[pair[1], 0]) / 2
+    apexes = (moves + 1) // 2
+    first = width * math.tan(angle)
+    if apexes > 1 and level + first >= goal[1]:
+        raise ValueError(
+            f"at {math.degrees(angle):.0f} deg the first apex over the start's baseline is "
+            "already past the goal: use a smaller angle or fewer moves"
+        )
+    rise = first if apexes == 1 else (goal[1] - level - first) / (apexes - 1)
+    steps: list[Move] = []
+    turn = 1.0  # the side the joiner takes when the scout is on the centre line: +, -, +, ...
+    for k in range(apexes):
+        h = first if k == 0 else rise
+        target = np.array([centre, level + h]) if k < apexes - 1 else goal.copy()
+        steps.append(Move(scout, target, (pair[0], pair[1])))
+        pos[scout] = target
+        if k == apexes - 1:
+            break
+        level += h
+        width = rise / math.tan(angle)
+        if abs(target[0] - goal[0]) < 1e-12:  # the scout on the centre line: alternate sides
+            side, turn = turn, -turn
+        else:  # off it: the pair's centre goes back to the line
+            side = -math.copysign(1.0, target[0] - goal[0])
+        joiner_at = np.array([target[0] + 2 * width * side, level])
+        joiner = min(pair, key=lambda i: float(np.hypot(*(pos[i] - joiner_at))))
+        left = pair[0] if joiner == pair[1] else pair[1]
+        steps.append(Move(joiner, joiner_at, (scout, left)))
+        pos[joiner] = joiner_at
+        pair, scout = [scout, joiner], left
+        centre = float(target[0] + width * side)
+    return steps
+
+
+def _form2(moves: int, angle: float, start: np.ndarray, goal: np.ndarray) -> list[Move]:
+    pos = start.copy()
+    base = float(pos[:, 1].max())
+    s = (goal[1] - base) / moves
+    w = s * math.tan(angle) / 2
+    order = [int(i) for i in np.argsort(pos[:, 1], kind="stable")]  # rearmost first
+    steps: list[Move] = []
+    for j in range(1, moves + 1):
+        mover = order[0]
+        target = (
+            goal.copy() if j == moves else np.array([goal[0] + (w if j % 2 else -w), base + j * s])
+        )
+        steps.append(Move(mover, target, (order[1], order[2])))
+        pos[mover] = target
+        order = [order[1], order[2], mover]
+    return steps
+
+
+@dataclass(frozen=True)
+class CoopRun:
+    """``runs`` noisy runs of one plan."""
+
+    plan: Plan
+    estimates: np.ndarray  # (runs, moves + 1, 3, 2): every robot's estimate after each move
+    truth: np.ndarray  # (moves + 1, 3, 2)
+    angle_sigma: float
+
+    @property
+    def goal_errors(self) -> np.ndarray:
+        """(runs,) distance between the goal and the estimate of the robot that moved there."""
+        last = self.plan.steps[-1]
+        return np.hypot(*(self.estimates[:, -1, last.robot] - last.target).T)
+
+
+def _wrap(a: np.ndarray) -> np.ndarray:
+    return np.remainder(a + np.pi, 2 * np.pi) - np.pi
+
+
+def simulate(
+    the_plan: Plan, runs: int = 100, angle_sigma: float = ANGLE_SIGMA, seed: int = 0
+) -> CoopRun:
+    """``runs`` runs of a plan with Gaussian noise of SD ``angle_sigma`` (rad) on every measured
+    angle. Seeded: the same seed gives the same runs."""
+    if not isinstance(runs, int) or isinstance(runs, bool) or not 1 <= runs <= 1_000_000:
+        raise ValueError(f"runs must be an integer in 1..1,000,000, got {runs!r}")
+    if not (math.isfinite(angle_sigma) and 0 <= angle_sigma < math.radians(10)):
+        raise ValueError(f"angle_sigma must lie in [0, 10 deg), got {angle_sigma}")
+    if not isinstance(seed, int) or not 0 <= seed < 2**64:
+        raise ValueError(f"seed must be an integer in 0..2^64-1, got {seed!r}")
+    rng = np.random.default_rng(seed)
+    truth = the_plan.nominal_positions()
+    est = np.empty((runs, len(the_plan.steps) + 1, 3, 2))
+    est[:, 0] = the_plan.start  # the start positions are measured beforehand (sec. 2)
+    for k, move in enumerate(the_plan.steps):
+        at = truth[k]
+        i, j = move.standing
+        current = est[:, k].copy()
+        bearings = []
+        for a, b in ((i, j), (j, i)):
+            measured = _wrap(
+                math.atan2(*(move.target - at[a])[::-1]) - math.atan2(*(at[b] - at[a])[::-1])
+            ) + rng.normal(0.0, angle_sigma, runs)
+            baseline = current[:, b] - current[:, a]
+            bearings.append(np.arctan2(baseline[:, 1], baseline[:, 0]) + measured)
+        try:
+            found = _core.triangulate_pairs(
+                current[:, i], current[:, j], bearings[0], bearings[1], MIN_INTERSECTION_ANGLE
+            )
+        except ValueError as err:
+            raise ValueError(
+                f"form {the_plan.form}, move {k + 1} (robot {move.robot + 1}): {err}"
+            ) from None
+        current[:, move.robot] = found
+        est[:, k + 1] = current
+    return CoopRun(the_plan, est, truth, angle_sigma)
