@@ -214,10 +214,10 @@ def test_coop_experiment_claims_and_cli(tmp_path) -> None:
 
     from kiseki.experiments import run_experiment
 
-    with pytest.raises(ValueError, match="9 settings"):
+    with pytest.raises(ValueError, match="10 settings"):
         run_experiment(
             "coop-forms",
-            runs=10,
+            runs=11,
             overrides=["form1_moves=3,5,7,9", "form2_moves=5,7"],
             out=tmp_path / "too_many",
             progress=False,
@@ -238,6 +238,8 @@ def test_coop_experiment_claims_and_cli(tmp_path) -> None:
     assert (table["mean_error_m"] > 0).all() and (table["mean_error_m"] < 1.0).all()
     dead = pd.read_csv(run.run_dir / "tables" / "dead_reckoning.csv")
     assert dead["mean_error_m"].iloc[0] > table["mean_error_m"].min()
+    planner = pd.read_csv(run.run_dir / "tables" / "planner.csv")
+    assert planner["predicted_rms_m"].iloc[0] < table["predicted_rms_m"].min()
     done = subprocess.run(
         [sys.executable, "-m", "kiseki.cli", "coop", "simulate", "--form", "2", "--moves", "7",
          "--runs", "50", "--plot", str(tmp_path / "g.png")],
@@ -250,3 +252,46 @@ def test_coop_experiment_claims_and_cli(tmp_path) -> None:
         capture_output=True, text=True,
     )  # fmt: skip
     assert bad.returncode == 1 and bad.stderr.startswith("kiseki: error: form 1 takes an odd")
+
+
+# --- first-order prediction and the move planner ---
+
+from kiseki.coop.planner import plan_moves, predict, predicted_goal_rms  # noqa: E402
+
+
+@pytest.mark.parametrize(("form", "moves"), [(1, 5), (1, 15), (2, 7), (2, 20)])
+def test_predicted_covariance_matches_monte_carlo(form: int, moves: int) -> None:
+    p = plan(form, moves)
+    tiny = math.radians(1e-3)  # first order holds
+    run = simulate(p, 3000, tiny, seed=11)
+    for k in (len(p.steps) // 2, len(p.steps)):
+        err = (run.estimates[:, k] - run.truth[k]).reshape(len(run.estimates), 6)
+        sample = np.cov(err.T)
+        cov = predict(p, tiny)[k]
+        assert np.linalg.norm(sample - cov) < 0.08 * np.linalg.norm(cov), (form, moves, k)
+    # and at the paper's noise the RMS at the goal
+    full = simulate(p, 3000, seed=12)
+    d = full.estimates[:, -1, p.steps[-1].robot] - p.steps[-1].target
+    assert predicted_goal_rms(p) == pytest.approx(np.sqrt((d**2).sum(1).mean()), rel=0.05)
+
+
+def test_prediction_stays_positive_semidefinite_on_long_chains() -> None:
+    p = plan(1, 71, None, START, (0.0, 21.5))
+    for cov in predict(p):
+        assert np.linalg.eigvalsh(cov).min() >= -1e-12 * max(1.0, np.trace(cov))
+
+
+def test_planner_beats_every_swept_setting() -> None:
+    chosen = plan_moves()
+    assert np.allclose(chosen.steps[-1].target, GOAL)
+    for m in chosen.steps:
+        assert m.robot not in m.standing and len(set(m.standing)) == 2
+        assert np.abs(m.target[0] - GOAL[0]) <= 2.0 + 1e-9  # within its region
+    swept = [plan(1, n) for n in range(1, 40, 2)] + [plan(2, n) for n in range(1, 31)]
+    best = min(swept, key=predicted_goal_rms)
+    assert predicted_goal_rms(chosen) < 0.9 * predicted_goal_rms(best)
+    ours = simulate(chosen, 3000, seed=21).goal_errors.mean()
+    theirs = simulate(best, 3000, seed=21).goal_errors.mean()
+    assert ours < theirs
+    with pytest.raises(ValueError, match="spacing"):
+        plan_moves(spacing=0.0)
