@@ -358,8 +358,10 @@ def sim_show(
 
 @coop_app.command("simulate")
 def coop_simulate(
-    form: int = typer.Option(1, help="Movement form: 1 (pair and scout) or 2 (leapfrog)."),
-    moves: int = typer.Option(15, help="Moves to the goal (form 1: odd)."),
+    form: int | None = typer.Option(
+        None, help="Movement form: 1 (pair and scout, the default) or 2 (leapfrog)."
+    ),
+    moves: int | None = typer.Option(None, help="Moves to the goal (form 1: odd; default 15)."),
     angle: float | None = typer.Option(
         None, help="Representative angle (deg); default: the start's width kept, as the paper."
     ),
@@ -368,6 +370,9 @@ def coop_simulate(
     seed: int = typer.Option(0, help="Seed of the angle noise."),
     goal: tuple[float, float] = typer.Option((0.0, 10.0), help="Goal x y (m)."),
     plot: Path | None = typer.Option(None, help="Draw the paths and error ellipses to this PNG."),
+    planner: bool = typer.Option(
+        False, "--planner", help="Let the move planner choose the moves (not --form/--moves)."
+    ),
 ) -> None:
     """Three robots advance to the goal by turns (Hirose, Nagata and Kurazume); prints the
     error at the goal over the runs.
@@ -381,12 +386,25 @@ def coop_simulate(
     check_outputs({"--plot": plot}, {})
     if not (math.isfinite(sigma) and 0 <= sigma < 10):
         raise ValueError(f"--sigma must lie in [0, 10) deg, got {sigma}")
-    the_plan = plan(form, moves, None if angle is None else math.radians(angle), START, goal)
+    if planner and (form, moves, angle) != (None, None, None):
+        raise ValueError("--planner chooses the moves itself: drop --form, --moves and --angle")
+    form = 1 if form is None else form
+    moves = 15 if moves is None else moves
+    if planner:
+        from kiseki.coop.planner import plan_moves
+
+        the_plan = plan_moves(START, goal, math.radians(sigma))
+        what = f"planner, {the_plan.moves} moves"
+    else:
+        the_plan = plan(form, moves, None if angle is None else math.radians(angle), START, goal)
+        what = (
+            f"form {form}, {moves} moves, representative angle "
+            f"{math.degrees(the_plan.angle):.1f} deg"
+        )
     run = simulate(the_plan, runs, math.radians(sigma), seed)
     e = run.goal_errors
     console.print(
-        f"form {form}, {moves} moves, representative angle {math.degrees(the_plan.angle):.1f} "
-        f"deg, {runs} runs, {sigma} deg: error at the goal mean {1000 * e.mean():.1f} mm, SD "
+        f"{what}, {runs} runs, {sigma} deg: error at the goal mean {1000 * e.mean():.1f} mm, SD "
         f"{1000 * e.std():.1f} mm, max {1000 * e.max():.1f} mm",
         soft_wrap=True,  # one line, also when piped
     )

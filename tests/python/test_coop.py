@@ -252,6 +252,16 @@ def test_coop_experiment_claims_and_cli(tmp_path) -> None:
         capture_output=True, text=True,
     )  # fmt: skip
     assert bad.returncode == 1 and bad.stderr.startswith("kiseki: error: form 1 takes an odd")
+    both = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "coop", "simulate", "--planner", "--moves", "5"],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert both.returncode == 1 and "--planner chooses the moves itself" in both.stderr
+    chosen = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "coop", "simulate", "--planner", "--runs", "20"],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert chosen.returncode == 0 and chosen.stdout.startswith("planner, 5 moves")
 
 
 # --- first-order prediction and the move planner ---

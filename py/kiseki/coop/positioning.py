@@ -67,9 +67,9 @@ class Move:
 
 @dataclass(frozen=True)
 class Plan:
-    form: int
+    form: int  # 1 or 2; 0: chosen by the planner (kiseki.coop.planner)
     moves: int
-    angle: float  # rad, the representative angle
+    angle: float  # rad, the representative angle (NaN for the planner's)
     start: np.ndarray = field(repr=False)
     steps: list[Move] = field(repr=False)
 

@@ -59,10 +59,11 @@ def render_run(run: CoopRun, path: str | os.PathLike, magnify: float | None = No
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title(
-        f"form {run.plan.form}, {run.plan.moves} moves, {np.degrees(run.plan.angle):.0f} deg; "
-        f"2-SD ellipses x{magnify:g}",
-        fontsize=9,
+    what = (
+        f"planner, {run.plan.moves} moves"
+        if run.plan.form == 0
+        else f"form {run.plan.form}, {run.plan.moves} moves, {np.degrees(run.plan.angle):.0f} deg"
     )
+    ax.set_title(f"{what}; 2-SD ellipses x{magnify:g}", fontsize=9)
     ax.legend(fontsize=7, loc="lower right")
     return save_figure(fig, path)
