@@ -15,7 +15,6 @@ from kiseki.sim.magnetic import (
     DEFAULT_EARTH_TOTAL,
     DEFAULT_INCLINATION_DEG,
     ROBOT_SOURCE_MOMENT,
-    BearingSensor,
     Dipole,
     DipoleLine,
     MagneticWorld,
@@ -470,57 +469,3 @@ def test_magnetic_azimuth_convention():
     assert magnetic_azimuth([-1.0, 0.0, 0.3]) == pytest.approx(-math.pi)  # [-pi, pi)
     with pytest.raises(ValueError, match="reading"):
         magnetic_azimuth([0.1, float("nan"), 0.3])
-
-
-# ----------------------------------------------------------------------------------- bearing
-
-
-def test_bearing_geometry_and_wrapping():
-    sensor = BearingSensor(noise_sd_deg=0.0)
-    assert sensor.measure((0, 0, 0), (1, 1)) == pytest.approx(math.pi / 4)
-    assert sensor.measure((1, 1, math.pi / 2), (1, 3)) == pytest.approx(0.0)
-    assert sensor.measure((0, 0, math.pi / 2), (1, 0)) == pytest.approx(-math.pi / 2)
-    assert sensor.measure((0, 0, 0), (-1, 0)) == pytest.approx(-math.pi)  # wrapped to [-pi, pi)
-    assert sensor.measure((0, 0, 3.0), (0, -1)) == pytest.approx(
-        math.atan2(math.sin(-math.pi / 2 - 3.0), math.cos(-math.pi / 2 - 3.0))
-    )
-    obs = np.array([[0, 0, 0], [2, 2, -1], [5, -1, 3]])
-    tgt = np.array([[1, -1], [0, 0], [4, 4]])
-    expected = [sensor.measure(o, t) for o, t in zip(obs, tgt, strict=True)]
-    np.testing.assert_allclose(sensor.measure_many(obs, tgt), expected)
-
-
-def test_bearing_noise_statistics_and_wrap_at_pi():
-    n = 20000
-    sd = math.radians(0.1)
-    sensor = BearingSensor(noise_sd_deg=0.1, seed=99)
-    obs = np.tile([1.0, 1.0, 0.4], (n, 1))
-    tgt = np.array([4.0, 5.0])
-    truth = BearingSensor.true_bearings(obs[:1], tgt)[0]
-    b = sensor.measure_many(obs, tgt)
-    assert b.std(ddof=1) == pytest.approx(sd, rel=0.03)
-    assert abs(b.mean() - truth) < 4 * sd / math.sqrt(n)
-    # a target straight behind: readings on both sides of the cut, all in [-pi, pi)
-    behind = sensor.measure_many(np.zeros((n, 3)), (-1.0, 0.0))
-    assert np.all((behind >= -math.pi) & (behind < math.pi))
-    assert (behind > 0).any() and (behind < 0).any()
-    error = np.angle(np.exp(1j * (behind - math.pi)))
-    assert error.std(ddof=1) == pytest.approx(sd, rel=0.03)
-    assert abs(error.mean()) < 4 * sd / math.sqrt(n)
-
-
-def test_bearing_determinism_and_bad_input():
-    obs, tgt = np.zeros((5, 3)), np.ones((5, 2))
-    a = BearingSensor(seed=1).measure_many(obs, tgt)
-    assert np.array_equal(a, BearingSensor(seed=1).measure_many(obs, tgt))
-    assert not np.allclose(a, BearingSensor(seed=2).measure_many(obs, tgt), rtol=0, atol=1e-9)
-    with pytest.raises(ValueError, match="noise_sd_deg"):
-        BearingSensor(noise_sd_deg=-0.1)
-    with pytest.raises(ValueError, match="observer_pose"):
-        BearingSensor().measure((0.0, float("nan"), 0.0), (1.0, 1.0))
-    with pytest.raises(ValueError, match="target_xy"):
-        BearingSensor().measure((0.0, 0.0, 0.0), (1.0, 1.0, 1.0))
-    with pytest.raises(ValueError, match="coincides"):
-        BearingSensor().measure((1.0, 1.0, 0.0), (1.0, 1.0))
-    with pytest.raises(ValueError, match="row counts"):
-        BearingSensor().measure_many(np.zeros((3, 3)), np.ones((2, 2)))

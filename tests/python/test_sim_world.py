@@ -313,7 +313,7 @@ def test_mutual_bearings_of_three_robots_match_the_geometry(tmp_path):
     simulate(scene, tmp_path / "coop.mcap", SimConfig(seed=7), progress=False)
     run = read_run(tmp_path / "coop.mcap")
     truth = {n: run.messages(f"/{n}/ground_truth") for n in ("r1", "r2", "r3")}
-    errors = []
+    errors, hidden = [], 0
     for observer in ("r1", "r2", "r3"):
         for i, (_, msg) in enumerate(run.messages(f"/{observer}/bearings")):
             me = truth[observer][i][1]["pose"]
@@ -321,8 +321,23 @@ def test_mutual_bearings_of_three_robots_match_the_geometry(tmp_path):
             yaw = 2 * math.atan2(me["orientation"]["z"], me["orientation"]["w"])
             for target, measured in zip(msg["targets"], msg["bearings"], strict=True):
                 other = truth[target][i][1]["pose"]["position"]
+                (third,) = {"r1", "r2", "r3"} - {observer, target}
+                c = truth[third][i][1]["pose"]["position"]
+                # the third robot's body (0.3 m) on the line of sight hides the target
+                a, b, q = (
+                    np.array([x, y]),
+                    np.array([other["x"], other["y"]]),
+                    np.array([c["x"], c["y"]]),
+                )
+                lam = np.clip((q - a) @ (b - a) / ((b - a) @ (b - a)), 0, 1)
+                blocked = np.linalg.norm(q - a - lam * (b - a)) < 0.3
+                assert (measured is None) == blocked, (observer, target, i)
+                if measured is None:
+                    hidden += 1
+                    continue
                 expected = math.atan2(other["y"] - y, other["x"] - x) - yaw
                 errors.append(math.remainder(measured - expected, 2 * math.pi))
+    assert hidden > 0  # r3 drives between r1 and r2
     errors = np.degrees(errors)
     assert len(errors) > 300
     assert abs(errors.std() - 0.1) < 0.1 * 4 / math.sqrt(2 * len(errors)) + 0.005

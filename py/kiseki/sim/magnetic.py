@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Simulated magnetic field, a 3-axis magnetometer and a bearing sensor.
+"""Simulated magnetic field and a 3-axis magnetometer.
 
 The field model follows the facts of the magnetic-navigation thesis
 (``002_74cea16d239c028f.txt``, Japanese original, chapter 2, pp. 13-24; English digest in
@@ -53,7 +53,6 @@ __all__ = [
     "DEFAULT_NOISE_SD",
     "MU0_OVER_4PI_GAUSS",
     "ROBOT_SOURCE_MOMENT",
-    "BearingSensor",
     "Dipole",
     "DipoleLine",
     "MagneticWorld",
@@ -702,53 +701,3 @@ def magnetic_azimuth(reading: Any) -> float | np.ndarray:
     a = _finite_array(a.reshape(1, 3) if single else a, (None, 3), "reading")
     az = np.asarray(normalize_angle(np.arctan2(a[:, 1], a[:, 0])), dtype=float)
     return float(az[0]) if single else az
-
-
-class BearingSensor:
-    """Bearing (direction) from one robot to another, for cooperative positioning (paper 001:
-    angle noise N(0, 0.1 deg)).
-
-    ``noise_sd_deg``: SD of the additive Gaussian noise, degrees (default 0.1, paper 001's
-    simulation). ``seed``: seed of the sensor's own :class:`kiseki.core.Random` stream.
-    """
-
-    def __init__(self, noise_sd_deg: float = 0.1, seed: int = 0) -> None:
-        self.noise_sd_deg = _finite_scalar(noise_sd_deg, "noise_sd_deg", minimum=0.0)
-        self.noise_sd = math.radians(self.noise_sd_deg)
-        self.seed = _seed(seed, "seed")
-        self._rng = Random(self.seed)
-
-    @staticmethod
-    def true_bearings(observer_poses: Any, targets_xy: Any) -> np.ndarray:
-        """Noiseless bearings (n,) rad in the observers' frames, wrapped to [-pi, pi)."""
-        obs, tgt = _bearing_inputs(observer_poses, targets_xy)
-        dx, dy = tgt[:, 0] - obs[:, 0], tgt[:, 1] - obs[:, 1]
-        if np.any((dx == 0) & (dy == 0)):
-            raise ValueError("targets_xy: a target coincides with its observer (no bearing)")
-        return np.asarray(normalize_angle(np.arctan2(dy, dx) - obs[:, 2]), dtype=float)
-
-    def measure_many(self, observer_poses: Any, targets_xy: Any) -> np.ndarray:
-        """Noisy bearings (n,) rad, counter-clockwise from the observer's x axis, wrapped to
-        [-pi, pi). ``observer_poses`` (n, 3) or (3,), ``targets_xy`` (n, 2) or (2,)."""
-        b = self.true_bearings(observer_poses, targets_xy)
-        if self.noise_sd > 0 and b.size:
-            b = np.asarray(normalize_angle(b + self._rng.normal(0.0, self.noise_sd, b.size)))
-        return b
-
-    def measure(self, observer_pose: Any, target_xy: Any) -> float:
-        """One noisy bearing, rad, in the observer's frame, wrapped to [-pi, pi)."""
-        obs, _ = _poses(observer_pose, "observer_pose")
-        tgt = _finite_array(target_xy, (2,), "target_xy")
-        if obs.shape[0] != 1:
-            raise ValueError(f"observer_pose: expected (x, y, theta), got shape {obs.shape}")
-        return float(self.measure_many(obs, tgt[None])[0])
-
-
-def _bearing_inputs(observer_poses: Any, targets_xy: Any) -> tuple[np.ndarray, np.ndarray]:
-    obs, _ = _poses(observer_poses, "observer_poses")
-    t = _float_array(targets_xy, "targets_xy")
-    t = _finite_array(t.reshape(1, 2) if t.shape == (2,) else t, (None, 2), "targets_xy")
-    n = max(obs.shape[0], t.shape[0])
-    if obs.shape[0] not in (1, n) or t.shape[0] not in (1, n):
-        raise ValueError(f"observer_poses {obs.shape} and targets_xy {t.shape}: row counts differ")
-    return np.broadcast_to(obs, (n, 3)), np.broadcast_to(t, (n, 2))

@@ -109,7 +109,11 @@ BEARING_SCHEMA = {
     "title": "kiseki.Bearings",
     "properties": {
         "targets": {"type": "array", "items": {"type": "string"}},
-        "bearings": {"type": "array", "description": "rad, counter-clockwise in the robot frame"},
+        "bearings": {
+            "type": "array",
+            "description": "rad, counter-clockwise in the sensor frame; null: not seen",
+        },
+        "elevations": {"type": "array", "description": "rad above the horizontal; null: not seen"},
     },
 }
 
@@ -172,13 +176,27 @@ class _Recorder:
                 MAG_SCHEMA,
             )
         elif s.kind == "bearing":
-            targets = np.array([positions[name][:2] for name in s.targets])
-            bearings = s.device.measure_many(np.asarray(pose), targets)
+            # the markers sit at the sensor's height on every robot (the scenes are planar)
+            planar = s.mount.planar(pose)
+            sensor = (planar[0], planar[1], s.mount.z, planar[2])
+            targets = np.array([[*positions[n][:2], s.mount.z] for n in s.targets])
+            others = np.array([v[:2] for v in positions.values()])
+            seen = s.device.observe(sensor, targets, self.scene.world, others)
             w.write_json(
                 topic,
                 t,
                 "kiseki.Bearings",
-                {"targets": list(s.targets), "bearings": [float(b) for b in bearings]},
+                {
+                    "targets": list(s.targets),
+                    "bearings": [
+                        float(b) if ok else None
+                        for b, ok in zip(seen.bearings, seen.visible, strict=True)
+                    ],
+                    "elevations": [
+                        float(e) if ok else None
+                        for e, ok in zip(seen.elevations, seen.visible, strict=True)
+                    ],
+                },
                 BEARING_SCHEMA,
             )
         elif s.kind == "tilting_laser":

@@ -269,3 +269,104 @@ def with_overrides(params, overrides: dict, where: str):
         return replace(params, **overrides)
     except (TypeError, ValueError) as err:
         raise ValueError(f"{where}: {err}") from err
+
+
+@dataclass(frozen=True)
+class BearingParams:
+    """A bearing sensor: the direction to another robot's marker (cooperative positioning,
+    paper 001), horizontally (bearing, in the sensor's frame) and vertically (elevation above
+    the horizontal plane; a levelled sensor).
+
+    Attributes (value -- source):
+        noise_sd_deg: 0.1 deg -- paper 001's simulation.
+        elevation_noise_sd_deg: 0.1 deg -- taken equal to the bearing's (assumption).
+        max_range: 20 m -- a camera finding a marker of a few centimetres (assumption); beyond
+            it a robot is not seen.
+        robot_radius: 0.3 m -- another robot hides what is behind it within this distance of
+            its centre (about the size of the paper's robots; assumption).
+    """
+
+    noise_sd_deg: float = 0.1
+    elevation_noise_sd_deg: float = 0.1
+    max_range: float = 20.0
+    robot_radius: float = 0.3
+
+    def __post_init__(self) -> None:
+        for name in ("noise_sd_deg", "elevation_noise_sd_deg", "robot_radius"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
+                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+        if not (isinstance(self.max_range, int | float) and 0 < self.max_range < 1e6):
+            raise ValueError(f"max_range must lie in (0, 1e6) m, got {self.max_range!r}")
+
+
+@dataclass(frozen=True)
+class BearingReadings:
+    """One reading per target: bearing (rad, counter-clockwise in the sensor frame, wrapped to
+    [-pi, pi)) and elevation (rad), NaN where the target is not seen; ``visible`` says which."""
+
+    bearings: np.ndarray
+    elevations: np.ndarray
+    visible: np.ndarray
+
+
+def _points(value, name: str, cols: int) -> np.ndarray:
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected numbers") from None
+    a = a.reshape(1, cols) if a.shape == (cols,) else a
+    if a.ndim != 2 or a.shape[1] != cols or not np.isfinite(a).all():
+        raise ValueError(f"{name}: expected finite rows of {cols} numbers, got shape {a.shape}")
+    return a
+
+
+class BearingSensor:
+    """Bearings and elevations from a sensor to other robots' markers, with line of sight:
+    a target is seen when it is within ``max_range``, when no obstacle of the world lies on the
+    straight line to it, and when no other robot's body (a vertical cylinder of
+    ``robot_radius``) crosses that line. Gaussian noise on what is seen; one seeded stream.
+    """
+
+    def __init__(self, params: BearingParams | None = None, seed: int = 0) -> None:
+        self.params = params if params is not None else BearingParams()
+        if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 2**64:
+            raise ValueError(f"seed must be an integer in 0..2^64-1, got {seed!r}")
+        self._rng = Random(seed)
+
+    def observe(self, sensor, targets, world=None, blockers=None) -> BearingReadings:
+        """``sensor`` (x, y, z, yaw) in the world; ``targets`` (n, 3) marker points;
+        ``world`` anything with ``cast_many(origins, directions, max_range)`` (a scene's world)
+        or None; ``blockers`` (m, 2) centres of the robots that can hide a target (the observer
+        and the target themselves are left out by distance)."""
+        s = _points(sensor, "sensor", 4)[0]
+        t = _points(targets, "targets", 3)
+        b = np.zeros((0, 2)) if blockers is None else _points(blockers, "blockers", 2)
+        p = self.params
+        d = t - s[:3]
+        dist = np.linalg.norm(d, axis=1)
+        if np.any(dist < 1e-9):
+            raise ValueError("targets: a target coincides with the sensor (no bearing)")
+        visible = dist <= p.max_range
+        if world is not None and len(t):
+            unit = d / dist[:, None]
+            hit = np.asarray(world.cast_many(np.tile(s[:3], (len(t), 1)), unit, p.max_range))
+            visible &= hit >= dist - 0.05  # the marker itself may touch its robot's box
+        if len(b) and len(t):
+            a2 = s[:2]
+            seg = t[:, :2] - a2  # (n, 2)
+            for c in b:
+                rel = c - a2
+                lam = np.clip((seg @ rel) / np.maximum((seg**2).sum(1), 1e-12), 0.0, 1.0)
+                gap = np.linalg.norm(rel - lam[:, None] * seg, axis=1)
+                own = (np.linalg.norm(rel) < 1e-6) | (np.linalg.norm(t[:, :2] - c, axis=1) < 1e-6)
+                visible &= ~((gap < p.robot_radius) & ~own)
+        bearing = np.arctan2(d[:, 1], d[:, 0]) - s[3]
+        elevation = np.arctan2(d[:, 2], np.hypot(d[:, 0], d[:, 1]))
+        z = self._rng.normal(0.0, 1.0, 2 * len(t)).reshape(2, len(t))
+        bearing = bearing + math.radians(p.noise_sd_deg) * z[0]
+        elevation = elevation + math.radians(p.elevation_noise_sd_deg) * z[1]
+        bearing = np.remainder(bearing + math.pi, 2 * math.pi) - math.pi
+        return BearingReadings(
+            np.where(visible, bearing, np.nan), np.where(visible, elevation, np.nan), visible
+        )

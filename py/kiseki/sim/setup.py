@@ -13,10 +13,12 @@ import numpy as np
 
 from kiseki.core import derive_seed
 from kiseki.sim import robot as robots
-from kiseki.sim.magnetic import BearingSensor, MagneticWorld, Magnetometer
+from kiseki.sim.magnetic import MagneticWorld, Magnetometer
 from kiseki.sim.scene import Scene
 from kiseki.sim.sensors import (
     LASER_PRESETS,
+    BearingParams,
+    BearingSensor,
     DepthCamera,
     DepthCameraParams,
     Laser2D,
@@ -219,7 +221,7 @@ def build_sensors(
                     f"{where}: bearing targets must be other robots of the scene "
                     f"({', '.join(sorted(others)) or 'none'}), got {list(targets)}"
                 )
-            device = BearingSensor(seed=s, **overrides)
+            device = BearingSensor(with_overrides(BearingParams(), overrides, where), s)
             period = _period(spec, dt, where)
         elif kind == "tilting_laser":
             device = TiltingLaser(with_overrides(TiltingLaserParams(), overrides, where), s)
