@@ -214,10 +214,10 @@ def test_coop_experiment_claims_and_cli(tmp_path) -> None:
 
     from kiseki.experiments import run_experiment
 
-    with pytest.raises(ValueError, match="10 settings"):
+    with pytest.raises(ValueError, match="12 settings"):
         run_experiment(
             "coop-forms",
-            runs=11,
+            runs=13,
             overrides=["form1_moves=3,5,7,9", "form2_moves=5,7"],
             out=tmp_path / "too_many",
             progress=False,
@@ -305,3 +305,30 @@ def test_planner_beats_every_swept_setting() -> None:
     assert ours < theirs
     with pytest.raises(ValueError, match="spacing"):
         plan_moves(spacing=0.0)
+
+
+# --- the 3-D case ---
+
+from kiseki.coop import simulate_3d  # noqa: E402
+
+
+def _wavy(x, y):
+    return 0.5 * np.sin(2 * np.pi * x / 4.0) * np.cos(2 * np.pi * y / 4.0)
+
+
+def test_three_d_on_uneven_ground() -> None:
+    p = plan(2, 7)
+    exact = simulate_3d(p, _wavy, 5, angle_sigma=0.0, elevation_sigma=0.0)
+    assert exact.goal_errors.max() < 1e-9
+    assert exact.truth[-1, p.steps[-1].robot, 2] == pytest.approx(_wavy(0.0, 10.0) + 0.5)
+    # flat ground: the horizontal error is the planar one (elevations add range information)
+    flat = simulate_3d(p, lambda x, y: np.zeros_like(x), 3000, seed=3)
+    planar = simulate(p, 3000, seed=3).goal_errors.mean()
+    horizontal = np.hypot(*flat.goal_offsets[:, :2].T).mean()
+    assert 0.75 * planar < horizontal <= 1.05 * planar
+    wavy = simulate_3d(p, _wavy, 3000, seed=3)
+    assert np.abs(wavy.goal_offsets[:, 2]).mean() < 0.2 * horizontal  # height from elevations
+    with pytest.raises(ValueError, match="ground"):
+        simulate_3d(p, lambda x, y: np.zeros(3))
+    with pytest.raises(ValueError, match="marker_height"):
+        simulate_3d(p, _wavy, marker_height=-1.0)

@@ -11,11 +11,13 @@ from kiseki.coop.positioning import (
     GOAL,
     START,
     CoopRun,
+    CoopRun3D,
     Move,
     Plan,
     paper_angle,
     plan,
     simulate,
+    simulate_3d,
 )
 from kiseki.coop.triangulation import (
     MIN_INTERSECTION_ANGLE,
@@ -31,6 +33,7 @@ __all__ = [
     "MIN_INTERSECTION_ANGLE",
     "START",
     "CoopRun",
+    "CoopRun3D",
     "Move",
     "Plan",
     "paper_angle",
@@ -38,5 +41,6 @@ __all__ = [
     "paper_position",
     "plan",
     "simulate",
+    "simulate_3d",
     "triangulate",
 ]

@@ -252,3 +252,97 @@ def simulate(
         current[:, move.robot] = found
         est[:, k + 1] = current
     return CoopRun(the_plan, est, truth, angle_sigma)
+
+
+@dataclass(frozen=True)
+class CoopRun3D:
+    """``runs`` noisy runs of a plan on uneven ground, in 3-D."""
+
+    plan: Plan
+    estimates: np.ndarray  # (runs, moves + 1, 3, 3)
+    truth: np.ndarray  # (moves + 1, 3, 3): the markers
+    angle_sigma: float
+    elevation_sigma: float
+
+    @property
+    def goal_offsets(self) -> np.ndarray:
+        """(runs, 3) estimate minus truth of the robot that moved to the goal."""
+        last = self.plan.steps[-1]
+        return self.estimates[:, -1, last.robot] - self.truth[-1, last.robot]
+
+    @property
+    def goal_errors(self) -> np.ndarray:
+        return np.linalg.norm(self.goal_offsets, axis=1)
+
+
+def simulate_3d(
+    the_plan: Plan,
+    ground,
+    runs: int = 100,
+    angle_sigma: float = ANGLE_SIGMA,
+    elevation_sigma: float | None = None,
+    seed: int = 0,
+    marker_height: float = 0.5,
+) -> CoopRun3D:
+    """The 3-D case (the paper's sec. 5: measure elevation angles too): the robots stand on
+    ``ground`` (a function z(x, y) of numpy arrays), each carrying a levelled sensor and a
+    marker ``marker_height`` above the ground. The standing robots measure the horizontal
+    angle between each other and the mover, as in 2-D, and the mover's elevation above the
+    horizontal; the mover's estimate is the least-squares point of the two lines of sight in
+    3-D (kiseki.coop.triangulate with elevations). ``elevation_sigma`` defaults to
+    ``angle_sigma``."""
+    if not isinstance(runs, int) or isinstance(runs, bool) or not 1 <= runs <= 100_000:
+        raise ValueError(f"runs must be an integer in 1..100,000, got {runs!r}")
+    e_sigma = angle_sigma if elevation_sigma is None else elevation_sigma
+    for name, v in (("angle_sigma", angle_sigma), ("elevation_sigma", e_sigma)):
+        if not (math.isfinite(v) and 0 <= v < math.radians(10)):
+            raise ValueError(f"{name} must lie in [0, 10 deg), got {v}")
+    if not (math.isfinite(marker_height) and 0 <= marker_height < 10):
+        raise ValueError(f"marker_height must lie in [0, 10) m, got {marker_height}")
+    if not isinstance(seed, int) or not 0 <= seed < 2**64:
+        raise ValueError(f"seed must be an integer in 0..2^64-1, got {seed!r}")
+    flat = the_plan.nominal_positions()
+    z = np.asarray(ground(flat[..., 0], flat[..., 1]), dtype=float)
+    if z.shape != flat.shape[:-1] or not np.isfinite(z).all():
+        raise ValueError("ground(x, y) must return finite heights of the shape of x")
+    truth = np.concatenate([flat, (z + marker_height)[..., None]], axis=-1)
+    rng = np.random.default_rng(seed)
+    est = np.empty((runs, len(the_plan.steps) + 1, 3, 3))
+    est[:, 0] = truth[0]
+    for k, move in enumerate(the_plan.steps):
+        at, target = truth[k], truth[k + 1][move.robot]
+        i, j = move.standing
+        current = est[:, k].copy()
+        measured = {}
+        for a, b in ((i, j), (j, i)):
+            d_target, d_other = target - at[a], at[b] - at[a]
+            horizontal = _wrap(
+                math.atan2(d_target[1], d_target[0]) - math.atan2(d_other[1], d_other[0])
+            )
+            elevation = math.atan2(d_target[2], math.hypot(d_target[0], d_target[1]))
+            measured[a] = (
+                horizontal + rng.normal(0.0, angle_sigma, runs),
+                elevation + rng.normal(0.0, e_sigma, runs),
+            )
+        for r in range(runs):
+            pa, pb = current[r, i], current[r, j]
+            bearings = [
+                math.atan2(*(pb - pa)[1::-1]) + measured[i][0][r],
+                math.atan2(*(pa - pb)[1::-1]) + measured[j][0][r],
+            ]
+            try:
+                position, _cov, _ranges, _angle = _core.triangulate_3d(
+                    np.stack([pa, pb]),
+                    bearings,
+                    [measured[i][1][r], measured[j][1][r]],
+                    0.0,
+                    0.0,
+                    MIN_INTERSECTION_ANGLE,
+                )
+            except ValueError as err:
+                raise ValueError(
+                    f"form {the_plan.form}, move {k + 1} (robot {move.robot + 1}): {err}"
+                ) from None
+            current[r, move.robot] = position
+        est[:, k + 1] = current
+    return CoopRun3D(the_plan, est, truth, angle_sigma, e_sigma)
