@@ -225,6 +225,72 @@ class _Agent:
     controller: PurePursuit | None
 
 
+TURN_SCHEMA = {
+    "type": "object",
+    "title": "kiseki.Turn",
+    "properties": {
+        "move": {"type": "integer", "description": "1-based index of the scene's turns"},
+        "robot": {"type": "string"},
+        "to": {"type": "array", "description": "planned place (x, y), m"},
+        "event": {"type": "string", "description": "start or arrived"},
+    },
+}
+
+
+class _Turns:
+    """The scene's turns: one robot drives to its place while the others stand; /turns logs
+    when each move starts and when its robot has arrived (the standing robots' bearings of that
+    moment are the move's measurement)."""
+
+    def __init__(self, scene: Scene, agents: list[_Agent], config: SimConfig) -> None:
+        self.moves = scene.turns["moves"]
+        self.speed = scene.turns["speed"]
+        self.by_name = {a.setup.name: a for a in agents}
+        self.config, self.index, self.controller = config, -1, None
+
+    @property
+    def done(self) -> bool:
+        return self.index >= len(self.moves)
+
+    def _at_rest(self) -> bool:
+        name = self.moves[self.index][0]
+        return all(abs(v) < 1e-6 for v in self.by_name[name].setup.robot.velocity)
+
+    def advance(self, writer, t: float) -> None:
+        """Starts the next move when the current robot has arrived and come to rest (a robot
+        that still rolls is not standing)."""
+        while not self.done and (
+            self.controller is None or (self.controller.done and self._at_rest())
+        ):
+            if self.controller is not None:
+                self._log(writer, t, "arrived")
+            self.index += 1
+            self.controller = None
+            if self.done:
+                return
+            name, to = self.moves[self.index]
+            setup = self.by_name[name].setup
+            x, y, _ = _pose(setup.robot.pose)
+            self.controller = PurePursuit(
+                [[x, y], list(to)],
+                self.speed,
+                self.config.lookahead,
+                self.config.goal_tolerance,
+                setup.robot.params.max_accel,
+            )
+            self._log(writer, t, "start")
+
+    def command(self, agent: _Agent) -> tuple[float, float, float]:
+        if self.done or agent.setup.name != self.moves[self.index][0]:
+            return 0.0, 0.0, 0.0  # standing
+        return self.controller.command(_pose(agent.setup.robot.pose))
+
+    def _log(self, writer, t: float, event: str) -> None:
+        name, to = self.moves[self.index]
+        payload = {"move": self.index + 1, "robot": name, "to": list(to), "event": event}
+        writer.write_json("/turns", t, "kiseki.Turn", payload, TURN_SCHEMA)
+
+
 def _agents(scene: Scene, config: SimConfig, commands) -> list[_Agent]:
     agents = []
     for index, spec in enumerate(scene.robot_specs):
@@ -240,7 +306,9 @@ def _agents(scene: Scene, config: SimConfig, commands) -> list[_Agent]:
                 setup.robot.params.max_accel,
             )
         agents.append(_Agent(setup, sensors, controller))
-    if commands is None and not any(a.controller for a in agents):
+    if scene.turns is not None and commands is not None:
+        raise ValueError(f"{scene.path}: the scene's robots take turns: no command script")
+    if commands is None and scene.turns is None and not any(a.controller for a in agents):
         raise ValueError(f"{scene.path}: no route: give velocity commands instead")
     if commands is not None and len(agents) > 1:
         raise ValueError(f"{scene.path}: command scripts drive one robot; this scene has several")
@@ -260,6 +328,7 @@ def simulate(
     config = config or SimConfig()
     agents = _agents(scene, config, commands)
     routed = [a for a in agents if a.controller is not None]
+    turns = _Turns(scene, agents, config) if scene.turns is not None else None
     limit = config.duration or (
         float(commands[-1, 0]) + config.dt if commands is not None else config.max_duration
     )
@@ -280,7 +349,7 @@ def simulate(
             _Recorder(writer, scene, a.setup, a.sensors, "" if single else f"/{a.setup.name}")
             for a in agents
         ]
-        total = steps if not routed else None  # a route ends when its goal is reached
+        total = steps if not (routed or turns) else None  # a route ends at its goal
         bar = tqdm(total=total, desc=scene.name, unit="step", disable=not progress, leave=False)
         with bar:
             for k in range(steps + 1):
@@ -288,10 +357,17 @@ def simulate(
                 positions = {a.setup.name: _pose(a.setup.robot.pose) for a in agents}
                 for recorder in recorders:
                     recorder.record(t, positions)
-                if k == steps or (routed and all(a.controller.done for a in routed)):
+                if turns is not None:
+                    turns.advance(writer, t)
+                if (
+                    k == steps
+                    or (routed and all(a.controller.done for a in routed))
+                    or (turns is not None and turns.done)
+                ):
                     break
                 for a in agents:
-                    _step(a.setup, _command(a, commands, t), config.dt)
+                    command = turns.command(a) if turns is not None else _command(a, commands, t)
+                    _step(a.setup, command, config.dt)
                 bar.update(1)
     counts = {topic: n for topic, (_, n) in _topic_counts(out).items()}
     first = agents[0].setup
@@ -300,7 +376,8 @@ def simulate(
         k,
         t,
         time.perf_counter() - start,
-        bool(routed) and all(a.controller.done for a in routed),
+        (bool(routed) and all(a.controller.done for a in routed))
+        or (turns is not None and turns.done),
         _pose(first.robot.pose),
         _pose(first.odometry.pose),
         counts,

@@ -10,11 +10,14 @@ kiseki.sim.primitives; an object may carry ``only_in: teach`` or ``only_in: play
 grid_resolution, robot {type, start [x, y, yaw_deg], params, odometry_errors}, sensors (list),
 route {waypoints [[x, y], ...], speed}, magnetic (see kiseki.sim.magnetic). Several robots:
 ``robots`` (a list of {name, type, start, params, odometry_errors, sensors, route}) instead of
-robot, sensors and route.
+robot, sensors and route; and with several robots, ``turns`` {goal, speed, moves [{robot, to}]}
+instead of routes: the robots take turns (cooperative positioning), one driving while the
+others stand.
 """
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -44,6 +47,7 @@ TOP_KEYS = {
     "route",
     "magnetic",
     "robots",
+    "turns",
 }
 ROBOT_ENTRY_KEYS = {"name", "type", "start", "params", "odometry_errors", "sensors", "route"}
 VARIANTS = ("teach", "playback")
@@ -66,6 +70,8 @@ class Scene:
     source: str = ""
     boxes: BoxList | None = None
     robot_specs: list = field(default_factory=list)  # [{name, robot, sensors, route}]
+    # cooperative positioning: {goal: (x, y), speed, moves: [(robot name, (x, y)), ...]}
+    turns: dict | None = None
 
     def ground_truth(
         self, z_min: float, z_max: float, resolution: float | None = None
@@ -173,8 +179,53 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
         source=str(doc.get("source", "")),
         boxes=boxes,
         robot_specs=specs,
+        turns=_turns(doc, where, specs),
     )
     return scene
+
+
+def _turns(doc: dict, where: str, specs: list[dict]) -> dict | None:
+    """``turns: {goal: [x, y], speed: m/s, moves: [{robot: NAME, to: [x, y]}, ...]}``: the
+    robots take turns (cooperative positioning): one drives straight to its place while the
+    others stand; the last move ends on the goal."""
+    if "turns" not in doc:
+        return None
+    t = doc["turns"]
+    if not isinstance(t, dict) or set(t) - {"goal", "speed", "moves"}:
+        raise ValueError(f"{where}: 'turns' must be a mapping of goal, speed and moves")
+    names = [spec["name"] for spec in specs]
+    if any(spec["route"] for spec in specs):
+        raise ValueError(f"{where}: a scene with 'turns' gives its robots no routes")
+
+    def point(value, what: str) -> tuple[float, float]:
+        if (
+            not isinstance(value, list | tuple)
+            or len(value) != 2
+            or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+            or not all(math.isfinite(v) for v in value)
+        ):
+            raise ValueError(f"{where}: turns: {what} must be [x, y] numbers, got {value!r}")
+        return float(value[0]), float(value[1])
+
+    goal = point(t.get("goal"), "goal")
+    speed = t.get("speed", 0.3)
+    if isinstance(speed, bool) or not isinstance(speed, int | float) or not 0 < speed <= 5:
+        raise ValueError(f"{where}: turns: speed must be in (0, 5] m/s, got {speed!r}")
+    moves = t.get("moves")
+    if not isinstance(moves, list) or not moves or len(moves) > 10_000:
+        raise ValueError(f"{where}: turns: moves must be a list of 1..10,000 moves")
+    out = []
+    for i, m in enumerate(moves):
+        if not isinstance(m, dict) or set(m) != {"robot", "to"}:
+            raise ValueError(f"{where}: turns: moves[{i}] must be {{robot: NAME, to: [x, y]}}")
+        if m["robot"] not in names:
+            raise ValueError(
+                f"{where}: turns: moves[{i}]: unknown robot {m['robot']!r} ({', '.join(names)})"
+            )
+        out.append((str(m["robot"]), point(m["to"], f"moves[{i}].to")))
+    if math.dist(out[-1][1], goal) > 1e-9:
+        raise ValueError(f"{where}: turns: the last move must end on the goal {list(goal)}")
+    return {"goal": goal, "speed": float(speed), "moves": out}
 
 
 def _robot_specs(doc: dict, where: str) -> list[dict]:
