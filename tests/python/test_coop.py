@@ -357,8 +357,16 @@ def test_the_scene_takes_the_turns_of_form_2_and_its_bearings_triangulate(tmp_pa
     summary = run_scene(scene, tmp_path / "coop.mcap", SimConfig(seed=3), progress=False)
     assert summary.reached_goal
     run = read_run(tmp_path / "coop.mcap")
-    truth = {n: np.array([[m["pose"]["position"]["x"], m["pose"]["position"]["y"]]
-                          for _, m in run.messages(f"/{n}/ground_truth")]) for n in names}  # fmt: skip
+
+    def track(name: str) -> np.ndarray:
+        return np.array(
+            [
+                [m["pose"]["position"]["x"], m["pose"]["position"]["y"]]
+                for _, m in run.messages(f"/{name}/ground_truth")
+            ]
+        )
+
+    truth = {n: track(n) for n in names}
     times = np.array([t for t, _ in run.messages("/r1/ground_truth")])
     bearings = {n: run.messages(f"/{n}/bearings") for n in names}
     events = run.messages("/turns")
