@@ -391,3 +391,12 @@ def test_the_scene_takes_the_turns_of_form_2_and_its_bearings_triangulate(tmp_pa
         found = triangulate(np.stack([truth[i][k1], truth[j][k1]]), world)
         errors.append(np.linalg.norm(found - truth[mover][k1]))
     assert max(errors) < 0.05 and len(errors) == 7  # 0.1 deg over a few metres: millimetres
+
+
+def test_the_papers_analytic_optimum_n_equals_tan_theta_e() -> None:
+    from kiseki.experiments.coop_forms import analytic_optimum
+
+    n, theta, _ = analytic_optimum(10.0, 1.0)
+    assert (n, round(theta, 6)) == (10, 45.0)  # eqs. 5-6 for the paper's goal
+    assert analytic_optimum(6.0, 1.0)[0] == 6  # n = tan(theta_e) = L / d elsewhere too
+    assert analytic_optimum(10.0, 2.0)[0] == 5

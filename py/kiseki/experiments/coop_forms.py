@@ -165,6 +165,23 @@ def trial(config: CoopFormsConfig, index: int, seed: int) -> TrialOutput:
     return TrialOutput({"kind": kind, **best, "distance_m": CPS2_DISTANCE})
 
 
+def analytic_optimum(distance: float = 10.0, d: float = 1.0, dtheta: float = 1e-3):
+    """The paper's sec. 3.1, from its eq. 4 (kiseki.coop.paper_error): each of n measurements
+    places the moving robot on the centre line, d tan(theta) ahead of a baseline of half-width
+    d, with theta1 = theta2 = theta and equal errors dtheta1 = dtheta2 (the along-track worst
+    case); the along-track errors add up over the n steps, and n d tan(theta) = distance.
+    Returns (n, theta in deg, the error) minimising that error over n = 1..200."""
+    from kiseki.coop import paper_error
+
+    best = None
+    for n in range(1, 201):
+        theta = math.atan(distance / (n * d))
+        error = n * abs(paper_error(d, theta, theta, dtheta, dtheta)[1])
+        if best is None or error < best[2]:
+            best = (n, math.degrees(theta), error)
+    return best
+
+
 def _best(rows: pd.DataFrame) -> pd.Series:
     return rows.loc[rows["mean_error_m"].idxmin()]
 
@@ -229,6 +246,21 @@ def analyze(config: CoopFormsConfig, trials: pd.DataFrame, timings: pd.DataFrame
                 holds=bool(s2 < s1),
             )
         )
+    n_opt, theta_opt, _ = analytic_optimum(float(GOAL[1] - START[:2, 1].mean()))
+    theta_e = math.degrees(math.atan((GOAL[1] - START[:2, 1].mean()) / 1.0))
+    claims.append(
+        Claim(
+            claim="along-track error (eq. 4, theta1 = theta2, equal errors) is smallest at "
+            "n = tan(theta_e) measurements and theta = pi/4",
+            paper_value=f"n = tan(theta_e) = {math.tan(math.radians(theta_e)):.0f}, 45 deg "
+            "(eqs. 5-6)",
+            measured_value=f"n = {n_opt}, {theta_opt:.1f} deg (brute force over n)",
+            unit="measurements, deg",
+            holds=bool(n_opt == round(math.tan(math.radians(theta_e))) and abs(theta_opt - 45) < 1),
+            note="the paper's own error model, summed over the steps; theta_e is the goal's "
+            "bearing from the start robots' baseline (half-width 1 m)",
+        )
+    )
     dead = ok[ok["kind"] == "dead-reckoning"]
     anchors = ok[ok["kind"] == "cps2"]
     extra = {}
