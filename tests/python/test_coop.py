@@ -200,6 +200,10 @@ def test_bad_plans_are_refused() -> None:
         plan(2, 5, math.radians(89))
     with pytest.raises(ValueError, match="ahead"):
         plan(2, 5, 0.9, goal=(0.0, -5.0))
+    with pytest.raises(ValueError, match="start: expected 3"):
+        plan(2, 5, start=[[0.0, 0.0]])
+    with pytest.raises(ValueError, match="numbers"):
+        plan(2, 5, goal=("a", 1))
     with pytest.raises(ValueError, match="runs"):
         simulate(plan(2, 5), 0)
     with pytest.raises(ValueError, match="seed"):

@@ -84,13 +84,27 @@ class Plan:
         return np.array(out)
 
 
+def _check_places(start, goal) -> tuple[np.ndarray, np.ndarray]:
+    try:
+        start = np.asarray(start, dtype=float)
+        goal = np.asarray(goal, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError("start and goal must be numbers") from None
+    if start.shape != (3, 2) or not np.isfinite(start).all():
+        raise ValueError(f"start: expected 3 finite (x, y) rows, got shape {start.shape}")
+    if goal.shape != (2,) or not np.isfinite(goal).all():
+        raise ValueError(f"goal: expected a finite (x, y), got {goal!r}")
+    if not goal[1] > start[:, 1].max():
+        raise ValueError("the goal must lie ahead (greater y) of every start position")
+    return start, goal
+
+
 def paper_angle(form: int, moves: int, start=START, goal=GOAL) -> float:
     """The representative angle (rad) when the formation keeps the start's width, as in the
     paper's simulation, where the number of moves alone sets the geometry: form 1, tan(theta)
     = h / w with h = distance / ((moves + 1) / 2); form 2, tan(theta) = 2 w / s with s =
     distance / moves (w: half the start's baseline, 1 m)."""
-    start = np.asarray(start, dtype=float)
-    goal = np.asarray(goal, dtype=float)
+    start, goal = _check_places(start, goal)
     if form not in FORMS:
         raise ValueError(f"form must be 1 or 2, got {form!r}")
     if not isinstance(moves, int) or isinstance(moves, bool) or moves < 1:
@@ -122,17 +136,10 @@ def plan(form: int, moves: int, angle: float | None = None, start=START, goal=GO
     """The planned moves of a form (see the module) from ``start`` (3 x 2, the paper's by
     default) to ``goal`` in ``moves`` moves at the representative ``angle`` (rad; None: the
     formation keeps the start's width and the angle follows from ``moves``, ``paper_angle``)."""
+    start, goal = _check_places(start, goal)
     if angle is None:
         angle = paper_angle(form, moves, start, goal)
     _check(form, moves, angle)
-    start = np.asarray(start, dtype=float)
-    goal = np.asarray(goal, dtype=float)
-    if start.shape != (3, 2) or not np.isfinite(start).all():
-        raise ValueError(f"start: expected 3 finite (x, y) rows, got shape {start.shape}")
-    if goal.shape != (2,) or not np.isfinite(goal).all():
-        raise ValueError(f"goal: expected a finite (x, y), got {goal!r}")
-    if not goal[1] > start[:, 1].max():
-        raise ValueError("the goal must lie ahead (greater y) of every start position")
     steps = _form1(moves, angle, start, goal) if form == 1 else _form2(moves, angle, start, goal)
     return Plan(form, moves, angle, start, steps)
 
