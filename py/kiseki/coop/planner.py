@@ -134,8 +134,14 @@ def plan_moves(
     formation would spread as wide as the lines of sight allow)."""
     start = np.asarray(start, dtype=float)
     goal = np.asarray(goal, dtype=float)
-    if start.shape != (3, 2) or goal.shape != (2,):
-        raise ValueError("start must be 3 x 2 and goal (x, y)")
+    if (
+        start.shape != (3, 2)
+        or goal.shape != (2,)
+        or not np.isfinite([*start.ravel(), *goal]).all()
+    ):
+        raise ValueError("start must be 3 finite (x, y) rows and goal a finite (x, y)")
+    if not (math.isfinite(angle_sigma) and 0 < angle_sigma < math.radians(10)):
+        raise ValueError(f"angle_sigma must lie in (0, 10 deg), got {angle_sigma}")
     if not (spacing > 0 and reach > spacing and half_width > 0 and 1 <= max_moves <= 1000):
         raise ValueError(
             "need spacing > 0, reach > spacing, half_width > 0 and 1 <= max_moves <= 1000"
@@ -168,6 +174,8 @@ def plan_moves(
         m, pair, target, gains_after = best[1]
         steps.append(Move(m, target.copy(), pair))
         at[m], g = target, gains_after
+    if not np.isfinite(finish):
+        raise ValueError("no robot can be triangulated on the goal from where the others stand")
     m = int(who)
     pair = tuple(r for r in range(3) if r != m)
     steps.append(Move(m, goal.copy(), pair))
