@@ -84,8 +84,24 @@ def render_scene(scene: Scene, path: str | os.PathLike) -> Path:
     for k, spec in enumerate(scene.robot_specs):
         label = spec["name"] if len(scene.robot_specs) > 1 else ""
         _draw_robot(ax, spec, label, f"C{k}")
+    if scene.turns is not None:
+        _draw_turns(ax, scene)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7)
     return _save(fig, path)
+
+
+def _draw_turns(ax, scene: Scene) -> None:
+    """The turns: each robot's moves as arrows from where it stands, numbered in order."""
+    names = [spec["name"] for spec in scene.robot_specs]
+    at = {spec["name"]: tuple(map(float, spec["robot"]["start"][:2])) for spec in scene.robot_specs}
+    for k, (name, to) in enumerate(scene.turns["moves"], start=1):
+        colour = f"C{names.index(name)}"
+        ax.annotate("", to, at[name], arrowprops={"arrowstyle": "->", "color": colour, "lw": 1})
+        ax.annotate(str(k), to, textcoords="offset points", xytext=(5, 3), fontsize=7)
+        at[name] = to
+    for k, name in enumerate(names):
+        ax.plot([], [], "-", color=f"C{k}", label=f"turns of {name}")
+    ax.plot(*scene.turns["goal"], "r*", markersize=12, label="goal")
 
 
 def _draw_robot(ax, spec: dict, label: str, colour: str) -> None:
