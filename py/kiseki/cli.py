@@ -61,6 +61,13 @@ def _root(
     """kiseki: mobile-robot localization and navigation toolkit."""
 
 
+def _seed_option(value: int) -> int:
+    """Every --seed: an integer in 0..2^64-1, refused in one line otherwise."""
+    from kiseki.core import check_seed
+
+    return check_seed(value, "--seed")
+
+
 def _positive(name: str, value: float) -> float:
     if not np.isfinite(value) or value <= 0:
         raise ValueError(f"{name} must be a positive number, got {value}")
@@ -232,7 +239,9 @@ def demo(
     scene: Path = typer.Option(
         Path("data/worlds/factory_turn.yaml"), "--scene", help="Scene with a taught route."
     ),
-    seed: int = typer.Option(0, help="Seed of every noise source of the run."),
+    seed: int = typer.Option(
+        0, callback=_seed_option, help="Seed of every noise source of the run."
+    ),
     particles: int = typer.Option(1000, help="Particles of the localization filter."),
     merge: str = typer.Option(
         "thesis", help="Merge rule of the taught maps: thesis or evidence (see kiseki teach)."
@@ -287,7 +296,9 @@ def sim_run(
     controller: str = typer.Option("route", help="'route' (pure pursuit) or 'commands'."),
     commands: Path | None = typer.Option(None, help="CSV t,v,w or t,vx,vy,w for 'commands'."),
     duration: float | None = typer.Option(None, help="Seconds to simulate (default: to goal)."),
-    seed: int = typer.Option(0, help="Seed of every noise source of the run."),
+    seed: int = typer.Option(
+        0, callback=_seed_option, help="Seed of every noise source of the run."
+    ),
     variant: str = typer.Option("teach", help="Scene variant: teach or playback."),
     overwrite: bool = typer.Option(False, help="Replace an existing output file."),
 ) -> None:
@@ -367,7 +378,7 @@ def coop_simulate(
     ),
     runs: int = typer.Option(100, help="Noisy runs."),
     sigma: float = typer.Option(0.1, help="SD of each measured angle (deg)."),
-    seed: int = typer.Option(0, help="Seed of the angle noise."),
+    seed: int = typer.Option(0, callback=_seed_option, help="Seed of the angle noise."),
     goal: tuple[float, float] = typer.Option((0.0, 10.0), help="Goal x y (m)."),
     plot: Path | None = typer.Option(None, help="Draw the paths and error ellipses to this PNG."),
     planner: bool = typer.Option(
@@ -419,7 +430,7 @@ def teach_command(
         ..., metavar="SCENE", help="Scene YAML (with a route unless --keyboard)."
     ),
     out: Path = typer.Option(..., "-o", "--out", help="Folder for maps, waypoints and the log."),
-    seed: int = typer.Option(0, help="Seed of the run's noise."),
+    seed: int = typer.Option(0, callback=_seed_option, help="Seed of the run's noise."),
     resume: bool = typer.Option(False, help="Rebuild maps and waypoints from OUT/teach.mcap."),
     overwrite: bool = typer.Option(False, help="Replace an existing teaching log."),
     keyboard: bool = typer.Option(
@@ -510,7 +521,7 @@ def playback_command(
         None, help="Waypoint YAML written by kiseki teach (instead of --taught)."
     ),
     method: str = typer.Option("proposal2", help="conventional, proposal1, proposal2 or both."),
-    seed: int = typer.Option(0, help="Seed of the run's noise."),
+    seed: int = typer.Option(0, callback=_seed_option, help="Seed of the run's noise."),
 ) -> None:
     """Play a taught route back on the particle filter's estimate; stop within 0.1 m of the goal.
     Give the teaching folder (--taught) or its waypoint file (--waypoints, and --map for a map
@@ -558,7 +569,9 @@ def localize_command(
     method: str = typer.Option(
         "likelihood-field", help="beam, likelihood-field, space-observation or odometry."
     ),
-    seed: int = typer.Option(0, help="Seed of the filter and of the odometry noise."),
+    seed: int = typer.Option(
+        0, callback=_seed_option, help="Seed of the filter and of the odometry noise."
+    ),
     odometry_noise: float = typer.Option(0.0, help="Odometry noise SD, fraction of each step."),
     particles: int | None = typer.Option(
         None,

@@ -11,4 +11,21 @@ from __future__ import annotations
 
 from kiseki._core import Pose2, Pose3, Random, derive_seed, library_versions, normalize_angle
 
-__all__ = ["Pose2", "Pose3", "Random", "derive_seed", "library_versions", "normalize_angle"]
+__all__ = [
+    "Pose2",
+    "Pose3",
+    "Random",
+    "check_seed",
+    "derive_seed",
+    "library_versions",
+    "normalize_angle",
+]
+
+
+def check_seed(seed, name: str = "seed") -> int:
+    """A seed as kiseki takes it: an integer in 0..2^64-1 (anything else: a ValueError)."""
+    import numbers
+
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= seed < 2**64:
+        raise ValueError(f"{name} must be an integer in 0..2^64-1, got {seed!r}")
+    return int(seed)

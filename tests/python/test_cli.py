@@ -117,6 +117,39 @@ def test_outputs_never_overwrite_inputs(tmp_path, args, needle):
         assert "would overwrite" not in done.stderr
 
 
+@pytest.mark.parametrize("seed", ["-1", str(2**64)])
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["sim", "run", "scene.yaml", "-o", "r.mcap"],
+        ["teach", "scene.yaml", "-o", "t"],
+        ["demo", "--out", "d"],
+        ["playback", "scene.yaml", "--route", "P0,G", "--taught", "t"],
+        ["localize", "log.gz", "--map", "good.yaml", "-o", "o.csv"],
+        ["coop", "simulate"],
+    ],
+)
+def test_bad_seeds_are_one_line_before_any_work(tmp_path, command, seed):
+    done = run(*command, "--seed", seed, cwd=tmp_path)
+    assert done.returncode == 1, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert lines == [f"kiseki: error: --seed must be an integer in 0..2^64-1, got {seed}"]
+    assert list(tmp_path.iterdir()) == []  # nothing written
+
+
 def test_unknown_command_fails():
     done = run("teleport")
     assert done.returncode != 0 and "teleport" in done.stderr
+
+
+def test_check_seed_takes_exactly_the_unsigned_64_bit_integers():
+    from kiseki.core import check_seed
+    from kiseki.sim.run import SimConfig
+
+    assert check_seed(0) == 0 and check_seed(2**64 - 1) == 2**64 - 1
+    assert check_seed(np.uint64(7)) == 7
+    for bad in (-1, 2**64, 1.0, True, "3", None):
+        with pytest.raises(ValueError, match="seed must be an integer"):
+            check_seed(bad)
+    with pytest.raises(ValueError, match="seed must be an integer"):
+        SimConfig(seed=-1)

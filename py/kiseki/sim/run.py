@@ -16,6 +16,7 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki.control import PurePursuit
+from kiseki.core import check_seed
 from kiseki.sim.mcap_log import RunWriter, read_run
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import RobotSetup, SensorSetup, build_robot, build_sensors
@@ -56,6 +57,7 @@ class SimConfig:
             raise ValueError(f"duration must be positive, got {self.duration}")
         if not (self.lookahead > 0 and self.goal_tolerance > 0):
             raise ValueError("lookahead and goal_tolerance must be positive")
+        check_seed(self.seed)
 
 
 @dataclass(frozen=True)
