@@ -49,7 +49,7 @@ from tqdm import tqdm
 
 from kiseki import _core
 from kiseki._atomic import atomic_write
-from kiseki.core import derive_seed
+from kiseki.core import check_seed, derive_seed
 from kiseki.grid import OccupancyGrid
 from kiseki.localization import (
     REAL_ODOMETRY_ALPHAS,
@@ -133,8 +133,7 @@ class GlobalConfig:
                 "global localization: method must be likelihood-field or space-observation, "
                 f"got {self.method!r}"
             )
-        if not (isinstance(self.seed, int) and 0 <= self.seed < 2**64):
-            raise ValueError(f"seed must be an integer in 0..2^64-1, got {self.seed!r}")
+        check_seed(self.seed)
         if self.particles < 1 or self.tracking_particles < 1:
             raise ValueError("global localization: particle counts must be >= 1")
         if not (isinstance(self.beams, int) and self.beams >= 0):

@@ -34,7 +34,7 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki import _core
-from kiseki.core import Pose2, Random, derive_seed
+from kiseki.core import Pose2, Random, check_seed, derive_seed
 from kiseki.grid import OccupancyGrid
 from kiseki.scans import LaserScans
 
@@ -358,10 +358,7 @@ class LocalizeConfig:
             self.method in LOCALIZATION_METHODS,
             f"method must be one of {', '.join(LOCALIZATION_METHODS)}, got {self.method!r}",
         )
-        _check(
-            isinstance(self.seed, int) and 0 <= self.seed < 2**64,
-            f"seed must be an integer in 0..2^64-1, got {self.seed!r}",
-        )
+        check_seed(self.seed)
         _check(
             self.odometry_noise >= 0 and math.isfinite(self.odometry_noise),
             f"odometry noise must be >= 0, got {self.odometry_noise}",

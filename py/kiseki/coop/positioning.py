@@ -48,6 +48,7 @@ import numpy as np
 
 from kiseki import _core
 from kiseki.coop.triangulation import MIN_INTERSECTION_ANGLE
+from kiseki.core import check_seed
 
 #: The paper's simulation (sec. 4): start positions, goal, angle noise.
 START = np.array([[-1.0, 0.0], [1.0, 0.0], [0.0, -1.0]])
@@ -231,8 +232,7 @@ def simulate(
         raise ValueError(f"runs must be an integer in 1..1,000,000, got {runs!r}")
     if not (math.isfinite(angle_sigma) and 0 <= angle_sigma < math.radians(10)):
         raise ValueError(f"angle_sigma must lie in [0, 10 deg), got {angle_sigma}")
-    if not isinstance(seed, int) or not 0 <= seed < 2**64:
-        raise ValueError(f"seed must be an integer in 0..2^64-1, got {seed!r}")
+    check_seed(seed)
     rng = np.random.default_rng(seed)
     truth = the_plan.nominal_positions()
     est = np.empty((runs, len(the_plan.steps) + 1, 3, 2))
@@ -306,8 +306,7 @@ def simulate_3d(
             raise ValueError(f"{name} must lie in [0, 10 deg), got {v}")
     if not (math.isfinite(marker_height) and 0 <= marker_height < 10):
         raise ValueError(f"marker_height must lie in [0, 10) m, got {marker_height}")
-    if not isinstance(seed, int) or not 0 <= seed < 2**64:
-        raise ValueError(f"seed must be an integer in 0..2^64-1, got {seed!r}")
+    check_seed(seed)
     flat = the_plan.nominal_positions()
     z = np.asarray(ground(flat[..., 0], flat[..., 1]), dtype=float)
     if z.shape != flat.shape[:-1] or not np.isfinite(z).all():

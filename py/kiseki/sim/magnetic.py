@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from kiseki.core import Random, normalize_angle
+from kiseki.core import Random, check_seed, normalize_angle
 
 __all__ = [
     "DEFAULT_DECLINATION_DEG",
@@ -147,12 +147,6 @@ def _finite_scalar(
         rel = ">" if strict else ">="
         raise ValueError(f"{name}: must be {rel} {minimum}, got {value!r}")
     return v
-
-
-def _seed(seed: Any, name: str) -> int:
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise ValueError(f"{name}: expected a non-negative integer seed, got {seed!r}")
-    return int(seed)
 
 
 def _points(points: Any, name: str = "points") -> tuple[np.ndarray, bool]:
@@ -626,7 +620,7 @@ class Magnetometer:
         self.mount = _finite_array(mount, (3,), "mount")
         self.yaw = _finite_scalar(yaw, "yaw")
         self.noise_sd = _finite_scalar(noise_sd, "noise_sd", minimum=0.0)
-        self.seed = _seed(seed, "seed")
+        self.seed = check_seed(seed)
         self.self_sources: tuple[Dipole, ...] = tuple(
             robot_self_sources() if self_sources is None else self_sources
         )

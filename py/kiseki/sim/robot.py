@@ -54,7 +54,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
-from kiseki.core import Pose2, Random, normalize_angle
+from kiseki.core import Pose2, Random, check_seed, normalize_angle
 
 __all__ = [
     "BodyMotion",
@@ -405,12 +405,6 @@ def _as_pose(pose: PoseLike, name: str) -> tuple[float, float, float]:
     return _finite(x, f"{name}.x"), _finite(y, f"{name}.y"), _finite(theta, f"{name}.theta")
 
 
-def _check_seed(seed: Any) -> int:
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
-        raise ValueError(f"seed must be an integer in [0, 2**64), got {seed!r}")
-    return seed
-
-
 def _sinc(a: float) -> float:
     """sin(a) / a, accurate near 0."""
     if abs(a) < 1e-4:
@@ -615,7 +609,7 @@ class WheelOdometry:
     ) -> None:
         self.robot_params = robot_params if robot_params is not None else DiffDriveParams()
         self.error_params = error_params if error_params is not None else OdometryErrorParams()
-        self._rng = Random(_check_seed(seed))
+        self._rng = Random(check_seed(seed))
         rp, ep = self.robot_params, self.error_params
         cpr = rp.counts_per_wheel_rev
         self._true_track = rp.track_width
@@ -692,7 +686,7 @@ class OmniOdometry:
         initial_pose: PoseLike = (0.0, 0.0, 0.0),
     ) -> None:
         self.error_params = error_params if error_params is not None else OmniOdometryErrorParams()
-        self._rng = Random(_check_seed(seed))
+        self._rng = Random(check_seed(seed))
         self._x, self._y, theta = _as_pose(initial_pose, "initial_pose")
         self._theta = _wrap(theta)
 

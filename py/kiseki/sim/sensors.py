@@ -12,7 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from kiseki.core import Random
+from kiseki.core import Random, check_seed
 from kiseki.grid import OccupancyGrid, beam_angles
 from kiseki.sim.primitives import rotation
 
@@ -330,9 +330,7 @@ class BearingSensor:
 
     def __init__(self, params: BearingParams | None = None, seed: int = 0) -> None:
         self.params = params if params is not None else BearingParams()
-        if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed < 2**64:
-            raise ValueError(f"seed must be an integer in 0..2^64-1, got {seed!r}")
-        self._rng = Random(seed)
+        self._rng = Random(check_seed(seed))
 
     def observe(self, sensor, targets, world=None, blockers=None) -> BearingReadings:
         """``sensor`` (x, y, z, yaw) in the world; ``targets`` (n, 3) marker points;
