@@ -22,7 +22,7 @@ import numpy as np
 
 from kiseki.datasets import read_carmen_log
 from kiseki.localization import LocalizeConfig, MclConfig, MonteCarloLocalizer, scan_model
-from kiseki.mapping import MapBuildConfig, build_map
+from kiseki.mapping import MapBuildConfig, map_of_log
 
 LOG = (
     Path(__file__).resolve().parents[2]
@@ -55,9 +55,7 @@ def main() -> None:
     if not LOG.is_file():
         raise SystemExit(f"the Freiburg-079 log is not at {LOG}")
     scans = read_carmen_log(LOG).scans
-    grid = build_map(
-        scans.poses, scans.ranges, scans.angles, scans.max_range, MapBuildConfig(0.05), False
-    )
+    grid = map_of_log(scans, MapBuildConfig(0.05))
     cores = os.cpu_count() or 1
     print(f"Freiburg-079: {scans.ranges.shape[1]} beams, map {grid.width} x {grid.height}")
     head = f"{'model':<17}{'particles':>10}{'beams':>7}{'1 thread ms':>13}"

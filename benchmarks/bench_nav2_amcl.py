@@ -41,7 +41,7 @@ from tqdm import tqdm
 from kiseki.datasets import read_carmen_log
 from kiseki.grid import FREE, OCCUPIED
 from kiseki.localization import LOCALIZATION_METHODS, LocalizeConfig, motion_alphas, noisy_odometry
-from kiseki.mapping import MapBuildConfig, build_map
+from kiseki.mapping import MapBuildConfig, map_of_log
 from kiseki.metrics import ape
 
 try:
@@ -319,14 +319,7 @@ def main(argv: list[str] | None = None) -> int:
     for log, beams, particles, n in tqdm(runs, desc="runs", unit="run"):
         if log not in logs:
             full = read_carmen_log(DATA / "carmen" / f"{log}-corrected.log.gz").scans
-            grid = build_map(
-                full.poses,
-                full.ranges,
-                full.angles,
-                full.max_range,
-                MapBuildConfig(resolution=0.05),
-                False,
-            )
+            grid = map_of_log(full, MapBuildConfig(resolution=0.05))
             alphas = motion_alphas(LocalizeConfig(odometry_noise=ODOMETRY_NOISE), full)
             odom = noisy_odometry(full.odometry, ODOMETRY_NOISE, args.seed)
             logs[log] = (full, alphas, odom)

@@ -111,7 +111,7 @@ def map_from_log(
     """Build an occupancy grid from a log's poses and scans and save it as a ROS map."""
     from kiseki.datasets import open_scans
     from kiseki.map_io import load_map, save_map
-    from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
+    from kiseki.mapping import MapBuildConfig, endpoint_agreement, map_of_log
     from kiseki.plots import render_map
     from kiseki.teach.environment_map import build_teaching_map
 
@@ -145,7 +145,7 @@ def map_from_log(
             progress=True,
         )
     else:
-        grid = build_map(scans.poses, scans.ranges, scans.angles, scans.max_range, config, True)
+        grid = map_of_log(scans, config, True)
     seconds = time.perf_counter() - start
     saved = load_map(save_map(grid, output))
     share = endpoint_agreement(saved, scans.poses, scans.ranges, scans.angles, scans.max_range)

@@ -13,6 +13,7 @@ from tqdm import tqdm
 
 from kiseki import _core
 from kiseki.grid import OccupancyGrid
+from kiseki.scans import LaserScans
 
 __all__ = [
     "MapBuildConfig",
@@ -101,6 +102,12 @@ def build_map(
     for s in tqdm(starts, desc="mapping", unit="chunk", disable=not progress, leave=False):
         mapper.integrate_scans(poses[s : s + chunk], ranges[s : s + chunk], angles)
     return mapper.to_occupancy()
+
+
+def map_of_log(scans: LaserScans, config: MapBuildConfig | None = None, progress: bool = False):
+    """``build_map`` over a log's scans at its reference poses (a corrected CARMEN log, a
+    simulated run)."""
+    return build_map(scans.poses, scans.ranges, scans.angles, scans.max_range, config, progress)
 
 
 def scan_local_builder(

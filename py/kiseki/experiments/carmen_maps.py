@@ -16,7 +16,7 @@ import pandas as pd
 
 from kiseki.datasets import read_carmen_log
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
-from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
+from kiseki.mapping import MapBuildConfig, endpoint_agreement, map_of_log
 from kiseki.plots import new_figure
 
 RANGE_BANDS = [(0.0, 5.0), (5.0, 15.0), (15.0, 100.0)]  # metres
@@ -62,7 +62,7 @@ def trial(config: CarmenMapsConfig, index: int, seed: int) -> TrialOutput:
     read_s = time.perf_counter() - start
     build_config = MapBuildConfig(resolution=config.resolution, usable_range=config.usable_range)
     start = time.perf_counter()
-    grid = build_map(scans.poses, scans.ranges, scans.angles, scans.max_range, build_config)
+    grid = map_of_log(scans, build_config)
     build_s = time.perf_counter() - start
     share = endpoint_agreement(grid, scans.poses, scans.ranges, scans.angles, scans.max_range)
     by_band = {}

@@ -106,7 +106,7 @@ def model_sees(scans, grid, lc: LocalizeConfig, estimates: np.ndarray, index: np
 
 def trial(config: ExcursionsConfig, index: int, seed: int) -> TrialOutput:
     from kiseki.datasets import read_carmen_log
-    from kiseki.mapping import MapBuildConfig, build_map
+    from kiseki.mapping import MapBuildConfig, map_of_log
     from kiseki.teach.environment_map import build_teaching_map
 
     name = config.logs[index % len(config.logs)]
@@ -115,9 +115,7 @@ def trial(config: ExcursionsConfig, index: int, seed: int) -> TrialOutput:
         "space-observation": build_teaching_map(
             scans.poses, scans.ranges, scans.angles, scans.max_range, 0.1
         ),
-        "likelihood-field": build_map(
-            scans.poses, scans.ranges, scans.angles, scans.max_range, MapBuildConfig(0.05)
-        ),
+        "likelihood-field": map_of_log(scans, MapBuildConfig(0.05)),
     }
     record: dict = {"log": name, "scans": len(scans)}
     timings: dict = {}

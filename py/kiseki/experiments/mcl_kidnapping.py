@@ -216,17 +216,11 @@ def trial_sim(config: KidnapConfig, index: int, seed: int) -> TrialOutput:
 
 def trial_carmen(config: KidnapConfig, index: int, seed: int) -> TrialOutput:
     from kiseki.datasets import read_carmen_log
-    from kiseki.mapping import MapBuildConfig, build_map
+    from kiseki.mapping import MapBuildConfig, map_of_log
 
     name = config.logs[index % len(config.logs)]
     scans = read_carmen_log(_carmen_dir(config) / f"{name}.log.gz").scans
-    grid = build_map(
-        scans.poses,
-        scans.ranges,
-        scans.angles,
-        scans.max_range,
-        MapBuildConfig(resolution=0.05),
-    )
+    grid = map_of_log(scans, MapBuildConfig(resolution=0.05))
     return _trial(scans, grid, config, seed, name)
 
 

@@ -52,11 +52,11 @@ def preflight(config: KldConfig) -> None:
 def trial(config: KldConfig, index: int, seed: int) -> TrialOutput:
     from kiseki.datasets import read_carmen_log
     from kiseki.global_localization import GlobalConfig, global_localize
-    from kiseki.mapping import MapBuildConfig, build_map
+    from kiseki.mapping import MapBuildConfig, map_of_log
 
     name = config.logs[index % len(config.logs)]
     scans = read_carmen_log(_carmen_dir(config) / f"{name}.log.gz").scans.first(config.max_scans)
-    grid = build_map(scans.poses, scans.ranges, scans.angles, scans.max_range, MapBuildConfig(0.05))
+    grid = map_of_log(scans, MapBuildConfig(0.05))
     noisy = dataclasses.replace(
         scans, odometry=noisy_odometry(scans.odometry, config.odometry_noise, seed)
     )
