@@ -20,6 +20,7 @@ from kiseki.core import check_seed
 from kiseki.sim.mcap_log import RunWriter, read_run
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import RobotSetup, SensorSetup, build_robot, build_sensors
+from kiseki.sim.turns import Turns
 
 __all__ = ["RunSummary", "SimConfig", "read_commands", "simulate"]
 
@@ -227,72 +228,6 @@ class _Agent:
     controller: PurePursuit | None
 
 
-TURN_SCHEMA = {
-    "type": "object",
-    "title": "kiseki.Turn",
-    "properties": {
-        "move": {"type": "integer", "description": "1-based index of the scene's turns"},
-        "robot": {"type": "string"},
-        "to": {"type": "array", "description": "planned place (x, y), m"},
-        "event": {"type": "string", "description": "start or arrived"},
-    },
-}
-
-
-class _Turns:
-    """The scene's turns: one robot drives to its place while the others stand; /turns logs
-    when each move starts and when its robot has arrived (the standing robots' bearings of that
-    moment are the move's measurement)."""
-
-    def __init__(self, scene: Scene, agents: list[_Agent], config: SimConfig) -> None:
-        self.moves = scene.turns["moves"]
-        self.speed = scene.turns["speed"]
-        self.by_name = {a.setup.name: a for a in agents}
-        self.config, self.index, self.controller = config, -1, None
-
-    @property
-    def done(self) -> bool:
-        return self.index >= len(self.moves)
-
-    def _at_rest(self) -> bool:
-        name = self.moves[self.index][0]
-        return all(abs(v) < 1e-6 for v in self.by_name[name].setup.robot.velocity)
-
-    def advance(self, writer, t: float) -> None:
-        """Starts the next move when the current robot has arrived and come to rest (a robot
-        that still rolls is not standing)."""
-        while not self.done and (
-            self.controller is None or (self.controller.done and self._at_rest())
-        ):
-            if self.controller is not None:
-                self._log(writer, t, "arrived")
-            self.index += 1
-            self.controller = None
-            if self.done:
-                return
-            name, to = self.moves[self.index]
-            setup = self.by_name[name].setup
-            x, y, _ = _pose(setup.robot.pose)
-            self.controller = PurePursuit(
-                [[x, y], list(to)],
-                self.speed,
-                self.config.lookahead,
-                self.config.goal_tolerance,
-                setup.robot.params.max_accel,
-            )
-            self._log(writer, t, "start")
-
-    def command(self, agent: _Agent) -> tuple[float, float, float]:
-        if self.done or agent.setup.name != self.moves[self.index][0]:
-            return 0.0, 0.0, 0.0  # standing
-        return self.controller.command(_pose(agent.setup.robot.pose))
-
-    def _log(self, writer, t: float, event: str) -> None:
-        name, to = self.moves[self.index]
-        payload = {"move": self.index + 1, "robot": name, "to": list(to), "event": event}
-        writer.write_json("/turns", t, "kiseki.Turn", payload, TURN_SCHEMA)
-
-
 def _agents(scene: Scene, config: SimConfig, commands) -> list[_Agent]:
     agents = []
     for index, spec in enumerate(scene.robot_specs):
@@ -330,7 +265,7 @@ def simulate(
     config = config or SimConfig()
     agents = _agents(scene, config, commands)
     routed = [a for a in agents if a.controller is not None]
-    turns = _Turns(scene, agents, config) if scene.turns is not None else None
+    turns = Turns(scene, agents, config) if scene.turns is not None else None
     limit = config.duration or (
         float(commands[-1, 0]) + config.dt if commands is not None else config.max_duration
     )
