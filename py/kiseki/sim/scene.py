@@ -12,7 +12,8 @@ route {waypoints [[x, y], ...], speed}, magnetic (see kiseki.sim.magnetic). Seve
 ``robots`` (a list of {name, type, start, params, odometry_errors, sensors, route}) instead of
 robot, sensors and route; and with several robots, ``turns`` {goal, speed, moves [{robot, to}]}
 instead of routes: the robots take turns (cooperative positioning), one driving while the
-others stand.
+others stand. ``poses`` {corner, distance, phi_deg [start, stop, step], heading_deg}: a sweep of
+test poses around a corner (``Scene.poses``, a list of (x, y, theta)).
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ TOP_KEYS = {
     "magnetic",
     "robots",
     "turns",
+    "poses",
 }
 ROBOT_ENTRY_KEYS = {"name", "type", "start", "params", "odometry_errors", "sensors", "route"}
 VARIANTS = ("teach", "playback")
@@ -72,6 +74,7 @@ class Scene:
     robot_specs: list = field(default_factory=list)  # [{name, robot, sensors, route}]
     # cooperative positioning: {goal: (x, y), speed, moves: [(robot name, (x, y)), ...]}
     turns: dict | None = None
+    poses: list[tuple[float, float, float]] | None = None  # a sweep of test poses (x, y, theta)
 
     def ground_truth(
         self, z_min: float, z_max: float, resolution: float | None = None
@@ -180,6 +183,7 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
         boxes=boxes,
         robot_specs=specs,
         turns=_turns(doc, where, specs),
+        poses=_poses(doc, where),
     )
     return scene
 
@@ -226,6 +230,47 @@ def _turns(doc: dict, where: str, specs: list[dict]) -> dict | None:
     if math.dist(out[-1][1], goal) > 1e-9:
         raise ValueError(f"{where}: turns: the last move must end on the goal {list(goal)}")
     return {"goal": goal, "speed": float(speed), "moves": out}
+
+
+def _poses(doc: dict, where: str) -> list[tuple[float, float, float]] | None:
+    """``poses: {corner: [x, y], distance: m, phi_deg: [start, stop, step], heading_deg}``: the
+    robot's centre at corner + distance * (-cos phi, -sin phi) for phi = start, start + step, ...
+    up to stop (inclusive), heading heading_deg in every pose (paper 004's Fig. 4 sweep)."""
+    if "poses" not in doc:
+        return None
+    p = doc["poses"]
+    keys = {"corner", "distance", "phi_deg", "heading_deg"}
+    if not isinstance(p, dict) or set(p) != keys:
+        raise ValueError(f"{where}: poses must be a mapping of exactly {', '.join(sorted(keys))}")
+
+    def numbers(key: str, n: int) -> list[float]:
+        value = p[key] if n > 1 else [p[key]]
+        if (
+            not isinstance(value, list | tuple)
+            or len(value) != n
+            or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+            or not all(math.isfinite(v) for v in value)
+        ):
+            raise ValueError(f"{where}: poses.{key} must be {n} finite number(s), got {p[key]!r}")
+        return [float(v) for v in value]
+
+    (cx, cy), (distance,) = numbers("corner", 2), numbers("distance", 1)
+    start, stop, step = numbers("phi_deg", 3)
+    (heading,) = numbers("heading_deg", 1)
+    if distance <= 0:
+        raise ValueError(f"{where}: poses.distance must be positive, got {distance}")
+    if step <= 0 or stop < start or (stop - start) / step > 10_000:
+        raise ValueError(
+            f"{where}: poses.phi_deg must be [start, stop, step] with step > 0 and stop >= start"
+            f" (at most 10,000 poses), got {p['phi_deg']!r}"
+        )
+    count = int(math.floor((stop - start) / step + 1e-9)) + 1
+    out = []
+    for i in range(count):
+        phi = math.radians(start + i * step)
+        x, y = cx - distance * math.cos(phi), cy - distance * math.sin(phi)
+        out.append((x, y, math.radians(heading)))
+    return out
 
 
 def _robot_specs(doc: dict, where: str) -> list[dict]:
