@@ -5,7 +5,14 @@ same follower; control imports nothing of the methods above it nor of the simula
 
 from __future__ import annotations
 
+from kiseki.control.fuzzy_potential import FuzzyPotentialConfig, FuzzyPotentialMethod
 from kiseki.control.pure_pursuit import PurePursuit
 from kiseki.control.speed_limit import SpeedLimit, SpeedLimitSource
 
-__all__ = ["PurePursuit", "SpeedLimit", "SpeedLimitSource"]
+__all__ = [
+    "FuzzyPotentialConfig",
+    "FuzzyPotentialMethod",
+    "PurePursuit",
+    "SpeedLimit",
+    "SpeedLimitSource",
+]
