@@ -1,0 +1,37 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Speed limits (paper 004): occlusion- and width-aware limits, the baselines they are compared
+with, and the navigator that drives a robot under a limit. Imports control, never the
+simulator."""
+
+from __future__ import annotations
+
+from kiseki.speed.baselines import (
+    AccelerationLimit,
+    DistanceLimiterConfig,
+    DistanceSpeedLimiter,
+    PolygonLimiterConfig,
+    PolygonSpeedLimiter,
+)
+from kiseki.speed.limiter import (
+    LimitTerms,
+    SpeedLimiter,
+    SpeedLimiterConfig,
+    occlusion_ratio,
+    passage_width,
+    width_factor,
+)
+
+__all__ = [
+    "AccelerationLimit",
+    "DistanceLimiterConfig",
+    "DistanceSpeedLimiter",
+    "PolygonLimiterConfig",
+    "LimitTerms",
+    "PolygonSpeedLimiter",
+    "SpeedLimiter",
+    "SpeedLimiterConfig",
+    "occlusion_ratio",
+    "passage_width",
+    "width_factor",
+]
