@@ -22,6 +22,7 @@ from kiseki.speed import (
 )
 
 ANGLES = np.linspace(-2 * math.pi / 3, 2 * math.pi / 3, 683)  # the paper's LRF: +-120 deg
+ONES = np.ones_like(ANGLES)
 MAX_RANGE = 4.0
 
 
@@ -155,17 +156,17 @@ def test_limiter_combines_the_terms_and_limits_acceleration():
     [
         (lambda g: occlusion_ratio(g, (0, 0, 0), [], [], 4.0, 1.0), "empty"),
         (lambda g: occlusion_ratio(g, (0, 0, 0), ANGLES, ANGLES[:5], 4.0, 1.0), "differ"),
-        (lambda g: occlusion_ratio(g, (0, 0, 0), ANGLES, ANGLES * 0 + 1, 4.0, 0.0), "half_angle"),
-        (lambda g: occlusion_ratio(g, (0, 0, 0), ANGLES, ANGLES * 0 + 1, 4.0, 3.2), "half_angle"),
-        (lambda g: occlusion_ratio(g, (0, 0, 0), ANGLES, ANGLES * 0 + 1, -1.0, 1.0), "max_range"),
-        (lambda g: occlusion_ratio(g, (0, 0), ANGLES, ANGLES * 0 + 1, 4.0, 1.0), "pose"),
-        (lambda g: occlusion_ratio(g, (0, 0, 0), ANGLES[::-1], ANGLES * 0 + 1, 4.0, 1.0), "increase"),
+        (lambda g: occlusion_ratio(g, (0, 0, 0), ANGLES, ONES, 4.0, 0.0), "half_angle"),
+        (lambda g: occlusion_ratio(g, (0, 0, 0), ANGLES, ONES, 4.0, 3.2), "half_angle"),
+        (lambda g: occlusion_ratio(g, (0, 0, 0), ANGLES, ONES, -1.0, 1.0), "max_range"),
+        (lambda g: occlusion_ratio(g, (0, 0), ANGLES, ONES, 4.0, 1.0), "pose"),
+        (lambda g: occlusion_ratio(g, (0, 0, 0), ANGLES[::-1], ONES, 4.0, 1.0), "increase"),
         (lambda g: width_factor(1.0, 2.0, 2.0, 4.9), "w2 must exceed w1"),
         (lambda g: width_factor(1.0, 0.7, 0.5, 4.9), "w2 must exceed w1"),
         (lambda g: width_factor(1.0, 0.7, 2.0, -1.0), "a must be positive"),
         (lambda g: SpeedLimiterConfig(w1=2.0, w2=1.0), "w2"),
         (lambda g: SpeedLimiterConfig(half_angle=0.0), "half_angle"),
-        (lambda g: SpeedLimiter(g).update((0, 0, 0), ANGLES, ANGLES * 0 + 1, 4.0, -0.1), "dt"),
+        (lambda g: SpeedLimiter(g).update((0, 0, 0), ANGLES, ONES, 4.0, -0.1), "dt"),
         (lambda g: SpeedLimiter("map.yaml"), "OccupancyGrid"),
     ],
 )
