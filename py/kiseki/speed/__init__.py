@@ -21,14 +21,18 @@ from kiseki.speed.limiter import (
     passage_width,
     width_factor,
 )
+from kiseki.speed.navigator import NavigatorLog, SpeedControlledNavigator, scan_about_body
 
 __all__ = [
     "AccelerationLimit",
     "DistanceLimiterConfig",
     "DistanceSpeedLimiter",
+    "NavigatorLog",
     "PolygonLimiterConfig",
     "LimitTerms",
     "PolygonSpeedLimiter",
+    "SpeedControlledNavigator",
+    "scan_about_body",
     "SpeedLimiter",
     "SpeedLimiterConfig",
     "occlusion_ratio",
