@@ -66,27 +66,37 @@ OcclusionRatio occlusion_ratio(const OccupancyGrid& map, const Pose2& sensor_pos
   const int y0 = std::max(0, static_cast<int>(std::floor(centre.y() - radius_cells)));
   const int x1 = std::min(map.width() - 1, static_cast<int>(std::ceil(centre.x() + radius_cells)));
   const int y1 = std::min(map.height() - 1, static_cast<int>(std::ceil(centre.y() + radius_cells)));
+  // Cell centres step by (res cos yaw, res sin yaw) along a row and (-res sin yaw, res cos yaw)
+  // across rows (the map's origin may be rotated).
+  const Eigen::Vector2d origin = map.cell_to_world(x0, y0);
+  const Eigen::Vector2d along_row = map.cell_to_world(x0 + 1, y0) - origin;
+  const Eigen::Vector2d across_rows = map.cell_to_world(x0, y0 + 1) - origin;
+  const double cs = std::cos(sensor_pose.theta), ss = std::sin(sensor_pose.theta);
+  const double range2 = range * range, cell_margin = 0.5 * res;
   OcclusionRatio out;
   for (int cy = y0; cy <= y1; ++cy) {
     const auto* row = map.cells().ptr<std::int8_t>(cy);
+    const Eigen::Vector2d first = origin + (cy - y0) * across_rows;
     for (int cx = x0; cx <= x1; ++cx) {
       const std::int8_t v = row[cx];
       if (v < 0 || v > options.free_threshold) continue;  // R_map_free
-      const Eigen::Vector2d c = map.cell_to_world(cx, cy);
-      const double dx = c.x() - sensor_pose.x, dy = c.y() - sensor_pose.y;
-      const double rho = std::hypot(dx, dy);
-      if (rho > range) continue;  // R_sensor: within reach ...
-      if (rho < 1e-9) {           // the sensor's own cell
+      const double dx = first.x() + (cx - x0) * along_row.x() - sensor_pose.x;
+      const double dy = first.y() + (cx - x0) * along_row.y() - sensor_pose.y;
+      const double rho2 = dx * dx + dy * dy;
+      if (rho2 > range2) continue;  // R_sensor: within reach ...
+      const double rho = std::sqrt(rho2);
+      if (rho < 1e-9) {  // the sensor's own cell
         ++out.free_cells, ++out.seen_cells;
         continue;
       }
       if (dx * hx + dy * hy < rho * cos_half) continue;  // ... and within +-theta of the heading
       ++out.free_cells;
-      const long beam = beam_of(scan, normalize_angle(std::atan2(dy, dx) - sensor_pose.theta));
+      // the bearing in the sensor frame, in (-pi, pi]
+      const long beam = beam_of(scan, std::atan2(-dx * ss + dy * cs, dx * cs + dy * ss));
       if (beam < 0) continue;
       const double r = scan.ranges[beam];
       if (std::isnan(r)) continue;
-      if (r >= range || rho <= r - 0.5 * res) ++out.seen_cells;  // R_recognize
+      if (r >= range || rho <= r - cell_margin) ++out.seen_cells;  // R_recognize
     }
   }
   out.ratio = out.free_cells == 0 ? 1.0 : static_cast<double>(out.seen_cells) / static_cast<double>(out.free_cells);
