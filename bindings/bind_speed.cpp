@@ -45,7 +45,8 @@ void bind_speed(py::module_& m) {
   m.def(
       "occlusion_ratio",
       [](const OccupancyGrid& grid, const py::handle& pose, const py::handle& angles, const py::handle& ranges,
-         double max_range, double half_angle, py::object heading, int free_threshold) {
+         double max_range, double half_angle, py::object heading, int free_threshold,
+         bool with_labels) -> py::tuple {
         const Pose2 sensor = pose_of(pose);
         const ScanArrays s(angles, ranges, max_range);
         if (free_threshold < 0 || free_threshold > 100) throw std::invalid_argument("free_threshold must be in 0..100");
@@ -54,14 +55,18 @@ void bind_speed(py::module_& m) {
         options.free_threshold = static_cast<std::int8_t>(free_threshold);
         const double h = heading.is_none() ? sensor.theta : heading.cast<double>();
         OcclusionRatio r;
+        cv::Mat labels;
         {
           py::gil_scoped_release release;
-          r = occlusion_ratio(grid, sensor, s.scan, h, options);
+          r = occlusion_ratio(grid, sensor, s.scan, h, options, with_labels ? &labels : nullptr);
         }
-        return py::make_tuple(r.ratio, r.seen_cells, r.free_cells);
+        if (!with_labels) return py::make_tuple(r.ratio, r.seen_cells, r.free_cells);
+        return py::make_tuple(r.ratio, r.seen_cells, r.free_cells, mat_to_numpy(labels));
       },
       "grid"_a, "pose"_a, "angles"_a, "ranges"_a, "max_range"_a, "half_angle"_a, "heading"_a = py::none(),
-      "free_threshold"_a = 25, "(ratio, seen cells, free cells) of eq. 1 (see kiseki.speed.occlusion_ratio).");
+      "free_threshold"_a = 25, "with_labels"_a = false,
+      "(ratio, seen cells, free cells[, labels]) of eq. 1 (see kiseki.speed.occlusion_ratio); labels: "
+      "uint8 [y, x], 0 outside the region, 1 occluded free cell, 2 seen.");
   m.def(
       "passage_width",
       [](const py::handle& angles, const py::handle& ranges, double max_range, double heading, double window_ahead) {

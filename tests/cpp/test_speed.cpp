@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <opencv2/core.hpp>
 #include <stdexcept>
 #include <vector>
 
@@ -77,6 +78,21 @@ TEST(OcclusionRatio, UnknownObstacleShrinksTheRatioAndNaNIsUnseen) {
   EXPECT_NEAR(1.0 - with_box.ratio, 1.82 / (kPi * 16 / 2), 0.012);
   for (auto& r : s.ranges) r = std::numeric_limits<float>::quiet_NaN();
   EXPECT_DOUBLE_EQ(occlusion_ratio(map, sensor, s.view(), sensor.theta, {}).ratio, 0.0);
+}
+
+TEST(OcclusionRatio, LabelsCountWhatTheRatioCounts) {
+  OccupancyGrid map = free_field();
+  for (int x = 0; x < map.width(); ++x) map.set(x, 160, kOccupied);  // 2 m ahead
+  const Pose2 sensor(0.3, -0.2, kPi / 3);
+  const Scan s = cast(map, sensor);
+  cv::Mat labels;
+  const OcclusionRatio r = occlusion_ratio(map, sensor, s.view(), kPi / 2, {}, &labels);
+  ASSERT_EQ(labels.rows, map.height());
+  EXPECT_EQ(static_cast<std::size_t>(cv::countNonZero(labels == 2)), r.seen_cells);
+  EXPECT_EQ(static_cast<std::size_t>(cv::countNonZero(labels)), r.free_cells);
+  EXPECT_EQ(labels.at<std::uint8_t>(160, 120), 0);  // the wall is not free
+  EXPECT_EQ(labels.at<std::uint8_t>(170, 126), 1);  // behind it: free, unseen
+  EXPECT_EQ(labels.at<std::uint8_t>(140, 126), 2);  // before it: seen
 }
 
 TEST(OcclusionRatio, HeadingBeyondTheFieldOfViewIsUnseen) {

@@ -16,6 +16,7 @@ from kiseki.grid import FREE, OCCUPIED, OccupancyGrid
 from kiseki.speed import (
     SpeedLimiter,
     SpeedLimiterConfig,
+    occlusion_labels,
     occlusion_ratio,
     passage_width,
     width_factor,
@@ -93,6 +94,20 @@ def test_ratio_matches_a_numpy_count_of_the_definition(seed):
     got = occlusion_ratio(prior, pose, ANGLES, ranges, MAX_RANGE, half, heading)
     want = _reference_ratio(prior, pose, ANGLES, ranges, MAX_RANGE, half, heading)
     assert got == pytest.approx(want, abs=2e-3)  # cells on the sector's edge may round apart
+
+
+def test_labels_mark_the_occluded_cells_behind_a_box():
+    prior = _field()
+    world = OccupancyGrid(prior.cells.copy(), 0.05, prior.origin)
+    world.cells[130:146, 96:104] = OCCUPIED  # 0.4 x 0.8 m, 1.5 m ahead, not in the map
+    pose = (0.0, 0.0, math.pi / 2)
+    ranges = _scan(world, pose)
+    ratio, labels = occlusion_labels(prior, pose, ANGLES, ranges, MAX_RANGE, math.pi / 2)
+    assert ratio == occlusion_ratio(prior, pose, ANGLES, ranges, MAX_RANGE, math.pi / 2)
+    assert ratio == pytest.approx((labels == 2).sum() / (labels > 0).sum())
+    assert (labels[150:170, 98:102] == 1).all()  # the box's shadow
+    assert (labels[110:125, 90:110] == 2).all()  # in front of it
+    assert (labels[:95] == 0).all()  # behind the sensor
 
 
 def test_unknown_obstacle_and_nan_readings_shrink_the_ratio():

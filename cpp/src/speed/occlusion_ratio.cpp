@@ -48,7 +48,7 @@ void check_scan(const PlanarScan& scan) {
 }
 
 OcclusionRatio occlusion_ratio(const OccupancyGrid& map, const Pose2& sensor_pose, const PlanarScan& scan,
-                               double heading, const OcclusionRatioOptions& options) {
+                               double heading, const OcclusionRatioOptions& options, cv::Mat* labels) {
   check_scan(scan);
   if (!(options.half_angle > 0 && options.half_angle <= kPi)) {
     throw std::invalid_argument("half_angle must be in (0, pi] rad, got " + std::to_string(options.half_angle));
@@ -73,10 +73,12 @@ OcclusionRatio occlusion_ratio(const OccupancyGrid& map, const Pose2& sensor_pos
   const Eigen::Vector2d across_rows = map.cell_to_world(x0, y0 + 1) - origin;
   const double cs = std::cos(sensor_pose.theta), ss = std::sin(sensor_pose.theta);
   const double range2 = range * range, cell_margin = 0.5 * res;
+  if (labels != nullptr) *labels = cv::Mat::zeros(map.height(), map.width(), CV_8UC1);
   OcclusionRatio out;
   for (int cy = y0; cy <= y1; ++cy) {
     const auto* row = map.cells().ptr<std::int8_t>(cy);
     const Eigen::Vector2d first = origin + (cy - y0) * across_rows;
+    auto* label = labels != nullptr ? labels->ptr<std::uint8_t>(cy) : nullptr;
     for (int cx = x0; cx <= x1; ++cx) {
       const std::int8_t v = row[cx];
       if (v < 0 || v > options.free_threshold) continue;  // R_map_free
@@ -87,16 +89,21 @@ OcclusionRatio occlusion_ratio(const OccupancyGrid& map, const Pose2& sensor_pos
       const double rho = std::sqrt(rho2);
       if (rho < 1e-9) {  // the sensor's own cell
         ++out.free_cells, ++out.seen_cells;
+        if (label != nullptr) label[cx] = 2;
         continue;
       }
       if (dx * hx + dy * hy < rho * cos_half) continue;  // ... and within +-theta of the heading
       ++out.free_cells;
+      if (label != nullptr) label[cx] = 1;
       // the bearing in the sensor frame, in (-pi, pi]
       const long beam = beam_of(scan, std::atan2(-dx * ss + dy * cs, dx * cs + dy * ss));
       if (beam < 0) continue;
       const double r = scan.ranges[beam];
       if (std::isnan(r)) continue;
-      if (r >= range || rho <= r - cell_margin) ++out.seen_cells;  // R_recognize
+      if (r >= range || rho <= r - cell_margin) {  // R_recognize
+        ++out.seen_cells;
+        if (label != nullptr) label[cx] = 2;
+      }
     }
   }
   out.ratio = out.free_cells == 0 ? 1.0 : static_cast<double>(out.seen_cells) / static_cast<double>(out.free_cells);

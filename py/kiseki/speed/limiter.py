@@ -40,6 +40,7 @@ __all__ = [
     "LimitTerms",
     "SpeedLimiter",
     "SpeedLimiterConfig",
+    "occlusion_labels",
     "occlusion_ratio",
     "passage_width",
     "width_factor",
@@ -89,6 +90,27 @@ def occlusion_ratio(
         grid, _pose(pose), angles, ranges, float(max_range), float(half_angle), heading
     )
     return float(ratio)
+
+
+def occlusion_labels(
+    grid: OccupancyGrid,
+    pose,
+    angles: np.ndarray,
+    ranges: np.ndarray,
+    max_range: float,
+    half_angle: float,
+    heading: float | None = None,
+) -> tuple[float, np.ndarray]:
+    """Eq. 1's ratio and the cells behind it, for pictures: a uint8 array indexed ``[y, x]`` like
+    ``grid.cells``: 0 outside the region, 1 a free cell of the region that the scan does not see
+    (occluded), 2 a seen one. Arguments as :func:`occlusion_ratio`."""
+    if not isinstance(grid, OccupancyGrid):
+        raise TypeError(f"grid must be a kiseki OccupancyGrid, got {type(grid).__name__}")
+    ratio, _, _, labels = _core.occlusion_ratio(
+        grid, _pose(pose), angles, ranges, float(max_range), float(half_angle), heading,
+        with_labels=True,
+    )  # fmt: skip
+    return float(ratio), labels
 
 
 def passage_width(

@@ -45,8 +45,12 @@ struct OcclusionRatio {
 /// bearing (each beam covers the wedge halfway to its neighbours; outside the scan's field of
 /// view nothing is seen) passes its centre at least half a cell before the beam's end, so the
 /// cell of an unknown obstacle and everything behind it are not seen.
+///
+/// labels, when given, receives the map's size in CV_8UC1: 0 outside the region, 1 a free cell
+/// of the region not seen (occluded), 2 a seen one (for pictures).
 OcclusionRatio occlusion_ratio(const OccupancyGrid& map, const Pose2& sensor_pose, const PlanarScan& scan,
-                               double heading, const OcclusionRatioOptions& options);
+                               double heading, const OcclusionRatioOptions& options,
+                               cv::Mat* labels = nullptr);
 
 /// Checks a scan (n >= 1, finite increasing angles, max_range > 0, ranges not negative);
 /// throws std::invalid_argument naming the problem.
