@@ -20,6 +20,7 @@ def _registry() -> dict[str, Experiment]:
         mcl_kidnapping,
         mcl_kld,
         merge_rules,
+        speed_fig4,
         teach_playback,
     )
 
@@ -33,6 +34,7 @@ def _registry() -> dict[str, Experiment]:
         mcl_kidnapping.CARMEN,
         mcl_kld.EXPERIMENT,
         merge_rules.EXPERIMENT,
+        speed_fig4.EXPERIMENT,
         teach_playback.EXP1,
         teach_playback.EXP2,
         teach_playback.EXP3,
