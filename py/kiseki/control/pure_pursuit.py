@@ -23,7 +23,11 @@ Speed: the route speed, capped so that the robot can still stop at the last wayp
 brakes at 0.8 of its acceleration limit a_max (constant deceleration a stops from v within
 v^2 / (2 a); d is the straight distance to the last waypoint)
 
-    v = min(v_route, sqrt(2 * 0.8 * a_max * d)).
+    v = min(v_route, sqrt(2 * 0.8 * a_max * d), v_cap)
+
+where v_cap is the optional ``max_speed`` of :meth:`PurePursuit.command` (a speed limiter's
+output, m/s; none by default). The cap bounds the forward speed only: a turn on the spot
+towards a goal point behind the robot keeps its 1 rad/s, also under a 0 m/s limit.
 
 The follower is done (and commands zero from then on) when the robot is within ``tolerance``
 of the last waypoint with less than 0.5 m of the path left to go.
@@ -84,8 +88,11 @@ class PurePursuit:
                 best, best_s = d, s
         return max(self.progress, best_s)
 
-    def command(self, pose) -> tuple[float, float, float]:
-        """(v_forward, v_left, yaw_rate) in the body frame."""
+    def command(self, pose, *, max_speed: float | None = None) -> tuple[float, float, float]:
+        """(v_forward, v_left, yaw_rate) in the body frame; ``max_speed`` (m/s, finite and
+        >= 0) caps the forward speed below the route speed and the braking cap."""
+        if max_speed is not None and not (math.isfinite(max_speed) and max_speed >= 0):
+            raise ValueError(f"max_speed must be a finite number >= 0 m/s, got {max_speed}")
         x, y, th = (float(v) for v in pose)
         xy = np.array([x, y])
         goal = self.points[-1]
@@ -101,6 +108,8 @@ class PurePursuit:
         dx, dy = target - xy
         lx, ly = c * dx + s * dy, -s * dx + c * dy  # target in the body frame
         speed = min(self.speed, math.sqrt(2 * self.max_accel * 0.8 * dist_goal))
+        if max_speed is not None:
+            speed = min(speed, float(max_speed))
         curvature = 2.0 * ly / max(lx * lx + ly * ly, 1e-9)  # Coulter's gamma = 2 y_l / l^2
         if lx < 0:  # target behind: turn on the spot
             return 0.0, 0.0, math.copysign(1.0, ly)
