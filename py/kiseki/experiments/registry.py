@@ -21,6 +21,7 @@ def _registry() -> dict[str, Experiment]:
         mcl_kld,
         merge_rules,
         speed_fig4,
+        speed_pedestrian,
         speed_situations,
         teach_playback,
     )
@@ -36,6 +37,7 @@ def _registry() -> dict[str, Experiment]:
         mcl_kld.EXPERIMENT,
         merge_rules.EXPERIMENT,
         speed_fig4.EXPERIMENT,
+        speed_pedestrian.EXPERIMENT,
         speed_situations.EXPERIMENT,
         teach_playback.EXP1,
         teach_playback.EXP2,
