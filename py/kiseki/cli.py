@@ -321,6 +321,12 @@ def sim_run(
         f"final pose ({x:.3f}, {y:.3f}, {th:.3f}), goal reached: {summary.reached_goal}; "
         + ", ".join(f"{k} {v}" for k, v in summary.messages.items())
     )
+    if summary.collision is not None:
+        c = summary.collision
+        console.print(
+            f"COLLISION at t = {c.t:.2f} s: {c.robot} hit {c.hit} at "
+            f"({c.contact[0]:.3f}, {c.contact[1]:.3f}); the run ended there"
+        )
 
 
 @sim_app.command("render")

@@ -11,7 +11,8 @@ Writing (:class:`RunWriter`)
     (the occupancy map, one INT8 field ``occupancy`` in the ROS convention, row 0 at the grid
     origin). kiseki's own messages (odometry, magnetometer, bearings, commands) go through
     :meth:`RunWriter.write_json` with a schema given by the caller; :meth:`RunWriter.write_odometry`
-    writes ``kiseki.Odometry2D`` (:data:`ODOMETRY_SCHEMA`). Each schema and each channel is
+    writes ``kiseki.Odometry2D`` (:data:`ODOMETRY_SCHEMA`); velocities are ``kiseki.Twist``
+    (:data:`TWIST_SCHEMA`, read back by :meth:`SimRun.velocities`). Each schema and each channel is
     registered once, on the first message of its name/topic; a topic keeps its schema.
 
     Times are seconds (float, >= 0, any order) stored as nanoseconds in ``log_time``,
@@ -77,6 +78,8 @@ __all__ = [
     "FOXGLOVE_SCHEMAS",
     "ODOMETRY_SCHEMA",
     "ODOMETRY_SCHEMA_NAME",
+    "TWIST_SCHEMA",
+    "TWIST_SCHEMA_NAME",
     "RunWriter",
     "SimRun",
     "TruncatedRunWarning",
@@ -323,6 +326,19 @@ ODOMETRY_SCHEMA: dict[str, Any] = {
         "angular_velocity": {"type": "number", "description": "turn rate, rad/s"},
     },
     "required": ["timestamp", "x", "y", "theta"],
+}
+
+TWIST_SCHEMA_NAME = "kiseki.Twist"
+TWIST_SCHEMA: dict[str, Any] = {
+    "title": TWIST_SCHEMA_NAME,
+    "description": "Planar body velocity (a command, /cmd_vel, or the robot's own, /velocity)",
+    "type": "object",
+    "properties": {
+        "vx": {"type": "number", "description": "forward, m/s, body frame"},
+        "vy": {"type": "number", "description": "left, m/s, body frame"},
+        "w": {"type": "number", "description": "yaw rate, rad/s, counterclockwise"},
+    },
+    "required": ["vx", "vy", "w"],
 }
 
 
@@ -837,6 +853,15 @@ class SimRun:
         rows = self._typed(topic, "foxglove.PoseInFrame")
         poses = np.array([self._xytheta(topic, m.get("pose")) for _, m in rows]).reshape(-1, 3)
         return _seconds(rows), poses
+
+    def velocities(self, topic: str = "/velocity") -> tuple[np.ndarray, np.ndarray]:
+        """A ``kiseki.Twist`` topic (/cmd_vel, /velocity) as (times (N,), (N, 3) vx, vy, w)."""
+        rows = self._typed(topic, TWIST_SCHEMA_NAME)
+        try:
+            values = [(float(m["vx"]), float(m["vy"]), float(m["w"])) for _, m in rows]
+        except (KeyError, TypeError, ValueError) as exc:
+            raise LogFormatError(f"{self.path}: bad kiseki.Twist on {topic!r} ({exc})") from exc
+        return _seconds(rows), np.array(values, dtype=float).reshape(-1, 3)
 
     def depth_images(self, topic: str) -> list[tuple[float, np.ndarray]]:
         """A ``foxglove.RawImage`` ``32FC1`` topic as (t, (h, w) float32 metres) pairs."""

@@ -13,7 +13,8 @@ route {waypoints [[x, y], ...], speed}, magnetic (see kiseki.sim.magnetic). Seve
 robot, sensors and route; and with several robots, ``turns`` {goal, speed, moves [{robot, to}]}
 instead of routes: the robots take turns (cooperative positioning), one driving while the
 others stand. ``poses`` {corner, distance, phi_deg [start, stop, step], heading_deg}: a sweep of
-test poses around a corner (``Scene.poses``, a list of (x, y, theta)).
+test poses around a corner (``Scene.poses``, a list of (x, y, theta)). ``pedestrians``: walking
+discs (see kiseki.sim.pedestrians; ``Scene.pedestrians``).
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ import yaml
 from kiseki import _core
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
+from kiseki.sim.pedestrians import Pedestrian, parse_pedestrians
 from kiseki.sim.primitives import BoxList, expand
 
 __all__ = ["Scene", "load_scene"]
@@ -50,6 +52,7 @@ TOP_KEYS = {
     "robots",
     "turns",
     "poses",
+    "pedestrians",
 }
 ROBOT_ENTRY_KEYS = {"name", "type", "start", "params", "odometry_errors", "sensors", "route"}
 VARIANTS = ("teach", "playback")
@@ -75,6 +78,7 @@ class Scene:
     # cooperative positioning: {goal: (x, y), speed, moves: [(robot name, (x, y)), ...]}
     turns: dict | None = None
     poses: list[tuple[float, float, float]] | None = None  # a sweep of test poses (x, y, theta)
+    pedestrians: list[Pedestrian] = field(default_factory=list)
 
     def ground_truth(
         self, z_min: float, z_max: float, resolution: float | None = None
@@ -184,6 +188,7 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
         robot_specs=specs,
         turns=_turns(doc, where, specs),
         poses=_poses(doc, where),
+        pedestrians=parse_pedestrians(doc.get("pedestrians"), where),
     )
     return scene
 

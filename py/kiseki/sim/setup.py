@@ -13,6 +13,7 @@ import numpy as np
 
 from kiseki.core import derive_seed
 from kiseki.sim import robot as robots
+from kiseki.sim.collisions import check_free_start
 from kiseki.sim.magnetic import MagneticWorld, Magnetometer
 from kiseki.sim.scene import Scene
 from kiseki.sim.sensors import (
@@ -77,24 +78,6 @@ def _start(scene: Scene, spec: dict) -> np.ndarray:
     return np.array([x, y, math.radians(yaw)])
 
 
-def _check_free_start(scene: Scene, pose: np.ndarray, length: float, width: float, height: float):
-    grid = scene.ground_truth(0.05, min(height, float(scene.bounds[1][2]) - 0.05))
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    u, v = np.meshgrid(
-        np.linspace(-length / 2, length / 2, 15), np.linspace(-width / 2, width / 2, 9)
-    )
-    pts = np.column_stack(
-        [pose[0] + c * u.ravel() - s * v.ravel(), pose[1] + s * u.ravel() + c * v.ravel()]
-    )
-    cells = grid.world_to_cell(pts)
-    inside = (cells[:, 0] >= 0) & (cells[:, 0] < grid.width) & (cells[:, 1] >= 0)
-    inside &= cells[:, 1] < grid.height
-    if not inside.all():
-        raise ValueError(f"{scene.path}: the robot's start footprint leaves the scene's bounds")
-    if (grid.cells[cells[:, 1], cells[:, 0]] == 100).any():
-        raise ValueError(f"{scene.path}: the robot's start footprint overlaps an obstacle")
-
-
 def build_robot(scene: Scene, seed: int, index: int = 0) -> RobotSetup:
     """The robot `index` of the scene (its true motion and its odometry)."""
     name, spec = scene.robot_specs[index]["name"], scene.robot_specs[index]["robot"]
@@ -131,7 +114,7 @@ def build_robot(scene: Scene, seed: int, index: int = 0) -> RobotSetup:
         )
     else:
         raise ValueError(f"{where}: type must be diff_drive or omni, got {kind!r}")
-    _check_free_start(scene, pose, setup.length, setup.width, setup.height)
+    check_free_start(scene, pose, setup.length, setup.width, setup.height)
     return setup
 
 
