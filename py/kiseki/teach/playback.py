@@ -5,24 +5,33 @@ estimate and stops when the estimate is within 0.1 m of the goal; it then decele
 acceleration limit (the filter still running) and its stop pose is where it comes to rest. The
 filter (kiseki's Monte Carlo engine, :mod:`kiseki.localization`) predicts from odometry and
 weighs particles with the space observation model on the chosen method's local map.
+
+A speed limiter (any :class:`~kiseki.control.SpeedLimitSource`; playback never imports the
+limiter's area) caps the follower's speed at every control step: the scene's first laser scans
+the world at the true pose, and the limiter gets that scan with the laser pose the robot knows,
+the one of its estimate in the taught map. With ``log`` the run is written to MCAP as it goes
+(:mod:`kiseki.teach.playback_log`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import math
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from kiseki import _core
-from kiseki.control import PurePursuit
+from kiseki.control import PurePursuit, SpeedLimit, SpeedLimitSource
 from kiseki.core import derive_seed
 from kiseki.grid import OccupancyGrid
 from kiseki.localization import MclConfig, MonteCarloLocalizer
 from kiseki.sim.scene import Scene
-from kiseki.sim.setup import build_robot, build_sensors
+from kiseki.sim.setup import SensorSetup, build_robot, build_sensors
 from kiseki.teach.local_maps import METHODS, LocalMapMaker
+from kiseki.teach.playback_log import PlaybackLog
 
 __all__ = ["PlaybackConfig", "PlaybackResult", "check_route", "playback"]
 
@@ -85,6 +94,13 @@ class PlaybackResult:
     passes: dict = field(default_factory=dict)  # waypoint -> true / estimate / odometry poses
     truth: np.ndarray | None = None
     estimates: np.ndarray | None = None
+    times: np.ndarray | None = None  # s, of each step (truth[k] and estimates[k] at times[k])
+    speed_limits: np.ndarray | None = None  # m/s the limiter allowed at each step, if any
+
+    @property
+    def duration(self) -> float:
+        """Seconds from the start to the last step (the stop at rest)."""
+        return float(self.times[-1]) if self.times is not None and len(self.times) else 0.0
 
 
 def _pose(p) -> tuple[float, float, float]:
@@ -96,8 +112,12 @@ def playback(
     environment: OccupancyGrid,
     waypoints: list[dict],
     config: PlaybackConfig | None = None,
+    speed_limiter: SpeedLimitSource | None = None,
+    log: str | os.PathLike | None = None,
 ) -> PlaybackResult:
-    """Runs the route through `waypoints` (taught marks, map frame) in the scene."""
+    """Runs the route through `waypoints` (taught marks, map frame) in the scene; the follower's
+    speed is capped by `speed_limiter` when given (the scene needs a laser), and the run is
+    written to the MCAP file `log` (which must not exist) when given."""
     config = config or PlaybackConfig()
     if len(waypoints) < 2:
         raise ValueError("a route needs a start and a goal waypoint")
@@ -112,11 +132,11 @@ def playback(
             "start": [x, y, math.degrees(th)],
         }
     setup = build_robot(scene, derive_seed(config.seed, 1))
-    cameras = [
-        s.device
-        for s in build_sensors(scene, setup, config.seed, config.dt)
-        if s.kind == "depth_camera"
-    ]
+    sensors = build_sensors(scene, setup, config.seed, config.dt)
+    cameras = [s.device for s in sensors if s.kind == "depth_camera"]
+    limiter = None
+    if speed_limiter is not None:
+        limiter = _ScanLimiter(scene, sensors, speed_limiter, config.dt)
     maker = LocalMapMaker(cameras, band)
     model = _core.SpaceObservationModel(environment, occlusion_aware=occlusion)
     localizer = MonteCarloLocalizer(
@@ -137,17 +157,34 @@ def playback(
         model.set_local_map(maker.make(images))
         return model
 
-    for _ in range(int(config.max_duration / config.dt)):
-        truth = _pose(setup.robot.pose)
-        localizer.step(_pose(setup.odometry.pose), observe)
-        estimate = tuple(float(v) for v in localizer.estimate)
-        truth_log.append(truth)
-        est_log.append(estimate)
-        _record_passes(passes, waypoints, controller, truth, estimate, _pose(setup.odometry.pose))
-        if controller.done and not any(setup.robot.velocity):
-            break  # the stop pose is where the robot comes to rest, not where it was told to stop
-        v, _, w = controller.command(estimate)
-        setup.odometry.update(setup.robot.step(v, w, config.dt))
+    meta = {
+        "scene_file": str(scene.path),
+        "route": ",".join(str(w["name"]) for w in waypoints),
+        "method": config.method,
+        "seed": str(config.seed),
+        "dt": str(config.dt),
+        "speed_limiter": type(speed_limiter).__name__ if speed_limiter is not None else "none",
+    }
+    with PlaybackLog(log, meta) if log is not None else contextlib.nullcontext() as writer:
+        for k in range(int(config.max_duration / config.dt)):
+            truth = _pose(setup.robot.pose)
+            localizer.step(_pose(setup.odometry.pose), observe)
+            estimate = tuple(float(v) for v in localizer.estimate)
+            truth_log.append(truth)
+            est_log.append(estimate)
+            odometry = _pose(setup.odometry.pose)
+            _record_passes(passes, waypoints, controller, truth, estimate, odometry)
+            cap = None  # m/s, the limiter's cap of the follower's speed
+            if limiter is not None:
+                cap = limiter.update(k * config.dt, truth, estimate, writer)
+            if writer is not None:
+                writer.step(k * config.dt, truth, estimate, odometry)
+            if controller.done and not any(setup.robot.velocity):
+                break  # the stop pose is where the robot comes to rest, not where it was told to
+            v, _, w = controller.command(estimate, max_speed=cap)
+            if writer is not None:
+                writer.command(k * config.dt, v, w)
+            setup.odometry.update(setup.robot.step(v, w, config.dt))
     return PlaybackResult(
         controller.done,
         len(truth_log),
@@ -157,7 +194,44 @@ def playback(
         passes,
         np.array(truth_log),
         np.array(est_log),
+        np.arange(len(truth_log)) * config.dt,
+        None if limiter is None else np.array(limiter.limits),
     )
+
+
+class _ScanLimiter:
+    """Feeds a speed limiter: the scene's first laser scans the world at the true pose (the
+    sensor sees the world); the limiter gets the laser pose of the estimate (the robot knows
+    only its estimate, in the taught map's frame) and, as the direction of motion of this
+    differential drive, the estimate's heading."""
+
+    def __init__(
+        self, scene: Scene, sensors: list[SensorSetup], source: SpeedLimitSource, dt: float
+    ) -> None:
+        if not isinstance(source, SpeedLimitSource):
+            raise TypeError(f"a speed limiter needs an update() method, got {type(source)}")
+        laser = next((s for s in sensors if s.kind == "laser"), None)
+        if laser is None:
+            raise ValueError(f"scene {scene.name} ({scene.path}) has no laser for a speed limiter")
+        self.laser, self.source, self.dt = laser, source, dt
+        self.angles, self.max_range = laser.device.params.angles, laser.device.params.max_range
+        self.grid = scene.ground_truth(laser.mount.z - 0.02, laser.mount.z + 0.02)
+        self.limits: list[float] = []  # m/s, one per update
+
+    def update(self, t: float, truth, estimate, writer: PlaybackLog | None) -> float:
+        """The step's speed cap (m/s); logs the scan and the limit when `writer` is given."""
+        true_sensor, ranges = self.laser.device.scan(self.grid, truth)
+        sensor = self.laser.mount.planar(estimate)
+        limit = self.source.update(
+            sensor, self.angles, ranges, self.max_range, self.dt, heading=float(estimate[2])
+        )
+        if not isinstance(limit, SpeedLimit):
+            raise TypeError(f"the speed limiter returned {type(limit)}, not a SpeedLimit")
+        self.limits.append(limit.metres_per_second)
+        if writer is not None:
+            writer.scan(t, true_sensor, self.angles, ranges, self.max_range)
+            writer.speed_limit(t, limit)
+        return limit.metres_per_second
 
 
 def _record_passes(passes, waypoints, controller, truth, estimate, odom) -> None:
