@@ -528,6 +528,16 @@ def playback_command(
     ),
     method: str = typer.Option("proposal2", help="conventional, proposal1, proposal2 or both."),
     seed: int = typer.Option(0, callback=_seed_option, help="Seed of the run's noise."),
+    speed_limit: str = typer.Option(
+        "none",
+        help="Speed limiter on the scene's laser: occlusion (occluded regions), "
+        "occlusion-width (and the movable width) or none.",
+    ),
+    log: Path | None = typer.Option(
+        None,
+        help="MCAP file to write the run to (poses, /cmd_vel; with a limiter /scan and "
+        "/speed_limit as nav2_msgs/SpeedLimit fields).",
+    ),
 ) -> None:
     """Play a taught route back on the particle filter's estimate; stop within 0.1 m of the goal.
     Give the teaching folder (--taught) or its waypoint file (--waypoints, and --map for a map
@@ -544,13 +554,21 @@ def playback_command(
         raise ValueError("give either --taught FOLDER or --waypoints FILE (with --map MAP.yaml)")
     if taught is not None and map_file is not None:
         raise ValueError("--map goes with --waypoints, not with --taught")
+    if speed_limit not in SPEED_LIMITS:
+        raise ValueError(f"--speed-limit must be {', '.join(SPEED_LIMITS)}, got {speed_limit!r}")
     config = PlaybackConfig(method=method, seed=seed)
     band, _ = METHODS[method]
     names = [n.strip() for n in route.split(",")]
     if taught is not None:
         waypoints = taught / "waypoints.yaml"
     map_path, marks = load_route(waypoints, band, names, map_file)
-    result = playback(load_scene(scene_file, "playback"), load_map(map_path), marks, config)
+    inputs = {"SCENE": scene_file, "the waypoint file": waypoints, "the map": map_path}
+    check_outputs({"--log": log}, inputs)
+    if log is not None and log.exists():
+        raise FileExistsError(f"--log {log} exists; give a new file")
+    scene, environment = load_scene(scene_file, "playback"), load_map(map_path)
+    limiter = _speed_limiter(speed_limit, scene, environment, config.speed)
+    result = playback(scene, environment, marks, config, limiter, log)
     goal = marks[-1]
     tx, ty, _ = result.stop_true
     ex, ey, _ = result.stop_estimate
@@ -559,7 +577,37 @@ def playback_command(
         f"map, {math.hypot(ex - goal['x'], ey - goal['y']):.3f} m from {goal['name']}; true stop "
         f"({tx:.3f}, {ty:.3f}), {math.hypot(tx - goal['truth'][0], ty - goal['truth'][1]):.3f} m "
         f"from where {goal['name']} was taught; goal reached: {result.reached}"
+        f" ({result.duration:.1f} s)"
     )
+    if result.speed_limits is not None:
+        limits = result.speed_limits
+        console.print(
+            f"  speed limit ({speed_limit}): {limits.min():.2f} to {limits.max():.2f} m/s, "
+            f"below the route speed {config.speed:.2f} m/s at {np.mean(limits < config.speed):.0%}"
+            " of the steps"
+        )
+    if log is not None:
+        console.print(f"  run logged to {log}", soft_wrap=True)
+
+
+SPEED_LIMITS = ("none", "occlusion", "occlusion-width")
+
+
+def _speed_limiter(name: str, scene, grid, v_max: float):
+    """The --speed-limit limiter on the taught map (kiseki.speed; playback never imports it)."""
+    if name == "none":
+        return None
+    sensors = scene.robot_specs[0]["sensors"]
+    if not any(isinstance(s, dict) and s.get("type") == "laser" for s in sensors):
+        raise ValueError(f"--speed-limit {name}: scene {scene.path} has no laser")
+    try:
+        from kiseki.speed import SpeedLimiter, SpeedLimiterConfig
+    except ImportError as err:
+        raise RuntimeError(f"--speed-limit {name} needs kiseki.speed ({err})") from None
+    config = SpeedLimiterConfig(
+        v_max=v_max, use_occlusion=True, use_width=name == "occlusion-width"
+    )
+    return SpeedLimiter(grid, config)
 
 
 @app.command("localize")
