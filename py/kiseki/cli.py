@@ -19,6 +19,7 @@ from rich.console import Console
 from rich.table import Table
 
 from kiseki._outputs import check_outputs
+from kiseki.cli_speed import speed_app
 from kiseki.errors import KisekiError
 
 app = typer.Typer(
@@ -39,6 +40,7 @@ coop_app = typer.Typer(
     no_args_is_help=True, help="Cooperative positioning: robots triangulate each other."
 )
 app.add_typer(coop_app, name="coop")
+app.add_typer(speed_app, name="speed")
 console = Console()
 
 

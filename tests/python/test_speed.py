@@ -21,6 +21,7 @@ from kiseki.speed import (
     passage_width,
     width_factor,
 )
+from speed_reference import reference_ratio
 
 ANGLES = np.linspace(-2 * math.pi / 3, 2 * math.pi / 3, 683)  # the paper's LRF: +-120 deg
 ONES = np.ones_like(ANGLES)
@@ -33,29 +34,6 @@ def _field(fill=FREE) -> OccupancyGrid:
 
 def _scan(world: OccupancyGrid, pose) -> np.ndarray:
     return world.cast_scans(np.array([pose]), ANGLES, max_range=MAX_RANGE)[0]
-
-
-def _reference_ratio(grid, pose, angles, ranges, max_range, half_angle, heading):
-    """The definition of eq. 1 counted with numpy over every cell: free map cells within reach
-    and +-half_angle of the heading; seen when the beam of nearest angle (inside the field of
-    view) passes the cell's centre half a cell before its end, or has no return."""
-    cells = grid.cells
-    ys, xs = np.nonzero((cells >= 0) & (cells <= 25))
-    res = grid.resolution
-    cx = grid.origin.x + (xs + 0.5) * res
-    cy = grid.origin.y + (ys + 0.5) * res
-    dx, dy = cx - pose[0], cy - pose[1]
-    rho = np.hypot(dx, dy)
-    rel = np.arctan2(np.sin(np.arctan2(dy, dx) - heading), np.cos(np.arctan2(dy, dx) - heading))
-    region = (rho <= max_range) & (np.abs(rel) <= half_angle + 1e-12)
-    beta = np.arctan2(np.sin(np.arctan2(dy, dx) - pose[2]), np.cos(np.arctan2(dy, dx) - pose[2]))
-    nearest = np.abs(beta[:, None] - angles[None, :]).argmin(axis=1)
-    half_step = (angles[1] - angles[0]) / 2
-    inside = (beta >= angles[0] - half_step) & (beta <= angles[-1] + half_step)
-    r = ranges[nearest]
-    seen = inside & ~np.isnan(r) & ((r >= max_range) | (rho <= r - res / 2))
-    free = int(region.sum())
-    return 1.0 if free == 0 else int((region & seen).sum()) / free
 
 
 def test_open_field_gives_one():
@@ -92,7 +70,7 @@ def test_ratio_matches_a_numpy_count_of_the_definition(seed):
     ranges[rng.random(ranges.size) < 0.05] = np.nan
     half, heading = rng.uniform(0.3, math.pi), pose[2] + rng.uniform(-1.5, 1.5)
     got = occlusion_ratio(prior, pose, ANGLES, ranges, MAX_RANGE, half, heading)
-    want = _reference_ratio(prior, pose, ANGLES, ranges, MAX_RANGE, half, heading)
+    want = reference_ratio(prior, pose, ANGLES, ranges, MAX_RANGE, half, heading)
     assert got == pytest.approx(want, abs=2e-3)  # cells on the sector's edge may round apart
 
 

@@ -6,6 +6,7 @@ simulator."""
 
 from __future__ import annotations
 
+from kiseki.speed.along_log import LimitsAlongLog, limits_along_log, motion_headings
 from kiseki.speed.baselines import (
     AccelerationLimit,
     DistanceLimiterConfig,
@@ -28,16 +29,19 @@ __all__ = [
     "AccelerationLimit",
     "DistanceLimiterConfig",
     "DistanceSpeedLimiter",
+    "LimitTerms",
+    "LimitsAlongLog",
     "NavigatorLog",
     "PolygonLimiterConfig",
-    "LimitTerms",
     "PolygonSpeedLimiter",
     "SpeedControlledNavigator",
-    "scan_about_body",
     "SpeedLimiter",
     "SpeedLimiterConfig",
+    "limits_along_log",
+    "motion_headings",
     "occlusion_labels",
     "occlusion_ratio",
     "passage_width",
+    "scan_about_body",
     "width_factor",
 ]
