@@ -358,9 +358,9 @@ def test_the_scene_takes_the_turns_of_form_2_and_its_bearings_triangulate(tmp_pa
     assert [m for m, _ in scene.turns["moves"]] == [names[s.robot] for s in p.steps]
     np.testing.assert_allclose([to for _, to in scene.turns["moves"]], [s.target for s in p.steps],
                                atol=1e-4)  # fmt: skip
-    # the paper's robots are points: the plan drives the 0.70 m bodies through each other, so
-    # the run goes on through contacts (kiseki.sim.run stops on the first one by default)
-    config = SimConfig(seed=3, stop_on_collision=False)
+    # the paper's robots are points (the scene's point_robots): the plan drives the 0.70 m
+    # bodies through each other, and they do not collide
+    config = SimConfig(seed=3)
     summary = run_scene(scene, tmp_path / "coop.mcap", config, progress=False)
     assert summary.reached_goal
     run = read_run(tmp_path / "coop.mcap")

@@ -5,6 +5,7 @@ against their parameters, every scene of data/worlds loads, renders and runs."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import shutil
 import subprocess
@@ -210,6 +211,7 @@ def test_octree_export_and_the_real_building(shared_data, tmp_path):
         ({"robot": {"type": "tank"}}, "diff_drive or omni"),
         ({"robots": [{"name": "a", "start": [2, 2, 0]}]}, "not both"),
         ({"sensors": [{"type": "bearing", "name": "b", "targets": ["ghost"]}]}, "other robots"),
+        ({"point_robots": "yes"}, "point_robots"),
     ],
 )
 def test_bad_scenes_are_rejected_with_the_file_named(tmp_path, patch, match):
@@ -310,18 +312,15 @@ def test_a_simulated_run_replays_through_the_dataset_interface(tmp_path):
 
 def test_mutual_bearings_of_three_robots_match_the_geometry(tmp_path):
     # The paper's robots are points: its leapfrog plan drives r3 0.54 m past r2's centre and
-    # later r2 straight through r3 (both on the rail x = 1), so the scene's 0.70 m bodies touch.
-    # The run therefore goes on through contacts here (stop_on_collision=False); the first one
-    # is logged.
+    # later r2 straight through r3 (both on the rail x = 1); the scene says point_robots, so
+    # their bodies do not collide with each other (they would: see below).
     scene = load_scene(WORLDS[[p.stem for p in WORLDS].index("coop_three_robots")])
-    summary = simulate(
-        scene,
-        tmp_path / "coop.mcap",
-        SimConfig(seed=7, stop_on_collision=False),
-        progress=False,
-    )
-    assert summary.reached_goal
-    assert {summary.collision.robot, summary.collision.hit} == {"r2", "r3"}
+    summary = simulate(scene, tmp_path / "coop.mcap", SimConfig(seed=7), progress=False)
+    assert summary.reached_goal and summary.collision is None
+    solid = dataclasses.replace(scene, point_robots=False)
+    stopped = simulate(solid, tmp_path / "solid.mcap", SimConfig(seed=7), progress=False)
+    assert not stopped.reached_goal
+    assert {stopped.collision.robot, stopped.collision.hit} == {"r2", "r3"}
     run = read_run(tmp_path / "coop.mcap")
     truth = {n: run.messages(f"/{n}/ground_truth") for n in ("r1", "r2", "r3")}
     errors, hidden = [], 0

@@ -159,10 +159,12 @@ def disc_contact(pose, length: float, width: float, center, radius: float):
 
 class CollisionCheck:
     """Every robot of a run (RobotSetup: name, robot.pose, length, width, height) against the
-    obstacles, the other robots and the pedestrians; the first contact found is returned."""
+    obstacles, the other robots (unless the scene's robots are points, ``point_robots``) and
+    the pedestrians; the first contact found is returned."""
 
     def __init__(self, scene, setups, pedestrians=()) -> None:
         self.setups, self.pedestrians = list(setups), list(pedestrians)
+        self.robots_touch = not getattr(scene, "point_robots", False)
         grids: dict[float, object] = {}
         self.checkers = []
         for s in self.setups:
@@ -178,6 +180,8 @@ class CollisionCheck:
                 return Collision(t, s.name, "obstacle", point)
         for i, (a, pa) in enumerate(zip(self.setups, poses, strict=True)):
             for b, pb in zip(self.setups[i + 1 :], poses[i + 1 :], strict=True):
+                if not self.robots_touch:
+                    break
                 point = rectangle_contact(pa, (a.length, a.width), pb, (b.length, b.width))
                 if point is not None:
                     return Collision(t, a.name, b.name, point)

@@ -14,7 +14,9 @@ robot, sensors and route; and with several robots, ``turns`` {goal, speed, moves
 instead of routes: the robots take turns (cooperative positioning), one driving while the
 others stand. ``poses`` {corner, distance, phi_deg [start, stop, step], heading_deg}: a sweep of
 test poses around a corner (``Scene.poses``, a list of (x, y, theta)). ``pedestrians``: walking
-discs (see kiseki.sim.pedestrians; ``Scene.pedestrians``).
+discs (see kiseki.sim.pedestrians; ``Scene.pedestrians``). ``point_robots: true``: the paper
+treats its robots as points, so the robots' bodies do not collide with each other (they still
+do with obstacles and pedestrians).
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ TOP_KEYS = {
     "turns",
     "poses",
     "pedestrians",
+    "point_robots",
 }
 ROBOT_ENTRY_KEYS = {"name", "type", "start", "params", "odometry_errors", "sensors", "route"}
 VARIANTS = ("teach", "playback")
@@ -79,6 +82,8 @@ class Scene:
     turns: dict | None = None
     poses: list[tuple[float, float, float]] | None = None  # a sweep of test poses (x, y, theta)
     pedestrians: list[Pedestrian] = field(default_factory=list)
+    # the paper treats its robots as points: contacts between them are logged, not stopped at
+    point_robots: bool = False
 
     def ground_truth(
         self, z_min: float, z_max: float, resolution: float | None = None
@@ -189,8 +194,16 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
         turns=_turns(doc, where, specs),
         poses=_poses(doc, where),
         pedestrians=parse_pedestrians(doc.get("pedestrians"), where),
+        point_robots=_flag(doc, "point_robots", where),
     )
     return scene
+
+
+def _flag(doc: dict, key: str, where: str) -> bool:
+    value = doc.get(key, False)
+    if not isinstance(value, bool):
+        raise ValueError(f"{where}: '{key}' must be true or false, got {value!r}")
+    return value
 
 
 def _turns(doc: dict, where: str, specs: list[dict]) -> dict | None:
