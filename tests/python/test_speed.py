@@ -137,7 +137,16 @@ def test_limiter_combines_the_terms_and_limits_acceleration():
     np.testing.assert_allclose(limits, np.minimum(0.05 * np.arange(1, 11), ref["v_ref"]))
     msg = limiter.update(pose, ANGLES, ranges, MAX_RANGE, 0.1)
     assert isinstance(msg, SpeedLimit) and not msg.percentage
-    assert msg.to_message() == {"percentage": False, "speed_limit": msg.speed_limit}
+    assert msg.to_message() == {
+        "percentage": False,
+        "speed_limit": msg.speed_limit,
+        "max_speed": 0.5,
+        "stop": False,
+    }
+    assert (
+        SpeedLimit(0.0).to_message()["stop"]
+        and not SpeedLimit(0.0, True).as_percentage().to_message()["speed_limit"]
+    )
     only_width = SpeedLimiter(grid, SpeedLimiterConfig(use_occlusion=False))
     assert only_width.reference(pose, ANGLES, ranges, MAX_RANGE)["v_ref"] == pytest.approx(
         0.5 * width_factor(w)

@@ -5,8 +5,9 @@ code that drives a robot (route playback, the simulator's navigators).
 
 ``SpeedLimit`` carries the two fields of nav2's ``nav2_msgs/msg/SpeedLimit``: ``percentage``
 (True: ``speed_limit`` is a percentage of the robot's maximum speed; False: metres per second)
-and ``speed_limit`` (0 means no limit in nav2; kiseki never sends 0 to mean that: a limiter that
-wants the robot to stop says 0 m/s with ``percentage=False`` and ``stop=True``).
+and ``speed_limit``. nav2 reads a ``speed_limit`` of 0 as "no limit"; kiseki's 0 means stop, so
+its messages (``to_message``) also carry ``stop`` (the limit is 0 m/s): a bridge to ROS must
+turn that into a stop, not into no limit.
 
 Code that drives a robot takes any object with the ``SpeedLimitSource`` method ``update``; it
 never imports the limiter's area (kiseki.speed), so playback stays independent of it.
@@ -58,8 +59,14 @@ class SpeedLimit:
         return SpeedLimit(value, True, self.max_speed)
 
     def to_message(self) -> dict:
-        """The fields of ``nav2_msgs/msg/SpeedLimit`` (without the header)."""
-        return {"percentage": bool(self.percentage), "speed_limit": float(self.speed_limit)}
+        """The fields of ``nav2_msgs/msg/SpeedLimit`` (without the header), the ``max_speed`` a
+        percentage refers to, and ``stop`` (the limit is 0 m/s; nav2 would read 0 as no limit)."""
+        return {
+            "percentage": bool(self.percentage),
+            "speed_limit": float(self.speed_limit),
+            "max_speed": float(self.max_speed),
+            "stop": self.metres_per_second == 0.0,
+        }
 
 
 @runtime_checkable

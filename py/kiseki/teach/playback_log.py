@@ -83,8 +83,6 @@ class PlaybackLog:
             "timestamp": {"sec": ns // 1_000_000_000, "nsec": ns % 1_000_000_000},
             "frame_id": "base_link",
             **limit.to_message(),
-            "max_speed": float(limit.max_speed),
-            "stop": limit.metres_per_second == 0.0,
         }
         self._writer.write_json("/speed_limit", t, "kiseki.SpeedLimit", payload, SPEED_LIMIT_SCHEMA)
 
