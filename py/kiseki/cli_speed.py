@@ -37,6 +37,9 @@ def speed_limits(
     reach: float = typer.Option(4.0, help="Sensor range of eq. 1's region (m); the paper's 4 m."),
     half_angle: float = typer.Option(90.0, help="theta: +-degrees around the motion (paper 90)."),
     v_max: float = typer.Option(0.5, help="The robot's maximum speed (m/s)."),
+    heading: str = typer.Option(
+        "laser", help="Direction of motion: laser (where the robot faces) or motion (its path)."
+    ),
     plot: Path | None = typer.Option(None, help="PNG: the map with the path coloured by limit."),
     scan_topic: str = typer.Option("/scan", help="Laser topic (ROS bags)."),
     reference_topic: str | None = typer.Option(
@@ -79,14 +82,15 @@ def speed_limits(
     scans = open_scans(log, **topics)
     if not scans.has_reference_poses:
         raise ValueError(f"{log}: the log has no reference poses (give --reference-topic)")
-    limits = limits_along_log(scans, grid, config, reach)
+    limits = limits_along_log(scans, grid, config, reach, heading)
     columns = limits.columns()
     rows = np.column_stack(list(columns.values()))
     text = ",".join(columns) + "\n" + "\n".join(",".join(f"{v:.6g}" for v in r) for r in rows)
     atomic_write(output, lambda tmp: Path(tmp).write_text(text + "\n", encoding="utf-8"))
     import yaml
 
-    doc = {"log": str(log), "map": str(map_file), "method": method, "reach": reach, **vars(config)}
+    doc = {"log": str(log), "map": str(map_file), "method": method, "reach": reach}
+    doc |= {"heading": heading, **vars(config)}
     atomic_write(side, lambda tmp: Path(tmp).write_text(yaml.safe_dump(doc), encoding="utf-8"))
     v = limits.v_ref
     console.print(

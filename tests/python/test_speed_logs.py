@@ -38,7 +38,9 @@ def intel(shared_data):
 def test_limits_on_real_scans_match_the_definitions(intel):
     scans, grid = intel
     part = scans.first(300)
-    limits = limits_along_log(part, grid, SpeedLimiterConfig(), reach=4.0)
+    limits = limits_along_log(part, grid, SpeedLimiterConfig(), reach=4.0, heading="motion")
+    laser = limits_along_log(part, grid, SpeedLimiterConfig(), reach=4.0)
+    np.testing.assert_array_equal(laser.headings, part.poses[:, 2])
     assert np.all((limits.ratio >= 0) & (limits.ratio <= 1))
     clipped = np.minimum(part.ranges, np.float32(4.0))
     for i in range(0, 300, 37):
@@ -78,6 +80,7 @@ def test_speed_limits_command_writes_the_csv_and_refuses_bad_input(intel, shared
         (("--method", "fast"), "--method"),
         (("--reach", "-1"), "--reach"),
         (("--half-angle", "0"), "--half-angle"),
+        (("--heading", "north"), "heading"),
     ]:
         bad = run("speed", "limits", log, "--map", map_yaml, "-o", tmp_path / "x.csv", *args)
         assert bad.returncode == 1 and message in bad.stderr, bad.stderr

@@ -2,8 +2,10 @@
 # Copyright (c) 2026 the kiseki authors
 """Paper 004's limit along a recorded log: for each scan at its reference pose on a map of the
 building, eq. 4's reference speed and its terms, as the robot would have been told to slow
-down. The direction of motion is the direction of the log's own displacement (the robot's
-next pose, or the last one while it stands: then the laser's heading).
+down. The direction of motion is the laser's heading (``heading="laser"``: a differential-drive
+robot, as in every CARMEN log, drives where it faces) or the direction of the log's own
+displacement (``"motion"``, for an omnidirectional robot with densely logged poses: toward the
+next pose at least 1 cm away, the pose's own heading once the robot stops).
 
 A real laser reaches further than the paper's 4 m: ``reach`` bounds the region of eq. 1 (the
 paper's sensor range; readings at or beyond it are free space seen up to it) and the passage
@@ -73,8 +75,11 @@ def limits_along_log(
     grid: OccupancyGrid,
     config: SpeedLimiterConfig | None = None,
     reach: float = 4.0,
+    heading: str = "laser",
 ) -> LimitsAlongLog:
     """Eq. 4 for every scan of a log with reference poses, on ``grid`` (the building's map)."""
+    if heading not in ("laser", "motion"):
+        raise ValueError(f"heading must be laser or motion, got {heading!r}")
     if not isinstance(scans, LaserScans):
         raise TypeError(f"scans must be kiseki LaserScans, got {type(scans).__name__}")
     if len(scans) == 0:
@@ -84,7 +89,7 @@ def limits_along_log(
     if not (math.isfinite(reach) and reach > 0):
         raise ValueError(f"reach must be a positive number of metres, got {reach}")
     limiter = SpeedLimiter(grid, config)
-    headings = motion_headings(scans.poses)
+    headings = motion_headings(scans.poses) if heading == "motion" else scans.poses[:, 2].copy()
     reach = min(reach, scans.max_range)
     clipped = np.minimum(scans.ranges, np.float32(reach))  # NaN stays NaN
     out = np.empty((len(scans), 4))
