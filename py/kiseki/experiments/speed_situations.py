@@ -115,6 +115,12 @@ def _between(row, y0: float, y1: float, what: str = "speed") -> np.ndarray:
     return np.asarray(row[what])[(y >= y0) & (y <= y1)]
 
 
+def _en_route(row) -> np.ndarray:
+    """The speeds past the start's ramp (1 s) and before the goal's braking (the last 1.5 s)."""
+    t, v = np.asarray(row["t"]), np.asarray(row["speed"])
+    return v[(t >= 1.0) & (t <= t[-1] - 1.5)]
+
+
 def _argmin_y(row, y0: float, y1: float) -> float:
     """The y at which the speed is lowest between y0 and y1."""
     y, v = np.asarray(row["y"]), np.asarray(row["speed"])
@@ -126,7 +132,7 @@ def analyze(config: SituationsConfig, trials: pd.DataFrame, timings, figures: Pa
     ok = trials[trials["error"].isna()]
     runs = {(int(r["situation"]), r["method"]): r for _, r in ok.iterrows()}
     table = ok[["situation", "method", "reached", "duration_s", "collision"]].copy()
-    table["min_speed"] = [float(np.min(r["speed"][5:])) for _, r in ok.iterrows()]
+    table["min_speed_en_route"] = [_en_route(r).min() for _, r in ok.iterrows()]
     table["mean_speed"] = [float(np.mean(r["speed"])) for _, r in ok.iterrows()]
     claims: list[Claim] = []
     v_max = 0.5
