@@ -281,14 +281,29 @@ def experiment_run(
     out: Path | None = typer.Option(None, "--out", help="Results folder (default results/NAME/…)."),
     resume: bool = typer.Option(False, "--resume", help="Run only the missing trials of a run."),
 ) -> None:
-    """Run an experiment's trials and write its results folder."""
-    from kiseki.experiments import run_experiment
+    """Run an experiment's trials and write its results folder. NAME may be a pattern
+    ('speed-*'): every matching experiment runs in turn, each into its own results folder
+    (--out/NAME with --out), with its default trials.
 
-    result = run_experiment(name, runs, seed, overrides, workers, scheduler, out, resume)
-    console.print(
-        f"{result.run_dir}: {result.runs} trials ({result.executed} run now, "
-        f"{result.failed} failed) in {result.wall_seconds:.1f} s"
-    )
+    Example: kiseki experiment run 'speed-*' --seed 0"""
+    import fnmatch
+
+    from kiseki.experiments import all_experiments, run_experiment
+
+    names, pattern = [name], any(c in name for c in "*?[")
+    if pattern:
+        names = sorted(fnmatch.filter(all_experiments(), name))
+        if not names:
+            raise KisekiError(f"no experiment matches {name!r} (see: kiseki experiment list)")
+        if runs is not None or overrides or resume:
+            raise KisekiError("a pattern runs several experiments: no --runs, --set or --resume")
+    for each in names:
+        where = out / each if out is not None and pattern else out
+        result = run_experiment(each, runs, seed, overrides, workers, scheduler, where, resume)
+        console.print(
+            f"{result.run_dir}: {result.runs} trials ({result.executed} run now, "
+            f"{result.failed} failed) in {result.wall_seconds:.1f} s"
+        )
 
 
 @sim_app.command("run")

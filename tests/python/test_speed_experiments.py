@@ -6,6 +6,8 @@ situations' claims, the pedestrian encounters' construction and outcomes, and th
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pandas as pd
@@ -104,6 +106,23 @@ def test_pedestrian_encounters_end_in_a_recorded_outcome(tmp_path):
     trials = pd.read_parquet(run.run_dir / "trials.parquet")
     hit = trials["none_outcome"] == "collision"
     assert (trials.loc[hit, "none_contact_speed"] >= 0.05).all()
+
+
+def test_a_pattern_runs_every_matching_experiment(tmp_path):
+    kiseki = [sys.executable, "-m", "kiseki.cli", "experiment", "run"]
+    done = subprocess.run(
+        [*kiseki, "speed-fig*", "--out", str(tmp_path)], capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    claims = pd.read_csv(tmp_path / "speed-fig4" / "claims.csv")
+    assert claims["holds"].all()
+    for args, message in [
+        (["nothing-*"], "no experiment matches"),
+        (["speed-*", "--runs", "2"], "no --runs"),
+        (["speed-*", "--set", "v_max=1"], "no --runs, --set"),
+    ]:
+        bad = subprocess.run([*kiseki, *args], capture_output=True, text=True)
+        assert bad.returncode == 1 and message in bad.stderr, bad.stderr
 
 
 def test_pedestrian_scene_copy_keeps_the_scene_file_untouched():
