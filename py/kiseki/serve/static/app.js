@@ -1,0 +1,334 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+// The route-instruction page (thesis 000, section 2.3): pick start, via and goal waypoints on the
+// taught map, start the route, watch the robot live, read the stop error at the goal.
+
+import { Api, ApiError, LiveSocket, loadToken, saveToken } from "./api.js";
+import { MapView } from "./mapview.js";
+import { RoutePicker } from "./route.js";
+
+const $ = (id) => document.getElementById(id);
+const fmt = (v, digits = 2) => (Number.isFinite(v) ? v.toFixed(digits) : "-");
+const STOP_TOLERANCE_M = 0.1; // the thesis' goal: stop within 0.1 m (section 2.2)
+
+const app = {
+  api: new Api(loadToken()),
+  view: new MapView($("map"), $("markers")),
+  waypoints: [],
+  state: { status: "idle", history: [] },
+  live: null,
+  socket: null,
+  latency: null, // {t0, posted} while waiting for the first pose after a click on start
+  updates: 0,
+};
+window.kiseki = app; // for the browser tests and a curious teacher's console
+
+function showMessage(text, kind = "error") {
+  const box = $("message");
+  box.hidden = !text;
+  box.textContent = text || "";
+  box.className = `message${kind === "info" ? " info" : ""}`;
+}
+
+function handleError(err) {
+  if (err instanceof ApiError && err.status === 401) {
+    $("token-form").hidden = false;
+    showMessage("This server needs its access token.");
+    return;
+  }
+  showMessage(err.message || String(err));
+}
+
+// ---- waypoints and the map ----
+
+function normaliseWaypoints(body) {
+  const list = Array.isArray(body) ? body : body.waypoints || [];
+  return list.map((w) => {
+    const pose = w.pose || [w.x, w.y, w.theta];
+    return { ...w, name: w.name, x: pose[0], y: pose[1], theta: pose[2] ?? 0 };
+  });
+}
+
+async function loadWaypoints() {
+  const body = await app.api.waypoints();
+  app.waypoints = normaliseWaypoints(body);
+  app.mapMeta = (body && (body.map || body.map_info)) || app.mapMeta || {};
+  picker.setNames(app.waypoints.map((w) => w.name));
+  renderRenameList();
+}
+
+async function loadMap() {
+  const source = await app.api.map();
+  app.view.setMap(source, app.mapMeta || {});
+  app.view.frame(app.waypoints);
+  app.view.resize();
+}
+
+function placeMarkers() {
+  if (!app.view.view) return;
+  app.view.placeMarkers(app.waypoints, (name) => picker.rolesOf(name), (name) => picker.tap(name));
+}
+
+// ---- the route being picked ----
+
+const picker = new RoutePicker({
+  onChange: () => {
+    const check = picker.check(app.waypoints, app.view.map ? app.view : null);
+    app.view.route = check.points;
+    app.view.blocked = check.blocked;
+    $("route-text").textContent = picker.text() || "no route";
+    const box = $("route-check");
+    box.hidden = !check.messages.length && !check.ok;
+    box.className = `check ${check.ok && !check.blocked.length ? "ok" : "bad"}`;
+    box.textContent = check.messages.length ? check.messages.join(" ") : "Route looks good.";
+    app.routeOk = check.ok;
+    updateButtons();
+    placeMarkers();
+    app.view.draw();
+  },
+});
+
+function updateButtons() {
+  // left enabled while a route runs: the server refuses a second one and the page says why
+  $("start-route").disabled = !app.routeOk;
+  // the stop button is never disabled: a stale view must not keep anyone from halting the robot
+}
+
+async function startRoute() {
+  const t0 = performance.now();
+  showMessage("");
+  try {
+    const body = await app.api.startRoute(picker.route());
+    app.latency = { t0, posted: performance.now() - t0, id: body && body.id };
+    app.state = { ...app.state, status: "running", route: body && (body.route || picker.route()) };
+    app.view.trail = [];
+    renderState();
+  } catch (err) {
+    handleError(err);
+  }
+}
+
+async function stopRoute() {
+  try {
+    await app.api.stop();
+    await refreshState();
+  } catch (err) {
+    handleError(err);
+  }
+}
+
+// ---- state and the live view ----
+
+function legText(state) {
+  const leg = state.leg;
+  if (leg === null || leg === undefined) return "-";
+  if (typeof leg === "string") return leg;
+  if (typeof leg === "object") {
+    const index = leg.index ?? leg.leg;
+    const count = leg.count ?? leg.of;
+    const head = index !== undefined ? `${index + 1}${count ? `/${count}` : ""}: ` : "";
+    return `${head}${leg.from ?? "?"} \u2192 ${leg.to ?? "?"}${leg.phase ? ` (${leg.phase})` : ""}`;
+  }
+  const names = routeNames(state.route);
+  if (Number.isInteger(leg) && names.length > leg + 1) {
+    return `${leg + 1}/${names.length - 1}: ${names[leg]} \u2192 ${names[leg + 1]}`;
+  }
+  return String(leg);
+}
+
+function routeNames(route) {
+  if (!route) return [];
+  return [route.start, ...(route.via || []), route.goal, route.home].filter((n) => n != null);
+}
+
+function routeText(route) {
+  if (!route) return "-";
+  const names = [route.start, ...(route.via || []), route.goal];
+  return `${names.join(" \u2192 ")}${route.home ? ` \u21a9 ${route.home}` : ""}`;
+}
+
+function stopErrorCell(value) {
+  if (!Number.isFinite(value)) return ["-", ""];
+  return [`${fmt(value, 3)} m`, value <= STOP_TOLERANCE_M ? "ok" : "bad"];
+}
+
+/** "x, y m  theta deg", short enough for a tile. */
+function poseText([x, y, theta]) {
+  return `${fmt(x)}, ${fmt(y)} m  ${fmt((theta * 180) / Math.PI, 0)}\u00b0`;
+}
+
+function renderState() {
+  const s = app.state;
+  document.body.dataset.status = s.status || "idle";
+  $("status").textContent = s.status || "idle";
+  $("leg").textContent = legText(s);
+  $("speed").textContent = Number.isFinite(s.speed) ? `${fmt(s.speed)} m/s` : "-";
+  const pose = $("pose");
+  if (Array.isArray(s.pose)) {
+    pose.textContent = poseText(s.pose);
+    [pose.dataset.x, pose.dataset.y, pose.dataset.theta] = s.pose.map(String);
+  }
+  if (Array.isArray(s.estimate)) {
+    const e = s.estimate;
+    $("estimate").textContent = poseText(e);
+    if (Array.isArray(s.pose)) {
+      $("est-error").textContent = `${fmt(Math.hypot(e[0] - s.pose[0], e[1] - s.pose[1]), 3)} m`;
+    }
+  }
+  const [stopText, stopClass] = stopErrorCell(s.stop_error_m);
+  const stop = $("stop-error");
+  stop.textContent = stopText;
+  stop.className = stopClass;
+  stop.dataset.m = Number.isFinite(s.stop_error_m) ? String(s.stop_error_m) : "";
+  $("dwell").textContent = dwellText(s);
+  if (s.status === "running" && s.route) {
+    // every page shows the route that runs, whoever started it
+    const check = picker.check(app.waypoints, null, s.route);
+    app.view.route = check.points;
+    app.view.blocked = [];
+  }
+  renderHistory(s.history || []);
+  updateButtons();
+}
+
+function dwellText(s) {
+  const d = s.dwell_s ?? s.dwell_remaining_s ?? s.dwell;
+  if (Number.isFinite(d)) return `${fmt(d, 1)} s${s.phase ? ` (${s.phase})` : ""}`;
+  if (typeof d === "string") return d;
+  return s.phase === "dwell" ? "taking the part" : "-";
+}
+
+function renderHistory(history) {
+  const body = $("history");
+  body.replaceChildren();
+  $("history-empty").hidden = history.length > 0;
+  [...history].reverse().forEach((h, i) => {
+    const row = document.createElement("tr");
+    const [text, cls] = stopErrorCell(h.stop_error_m);
+    const cells = [h.id ?? history.length - i, routeText(h.route || h), h.status || "", text];
+    cells.forEach((value, k) => {
+      const td = document.createElement("td");
+      td.textContent = value;
+      if (k === 3 && cls) td.className = cls;
+      row.append(td);
+    });
+    row.dataset.stopError = Number.isFinite(h.stop_error_m) ? String(h.stop_error_m) : "";
+    body.append(row);
+  });
+}
+
+async function refreshState() {
+  const previous = app.state.status;
+  app.state = { history: [], ...(await app.api.state()) };
+  if (previous !== "running" && app.state.status === "running") app.view.trail = [];
+  app.view.setLive(app.state);
+  renderState();
+}
+
+function onLive(message) {
+  const before = app.state.status;
+  app.state = { ...app.state, ...message };
+  app.updates += 1;
+  $("map").dataset.updates = String(app.updates);
+  app.view.setLive(app.state);
+  renderState();
+  if (app.latency && app.state.status === "running" && Array.isArray(message.pose)) {
+    const pending = app.latency;
+    app.latency = null;
+    // drawn: the frame after this one has painted the canvas
+    requestAnimationFrame(() => {
+      const ms = performance.now() - pending.t0;
+      app.lastLatency = { click_to_first_pose_ms: ms, click_to_accepted_ms: pending.posted };
+      const p = $("latency");
+      p.hidden = false;
+      p.textContent = `Click to first pose on screen: ${fmt(ms, 0)} ms`;
+    });
+  }
+  // a route that ended: fetch the full state once for the history and the stop report
+  if (before === "running" && message.status && message.status !== "running") {
+    refreshState().catch(handleError);
+  }
+}
+
+function connect() {
+  if (app.socket) app.socket.close();
+  app.socket = new LiveSocket(app.api, {
+    onMessage: onLive,
+    onOpen: () => refreshState().catch(handleError),
+    onStatus: (status) => {
+      document.body.dataset.connection = status;
+      $("connection").textContent = status === "live" ? "live" : "reconnecting\u2026";
+    },
+  });
+  app.socket.open();
+}
+
+// ---- renaming ----
+
+function renderRenameList() {
+  const list = $("rename-list");
+  list.replaceChildren();
+  for (const w of app.waypoints) {
+    const item = document.createElement("li");
+    const input = document.createElement("input");
+    input.value = w.name;
+    input.setAttribute("aria-label", `new name for ${w.name}`);
+    input.dataset.waypoint = w.name;
+    const button = document.createElement("button");
+    button.type = "button";
+    button.textContent = "Rename";
+    button.dataset.rename = w.name;
+    button.addEventListener("click", () => rename(w.name, input.value.trim()));
+    input.addEventListener("keydown", (e) => {
+      if (e.key === "Enter") rename(w.name, input.value.trim());
+    });
+    item.append(input, button);
+    list.append(item);
+  }
+}
+
+async function rename(name, newName) {
+  if (!newName || newName === name) return;
+  try {
+    await app.api.rename(name, newName);
+    picker.renamed(name, newName);
+    await loadWaypoints();
+    placeMarkers();
+    showMessage(`Renamed ${name} to ${newName}.`, "info");
+  } catch (err) {
+    handleError(err);
+  }
+}
+
+// ---- start-up ----
+
+async function boot() {
+  try {
+    await loadWaypoints();
+    await loadMap();
+    picker.changed();
+    await refreshState();
+    connect();
+    $("token-form").hidden = true;
+    showMessage("");
+  } catch (err) {
+    handleError(err);
+  }
+}
+
+$("token-form").addEventListener("submit", (e) => {
+  e.preventDefault();
+  const token = $("token-input").value.trim();
+  saveToken(token);
+  app.api.token = token;
+  boot();
+});
+$("start-route").addEventListener("click", startRoute);
+$("stop").addEventListener("click", stopRoute);
+$("clear-route").addEventListener("click", () => picker.clear());
+window.addEventListener("resize", () => {
+  app.view.resize();
+  placeMarkers();
+});
+picker.bind();
+boot();
