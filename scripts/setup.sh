@@ -18,6 +18,7 @@ APT_PACKAGES=(
   python3 python3-venv python3-dev
   libeigen3-dev libpcl-dev liboctomap-dev libopencv-dev octomap-tools
   libgtest-dev googletest
+  chromium  # the serve page's browser tests (Playwright drives it; it downloads no browser)
 )
 
 log() { printf '[setup] %s\n' "$*" >&2; }

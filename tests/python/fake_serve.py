@@ -32,9 +32,17 @@ def build(taught: Path, speed: float) -> FastAPI:
     png = io.BytesIO()
     image.save(png, "PNG")
     wps = {w["name"]: [w["x"], w["y"], w["theta"]] for w in doc["waypoints"]}
-    st = {"status": "idle", "route": None, "leg": None, "pose": list(wps[next(iter(wps))]),
-          "estimate": list(wps[next(iter(wps))]), "speed": 0.0, "stop_error_m": None,
-          "history": [], "phase": None}
+    st = {
+        "status": "idle",
+        "route": None,
+        "leg": None,
+        "pose": list(wps[next(iter(wps))]),
+        "estimate": list(wps[next(iter(wps))]),
+        "speed": 0.0,
+        "stop_error_m": None,
+        "history": [],
+        "phase": None,
+    }
     task: dict = {}
     app = FastAPI()
 
@@ -44,9 +52,15 @@ def build(taught: Path, speed: float) -> FastAPI:
 
     @app.get("/api/waypoints")
     def waypoints():
-        return {"waypoints": [{"name": n, "pose": p} for n, p in wps.items()],
-                "map": {"resolution": meta["resolution"], "origin": meta["origin"],
-                        "width": image.width, "height": image.height}}
+        return {
+            "waypoints": [{"name": n, "pose": p} for n, p in wps.items()],
+            "map": {
+                "resolution": meta["resolution"],
+                "origin": meta["origin"],
+                "width": image.width,
+                "height": image.height,
+            },
+        }
 
     @app.get("/api/map")
     def get_map():
@@ -59,7 +73,12 @@ def build(taught: Path, speed: float) -> FastAPI:
     async def drive(rid: int, names: list[str], goal_leg: int):
         try:
             for i in range(len(names) - 1):
-                st["leg"] = {"index": i, "count": len(names) - 1, "from": names[i], "to": names[i + 1]}
+                st["leg"] = {
+                    "index": i,
+                    "count": len(names) - 1,
+                    "from": names[i],
+                    "to": names[i + 1],
+                }
                 a, b = wps[names[i]], wps[names[i + 1]]
                 n = max(1, int(math.hypot(b[0] - a[0], b[1] - a[1]) / speed / 0.05))
                 heading = math.atan2(b[1] - a[1], b[0] - a[0])
@@ -78,8 +97,14 @@ def build(taught: Path, speed: float) -> FastAPI:
         except asyncio.CancelledError:
             st["status"] = "stopped"
         st["speed"] = 0.0
-        st["history"].append({"id": rid, "route": st["route"], "status": st["status"],
-                              "stop_error_m": st["stop_error_m"]})
+        st["history"].append(
+            {
+                "id": rid,
+                "route": st["route"],
+                "status": st["status"],
+                "stop_error_m": st["stop_error_m"],
+            }
+        )
 
     @app.post("/api/routes", status_code=202)
     async def routes(body: dict):
@@ -116,11 +141,24 @@ def build(taught: Path, speed: float) -> FastAPI:
         try:
             while True:
                 e = st["estimate"]
-                particles = [[e[0] + rng.gauss(0, 0.15), e[1] + rng.gauss(0, 0.15), e[2]]
-                             for _ in range(200)]
-                await socket.send_json({k: st[k] for k in
-                                        ("status", "pose", "estimate", "speed", "leg",
-                                         "stop_error_m", "phase")} | {"particles": particles})
+                particles = [
+                    [e[0] + rng.gauss(0, 0.15), e[1] + rng.gauss(0, 0.15), e[2]] for _ in range(200)
+                ]
+                await socket.send_json(
+                    {
+                        k: st[k]
+                        for k in (
+                            "status",
+                            "pose",
+                            "estimate",
+                            "speed",
+                            "leg",
+                            "stop_error_m",
+                            "phase",
+                        )
+                    }
+                    | {"particles": particles}
+                )
                 await asyncio.sleep(0.1)
         except WebSocketDisconnect:
             pass
@@ -135,4 +173,6 @@ if __name__ == "__main__":
     parser.add_argument("--port", type=int, default=8000)
     parser.add_argument("--speed", type=float, default=2.0)
     args = parser.parse_args()
-    uvicorn.run(build(args.taught, args.speed), host="127.0.0.1", port=args.port, log_level="warning")
+    uvicorn.run(
+        build(args.taught, args.speed), host="127.0.0.1", port=args.port, log_level="warning"
+    )

@@ -1,0 +1,248 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The route-instruction page in a real browser (headless Chromium from Debian, driven by
+Playwright): a worker's route start -> via -> goal -> home with the stop report, two pages on one
+robot, a refused second route, the stop button, a reload during a route, the server's refusal of a
+leg through a wall, and renaming. The server runs as a subprocess on a route taught here."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import pytest
+
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+IN_CI = os.environ.get("CI", "").lower() == "true"
+if not Path(CHROMIUM).exists() and not IN_CI:
+    pytest.skip(
+        "Debian's chromium is not installed (apt-get install chromium; CI runs these tests)",
+        allow_module_level=True,
+    )
+if IN_CI:
+    from playwright.sync_api import expect, sync_playwright
+else:
+    sync_playwright = pytest.importorskip("playwright.sync_api").sync_playwright
+    from playwright.sync_api import expect
+
+ROUTE = {"start": "P0", "via": ["T1", "T2"], "goal": "G", "home": "P0"}
+STOP_TOLERANCE_M = 0.1  # thesis 000, section 2.2
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def api(base: str, method: str, path: str, body: dict | None = None) -> tuple[int, dict]:
+    data = None if body is None else json.dumps(body).encode()
+    request = urllib.request.Request(base + path, data=data, method=method)
+    request.add_header("Content-Type", "application/json")
+    try:
+        with urllib.request.urlopen(request, timeout=10) as response:
+            return response.status, json.loads(response.read() or b"null")
+    except urllib.error.HTTPError as err:
+        return err.code, json.loads(err.read() or b"null")
+
+
+def serve_command(taught: Path, port: int) -> list[str]:
+    """`kiseki serve`, once it exists; until then the stand-in beside this file."""
+    real = Path(__file__).resolve().parents[2] / "py" / "kiseki" / "serve" / "__init__.py"
+    if real.exists():
+        return [sys.executable, "-m", "kiseki.cli", "serve", "--taught", str(taught),
+                "--port", str(port)]  # fmt: skip
+    fake = Path(__file__).with_name("fake_serve.py")
+    return [sys.executable, str(fake), "--taught", str(taught), "--port", str(port)]
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory, project_root):
+    from kiseki.sim.scene import load_scene
+    from kiseki.teach import teach
+
+    taught = tmp_path_factory.mktemp("serve") / "teach"
+    teach(load_scene(project_root / "data" / "worlds" / "factory_turn.yaml"), taught, seed=3)
+    port = free_port()
+    log = open(taught.parent / "serve.log", "w")  # noqa: SIM115 (closed below)
+    process = subprocess.Popen(serve_command(taught, port), stdout=log, stderr=subprocess.STDOUT)
+    base = f"http://127.0.0.1:{port}/"
+    deadline = time.monotonic() + 30
+    while True:
+        try:
+            if api(base, "GET", "api/state")[0] == 200:
+                break
+        except OSError:
+            pass
+        if process.poll() is not None or time.monotonic() > deadline:
+            process.kill()
+            log.close()
+            pytest.fail(f"kiseki serve did not start:\n{(taught.parent / 'serve.log').read_text()}")
+        time.sleep(0.2)
+    yield base
+    process.terminate()
+    process.wait(10)
+    log.close()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with sync_playwright() as p:
+        chromium = p.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        yield chromium
+        chromium.close()
+
+
+@pytest.fixture
+def idle(server):
+    """The robot at rest before and after each test (one robot for the whole module)."""
+
+    def settle():
+        api(server, "POST", "api/stop")
+        deadline = time.monotonic() + 20
+        while api(server, "GET", "api/state")[1]["status"] == "running":
+            assert time.monotonic() < deadline, "the robot did not stop"
+            time.sleep(0.1)
+
+    settle()
+    yield server
+    settle()
+
+
+def open_page(browser, base):
+    page = browser.new_page(viewport={"width": 1280, "height": 800})
+    errors: list[str] = []
+    page.on("pageerror", lambda err: errors.append(str(err)))
+    page.goto(base)
+    page.wait_for_selector("body[data-connection=live]")
+    page.js_errors = errors
+    return page
+
+
+def pick_route(page, route=ROUTE):
+    """Taps the markers: Start, the vias in order, Goal, Home (the role moves on by itself)."""
+    page.click(".role[data-role=start]")
+    page.click(f".marker[data-waypoint='{route['start']}']")
+    for name in route["via"]:
+        page.click(f".marker[data-waypoint='{name}']")
+    page.click(".role[data-role=goal]")
+    page.click(f".marker[data-waypoint='{route['goal']}']")
+    page.click(f".marker[data-waypoint='{route['home']}']")
+
+
+def pose(page) -> tuple[float, float]:
+    x, y = page.eval_on_selector("#pose", "e => [e.dataset.x, e.dataset.y]")
+    return float(x), float(y)
+
+
+def wait_moved(page, start, metres=0.3, timeout_s=30.0):
+    deadline = time.monotonic() + timeout_s
+    while True:
+        x, y = pose(page)
+        if ((x - start[0]) ** 2 + (y - start[1]) ** 2) ** 0.5 > metres:
+            return x, y
+        assert time.monotonic() < deadline, f"the robot did not move from {start}"
+        page.wait_for_timeout(100)
+
+
+def test_route_start_via_goal_home_with_stop_report(browser, idle):
+    page = open_page(browser, idle)
+    pick_route(page)
+    expect(page.locator("#route-text")).to_have_text("P0 → T1 → T2 → G ↩ P0")
+    expect(page.locator("#route-check")).to_have_text("Route looks good.")
+    start = pose(page)
+    page.click("#start-route")
+    expect(page.locator("body")).to_have_attribute("data-status", "running")
+    wait_moved(page, start)  # the robot moves on the page
+    stop = page.locator("#stop-error")
+    expect(stop).not_to_have_attribute("data-m", "", timeout=180_000)  # at the goal
+    assert float(stop.get_attribute("data-m")) < STOP_TOLERANCE_M
+    expect(page.locator("body")).to_have_attribute("data-status", "finished", timeout=180_000)
+    row = page.locator("#history tr").first
+    expect(row).to_contain_text("P0 → T1 → T2 → G ↩ P0")
+    assert float(row.get_attribute("data-stop-error")) < STOP_TOLERANCE_M
+    home = api(idle, "GET", "api/waypoints")[1]
+    latency = page.evaluate("window.kiseki.lastLatency")
+    print(f"click to first pose drawn: {latency['click_to_first_pose_ms']:.0f} ms")
+    assert latency["click_to_first_pose_ms"] < 2000, latency
+    assert not page.js_errors and home
+
+
+def test_two_pages_see_the_same_state_and_a_second_route_is_refused(browser, idle):
+    first, second = open_page(browser, idle), open_page(browser, idle)
+    pick_route(first)
+    start = pose(second)
+    first.click("#start-route")
+    for page in (first, second):
+        expect(page.locator("body")).to_have_attribute("data-status", "running")
+    wait_moved(second, start)
+    expect(second.locator("#leg")).to_have_text(first.locator("#leg").inner_text(), timeout=5000)
+    a, b = pose(first), pose(second)  # both at 10 Hz from one robot
+    assert abs(a[0] - b[0]) + abs(a[1] - b[1]) < 0.5, (a, b)
+    pick_route(second)
+    second.click("#start-route")
+    message = second.locator("#message")
+    expect(message).to_be_visible()
+    assert message.inner_text().strip(), "the 409's detail is shown"
+    assert api(idle, "GET", "api/state")[1]["status"] == "running"  # the first route goes on
+    assert not first.js_errors and not second.js_errors
+
+
+def test_the_stop_button_halts_the_robot(browser, idle):
+    page = open_page(browser, idle)
+    pick_route(page)
+    start = pose(page)
+    page.click("#start-route")
+    wait_moved(page, start)
+    page.click("#stop")
+    expect(page.locator("body")).to_have_attribute("data-status", "stopped", timeout=5000)
+    still = pose(page)
+    page.wait_for_timeout(1000)
+    assert pose(page) == still
+    x, y = api(idle, "GET", "api/state")[1]["pose"][:2]
+    assert abs(x - still[0]) < 0.05 and abs(y - still[1]) < 0.05
+
+
+def test_a_reload_reconnects_to_the_running_route(browser, idle):
+    page = open_page(browser, idle)
+    pick_route(page)
+    start = pose(page)
+    page.click("#start-route")
+    moved = wait_moved(page, start)
+    page.reload()
+    page.wait_for_selector("body[data-connection=live]")
+    expect(page.locator("body")).to_have_attribute("data-status", "running")
+    wait_moved(page, moved, metres=0.1)  # live updates again after the reload
+    expect(page.locator("#leg")).not_to_have_text("-")
+    assert page.evaluate("window.kiseki.view.route.length") >= 4  # the running route is drawn
+
+
+def test_a_leg_through_a_wall_is_refused_with_the_servers_reason(browser, idle):
+    page = open_page(browser, idle)
+    pick_route(page, {"start": "P0", "via": [], "goal": "G", "home": "P0"})
+    expect(page.locator("#route-check")).to_contain_text("crosses an obstacle")
+    page.click("#start-route")
+    message = page.locator("#message")
+    expect(message).to_be_visible()
+    status, body = api(idle, "POST", "api/routes", {**ROUTE, "via": []})
+    assert status == 422 and message.inner_text() == body["detail"]
+    assert api(idle, "GET", "api/state")[1]["status"] != "running"
+
+
+def test_renaming_a_waypoint(browser, idle):
+    page = open_page(browser, idle)
+    page.fill("input[data-waypoint=G]", "Shelf A")
+    page.click("button[data-rename=G]")
+    expect(page.locator(".marker[data-waypoint='Shelf A']")).to_be_visible()
+    names = [w["name"] for w in api(idle, "GET", "api/waypoints")[1]["waypoints"]]
+    assert "Shelf A" in names and "G" not in names
+    page.fill("input[data-waypoint='Shelf A']", "G")
+    page.click("button[data-rename='Shelf A']")
+    expect(page.locator(".marker[data-waypoint=G]")).to_be_visible()
