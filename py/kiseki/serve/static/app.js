@@ -67,6 +67,7 @@ async function loadMap() {
 function placeMarkers() {
   if (!app.view.view) return;
   app.view.placeMarkers(app.waypoints, (name) => picker.rolesOf(name), (name) => picker.tap(name));
+  app.view.draw();
 }
 
 // ---- the route being picked ----

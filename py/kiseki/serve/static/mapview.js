@@ -64,7 +64,7 @@ export class MapView {
     for (let i = 0; i < grey.length; i++) {
       const g = grey[i];
       // occupied cells dark, free white, unknown a light blue-grey (legible on a projector)
-      const [r, gg, b] = g < 100 ? [40, 44, 52] : g > 230 ? [255, 255, 255] : [214, 220, 228];
+      const [r, gg, b] = g < 100 ? [57, 64, 77] : g > 230 ? [255, 255, 255] : [214, 220, 228];
       img.data.set([r, gg, b, 255], 4 * i);
     }
     ctx.putImageData(img, 0, 0);
@@ -97,7 +97,7 @@ export class MapView {
     if (c1 <= c0 || r1 <= r0) [c0, r0, c1, r1] = [0, 0, width, height];
     const m = 1.0 / resolution;
     this.view = {
-      c0: Math.max(0, c0 - m), r0: Math.max(0, r0 - m),
+      c0: Math.max(0, c0 - m), r0: Math.max(0, r0 - 2 * m), // room for the labels above
       c1: Math.min(width, c1 + m), r1: Math.min(height, r1 + m),
     };
   }
@@ -145,6 +145,7 @@ export class MapView {
   }
 
   placeMarkers(waypoints, roles, onTap) {
+    this.waypoints = waypoints;
     this.markers.replaceChildren();
     for (const w of waypoints) {
       const button = document.createElement("button");
@@ -181,7 +182,26 @@ export class MapView {
       (v.c1 - v.c0) * this.scale, (v.r1 - v.r0) * this.scale);
     this.drawGrid(ctx);
     this.drawRoute(ctx);
+    this.drawWaypoints(ctx);
     if (this.live) this.drawLive(ctx, this.live);
+  }
+
+  /** Each waypoint's exact place: a ring with a stem up to its label (the label sits above). */
+  drawWaypoints(ctx) {
+    ctx.lineWidth = 3;
+    ctx.strokeStyle = "#1b1f24";
+    for (const w of this.waypoints || []) {
+      const [sx, sy] = this.toScreen(w.x, w.y);
+      ctx.beginPath();
+      ctx.moveTo(sx, sy - 6);
+      ctx.lineTo(sx, sy - 14);
+      ctx.stroke();
+      ctx.beginPath();
+      ctx.arc(sx, sy, 6, 0, 2 * Math.PI);
+      ctx.fillStyle = "#ffd166";
+      ctx.fill();
+      ctx.stroke();
+    }
   }
 
   /** A 1 m grid, faint, so that a class can read distances off the map. */
