@@ -33,7 +33,7 @@ from kiseki.sim.setup import SensorSetup, build_robot, build_sensors
 from kiseki.teach.local_maps import METHODS, LocalMapMaker
 from kiseki.teach.playback_log import PlaybackLog
 
-__all__ = ["PlaybackConfig", "PlaybackResult", "check_route", "playback"]
+__all__ = ["PlaybackConfig", "PlaybackResult", "PlaybackRun", "check_route", "playback"]
 
 
 def check_route(environment: OccupancyGrid, waypoints: list[dict]) -> None:
@@ -117,46 +117,10 @@ def playback(
 ) -> PlaybackResult:
     """Runs the route through `waypoints` (taught marks, map frame) in the scene; the follower's
     speed is capped by `speed_limiter` when given (the scene needs a laser), and the run is
-    written to the MCAP file `log` (which must not exist) when given."""
+    written to the MCAP file `log` (which must not exist) when given. A loop over
+    :class:`PlaybackRun`'s steps, for at most ``config.max_duration``."""
     config = config or PlaybackConfig()
-    if len(waypoints) < 2:
-        raise ValueError("a route needs a start and a goal waypoint")
-    check_route(environment, waypoints)
-    band, occlusion = METHODS[config.method]
-    if "truth" in waypoints[0]:  # in simulation the robot starts where the start was taught
-        x, y, th = waypoints[0]["truth"]
-        scene = copy.copy(scene)
-        scene.robot_specs = [dict(scene.robot_specs[0])]
-        scene.robot_specs[0]["robot"] = {
-            **scene.robot_specs[0]["robot"],
-            "start": [x, y, math.degrees(th)],
-        }
-    setup = build_robot(scene, derive_seed(config.seed, 1))
-    sensors = build_sensors(scene, setup, config.seed, config.dt)
-    cameras = [s.device for s in sensors if s.kind == "depth_camera"]
-    limiter = None
-    if speed_limiter is not None:
-        limiter = _ScanLimiter(scene, sensors, speed_limiter, config.dt)
-    maker = LocalMapMaker(cameras, band)
-    model = _core.SpaceObservationModel(environment, occlusion_aware=occlusion)
-    localizer = MonteCarloLocalizer(
-        MclConfig(particles=config.particles, alphas=tuple(config.alphas)),
-        derive_seed(config.seed, 2),
-    )
-    start = waypoints[0]
-    localizer.initialize((start["x"], start["y"], start["theta"]), config.initial_sd)
-    points = [[w["x"], w["y"]] for w in waypoints]
-    controller = PurePursuit(
-        points, config.speed, 0.6, config.goal_tolerance, setup.robot.params.max_accel
-    )
-    passes: dict = {}
-    truth_log, est_log = [], []
-
-    def observe():
-        images = [c.render(scene.world, truth) for c in cameras]
-        model.set_local_map(maker.make(images))
-        return model
-
+    run = PlaybackRun(scene, environment, waypoints, config, speed_limiter)
     meta = {
         "scene_file": str(scene.path),
         "route": ",".join(str(w["name"]) for w in waypoints),
@@ -166,37 +130,182 @@ def playback(
         "speed_limiter": type(speed_limiter).__name__ if speed_limiter is not None else "none",
     }
     with PlaybackLog(log, meta) if log is not None else contextlib.nullcontext() as writer:
-        for k in range(int(config.max_duration / config.dt)):
-            truth = _pose(setup.robot.pose)
-            localizer.step(_pose(setup.odometry.pose), observe)
-            estimate = tuple(float(v) for v in localizer.estimate)
-            truth_log.append(truth)
-            est_log.append(estimate)
-            odometry = _pose(setup.odometry.pose)
-            _record_passes(passes, waypoints, controller, truth, estimate, odometry)
-            cap = None  # m/s, the limiter's cap of the follower's speed
-            if limiter is not None:
-                cap = limiter.update(k * config.dt, truth, estimate, writer)
-            if writer is not None:
-                writer.step(k * config.dt, truth, estimate, odometry)
-            if controller.done and not any(setup.robot.velocity):
-                break  # the stop pose is where the robot comes to rest, not where it was told to
-            v, _, w = controller.command(estimate, max_speed=cap)
-            if writer is not None:
-                writer.command(k * config.dt, v, w)
-            setup.odometry.update(setup.robot.step(v, w, config.dt))
-    return PlaybackResult(
-        controller.done,
-        len(truth_log),
-        truth_log[-1],
-        est_log[-1],
-        _pose(setup.odometry.pose),
-        passes,
-        np.array(truth_log),
-        np.array(est_log),
-        np.arange(len(truth_log)) * config.dt,
-        None if limiter is None else np.array(limiter.limits),
-    )
+        run.writer = writer
+        for _ in range(int(config.max_duration / config.dt)):
+            if not run.step():
+                break
+    return run.result()
+
+
+class PlaybackRun:
+    """One playback in steps of one control period, for a driver that cannot wait for the whole
+    route (a server streaming the run, a stop button). Created with :func:`playback`'s
+    arguments: the simulated robot is placed where the start was taught (its ``truth``) and the
+    filter starts around the start's taught pose. :meth:`step` runs one period; :meth:`stop`
+    brings the robot to rest at its acceleration limit; :meth:`follow` starts the next route
+    from where the robot rests with the same robot, sensors and filter (a route that starts
+    where the previous one ended). ``writer`` (a :class:`PlaybackLog`) logs the steps when set.
+    """
+
+    def __init__(
+        self,
+        scene: Scene,
+        environment: OccupancyGrid,
+        waypoints: list[dict],
+        config: PlaybackConfig | None = None,
+        speed_limiter: SpeedLimitSource | None = None,
+        writer: PlaybackLog | None = None,
+    ) -> None:
+        self.config = config = config or PlaybackConfig()
+        _check_waypoints(environment, waypoints)
+        band, occlusion = METHODS[config.method]
+        if "truth" in waypoints[0]:  # in simulation the robot starts where the start was taught
+            x, y, th = waypoints[0]["truth"]
+            scene = copy.copy(scene)
+            scene.robot_specs = [dict(scene.robot_specs[0])]
+            scene.robot_specs[0]["robot"] = {
+                **scene.robot_specs[0]["robot"],
+                "start": [x, y, math.degrees(th)],
+            }
+        self.scene, self.environment, self.writer = scene, environment, writer
+        self.setup = build_robot(scene, derive_seed(config.seed, 1))
+        sensors = build_sensors(scene, self.setup, config.seed, config.dt)
+        self.cameras = [s.device for s in sensors if s.kind == "depth_camera"]
+        self.limiter = None
+        if speed_limiter is not None:
+            self.limiter = _ScanLimiter(scene, sensors, speed_limiter, config.dt)
+        self.maker = LocalMapMaker(self.cameras, band)
+        self.model = _core.SpaceObservationModel(environment, occlusion_aware=occlusion)
+        self.localizer = MonteCarloLocalizer(
+            MclConfig(particles=config.particles, alphas=tuple(config.alphas)),
+            derive_seed(config.seed, 2),
+        )
+        start = waypoints[0]
+        self.localizer.initialize((start["x"], start["y"], start["theta"]), config.initial_sd)
+        self._begin(waypoints)
+
+    def _begin(self, waypoints: list[dict]) -> None:
+        self.waypoints = list(waypoints)
+        self.controller = PurePursuit(
+            [[w["x"], w["y"]] for w in waypoints],
+            self.config.speed,
+            0.6,
+            self.config.goal_tolerance,
+            self.setup.robot.params.max_accel,
+        )
+        self.passes: dict = {}
+        self._truths: list[tuple[float, float, float]] = []
+        self._estimates: list[tuple[float, float, float]] = []
+        self.command: tuple[float, float] = (0.0, 0.0)  # (v m/s, w rad/s) of the last step
+        self.stopping = False  # stop() was called
+        self.done = False  # the robot rests at the end of the route, or after stop()
+
+    def follow(self, waypoints: list[dict]) -> None:
+        """Starts the next route with the same robot and filter, from where the robot rests
+        (the filter is not reset: the start waypoint should be where the robot is)."""
+        if not self.done:
+            raise ValueError("the robot is still on its route: stop it or let it finish first")
+        _check_waypoints(self.environment, waypoints)
+        self._begin(waypoints)
+
+    @property
+    def steps(self) -> int:
+        """Steps recorded on this route."""
+        return len(self._truths)
+
+    @property
+    def truth(self) -> tuple[float, float, float]:
+        """The true pose of the last recorded step (simulation)."""
+        return self._truths[-1] if self._truths else _pose(self.setup.robot.pose)
+
+    @property
+    def estimate(self) -> tuple[float, float, float]:
+        """The filter's estimate of the last recorded step."""
+        return tuple(float(v) for v in self.localizer.estimate)
+
+    @property
+    def velocity(self) -> tuple[float, float]:
+        """The robot's (v m/s, w rad/s) now (after its acceleration limit)."""
+        v, w = self.setup.robot.velocity
+        return float(v), float(w)
+
+    @property
+    def reached(self) -> bool:
+        """The estimate came within the goal tolerance of the goal (the follower's stop rule)."""
+        return bool(self.controller.done)
+
+    def particles(self, count: int | None = None) -> np.ndarray:
+        """The filter's particles (n, 3), or `count` of them, evenly spaced in its array."""
+        poses = np.asarray(self.localizer.engine.poses, dtype=float)
+        if count is None or count >= len(poses):
+            return poses
+        return poses[np.linspace(0, len(poses) - 1, max(count, 1)).astype(int)]
+
+    def stop(self) -> None:
+        """Commands zero speed from the next step on: the robot brakes at its acceleration
+        limit (the filter still running) and the run is done once it rests."""
+        self.stopping = True
+
+    def step(self) -> bool:
+        """One control period: the filter's update at the current pose (recorded), then the
+        follower's command for dt, unless the route is over (reached or stopped) and the robot
+        at rest. Returns False when the robot rests at the end (that step recorded, no command),
+        and from then on."""
+        if self.done:
+            return False
+        config, setup, writer = self.config, self.setup, self.writer
+        t = len(self._truths) * config.dt
+        truth = _pose(setup.robot.pose)
+        self._observed = truth
+        self.localizer.step(_pose(setup.odometry.pose), self._observe)
+        estimate = self.estimate
+        self._truths.append(truth)
+        self._estimates.append(estimate)
+        odometry = _pose(setup.odometry.pose)
+        _record_passes(self.passes, self.waypoints, self.controller, truth, estimate, odometry)
+        cap = None  # m/s, the limiter's cap of the follower's speed
+        if self.limiter is not None:
+            cap = self.limiter.update(t, truth, estimate, writer)
+        if writer is not None:
+            writer.step(t, truth, estimate, odometry)
+        if (self.controller.done or self.stopping) and not any(setup.robot.velocity):
+            self.done, self.command = True, (0.0, 0.0)
+            return False  # the stop pose is where the robot comes to rest, not where it was told
+        if self.stopping:
+            v, w = 0.0, 0.0
+        else:
+            v, _, w = self.controller.command(estimate, max_speed=cap)
+        self.command = (float(v), float(w))
+        if writer is not None:
+            writer.command(t, v, w)
+        setup.odometry.update(setup.robot.step(v, w, config.dt))
+        return True
+
+    def _observe(self):
+        images = [c.render(self.scene.world, self._observed) for c in self.cameras]
+        self.model.set_local_map(self.maker.make(images))
+        return self.model
+
+    def result(self) -> PlaybackResult:
+        """The route so far as a :class:`PlaybackResult`."""
+        return PlaybackResult(
+            self.reached,
+            len(self._truths),
+            self._truths[-1],
+            self._estimates[-1],
+            _pose(self.setup.odometry.pose),
+            self.passes,
+            np.array(self._truths),
+            np.array(self._estimates),
+            np.arange(len(self._truths)) * self.config.dt,
+            None if self.limiter is None else np.array(self.limiter.limits),
+        )
+
+
+def _check_waypoints(environment: OccupancyGrid, waypoints: list[dict]) -> None:
+    if len(waypoints) < 2:
+        raise ValueError("a route needs a start and a goal waypoint")
+    check_route(environment, waypoints)
 
 
 class _ScanLimiter:
