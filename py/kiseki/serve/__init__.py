@@ -1,0 +1,96 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""``kiseki serve``: the thesis' use phase (sec. 2.3) through a web page. A worker picks start,
+via and goal waypoints on the taught map; the AGV drives there, stops within 0.1 m, dwells
+while the part is taken, and returns to the worker's cell, watched live. An application layer
+beside the CLI: it uses teach, sim and map_io; nothing imports it."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import replace
+from pathlib import Path
+
+from kiseki.serve.app import STATIC, create_app
+from kiseki.serve.robot import Robot, RobotState, SimulatedAgv
+from kiseki.serve.routes import RouteRequest, RouteRunner
+from kiseki.serve.taught import TaughtRun, taught_scene
+
+__all__ = [
+    "LOOPBACK",
+    "STATIC",
+    "Robot",
+    "RobotState",
+    "RouteRequest",
+    "RouteRunner",
+    "Server",
+    "SimulatedAgv",
+    "TaughtRun",
+    "build_server",
+    "create_app",
+    "scene_of",
+]
+
+LOOPBACK = ("127.0.0.1", "localhost", "::1")
+
+
+class Server:
+    """The pieces of a served taught run: the FastAPI app, its runner and the taught run."""
+
+    def __init__(self, app, runner: RouteRunner, taught: TaughtRun, scene: Path) -> None:
+        self.app, self.runner, self.taught, self.scene = app, runner, taught, scene
+
+
+def scene_of(folder: str | os.PathLike, scene: str | os.PathLike | None) -> Path:
+    """The scene to play the taught run in: `scene`, which must be the one the teaching log
+    records (the same file or the same text), or the recorded one when `scene` is None."""
+    folder = Path(folder)
+    recorded = taught_scene(folder)
+    if scene is None:
+        if recorded is None:
+            raise ValueError(f"{folder}: the teaching log records no scene; give --scene SCENE")
+        if not Path(recorded).is_file():
+            raise FileNotFoundError(
+                f"{recorded}: the scene {folder} was taught in is not here; give --scene SCENE"
+            )
+        return Path(recorded)
+    scene = Path(scene)
+    if not scene.is_file():
+        raise FileNotFoundError(f"{scene}: scene file not found")
+    if recorded is None:
+        return scene
+    taught_in = Path(recorded)
+    same = (
+        (scene.samefile(taught_in) or scene.read_bytes() == taught_in.read_bytes())
+        if taught_in.is_file()
+        else scene.name == taught_in.name
+    )
+    if not same:
+        raise ValueError(f"{scene}: the run in {folder} was taught in {recorded}, not this scene")
+    return scene
+
+
+def build_server(
+    folder: str | os.PathLike,
+    scene: str | os.PathLike | None = None,
+    method: str = "both",
+    token: str | None = None,
+    dwell: float = 5.0,
+    speed_up: float = 1.0,
+    particles: int = 1000,
+    seed: int = 0,
+    static: Path = STATIC,
+) -> Server:
+    """Loads the taught run in `folder` and its scene and returns the app driving the
+    simulated AGV there (playback's configuration with `method`, `particles` and `seed`)."""
+    from kiseki.sim.scene import load_scene
+    from kiseki.teach.playback import PlaybackConfig
+
+    taught = TaughtRun(folder, method)
+    scene_file = scene_of(folder, scene)
+    if not all("truth" in w for w in taught.waypoints):
+        raise ValueError(f"{taught.path}: waypoints without their taught truth (not simulated)")
+    config = replace(PlaybackConfig(), method=method, particles=particles, seed=seed)
+    robot = SimulatedAgv(load_scene(scene_file, "playback"), taught.environment, config)
+    runner = RouteRunner(robot, taught, dwell, speed_up)
+    return Server(create_app(taught, runner, token, static), runner, taught, scene_file)

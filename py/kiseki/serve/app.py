@@ -1,0 +1,189 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The web API over a taught run (FastAPI). Errors are JSON ``{"detail": "..."}``.
+
+- ``GET /api/waypoints``: ``{"waypoints": [{"id", "name", "x", "y", "theta"}], "map": {"method",
+  "band", "width", "height", "resolution", "origin": [x, y, theta], "image": "/api/map"}}``
+- ``GET /api/map``: the taught map as PNG (ROS image: top row = largest y); ``?format=json``:
+  the map's metadata and ``cells`` (row-major from the bottom row; -1 unknown, 0 free,
+  100 occupied)
+- ``POST /api/routes`` ``{"start", "via": [...], "goal", "home"}`` (``via`` optional, ``home``
+  the start when omitted): 202 ``{"id", "route": {...}}``; 409 while a route runs; 422 for an
+  unknown waypoint, a leg through occupied space or a malformed body
+- ``GET /api/state``: ``{"status": "idle"|"running"|"finished"|"stopped", "route", "leg":
+  {"phase": "outbound"|"dwell"|"return", "index", "from", "to"}, "pose", "estimate",
+  "speed", "command", "t", "stop_error_m", "dwell_left_s", "detail", "history": [...]}``
+- ``POST /api/stop``: the robot brakes at once; ``{"stopping": bool, "status"}``
+- ``PATCH /api/waypoints/{name}`` ``{"name": NEW}``: 200 ``{"waypoint"}``; 404 unknown, 409 a
+  duplicate name or a route running, 422 a bad name
+- ``/ws``: the state (``"type": "state"``, ``"seq"``, ``"particles"`` [[x, y, theta], ...]) on
+  connecting and at every control period of a route, the same text to every page
+
+With a token (any address but loopback) every ``/api/`` request needs ``Authorization: Bearer
+TOKEN`` and the websocket the header or ``?token=TOKEN``; the page itself (static files, no
+data) loads without it so that it can ask for the token.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import hmac
+from contextlib import asynccontextmanager
+from pathlib import Path
+
+from fastapi import FastAPI, Request, WebSocket, WebSocketDisconnect
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse, Response
+from fastapi.staticfiles import StaticFiles
+from pydantic import BaseModel, ConfigDict
+
+from kiseki.serve.routes import RouteBusyError, RouteRefusedError, RouteRequest, RouteRunner
+from kiseki.serve.taught import TaughtRun, WaypointError
+
+__all__ = ["STATIC", "create_app"]
+
+STATIC = Path(__file__).resolve().parent / "static"
+
+
+class RouteBody(BaseModel):
+    model_config = ConfigDict(extra="forbid", str_strip_whitespace=True)
+    start: str
+    via: list[str] = []
+    goal: str
+    home: str | None = None
+
+
+class RenameBody(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    name: str
+
+
+def _error(status: int, detail: str, **headers: str) -> JSONResponse:
+    return JSONResponse({"detail": detail}, status_code=status, headers=headers or None)
+
+
+def _validation_detail(err: RequestValidationError) -> str:
+    parts = []
+    for e in err.errors():
+        where = ".".join(str(p) for p in e.get("loc", ()))
+        message = "invalid JSON" if e.get("type") == "json_invalid" else e.get("msg", "invalid")
+        parts.append(f"{where}: {message}")
+    return "; ".join(parts) or "invalid request"
+
+
+def _bearer(value: str | None) -> str | None:
+    if value and value[:7].lower() == "bearer ":
+        return value[7:].strip()
+    return None
+
+
+def create_app(
+    taught: TaughtRun, runner: RouteRunner, token: str | None = None, static: Path = STATIC
+) -> FastAPI:
+    """The app; `token` None (loopback) needs no authorization."""
+
+    def authorized(given: str | None) -> bool:
+        return token is None or (given is not None and hmac.compare_digest(given, token))
+
+    @asynccontextmanager
+    async def lifespan(_app: FastAPI):
+        yield
+        runner.close()
+
+    app = FastAPI(title="kiseki", lifespan=lifespan, docs_url=None, redoc_url=None)
+
+    @app.exception_handler(RequestValidationError)
+    async def invalid(_request: Request, err: RequestValidationError) -> JSONResponse:
+        return _error(422, _validation_detail(err))
+
+    @app.middleware("http")
+    async def check_token(request: Request, call_next):
+        if request.url.path.startswith("/api") and not authorized(
+            _bearer(request.headers.get("authorization"))
+        ):
+            return _error(401, "missing or wrong access token", **{"WWW-Authenticate": "Bearer"})
+        return await call_next(request)
+
+    @app.get("/api/waypoints")
+    def waypoints() -> dict:
+        return taught.public()
+
+    @app.get("/api/map")
+    def map_image(format: str = "png") -> Response:  # noqa: A002 (the query's name)
+        if format == "json":
+            return JSONResponse(taught.map_json())
+        if format != "png":
+            return _error(422, f"format must be png or json, got {format!r}")
+        return Response(taught.map_png(), media_type="image/png")
+
+    @app.post("/api/routes", status_code=202)
+    def start_route(body: RouteBody):
+        request = RouteRequest(body.start, body.goal, list(body.via), body.home)
+        try:
+            route = runner.submit(request)
+        except RouteRefusedError as err:
+            return _error(422, str(err))
+        except RouteBusyError as err:
+            return _error(409, str(err))
+        return {"id": route["id"], "route": route}
+
+    @app.get("/api/state")
+    def state() -> dict:
+        return runner.state()
+
+    @app.post("/api/stop")
+    def stop() -> dict:
+        return runner.stop()
+
+    @app.patch("/api/waypoints/{name}")
+    def rename(name: str, body: RenameBody):
+        if runner.state()["status"] == "running":
+            return _error(409, "a route is running; rename its waypoints when it is over")
+        try:
+            return {"waypoint": taught.rename(name, body.name)}
+        except WaypointError as err:
+            return _error(err.status, str(err))
+
+    @app.websocket("/ws")
+    async def live(websocket: WebSocket) -> None:
+        given = _bearer(websocket.headers.get("authorization")) or websocket.query_params.get(
+            "token"
+        )
+        if not authorized(given):
+            try:
+                await websocket.send_denial_response(_error(401, "missing or wrong access token"))
+            except RuntimeError:  # the server cannot send an HTTP response on a websocket
+                await websocket.close(code=1008, reason="missing or wrong access token")
+            return
+        await websocket.accept()
+        key, queue = runner.broadcaster.subscribe()
+        reader = asyncio.create_task(_until_closed(websocket))
+        try:
+            await websocket.send_text(runner.message())
+            while not reader.done():
+                getter = asyncio.create_task(queue.get())
+                await asyncio.wait({getter, reader}, return_when=asyncio.FIRST_COMPLETED)
+                if not getter.done():
+                    getter.cancel()
+                    break
+                await websocket.send_text(getter.result())
+        except (WebSocketDisconnect, RuntimeError):
+            pass
+        finally:
+            runner.broadcaster.unsubscribe(key)
+            reader.cancel()
+            with contextlib.suppress(asyncio.CancelledError, Exception):
+                await reader
+
+    app.mount("/", StaticFiles(directory=static, html=True, check_dir=False), name="page")
+    return app
+
+
+async def _until_closed(websocket: WebSocket) -> None:
+    """Reads (and ignores) what the page sends until it goes away."""
+    with contextlib.suppress(WebSocketDisconnect, RuntimeError):
+        while True:
+            message = await websocket.receive()
+            if message["type"] == "websocket.disconnect":
+                return
