@@ -627,6 +627,48 @@ def _speed_limiter(name: str, scene, grid, v_max: float):
     return SpeedLimiter(grid, config)
 
 
+@app.command("serve")
+def serve_command(
+    taught: Path = typer.Option(..., help="Folder written by kiseki teach (or kiseki demo's)."),
+    scene: Path | None = typer.Option(
+        None, help="Scene YAML the run was taught in (default: the one its log records)."
+    ),
+    method: str = typer.Option("both", help="conventional, proposal1, proposal2 or both."),
+    host: str = typer.Option("127.0.0.1", help="Address to bind; beyond loopback a token."),
+    port: int = typer.Option(8000, help="TCP port."),
+    dwell: float = typer.Option(5.0, help="Seconds the robot waits at the goal (part taken)."),
+    speed_up: float = typer.Option(1.0, help="Simulated seconds per wall-clock second."),
+    particles: int = typer.Option(1000, help="Particles of the localization filter."),
+    seed: int = typer.Option(0, callback=_seed_option, help="Seed of the run's noise."),
+) -> None:
+    """Serve the route-instruction page and its JSON API over a taught run: a worker picks
+    start, via and goal waypoints, the simulated AGV drives there, stops within 0.1 m, dwells
+    and returns home, watched live over a websocket. Binding beyond loopback prints an access
+    token that every API request must carry (Authorization: Bearer TOKEN)."""
+    import secrets
+
+    from kiseki.serve import LOOPBACK, build_server
+
+    if not (np.isfinite(dwell) and dwell >= 0):
+        raise ValueError(f"--dwell must be a number of seconds >= 0, got {dwell}")
+    _positive("--speed-up", speed_up)
+    if not 0 < port < 65536:
+        raise ValueError(f"--port must be 1..65535, got {port}")
+    token = None if host in LOOPBACK else secrets.token_urlsafe(24)
+    server = build_server(taught, scene, method, token, dwell, speed_up, particles, seed)
+    import uvicorn
+
+    names = ", ".join(w["name"] for w in server.taught.waypoints)
+    console.print(
+        f"kiseki serve: {taught} ({method}, waypoints {names}; scene {server.scene}) on "
+        f"http://{host}:{port}/",
+        soft_wrap=True,
+    )
+    if token is not None:
+        console.print(f"access token: {token}  (Authorization: Bearer TOKEN)", soft_wrap=True)
+    uvicorn.run(server.app, host=host, port=port, log_level="warning")
+
+
 @app.command("localize")
 def localize_command(
     log: Path = typer.Argument(
