@@ -144,6 +144,8 @@ def create_app(
             return {"waypoint": taught.rename(name, body.name)}
         except WaypointError as err:
             return _error(err.status, str(err))
+        except OSError as err:  # the file is as it was (atomic write)
+            return _error(500, f"the waypoint file was not changed: {err}")
 
     @app.websocket("/ws")
     async def live(websocket: WebSocket) -> None:
