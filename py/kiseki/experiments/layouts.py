@@ -1,0 +1,300 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""layouts-exp2-exp3: the teaching-and-playback thesis' Exp. 2 and Exp. 3 across factory layouts.
+
+kiseki's factory_turn.yaml is one assumed layout around the thesis' route with a turn, and
+exp2-turn's report finds that the methods' ordering depends on what lies behind the final
+leg's wall. Trial i runs both experiments on layout i (kiseki.sim.layouts.generate_layout with
+the trial's seed): ``runs_per_layout`` runs, each one call of exp2-turn's trial (teaching, then
+playback with the four methods) and one of exp3-boxes' trial (the same seed, so the same
+teaching; proposal 2 with three unknown boxes, and the same run without them). The analysis
+applies exp2-turn's and exp3-boxes' own analyses to each layout's runs, so a layout's claims are
+exactly those experiments' claims; then the share of layouts in which each claim holds, with a
+95 % Wilson interval, and the maps of the layouts where it fails. Every simulation parameter
+(noise, particles, motion model) is the same for every method and every layout.
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from matplotlib.colors import ListedColormap
+
+from kiseki.core import derive_seed
+from kiseki.experiments import teach_playback as tp
+from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.plots import new_figure
+from kiseki.sim.layouts import generate_layout, write_layout
+from kiseki.sim.scene import load_scene
+from kiseki.teach.environment_map import MERGE_RULES
+from kiseki.teach.local_maps import METHODS
+
+GENERAL = 0.8  # a claim generalises when it holds in at least this share of layouts
+SHADES = ListedColormap(["white", "#a0a0a0", "black"])
+
+
+@dataclass(frozen=True)
+class LayoutsConfig:
+    # Runs of each experiment per layout: the thesis' claims are means and counts over runs,
+    # so one run is not a claim; more than 2 puts the 20 layouts over 40 min on one core.
+    runs_per_layout: int = 2
+    methods: list[str] = field(
+        default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
+    )
+    particles: int = 1000
+    boxes: int = 3
+    merge: str = "thesis"
+
+
+def _configs(config: LayoutsConfig, scene: Path) -> dict:
+    common = {"scene": str(scene), "particles": config.particles, "merge": config.merge}
+    return {
+        "exp2": tp.Exp2Config(methods=list(config.methods), **common),
+        "exp3": tp.Exp3Config(boxes=config.boxes, **common),
+    }
+
+
+def trial(config: LayoutsConfig, index: int, seed: int) -> TrialOutput:
+    layout = generate_layout(seed)
+    record = {f"layout_{k}": v for k, v in layout.params.items()}
+    timings = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = write_layout(layout, Path(tmp) / f"layout_{index}.yaml")
+        for name, cfg in _configs(config, scene).items():
+            for r in range(config.runs_per_layout):
+                start = time.perf_counter()
+                out = tp.trial(cfg, index, derive_seed(seed, 10 + r))
+                timings[f"{name}_r{r}_seconds"] = time.perf_counter() - start
+                record |= {f"{name}_r{r}_{k}": v for k, v in out.record.items()}
+    return TrialOutput(record, timings)
+
+
+def _runs(row: pd.Series, name: str, runs: int) -> pd.DataFrame:
+    """One layout's runs of one experiment as that experiment's trials frame."""
+    rows = []
+    for r in range(runs):
+        prefix = f"{name}_r{r}_"
+        rec = {k[len(prefix) :]: v for k, v in row.items() if k.startswith(prefix)}
+        rows.append({"trial": r, "error": None, **rec})
+    return pd.DataFrame(rows)
+
+
+def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """The 95 % Wilson score interval of a share k/n."""
+    if n == 0:
+        return (math.nan, math.nan)
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+def _layout_claims(config: LayoutsConfig, ok: pd.DataFrame, scratch: Path) -> pd.DataFrame:
+    """Per layout and claim of exp2-turn / exp3-boxes: its measured value and whether it holds."""
+    rows = []
+    analyses = {"exp2": tp.analyze_exp2, "exp3": tp.analyze_exp3}
+    for _, row in ok.iterrows():
+        for name, cfg in _configs(config, Path("layout.yaml")).items():
+            frame = _runs(row, name, config.runs_per_layout)
+            for c in analyses[name](cfg, frame, pd.DataFrame(), scratch).claims:
+                rows.append(
+                    {
+                        "layout": int(row["trial"]),
+                        "seed": int(row["layout_seed"]),
+                        "final_left_behind": row["layout_final_left_behind"],
+                        "final_right_behind": row["layout_final_right_behind"],
+                        "experiment": name,
+                        "claim": c.claim,
+                        "paper_value": c.paper_value,
+                        "measured_value": c.measured_value,
+                        "holds": bool(c.holds),
+                    }
+                )
+    return pd.DataFrame(rows)
+
+
+def _shares(per: pd.DataFrame) -> pd.DataFrame:
+    rows = []
+    for (name, claim), g in per.groupby(["experiment", "claim"], sort=False):
+        k, n = int(g["holds"].sum()), len(g)
+        lo, hi = wilson(k, n)
+        fails = ", ".join(str(v) for v in g.loc[~g["holds"], "layout"])
+        rows.append(
+            {
+                "experiment": name,
+                "claim": claim,
+                "paper_value": g["paper_value"].iloc[0],
+                "layouts_holding": k,
+                "layouts": n,
+                "share": k / n,
+                "ci95_low": lo,
+                "ci95_high": hi,
+                "fails_in_layouts": fails,
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def _stops(config: LayoutsConfig, ok: pd.DataFrame) -> pd.DataFrame:
+    """Per layout: each method's mean stop error over its runs (Exp. 2; Exp. 3 with and
+    without the boxes), the best method, and what lies behind the final leg."""
+    rows = []
+    for _, row in ok.iterrows():
+        out = {
+            "layout": int(row["trial"]),
+            "final_left_behind": row["layout_final_left_behind"],
+            "final_right_behind": row["layout_final_right_behind"],
+        }
+        for m in config.methods:
+            out[f"{m}_stop_m"] = _runs(row, "exp2", config.runs_per_layout)[
+                f"{m}_stop_error"
+            ].mean()
+        exp3 = _runs(row, "exp3", config.runs_per_layout)
+        out["exp3_boxes_stop_m"] = exp3["proposal2_stop_error"].mean()
+        out["exp3_noboxes_stop_m"] = exp3["proposal2_nobox_stop_error"].mean()
+        out["best_method"] = min(config.methods, key=lambda m: out[f"{m}_stop_m"])
+        rows.append(out)
+    return pd.DataFrame(rows)
+
+
+def _by_behind(per: pd.DataFrame) -> pd.DataFrame:
+    """Share of layouts holding each claim, by what lies behind the final leg's left and right
+    boundary lines."""
+    rows = []
+    for side in ("left", "right"):
+        for behind, g in per.groupby(f"final_{side}_behind"):
+            shares = g.groupby("claim", sort=False)["holds"].mean()
+            rows.append(
+                {"side": side, "behind": behind, "layouts": g["layout"].nunique(), **shares}
+            )
+    return pd.DataFrame(rows)
+
+
+def _draw_layouts(ok: pd.DataFrame, layouts: list[int], title: str, path: Path) -> Path:
+    """A small multiple of the layouts from above (black: obstacles at 0.05-0.6 m, the plane
+    at 0.4 m among them; grey: higher, up to 2.0 m, table tops and shelves) with the route."""
+    cols = min(4, len(layouts))
+    nrows = math.ceil(len(layouts) / cols)
+    fig = new_figure(figsize=(4.4 * cols, 3.0 * nrows + 0.6), dpi=100)
+    axes = np.atleast_1d(fig.subplots(nrows, cols, squeeze=False)).ravel()
+    seeds = ok.set_index("trial")["layout_seed"]
+    with tempfile.TemporaryDirectory() as tmp:
+        for ax, index in zip(axes, layouts, strict=False):
+            layout = generate_layout(int(seeds.loc[index]))
+            scene = load_scene(write_layout(layout, Path(tmp) / "layout.yaml"))
+            low, high = scene.ground_truth(0.05, 0.6), scene.ground_truth(0.6, 2.0)
+            shade = np.where(low.cells == 100, 2, np.where(high.cells == 100, 1, 0))
+            o, r = low.origin, low.resolution
+            extent = [o.x, o.x + low.width * r, o.y, o.y + low.height * r]
+            ax.imshow(shade, origin="lower", extent=extent, cmap=SHADES, vmin=0, vmax=2)
+            route = np.asarray(scene.route["waypoints"], dtype=float)
+            ax.plot(route[:, 0], route[:, 1], "-o", color="tab:blue", lw=1.2, ms=3)
+            p = layout.params
+            ax.set_title(
+                f"layout {index}: behind the final leg left {p['final_left_behind']}, "
+                f"right {p['final_right_behind']}",
+                fontsize=7,
+            )
+            ax.tick_params(labelsize=6)
+    for ax in axes[len(layouts) :]:
+        ax.set_visible(False)
+    fig.suptitle(title, fontsize=10)
+    fig.savefig(path, bbox_inches="tight")
+    return path
+
+
+def _slug(text: str) -> str:
+    keep = "".join(ch if ch.isalnum() else "_" for ch in text.lower())
+    return "_".join(part for part in keep.split("_") if part)[:60]
+
+
+def analyze(config: LayoutsConfig, trials, timings, figures: Path) -> Analysis:
+    ok = trials[trials["error"].isna()]
+    with tempfile.TemporaryDirectory() as scratch:
+        per = _layout_claims(config, ok, Path(scratch))
+    shares = _shares(per)
+    wide = per.pivot_table(index="layout", columns="claim", values="holds", aggfunc="first")
+    layout_cols = [c for c in ok.columns if c.startswith("layout_") and c != "layout_attempt"]
+    table = ok.set_index("trial")[layout_cols].join(wide.astype(str))
+    figs = [_draw_layouts(ok, list(ok["trial"]), "all layouts", figures / "layouts.png")]
+    for _, s in shares.iterrows():
+        if s["fails_in_layouts"]:
+            failing = [int(v) for v in s["fails_in_layouts"].split(", ")]
+            path = figures / f"fails_{s['experiment']}_{_slug(s['claim'])}.png"
+            figs.append(_draw_layouts(ok, failing, f"fails: {s['claim']}", path))
+    claims = [
+        Claim(
+            f"{s['experiment']}: {s['claim']} (holds in >= {GENERAL:.0%} of layouts)",
+            f"{s['paper_value']} (thesis' factory)",
+            f"{s['layouts_holding']}/{s['layouts']} layouts ({s['share']:.0%}, "
+            f"95 % CI {s['ci95_low']:.0%}-{s['ci95_high']:.0%})",
+            "layouts",
+            bool(s["share"] >= GENERAL),
+            "general"
+            if s["ci95_low"] >= GENERAL
+            else "layout-specific"
+            if s["ci95_high"] < GENERAL
+            else "undecided by this many layouts",
+        )
+        for _, s in shares.iterrows()
+    ]
+    return Analysis(
+        tables={
+            "claim_shares": shares,
+            "per_layout": table.reset_index(),
+            "claims_per_layout": per,
+            "by_behind": _by_behind(per),
+            "stops_per_layout": _stops(config, ok),
+        },
+        figures=figs,
+        claims=claims,
+        notes=_notes(config, len(ok), len(trials)),
+    )
+
+
+def _notes(config: LayoutsConfig, ok: int, total: int) -> str:
+    return (
+        f"{ok} of {total} layouts ran (kiseki.sim.layouts states every range and its reason). "
+        f"Each layout: {config.runs_per_layout} run(s) of exp2-turn's trial (teaching, then "
+        "conventional, proposal 1, proposal 2 and both on the taught maps) and of exp3-boxes' "
+        f"trial ({config.boxes} unknown boxes, proposal 2, and the control without them), "
+        f"{config.particles} particles, merge rule {config.merge!r}; a layout's claims are "
+        "exp2-turn's and exp3-boxes' own analyses applied to its runs. The thesis' claims are "
+        "means and counts over 5 runs; with fewer runs per layout a claim is judged on fewer "
+        "stops, so a layout's verdict is noisier than the thesis' (a count claim such as 4/5 "
+        "within 0.1 m needs every run within when there are 2). A claim generalises when it "
+        f"holds in >= {GENERAL:.0%} of layouts; the note of each claim says whether the 95 % "
+        "Wilson interval lies above that (general), below it (layout-specific) or across it. "
+        "Table `by_behind` splits the shares by what lies behind the final leg's boundary "
+        "lines; figures `fails_*.png` draw the layouts where a claim fails (ground truth "
+        "0.05-2.0 m, route P0 -> T1 -> T2 -> G)."
+    )
+
+
+def _preflight(config: LayoutsConfig) -> None:
+    if config.runs_per_layout < 1:
+        raise ValueError(f"runs_per_layout must be at least 1, got {config.runs_per_layout}")
+    unknown = [m for m in config.methods if m not in METHODS]
+    if unknown:
+        raise ValueError(f"unknown method(s) {unknown} (known: {', '.join(METHODS)})")
+    if config.merge not in MERGE_RULES:
+        raise ValueError(f"unknown merge rule {config.merge!r} (known: {', '.join(MERGE_RULES)})")
+
+
+EXPERIMENT = Experiment(
+    name="layouts-exp2-exp3",
+    paper="000_7c5a0f8de3fa28f5.txt",
+    artefact="Tables 4.5-4.7 across layouts",
+    description="Exp. 2 and Exp. 3 on 20 seeded factory layouts: share of layouts per claim",
+    config_type=LayoutsConfig,
+    trial=trial,
+    analyze=analyze,
+    default_runs=20,
+    preflight=_preflight,
+)
