@@ -47,11 +47,8 @@ def post(base: str, path: str) -> None:
 
 
 def start_server(taught: Path, port: int, log: Path) -> subprocess.Popen:
-    if (ROOT / "py" / "kiseki" / "serve" / "__init__.py").exists():
-        command = [sys.executable, "-m", "kiseki.cli", "serve", "--taught", str(taught)]
-    else:  # before the server landed: the tests' stand-in
-        command = [sys.executable, str(ROOT / "tests" / "python" / "fake_serve.py"), "--taught",
-                   str(taught)]  # fmt: skip
+    command = [sys.executable, "-m", "kiseki.cli", "serve", "--taught", str(taught),
+               "--speed-up", "4", "--dwell", "3", "--seed", "1"]  # fmt: skip
     out = open(log, "w")  # noqa: SIM115 (the server's output for the whole run)
     process = subprocess.Popen([*command, "--port", str(port)], stdout=out, stderr=out)
     base = f"http://127.0.0.1:{port}/"

@@ -20,6 +20,7 @@ const app = {
   socket: null,
   latency: null, // {t0, posted} while waiting for the first pose after a click on start
   updates: 0,
+  recent: [],
 };
 window.kiseki = app; // for the browser tests and a curious teacher's console
 
@@ -101,7 +102,8 @@ async function startRoute() {
   try {
     const body = await app.api.startRoute(picker.route());
     app.latency = { t0, posted: performance.now() - t0, id: body && body.id };
-    app.state = { ...app.state, status: "running", route: body && (body.route || picker.route()) };
+    app.state = { ...app.state, status: "running", route: (body && body.route) || picker.route() };
+    app.state.pose = null; // the next pose drawn is the route's
     app.view.trail = [];
     renderState();
   } catch (err) {
@@ -120,15 +122,16 @@ async function stopRoute() {
 
 // ---- state and the live view ----
 
+const PHASES = { outbound: "to the goal", dwell: "at the goal", return: "going home" };
+
 function legText(state) {
   const leg = state.leg;
   if (leg === null || leg === undefined) return "-";
   if (typeof leg === "string") return leg;
   if (typeof leg === "object") {
-    const index = leg.index ?? leg.leg;
-    const count = leg.count ?? leg.of;
-    const head = index !== undefined ? `${index + 1}${count ? `/${count}` : ""}: ` : "";
-    return `${head}${leg.from ?? "?"} \u2192 ${leg.to ?? "?"}${leg.phase ? ` (${leg.phase})` : ""}`;
+    const phase = PHASES[leg.phase] || leg.phase || "";
+    if (leg.from == null) return phase || "-";
+    return `${leg.from} \u2192 ${leg.to}${phase ? ` (${phase})` : ""}`;
   }
   const names = routeNames(state.route);
   if (Number.isInteger(leg) && names.length > leg + 1) {
@@ -193,10 +196,10 @@ function renderState() {
 }
 
 function dwellText(s) {
-  const d = s.dwell_s ?? s.dwell_remaining_s ?? s.dwell;
-  if (Number.isFinite(d)) return `${fmt(d, 1)} s${s.phase ? ` (${s.phase})` : ""}`;
-  if (typeof d === "string") return d;
-  return s.phase === "dwell" ? "taking the part" : "-";
+  const left = s.dwell_left_s ?? s.dwell_s;
+  if (Number.isFinite(left)) return `${fmt(left, 1)} s left (part taken)`;
+  if (s.leg && s.leg.phase === "return") return "done";
+  return "-";
 }
 
 function renderHistory(history) {
@@ -226,29 +229,40 @@ async function refreshState() {
   renderState();
 }
 
+/** Live messages merge at once; the page draws at most once per frame. */
 function onLive(message) {
   const before = app.state.status;
   app.state = { ...app.state, ...message };
   app.updates += 1;
+  if (Number.isInteger(message.seq)) {
+    // the last messages by sequence number: pages on one robot can be compared exactly
+    app.recent.push({ seq: message.seq, pose: message.pose, leg: message.leg });
+    if (app.recent.length > 100) app.recent.shift();
+  }
+  if (before === "running" && app.state.status !== "running") showEnd(app.state);
+  if (!app.frame) app.frame = requestAnimationFrame(drawFrame);
+}
+
+function drawFrame() {
+  app.frame = 0;
   $("map").dataset.updates = String(app.updates);
   app.view.setLive(app.state);
   renderState();
-  if (app.latency && app.state.status === "running" && Array.isArray(message.pose)) {
-    const pending = app.latency;
+  const pending = app.latency;
+  if (pending && app.state.status === "running" && Array.isArray(app.state.pose)) {
     app.latency = null;
-    // drawn: the frame after this one has painted the canvas
-    requestAnimationFrame(() => {
-      const ms = performance.now() - pending.t0;
-      app.lastLatency = { click_to_first_pose_ms: ms, click_to_accepted_ms: pending.posted };
-      const p = $("latency");
-      p.hidden = false;
-      p.textContent = `Click to first pose on screen: ${fmt(ms, 0)} ms`;
-    });
+    const ms = performance.now() - pending.t0; // the first pose of the route is on the canvas
+    app.lastLatency = { click_to_first_pose_ms: ms, click_to_accepted_ms: pending.posted };
+    const p = $("latency");
+    p.hidden = false;
+    p.textContent = `Click to first pose on screen: ${fmt(ms, 0)} ms`;
   }
-  // a route that ended: fetch the full state once for the history and the stop report
-  if (before === "running" && message.status && message.status !== "running") {
-    refreshState().catch(handleError);
-  }
+}
+
+/** A route that ended on its own with a reason (or was stopped) says so once. */
+function showEnd(state) {
+  if (state.status === "stopped") showMessage(`Route stopped: ${state.detail || "stopped"}.`, "info");
+  else if (state.status === "finished") showMessage("");
 }
 
 function connect() {

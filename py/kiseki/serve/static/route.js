@@ -127,36 +127,47 @@ export class RoutePicker {
     this.onChange();
   }
 
+  /** The names along the route, out and back, as the server plans them (or planned them). */
+  static legs(route) {
+    if (route.outbound && route.return) return { out: route.outbound, back: route.return };
+    const via = route.via || [];
+    const out = [route.start, ...via, route.goal];
+    // home through the vias in reverse; a home among the vias (or the goal) is reached directly
+    let back = [route.goal, ...[...via].reverse(), route.home];
+    if (via.includes(route.home) || route.home === route.goal) {
+      back = route.home !== route.goal ? [route.goal, route.home] : [];
+    }
+    return { out, back };
+  }
+
   /**
-   * The route's points and what is wrong with it: missing or unknown names, a leg of zero
-   * length, legs that cross occupied cells of the taught map (the server has the last word).
+   * The route's points and what is wrong with it: missing, unknown or repeated names, legs
+   * that cross occupied cells of the taught map (a warning: the server has the last word).
    */
   check(waypoints, view, route = this.route()) {
     const byName = new Map(waypoints.map((w) => [w.name, w]));
-    const via = route.via || [];
-    const outbound = [route.start, ...via, route.goal];
-    // back to the worker's cell along the taught legs: the vias in reverse, then home
-    const legs = route.legs || [...outbound, ...[...via].reverse(), route.home];
     const messages = [];
     for (const [role, value] of [["start", route.start], ["goal", route.goal], ["home", route.home]]) {
       if (!value) messages.push(`Pick a ${role} waypoint.`);
     }
-    const unknown = [...new Set([...outbound, route.home].filter((n) => n && !byName.has(n)))];
+    const { out, back } = RoutePicker.legs(route);
+    const named = out.filter((n) => n);
+    const unknown = [...new Set([...named, route.home].filter((n) => n && !byName.has(n)))];
     if (unknown.length) messages.push(`Unknown waypoint ${unknown.join(", ")}.`);
+    const twice = named.filter((n, i) => named.indexOf(n) !== i);
+    if (twice.length) messages.push(`${[...new Set(twice)].join(", ")} appears twice.`);
     const points = [];
-    legs.forEach((n, i) => {
-      if (n && byName.has(n)) points.push({ ...byName.get(n), back: i >= outbound.length });
+    [...out, ...back.slice(1)].forEach((n, i) => {
+      if (n && byName.has(n)) points.push({ ...byName.get(n), back: i >= out.length });
     });
     const blocked = [];
     for (let i = 0; i + 1 < points.length; i++) {
-      if (points[i].name === points[i + 1].name) {
-        if (!points[i + 1].back) messages.push(`${points[i].name} follows itself.`);
-      } else if (view && view.legBlocked(points[i], points[i + 1])) {
+      if (view && points[i].name !== points[i + 1].name && view.legBlocked(points[i], points[i + 1])) {
         blocked.push(i);
         messages.push(`Leg ${points[i].name} \u2192 ${points[i + 1].name} crosses an obstacle.`);
       }
     }
-    const ok = messages.length === blocked.length; // blocked legs: the server decides
+    const ok = messages.length === blocked.length;
     return { points, blocked, messages, ok };
   }
 }
