@@ -165,6 +165,7 @@ class RouteRunner:
             self._state.update(
                 status="running", route=route, leg=None, stop_error_m=None, detail=None, t=0.0
             )
+            self._publish()  # the pages hear of the route before the robot has started it
             self._thread = threading.Thread(
                 target=self._run, args=(route, legs), name=f"route-{route['id']}", daemon=True
             )
