@@ -53,6 +53,12 @@ def _trial(base: str, ws, route: dict) -> tuple[float, float]:
             return first_message, now
 
 
+def _until_over(ws) -> None:
+    """Reads the page's messages (as a page does) until the route is over."""
+    while json.loads(ws.recv())["status"] == "running":
+        pass
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--taught", type=Path, default=Path("results/demo/teach"))
@@ -79,8 +85,7 @@ def main() -> None:
                 firsts.append(first)
                 moved.append(move)
                 httpx.post(f"{base}/api/stop")
-                while httpx.get(f"{base}/api/state").json()["status"] == "running":
-                    time.sleep(0.05)
+                _until_over(ws)
         # routes that go on from where the previous one rested (same robot and filter): the
         # worker's case, without the new placement's collision check of the scene
         with connect(f"ws://127.0.0.1:{port}/ws") as ws:
@@ -91,8 +96,7 @@ def main() -> None:
                 if k > 0:  # the first one places the robot
                     on_firsts.append(first)
                     on_moved.append(move)
-                while httpx.get(f"{base}/api/state").json()["status"] == "running":
-                    time.sleep(0.05)
+                _until_over(ws)
     finally:
         uv.should_exit = True
         thread.join(5)
