@@ -5,6 +5,7 @@
 const UNKNOWN = 205; // map_server's grey for unknown cells; 0 is occupied, 254 free
 const ROBOT_LENGTH = 1.05; // CARTIS TypeB, metres (thesis, section 3.1)
 const ROBOT_WIDTH = 0.58;
+const INSET_M = 2.5; // the magnifier's side, metres
 
 /** A map's grey levels (0 occupied .. 255 free) from a PNG bitmap or from JSON cells. */
 function greyLevels(source) {
@@ -306,14 +307,55 @@ export class MapView {
       });
       ctx.stroke();
     }
-    if (live.pose) this.drawRobot(ctx, live.pose, "#1b7f3b", true);
-    if (live.estimate) this.drawRobot(ctx, live.estimate, "#c0262d", false);
+    const k = this.scale / this.map.resolution;
+    const onMap = (x, y) => this.toScreen(x, y);
+    if (live.pose) this.drawRobot(ctx, live.pose, "#1b7f3b", true, onMap, k);
+    if (live.estimate) this.drawRobot(ctx, live.estimate, "#c0262d", false, onMap, k);
+    if (live.estimate) this.drawInset(ctx, live);
+  }
+
+  /**
+   * A magnifier in the top-right corner: INSET_M metres around the estimate, where the
+   * particles (a few centimetres apart once the filter has converged) can be told apart.
+   */
+  drawInset(ctx, live) {
+    const size = Math.min(220, this.canvas.clientWidth * 0.35);
+    const [ex, ey] = live.estimate;
+    const k = size / INSET_M; // pixels per metre
+    const x0 = this.canvas.clientWidth - size - 10;
+    const y0 = 10;
+    const project = (x, y) => [x0 + size / 2 + (x - ex) * k, y0 + size / 2 - (y - ey) * k];
+    const [c, r] = this.toCell(ex, ey);
+    const half = INSET_M / 2 / this.map.resolution;
+    ctx.save();
+    ctx.fillStyle = "#fff";
+    ctx.fillRect(x0, y0, size, size);
+    ctx.beginPath();
+    ctx.rect(x0, y0, size, size);
+    ctx.clip();
+    ctx.imageSmoothingEnabled = false;
+    ctx.drawImage(this.base, c - half, r - half, 2 * half, 2 * half, x0, y0, size, size);
+    if (live.pose) this.drawRobot(ctx, live.pose, "#1b7f3b", true, project, k);
+    this.drawRobot(ctx, live.estimate, "#c0262d", false, project, k);
+    ctx.fillStyle = "rgba(123, 63, 196, 0.7)"; // the particles on top, each one visible
+    for (const p of live.particles || []) {
+      const [sx, sy] = project(p[0], p[1]);
+      ctx.fillRect(sx - 2, sy - 2, 4, 4);
+    }
+    ctx.restore();
+    ctx.strokeStyle = "#1b1f24";
+    ctx.lineWidth = 2;
+    ctx.strokeRect(x0, y0, size, size);
+    ctx.fillStyle = "rgba(255, 255, 255, 0.85)";
+    ctx.fillRect(x0 + 1, y0 + size - 22, size - 2, 21);
+    ctx.fillStyle = "#1b1f24";
+    ctx.font = "600 13px system-ui, 'DejaVu Sans', sans-serif";
+    ctx.fillText(`${INSET_M} m around the estimate`, x0 + 6, y0 + size - 7);
   }
 
   /** The robot's footprint (filled for the true pose, outlined for the estimate) and heading. */
-  drawRobot(ctx, [x, y, theta], colour, filled) {
-    const [sx, sy] = this.toScreen(x, y);
-    const k = this.scale / this.map.resolution; // pixels per metre
+  drawRobot(ctx, [x, y, theta], colour, filled, project, k) {
+    const [sx, sy] = project(x, y); // k: pixels per metre
     ctx.save();
     ctx.translate(sx, sy);
     ctx.rotate(-theta); // y up in the world, down on the screen
