@@ -84,6 +84,7 @@ class Scene:
     pedestrians: list[Pedestrian] = field(default_factory=list)
     # the paper treats its robots as points: contacts between them are logged, not stopped at
     point_robots: bool = False
+    _bands: dict = field(default_factory=dict, repr=False, compare=False)  # ground_truth's
 
     def ground_truth(
         self, z_min: float, z_max: float, resolution: float | None = None
@@ -94,11 +95,14 @@ class Scene:
         res = self.grid_resolution if resolution is None else float(resolution)
         if not (np.isfinite(res) and res > 0):
             raise ValueError(f"resolution must be a positive number of metres, got {resolution}")
-        width = max(1, int(np.ceil((hi[0] - lo[0]) / res)))
-        height = max(1, int(np.ceil((hi[1] - lo[1]) / res)))
-        grid = OccupancyGrid(width, height, res, Pose2(float(lo[0]), float(lo[1]), 0.0))
-        self.world.rasterize_band(z_min, z_max, grid)
-        return grid
+        key = (id(self.world), float(z_min), float(z_max), res)
+        if key not in self._bands:  # rasterising takes 0.1-0.3 s: once per band and scene
+            width = max(1, int(np.ceil((hi[0] - lo[0]) / res)))
+            height = max(1, int(np.ceil((hi[1] - lo[1]) / res)))
+            grid = OccupancyGrid(width, height, res, Pose2(float(lo[0]), float(lo[1]), 0.0))
+            self.world.rasterize_band(z_min, z_max, grid)
+            self._bands[key] = grid
+        return self._bands[key].copy()  # the caller's own cells
 
 
 def _bounds(doc: dict, where: str, world) -> tuple[np.ndarray, np.ndarray]:
