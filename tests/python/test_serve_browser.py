@@ -63,12 +63,17 @@ def serve_command(taught: Path, port: int) -> list[str]:
 
 
 @pytest.fixture(scope="module")
-def server(tmp_path_factory, project_root):
+def taught(tmp_path_factory, project_root):
     from kiseki.sim.scene import load_scene
     from kiseki.teach import teach
 
-    taught = tmp_path_factory.mktemp("serve") / "teach"
-    teach(load_scene(project_root / "data" / "worlds" / "factory_turn.yaml"), taught, seed=3)
+    folder = tmp_path_factory.mktemp("serve") / "teach"
+    teach(load_scene(project_root / "data" / "worlds" / "factory_turn.yaml"), folder, seed=3)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def server(taught):
     port = free_port()
     log = open(taught.parent / "serve.log", "w")  # noqa: SIM115 (closed below)
     process = subprocess.Popen(serve_command(taught, port), stdout=log, stderr=subprocess.STDOUT)
@@ -248,3 +253,47 @@ def test_renaming_a_waypoint(browser, idle):
     page.fill("input[data-waypoint='Shelf A']", "G")
     page.click("button[data-rename='Shelf A']")
     expect(page.locator(".marker[data-waypoint=G]")).to_be_visible()
+
+
+def test_the_token_beyond_loopback_is_asked_for_once_or_taken_from_the_url(browser, taught):
+    port = free_port()
+    command = [*serve_command(taught, port), "--host", "0.0.0.0"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        token = None
+        for line in process.stdout:
+            if line.startswith("access token:"):
+                token = line.split()[2]
+                break
+        assert token, "kiseki serve printed no access token"
+        base = f"http://127.0.0.1:{port}/"
+        deadline = time.monotonic() + 30
+        while True:
+            try:
+                if api(base, "GET", "api/state")[0] == 401:  # up, and asking for the token
+                    break
+            except OSError:
+                pass
+            assert time.monotonic() < deadline, "kiseki serve --host 0.0.0.0 did not start"
+            time.sleep(0.2)
+        context = browser.new_context()
+        page = context.new_page()
+        page.goto(base)
+        expect(page.locator("#token-form")).to_be_visible()
+        page.fill("#token-input", token)
+        page.click("#token-form button")
+        expect(page.locator("body")).to_have_attribute("data-connection", "live")
+        expect(page.locator(".marker[data-waypoint=G]")).to_be_visible()
+        page.reload()  # kept: not asked again
+        expect(page.locator("body")).to_have_attribute("data-connection", "live")
+        expect(page.locator("#token-form")).to_be_hidden()
+        context.close()
+        context = browser.new_context()
+        page = context.new_page()
+        page.goto(f"{base}?token={token}")
+        expect(page.locator("body")).to_have_attribute("data-connection", "live")
+        assert "token" not in page.url  # taken out of the address bar
+        context.close()
+    finally:
+        process.terminate()
+        process.wait(10)

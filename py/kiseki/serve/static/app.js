@@ -3,7 +3,8 @@
 // The route-instruction page (thesis 000, section 2.3): pick start, via and goal waypoints on the
 // taught map, start the route, watch the robot live, read the stop error at the goal.
 
-import { Api, ApiError, LiveSocket, loadToken, saveToken } from "./api.js";
+// client.js, not api.js: the server asks a token of every path that starts with /api
+import { Api, ApiError, LiveSocket, loadToken, saveToken } from "./client.js";
 import { MapView } from "./mapview.js";
 import { RoutePicker } from "./route.js";
 
