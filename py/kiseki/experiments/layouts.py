@@ -35,14 +35,29 @@ from kiseki.sim.scene import load_scene
 from kiseki.teach.environment_map import MERGE_RULES
 from kiseki.teach.local_maps import METHODS
 
+REFUSED = "crosses occupied space"  # kiseki.teach.playback.check_route's refusal
 GENERAL = 0.8  # a claim generalises when it holds in at least this share of layouts
 SHADES = ListedColormap(["white", "#a0a0a0", "black"])
+# the layout parameters in the report's per-layout table (all of them are in trials.parquet)
+LAYOUT_COLUMNS = [
+    "seed",
+    "leg1_width",
+    "leg2_width",
+    "final_width",
+    "final_left_behind",
+    "final_left_wall_behind",
+    "final_right_behind",
+    "final_right_wall_behind",
+    "goal_shelf_side",
+]
 
 
 @dataclass(frozen=True)
 class LayoutsConfig:
-    # Runs of each experiment per layout: the thesis' claims are means and counts over runs,
-    # so one run is not a claim; more than 2 puts the 20 layouts over 40 min on one core.
+    # Runs of each experiment per layout. The thesis' claims are means and counts over runs:
+    # 2 is the fewest with a mean over runs and an SD (Exp. 3). One run of both experiments
+    # took 63 s of CPU (1000 particles), so 20 layouts x 2 runs take about 42 min on one core;
+    # 3 runs would take over an hour.
     runs_per_layout: int = 2
     methods: list[str] = field(
         default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
@@ -52,37 +67,83 @@ class LayoutsConfig:
     merge: str = "thesis"
 
 
-def _configs(config: LayoutsConfig, scene: Path) -> dict:
+def _configs(config: LayoutsConfig, scene: Path, method: str | None = None) -> dict:
     common = {"scene": str(scene), "particles": config.particles, "merge": config.merge}
+    methods = list(config.methods) if method is None else [method]
     return {
-        "exp2": tp.Exp2Config(methods=list(config.methods), **common),
+        "exp2": tp.Exp2Config(methods=methods, **common),
         "exp3": tp.Exp3Config(boxes=config.boxes, **common),
     }
 
 
+def _run(cfg, index: int, seed: int, prefix: str) -> dict:
+    """One call of exp2-turn's / exp3-boxes' trial, its record keys prefixed. When playback
+    refuses the route (a leg crosses occupied cells of the taught map), the record says so."""
+    try:
+        record = tp.trial(cfg, index, seed).record
+    except ValueError as err:
+        if REFUSED not in str(err):
+            raise
+        return {f"{prefix}{m}_refused": str(err) for m in cfg.methods}
+    return {f"{prefix}{k}": v for k, v in record.items()}
+
+
 def trial(config: LayoutsConfig, index: int, seed: int) -> TrialOutput:
+    """Layout `seed`: per run, exp2-turn's trial once per method (the same teaching seed, so the
+    same taught maps and the same results as one call with every method, but one method's
+    refused route does not stop the others) and exp3-boxes' trial."""
     layout = generate_layout(seed)
     record = {f"layout_{k}": v for k, v in layout.params.items()}
     timings = {}
     with tempfile.TemporaryDirectory() as tmp:
         scene = write_layout(layout, Path(tmp) / f"layout_{index}.yaml")
-        for name, cfg in _configs(config, scene).items():
-            for r in range(config.runs_per_layout):
-                start = time.perf_counter()
-                out = tp.trial(cfg, index, derive_seed(seed, 10 + r))
-                timings[f"{name}_r{r}_seconds"] = time.perf_counter() - start
-                record |= {f"{name}_r{r}_{k}": v for k, v in out.record.items()}
+        for r in range(config.runs_per_layout):
+            run_seed = derive_seed(seed, 10 + r)
+            start = time.perf_counter()
+            for m in config.methods:
+                record |= _run(_configs(config, scene, m)["exp2"], index, run_seed, f"exp2_r{r}_")
+            timings[f"exp2_r{r}_seconds"] = time.perf_counter() - start
+            start = time.perf_counter()
+            record |= _run(_configs(config, scene)["exp3"], index, run_seed, f"exp3_r{r}_")
+            timings[f"exp3_r{r}_seconds"] = time.perf_counter() - start
     return TrialOutput(record, timings)
 
 
 def _runs(row: pd.Series, name: str, runs: int) -> pd.DataFrame:
-    """One layout's runs of one experiment as that experiment's trials frame."""
+    """One layout's runs of one experiment as that experiment's trials frame. A method whose
+    route playback refused in a run never stops: its stop and estimate errors are infinite
+    there, its other columns empty."""
     rows = []
     for r in range(runs):
         prefix = f"{name}_r{r}_"
         rec = {k[len(prefix) :]: v for k, v in row.items() if k.startswith(prefix)}
-        rows.append({"trial": r, "error": None, **rec})
-    return pd.DataFrame(rows)
+        rows.append({"trial": r, "error": None, **{k: v for k, v in rec.items() if _set(v)}})
+    frame = pd.DataFrame(rows)
+    for m in _refused(frame):
+        template = next((c for c in frame if c.endswith("_stop_error") and c[:-11] != m), None)
+        if template is not None:  # give the method every column the others have
+            other = template[: -len("_stop_error")]
+            for c in [c for c in frame if c.startswith(f"{other}_")]:
+                if m + c[len(other) :] not in frame:
+                    frame[m + c[len(other) :]] = np.nan
+        refused = frame[f"{m}_refused"].notna()
+        for c in ("stop_error", "estimate_error"):
+            frame[f"{m}_{c}"] = frame.get(f"{m}_{c}", np.nan)
+            frame.loc[refused, f"{m}_{c}"] = np.inf
+    return frame
+
+
+def _set(value) -> bool:
+    return not (value is None or (isinstance(value, float) and math.isnan(value)))
+
+
+def _refused(frame: pd.DataFrame) -> list[str]:
+    """The methods whose playback refused the route in at least one run of the frame."""
+    return [c[: -len("_refused")] for c in frame if c.endswith("_refused")]
+
+
+def _names(method: str) -> set[str]:
+    return {method, method.replace("proposal", "proposal ")}
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -96,24 +157,39 @@ def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
 
 
 def _layout_claims(config: LayoutsConfig, ok: pd.DataFrame, scratch: Path) -> pd.DataFrame:
-    """Per layout and claim of exp2-turn / exp3-boxes: its measured value and whether it holds."""
-    rows = []
+    """Per layout and claim of exp2-turn / exp3-boxes: its measured value and whether it holds
+    (exp2-turn's and exp3-boxes' own analyses on the layout's runs). A claim that names a
+    method whose playback refused the route in some run does not hold there."""
     analyses = {"exp2": tp.analyze_exp2, "exp3": tp.analyze_exp3}
+    found: dict[tuple[int, str], list[Claim]] = {}
+    refusals: dict[tuple[int, str], list[str]] = {}
     for _, row in ok.iterrows():
         for name, cfg in _configs(config, Path("layout.yaml")).items():
             frame = _runs(row, name, config.runs_per_layout)
-            for c in analyses[name](cfg, frame, pd.DataFrame(), scratch).claims:
+            key = (int(row["trial"]), name)
+            refusals[key] = _refused(frame)
+            if any(c.endswith("_stop_error") and np.isfinite(frame[c]).any() for c in frame):
+                found[key] = analyses[name](cfg, frame, pd.DataFrame(), scratch).claims
+    templates = {name: claims for (_, name), claims in found.items()}
+    rows = []
+    for _, row in ok.iterrows():
+        for name in analyses:
+            key = (int(row["trial"]), name)
+            refused = set().union(*(_names(m) for m in refusals[key]))
+            claims = found.get(key, templates.get(name, []))
+            for c in claims:
+                blocked = any(n in c.claim for n in refused)
                 rows.append(
                     {
-                        "layout": int(row["trial"]),
+                        "layout": key[0],
                         "seed": int(row["layout_seed"]),
                         "final_left_behind": row["layout_final_left_behind"],
                         "final_right_behind": row["layout_final_right_behind"],
                         "experiment": name,
                         "claim": c.claim,
                         "paper_value": c.paper_value,
-                        "measured_value": c.measured_value,
-                        "holds": bool(c.holds),
+                        "measured_value": "route refused" if blocked else c.measured_value,
+                        "holds": bool(c.holds) and not blocked,
                     }
                 )
     return pd.DataFrame(rows)
@@ -156,11 +232,34 @@ def _stops(config: LayoutsConfig, ok: pd.DataFrame) -> pd.DataFrame:
                 f"{m}_stop_error"
             ].mean()
         exp3 = _runs(row, "exp3", config.runs_per_layout)
-        out["exp3_boxes_stop_m"] = exp3["proposal2_stop_error"].mean()
-        out["exp3_noboxes_stop_m"] = exp3["proposal2_nobox_stop_error"].mean()
+        for key, col in (
+            ("boxes", "proposal2_stop_error"),
+            ("noboxes", "proposal2_nobox_stop_error"),
+        ):
+            out[f"exp3_{key}_stop_m"] = exp3[col].mean() if col in exp3 else np.inf
         out["best_method"] = min(config.methods, key=lambda m: out[f"{m}_stop_m"])
         rows.append(out)
     return pd.DataFrame(rows)
+
+
+def _refusals(ok: pd.DataFrame) -> pd.DataFrame:
+    """Each run in which playback refused the route: layout, experiment, run, method, why."""
+    rows = []
+    for _, row in ok.iterrows():
+        for c, v in row.items():
+            if c.endswith("_refused") and _set(v):
+                name, run, rest = c.split("_", 2)
+                method = rest[: -len("_refused")]
+                rows.append(
+                    {
+                        "layout": int(row["trial"]),
+                        "experiment": name,
+                        "run": run[1:],
+                        "method": method,
+                        "why": v,
+                    }  # fmt: skip
+                )
+    return pd.DataFrame(rows, columns=["layout", "experiment", "run", "method", "why"])
 
 
 def _by_behind(per: pd.DataFrame) -> pd.DataFrame:
@@ -176,32 +275,36 @@ def _by_behind(per: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _draw_layouts(ok: pd.DataFrame, layouts: list[int], title: str, path: Path) -> Path:
+def _layout_picture(seed: int) -> tuple[np.ndarray, list[float], np.ndarray, dict]:
+    """Layout `seed` from above: shades (0 free, 1 at 0.6-2.0 m only, 2 at 0.05-0.6 m), the
+    picture's extent, the route and the layout's parameters."""
+    layout = generate_layout(seed)
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = load_scene(write_layout(layout, Path(tmp) / "layout.yaml"))
+    low, high = scene.ground_truth(0.05, 0.6), scene.ground_truth(0.6, 2.0)
+    shade = np.where(low.cells == 100, 2, np.where(high.cells == 100, 1, 0))
+    o, r = low.origin, low.resolution
+    extent = [o.x, o.x + low.width * r, o.y, o.y + low.height * r]
+    return shade, extent, np.asarray(scene.route["waypoints"], dtype=float), layout.params
+
+
+def _draw_layouts(pictures: dict, layouts: list[int], title: str, path: Path) -> Path:
     """A small multiple of the layouts from above (black: obstacles at 0.05-0.6 m, the plane
     at 0.4 m among them; grey: higher, up to 2.0 m, table tops and shelves) with the route."""
     cols = min(4, len(layouts))
     nrows = math.ceil(len(layouts) / cols)
     fig = new_figure(figsize=(4.4 * cols, 3.0 * nrows + 0.6), dpi=100)
     axes = np.atleast_1d(fig.subplots(nrows, cols, squeeze=False)).ravel()
-    seeds = ok.set_index("trial")["layout_seed"]
-    with tempfile.TemporaryDirectory() as tmp:
-        for ax, index in zip(axes, layouts, strict=False):
-            layout = generate_layout(int(seeds.loc[index]))
-            scene = load_scene(write_layout(layout, Path(tmp) / "layout.yaml"))
-            low, high = scene.ground_truth(0.05, 0.6), scene.ground_truth(0.6, 2.0)
-            shade = np.where(low.cells == 100, 2, np.where(high.cells == 100, 1, 0))
-            o, r = low.origin, low.resolution
-            extent = [o.x, o.x + low.width * r, o.y, o.y + low.height * r]
-            ax.imshow(shade, origin="lower", extent=extent, cmap=SHADES, vmin=0, vmax=2)
-            route = np.asarray(scene.route["waypoints"], dtype=float)
-            ax.plot(route[:, 0], route[:, 1], "-o", color="tab:blue", lw=1.2, ms=3)
-            p = layout.params
-            ax.set_title(
-                f"layout {index}: behind the final leg left {p['final_left_behind']}, "
-                f"right {p['final_right_behind']}",
-                fontsize=7,
-            )
-            ax.tick_params(labelsize=6)
+    for ax, index in zip(axes, layouts, strict=False):
+        shade, extent, route, p = pictures[index]
+        ax.imshow(shade, origin="lower", extent=extent, cmap=SHADES, vmin=0, vmax=2)
+        ax.plot(route[:, 0], route[:, 1], "-o", color="tab:blue", lw=1.2, ms=3)
+        ax.set_title(
+            f"layout {index}: behind the final leg left {p['final_left_behind']}, "
+            f"right {p['final_right_behind']}",
+            fontsize=7,
+        )
+        ax.tick_params(labelsize=6)
     for ax in axes[len(layouts) :]:
         ax.set_visible(False)
     fig.suptitle(title, fontsize=10)
@@ -220,14 +323,15 @@ def analyze(config: LayoutsConfig, trials, timings, figures: Path) -> Analysis:
         per = _layout_claims(config, ok, Path(scratch))
     shares = _shares(per)
     wide = per.pivot_table(index="layout", columns="claim", values="holds", aggfunc="first")
-    layout_cols = [c for c in ok.columns if c.startswith("layout_") and c != "layout_attempt"]
-    table = ok.set_index("trial")[layout_cols].join(wide.astype(str))
-    figs = [_draw_layouts(ok, list(ok["trial"]), "all layouts", figures / "layouts.png")]
+    table = ok.set_index("trial")[[f"layout_{c}" for c in LAYOUT_COLUMNS]]
+    table = table.rename(columns=lambda c: c[len("layout_") :]).join(wide.astype(str))
+    pictures = {int(r["trial"]): _layout_picture(int(r["layout_seed"])) for _, r in ok.iterrows()}
+    figs = [_draw_layouts(pictures, sorted(pictures), "all layouts", figures / "layouts.png")]
     for _, s in shares.iterrows():
         if s["fails_in_layouts"]:
             failing = [int(v) for v in s["fails_in_layouts"].split(", ")]
             path = figures / f"fails_{s['experiment']}_{_slug(s['claim'])}.png"
-            figs.append(_draw_layouts(ok, failing, f"fails: {s['claim']}", path))
+            figs.append(_draw_layouts(pictures, failing, f"fails: {s['claim']}", path))
     claims = [
         Claim(
             f"{s['experiment']}: {s['claim']} (holds in >= {GENERAL:.0%} of layouts)",
@@ -236,11 +340,7 @@ def analyze(config: LayoutsConfig, trials, timings, figures: Path) -> Analysis:
             f"95 % CI {s['ci95_low']:.0%}-{s['ci95_high']:.0%})",
             "layouts",
             bool(s["share"] >= GENERAL),
-            "general"
-            if s["ci95_low"] >= GENERAL
-            else "layout-specific"
-            if s["ci95_high"] < GENERAL
-            else "undecided by this many layouts",
+            _verdict(s["ci95_low"], s["ci95_high"]),
         )
         for _, s in shares.iterrows()
     ]
@@ -251,11 +351,22 @@ def analyze(config: LayoutsConfig, trials, timings, figures: Path) -> Analysis:
             "claims_per_layout": per,
             "by_behind": _by_behind(per),
             "stops_per_layout": _stops(config, ok),
+            "refusals": _refusals(ok),
         },
         figures=figs,
         claims=claims,
         notes=_notes(config, len(ok), len(trials)),
     )
+
+
+def _verdict(low: float, high: float) -> str:
+    """Whether a claim's share of layouts is above GENERAL (its 95 % interval above it),
+    below it, or undecided by this many layouts."""
+    if low >= GENERAL:
+        return "general: holds in >= 80 % of layouts (95 % interval)"
+    if high < GENERAL:
+        return "layout-specific: holds in < 80 % of layouts (95 % interval)"
+    return "undecided by this many layouts (the 95 % interval spans 80 %)"
 
 
 def _notes(config: LayoutsConfig, ok: int, total: int) -> str:
@@ -268,7 +379,9 @@ def _notes(config: LayoutsConfig, ok: int, total: int) -> str:
         "exp2-turn's and exp3-boxes' own analyses applied to its runs. The thesis' claims are "
         "means and counts over 5 runs; with fewer runs per layout a claim is judged on fewer "
         "stops, so a layout's verdict is noisier than the thesis' (a count claim such as 4/5 "
-        "within 0.1 m needs every run within when there are 2). A claim generalises when it "
+        "within 0.1 m needs every run within when there are 2; exp2-turn's conventional 0/5 "
+        "count claim, at least 0/5 within, holds everywhere by construction). A claim "
+        "generalises when it "
         f"holds in >= {GENERAL:.0%} of layouts; the note of each claim says whether the 95 % "
         "Wilson interval lies above that (general), below it (layout-specific) or across it. "
         "Table `by_behind` splits the shares by what lies behind the final leg's boundary "
