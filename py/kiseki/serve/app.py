@@ -99,7 +99,8 @@ def create_app(
 
     @app.middleware("http")
     async def check_token(request: Request, call_next):
-        if request.url.path.startswith("/api") and not authorized(
+        path = request.url.path
+        if (path == "/api" or path.startswith("/api/")) and not authorized(
             _bearer(request.headers.get("authorization"))
         ):
             return _error(401, "missing or wrong access token", **{"WWW-Authenticate": "Bearer"})
