@@ -258,16 +258,36 @@ def demo(
 
 
 @experiment_app.command("list")
-def experiment_list() -> None:
-    """List the registered experiments."""
+def experiment_list(
+    as_json: bool = typer.Option(False, "--json", help="Print a JSON list of objects."),
+) -> None:
+    """List the registered experiments: a table on a terminal, tab-separated lines (a header,
+    then one experiment a line) when piped, or JSON with --json.
+
+    Example: kiseki experiment list | cut -f1"""
+    import json
+
     from kiseki.experiments import all_experiments
 
-    table = Table(title="kiseki experiments")
-    for column in ("name", "paper", "table/figure", "description", "default trials"):
-        table.add_column(column)
-    for name, e in sorted(all_experiments().items()):
-        table.add_row(name, e.paper, e.artefact, e.description, str(e.default_runs))
-    console.print(table)
+    columns = ("name", "paper", "table/figure", "description", "default trials")
+    rows = [
+        (name, e.paper, e.artefact, e.description, str(e.default_runs))
+        for name, e in sorted(all_experiments().items())
+    ]
+    if as_json:
+        keys = ("name", "paper", "artefact", "description", "default_runs")
+        items = [dict(zip(keys, row[:4] + (int(row[4]),), strict=True)) for row in rows]
+        typer.echo(json.dumps(items, indent=2))
+    elif not sys.stdout.isatty():
+        for row in (columns, *rows):
+            typer.echo("\t".join(" ".join(str(v).split()) for v in row))
+    else:
+        table = Table(title="kiseki experiments")
+        for column in columns:
+            table.add_column(column)
+        for row in rows:
+            table.add_row(*row)
+        console.print(table)
 
 
 @experiment_app.command("run")

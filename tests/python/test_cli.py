@@ -153,3 +153,43 @@ def test_check_seed_takes_exactly_the_unsigned_64_bit_integers():
             check_seed(bad)
     with pytest.raises(ValueError, match="seed must be an integer"):
         SimConfig(seed=-1)
+
+
+def test_experiment_list_is_plain_lines_when_piped_json_with_json_and_a_table_on_a_terminal():
+    import json
+    import os
+    import pty
+
+    from kiseki.experiments import all_experiments
+
+    names = sorted(all_experiments())
+    done = run("experiment", "list")
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    header = ["name", "paper", "table/figure", "description", "default trials"]
+    assert lines[0].split("\t") == header
+    rows = [line.split("\t") for line in lines[1:]]
+    assert [r[0] for r in rows] == names and all(len(r) == 5 for r in rows)  # no wrapping
+    assert "┃" not in done.stdout
+    done = run("experiment", "list", "--json")
+    assert done.returncode == 0, done.stderr
+    items = json.loads(done.stdout)
+    assert [i["name"] for i in items] == names
+    assert items[0]["default_runs"] == all_experiments()[names[0]].default_runs
+    main, child = pty.openpty()  # a terminal: the rich table
+    with subprocess.Popen(
+        [sys.executable, "-m", "kiseki.cli", "experiment", "list"], stdout=child, stderr=child
+    ) as proc:
+        os.close(child)
+        out = b""
+        while True:
+            try:
+                chunk = os.read(main, 65536)
+            except OSError:
+                break
+            if not chunk:
+                break
+            out += chunk
+        assert proc.wait() == 0
+    os.close(main)
+    assert "┃" in out.decode("utf-8") and "\t" not in out.decode("utf-8")
