@@ -211,3 +211,31 @@ def test_bad_input_is_one_line_and_non_zero(tmp_path, args, needle):
     assert done.returncode == 1, done.stdout + done.stderr
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], done.stderr
+
+
+@pytest.mark.parametrize(
+    ("claims", "manifest", "needle"),
+    [
+        (None, None, "nonexistent: results folder not found"),
+        ("claim,value\nx,1\n", "{}", "corridor-scans/latest/claims.csv: no column holds"),
+        (b"\xff\xfe\x00garbage\x81", "{}", "corridor-scans/latest/claims.csv: not a claims"),
+        ("claim,holds\nx,True\n", "[1,", "corridor-scans/latest/manifest.json: not a JSON"),
+        ("claim,holds\nx,True\n", "{}", "corridor-scans/latest/manifest.json: a manifest needs"),
+    ],
+)
+def test_report_refuses_a_missing_folder_and_broken_results_in_one_line(
+    tmp_path, claims, manifest, needle
+):
+    results = tmp_path / "results"
+    if claims is not None:
+        latest = results / "corridor-scans" / "latest"
+        latest.mkdir(parents=True)
+        write = latest.joinpath("claims.csv")
+        write.write_bytes(claims) if isinstance(claims, bytes) else write.write_text(claims)
+        latest.joinpath("manifest.json").write_text(manifest)
+    where = "nonexistent" if claims is None else str(results)
+    done = cli("report", "--results", where, "-o", "R.md", cwd=tmp_path)
+    assert done.returncode == 1, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], done.stderr
+    assert not (tmp_path / "R.md").exists()  # no report of 0 claims

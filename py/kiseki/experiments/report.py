@@ -104,6 +104,8 @@ def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) 
 def write_reproduction(results_root: Path, out: Path) -> tuple[int, int, list[str]]:
     """Gathers the latest run of every registered experiment into one markdown file.
     Returns (claims, claims that hold, missing experiment names)."""
+    if not results_root.is_dir():
+        raise FileNotFoundError(f"{results_root}: results folder not found")
     by_paper: dict[str, list[str]] = {}
     total = held = 0
     missing: list[str] = []
@@ -116,8 +118,7 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[int, int, list[st
             missing.append(name)
             section.append(f"**missing**: no result yet; run `kiseki experiment run {name}`.")
             continue
-        claims = pd.read_csv(claims_path, keep_default_na=False)
-        manifest = json.loads((latest / "manifest.json").read_text(encoding="utf-8"))
+        claims, manifest = _read_result(latest)
         total += len(claims)
         held += int(claims["holds"].astype(str).str.lower().eq("true").sum())
         section += [
@@ -134,3 +135,25 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[int, int, list[st
         lines += ["", f"## {paper}", *section]
     _text(out, "\n".join(lines) + "\n")
     return total, held, missing
+
+
+def _read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
+    """A run's claims.csv and manifest.json, refused in one line naming the file when unreadable
+    or without the columns and fields the report needs."""
+    claims_path, manifest_path = latest / "claims.csv", latest / "manifest.json"
+    try:
+        claims = pd.read_csv(claims_path, keep_default_na=False)
+    except (ValueError, UnicodeDecodeError) as err:
+        raise ValueError(f"{claims_path}: not a claims table ({err})") from None
+    if "holds" not in claims.columns:
+        raise ValueError(
+            f"{claims_path}: no column holds (a claims table has {', '.join(CLAIM_COLUMNS)})"
+        )
+    try:
+        manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
+    except (ValueError, UnicodeDecodeError) as err:
+        raise ValueError(f"{manifest_path}: not a JSON manifest ({err})") from None
+    needed = ("trials", "trials_failed", "git")
+    if not isinstance(manifest, dict) or any(k not in manifest for k in needed):
+        raise ValueError(f"{manifest_path}: a manifest needs the fields {', '.join(needed)}")
+    return claims, manifest
