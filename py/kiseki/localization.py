@@ -183,6 +183,25 @@ class MclConfig:
         return p
 
 
+MAX_ODOMETRY_STEP = 1000.0  # metres between two filter updates: more is a broken odometry
+
+
+def _odometry_pose(odometry, last: np.ndarray | None) -> np.ndarray:
+    """An odometry pose (x, y, theta) checked before it moves the particles: finite, and at
+    most MAX_ODOMETRY_STEP from the last update (a 1e308 jump would make every particle NaN)."""
+    pose = np.asarray(odometry, dtype=float)
+    if pose.shape != (3,) or not np.isfinite(pose).all():
+        raise ValueError(f"odometry must be 3 finite numbers (x, y, theta), got {odometry!r}")
+    if last is not None:
+        step = math.hypot(*(pose[:2] - last[:2]))
+        if not step <= MAX_ODOMETRY_STEP:
+            raise ValueError(
+                f"odometry step of {step:.6g} m since the last update: more than the "
+                f"{MAX_ODOMETRY_STEP:g} m a robot can move between two updates"
+            )
+    return pose
+
+
 def _moved(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
     step = Pose2(*a).between(Pose2(*b))
     return math.hypot(step.x, step.y), abs(step.theta)
@@ -228,7 +247,7 @@ class MonteCarloLocalizer:
         """Moves the particles by the odometry since the last update and weighs them with the
         model ``prepare()`` returns (called only when an update is due), or, when none is due,
         moves the estimate with the odometry. Returns the update's report or None."""
-        odometry = np.asarray(odometry, dtype=float)
+        odometry = _odometry_pose(odometry, self._last_update)
         if prepare is None:
             self._follow(odometry)
             return None
@@ -245,7 +264,7 @@ class MonteCarloLocalizer:
     ) -> _core.UpdateReport | None:
         """As :meth:`step` for a model written elsewhere: ``log_likelihoods(poses)`` gives one
         log-likelihood per particle pose (n, 3)."""
-        odometry = np.asarray(odometry, dtype=float)
+        odometry = _odometry_pose(odometry, self._last_update)
         if not self._predict_if_due(odometry):
             return None
         log_l = np.asarray(log_likelihoods(self.engine.poses), dtype=float)

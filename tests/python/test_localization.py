@@ -220,3 +220,30 @@ def test_localize_refuses_its_own_inputs_as_output_and_maps_without_free_space(
     )  # fmt: skip
     assert done.returncode == 1 and "would overwrite the input" in done.stderr
     assert (tmp_path / "m.yaml").read_bytes() == before
+
+
+@pytest.mark.parametrize(
+    ("odometry", "needle"),
+    [
+        ((1e308, 0.0, 0.0), r"odometry step of 1e\+308 m"),
+        ((2000.0, 0.0, 0.0), "more than the 1000 m"),
+        ((np.nan, 0.0, 0.0), "odometry must be 3 finite numbers"),
+        ((0.0, 0.0, np.inf), "odometry must be 3 finite numbers"),
+        ((0.0, 0.0), "odometry must be 3 finite numbers"),
+    ],
+)
+def test_localizer_refuses_non_finite_and_absurd_odometry_steps(odometry, needle):
+    from kiseki.localization import MclConfig, MonteCarloLocalizer
+
+    localizer = MonteCarloLocalizer(MclConfig(particles=200), 1)
+    localizer.initialize((0.0, 0.0, 0.0), (0.1, 0.1, 0.05))
+    log_l = lambda poses: np.zeros(len(poses))  # noqa: E731
+    localizer.step_log_likelihoods((0.0, 0.0, 0.0), log_l)  # the first update
+    before = localizer.engine.poses.copy()
+    with pytest.raises(ValueError, match=needle):
+        localizer.step_log_likelihoods(odometry, log_l)
+    with pytest.raises(ValueError, match=needle):
+        localizer.step(odometry, None)
+    np.testing.assert_array_equal(localizer.engine.poses, before)  # untouched, no NaN
+    localizer.step_log_likelihoods((0.5, 0.0, 0.1), log_l)  # an ordinary step still goes
+    assert np.isfinite(localizer.engine.poses).all() and np.isfinite(localizer.estimate).all()
