@@ -6,6 +6,7 @@ from logs by the thesis' merge rules is `kiseki.teach.environment_map.build_teac
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass, fields
 
 import numpy as np
@@ -16,12 +17,36 @@ from kiseki.grid import OccupancyGrid
 from kiseki.scans import LaserScans
 
 __all__ = [
+    "MAX_MAP_CELLS",
+    "MIN_MAP_SIDE",
     "MapBuildConfig",
     "build_map",
+    "check_map_size",
     "endpoint_agreement",
     "scan_local_builder",
     "scan_local_map",
 ]
+
+
+MAX_MAP_CELLS = 10**8  # 100 M int8 cells (and as many float log-odds while building)
+MIN_MAP_SIDE = 2  # cells: a map of one cell across says nothing
+
+
+def check_map_size(width_m: float, height_m: float, resolution: float) -> tuple[int, int]:
+    """The (width, height) in cells of a map of this extent, refused in one line when it has
+    fewer than MIN_MAP_SIDE cells across or more than MAX_MAP_CELLS cells (limits stated)."""
+    width, height = (math.ceil(side / resolution) for side in (width_m, height_m))
+    if min(width, height) < MIN_MAP_SIDE:
+        raise ValueError(
+            f"resolution {resolution:g} m makes a map of {width} x {height} cells over "
+            f"{width_m:.3g} x {height_m:.3g} m: at least {MIN_MAP_SIDE} cells across are needed"
+        )
+    if width * height > MAX_MAP_CELLS:
+        raise ValueError(
+            f"resolution {resolution:g} m makes a map of {width} x {height} cells over "
+            f"{width_m:.3g} x {height_m:.3g} m: more than the limit of {MAX_MAP_CELLS:.0e} cells"
+        )
+    return width, height
 
 
 @dataclass(frozen=True)
@@ -86,7 +111,9 @@ def build_map(
     chunk: int = 100,
 ) -> OccupancyGrid:
     """Builds a trinary occupancy grid from scans (ranges (n, b)) taken at sensor poses
-    (n, 3: x, y, theta) with beam angles (b,). Readings >= max_range are "no return"."""
+    (n, 3: x, y, theta) with beam angles (b,). Readings >= max_range are "no return"; NaN
+    readings (no measurement) say nothing and are skipped; a negative reading is an error, as
+    is a pose that is not finite or a resolution giving a map outside `check_map_size`."""
     config = config or MapBuildConfig()
     if not np.isfinite(config.margin) or config.margin < 0:
         raise ValueError(f"margin must be >= 0, got {config.margin}")
@@ -95,8 +122,18 @@ def build_map(
     ranges = np.ascontiguousarray(ranges, dtype=np.float32)
     if poses.ndim != 2 or poses.shape[0] == 0:
         raise ValueError(f"poses: expected a non-empty (n, 3) array, got shape {poses.shape}")
+    if poses.shape[1:] != (3,) or not np.isfinite(poses).all():
+        raise ValueError(f"poses: expected (n, 3) rows x, y, theta, no NaN or inf: {poses.shape}")
+    negative = np.flatnonzero((ranges < 0).any(axis=tuple(range(1, ranges.ndim))))
+    if negative.size:
+        first = negative[0]
+        raise ValueError(
+            f"ranges: scan {first} has a negative reading ({np.nanmin(ranges[first]):g} m; "
+            f"{negative.size} scans with negative readings): a range is >= 0 (NaN: none)"
+        )
     min_x, min_y, max_x, max_y = _core.LogOddsMapper.scan_bounds(poses, ranges, angles, params)
     m = config.margin
+    check_map_size(max_x - min_x + 2 * m, max_y - min_y + 2 * m, config.resolution)
     mapper = _core.LogOddsMapper(min_x - m, min_y - m, max_x + m, max_y + m, params)
     starts = range(0, len(poses), chunk)
     for s in tqdm(starts, desc="mapping", unit="chunk", disable=not progress, leave=False):

@@ -100,3 +100,46 @@ def test_build_map_rejects_bad_parameters():
         build_map(poses, ranges, np.zeros(4), 10.0, MapBuildConfig(prob_hit=0.3))
     with pytest.raises(ValueError, match="unknown"):
         MapBuildConfig.from_dict({"resolutoin": 0.1})
+
+
+def test_build_map_refuses_negative_ranges_and_skips_nan_readings():
+    poses, angles = np.zeros((2, 3)), np.linspace(-0.5, 0.5, 5)
+    ranges = np.full((2, 5), 1.0)
+    ranges[1, 2] = -2.0
+    with pytest.raises(ValueError, match=r"ranges: scan 1 has a negative reading \(-2 m"):
+        build_map(poses, ranges, angles, 10.0)
+    ranges[1, 2] = np.nan  # no measurement: says nothing, the other beams map as before
+    with_nan = build_map(poses, ranges, angles, 10.0)
+    without = build_map(poses[:1], ranges[:1], angles, 10.0)
+    np.testing.assert_array_equal(with_nan.cells, without.cells)
+
+
+@pytest.mark.parametrize(
+    ("resolution", "needle"),
+    [
+        (1e308, "makes a map of 1 x 1 cells .* at least 2 cells across"),
+        (1e-9, "more than the limit of 1e\\+08 cells"),
+    ],
+)
+def test_build_map_states_its_cell_limits(resolution, needle):
+    poses, ranges = np.zeros((1, 3)), np.ones((1, 4))
+    with pytest.raises(ValueError, match=needle):
+        build_map(poses, ranges, np.linspace(-1, 1, 4), 10.0, MapBuildConfig(resolution))
+
+
+def test_map_from_log_refuses_a_resolution_giving_a_one_cell_map(tmp_path):
+    rows = [
+        f"FLASER 180 {' '.join(['1.5', '3.0'] * 90)} {0.1 * k} 0 0 {0.1 * k} 0 0 {k} host {k}"
+        for k in range(5)
+    ]
+    (tmp_path / "tiny.log").write_text("\n".join(rows) + "\n")
+    args = [sys.executable, "-m", "kiseki.cli", "map", "from-log", "tiny.log", "-o", "m.yaml"]
+    done = subprocess.run(
+        [*args, "--resolution", "1e308"], cwd=tmp_path, capture_output=True, text=True
+    )
+    assert done.returncode == 1
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "at least 2 cells across" in lines[-1], done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tiny.log"]  # no map written
+    done = subprocess.run(args, cwd=tmp_path, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr  # the same log at the default resolution maps
