@@ -17,13 +17,15 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 from kiseki import _core
 from kiseki._atomic import atomic_write
+from kiseki._yaml import safe_load_12
 from kiseki.core import Pose2
 from kiseki.errors import MapFormatError
-from kiseki.grid import OccupancyGrid
+from kiseki.grid import OCCUPIED, UNKNOWN, OccupancyGrid
 
 __all__ = ["MapMetadata", "load_map", "read_map_metadata", "save_map"]
 
@@ -58,7 +60,7 @@ def _parse_yaml(path: Path) -> dict:
     except UnicodeDecodeError as err:
         raise MapFormatError(f"{path}: not a text YAML file ({err})") from err
     try:
-        doc = yaml.safe_load(text)
+        doc = safe_load_12(text)  # resolution: 5e-2 is a number, as nav2 reads it
     except yaml.YAMLError as err:
         raise MapFormatError(f"{path}: invalid YAML ({err})") from err
     if not isinstance(doc, dict):
@@ -165,6 +167,14 @@ def save_map(
         raise ValueError(f"image_format must be 'pgm' or 'png', got {image_format!r}")
     if mode == "scale" and image_format == "pgm":
         raise ValueError("scale mode stores unknown cells in an alpha channel: use PNG")
+    cells = grid.cells
+    bad = (cells < UNKNOWN) | (cells > OCCUPIED)
+    if bad.any():
+        y, x = np.argwhere(bad)[0]
+        raise ValueError(
+            f"{path}: the grid has {int(bad.sum())} cells outside -1..100 (cell x={x}, y={y} "
+            f"holds {int(cells[y, x])}): nothing written"
+        )
     image = _core.image_from_occupancy(
         grid, mode=mode, occupied_thresh=occupied_thresh, free_thresh=free_thresh
     )

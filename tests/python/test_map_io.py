@@ -220,3 +220,28 @@ def test_bad_saves(tmp_path):
         save_map(grid, tmp_path / "a.pgm")
     with pytest.raises(ValueError, match="mode"):
         save_map(grid, tmp_path / "a.yaml", mode="fancy")
+
+
+@pytest.mark.parametrize(("text", "value"), [("5e-2", 0.05), ("5E-2", 0.05), ("+1e-1", 0.1)])
+def test_yaml_1_2_numbers_are_numbers_as_nav2_reads_them(tmp_path, text, value):
+    write_pgm(tmp_path / "m.pgm", np.full((3, 4), 254, dtype=np.uint8))
+    (tmp_path / "m.yaml").write_text(
+        f"image: m.pgm\nresolution: {text}\norigin: [-1e1, 0.0, 0]\nfree_thresh: 2e-1\n"
+    )
+    meta = read_map_metadata(tmp_path / "m.yaml")
+    assert meta.resolution == value and meta.origin == (-10.0, 0.0, 0.0)
+    assert meta.free_thresh == 0.2
+    assert load_map(tmp_path / "m.yaml").resolution == value
+    (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: '5e-2'\norigin: [0, 0, 0]\n")
+    with pytest.raises(MapFormatError, match="'resolution' must be a number, got '5e-2'"):
+        read_map_metadata(tmp_path / "m.yaml")  # quoted: a string in YAML 1.2 too
+
+
+@pytest.mark.parametrize("value", [120, -2, -128, 101])
+def test_save_map_refuses_cells_outside_minus_one_to_hundred(tmp_path, value):
+    grid = OccupancyGrid(4, 3, 0.1)
+    grid.cells[2, 1] = value
+    with pytest.raises(ValueError, match=rf"a\.yaml: the grid has 1 cells outside -1\.\.100 "
+                       rf"\(cell x=1, y=2 holds {value}\)"):  # fmt: skip
+        save_map(grid, tmp_path / "a.yaml")
+    assert list(tmp_path.iterdir()) == []  # neither the YAML nor the image
