@@ -276,7 +276,7 @@ def _goal_shelf(d: _Draw, p: dict, lines: list, route: np.ndarray) -> dict:
     depth = _clear_depth(at, u, n, length, d.u(FURNITURE["shelf"][2]), route)
     spec = _item(d, "shelf", at, u, n, length, depth, "goal_shelf")
     spec["items"] = 3  # a parts shelf is stocked
-    p["goal_shelf_x"] = x
+    p["goal_shelf_x"] = float(x)
     s0 = x - length / 2 - a[0]
     return {"line": tag, "spec": spec, "reserved": [(s0 - 0.2, s0 + length + 0.2)]}
 
