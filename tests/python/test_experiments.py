@@ -17,6 +17,7 @@ import pytest
 import yaml
 
 from kiseki.core import derive_seed
+from kiseki.errors import KisekiError
 from kiseki.experiments import base, registry, run_experiment, write_reproduction
 from kiseki.experiments.config import ConfigError, apply_overrides
 from kiseki.experiments.corridor_scans import CorridorScansConfig
@@ -239,3 +240,41 @@ def test_report_refuses_a_missing_folder_and_broken_results_in_one_line(
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], done.stderr
     assert not (tmp_path / "R.md").exists()  # no report of 0 claims
+
+
+def test_a_run_whose_every_trial_fails_says_so_and_resumes_after_the_fix(tmp_path, monkeypatch):
+    broken = {"yes": True}
+
+    def trial(config, index, seed):
+        if broken["yes"]:
+            raise FileNotFoundError(f"input {index} is missing")
+        return base.TrialOutput({"value": float(index)})
+
+    def analyze(config, trials, timings, figures):  # needs the records: KeyError without them
+        claim = base.Claim("values", "3", str(trials["value"].count()), "trials", True)
+        return base.Analysis(claims=[claim])
+
+    experiment = base.Experiment(
+        "doomed", "test paper", "Table 0", "fails until fixed", CorridorScansConfig, trial, analyze,
+        default_runs=3,
+    )  # fmt: skip
+    real = registry._registry()
+    monkeypatch.setattr(registry, "_registry", lambda: {**real, "doomed": experiment})
+    out = tmp_path / "run"
+    with pytest.raises(KisekiError, match="every one of its 3 trials failed") as err:
+        run_experiment("doomed", out=out, progress=False)
+    assert "FileNotFoundError: input 0 is missing" in str(err.value) and str(out) in str(err.value)
+    assert "\n" not in str(err.value)
+    trials = frame(out)
+    assert len(trials) == 3 and trials["error"].notna().all()
+    report = (out / "report.md").read_text()
+    assert "Every trial failed" in report and "input 0 is missing" in report
+    assert yaml.safe_load((out / "manifest.json").read_text())["trials_failed"] == 3
+    assert not (out / "claims.csv").exists()
+    with pytest.raises(KisekiError, match="already holds trials"):  # no silent rerun over it
+        run_experiment("doomed", out=out, progress=False)
+    broken["yes"] = False  # the cause fixed: --resume runs the failed trials again
+    result = run_experiment("doomed", out=out, resume=True, progress=False)
+    assert (result.runs, result.failed, result.executed) == (3, 0, 3)
+    assert frame(out)["value"].tolist() == [0.0, 1.0, 2.0]
+    assert pd.read_csv(out / "claims.csv")["measured_value"].tolist() == [3]

@@ -19,7 +19,13 @@ from kiseki._atomic import atomic_write
 from kiseki.experiments.base import CLAIM_COLUMNS, Analysis, Claim, Experiment
 from kiseki.experiments.registry import all_experiments
 
-__all__ = ["claims_table", "markdown_table", "write_outputs", "write_reproduction"]
+__all__ = [
+    "claims_table",
+    "markdown_table",
+    "write_failed_outputs",
+    "write_outputs",
+    "write_reproduction",
+]
 
 
 def _text(path: Path, text: str) -> None:
@@ -79,11 +85,39 @@ def claims_table(title: str, claims: pd.DataFrame) -> Table:
     return table
 
 
-def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) -> pd.DataFrame:
+def _write_frames(trials, timings, run_dir: Path) -> None:
     trials.to_parquet(run_dir / ".trials.parquet.tmp", index=False)
     (run_dir / ".trials.parquet.tmp").replace(run_dir / "trials.parquet")
     timings.to_parquet(run_dir / ".timings.parquet.tmp", index=False)
     (run_dir / ".timings.parquet.tmp").replace(run_dir / "timings.parquet")
+
+
+def write_failed_outputs(experiment, trials, timings, manifest, run_dir: Path) -> str:
+    """A run whose every trial failed: the trials with their errors, the manifest and a
+    report.md saying so and giving the first error; no claims (nothing to analyse). Returns
+    the first error."""
+    _write_frames(trials, timings, run_dir)
+    (run_dir / "claims.csv").unlink(missing_ok=True)
+    first = " ".join(str(trials["error"].iloc[0]).split())  # one line
+    lines = [
+        f"# {experiment.name}: {experiment.description}",
+        "",
+        f"Run: {manifest['finished']}, seed {manifest['seed']}, {manifest['execution']}.",
+        "",
+        f"**Every trial failed** ({manifest['trials']} of {manifest['trials']}): no claims.",
+        "",
+        f"First error (trial {int(trials['trial'].iloc[0])}): `{first}`",
+        "",
+        "Fix the cause, then `kiseki experiment run "
+        f"{experiment.name} --resume --out {run_dir}` runs the failed trials again.",
+    ]
+    _text(run_dir / "report.md", "\n".join(lines) + "\n")
+    _text(run_dir / "manifest.json", json.dumps(manifest, indent=2))
+    return first
+
+
+def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) -> pd.DataFrame:
+    _write_frames(trials, timings, run_dir)
     (run_dir / "tables").mkdir(exist_ok=True)
     (run_dir / "figures").mkdir(exist_ok=True)
     analysis = experiment.analyze(config, trials, timings, run_dir / "figures")

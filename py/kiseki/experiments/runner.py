@@ -33,7 +33,7 @@ from kiseki.experiments.config import (
 )
 from kiseki.experiments.manifest import build_manifest
 from kiseki.experiments.registry import get_experiment
-from kiseki.experiments.report import write_outputs
+from kiseki.experiments.report import write_failed_outputs, write_outputs
 from kiseki.experiments.trials_log import TrialLog
 
 __all__ = ["RunResult", "run_experiment", "run_trial"]
@@ -185,7 +185,9 @@ def run_experiment(
     results_root: str | os.PathLike = "results",
     progress: bool = True,
 ) -> RunResult:
-    """Runs (or resumes) an experiment and writes its results folder."""
+    """Runs (or resumes) an experiment and writes its results folder. A resumed run runs its
+    missing and its failed trials. When every trial fails, the trials, the manifest and a
+    report.md saying so are written and KisekiError names the first error."""
     if workers is not None and scheduler is not None:
         raise KisekiError("give --workers or --scheduler, not both")
     if workers is not None and workers < 1:
@@ -199,7 +201,12 @@ def run_experiment(
             experiment.preflight(config)
         log = TrialLog(run_dir / "trials.jsonl")
         done = log.read()
-        jobs = [(i, derive_seed(seed, i)) for i in range(runs) if i not in done]
+        # a resumed run also runs its failed trials again (after their cause was fixed)
+        jobs = [
+            (i, derive_seed(seed, i))
+            for i in range(runs)
+            if i not in done or done[i]["error"] is not None
+        ]
         values = config_to_dict(config)
         start = time.perf_counter()
         if jobs:
@@ -215,8 +222,16 @@ def run_experiment(
         wall = time.perf_counter() - start  # the trials only, not the cluster's start and stop
     trials, timings = TrialLog.frames(done)
     manifest = build_manifest(name, runs, seed, wall, workers, scheduler, len(jobs), trials)
+    failed = int(trials["error"].notna().sum())
+    if failed == len(trials):
+        first = write_failed_outputs(experiment, trials, timings, manifest, run_dir)
+        if run_dir.parent.name == name:
+            _link_latest(run_dir)
+        raise KisekiError(
+            f"{name}: every one of its {runs} trials failed, first: {first}; trials and "
+            f"report in {run_dir}; fix the cause, then run it again with --resume --out {run_dir}"
+        )
     write_outputs(experiment, config, trials, timings, manifest, run_dir)
     if run_dir.parent.name == name:
         _link_latest(run_dir)
-    failed = int(trials["error"].notna().sum())
     return RunResult(run_dir, runs, failed, len(jobs), wall)
