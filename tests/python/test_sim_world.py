@@ -212,6 +212,10 @@ def test_octree_export_and_the_real_building(shared_data, tmp_path):
         ({"robots": [{"name": "a", "start": [2, 2, 0]}]}, "not both"),
         ({"sensors": [{"type": "bearing", "name": "b", "targets": ["ghost"]}]}, "other robots"),
         ({"point_robots": "yes"}, "point_robots"),
+        ({"bounds": [1, 2]}, "'bounds' needs min"),
+        ({"bounds": {"max": [4, 4, 2]}}, "'bounds' needs min"),
+        ({"grid_resolution": 1.0e-9}, r"grid_resolution 1e-09 m .* limit of 1e\+08 cells"),
+        ({"grid_resolution": 100.0}, "at least 2 cells across"),
     ],
 )
 def test_bad_scenes_are_rejected_with_the_file_named(tmp_path, patch, match):
@@ -352,3 +356,14 @@ def test_mutual_bearings_of_three_robots_match_the_geometry(tmp_path):
     assert len(errors) > 300
     assert abs(errors.std() - 0.1) < 0.1 * 4 / math.sqrt(2 * len(errors)) + 0.005
     assert abs(errors.mean()) < 4 * 0.1 / math.sqrt(len(errors))
+
+
+def test_scene_files_of_random_bytes_are_named_and_yaml_1_2_numbers_read(tmp_path):
+    path = tmp_path / "noise.yaml"
+    path.write_bytes(bytes(range(256)) * 4)
+    with pytest.raises(ValueError, match=r"noise\.yaml: not a scene file \(not UTF-8 text\)"):
+        load_scene(path)
+    text = WORLDS[[p.stem for p in WORLDS].index("factory_corridor")].read_text()
+    assert "grid_resolution: 0.05\n" in text
+    path.write_text(text.replace("grid_resolution: 0.05\n", "grid_resolution: 2.5e-2\n"))
+    assert load_scene(path).grid_resolution == 0.025  # YAML 1.1 would read a string

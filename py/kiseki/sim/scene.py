@@ -31,8 +31,10 @@ import numpy as np
 import yaml
 
 from kiseki import _core
+from kiseki._yaml import safe_load_12
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
+from kiseki.mapping import check_map_size
 from kiseki.sim.pedestrians import Pedestrian, parse_pedestrians
 from kiseki.sim.primitives import BoxList, expand
 
@@ -110,6 +112,8 @@ def _bounds(doc: dict, where: str, world) -> tuple[np.ndarray, np.ndarray]:
         lo, hi = world.bounds
         return np.asarray(lo), np.asarray(hi)
     b = doc["bounds"]
+    if not isinstance(b, dict):
+        raise ValueError(f"{where}: 'bounds' needs min: [x, y, z] and max: [x, y, z], got {b!r}")
     try:
         lo, hi = np.asarray(b["min"], dtype=float), np.asarray(b["max"], dtype=float)
     except (KeyError, TypeError, ValueError):
@@ -139,7 +143,7 @@ def _floor(doc: dict, where: str, boxes: BoxList) -> None:
         return
     if "bounds" not in doc:
         raise ValueError(f"{where}: 'floor: true' needs 'bounds'")
-    lo, hi = (np.asarray(doc["bounds"][k], dtype=float) for k in ("min", "max"))
+    lo, hi = _bounds(doc, where, None)
     boxes.add(
         [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, -0.05], [hi[0] - lo[0], hi[1] - lo[1], 0.1]
     )
@@ -154,7 +158,9 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
     if not path.is_file():
         raise FileNotFoundError(f"{path}: scene file not found")
     try:
-        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+        doc = safe_load_12(path.read_text(encoding="utf-8"))  # 5e-2 is a number, as in YAML 1.2
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a scene file (not UTF-8 text)") from None
     except yaml.YAMLError as err:
         raise ValueError(f"{path}: invalid YAML ({err})") from err
     if not isinstance(doc, dict):
@@ -180,12 +186,17 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
     res = doc.get("grid_resolution", 0.05)
     if isinstance(res, bool) or not isinstance(res, int | float) or not res > 0:
         raise ValueError(f"{path}: 'grid_resolution' must be a positive number")
+    lo, hi = _bounds(doc, where, world)
+    try:  # the ground truth's cells: the map limits of kiseki.mapping
+        check_map_size(hi[0] - lo[0], hi[1] - lo[1], float(res))
+    except ValueError as err:
+        raise ValueError(f"{path}: grid_{err}") from None
     specs = _robot_specs(doc, where)
     scene = Scene(
         name=str(doc.get("name", path.stem)),
         path=path,
         world=world,
-        bounds=_bounds(doc, where, world),
+        bounds=(lo, hi),
         grid_resolution=float(res),
         robot=specs[0]["robot"],
         sensors=specs[0]["sensors"],
