@@ -62,6 +62,7 @@ def run_demo(
     merge: str = "thesis",
 ) -> dict:
     config = DemoConfig(scene=str(scene_file), seed=seed, particles=particles, merge=merge)
+    PlaybackConfig(particles=particles)  # a bad --particles is refused before the teaching
     out.mkdir(parents=True, exist_ok=True)
     scene = load_scene(scene_file)
     render_scene(scene, out / "scene.png")

@@ -60,6 +60,8 @@ def test_map_info_and_render(tmp_path):
         (["map", "from-log", "empty.log", "-o", "out.yaml", "--rules", "bayes"], "--rules"),
         (["teach", "scene.yaml", "-o", "t", "--merge", "bayes"], "--merge"),
         (["demo", "--out", "d", "--merge", "bayes"], "--merge"),
+        (["demo", "--out", "d", "--particles", "0"], "particles must be an integer in 1.."),
+        (["demo", "--out", "d", "--particles", "2147483648"], "1..10,000,000, got 2147483648"),
     ],
 )
 def test_bad_input_prints_one_line_and_fails(tmp_path, args, needle):
@@ -75,6 +77,7 @@ def test_bad_input_prints_one_line_and_fails(tmp_path, args, needle):
     assert len(lines) == 1 and lines[0].startswith("kiseki: error: "), done.stderr
     assert needle in lines[0]
     assert "Traceback" not in done.stderr
+    assert not (tmp_path / "d").exists()  # demo: refused before anything is taught
 
 
 @pytest.mark.parametrize(

@@ -80,8 +80,12 @@ class PlaybackConfig:
     def __post_init__(self) -> None:
         if self.method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, got {self.method!r}")
-        if self.particles < 1 or not self.dt > 0 or not self.goal_tolerance > 0:
-            raise ValueError("particles >= 1, dt > 0 and goal_tolerance > 0 are needed")
+        if not (isinstance(self.particles, int) and 1 <= self.particles <= 10_000_000):
+            raise ValueError(
+                f"particles must be an integer in 1..10,000,000, got {self.particles!r}"
+            )
+        if not self.dt > 0 or not self.goal_tolerance > 0:
+            raise ValueError("dt > 0 and goal_tolerance > 0 are needed")
 
 
 @dataclass
