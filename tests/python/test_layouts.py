@@ -105,3 +105,23 @@ def test_the_experiment_runs_on_two_layouts_and_writes_the_table(tmp_path):
     claims = pd.read_csv(result.run_dir / "claims.csv")
     assert claims["claim"].str.contains("of layouts").all()
     assert "claim_shares" in (result.run_dir / "report.md").read_text(encoding="utf-8")
+
+
+def test_a_refused_route_fails_only_that_method(monkeypatch, tmp_path):
+    """Playback refuses a route through the taught map's occupied cells; exp2 then runs once
+    per method, so the refusal is recorded for that method and the others still stop."""
+    from kiseki.experiments import layouts as exp
+
+    def fake_trial(cfg, index, seed):
+        if "conventional" in cfg.methods:
+            raise ValueError(f"the route leg T2 -> G {exp.REFUSED} at (7.05, -3.15) m")
+        return exp.TrialOutput({f"{m}_stop_error": 0.05 for m in cfg.methods})
+
+    monkeypatch.setattr(exp.tp, "trial", fake_trial)
+    config = exp.LayoutsConfig(methods=["conventional", "proposal2"])
+    record = exp._exp2(config, tmp_path / "layout.yaml", 0, 1, "exp2_r0_")
+    assert exp.REFUSED in record["exp2_r0_conventional_refused"]
+    assert record["exp2_r0_proposal2_stop_error"] == 0.05
+    monkeypatch.setattr(exp.tp, "trial", lambda *a: (_ for _ in ()).throw(ValueError("other")))
+    with pytest.raises(ValueError, match="other"):
+        exp._exp2(config, tmp_path / "layout.yaml", 0, 1, "exp2_r0_")
