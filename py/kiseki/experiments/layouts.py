@@ -137,9 +137,9 @@ def _runs(row: pd.Series, name: str, runs: int) -> pd.DataFrame:
         template = next((c for c in frame if c.endswith("_stop_error") and c[:-11] != m), None)
         if template is not None:  # give the method every column the others have
             other = template[: -len("_stop_error")]
-            for c in [c for c in frame if c.startswith(f"{other}_")]:
-                if m + c[len(other) :] not in frame:
-                    frame[m + c[len(other) :]] = np.nan
+            names = [m + c[len(other) :] for c in frame if c.startswith(f"{other}_")]
+            missing = [c for c in names if c not in frame]
+            frame = pd.concat([frame, pd.DataFrame(np.nan, frame.index, missing)], axis=1)
         refused = frame[f"{m}_refused"].notna()
         for c in ("stop_error", "estimate_error"):
             frame[f"{m}_{c}"] = frame.get(f"{m}_{c}", np.nan)
