@@ -302,7 +302,9 @@ def _layout_picture(seed: int) -> tuple[np.ndarray, list[float], np.ndarray, dic
     return shade, extent, np.asarray(scene.route["waypoints"], dtype=float), layout.params
 
 
-def _draw_layouts(pictures: dict, layouts: list[int], title: str, path: Path) -> Path:
+def _draw_layouts(
+    pictures: dict, layouts: list[int], title: str, path: Path, measured: dict | None = None
+) -> Path:
     """A small multiple of the layouts from above (black: obstacles at 0.05-0.6 m, the plane
     at 0.4 m among them; grey: higher, up to 2.0 m, table tops and shelves) with the route."""
     cols = min(4, len(layouts))
@@ -313,9 +315,10 @@ def _draw_layouts(pictures: dict, layouts: list[int], title: str, path: Path) ->
         shade, extent, route, p = pictures[index]
         ax.imshow(shade, origin="lower", extent=extent, cmap=SHADES, vmin=0, vmax=2)
         ax.plot(route[:, 0], route[:, 1], "-o", color="tab:blue", lw=1.2, ms=3)
+        value = f"\nmeasured {measured[index]}" if measured else ""
         ax.set_title(
             f"layout {index}: behind the final leg left {p['final_left_behind']}, "
-            f"right {p['final_right_behind']}",
+            f"right {p['final_right_behind']}{value}",
             fontsize=7,
         )
         ax.tick_params(labelsize=6)
@@ -341,11 +344,13 @@ def analyze(config: LayoutsConfig, trials, timings, figures: Path) -> Analysis:
     table = table.rename(columns=lambda c: c[len("layout_") :]).join(wide.astype(str))
     pictures = {int(r["trial"]): _layout_picture(int(r["layout_seed"])) for _, r in ok.iterrows()}
     figs = [_draw_layouts(pictures, sorted(pictures), "all layouts", figures / "layouts.png")]
-    for _, s in shares.iterrows():
-        if s["fails_in_layouts"]:
-            failing = [int(v) for v in s["fails_in_layouts"].split(", ")]
-            path = figures / f"fails_{s['experiment']}_{_slug(s['claim'])}.png"
-            figs.append(_draw_layouts(pictures, failing, f"fails: {s['claim']}", path))
+    for (name, claim), g in per.groupby(["experiment", "claim"], sort=False):
+        fails = g[~g["holds"]]
+        if len(fails):
+            measured = dict(zip(fails["layout"], fails["measured_value"], strict=True))
+            path = figures / f"fails_{name}_{_slug(claim)}.png"
+            title = f"{name}: {claim} fails (thesis: {g['paper_value'].iloc[0]})"
+            figs.append(_draw_layouts(pictures, sorted(measured), title, path, measured))
     claims = [
         Claim(
             f"{s['experiment']}: {s['claim']} (holds in >= {GENERAL:.0%} of layouts)",
