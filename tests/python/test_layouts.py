@@ -51,6 +51,14 @@ def test_every_route_is_free_for_the_footprint(scenes):
     doc = dict(scenes[0][0].doc)
     doc["objects"] = [*doc["objects"], {"type": "box", "center": [9.0, -3.29], "size": [0.3] * 3}]
     layout = lay.Layout(0, 0, {}, doc)
+    for _, scene in scenes:  # independently: sideways clearance along the legs at body height
+        body = scene.ground_truth(0.05, 0.99)
+        route = np.asarray(scene.route["waypoints"], dtype=float)
+        for a, b in zip(route[:-1], route[1:], strict=True):
+            u = (b - a) / np.linalg.norm(b - a)
+            for f in np.arange(0.0, np.linalg.norm(b - a), 0.25):
+                for side in (np.array([-u[1], u[0]]), np.array([u[1], -u[0]])):
+                    assert _free_run(body, a + f * u, side) >= lay.MIN_CLEAR - 0.05
     path = lay.write_layout(layout, scenes[0][1].path.parent / "blocked.yaml")
     assert lay.route_contact(load_scene(path)) is not None
 
