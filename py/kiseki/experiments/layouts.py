@@ -12,6 +12,12 @@ applies exp2-turn's and exp3-boxes' own analyses to each layout's runs, so a lay
 exactly those experiments' claims; then the share of layouts in which each claim holds, with a
 95 % Wilson interval, and the maps of the layouts where it fails. Every simulation parameter
 (noise, particles, motion model) is the same for every method and every layout.
+
+    kiseki experiment run layouts-exp2-exp3 --workers 2      # 20 layouts x 2 runs, ~42 CPU-min
+    kiseki experiment run layouts-exp2-exp3 --set runs_per_layout=1 --workers 2   # ~21 CPU-min
+
+A layout is regenerated from the seed in the per-layout table with
+``kiseki.sim.layouts.generate_layout(seed)``.
 """
 
 from __future__ import annotations
