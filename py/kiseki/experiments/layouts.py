@@ -257,7 +257,8 @@ def _stops(config: LayoutsConfig, ok: pd.DataFrame) -> pd.DataFrame:
             ("noboxes", "proposal2_nobox_stop_error"),
         ):
             out[f"exp3_{key}_stop_m"] = exp3[col].mean() if col in exp3 else np.inf
-        out["best_method"] = min(config.methods, key=lambda m: out[f"{m}_stop_m"])
+        best = min(config.methods, key=lambda m: out[f"{m}_stop_m"])
+        out["best_method"] = best if np.isfinite(out[f"{best}_stop_m"]) else "none (refused)"
         rows.append(out)
     return pd.DataFrame(rows)
 
