@@ -134,8 +134,13 @@ class GlobalConfig:
                 f"got {self.method!r}"
             )
         check_seed(self.seed)
-        if self.particles < 1 or self.tracking_particles < 1:
-            raise ValueError("global localization: particle counts must be >= 1")
+        for name in ("particles", "tracking_particles"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 10**7:
+                raise ValueError(
+                    f"global localization: {name} must be an integer in 1..10,000,000, "
+                    f"got {value!r}"
+                )
         if not (isinstance(self.beams, int) and self.beams >= 0):
             raise ValueError(f"beams must be an integer >= 0 (0 = every beam), got {self.beams!r}")
         if self.recovery not in RECOVERY_MODES:

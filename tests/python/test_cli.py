@@ -62,9 +62,18 @@ def test_map_info_and_render(tmp_path):
         (["demo", "--out", "d", "--merge", "bayes"], "--merge"),
         (["demo", "--out", "d", "--particles", "0"], "particles must be an integer in 1.."),
         (["demo", "--out", "d", "--particles", "2147483648"], "1..10,000,000, got 2147483648"),
-    ],
+        (
+            ["sim", "run", "WORLDS/speed_corridor.yaml", "-o", "r.mcap", "--duration", "1e308"],
+            "duration must be in (0, 86,400] s",
+        ),
+        (
+            ["sim", "run", "WORLDS/speed_corridor.yaml", "-o", "r.mcap", "--duration", "nan"],
+            "duration must be in",
+        ),
+    ],  # fmt: skip
 )
-def test_bad_input_prints_one_line_and_fails(tmp_path, args, needle):
+def test_bad_input_prints_one_line_and_fails(tmp_path, project_root, args, needle):
+    args = [a.replace("WORLDS", str(project_root / "data" / "worlds")) for a in args]
     (tmp_path / "bad.yaml").write_text(
         yaml.safe_dump({"image": "x.pgm", "resolution": -1, "origin": [0, 0, 0]})
     )
@@ -78,6 +87,7 @@ def test_bad_input_prints_one_line_and_fails(tmp_path, args, needle):
     assert needle in lines[0]
     assert "Traceback" not in done.stderr
     assert not (tmp_path / "d").exists()  # demo: refused before anything is taught
+    assert not (tmp_path / "r.mcap").exists()  # sim run: refused before the run
 
 
 @pytest.mark.parametrize(

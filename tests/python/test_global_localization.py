@@ -73,6 +73,10 @@ def test_bad_config_is_refused() -> None:
         GlobalConfig(likelihood_power=0.0)
     with pytest.raises(ValueError, match="particle"):
         GlobalConfig(tracking_particles=0)
+    with pytest.raises(ValueError, match=r"particles must be an integer in 1..10,000,000"):
+        GlobalConfig(particles=2**31)  # the old code took it and failed in the engine
+    with pytest.raises(ValueError, match="tracking_particles"):
+        GlobalConfig(tracking_particles=2.5)
 
 
 def test_spread_radius() -> None:

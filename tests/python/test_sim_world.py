@@ -212,6 +212,14 @@ def test_octree_export_and_the_real_building(shared_data, tmp_path):
         ({"robots": [{"name": "a", "start": [2, 2, 0]}]}, "not both"),
         ({"sensors": [{"type": "bearing", "name": "b", "targets": ["ghost"]}]}, "other robots"),
         ({"point_robots": "yes"}, "point_robots"),
+        (
+            {"objects": [{"type": "shelf", "center": [2, 2], "size": [1, 0.4], "levels": 3000}]},
+            "'levels' must be at most 50, got 3,000",
+        ),
+        (
+            {"objects": [{"type": "shelf", "center": [2, 2], "size": [1, 0.4], "items": 3000}]},
+            "'items' must be at most 100",
+        ),
         ({"bounds": [1, 2]}, "'bounds' needs min"),
         ({"bounds": {"max": [4, 4, 2]}}, "'bounds' needs min"),
         ({"grid_resolution": 1.0e-9}, r"grid_resolution 1e-09 m .* limit of 1e\+08 cells"),

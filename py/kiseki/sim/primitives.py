@@ -88,11 +88,21 @@ class _Fields:
             raise ValueError(f"{self.where}: '{key}' must be >= {minimum}, got {value}")
         return float(value)
 
-    def int(self, key: str, default: int, minimum: int = 0) -> int:
+    def int(self, key: str, default: int, minimum: int = 0, maximum: int | None = None) -> int:
         value = self.spec.get(key, default)
         if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
             raise ValueError(f"{self.where}: '{key}' must be an integer >= {minimum}")
+        if maximum is not None and value > maximum:
+            raise ValueError(f"{self.where}: '{key}' must be at most {maximum:,}, got {value:,}")
         return value
+
+
+# Limits on what sizes a world (every box is ray cast by every sensor): a shelf of 50 boards and
+# 100 items per board is far beyond a real one; a heap of 100,000 pieces is ten times the largest
+# rubble scene.
+MAX_SHELF_LEVELS = 50
+MAX_SHELF_ITEMS = 100
+MAX_RUBBLE_PIECES = 100_000
 
 
 def _wall(f: _Fields) -> BoxList:
@@ -144,8 +154,8 @@ def _workbench(f: _Fields) -> BoxList:
 
 def _shelf(f: _Fields) -> BoxList:
     c, (length, depth) = f.vec("center", 2), f.vec("size", 2, positive=True)
-    height, levels = f.num("height", 1.8, True), f.int("levels", 4, 1)
-    items, post, board = f.int("items", 0), f.num("post", 0.04, True), 0.02
+    height, levels = f.num("height", 1.8, True), f.int("levels", 4, 1, MAX_SHELF_LEVELS)
+    items, post, board = f.int("items", 0, 0, MAX_SHELF_ITEMS), f.num("post", 0.04, True), 0.02
     yaw = math.radians(f.num("yaw", 0.0))
     rot = rotation(yaw)[:2, :2]
     rng = Random(f.int("seed", 0))
@@ -187,7 +197,7 @@ def _slope(f: _Fields) -> BoxList:
 def _rubble(f: _Fields) -> BoxList:
     """A heap of slabs and blocks: random sizes and tilts, seeded."""
     c, radius = f.vec("center", 2), f.num("radius", None, True)
-    count, rng = f.int("count", 20, 1), Random(f.int("seed", 0))
+    count, rng = f.int("count", 20, 1, MAX_RUBBLE_PIECES), Random(f.int("seed", 0))
     smin, smax = f.vec("size_range", 2, [0.1, 0.6], positive=True)
     if smin > smax:
         raise ValueError(f"{f.where}: size_range must be [min, max]")

@@ -32,6 +32,9 @@ from kiseki.sim.turns import Turns
 __all__ = ["RunSummary", "SimConfig", "read_commands", "simulate"]
 
 
+MAX_SIM_SECONDS = 86_400.0  # a run is at most a day of simulated time
+
+
 @dataclass(frozen=True)
 class SimConfig:
     dt: float = 0.1  # s, the thesis' 10 Hz control loop
@@ -47,8 +50,12 @@ class SimConfig:
     def __post_init__(self) -> None:
         if not (self.dt > 0 and math.isfinite(self.dt)):
             raise ValueError(f"dt must be positive, got {self.dt}")
-        if self.duration is not None and not (self.duration > 0 and math.isfinite(self.duration)):
-            raise ValueError(f"duration must be positive, got {self.duration}")
+        for name in ("duration", "max_duration"):
+            value = getattr(self, name)
+            if value is not None and not 0 < value <= MAX_SIM_SECONDS:
+                raise ValueError(
+                    f"{name} must be in (0, {MAX_SIM_SECONDS:,.0f}] s (24 h), got {value}"
+                )
         if not (self.lookahead > 0 and self.goal_tolerance > 0):
             raise ValueError("lookahead and goal_tolerance must be positive")
         check_seed(self.seed)
