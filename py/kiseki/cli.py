@@ -387,6 +387,9 @@ def sim_render(
     console.print(f"{output}: animation written")
 
 
+MAX_OCTREE_VOXELS = 5e7  # a few GB of OcTree nodes; the factory fills 2.6e5 at 0.05 m
+
+
 @sim_app.command("show")
 def sim_show(
     scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML."),
@@ -401,11 +404,20 @@ def sim_show(
 
     check_outputs({"--output": output, "--octree": octree}, {"SCENE": scene_file})
     scene = load_scene(scene_file)
-    render_scene(scene, output)
-    if octree is not None:
+    if octree is not None:  # checked before anything is written
         if not isinstance(scene.world, _core.BoxWorld):
             raise ValueError(f"{scene_file}: the world is already an OctoMap")
-        tree = _core.OctreeWorld.from_boxes(scene.world, _positive("--resolution", resolution))
+        _positive("--resolution", resolution)
+        _, half, _ = scene.boxes.arrays()
+        voxels = float(np.prod(np.ceil(2 * half / resolution) + 1, axis=1).sum())
+        if voxels > MAX_OCTREE_VOXELS:
+            raise ValueError(
+                f"--resolution {resolution} m would fill about {voxels:.3g} voxels (at most "
+                f"{MAX_OCTREE_VOXELS:.0e}): give a coarser resolution"
+            )
+    render_scene(scene, output)
+    if octree is not None:
+        tree = _core.OctreeWorld.from_boxes(scene.world, resolution)
         tree.write_binary(str(octree))
     console.print(f"{output}: scene drawn" + (f"; {octree} written" if octree else ""))
 

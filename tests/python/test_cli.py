@@ -70,6 +70,20 @@ def test_map_info_and_render(tmp_path):
             ["sim", "run", "WORLDS/speed_corridor.yaml", "-o", "r.mcap", "--duration", "nan"],
             "duration must be in",
         ),
+        (
+            [
+                "sim",
+                "show",
+                "WORLDS/factory_turn.yaml",
+                "-o",
+                "r.png",
+                "--octree",
+                "r.bt",
+                "--resolution",
+                "0.001",
+            ],
+            "would fill about 2.05e+10 voxels",
+        ),
     ],  # fmt: skip
 )
 def test_bad_input_prints_one_line_and_fails(tmp_path, project_root, args, needle):
@@ -88,6 +102,7 @@ def test_bad_input_prints_one_line_and_fails(tmp_path, project_root, args, needl
     assert "Traceback" not in done.stderr
     assert not (tmp_path / "d").exists()  # demo: refused before anything is taught
     assert not (tmp_path / "r.mcap").exists()  # sim run: refused before the run
+    assert not (tmp_path / "r.png").exists()  # sim show: refused before drawing
 
 
 @pytest.mark.parametrize(
