@@ -10,7 +10,7 @@ import re
 
 import yaml
 
-__all__ = ["safe_load_12"]
+__all__ = ["read_yaml_file", "safe_load_12"]
 
 _FLOAT_12 = re.compile(r"^[-+]?(\.[0-9]+|[0-9]+(\.[0-9]*)?)([eE][-+]?[0-9]+)?$")
 
@@ -25,3 +25,18 @@ _Loader12.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT_12, list("-+01
 def safe_load_12(text: str):
     """``yaml.safe_load`` with YAML 1.2 floats (``5e-2``, ``1E3``) read as numbers."""
     return yaml.load(text, Loader=_Loader12)  # noqa: S506 (a SafeLoader subclass)
+
+
+def read_yaml_file(path, what: str):
+    """A YAML file's content (YAML 1.2 numbers), or a ValueError naming the file and ``what`` it
+    should be when it is not UTF-8 text or not YAML (random bytes, a binary file)."""
+    from pathlib import Path
+
+    path = Path(path)
+    try:
+        return safe_load_12(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a {what} (not UTF-8 text)") from None
+    except yaml.YAMLError as err:
+        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise ValueError(f"{path}: not a {what} (invalid YAML: {first})") from None

@@ -18,6 +18,7 @@ import yaml
 
 from kiseki import _core
 from kiseki._atomic import atomic_write
+from kiseki._yaml import read_yaml_file
 from kiseki.grid import OccupancyGrid
 from kiseki.map_io import load_map
 from kiseki.teach.local_maps import METHODS
@@ -44,7 +45,9 @@ def taught_scene(folder: str | os.PathLike) -> str | None:
     from kiseki.sim.mcap_log import read_run
 
     path = Path(folder) / "waypoints.yaml"
-    doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    doc = read_yaml_file(path, "kiseki waypoint file")
+    if not isinstance(doc, dict):
+        raise ValueError(f"{path}: not a kiseki waypoint file")
     log = Path(folder) / str(doc.get("log", "teach.mcap"))
     if not log.is_file():
         return None
@@ -78,10 +81,7 @@ class TaughtRun:
         self._png: bytes | None = None
 
     def _read(self) -> dict:
-        try:
-            doc = yaml.safe_load(self.path.read_text(encoding="utf-8"))
-        except yaml.YAMLError as err:
-            raise ValueError(f"{self.path}: invalid YAML ({err})") from err
+        doc = read_yaml_file(self.path, "kiseki waypoint file")
         if not isinstance(doc, dict) or not isinstance(doc.get("waypoints"), list):
             raise ValueError(f"{self.path}: not a kiseki waypoint file")
         return doc
@@ -94,8 +94,14 @@ class TaughtRun:
         """The waypoints (id, name, taught pose) and the map's metadata, for GET /api/waypoints."""
         with self._lock:
             marks = [
-                {"id": w["id"], "name": w["name"], "x": w["x"], "y": w["y"], "theta": w["theta"]}
-                for w in self.waypoints
+                {
+                    "id": w.get("id", i),
+                    "name": w["name"],
+                    "x": w["x"],
+                    "y": w["y"],
+                    "theta": w["theta"],
+                }
+                for i, w in enumerate(self.waypoints)
             ]
         return {"waypoints": marks, "map": self.map_info()}
 

@@ -80,9 +80,17 @@ def read_commands(path: str | os.PathLike) -> np.ndarray:
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: command file not found")
-    header = path.read_text(encoding="utf-8").splitlines()[0].strip().split(",")
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a command CSV (not UTF-8 text)") from None
+    if not lines:
+        raise ValueError(f"{path}: empty command file (header t,v,w or t,vx,vy,w)")
+    header = lines[0].strip().split(",")
     if header not in (["t", "v", "w"], ["t", "vx", "vy", "w"]):
         raise ValueError(f"{path}: header must be t,v,w or t,vx,vy,w, got {','.join(header)}")
+    if not any(line.strip() for line in lines[1:]):
+        raise ValueError(f"{path}: no commands below the header")
     try:
         data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
     except ValueError as err:

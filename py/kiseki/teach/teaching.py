@@ -22,6 +22,7 @@ import yaml
 from tqdm import tqdm
 
 from kiseki._atomic import atomic_write
+from kiseki._yaml import read_yaml_file
 from kiseki.control import PurePursuit
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
@@ -78,7 +79,7 @@ def _environment(scene: Scene, resolution: float = 0.1, margin: float = 4.0) -> 
 def waypoints_file_hash(map_yaml: Path) -> str:
     """SHA-1 of the map image beside a map YAML: ties a waypoint file to the map it was taught
     with."""
-    meta = yaml.safe_load(Path(map_yaml).read_text(encoding="utf-8"))
+    meta = read_yaml_file(map_yaml, "ROS map YAML")
     return hashlib.sha1((Path(map_yaml).parent / meta["image"]).read_bytes()).hexdigest()
 
 
@@ -364,6 +365,44 @@ def load_taught(folder: str | os.PathLike, band: str, route: list[str]) -> tuple
     return load_route(Path(folder) / "waypoints.yaml", band, route)
 
 
+def _check_waypoints(doc: dict, path: Path) -> None:
+    """A waypoint file's entries as kiseki wrote them, or a ValueError naming the file, the entry
+    and the field (the file may have been edited by hand)."""
+    marks = doc["waypoints"]
+    if not isinstance(marks, list) or not marks:
+        raise ValueError(f"{path}: 'waypoints' must be a non-empty list")
+    maps = doc["maps"]
+    if not isinstance(maps, dict) or not all(
+        isinstance(m, dict) and {"file", "image_sha1"} <= set(m) for m in maps.values()
+    ):
+        raise ValueError(f"{path}: 'maps' must map each band to its file and image_sha1")
+
+    def number(value) -> bool:
+        return (
+            isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+        )
+
+    for i, w in enumerate(marks):
+        where = f"{path}: waypoints[{i}]"
+        if not isinstance(w, dict):
+            raise ValueError(f"{where} must be a mapping of name, x, y, theta, got {w!r}")
+        if not isinstance(w.get("name"), str) or not w["name"]:
+            raise ValueError(f"{where}: 'name' must be a non-empty string")
+        for key in ("x", "y", "theta"):
+            if not number(w.get(key)):
+                raise ValueError(
+                    f"{where} ({w['name']}): '{key}' must be a number, got {w.get(key)!r}"
+                )
+        truth = w.get("truth")
+        if truth is not None and not (
+            isinstance(truth, list) and len(truth) == 3 and all(number(v) for v in truth)
+        ):
+            raise ValueError(f"{where} ({w['name']}): 'truth' must be [x, y, theta], got {truth!r}")
+    names = [w["name"] for w in marks]
+    if len(set(names)) != len(names):
+        raise ValueError(f"{path}: waypoint names must be unique, got {names}")
+
+
 def load_route(
     waypoints: str | os.PathLike,
     band: str,
@@ -376,9 +415,10 @@ def load_route(
     path = Path(waypoints)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no waypoint file (run kiseki teach first)")
-    doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    doc = read_yaml_file(path, "kiseki waypoint file")
     if not isinstance(doc, dict) or "waypoints" not in doc or "maps" not in doc:
         raise ValueError(f"{path}: not a kiseki waypoint file")
+    _check_waypoints(doc, path)
     if band not in doc["maps"]:
         raise ValueError(f"{path}: no {band!r} map was taught")
     map_path = path.parent / doc["maps"][band]["file"] if map_file is None else Path(map_file)

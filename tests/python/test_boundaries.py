@@ -1,0 +1,109 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Files a user may hand kiseki broken: random bytes or hand-edited waypoint, trajectory and
+command files give one line naming the file (and the entry and field), never a traceback or a
+codec error without a file name."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+import yaml
+
+from kiseki.sim.run import read_commands
+from kiseki.teach.teaching import load_route
+
+RANDOM_BYTES = bytes(range(128, 256)) * 4  # not UTF-8
+
+GOOD = {
+    "maps": {"band": {"file": "map_band.yaml", "image_sha1": "0" * 40}},
+    "waypoints": [
+        {"id": 0, "name": "P0", "x": 0.0, "y": 0.0, "theta": 0.0, "truth": [0.0, 0.0, 0.0]},
+        {"id": 1, "name": "G", "x": 1.0, "y": 0.0, "theta": 0.0, "truth": [1.0, 0.0, 0.0]},
+    ],
+}
+
+
+def _edited(change) -> dict:
+    doc = yaml.safe_load(yaml.safe_dump(GOOD))
+    change(doc)
+    return doc
+
+
+@pytest.mark.parametrize(
+    ("doc", "needle"),
+    [
+        (_edited(lambda d: d.update(waypoints=None)), "'waypoints' must be a non-empty list"),
+        (_edited(lambda d: d["waypoints"].__setitem__(1, "G")), "waypoints[1] must be a mapping"),
+        (_edited(lambda d: d["waypoints"][1].update(x="abc")), "waypoints[1] (G): 'x' must be"),
+        (_edited(lambda d: d["waypoints"][0].pop("name")), "waypoints[0]: 'name' must be"),
+        (_edited(lambda d: d["waypoints"][0].update(truth=[0, 0])), "'truth' must be [x, y,"),
+        (_edited(lambda d: d["waypoints"][1].update(name="P0")), "names must be unique"),
+        (_edited(lambda d: d.update(maps={"band": "map.yaml"})), "'maps' must map each band"),
+    ],
+)
+def test_hand_edited_waypoint_files_are_refused_by_entry_and_field(tmp_path, doc, needle):
+    path = tmp_path / "waypoints.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    with pytest.raises(ValueError) as err:
+        load_route(path, "band", ["P0", "G"])
+    assert str(path) in str(err.value) and needle in str(err.value)
+
+
+def test_a_waypoint_without_truth_is_still_a_waypoint(tmp_path):
+    doc = _edited(lambda d: [w.pop("truth") for w in d["waypoints"]])
+    path = tmp_path / "waypoints.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    with pytest.raises(FileNotFoundError, match="the taught map is missing"):
+        load_route(path, "band", ["P0", "G"])  # past the entries' checks: the map is next
+
+
+def test_random_bytes_are_named_as_what_they_should_be(tmp_path):
+    junk = tmp_path / "junk.bin"
+    junk.write_bytes(RANDOM_BYTES)
+    with pytest.raises(ValueError, match=f"{junk}: not a kiseki waypoint file"):
+        load_route(junk, "band", ["P0", "G"])
+    with pytest.raises(ValueError, match=f"{junk}: not a command CSV"):
+        read_commands(junk)
+    header_only = tmp_path / "c.csv"
+    header_only.write_text("t,v,w\n")
+    with pytest.raises(ValueError, match="no commands below the header"):
+        read_commands(header_only)
+    empty = tmp_path / "e.csv"
+    empty.write_text("")
+    with pytest.raises(ValueError, match="empty command file"):
+        read_commands(empty)
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["map", "render", "MAP", "-o", "x.png", "--trajectory", "JUNK"],
+        ["sim", "run", "SCENE", "-o", "r.mcap", "--controller", "commands", "--commands", "JUNK"],
+        ["playback", "SCENE", "--route", "P0,G", "--waypoints", "JUNK", "--map", "MAP"],
+        ["serve", "--taught", "FOLDER"],
+    ],
+)
+def test_the_cli_names_a_file_of_random_bytes(tmp_path, project_root, args):
+    from kiseki.grid import OccupancyGrid
+    from kiseki.map_io import save_map
+
+    junk = tmp_path / "junk.bin"
+    junk.write_bytes(RANDOM_BYTES)
+    folder = tmp_path / "taught"
+    folder.mkdir()
+    (folder / "waypoints.yaml").write_bytes(RANDOM_BYTES)
+    map_yaml = save_map(OccupancyGrid(10, 10, 0.1), tmp_path / "m.yaml")
+    scene = project_root / "data" / "worlds" / "factory_turn.yaml"
+    swap = {"JUNK": junk, "MAP": map_yaml, "SCENE": scene, "FOLDER": folder}
+    args = [str(swap.get(a, a)) for a in args]
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", *args], capture_output=True, text=True, cwd=tmp_path
+    )
+    assert done.returncode == 1, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in done.stderr, done.stderr
+    assert "junk.bin" in lines[0] or "waypoints.yaml" in lines[0], lines[0]
+    assert "codec" not in lines[0]
