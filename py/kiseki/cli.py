@@ -354,7 +354,17 @@ def sim_run(
     check_outputs({"--output": output}, {"SCENE": scene_file, "--commands": commands})
     script = read_commands(commands) if commands is not None else None
     scene = load_scene(scene_file, variant)
-    summary = simulate(scene, output, SimConfig(duration=duration, seed=seed), script, overwrite)
+    try:
+        summary = simulate(
+            scene, output, SimConfig(duration=duration, seed=seed), script, overwrite
+        )
+    except (KeyboardInterrupt, SystemExit) as stop:  # Ctrl-C, or SIGTERM through _terminate
+        typer.echo(
+            f"kiseki: interrupted; {output} holds the run up to the interruption, closed "
+            "properly (every reader takes it)",
+            err=True,
+        )
+        raise typer.Exit(stop.code if isinstance(stop, SystemExit) else 130) from None
     x, y, th = summary.final_pose
     console.print(
         f"{output}: {summary.sim_seconds:.1f} s simulated in {summary.wall_seconds:.1f} s "
@@ -886,8 +896,17 @@ def report(
     console.print(f"{output}: {total} claims, {held} hold; {len(missing)} experiments missing")
 
 
+def _terminate(signum, frame) -> None:
+    """SIGTERM ends a command as Ctrl-C does, through its cleanup: files being written are
+    closed properly (a run's MCAP keeps its summary) and temporary files are removed."""
+    sys.exit(128 + signum)
+
+
 def main() -> None:
     """Entry point: runs the app and turns input errors into one line and exit status 1."""
+    import signal
+
+    signal.signal(signal.SIGTERM, _terminate)
     try:
         app()
     except (KisekiError, ValueError, OSError, RuntimeError, IndexError) as err:

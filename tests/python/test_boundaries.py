@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import warnings
 
 import pytest
 import yaml
@@ -107,3 +108,31 @@ def test_the_cli_names_a_file_of_random_bytes(tmp_path, project_root, args):
     assert len(lines) == 1 and "Traceback" not in done.stderr, done.stderr
     assert "junk.bin" in lines[0] or "waypoints.yaml" in lines[0], lines[0]
     assert "codec" not in lines[0]
+
+
+@pytest.mark.parametrize(("signum", "code"), [(15, 143), (2, 130)])  # SIGTERM, SIGINT
+def test_an_interrupted_sim_run_closes_its_mcap_and_says_so(tmp_path, project_root, signum, code):
+    import time
+
+    from kiseki.sim.mcap_log import read_run
+
+    out = tmp_path / "run.mcap"
+    scene = project_root / "data" / "worlds" / "factory_turn.yaml"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "kiseki.cli", "sim", "run", str(scene), "-o", str(out)],
+        stderr=subprocess.PIPE,
+        stdout=subprocess.DEVNULL,
+        text=True,
+    )
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and (not out.exists() or out.stat().st_size < 100_000):
+        time.sleep(0.2)  # until the run has written something
+    proc.send_signal(signum)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == code, err
+    assert "interrupted" in err and str(out) in err
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a truncated MCAP would warn
+        run = read_run(out)
+    assert not run.truncated
+    assert run.topics()["/ground_truth"][1] > 0
