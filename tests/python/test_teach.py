@@ -165,6 +165,13 @@ def test_bad_input(tmp_path, project_root):
         text=True,
     )
     assert done.returncode == 1 and "no teaching log" in done.stderr
+    # rebuilding a log in another scene is refused (the old code rebuilt the maps silently);
+    # the same scene is accepted and rebuilds the same waypoints
+    other_scene = project_root / "data" / "worlds" / "factory_turn.yaml"
+    with pytest.raises(ValueError, match="was taught in .*factory_corridor.yaml, not in"):
+        recover(load_scene(other_scene), tmp_path / "o" / "teach.mcap", tmp_path / "r")
+    again = recover(load_scene(scene_file), tmp_path / "o" / "teach.mcap", tmp_path / "r")
+    assert [m["name"] for m in again.marks] == ["P0", "P1", "P2"]
 
 
 def test_experiment_trial_records_the_goal_likelihood_profile():

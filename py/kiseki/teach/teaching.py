@@ -184,7 +184,13 @@ class TeachingRun:
         self.steps = 0  # steps logged
         self.out.mkdir(parents=True, exist_ok=True)
         self.log = self.out / "teach.mcap"
-        meta = {"scene_file": str(scene.path), "seed": str(seed), "dt": str(dt), "merge": merge}
+        meta = {
+            "scene_file": str(scene.path),
+            "scene_sha1": scene_digest(scene.path),
+            "seed": str(seed),
+            "dt": str(dt),
+            "merge": merge,
+        }
         self._writer = RunWriter(self.log, {**meta, **(metadata or {})}, overwrite=overwrite)
         try:
             self._record()
@@ -320,12 +326,32 @@ def _mark(run: TeachingRun, names, controller: PurePursuit, resting: bool) -> No
     run.mark(names[i])
 
 
+def scene_digest(path: str | os.PathLike) -> str:
+    """SHA-1 of a scene file's bytes: ties a teaching log to the scene it was taught in."""
+    return hashlib.sha1(Path(path).read_bytes()).hexdigest()
+
+
+def _check_same_scene(metadata: dict, scene: Scene, log) -> None:
+    """Refuses to rebuild a log in a scene other than the one it was taught in: by the scene
+    file's SHA-1 when the log records it, else by the recorded file when it still exists."""
+    taught = metadata.get("scene_file", "")
+    recorded = metadata.get("scene_sha1")
+    if recorded is None and taught and Path(taught).is_file():
+        recorded = scene_digest(taught)  # logs from before the digest was recorded
+    if recorded is not None and recorded != scene_digest(scene.path):
+        raise ValueError(
+            f"{log} was taught in {taught or 'another scene'}, not in {scene.path} (the scene "
+            "files differ): give the scene it was taught in"
+        )
+
+
 def recover(
     scene: Scene, log: str | os.PathLike, out: str | os.PathLike, merge: str | None = None
 ) -> TeachResult:
     """Rebuilds the maps and waypoints of a teaching run from its MCAP log (after a crash),
     with the merge rule the run was taught with (or `merge`)."""
     run = read_run(log)
+    _check_same_scene(run.metadata, scene, log)
     topics = run.topics()
     merge = merge or run.metadata.get("merge", "thesis")
     if merge not in MERGE_RULES:
