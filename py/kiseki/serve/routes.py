@@ -182,8 +182,10 @@ class RouteRunner:
             return {"stopping": running, "status": self._state["status"]}
 
     def state(self) -> dict:
+        """The state (a deep copy) with the sequence number of the last message sent, so a page
+        can tell a reply that is older than the websocket's latest message and drop it."""
         with self._lock:
-            return json.loads(json.dumps(self._state))  # a deep copy
+            return {**json.loads(json.dumps(self._state)), "seq": self._seq}
 
     def message(self) -> str:
         """The latest state with the particles, as sent on the websocket."""

@@ -22,6 +22,7 @@ const app = {
   latency: null, // {t0, posted} while waiting for the first pose after a click on start
   updates: 0,
   recent: [],
+  seq: -1, // the sequence number of the state shown (the server's message count)
 };
 window.kiseki = app; // for the browser tests and a curious teacher's console
 
@@ -224,7 +225,12 @@ function renderHistory(history) {
 
 async function refreshState() {
   const previous = app.state.status;
-  app.state = { history: [], ...(await app.api.state()) };
+  const fresh = await app.api.state();
+  // a reply older than the last live message (a stop's reply overtaken by the "stopped"
+  // message) must not put the old state back
+  if (Number.isInteger(fresh.seq) && fresh.seq < app.seq) return;
+  if (Number.isInteger(fresh.seq)) app.seq = fresh.seq;
+  app.state = { history: [], ...fresh };
   if (previous !== "running" && app.state.status === "running") app.view.trail = [];
   app.view.setLive(app.state);
   renderState();
@@ -232,6 +238,10 @@ async function refreshState() {
 
 /** Live messages merge at once; the page draws at most once per frame. */
 function onLive(message) {
+  if (Number.isInteger(message.seq)) {
+    if (message.seq < app.seq) return; // an older message than the state shown
+    app.seq = message.seq;
+  }
   const before = app.state.status;
   app.state = { ...app.state, ...message };
   app.updates += 1;
@@ -270,7 +280,10 @@ function connect() {
   if (app.socket) app.socket.close();
   app.socket = new LiveSocket(app.api, {
     onMessage: onLive,
-    onOpen: () => refreshState().catch(handleError),
+    onOpen: () => {
+      app.seq = -1; // a new connection (perhaps to a restarted server) starts counting again
+      refreshState().catch(handleError);
+    },
     onStatus: (status) => {
       document.body.dataset.connection = status;
       $("connection").textContent = status === "live" ? "live" : "reconnecting\u2026";
