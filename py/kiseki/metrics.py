@@ -11,6 +11,7 @@ ddof = 0, min, max, sse).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,6 +27,7 @@ __all__ = [
     "stop_error",
     "taught_map_truth",
     "umeyama_alignment",
+    "wilson_interval",
 ]
 
 RELATIONS = ("translation", "rotation_deg", "rotation_rad", "full")
@@ -320,3 +322,14 @@ def taught_map_truth(
         n_open,
         false_occ,
     )
+
+
+def wilson_interval(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
+    """The Wilson score interval of a share k/n (95 % with z = 1.96; E. B. Wilson, JASA 22,
+    1927); (NaN, NaN) when n is 0."""
+    if n == 0:
+        return (math.nan, math.nan)
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return (max(0.0, centre - half), min(1.0, centre + half))

@@ -120,3 +120,14 @@ def test_stop_error_in_goal_frame():
 def test_bad_input(call, match):
     with pytest.raises(ValueError, match=match):
         call()
+
+
+def test_wilson_interval_against_its_closed_form_values():
+    from kiseki.metrics import wilson_interval
+
+    # Wilson (1927) at z = 1.96: 5 of 20 -> (0.1119, 0.4687); 0 of 20 -> (0, 0.1611)
+    lo, hi = wilson_interval(5, 20)
+    assert lo == pytest.approx(0.11186, abs=1e-5) and hi == pytest.approx(0.46871, abs=1e-5)
+    lo, hi = wilson_interval(0, 20)
+    assert lo == 0.0 and hi == pytest.approx(0.16113, abs=1e-5)
+    assert all(np.isnan(v) for v in wilson_interval(0, 0))

@@ -35,6 +35,7 @@ from matplotlib.colors import ListedColormap
 from kiseki.core import derive_seed
 from kiseki.experiments import teach_playback as tp
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.metrics import wilson_interval
 from kiseki.plots import new_figure
 from kiseki.sim.layouts import generate_layout, write_layout
 from kiseki.sim.scene import load_scene
@@ -166,16 +167,6 @@ def _names(method: str) -> set[str]:
     return {method, method.replace("proposal", "proposal ")}
 
 
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    """The 95 % Wilson score interval of a share k/n."""
-    if n == 0:
-        return (math.nan, math.nan)
-    p = k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return (max(0.0, centre - half), min(1.0, centre + half))
-
-
 def _layout_claims(config: LayoutsConfig, ok: pd.DataFrame, scratch: Path) -> pd.DataFrame:
     """Per layout and claim of exp2-turn / exp3-boxes: its measured value and whether it holds
     (exp2-turn's and exp3-boxes' own analyses on the layout's runs). A claim that names a
@@ -219,7 +210,7 @@ def _shares(per: pd.DataFrame) -> pd.DataFrame:
     rows = []
     for (name, claim), g in per.groupby(["experiment", "claim"], sort=False):
         k, n = int(g["holds"].sum()), len(g)
-        lo, hi = wilson(k, n)
+        lo, hi = wilson_interval(k, n)
         fails = ", ".join(str(v) for v in g.loc[~g["holds"], "layout"])
         rows.append(
             {

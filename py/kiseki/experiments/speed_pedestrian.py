@@ -36,6 +36,7 @@ import pandas as pd
 from kiseki.core import Random
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.experiments.speed_common import WORLDS, drive, prior_map, with_pedestrians
+from kiseki.metrics import wilson_interval
 from kiseki.plots import new_figure
 from kiseki.sim.pedestrians import Pedestrian
 from kiseki.sim.scene import load_scene
@@ -133,15 +134,6 @@ def trial(config: PedestrianConfig, index: int, seed: int) -> TrialOutput:
     return TrialOutput(record)
 
 
-def _wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    if n == 0:
-        return math.nan, math.nan
-    p = k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return centre - half, centre + half
-
-
 def analyze(config: PedestrianConfig, trials: pd.DataFrame, timings, figures: Path) -> Analysis:
     ok = trials[trials["error"].isna()]
     rows = []
@@ -149,7 +141,7 @@ def analyze(config: PedestrianConfig, trials: pd.DataFrame, timings, figures: Pa
         outcomes = ok[f"{method}_outcome"]
         n = len(outcomes)
         safe = int(outcomes.isin(["clear", "stopped"]).sum())
-        lo, hi = _wilson(safe, n)
+        lo, hi = wilson_interval(safe, n)
         hits = ok.loc[outcomes == "collision", f"{method}_contact_speed"]
         _, _, route = _reference(config.scene, tuple(config.goal), method, config.max_duration)
         rows.append(
