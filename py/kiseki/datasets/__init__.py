@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """Readers for recorded robot data: CARMEN logs, ROS 1 and ROS 2 bags, kiseki's simulated runs
-(MCAP), and the CMU Wean Hall map. ``open_scans`` gives the laser scans of any supported log
-through one interface."""
+(MCAP), the CMU Wean Hall map, and magnetic-field samples (CSV, Aalto robot runs, Kok-Solin
+walks). ``open_scans`` gives the laser scans of any supported log through one interface;
+``read_magnetic_data`` the samples of any supported magnetic recording."""
 
 from __future__ import annotations
 
@@ -10,6 +11,14 @@ import os
 from pathlib import Path
 
 from kiseki.datasets.carmen import CarmenLog, OdometryRecords, read_carmen_log
+from kiseki.datasets.kok import read_kok_walk
+from kiseki.datasets.magnetic import (
+    MagneticSamples,
+    concatenate_samples,
+    read_aalto_run,
+    read_field_csv,
+    read_magnetic_data,
+)
 from kiseki.datasets.rosbag import BAG_KINDS, is_ros_bag, read_bag_scans, write_bag
 from kiseki.datasets.wean import WeanMap, read_wean_map
 from kiseki.datasets.wean_log import WeanLog, is_wean_log, read_wean_log
@@ -21,13 +30,19 @@ __all__ = [
     "BAG_KINDS",
     "CarmenLog",
     "LaserScans",
+    "MagneticSamples",
     "OdometryRecords",
     "WeanLog",
     "WeanMap",
+    "concatenate_samples",
     "is_ros_bag",
     "is_wean_log",
+    "read_aalto_run",
     "read_bag_scans",
     "read_carmen_log",
+    "read_field_csv",
+    "read_kok_walk",
+    "read_magnetic_data",
     "read_wean_log",
     "read_wean_map",
     "write_bag",

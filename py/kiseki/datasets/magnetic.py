@@ -1,0 +1,316 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Recorded magnetic-field samples: positions, the field vector there, its units.
+
+Three sources give :class:`MagneticSamples`:
+
+* a CSV with a header naming the columns ``x,y[,z],mx,my,mz`` (any order, other columns ignored;
+  an optional ``t`` or ``time`` column gives the times): :func:`read_field_csv`;
+* a run in the layout of the Aalto robot data (Solin et al., IEEE T-RO 2018), named by its prefix
+  ``DIR/N`` for ``DIR/N-loc.csv`` (x, y in m), ``DIR/N-mag.csv`` (field in uT, already in the world
+  frame) and ``DIR/N-time.csv`` (s), comma-separated without a header: :func:`read_aalto_run`;
+* a MATLAB v5 hand-held walk in the layout of Kok and Solin (MFI 2024):
+  :func:`kiseki.datasets.kok.read_kok_walk`.
+
+:func:`read_magnetic_data` picks the reader from the name. Bad files raise
+:class:`~kiseki.errors.LogFormatError` (a ``ValueError``) naming the file and the line; a missing
+file raises ``FileNotFoundError`` naming it.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from kiseki.errors import LogFormatError
+
+__all__ = [
+    "UNITS",
+    "MagneticSamples",
+    "concatenate_samples",
+    "read_aalto_run",
+    "read_field_csv",
+    "read_magnetic_data",
+]
+
+UNITS = ("uT", "G", "unknown")
+_CSV_COLUMNS = ("x", "y", "z", "mx", "my", "mz", "t")
+_AALTO_PARTS = (("loc", 2, "x, y"), ("mag", 3, "mx, my, mz"), ("time", 1, "t"))
+
+
+@dataclass(frozen=True, eq=False)
+class MagneticSamples:
+    """Magnetic-field vectors measured at known positions, in one world frame.
+
+    ``positions`` (n, 2) or (n, 3) in metres; ``field`` (n, 3), the field's components along the
+    x, y, z axes of the positions' frame; ``units`` one of ``"uT"``, ``"G"`` or ``"unknown"`` (a
+    sensor whose units are not stated); ``source`` the file or prefix the samples came from;
+    ``times`` (n,) in seconds or None. The arrays are stored as read-only float64 copies.
+    """
+
+    positions: np.ndarray
+    field: np.ndarray
+    units: str
+    source: str
+    times: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        source = str(self.source)
+        object.__setattr__(self, "source", source)
+        if self.units not in UNITS:
+            raise ValueError(f"{source}: units {self.units!r} not one of {', '.join(UNITS)}")
+        positions = _frozen_array(self.positions, source, "positions")
+        field = _frozen_array(self.field, source, "field")
+        if positions.ndim != 2 or positions.shape[1] not in (2, 3):
+            raise ValueError(f"{source}: positions must be (n, 2) or (n, 3), got {positions.shape}")
+        if field.ndim != 2 or field.shape[1] != 3:
+            raise ValueError(f"{source}: field must be (n, 3), got {field.shape}")
+        if len(positions) != len(field):
+            raise ValueError(
+                f"{source}: {len(positions)} positions but {len(field)} field readings"
+            )
+        if len(positions) == 0:
+            raise ValueError(f"{source}: no samples")
+        _check_finite(positions, source, "position")
+        _check_finite(field, source, "field reading")
+        object.__setattr__(self, "positions", positions)
+        object.__setattr__(self, "field", field)
+        if self.times is not None:
+            times = _frozen_array(self.times, source, "times")
+            if times.shape != (len(positions),):
+                raise ValueError(
+                    f"{source}: times must be ({len(positions)},) like the positions, "
+                    f"got {times.shape}"
+                )
+            _check_finite(times[:, None], source, "time")
+            object.__setattr__(self, "times", times)
+
+    def __len__(self) -> int:
+        return len(self.positions)
+
+    @property
+    def dimension(self) -> int:
+        """2 or 3: the number of position coordinates."""
+        return self.positions.shape[1]
+
+    @property
+    def magnitude(self) -> np.ndarray:
+        """(n,) field strength |m| in the samples' units."""
+        return np.linalg.norm(self.field, axis=1)
+
+    def take(self, index: np.ndarray | slice | Sequence[int]) -> MagneticSamples:
+        """The samples selected by an index array, a boolean mask or a slice."""
+        times = None if self.times is None else self.times[index]
+        return MagneticSamples(
+            self.positions[index], self.field[index], self.units, self.source, times
+        )
+
+
+def concatenate_samples(
+    samples: Sequence[MagneticSamples], source: str | None = None
+) -> MagneticSamples:
+    """The samples of several runs in one set (same units and dimension required). Times are
+    kept only when every run has them; ``source`` defaults to the sources joined by '+'."""
+    if len(samples) == 0:
+        raise ValueError("no samples to concatenate")
+    units = {s.units for s in samples}
+    if len(units) > 1:
+        names = ", ".join(f"{s.source} ({s.units})" for s in samples)
+        raise ValueError(f"cannot combine samples in different units: {names}")
+    dimensions = {s.dimension for s in samples}
+    if len(dimensions) > 1:
+        names = ", ".join(f"{s.source} ({s.dimension}-D)" for s in samples)
+        raise ValueError(f"cannot combine 2-D and 3-D positions: {names}")
+    with_times = all(s.times is not None for s in samples)
+    return MagneticSamples(
+        np.concatenate([s.positions for s in samples]),
+        np.concatenate([s.field for s in samples]),
+        samples[0].units,
+        source if source is not None else "+".join(s.source for s in samples),
+        np.concatenate([s.times for s in samples]) if with_times else None,
+    )
+
+
+def read_field_csv(path: str | os.PathLike, units: str = "unknown") -> MagneticSamples:
+    """Samples from a CSV whose header names ``x,y[,z],mx,my,mz`` (any order, case ignored,
+    other columns ignored; ``t`` or ``time`` read as times). ``units`` states the field's units
+    ("uT", "G" or "unknown")."""
+    path = Path(path)
+    if units not in UNITS:
+        raise ValueError(f"{path}: units {units!r} not one of {', '.join(UNITS)}")
+    lines = _numbered_lines(path)
+    if not lines:
+        raise LogFormatError(f"{path}: empty file: expected a header x,y[,z],mx,my,mz and rows")
+    header_line, header = lines[0]
+    names = [name.strip().strip('"').strip().lower() for name in header.split(",")]
+    columns = _header_columns(path, header_line, names)
+    present = [name for name in _CSV_COLUMNS if name in columns]
+    table = _parse_rows(path, lines[1:], len(names), [columns[n] for n in present], header)
+    if len(table) == 0:
+        raise LogFormatError(f"{path}: header but no data rows")
+    values = dict(zip(present, table.T, strict=True))
+    coords = ("x", "y", "z") if "z" in columns else ("x", "y")
+    return MagneticSamples(
+        positions=np.column_stack([values[c] for c in coords]),
+        field=np.column_stack([values["mx"], values["my"], values["mz"]]),
+        units=units,
+        source=str(path),
+        times=values.get("t"),
+    )
+
+
+def read_aalto_run(prefix: str | os.PathLike) -> MagneticSamples:
+    """One run in the Aalto layout: ``DIR/N`` names ``DIR/N-loc.csv``, ``DIR/N-mag.csv`` and
+    ``DIR/N-time.csv`` (comma-separated, no header, one row per sample). The field is in uT and
+    already in the motion-capture (world) frame; positions are 2-D."""
+    prefix = str(prefix)
+    paths = {part: Path(f"{prefix}-{part}.csv") for part, _, _ in _AALTO_PARTS}
+    missing = [str(p) for p in paths.values() if not p.is_file()]
+    if missing:
+        raise FileNotFoundError(
+            f"{prefix}: not an Aalto run: missing {', '.join(missing)} "
+            "(a run DIR/N needs DIR/N-loc.csv, DIR/N-mag.csv and DIR/N-time.csv)"
+        )
+    tables = {}
+    for part, count, names in _AALTO_PARTS:
+        path = paths[part]
+        tables[part] = _parse_rows(path, _numbered_lines(path), count, list(range(count)), names)
+        if len(tables[part]) == 0:
+            raise LogFormatError(f"{path}: no rows")
+    rows = {part: len(table) for part, table in tables.items()}
+    for part in ("mag", "time"):
+        if rows[part] != rows["loc"]:
+            raise LogFormatError(
+                f"{prefix}: {paths['loc']} has {rows['loc']} rows but {paths[part]} has "
+                f"{rows[part]}: one row per sample in each file"
+            )
+    return MagneticSamples(
+        positions=tables["loc"],
+        field=tables["mag"],
+        units="uT",
+        source=prefix,
+        times=tables["time"][:, 0],
+    )
+
+
+def read_magnetic_data(spec: str | os.PathLike) -> MagneticSamples:
+    """Samples from ``spec``: an existing ``.csv`` file is read by :func:`read_field_csv` (units
+    "unknown"), a ``.mat`` file by :func:`kiseki.datasets.kok.read_kok_walk`, anything else is
+    taken as an Aalto run prefix (:func:`read_aalto_run`)."""
+    path = Path(spec)
+    suffix = path.suffix.lower()
+    if suffix == ".mat":
+        from kiseki.datasets.kok import read_kok_walk  # kok imports this module
+
+        return read_kok_walk(path)
+    if suffix == ".csv":
+        if not path.exists():
+            raise FileNotFoundError(f"{path}: file not found")
+        return read_field_csv(path)
+    if path.is_file():
+        raise LogFormatError(
+            f"{path}: not magnetic data: expected a .csv with columns x,y[,z],mx,my,mz, a .mat "
+            "walk, or an Aalto run prefix DIR/N"
+        )
+    return read_aalto_run(spec)
+
+
+def _frozen_array(values: object, source: str, name: str) -> np.ndarray:
+    try:
+        array = np.array(values, dtype=np.float64, copy=True)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{source}: {name} are not numbers ({exc})") from exc
+    array.setflags(write=False)
+    return array
+
+
+def _check_finite(array: np.ndarray, source: str, what: str) -> None:
+    bad = ~np.isfinite(array).all(axis=1)
+    if bad.any():
+        row, count = int(np.argmax(bad)), int(bad.sum())
+        rows = "1 row" if count == 1 else f"{count} rows"
+        raise ValueError(
+            f"{source}: {rows} with a NaN or infinite {what}, the first in data row {row + 1} "
+            f"(counting from 1): {array[row].tolist()}"
+        )
+
+
+def _numbered_lines(path: Path) -> list[tuple[int, str]]:
+    """The file's non-blank lines with their 1-based line numbers."""
+    if path.is_dir():
+        raise LogFormatError(f"{path}: a directory, not a file")
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: file not found")
+    data = path.read_bytes()
+    if b"\x00" in data:
+        raise LogFormatError(f"{path}: binary data, not a comma-separated text table")
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise LogFormatError(
+            f"{path}: not a text table (byte {exc.start} is not valid UTF-8)"
+        ) from exc
+    return [(k + 1, line) for k, line in enumerate(text.splitlines()) if line.strip()]
+
+
+def _header_columns(path: Path, line: int, names: list[str]) -> dict[str, int]:
+    if all(_is_number(name) for name in names):
+        raise LogFormatError(
+            f"{path}: line {line}: no header: the first line must name the columns "
+            "x,y[,z],mx,my,mz (an Aalto run is named by its prefix DIR/N, not by one of its files)"
+        )
+    aliases = {"time": "t"}
+    columns: dict[str, int] = {}
+    for k, name in enumerate(names):
+        name = aliases.get(name, name)
+        if name in _CSV_COLUMNS:
+            if name in columns:
+                raise LogFormatError(f"{path}: line {line}: column {name!r} given twice")
+            columns[name] = k
+    missing = [name for name in ("x", "y", "mx", "my", "mz") if name not in columns]
+    if missing:
+        raise LogFormatError(
+            f"{path}: line {line}: header lacks {', '.join(missing)} "
+            f"(needs x,y[,z],mx,my,mz; found {','.join(names)})"
+        )
+    return columns
+
+
+def _parse_rows(
+    path: Path, lines: list[tuple[int, str]], count: int, wanted: list[int], names: str
+) -> np.ndarray:
+    """The wanted columns of comma-separated rows of exactly ``count`` fields, as float64."""
+    if lines:
+        try:  # numpy's parser first; the loop below finds the line of any error
+            table = np.loadtxt([t for _, t in lines], delimiter=",", comments=None, ndmin=2)
+            if table.shape == (len(lines), count):
+                return table[:, wanted]
+        except ValueError:
+            pass
+    table = np.empty((len(lines), len(wanted)))
+    for row, (line, text) in enumerate(lines):
+        fields = text.split(",")
+        if len(fields) != count:
+            raise LogFormatError(
+                f"{path}: line {line}: {len(fields)} columns, expected {count} ({names})"
+            )
+        for j, k in enumerate(wanted):
+            try:
+                table[row, j] = float(fields[k])
+            except ValueError:
+                raise LogFormatError(
+                    f"{path}: line {line}: column {k + 1} is not a number: {fields[k].strip()!r}"
+                ) from None
+    return table
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
