@@ -4,10 +4,12 @@
 #include <pybind11/stl.h>
 
 #include <cstring>
+#include <memory>
 
 #include "kiseki/models/beam_model.hpp"
 #include "kiseki/models/likelihood_field.hpp"
 #include "kiseki/models/local_map.hpp"
+#include "kiseki/models/magnetic_map_model.hpp"
 #include "kiseki/models/space_observation.hpp"
 #include "numpy_helpers.hpp"
 
@@ -98,6 +100,50 @@ void bind_models(py::module_& m) {
       .def("agreement", &SensorModel::agreement, "pose"_a,
            "Share of the measurement that agrees with the map from this pose (NaN: unknown).")
       .def_property_readonly("readings", &SensorModel::readings);
+
+  py::class_<MagneticMapModel, SensorModel>(m, "MagneticMapModel",
+                                            "Eqs. 6.17-6.18 of the magnetic thesis on a 2-D field map (see "
+                                            "kiseki.magnetic.MagneticMapModel).")
+      .def(py::init([](const py::handle& mean, const py::handle& variance, double origin_x, double origin_y,
+                       double resolution, const Eigen::Vector3d& prior_mean, const Eigen::Vector3d& prior_variance,
+                       const py::handle& offsets, double noise_sd, bool world_frame) {
+             const DoubleArray mu = as_doubles(mean, "mean");
+             const DoubleArray var = as_doubles(variance, "variance");
+             if (mu.ndim() != 3 || mu.shape(2) != 3) {
+               throw std::invalid_argument("mean: expected shape (height, width, 3), got " + shape_string(mu));
+             }
+             if (var.ndim() != 3 || var.shape(0) != mu.shape(0) || var.shape(1) != mu.shape(1) || var.shape(2) != 3) {
+               throw std::invalid_argument("variance: expected the mean's shape " + shape_string(mu) + ", got " +
+                                           shape_string(var));
+             }
+             const DoubleArray off = as_doubles(offsets, "offsets");
+             require_shape(off, "offsets", 2, 2);
+             MagneticGrid g;
+             g.origin_x = origin_x;
+             g.origin_y = origin_y;
+             g.resolution = resolution;
+             g.height = static_cast<int>(mu.shape(0));
+             g.width = static_cast<int>(mu.shape(1));
+             g.mean.assign(mu.data(), mu.data() + mu.size());
+             g.variance.assign(var.data(), var.data() + var.size());
+             g.prior_mean = prior_mean;
+             g.prior_variance = prior_variance;
+             std::vector<Eigen::Vector2d> o;
+             for (py::ssize_t i = 0; i < off.shape(0); ++i) o.emplace_back(off.at(i, 0), off.at(i, 1));
+             return std::make_unique<MagneticMapModel>(std::move(g), std::move(o), noise_sd, world_frame);
+           }),
+           "mean"_a, "variance"_a, "origin_x"_a, "origin_y"_a, "resolution"_a, "prior_mean"_a, "prior_variance"_a,
+           "offsets"_a, "noise_sd"_a, "world_frame"_a = false)
+      .def(
+          "set_readings",
+          [](MagneticMapModel& model, const py::handle& readings) {
+            const DoubleArray r = as_doubles(readings, "readings");
+            require_shape(r, "readings", 2, 3);
+            std::vector<Eigen::Vector3d> v;
+            for (py::ssize_t i = 0; i < r.shape(0); ++i) v.emplace_back(r.at(i, 0), r.at(i, 1), r.at(i, 2));
+            model.set_readings(v);
+          },
+          "readings"_a, "One (mx, my, mz) per sensor: body frame (x forward, y left, z up) unless world_frame.");
 
   py::enum_<BeamCombination>(m, "BeamCombination")
       .value("product", BeamCombination::product)

@@ -12,6 +12,7 @@ void bind_filters(pybind11::module_& m);
 void bind_teach(pybind11::module_& m);
 void bind_coop(pybind11::module_& m);
 void bind_speed(pybind11::module_& m);
+void bind_gp(pybind11::module_& m);
 }  // namespace kiseki::bindings
 
 PYBIND11_MODULE(_core, m) {
@@ -25,4 +26,5 @@ PYBIND11_MODULE(_core, m) {
   kiseki::bindings::bind_teach(m);
   kiseki::bindings::bind_coop(m);
   kiseki::bindings::bind_speed(m);
+  kiseki::bindings::bind_gp(m);
 }

@@ -17,6 +17,7 @@ APT_PACKAGES=(
   build-essential pkg-config git
   python3 python3-venv python3-dev
   libeigen3-dev libpcl-dev liboctomap-dev libopencv-dev octomap-tools
+  libopenblas-dev liblapacke-dev  # the Gaussian processes' Cholesky factorisations (kiseki/gp)
   libgtest-dev googletest
   chromium  # the serve page's browser tests (Playwright drives it; it downloads no browser)
 )

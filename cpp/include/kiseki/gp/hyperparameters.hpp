@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "kiseki/gp/exact_gp.hpp"
+
+namespace kiseki {
+
+/// log p(Y | X, theta) (thesis eq. 6.11, summed over Y's columns) and its gradient with respect to
+/// (log sigma_f, log l, log sigma_n).
+///
+/// The gradient is Rasmussen & Williams' eq. 5.9, 1/2 tr((alpha alpha^T - K^-1) dK/dtheta), with
+/// the kernel derivatives of eqs. 6.13-6.15 times theta (the chain rule for log-parameters). The
+/// thesis' eq. 6.12 prints only the alpha alpha^T term; without -K^-1 the gradient is not that of
+/// eq. 6.11, so kiseki uses the complete form.
+struct LogMarginalLikelihood {
+  double value = 0.0;
+  Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
+};
+
+/// Targets are used as given (remove a mean first if the model has one). Throws
+/// std::runtime_error when K + sigma_n^2 I cannot be factorised.
+LogMarginalLikelihood log_marginal_likelihood(const Eigen::Ref<const RowMatrix>& inputs,
+                                              const Eigen::Ref<const RowMatrix>& targets,
+                                              const SquaredExponential& kernel);
+
+struct HyperparameterOptions {
+  int restarts = 3;           ///< random starts after the first
+  std::uint64_t seed = 0;     ///< for the random starts
+  int max_iterations = 100;   ///< BFGS iterations per start
+  double tolerance = 1e-6;    ///< on the largest gradient component of LML / (n k)
+};
+
+struct HyperparameterFit {
+  SquaredExponential kernel;
+  double log_marginal_likelihood = 0.0;
+  int evaluations = 0;                  ///< LML + gradient evaluations, all starts
+  std::vector<double> start_values;     ///< the best LML reached from each start
+};
+
+/// Maximises eq. 6.11 over (sigma_f, l, sigma_n) by BFGS in log-parameters with a backtracking
+/// (Armijo) line search, from `initial` and from `restarts` random starts (log-uniform within
+/// the bounds below, drawn from kiseki::Random(seed)); the best start wins. Bounds, from the
+/// data: sigma_f and sigma_n in [1e-6, 1e3] x the targets' RMS, l in [1e-3, 1e2] x the inputs'
+/// largest extent. Targets are used as given (remove a mean first).
+HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
+                                      const Eigen::Ref<const RowMatrix>& targets,
+                                      const SquaredExponential& initial, const HyperparameterOptions& options = {});
+
+/// A starting point from the data: sigma_f the targets' RMS, l a tenth of the inputs' largest
+/// extent, sigma_n a tenth of sigma_f.
+SquaredExponential initial_kernel(const Eigen::Ref<const RowMatrix>& inputs, const Eigen::Ref<const RowMatrix>& targets);
+
+}  // namespace kiseki

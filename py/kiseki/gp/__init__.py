@@ -1,0 +1,18 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Gaussian-process regression of vector fields (the magnetic-navigation thesis, chapter 6).
+
+* :class:`SquaredExponential`: the kernel sigma_f^2 exp(-|p - q|^2 / (2 l^2)) and noise sigma_n;
+* :func:`fit_hyperparameters`: maximum of the log marginal likelihood (eqs. 6.11-6.15), BFGS;
+* :class:`ExactGP`: exact regression (eqs. 6.7-6.9), one factorisation for all field components;
+* :class:`HilbertGP`: the reduced-rank approximation for maps of tens of thousands of readings.
+
+The C++ core (``cpp/include/kiseki/gp``) does the work with LAPACK; these classes check inputs
+and shape the results.
+"""
+
+from kiseki.gp.exact import ExactGP
+from kiseki.gp.hilbert import HilbertGP
+from kiseki.gp.kernel import HyperparameterFit, SquaredExponential, fit_hyperparameters
+
+__all__ = ["ExactGP", "HilbertGP", "HyperparameterFit", "SquaredExponential", "fit_hyperparameters"]

@@ -1,0 +1,113 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Reduced-rank GP regression for large maps (Solin & Sarkka, Statistics and Computing 2020)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from kiseki import _core
+from kiseki.gp._data import check_mean, inputs_array, targets_array
+from kiseki.gp.kernel import SquaredExponential
+
+__all__ = ["HilbertGP"]
+
+
+class HilbertGP:
+    """The GP approximated by the Laplacian's eigenfunctions on a box around the data (see
+    ``cpp/include/kiseki/gp/hilbert_gp.hpp``): fit O(n m^2), prediction O(m^2) per point,
+    m the basis size, which depends on the box and the length scale but not on n.
+
+    Use it beyond ~10,000 readings, with hyperparameters from :func:`fit_hyperparameters` on
+    a subsample. The default box is the data's bounding box grown by 4 length scales on every
+    side (the approximation falls to the prior at the box's faces); ``tolerance`` is the share
+    of the kernel's spectral density below which frequencies are dropped."""
+
+    def __init__(self, core: Any, kernel: SquaredExponential, mean: str, lower, upper) -> None:
+        self._core = core
+        self.kernel = kernel
+        self.mean = mean
+        self.lower = np.asarray(lower, dtype=float)
+        self.upper = np.asarray(upper, dtype=float)
+
+    @classmethod
+    def fit(
+        cls,
+        x: Any,
+        y: Any,
+        kernel: SquaredExponential,
+        *,
+        domain: tuple[Any, Any] | None = None,
+        tolerance: float = 1e-4,
+        max_basis: int = 20000,
+        mean: str = "constant",
+    ) -> HilbertGP:
+        x = inputs_array(x)
+        y, _ = targets_array(y, x.shape[0])
+        constant = check_mean(mean)
+        if not isinstance(kernel, SquaredExponential):
+            raise ValueError(f"kernel must be a SquaredExponential, got {type(kernel).__name__}")
+        if x.shape[1] > 3:
+            raise ValueError(f"HilbertGP takes 1-3 coordinates, got {x.shape[1]}")
+        if not np.isfinite(x).all():
+            raise ValueError("X: contains NaN or infinite values")
+        if domain is None:
+            margin = 4.0 * kernel.length_scale
+            lower, upper = x.min(axis=0) - margin, x.max(axis=0) + margin
+        else:
+            lower, upper = (np.asarray(v, dtype=float).reshape(-1) for v in domain)
+        if not (
+            isinstance(tolerance, (int, float)) and 0 < tolerance < 1 and math.isfinite(tolerance)
+        ):
+            raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
+        core = _core.HilbertGaussianProcess(
+            x,
+            y,
+            kernel.sigma_f,
+            kernel.length_scale,
+            kernel.sigma_n,
+            lower,
+            upper,
+            tolerance,
+            max_basis,
+            constant,
+        )
+        return cls(core, kernel, mean, lower, upper)
+
+    def predict(self, points: Any) -> tuple[np.ndarray, np.ndarray]:
+        """(mean (m, k), variance (m, k)) of the noise-free field; the prior outside the box."""
+        p = inputs_array(points, "points")
+        if p.shape[1] != self.dimension:
+            raise ValueError(
+                f"points have {p.shape[1]} coordinates, the GP was fitted on {self.dimension}"
+            )
+        mean, var = self._core.predict(p)
+        return mean, np.repeat(var[:, None], mean.shape[1], axis=1)
+
+    @property
+    def basis_size(self) -> int:
+        return int(self._core.basis_size)
+
+    @property
+    def dimension(self) -> int:
+        return int(self._core.dimension)
+
+    @property
+    def outputs(self) -> int:
+        return int(self._core.outputs)
+
+    @property
+    def size(self) -> int:
+        return int(self._core.size)
+
+    @property
+    def prior_mean(self) -> np.ndarray:
+        return np.asarray(self._core.prior_mean)
+
+    @property
+    def prior_variance(self) -> np.ndarray:
+        """sigma_f^2 per column."""
+        return np.full(self.outputs, self.kernel.sigma_f**2)

@@ -1,0 +1,156 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""kiseki.gp against scikit-learn's GaussianProcessRegressor (the reference) and closed forms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from sklearn.gaussian_process import GaussianProcessRegressor
+from sklearn.gaussian_process.kernels import RBF, WhiteKernel
+from sklearn.gaussian_process.kernels import ConstantKernel as Constant
+
+from kiseki.gp import ExactGP, HilbertGP, SquaredExponential, fit_hyperparameters
+from kiseki.gp.kernel import log_marginal_likelihood
+
+
+def field(x: np.ndarray, noise: float, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    y = np.c_[
+        np.sin(1.3 * x[:, 0]) * np.cos(0.7 * x[:, 1]),
+        0.3 * x[:, 0] - np.cos(x[:, 1]),
+        x[:, 1] ** 2 / 9,
+    ]
+    return y + rng.normal(0.0, noise, y.shape)
+
+
+@pytest.fixture(scope="module")
+def data():
+    rng = np.random.default_rng(0)
+    x = rng.uniform(0.0, 3.0, (250, 2))
+    return x, field(x, 0.05, 1), rng.uniform(-0.5, 3.5, (120, 2))
+
+
+def sklearn_fixed(kernel: SquaredExponential, x, y):
+    k = Constant(kernel.sigma_f**2, "fixed") * RBF(kernel.length_scale, "fixed")
+    return GaussianProcessRegressor(k, alpha=kernel.sigma_n**2, optimizer=None).fit(x, y)
+
+
+def test_prediction_equals_scikit_learn(data):
+    x, y, q = data
+    kernel = SquaredExponential(1.1, 0.6, 0.07)
+    gp = ExactGP.fit(x, y, kernel, mean="zero")
+    mean, var = gp.predict(q)
+    ref_mean, ref_std = sklearn_fixed(kernel, x, y).predict(q, return_std=True)
+    np.testing.assert_allclose(mean, ref_mean, atol=1e-10)
+    np.testing.assert_allclose(var, ref_std**2, atol=1e-10)
+    assert var.shape == (len(q), 3)
+
+
+def test_log_marginal_likelihood_and_gradient_equal_scikit_learn(data):
+    x, y, _ = data
+    kernel = SquaredExponential(0.9, 0.5, 0.1)
+    value, gradient = log_marginal_likelihood(x, y[:, 0], kernel, mean="zero")
+    sk = Constant(1.0) * RBF(1.0) + WhiteKernel(1.0)
+    reg = GaussianProcessRegressor(sk, alpha=0.0, optimizer=None).fit(x, y[:, 0])
+    # scikit-learn's theta: (log sigma_f^2, log l, log sigma_n^2).
+    theta = np.log([kernel.sigma_f**2, kernel.length_scale, kernel.sigma_n**2])
+    ref_value, ref_gradient = reg.log_marginal_likelihood(theta, eval_gradient=True)
+    assert value == pytest.approx(ref_value, rel=1e-10)
+    np.testing.assert_allclose(gradient, ref_gradient * [2.0, 1.0, 2.0], rtol=1e-7)
+
+
+def test_hyperparameters_reach_scikit_learns_optimum(data):
+    x, y, _ = data
+    fit = fit_hyperparameters(x, y[:, 1], mean="zero", restarts=3, seed=0)
+    sk = Constant(1.0) * RBF(1.0) + WhiteKernel(0.1)
+    reg = GaussianProcessRegressor(sk, n_restarts_optimizer=3, random_state=0).fit(x, y[:, 1])
+    assert fit.log_marginal_likelihood >= reg.log_marginal_likelihood_value_ - 1e-6
+    params = reg.kernel_.get_params()
+    assert fit.kernel.length_scale == pytest.approx(params["k1__k2__length_scale"], rel=1e-2)
+    assert fit.kernel.sigma_n**2 == pytest.approx(params["k2__noise_level"], rel=2e-2)
+    again = fit_hyperparameters(x, y[:, 1], mean="zero", restarts=3, seed=0)
+    assert again.kernel == fit.kernel  # the same seed, the same answer
+
+
+def test_shared_and_per_component_kernels(data):
+    x, y, q = data
+    shared = ExactGP.fit(x, y, restarts=1)
+    per = ExactGP.fit(x, y, restarts=1, per_component=True)
+    assert len(shared.kernels) == 1 and len(per.kernels) == 3
+    for c in range(3):
+        alone = ExactGP.fit(x, y[:, c], per.kernels[c])
+        np.testing.assert_allclose(per.predict(q)[0][:, c], alone.predict(q)[0][:, 0], atol=1e-12)
+    # Each component's own kernel explains it at least as well as the shared one.
+    assert per.log_marginal_likelihood() >= shared.log_marginal_likelihood() - 1e-6
+
+
+def test_constant_mean_is_the_prior_far_away(data):
+    x, y, _ = data
+    gp = ExactGP.fit(x, y, SquaredExponential(1.0, 0.5, 0.05))
+    mean, var = gp.predict([[100.0, 100.0]])
+    np.testing.assert_allclose(mean[0], y.mean(axis=0), atol=1e-12)
+    np.testing.assert_allclose(var[0], 1.0, atol=1e-12)
+
+
+def test_far_coordinates_lose_no_digits(data):
+    # The same problem 5e6 m from the origin (UTM-like northings): the same predictions.
+    x, y, q = data
+    kernel = SquaredExponential(1.0, 0.5, 0.05)
+    near = ExactGP.fit(x, y, kernel).predict(q)
+    far = ExactGP.fit(x + 5e6, y, kernel).predict(q + 5e6)
+    np.testing.assert_allclose(far[0], near[0], atol=1e-8)
+    np.testing.assert_allclose(far[1], near[1], atol=1e-8)
+
+
+def test_duplicate_inputs_are_fitted(data):
+    x, y, q = data
+    xx, yy = np.vstack([x, x]), np.vstack([y, y + 0.01])
+    gp = ExactGP.fit(xx, yy, SquaredExponential(1.0, 0.5, 1e-6))
+    assert np.isfinite(gp.predict(q)[0]).all()
+
+
+def test_hilbert_gp_approaches_the_exact_gp(data):
+    x, y, q = data
+    kernel = SquaredExponential(1.0, 0.6, 0.05)
+    exact = ExactGP.fit(x, y, kernel)
+    hilbert = HilbertGP.fit(x, y, kernel, tolerance=1e-8)
+    inside = (q >= 0).all(axis=1) & (q <= 3).all(axis=1)
+    e_mean, e_var = exact.predict(q[inside])
+    h_mean, h_var = hilbert.predict(q[inside])
+    assert np.abs(e_mean - h_mean).max() < 5e-3
+    assert np.abs(e_var - h_var).max() < 5e-3
+    # Fewer basis functions, a coarser approximation.
+    coarse = HilbertGP.fit(x, y, kernel, tolerance=1e-2)
+    assert coarse.basis_size < hilbert.basis_size
+    assert np.abs(coarse.predict(q[inside])[0] - e_mean).max() > np.abs(h_mean - e_mean).max()
+
+
+@pytest.mark.parametrize(
+    ("x", "y", "message"),
+    [
+        (np.zeros((2, 3)) + [[0, 0, 0], [1, 1, 1]], np.zeros(2), "at least 4 are needed"),
+        (np.ones((10, 2)), np.zeros(10), "identical"),
+        (np.arange(20.0).reshape(10, 2), np.zeros(9), "10 points but Y has 9 rows"),
+        (np.arange(20.0).reshape(10, 2), np.r_[np.zeros(9), np.nan], "target row 9 is NaN"),
+        (np.r_[np.arange(18.0), np.nan, 1].reshape(10, 2), np.zeros(10), "input point 9 is NaN"),
+        ([["a", "b"]], [1.0], "expected numbers"),
+    ],
+)
+def test_bad_input_is_refused(x, y, message):
+    with pytest.raises(ValueError, match=message):
+        ExactGP.fit(x, y, SquaredExponential(1.0, 0.5, 0.1))
+
+
+def test_bad_kernels_and_options_are_refused(data):
+    x, y, _ = data
+    with pytest.raises(ValueError, match="length_scale must be a finite number > 0"):
+        SquaredExponential(1.0, 0.0, 0.1)
+    with pytest.raises(ValueError, match="mean must be one of"):
+        ExactGP.fit(x, y, SquaredExponential(1.0, 0.5, 0.1), mean="linear")
+    with pytest.raises(ValueError, match="points have 3 coordinates"):
+        ExactGP.fit(x, y, SquaredExponential(1.0, 0.5, 0.1)).predict(np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="outside the domain"):
+        HilbertGP.fit(x, y, SquaredExponential(1.0, 0.5, 0.1), domain=([0.5, 0.5], [2.0, 2.0]))
+    with pytest.raises(ValueError, match="more than 10 basis functions"):
+        HilbertGP.fit(x, y, SquaredExponential(1.0, 0.1, 0.1), max_basis=10)
