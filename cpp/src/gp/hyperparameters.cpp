@@ -41,7 +41,9 @@ LogMarginalLikelihood log_marginal_likelihood(const Eigen::Ref<const RowMatrix>&
   const Eigen::MatrixXd d2 = squared_distances(inputs, inputs);
   const double l2 = kernel.length_scale * kernel.length_scale;
   const double sn2 = kernel.sigma_n * kernel.sigma_n;
-  Eigen::MatrixXd kf = ((d2.array() * (-0.5 / l2)).exp() * (kernel.sigma_f * kernel.sigma_f)).matrix();
+  // As kernel_matrix: no subnormal values (see there).
+  const Eigen::ArrayXXd exponent = d2.array() * (-0.5 / l2);
+  Eigen::MatrixXd kf = (exponent < -700.0).select(0.0, exponent.exp() * (kernel.sigma_f * kernel.sigma_f)).matrix();
   Eigen::MatrixXd l = kf;
   l.diagonal().array() += sn2;
   if (!gp_detail::cholesky(l)) {
