@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Magnetic maps and magnetometers (thesis chapter 6): calibration of the sensors (eq. 6.16)."""
+"""Magnetic maps and magnetometers (thesis chapter 6): calibration of the sensors (eq. 6.16),
+field maps from Gaussian-process regression, and localization on them (eqs. 6.17-6.18)."""
 
 from __future__ import annotations
 
@@ -11,11 +12,21 @@ from kiseki.magnetic.calibration import (
     fit_ellipsoid,
     fit_sphere,
 )
+from kiseki.magnetic.localization import (
+    MagneticLocalization,
+    MagneticMapModel,
+    MagneticMclConfig,
+    localize_on_magnetic_map,
+)
 
 __all__ = [
     "EllipsoidCalibration",
+    "MagneticLocalization",
+    "MagneticMapModel",
+    "MagneticMclConfig",
     "SphereCalibration",
     "calibrated_magnitude",
     "fit_ellipsoid",
     "fit_sphere",
+    "localize_on_magnetic_map",
 ]
