@@ -16,7 +16,7 @@ namespace kiseki {
 namespace {
 constexpr double kLog2Pi = 1.8378770664093454836;
 constexpr Eigen::Index kDenseBelow = 2000;  // training points up to which predict uses them all
-constexpr Eigen::Index kMaxBlock = 512;      // prediction points per block
+constexpr Eigen::Index kMaxBlock = 1024;     // prediction points per block
 }  // namespace
 
 void check_training_data(const Eigen::Ref<const RowMatrix>& inputs, const Eigen::Ref<const RowMatrix>& targets) {
@@ -64,10 +64,13 @@ ExactGaussianProcess::ExactGaussianProcess(const Eigen::Ref<const RowMatrix>& in
 
   Eigen::MatrixXd cov = kernel_matrix(kernel_, inputs_, inputs_);
   cov.diagonal().array() += kernel_.sigma_n * kernel_.sigma_n;
-  const Eigen::MatrixXd l = gp_detail::cholesky_with_jitter(cov, &jitter_, "Gaussian process");
+  factor_ = gp_detail::cholesky_with_jitter(cov, &jitter_, "Gaussian process");
+  cov.resize(0, 0);
+  const Eigen::MatrixXd& l = factor_;
   alpha_ = y;
   gp_detail::cholesky_solve(l, alpha_);
-  inverse_ = gp_detail::inverse_from_cholesky(l);
+  // Blocks of prediction points far apart use parts of the inverse (see predict()).
+  if (n > kDenseBelow) inverse_ = gp_detail::inverse_from_cholesky(l);
   // Eq. 6.11 per column, summed: -1/2 y^T alpha - 1/2 log|K + sn^2 I| - n/2 log 2 pi.
   log_marginal_likelihood_ = -0.5 * (y.array() * alpha_.array()).sum() -
                              0.5 * static_cast<double>(k) * gp_detail::log_determinant(l) -
@@ -99,21 +102,29 @@ void ExactGaussianProcess::predict(const Eigen::Ref<const RowMatrix>& points, Ro
   std::vector<Eigen::Index> order(static_cast<std::size_t>(m));
   std::iota(order.begin(), order.end(), Eigen::Index{0});
   const bool dense = truncation == 0.0 || n <= kDenseBelow;
-  if (!dense) {
+  // Block boundaries: every kMaxBlock points; without `dense`, also wherever the tile changes.
+  std::vector<Eigen::Index> starts;
+  if (dense) {
+    for (Eigen::Index b = 0; b < m; b += kMaxBlock) starts.push_back(b);
+  } else {
     const double tile = 2.0 * kernel_.length_scale;
     std::vector<std::vector<long long>> keys(static_cast<std::size_t>(m));
     for (Eigen::Index i = 0; i < m; ++i) {
       for (Eigen::Index c = 0; c < p.cols(); ++c) keys[i].push_back(static_cast<long long>(std::floor(p(i, c) / tile)));
     }
     std::stable_sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) { return keys[a] < keys[b]; });
+    for (Eigen::Index i = 0; i < m; ++i) {
+      if (i == 0 || keys[order[i]] != keys[order[i - 1]] || i - starts.back() >= kMaxBlock) starts.push_back(i);
+    }
   }
+  starts.push_back(m);
   const double radius = dense ? 0.0 : kernel_.cutoff_radius(truncation);
-  const Eigen::Index blocks = (m + kMaxBlock - 1) / kMaxBlock;
+  const auto blocks = static_cast<Eigen::Index>(starts.size()) - 1;
 
   // Blocks one after another: the products inside run on every core through BLAS.
   for (Eigen::Index b = 0; b < blocks; ++b) {
-    const Eigen::Index begin = b * kMaxBlock;
-    const Eigen::Index count = std::min(kMaxBlock, m - begin);
+    const Eigen::Index begin = starts[static_cast<std::size_t>(b)];
+    const Eigen::Index count = starts[static_cast<std::size_t>(b + 1)] - begin;
     RowMatrix q(count, p.cols());
     for (Eigen::Index r = 0; r < count; ++r) q.row(r) = p.row(order[static_cast<std::size_t>(begin + r)]);
     std::vector<Eigen::Index> near;
@@ -129,29 +140,38 @@ void ExactGaussianProcess::predict(const Eigen::Ref<const RowMatrix>& points, Ro
         if (gap.norm() <= radius) near.push_back(j);
       }
     }
-    const auto s = static_cast<Eigen::Index>(near.size());
-    RowMatrix xs(s, p.cols());
-    Eigen::MatrixXd alpha_s(s, outputs());
-    for (Eigen::Index j = 0; j < s; ++j) {
-      xs.row(j) = inputs_.row(near[static_cast<std::size_t>(j)]);
-      alpha_s.row(j) = alpha_.row(near[static_cast<std::size_t>(j)]);
+    auto s = static_cast<Eigen::Index>(near.size());
+    // Beyond half the training points a block is cheaper with the triangular factor: n^2 per
+    // point against 2 s^2 with the inverse's sub-block.
+    const bool use_factor = dense || 2 * s > n;
+    if (use_factor && s != n) {
+      near.resize(static_cast<std::size_t>(n));
+      std::iota(near.begin(), near.end(), Eigen::Index{0});
+      s = n;
     }
-    const Eigen::MatrixXd ks = kernel_matrix(kernel_, q, xs);  // count x s
-    const Eigen::MatrixXd mu = gp_detail::multiply(ks, alpha_s);
+    const Eigen::MatrixXd ks = use_factor ? kernel_matrix(kernel_, q, inputs_) : [&] {
+      RowMatrix xs(s, p.cols());
+      for (Eigen::Index j = 0; j < s; ++j) xs.row(j) = inputs_.row(near[static_cast<std::size_t>(j)]);
+      return kernel_matrix(kernel_, q, xs);
+    }();  // count x s
+    Eigen::MatrixXd alpha_s(s, outputs());
+    for (Eigen::Index j = 0; j < s; ++j) alpha_s.row(j) = alpha_.row(near[static_cast<std::size_t>(j)]);
+    const Eigen::MatrixXd mu = gp_detail::multiply(ks, alpha_s);  // eq. 6.8
     Eigen::VectorXd var;
     if (variance != nullptr) {
-      Eigen::MatrixXd projected;
-      if (s == n) {
-        projected = gp_detail::multiply(ks, inverse_);
+      // Eq. 6.9: k** - k*^T (K + sn^2 I)^-1 k*.
+      if (use_factor) {
+        Eigen::MatrixXd v = ks.transpose();
+        gp_detail::lower_solve(factor_, v);  // L^-1 k*
+        var = (f2 - v.colwise().squaredNorm().array()).cwiseMax(0.0).matrix().transpose();
       } else {
         Eigen::MatrixXd inv_s(s, s);
         for (Eigen::Index c = 0; c < s; ++c) {
           for (Eigen::Index r = 0; r < s; ++r) inv_s(r, c) = inverse_(near[r], near[c]);
         }
-        projected = gp_detail::multiply(ks, inv_s);
+        const Eigen::MatrixXd projected = gp_detail::multiply(ks, inv_s);
+        var = (f2 - (projected.array() * ks.array()).rowwise().sum()).cwiseMax(0.0).matrix();
       }
-      // Eq. 6.9: k** - k*^T (K + sn^2 I)^-1 k*.
-      var = (f2 - (projected.array() * ks.array()).rowwise().sum()).cwiseMax(0.0).matrix();
     }
     for (Eigen::Index r = 0; r < count; ++r) {
       const Eigen::Index row = order[static_cast<std::size_t>(begin + r)];

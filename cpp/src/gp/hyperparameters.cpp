@@ -32,13 +32,14 @@ double extent(const Eigen::Ref<const RowMatrix>& inputs) {
 
 }  // namespace
 
-LogMarginalLikelihood log_marginal_likelihood(const Eigen::Ref<const RowMatrix>& inputs,
-                                              const Eigen::Ref<const RowMatrix>& targets,
-                                              const SquaredExponential& kernel) {
+namespace {
+
+/// Eq. 6.11 and its gradient from the inputs' squared distances (computed once per fit).
+LogMarginalLikelihood from_distances(const Eigen::MatrixXd& d2, const Eigen::Ref<const RowMatrix>& targets,
+                                     const SquaredExponential& kernel) {
   kernel.validate();
-  const Eigen::Index n = inputs.rows();
+  const Eigen::Index n = d2.rows();
   const Eigen::Index k = targets.cols();
-  const Eigen::MatrixXd d2 = squared_distances(inputs, inputs);
   const double l2 = kernel.length_scale * kernel.length_scale;
   const double sn2 = kernel.sigma_n * kernel.sigma_n;
   // As kernel_matrix: no subnormal values (see there).
@@ -81,6 +82,15 @@ LogMarginalLikelihood log_marginal_likelihood(const Eigen::Ref<const RowMatrix>&
   return out;
 }
 
+}  // namespace
+
+LogMarginalLikelihood log_marginal_likelihood(const Eigen::Ref<const RowMatrix>& inputs,
+                                              const Eigen::Ref<const RowMatrix>& targets,
+                                              const SquaredExponential& kernel) {
+  if (inputs.rows() != targets.rows()) throw std::invalid_argument("log_marginal_likelihood: row counts differ");
+  return from_distances(squared_distances(inputs, inputs), targets, kernel);
+}
+
 SquaredExponential initial_kernel(const Eigen::Ref<const RowMatrix>& inputs, const Eigen::Ref<const RowMatrix>& targets) {
   check_training_data(inputs, targets);
   const double s = rms(targets);
@@ -101,6 +111,7 @@ HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
   const Eigen::Vector3d lower(std::log(1e-6 * s), std::log(1e-3 * e), std::log(1e-6 * s));
   const Eigen::Vector3d upper(std::log(1e3 * s), std::log(1e2 * e), std::log(1e3 * s));
   const double scale = 1.0 / static_cast<double>(x.rows() * targets.cols());
+  const Eigen::MatrixXd d2 = squared_distances(x, x);
 
   HyperparameterFit fit;
   fit.log_marginal_likelihood = -std::numeric_limits<double>::infinity();
@@ -108,7 +119,7 @@ HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
   const auto evaluate = [&](const Eigen::Vector3d& p, Eigen::Vector3d* g) {
     ++fit.evaluations;
     try {
-      const LogMarginalLikelihood r = log_marginal_likelihood(x, targets, from_log(p));
+      const LogMarginalLikelihood r = from_distances(d2, targets, from_log(p));
       if (g != nullptr) *g = -scale * r.gradient;
       return -scale * r.value;
     } catch (const std::runtime_error&) {
@@ -158,6 +169,7 @@ HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
       f = f_next;
       g = g_next;
       if (sy > 1e-12) {  // BFGS update of the inverse Hessian (Nocedal & Wright eq. 6.17)
+        if (it == 0) h *= sy / change.squaredNorm();  // the first step's scale (their eq. 6.20)
         const double rho = 1.0 / sy;
         const Eigen::Matrix3d a = Eigen::Matrix3d::Identity() - rho * step * change.transpose();
         h = a * h * a.transpose() + rho * step * step.transpose();

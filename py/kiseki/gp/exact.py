@@ -43,7 +43,7 @@ class ExactGP:
         mean: str = "constant",
         restarts: int = 3,
         seed: int = 0,
-        max_points: int = 3000,
+        max_points: int = 2000,
         per_component: bool = False,
     ) -> ExactGP:
         """Fits to readings y (n,) or (n, k) at positions x (n, d). Without a kernel the

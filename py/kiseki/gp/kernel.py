@@ -85,7 +85,7 @@ def fit_hyperparameters(
     initial: SquaredExponential | None = None,
     restarts: int = 3,
     seed: int = 0,
-    max_points: int = 3000,
+    max_points: int = 2000,
     max_iterations: int = 100,
     mean: str = "constant",
 ) -> HyperparameterFit:

@@ -53,7 +53,8 @@ class ExactGaussianProcess {
   RowMatrix inputs_;            // centred
   Eigen::VectorXd prior_mean_;  // k
   Eigen::MatrixXd alpha_;       // (K + sn^2 I)^-1 (Y - mean), n x k
-  Eigen::MatrixXd inverse_;     // (K + sn^2 I)^-1, n x n
+  Eigen::MatrixXd factor_;      // the lower Cholesky factor of K + sn^2 I
+  Eigen::MatrixXd inverse_;     // (K + sn^2 I)^-1 (only above the dense limit), n x n
   double log_marginal_likelihood_ = 0.0;
   double jitter_ = 0.0;
 };
