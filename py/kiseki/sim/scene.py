@@ -8,7 +8,9 @@ Top-level keys: name, description, source, bounds {min: [x, y, z], max: [x, y, z
 octomap (a .bt file instead of, or beside, objects), objects (list of primitives, see
 kiseki.sim.primitives; an object may carry ``only_in: teach`` or ``only_in: playback``),
 grid_resolution, robot {type, start [x, y, yaw_deg], params, odometry_errors}, sensors (list),
-route {waypoints [[x, y], ...], speed}, magnetic (see kiseki.sim.magnetic). Several robots:
+route {waypoints [[x, y], ...], speed}, magnetic (see kiseki.sim.magnetic), measurement_grid
+{lower: [x, y, z], upper: [x, y, z], spacing} (where the field is surveyed or scored, see
+kiseki.sim.magnetic_survey; ``Scene.measurement_grid``). Several robots:
 ``robots`` (a list of {name, type, start, params, odometry_errors, sensors, route}) instead of
 robot, sensors and route; and with several robots, ``turns`` {goal, speed, moves [{robot, to}]}
 instead of routes: the robots take turns (cooperative positioning), one driving while the
@@ -35,6 +37,7 @@ from kiseki._yaml import safe_load_12
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
 from kiseki.mapping import check_map_size
+from kiseki.sim.magnetic_survey import MeasurementGrid
 from kiseki.sim.pedestrians import Pedestrian, parse_pedestrians
 from kiseki.sim.primitives import BoxList, expand
 
@@ -53,6 +56,7 @@ TOP_KEYS = {
     "sensors",
     "route",
     "magnetic",
+    "measurement_grid",
     "robots",
     "turns",
     "poses",
@@ -76,6 +80,7 @@ class Scene:
     sensors: list = field(default_factory=list)
     route: dict = field(default_factory=dict)
     magnetic: dict | None = None
+    measurement_grid: MeasurementGrid | None = None  # where the magnetic field is surveyed
     description: str = ""
     source: str = ""
     boxes: BoxList | None = None
@@ -202,6 +207,7 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
         sensors=specs[0]["sensors"],
         route=specs[0]["route"],
         magnetic=doc.get("magnetic"),
+        measurement_grid=_measurement_grid(doc, where, (lo, hi)),
         description=str(doc.get("description", "")),
         source=str(doc.get("source", "")),
         boxes=boxes,
@@ -212,6 +218,20 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
         point_robots=_flag(doc, "point_robots", where),
     )
     return scene
+
+
+def _measurement_grid(doc: dict, where: str, bounds) -> MeasurementGrid | None:
+    """``measurement_grid``: a regular grid inside the scene's bounds (see MeasurementGrid)."""
+    if "measurement_grid" not in doc:
+        return None
+    grid = MeasurementGrid.from_dict(doc["measurement_grid"], f"{where}: measurement_grid")
+    lo, hi = bounds
+    if np.any(np.array(grid.lower) < lo) or np.any(np.array(grid.upper) > hi):
+        raise ValueError(
+            f"{where}: measurement_grid {list(grid.lower)}..{list(grid.upper)} leaves the "
+            f"scene's bounds {lo.tolist()}..{hi.tolist()}"
+        )
+    return grid
 
 
 def _flag(doc: dict, key: str, where: str) -> bool:

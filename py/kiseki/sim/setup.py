@@ -1,7 +1,12 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """Builds a scene's robot, odometry and sensors from its file, checking that the robot starts
-in free space and that every sensor sits on the robot."""
+in free space and that every sensor sits on the robot.
+
+A magnetometer with an ``arm`` mapping is one of the two sensors on the bar of the 3-D mapping
+robot's 2-DOF arm (kiseki.sim.magnetic_arm): its ``mount`` is the arm's pivot, and the arm
+carries it up to ``heights[1]`` whatever the robot's height. Both sensors of one arm (same
+pivot) must give the same bar."""
 
 from __future__ import annotations
 
@@ -15,6 +20,7 @@ from kiseki.core import derive_seed
 from kiseki.sim import robot as robots
 from kiseki.sim.collisions import check_free_start
 from kiseki.sim.magnetic import MagneticWorld, Magnetometer
+from kiseki.sim.magnetic_arm import arm_sensor_from_spec
 from kiseki.sim.scene import Scene
 from kiseki.sim.sensors import (
     LASER_PRESETS,
@@ -43,6 +49,7 @@ SENSOR_KEYS = {
     "height",
     "pitch",
     "targets",
+    "arm",
 }
 
 
@@ -142,6 +149,18 @@ def _mount(spec: dict, where: str, robot: RobotSetup) -> Mount:
     return mount
 
 
+def _same_bar(arms: dict, mount: Mount, arm: dict, where: str) -> None:
+    """Both sensors on one pivot share one bar and are its near and its far sensor."""
+    pivot = (mount.x, mount.y, mount.z, mount.yaw_deg)
+    bar = {k: v for k, v in arm.items() if k != "sensor"}
+    seen, names = arms.setdefault(pivot, (bar, set()))
+    if seen != bar:
+        raise ValueError(f"{where}: arm differs from the other sensor's on the same pivot")
+    if arm["sensor"] in names:
+        raise ValueError(f"{where}: arm: a second {arm['sensor']} sensor on the same pivot")
+    names.add(arm["sensor"])
+
+
 def _period(spec: dict, default: float, where: str) -> float:
     rate = spec.get("rate_hz")
     if rate is None:
@@ -158,6 +177,7 @@ def build_sensors(
     out: list[SensorSetup] = []
     magnetic = MagneticWorld.from_dict(scene.magnetic, str(scene.path)) if scene.magnetic else None
     others = {s["name"] for s in scene.robot_specs} - {robot.name}
+    arms: dict[tuple, tuple[dict, set]] = {}  # pivot -> (bar, sensors on it)
     for i, spec in enumerate(scene.robot_specs[index]["sensors"]):
         where = f"{scene.path}: sensors[{i}]" + (
             f" of {robot.name}" if len(scene.robot_specs) > 1 else ""
@@ -189,13 +209,25 @@ def build_sensors(
         elif kind == "magnetometer":
             if magnetic is None:
                 raise ValueError(f"{where}: a magnetometer needs the scene's 'magnetic' section")
-            device = Magnetometer(
-                magnetic,
-                (mount.x, mount.y, mount.z),
-                math.radians(mount.yaw_deg),
-                seed=s,
-                **overrides,
-            )
+            if "arm" in spec:
+                device = arm_sensor_from_spec(
+                    spec["arm"],
+                    magnetic,
+                    (mount.x, mount.y, mount.z),
+                    math.radians(mount.yaw_deg),
+                    s,
+                    f"{where}: arm",
+                    **overrides,
+                )
+                _same_bar(arms, mount, spec["arm"], where)
+            else:
+                device = Magnetometer(
+                    magnetic,
+                    (mount.x, mount.y, mount.z),
+                    math.radians(mount.yaw_deg),
+                    seed=s,
+                    **overrides,
+                )
             period = _period(spec, dt, where)
         elif kind == "bearing":
             targets = tuple(str(t) for t in spec.get("targets") or sorted(others))
@@ -213,6 +245,8 @@ def build_sensors(
             raise ValueError(f"{where}: unknown sensor type {kind!r}")
         if "targets" in spec and kind != "bearing":
             raise ValueError(f"{where}: only bearing sensors take targets")
+        if "arm" in spec and kind != "magnetometer":
+            raise ValueError(f"{where}: only magnetometers ride on an arm")
         out.append(SensorSetup(kind, name, device, period, mount, targets))
     names = [s.name for s in out]
     if len(set(names)) != len(names):
