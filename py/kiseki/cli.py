@@ -19,6 +19,7 @@ from rich.console import Console
 from rich.table import Table
 
 from kiseki._outputs import check_outputs
+from kiseki.cli_magnetic import magnetic_app
 from kiseki.cli_speed import speed_app
 from kiseki.errors import KisekiError
 
@@ -41,6 +42,7 @@ coop_app = typer.Typer(
 )
 app.add_typer(coop_app, name="coop")
 app.add_typer(speed_app, name="speed")
+app.add_typer(magnetic_app, name="magnetic")
 console = Console()
 
 

@@ -1,0 +1,305 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""``kiseki magnetic``: magnetic field maps by Gaussian-process regression (thesis ch. 6)."""
+
+from __future__ import annotations
+
+import csv
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import typer
+from rich.console import Console
+
+from kiseki._outputs import check_outputs
+
+__all__ = ["magnetic_app"]
+
+magnetic_app = typer.Typer(
+    no_args_is_help=True,
+    help="Magnetic field maps by Gaussian-process regression: fit, predict, render.",
+)
+console = Console(soft_wrap=True)
+EXACT_LIMIT = 10_000  # beyond this many measurements the default is the reduced-rank GP
+METHODS = ("exact", "hilbert")
+
+
+def _data_files(spec: Path) -> list[Path]:
+    """The files DATA stands for: itself, or an Aalto prefix's three files."""
+    if spec.is_file() or spec.suffix.lower() in (".csv", ".mat"):
+        return [spec]
+    return [Path(f"{spec}-{part}.csv") for part in ("loc", "mag", "time")]
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    return folder.resolve() in (path.resolve(), *path.resolve().parents)
+
+
+def _map_files(folder: Path) -> dict[str, Path]:
+    return {f"MAP's {p.name}": p for p in sorted(folder.iterdir())} if folder.is_dir() else {}
+
+
+def _parse_kernel(text: str):
+    from kiseki.gp import SquaredExponential
+
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not all(math.isfinite(v) and v > 0 for v in values):
+        raise ValueError(f"--kernel must be three positive numbers sigma_f,l,sigma_n, got {text!r}")
+    return SquaredExponential(*values)
+
+
+def _check_fit_options(dimension, resolution, margin, max_points, method, units) -> None:
+    if dimension is not None and dimension not in (2, 3):
+        raise ValueError(f"--dimension must be 2 or 3, got {dimension}")
+    if not (math.isfinite(resolution) and resolution > 0):
+        raise ValueError(f"--resolution must be a positive number of metres, got {resolution}")
+    if not (math.isfinite(margin) and margin >= 0):
+        raise ValueError(f"--margin must be a number of metres >= 0, got {margin}")
+    if max_points is not None and max_points < 4:
+        raise ValueError(f"--max-points must be at least 4, got {max_points}")
+    if method is not None and method not in METHODS:
+        raise ValueError(f"--method must be exact or hilbert, got {method!r}")
+    if units is not None and units not in ("uT", "G"):
+        raise ValueError(f"--units must be uT or G, got {units!r}")
+
+
+def _read_data(data: list[Path], units: str | None, dimension: int | None):
+    """(positions, field, height, units) of DATA, positions in the map's dimension (a 2-D map
+    of 3-D data: x, y, and the height is the median z)."""
+    from kiseki.datasets.magnetic import concatenate_samples, read_magnetic_data
+
+    samples = concatenate_samples([read_magnetic_data(d) for d in data])
+    if units is not None and samples.units not in ("unknown", units):
+        raise ValueError(f"--units {units}: the data state their units as {samples.units}")
+    x, height = np.asarray(samples.positions), None
+    dimension = dimension or samples.dimension
+    if dimension == 3 and samples.dimension == 2:
+        raise ValueError(f"--dimension 3: {samples.source} has 2-D positions (no z)")
+    if dimension == 2 and samples.dimension == 3:
+        height, x = float(np.median(x[:, 2])), x[:, :2]
+    return x, np.asarray(samples.field), height, units or samples.units
+
+
+def _fit_gps(x, y, kernel, per_component: bool, method: str, seed: int):
+    """(GPs, kernels, seconds for the hyperparameters, seconds for the fit)."""
+    from kiseki.gp import ExactGP, HilbertGP, fit_hyperparameters
+
+    columns = [slice(k, k + 1) for k in range(3)] if per_component else [slice(0, 3)]
+    start = time.perf_counter()
+    if kernel is not None:
+        kernels = [kernel] * len(columns)
+    else:  # maximise the log marginal likelihood (eqs. 6.11-6.15)
+        fits = [fit_hyperparameters(x, y[:, c], seed=seed) for c in columns]
+        kernels = [f.kernel for f in fits]
+    hyper = time.perf_counter() - start
+    start = time.perf_counter()
+    if method == "exact":
+        gps = [ExactGP.fit(x, y[:, c], k) for c, k in zip(columns, kernels, strict=True)]
+    else:
+        gps = [HilbertGP.fit(x, y[:, c], k) for c, k in zip(columns, kernels, strict=True)]
+    return gps, kernels, hyper, time.perf_counter() - start
+
+
+def _hilbert_settings(gp) -> dict | None:
+    """The reduced-rank GP's box, so that predictions rebuild the same GP."""
+    if not hasattr(gp, "lower"):
+        return None
+    return {"domain": [np.asarray(gp.lower).tolist(), np.asarray(gp.upper).tolist()]}
+
+
+@magnetic_app.command("fit")
+def fit(
+    data: list[Path] = typer.Argument(
+        ...,
+        help="Measurements: Aalto run prefixes DIR/N (DIR/N-loc.csv, -mag.csv, -time.csv), CSV "
+        "files with columns x,y[,z],mx,my,mz, or .mat hand-held walks.",
+    ),
+    output: Path = typer.Option(..., "-o", "--output", help="Map folder to write."),
+    dimension: int | None = typer.Option(
+        None, help="2 (grid over x, y) or 3 (voxels); default: the data's."
+    ),
+    resolution: float = typer.Option(0.1, help="Cell (voxel) size in metres."),
+    margin: float = typer.Option(0.5, help="Metres added around the data's bounding box."),
+    per_component: bool = typer.Option(
+        False, "--per-component", help="Own hyperparameters for each of mx, my, mz."
+    ),
+    kernel: str | None = typer.Option(
+        None, help="sigma_f,l,sigma_n (default: maximise the log marginal likelihood)."
+    ),
+    max_points: int | None = typer.Option(
+        None, help="Fit on a seeded random subsample of this many measurements."
+    ),
+    seed: int = typer.Option(0, help="Seed of the subsample and the optimizer's restarts."),
+    method: str | None = typer.Option(
+        None, help=f"exact or hilbert (default: exact up to {EXACT_LIMIT:,} measurements)."
+    ),
+    units: str | None = typer.Option(None, help="uT or G: the units of CSV data."),
+) -> None:
+    """Fit a GP to magnetic measurements and write the map of its mean and variance (the
+    data's bounding box plus --margin), with the measurements for exact predictions.
+
+    Example: kiseki magnetic fit aalto/invensense/1 aalto/invensense/2 -o hall-map
+    """
+    from kiseki.core import check_seed
+    from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
+    from kiseki.magnetic.map_folder import check_map_destination
+
+    _check_fit_options(dimension, resolution, margin, max_points, method, units)
+    seed = check_seed(seed, "--seed")
+    fixed = _parse_kernel(kernel) if kernel is not None else None
+    check_map_destination(output)
+    for spec in data:
+        for f in _data_files(spec):
+            if _inside(f, output):
+                raise ValueError(f"-o {output} would replace the folder holding the input {f}")
+    x, y, height, units = _read_data(data, units, dimension)
+    n_read = len(x)
+    if max_points is not None and n_read > max_points:
+        keep = np.sort(np.random.default_rng(seed).choice(n_read, max_points, replace=False))
+        x, y = x[keep], y[keep]
+    method = method or ("exact" if len(x) <= EXACT_LIMIT else "hilbert")
+    gps, kernels, t_hyper, t_fit = _fit_gps(x, y, fixed, per_component, method, seed)
+    lml = [float(g.log_marginal_likelihood()) for g in gps if hasattr(g, "log_marginal_likelihood")]
+    start = time.perf_counter()
+    lower, upper = x.min(axis=0) - margin, x.max(axis=0) + margin
+    training = TrainingData(x, y, method, "constant", _hilbert_settings(gps[0]))
+    provenance = {
+        "data": {"sources": [str(d) for d in data], "points": n_read, "used_points": len(x)},
+        "fit": {
+            "method": method,
+            "per_component": per_component,
+            "hyperparameters": "given"
+            if fixed is not None
+            else "maximised log marginal likelihood",
+            "log_marginal_likelihood": lml or None,
+            "seed": seed,
+            "seconds": {"hyperparameters": round(t_hyper, 3), "fit": round(t_fit, 3)},
+        },
+    }
+    fmap = MagneticFieldMap.from_gp(
+        gps,
+        lower,
+        upper,
+        resolution,
+        height,
+        units=units,
+        provenance=provenance,
+        training=training,
+        progress=True,
+    )
+    t_map = time.perf_counter() - start
+    fmap.save(output)
+    _report_fit(fmap, output, kernels, lml, len(x), n_read, (t_hyper, t_fit, t_map))
+
+
+def _report_fit(fmap, output: Path, kernels, lml: list, used: int, read: int, seconds) -> None:
+    names = ("mx, my, mz",) if len(kernels) == 1 else ("mx", "my", "mz")
+    u = "" if fmap.units == "unknown" else f" {fmap.units}"
+    for c, k in zip(names, kernels, strict=True):
+        console.print(
+            f"{c}: sigma_f {k.sigma_f:.4g}{u}, length scale {k.length_scale:.4g} m, "
+            f"sigma_n {k.sigma_n:.4g}{u}"
+        )
+    if lml:
+        console.print(f"log marginal likelihood {sum(lml):.6g} (eq. 6.11)")
+    t_hyper, t_fit, t_map = seconds
+    console.print(
+        f"{output}: {fmap.dimension}-D map, {' x '.join(map(str, fmap.cells))} cells of "
+        f"{fmap.resolution:g} m from {used:,} of {read:,} measurements "
+        f"({fmap.training.method} GP); hyperparameters {t_hyper:.2f} s, fit {t_fit:.2f} s, "
+        f"map {t_map:.2f} s"
+    )
+
+
+def _read_points(path: Path, d: int) -> tuple[np.ndarray, bool]:
+    """(points (m, d), whether a z column was dropped) from a CSV whose header names x, y[, z]."""
+    try:
+        with path.open(newline="", encoding="utf-8") as f:
+            rows = [r for r in csv.reader(f) if any(cell.strip() for cell in r)]
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a CSV file (not UTF-8 text)") from None
+    if not rows:
+        raise ValueError(f"{path}: empty file: expected a header x,y[,z] and rows")
+    names = [n.strip().lower() for n in rows[0]]
+    need = ("x", "y", "z")[:d]
+    missing = [n for n in need if n not in names]
+    if missing:
+        raise ValueError(f"{path}: the header has no {', '.join(missing)} column (got {rows[0]})")
+    columns = [names.index(n) for n in need]
+    points = np.empty((len(rows) - 1, d))
+    for i, row in enumerate(rows[1:]):
+        try:
+            points[i] = [float(row[c]) for c in columns]
+        except (ValueError, IndexError):
+            raise ValueError(
+                f"{path}: line {i + 2}: expected numbers in {', '.join(need)}"
+            ) from None
+    if len(points) == 0:
+        raise ValueError(f"{path}: header but no points")
+    if not np.all(np.isfinite(points)):
+        raise ValueError(
+            f"{path}: line {int(np.argmax(~np.isfinite(points).all(1))) + 2}: not finite"
+        )
+    return points, d == 2 and "z" in names
+
+
+@magnetic_app.command("predict")
+def predict(
+    map_folder: Path = typer.Argument(..., metavar="MAP", help="Map folder (kiseki magnetic fit)."),
+    at: Path = typer.Option(..., "--at", help="CSV with a header and columns x,y[,z]."),
+    output: Path = typer.Option(..., "-o", "--output", help="CSV to write."),
+    interpolate: bool = typer.Option(
+        False, "--interpolate", help="Interpolate the map's grid even when it keeps its data."
+    ),
+) -> None:
+    """Mean and variance of the field at points: columns x,y[,z],mx,my,mz,var_mx,var_my,var_mz
+    (variances of the noise-free field, in the map's units squared). A map that keeps its
+    measurements re-evaluates the GP exactly at each point (eqs. 6.8-6.9); otherwise, or with
+    --interpolate, the grid is interpolated (the GP prior outside the map)."""
+    from kiseki._atomic import atomic_write
+    from kiseki.magnetic.field_map import MagneticFieldMap
+
+    check_outputs({"-o": output}, {"--at": at, **_map_files(map_folder)})
+    fmap = MagneticFieldMap.load(map_folder)
+    points, dropped = _read_points(at, fmap.dimension)
+    exact = fmap.training is not None and not interpolate
+    start = time.perf_counter()
+    mean, var = fmap.predict(points) if exact else fmap.value_at(points)
+    seconds = time.perf_counter() - start
+    header = ",".join([*"xyz"[: fmap.dimension], "mx", "my", "mz", "var_mx", "var_my", "var_mz"])
+    rows = np.column_stack([points, mean, var])
+    text = header + "\n" + "\n".join(",".join(f"{v:.9g}" for v in r) for r in rows) + "\n"
+    atomic_write(output, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+    how = "the GP re-evaluated exactly" if exact else "interpolated from the grid"
+    console.print(
+        f"{output}: {len(points):,} points, {how} ({seconds:.2f} s); field in {fmap.units}"
+    )
+    if dropped:
+        console.print(f"  the z column of {at} is ignored: the map is 2-D (height {fmap.height})")
+
+
+@magnetic_app.command("render")
+def render(
+    map_folder: Path = typer.Argument(..., metavar="MAP", help="Map folder (kiseki magnetic fit)."),
+    output: Path = typer.Option(..., "-o", "--output", help="PNG to write."),
+    slices: int = typer.Option(4, help="3-D maps: horizontal slices drawn (one row each)."),
+) -> None:
+    """Draw the mean and variance of mx, my, mz as six panels with colour bars (the thesis'
+    Fig. 6.13: 1500 x 800 px); a 3-D map as one row of six per slice height (Fig. 6.14)."""
+    from kiseki.magnetic.field_map import MagneticFieldMap
+    from kiseki.magnetic.render import picture_size, render_field_map
+
+    if output.suffix.lower() != ".png":
+        raise ValueError(f"-o {output}: the picture is a PNG: give a .png file")
+    if slices < 1:
+        raise ValueError(f"--slices must be at least 1, got {slices}")
+    check_outputs({"-o": output}, _map_files(map_folder))
+    fmap = MagneticFieldMap.load(map_folder)
+    render_field_map(fmap, output, slices)
+    width, height = picture_size(fmap, slices)
+    console.print(f"{output}: {width} x {height} px")

@@ -1,0 +1,395 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Magnetic field maps: the Gaussian-process mean and variance of (mx, my, mz) on a 2-D grid
+or on 3-D voxels (thesis ch. 6: mean eq. 6.8, variance of the noise-free field eq. 6.9; the
+pictures of Figs. 6.13 and 6.14).
+
+In memory, ``mean`` and ``variance`` are float64 arrays shaped (ny, nx, 3) or (nz, ny, nx, 3),
+index 0 at the lowest y (and z), never image-flipped; cell (j, i) of a 2-D map has its centre
+at ``origin + ((i, j) + 0.5) * resolution``, and ``origin`` is the lower corner of cell 0, as
+in ROS maps. Grids made by :meth:`MagneticFieldMap.from_gp` are OctoMap-aligned: the origin is
+a multiple of the resolution, so every voxel is the cell of one OctoMap key at that resolution
+(OctoMap: ``key = floor(c / resolution) + 32768``, centre ``(key - 32768 + 0.5) *
+resolution``; voxel index i on an axis is key ``origin / resolution + 32768 + i``).
+
+On disk a map is a folder (kind and dimension declared in ``magnetic_map.yaml``): see
+:mod:`kiseki.magnetic.map_folder` for the layout.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+import numpy as np
+
+from kiseki.gp import SquaredExponential
+
+__all__ = ["COMPONENTS", "MAX_CELLS", "MagneticFieldMap", "TrainingData"]
+
+COMPONENTS = ("mx", "my", "mz")
+MAX_CELLS = 20_000_000  # 6 float64 layers: about 1 GB in memory
+OCTOMAP_KEY_OFFSET = 32768  # tree_max_val of OctoMap's default 16-level tree
+_CHUNK = 20_000  # at most this many cells per gp.predict call
+_CHUNK_ENTRIES = 20_000_000  # and a (cells x training points) cross-covariance of <= 160 MB
+
+
+def _finite(name: str, value, shape: tuple | None = None) -> np.ndarray:
+    array = np.array(value, dtype=np.float64)  # a copy: the map owns its arrays
+    if shape is not None and array.shape != shape:
+        raise ValueError(f"{name} must have shape {shape}, got {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be finite (it holds NaN or infinity)")
+    array.setflags(write=False)
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class TrainingData:
+    """The measurements a map was fitted from, kept so that predictions can re-evaluate the
+    GP exactly (eqs. 6.8-6.9) at any point instead of interpolating the grid.
+
+    inputs (n, d) metres; outputs (n, 3) field in the map's units; method "exact" or
+    "hilbert"; mean "constant" or "zero" (the GP's prior mean); hilbert: the reduced-rank GP's
+    box ``{"domain": [lower, upper]}``, or None."""
+
+    inputs: np.ndarray
+    outputs: np.ndarray
+    method: str = "exact"
+    mean: str = "constant"
+    hilbert: Mapping | None = None  # {"domain": [lower, upper]} of the reduced-rank GP
+
+    def __post_init__(self) -> None:
+        x = np.asarray(self.inputs)
+        if x.ndim != 2 or x.shape[1] not in (2, 3) or len(x) == 0:
+            raise ValueError(f"training inputs must have shape (n, 2) or (n, 3), got {x.shape}")
+        object.__setattr__(self, "inputs", _finite("training inputs", x))
+        object.__setattr__(self, "outputs", _finite("training outputs", self.outputs, (len(x), 3)))
+        if self.method not in ("exact", "hilbert"):
+            raise ValueError(f"training method must be exact or hilbert, got {self.method!r}")
+        if self.mean not in ("constant", "zero"):
+            raise ValueError(f"training mean must be constant or zero, got {self.mean!r}")
+
+
+def _check_kernel(kernel) -> SquaredExponential | tuple[SquaredExponential, ...]:
+    if isinstance(kernel, SquaredExponential):
+        return kernel
+    if (
+        isinstance(kernel, Sequence)
+        and len(kernel) == 3
+        and all(isinstance(k, SquaredExponential) for k in kernel)
+    ):
+        return tuple(kernel)
+    raise ValueError(
+        f"kernel must be a SquaredExponential or three of them (one per component), got {kernel!r}"
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class MagneticFieldMap:
+    """Mean and variance of the field on a grid (2-D) or voxels (3-D); see the module text.
+
+    kernel: the GP's hyperparameters, one SquaredExponential shared by the three components or
+    a tuple of three (mx, my, mz). prior_mean (3,) and prior_variance (3,) (sigma_f^2) are the
+    GP's prior, returned outside the map. height: a 2-D map's sensor height (m) or None.
+    provenance: what the map was fitted from (``data``: sources, points; ``fit``: method,
+    log marginal likelihood, times), saved in the folder's YAML. training: the measurements,
+    for exact predictions (:meth:`predict`), or None."""
+
+    origin: np.ndarray
+    resolution: float
+    mean: np.ndarray
+    variance: np.ndarray
+    prior_mean: np.ndarray
+    prior_variance: np.ndarray
+    kernel: SquaredExponential | tuple[SquaredExponential, ...]
+    units: str = "unknown"
+    height: float | None = None
+    provenance: Mapping = field(default_factory=dict)
+    training: TrainingData | None = None
+
+    def __post_init__(self) -> None:
+        mean = np.asarray(self.mean)
+        if mean.ndim not in (3, 4) or mean.shape[-1] != 3 or 0 in mean.shape:
+            raise ValueError(
+                f"mean must have shape (ny, nx, 3) or (nz, ny, nx, 3), got {mean.shape}"
+            )
+        d = mean.ndim - 1
+        if mean.size // 3 > MAX_CELLS:
+            raise ValueError(f"the map has {mean.size // 3:,} cells, more than {MAX_CELLS:,}")
+        set_ = object.__setattr__
+        set_(self, "mean", _finite("mean", mean))
+        set_(self, "variance", _finite("variance", self.variance, mean.shape))
+        if np.any(self.variance < 0):
+            raise ValueError("variance must be >= 0")
+        set_(self, "origin", _finite("origin", self.origin, (d,)))
+        r = self.resolution
+        if isinstance(r, bool) or not isinstance(r, (int, float, np.floating)) or not r > 0:
+            raise ValueError(f"resolution must be a positive number of metres, got {r!r}")
+        if not math.isfinite(r):
+            raise ValueError(f"resolution must be finite, got {r!r}")
+        set_(self, "resolution", float(r))
+        set_(self, "prior_mean", _finite("prior_mean", self.prior_mean, (3,)))
+        set_(self, "prior_variance", _finite("prior_variance", self.prior_variance, (3,)))
+        if np.any(self.prior_variance <= 0):
+            raise ValueError("prior_variance must be > 0")
+        set_(self, "kernel", _check_kernel(self.kernel))
+        if not isinstance(self.units, str) or not self.units:
+            raise ValueError(f"units must be a non-empty string, got {self.units!r}")
+        if self.height is not None:
+            if d == 3:
+                raise ValueError("height is for 2-D maps: a 3-D map has z in its voxels")
+            set_(self, "height", float(_finite("height", self.height, ())))
+        set_(self, "provenance", MappingProxyType(dict(self.provenance)))
+        if self.training is not None:
+            if not isinstance(self.training, TrainingData):
+                raise ValueError(f"training must be TrainingData, got {type(self.training)}")
+            need = (d,) if self.height is None else (d, d + 1)
+            if self.training.inputs.shape[1] not in need:
+                raise ValueError(
+                    f"training inputs have {self.training.inputs.shape[1]} coordinates; a "
+                    f"{d}-D map needs {' or '.join(map(str, need))}"
+                )
+        set_(self, "_regressors", None)
+
+    @property
+    def dimension(self) -> int:
+        """2 (a grid over x, y) or 3 (voxels over x, y, z)."""
+        return self.mean.ndim - 1
+
+    @property
+    def cells(self) -> tuple[int, ...]:
+        """Number of cells along x, y[, z] (the arrays' shape reversed)."""
+        return tuple(self.mean.shape[:-1][::-1])
+
+    @property
+    def lower(self) -> np.ndarray:
+        """World coordinates of the map's lower corner (= origin)."""
+        return self.origin.copy()
+
+    @property
+    def upper(self) -> np.ndarray:
+        """World coordinates of the map's upper corner."""
+        return self.origin + np.array(self.cells) * self.resolution
+
+    def cell_centres(self) -> np.ndarray:
+        """(N, d) centres in x, y[, z] order, in the arrays' C order (x fastest)."""
+        return _centres(self.origin, self.resolution, self.mean.shape[:-1], 0, self.mean.size // 3)
+
+    def octomap_key_origin(self) -> np.ndarray:
+        """The OctoMap key (16-level tree) of cell 0: cell (i, j[, k]) has key origin + (i, j[,
+        k]). Raises ValueError when the origin is not a multiple of the resolution."""
+        steps = self.origin / self.resolution
+        if not np.allclose(steps, np.round(steps), rtol=0, atol=1e-6):
+            raise ValueError(f"origin {self.origin} is not a multiple of {self.resolution} m")
+        return np.round(steps).astype(np.int64) + OCTOMAP_KEY_OFFSET
+
+    def value_at(self, points) -> tuple[np.ndarray, np.ndarray]:
+        """(mean (m, 3), variance (m, 3)) at world points (m, d): (bi/tri)linear interpolation
+        between cell centres (constant within the outer half cell), the GP prior (prior_mean,
+        prior_variance) outside the map."""
+        p = _points(points, self.dimension)
+        n = np.array(self.cells)
+        u = (p - self.origin) / self.resolution  # 0 .. n across the map
+        inside = np.all((u >= 0) & (u <= n), axis=1)
+        c = np.clip(u[inside] - 0.5, 0, n - 1)  # coordinates of the cell centres' lattice
+        i0 = np.minimum(np.floor(c).astype(np.int64), np.maximum(n - 2, 0))
+        t = c - i0
+        mean = np.tile(self.prior_mean, (len(p), 1))
+        var = np.tile(self.prior_variance, (len(p), 1))
+        m_in = np.zeros((len(c), 3))
+        v_in = np.zeros((len(c), 3))
+        for corner in itertools.product((0, 1), repeat=self.dimension):
+            index = np.minimum(i0 + corner, n - 1)
+            w = np.prod(np.where(np.array(corner, dtype=bool), t, 1.0 - t), axis=1)[:, None]
+            cell = tuple(index[:, k] for k in reversed(range(self.dimension)))
+            m_in += w * self.mean[cell]
+            v_in += w * self.variance[cell]
+        mean[inside], var[inside] = m_in, v_in
+        return mean, var
+
+    def predict(self, points) -> tuple[np.ndarray, np.ndarray]:
+        """(mean (m, 3), variance (m, 3)) of the GP itself at world points (m, d) (eqs. 6.8,
+        6.9): the GP is rebuilt once from the stored training data with the stored
+        hyperparameters (no optimisation). A 2-D map made from a 3-D GP predicts at its
+        height. Raises ValueError when the map keeps no training data."""
+        p = _points(points, self.dimension)
+        if self.training is None:
+            raise ValueError("the map keeps no training data: use value_at (interpolation)")
+        if self.training.inputs.shape[1] == self.dimension + 1:
+            p = np.column_stack([p, np.full(len(p), self.height)])
+        if self._regressors is None:
+            object.__setattr__(self, "_regressors", _rebuild(self.training, self.kernel))
+        return _predict_all(self._regressors, p)
+
+    @classmethod
+    def from_gp(
+        cls,
+        gp,
+        lower,
+        upper,
+        resolution: float,
+        height: float | None = None,
+        *,
+        units: str = "unknown",
+        provenance: Mapping | None = None,
+        training: TrainingData | None = None,
+        progress: bool = False,
+    ) -> MagneticFieldMap:
+        """The map of a fitted GP (``ExactGP``/``HilbertGP``, or three one-output GPs for
+        mx, my, mz) over the box lower..upper (d,) at `resolution`: the grid is OctoMap-aligned
+        (origin floor(lower / resolution) * resolution, upper corner rounded up), and gp.predict
+        is evaluated on the cell centres in chunks (a tqdm bar when `progress`). A 2-D box with
+        a 3-D GP gives the horizontal slice at `height`."""
+        gps = _as_gp_list(gp)
+        lo = _finite("lower", lower)
+        hi = _finite("upper", upper)
+        if lo.ndim != 1 or lo.shape not in ((2,), (3,)) or hi.shape != lo.shape:
+            raise ValueError(f"lower and upper must be (2,) or (3,), got {lo.shape}, {hi.shape}")
+        if np.any(hi < lo):
+            raise ValueError(f"upper {hi} must not be below lower {lo} on any axis")
+        d, gd = len(lo), gps[0].dimension
+        if gd != d and not (d == 2 and gd == 3 and height is not None):
+            hint = " (give height for a 2-D slice of a 3-D GP)" if (d, gd) == (2, 3) else ""
+            raise ValueError(f"the GP is {gd}-D but the box is {d}-D{hint}")
+        if not (isinstance(resolution, (int, float)) and math.isfinite(resolution)):
+            raise ValueError(f"resolution must be a positive number of metres, got {resolution!r}")
+        if resolution <= 0:
+            raise ValueError(f"resolution must be a positive number of metres, got {resolution!r}")
+        first = np.floor(lo / resolution + 1e-9).astype(np.int64)
+        last = np.ceil(hi / resolution - 1e-9).astype(np.int64)
+        if d == 3 and np.any(np.abs(np.concatenate([first, last])) > OCTOMAP_KEY_OFFSET):
+            raise ValueError(f"the box {lo}..{hi} lies beyond OctoMap's keys at {resolution} m")
+        counts = np.maximum(last - first, 1)
+        total = int(np.prod(counts))
+        if total > MAX_CELLS:
+            raise ValueError(
+                f"{' x '.join(map(str, counts))} cells at {resolution} m is {total:,} cells, more "
+                f"than {MAX_CELLS:,}: choose a coarser resolution or a smaller box"
+            )
+        origin = first * float(resolution)
+        shape = tuple(int(k) for k in counts[::-1])
+        mean, var = _evaluate(gps, origin, resolution, shape, height if gd > d else None, progress)
+        kernels = _column_kernels(gps)
+        kernel = kernels[0] if len(set(kernels)) == 1 else kernels
+        return cls(
+            origin=origin,
+            resolution=float(resolution),
+            mean=mean,
+            variance=var,
+            prior_mean=np.concatenate([np.atleast_1d(g.prior_mean) for g in gps]),
+            prior_variance=[k.sigma_f**2 for k in kernels],  # the prior k(x, x) = sigma_f^2
+            kernel=kernel,
+            units=units,
+            height=height if d == 2 else None,
+            provenance=provenance or {},
+            training=training,
+        )
+
+    def save(self, folder) -> None:
+        """Writes the map folder (write-then-rename of the whole folder); see map_folder."""
+        from kiseki.magnetic.map_folder import save_map_folder
+
+        save_map_folder(self, folder)
+
+    @classmethod
+    def load(cls, folder) -> MagneticFieldMap:
+        """Reads a map folder, refusing (MapFormatError naming the file) another kind, a
+        missing layer, shapes that disagree and non-finite values."""
+        from kiseki.magnetic.map_folder import load_map_folder
+
+        return load_map_folder(folder)
+
+
+def _points(points, d: int) -> np.ndarray:
+    p = np.asarray(points, dtype=np.float64)
+    if p.ndim == 1 and p.shape == (d,):
+        p = p[None]
+    if p.ndim != 2 or p.shape[1] != d:
+        raise ValueError(f"points must have shape (m, {d}) for a {d}-D map, got {p.shape}")
+    if not np.all(np.isfinite(p)):
+        raise ValueError("points must be finite (they hold NaN or infinity)")
+    return p
+
+
+def _centres(origin, resolution, shape, start: int, stop: int) -> np.ndarray:
+    """Centres of the cells with flat C-order indices start..stop of an array shaped `shape`
+    ((ny, nx) or (nz, ny, nx)), in x, y[, z] order."""
+    index = np.unravel_index(np.arange(start, stop), shape)
+    return origin + (np.column_stack(index[::-1]) + 0.5) * resolution
+
+
+def _as_gp_list(gp) -> list:
+    gps = list(gp) if isinstance(gp, (list, tuple)) else [gp]
+    for g in gps:
+        for name in ("predict", "dimension", "outputs", "kernel", "prior_mean"):
+            if not hasattr(g, name):
+                raise ValueError(f"not a fitted GP (no {name}): {g!r}")
+    if sum(g.outputs for g in gps) != 3:
+        raise ValueError(f"the GPs give {sum(g.outputs for g in gps)} outputs; a map needs 3")
+    if len({g.dimension for g in gps}) != 1:
+        raise ValueError("the GPs of the three components must share their input dimension")
+    return gps
+
+
+def _column_kernels(gps: list) -> tuple:
+    """The kernel of each of the three components (a GP holds one shared kernel, or with
+    ``kernels`` one per output)."""
+    out = []
+    for g in gps:
+        kernels = tuple(getattr(g, "kernels", (g.kernel,)))
+        if len(kernels) not in (1, g.outputs):
+            raise ValueError(f"a GP with {g.outputs} outputs has {len(kernels)} kernels")
+        out += kernels * g.outputs if len(kernels) == 1 else kernels
+    return tuple(out)
+
+
+def _predict_all(gps: list, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    means, variances = [], []
+    for g in gps:
+        m, v = g.predict(points)
+        means.append(np.asarray(m, dtype=np.float64).reshape(len(points), -1))
+        variances.append(np.asarray(v, dtype=np.float64).reshape(len(points), -1))
+    # eq. 6.9 can fall a rounding error below zero where the data pin the field down
+    return np.hstack(means), np.maximum(np.hstack(variances), 0.0)
+
+
+def _evaluate(gps, origin, resolution, shape, height, progress):
+    from tqdm import tqdm
+
+    total = int(np.prod(shape))
+    mean = np.empty((total, 3))
+    var = np.empty((total, 3))
+    # the exact GP's cross-covariance has a column per training point, the reduced-rank
+    # GP's one per basis function
+    training = max(int(getattr(g, "basis_size", getattr(g, "size", 1))) for g in gps)
+    chunk = max(1, min(_CHUNK, _CHUNK_ENTRIES // max(training, 1)))
+    starts = range(0, total, chunk)
+    bar = tqdm(starts, desc="map", unit="chunk", disable=not progress or total <= chunk)
+    for start in bar:
+        stop = min(start + chunk, total)
+        p = _centres(origin, resolution, shape, start, stop)
+        if height is not None:
+            p = np.column_stack([p, np.full(len(p), height)])
+        mean[start:stop], var[start:stop] = _predict_all(gps, p)
+    return mean.reshape(*shape, 3), var.reshape(*shape, 3)
+
+
+def _rebuild(training: TrainingData, kernel) -> list:
+    """The GP(s) of the stored training data with the stored hyperparameters."""
+    from kiseki.gp import ExactGP, HilbertGP
+
+    x, y = training.inputs, training.outputs
+    kernels = [kernel] if isinstance(kernel, SquaredExponential) else list(kernel)
+    columns = [slice(0, 3)] if len(kernels) == 1 else [slice(k, k + 1) for k in range(3)]
+    gps = []
+    for k, cols in zip(kernels, columns, strict=True):
+        if training.method == "exact":
+            gps.append(ExactGP.fit(x, y[:, cols], k, mean=training.mean))
+        else:
+            domain = (training.hilbert or {}).get("domain")
+            gps.append(HilbertGP.fit(x, y[:, cols], k, domain=domain, mean=training.mean))
+    return gps

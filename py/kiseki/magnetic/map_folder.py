@@ -1,0 +1,397 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""A magnetic field map on disk: one folder that declares its kind and dimension.
+
+``magnetic_map.yaml``: ``kind: magnetic_field_map``, ``format_version``, ``dimension``,
+``origin`` (world coordinates of the lower corner of cell 0), ``resolution`` (m), ``shape``
+(cells along x, y[, z]), ``units`` (of the mean; the variance is in units squared),
+``frame: world``, ``prior_mean``, ``prior_variance``, ``kernel`` (sigma_f, length_scale,
+sigma_n; or one such entry per component), ``height`` (2-D), ``provenance`` (the data it was
+fitted from and how), ``kiseki_version`` and ``files``.
+
+2-D maps: one image per layer, ``mx_mean.png`` ... ``mz_variance.png``, like the ROS map format:
+row 0 of the image is the top of the map (the highest y), and each image is a 16-bit grey PNG
+whose pixel p stands for ``offset + scale * p`` (``scale`` and ``offset`` per layer in the
+YAML; scale = range / 65535, so the rounding is at most range / 131070, about 0.5 nT over a
+60 uT range, far below a magnetometer's noise). Any image viewer or GIS tool opens them, and
+OpenCV writes them; a 32-bit float TIFF would keep the values but most viewers show it black
+or refuse it. The exact float64 values are in ``layers.npz`` (one array per layer, shaped
+(ny, nx), row 0 at the LOWEST y, plus ``origin`` and ``resolution``), which loading reads.
+
+3-D maps: ``voxels.npz`` with ``mean`` and ``variance`` (nz, ny, nx, 3), ``origin`` and
+``resolution``; the layout is OctoMap's: voxel (i, j, k) has its centre at ``origin + ((i, j,
+k) + 0.5) * resolution`` with the origin a multiple of the resolution, which is the centre of
+OctoMap key ``origin / resolution + 32768 + (i, j, k)`` (the YAML's ``octomap_key_origin``).
+
+``training.npz`` (X (n, d), Y (n, 3)), when the map keeps its measurements, lets predictions
+re-evaluate the GP exactly. A folder is written under a temporary name and renamed into place.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from kiseki.errors import MapFormatError
+from kiseki.gp import SquaredExponential
+from kiseki.magnetic.field_map import COMPONENTS, MagneticFieldMap, TrainingData
+
+__all__ = ["MAP_FILE", "KIND", "check_map_destination", "load_map_folder", "save_map_folder"]
+
+MAP_FILE = "magnetic_map.yaml"
+KIND = "magnetic_field_map"
+FORMAT_VERSION = 1
+LAYERS = tuple(f"{c}_{q}" for q in ("mean", "variance") for c in COMPONENTS)
+_LEVELS = 65535
+
+
+def _is_map_folder(path: Path) -> bool:
+    try:
+        doc = yaml.safe_load((path / MAP_FILE).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return False
+    return isinstance(doc, dict) and doc.get("kind") == KIND
+
+
+def check_map_destination(folder) -> Path:
+    """Checks before any work that a map can be written to `folder`: its parent exists and is
+    writable, and the folder is absent, empty, or a magnetic field map (which is replaced).
+    Returns the folder as a Path."""
+    folder = Path(folder)
+    parent = folder.parent if str(folder.parent) else Path(".")
+    if not parent.is_dir():
+        raise FileNotFoundError(f"{folder}: folder {parent} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise PermissionError(f"{folder}: folder {parent} is not writable")
+    if folder.exists() or folder.is_symlink():
+        if not folder.is_dir() or folder.is_symlink():
+            raise FileExistsError(f"{folder} exists and is not a folder: refusing to replace it")
+        if any(folder.iterdir()) and not _is_map_folder(folder):
+            raise FileExistsError(
+                f"{folder} exists and is not a magnetic field map folder: refusing to replace it"
+            )
+    return folder
+
+
+def _plain(value):
+    if isinstance(value, dict | type(None)) or hasattr(value, "items"):
+        return None if value is None else {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple | np.ndarray):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _kernel_doc(kernel) -> dict:
+    def one(k: SquaredExponential) -> dict:
+        return {
+            "sigma_f": float(k.sigma_f),
+            "length_scale": float(k.length_scale),
+            "sigma_n": float(k.sigma_n),
+        }
+
+    if isinstance(kernel, SquaredExponential):
+        return one(kernel)
+    return {c: one(k) for c, k in zip(COMPONENTS, kernel, strict=True)}
+
+
+def _document(fmap: MagneticFieldMap, files: dict) -> dict:
+    from kiseki import __version__
+
+    d = fmap.dimension
+    doc = {
+        "kind": KIND,
+        "format_version": FORMAT_VERSION,
+        "dimension": d,
+        "origin": [float(v) for v in fmap.origin],
+        "resolution": fmap.resolution,
+        "shape": dict(zip("xyz", fmap.cells, strict=False)),
+        "units": fmap.units,
+        "variance_units": f"({fmap.units})^2",
+        "frame": "world",
+        "prior_mean": [float(v) for v in fmap.prior_mean],
+        "prior_variance": [float(v) for v in fmap.prior_variance],
+        "kernel": _kernel_doc(fmap.kernel),
+    }
+    if d == 2:
+        doc["height"] = fmap.height
+        doc["image_rows"] = "row 0 is the top of the map (highest y), as ROS map images"
+    else:
+        doc["layout"] = "octomap: voxel centre = origin + (index + 0.5) * resolution"
+        try:
+            doc["octomap_key_origin"] = [int(k) for k in fmap.octomap_key_origin()]
+        except ValueError:
+            doc["layout"] = "voxel centre = origin + (index + 0.5) * resolution"
+    if fmap.training is not None:
+        t = fmap.training
+        doc["training"] = {"points": len(t.inputs), "method": t.method, "mean": t.mean}
+        if t.hilbert is not None:
+            doc["training"]["hilbert"] = _plain(dict(t.hilbert))
+    doc["provenance"] = _plain(dict(fmap.provenance))
+    doc["kiseki_version"] = __version__
+    doc["files"] = files
+    return doc
+
+
+def _write_layers_2d(fmap: MagneticFieldMap, tmp: Path) -> dict:
+    from kiseki import _core
+
+    arrays = {"origin": fmap.origin, "resolution": np.float64(fmap.resolution)}
+    images = {}
+    for name in LAYERS:
+        component, quantity = name.split("_")
+        layer = getattr(fmap, quantity)[..., COMPONENTS.index(component)]
+        arrays[name] = layer
+        lo, hi = float(layer.min()), float(layer.max())
+        scale = (hi - lo) / _LEVELS
+        pixels = np.zeros(layer.shape) if scale == 0 else np.rint((layer - lo) / scale)
+        image = np.clip(pixels, 0, _LEVELS).astype(np.uint16)[::-1]  # row 0 = highest y
+        _core.write_image(str(tmp / f"{name}.png"), np.ascontiguousarray(image))
+        images[name] = {"image": f"{name}.png", "scale": scale, "offset": lo}
+    np.savez(tmp / "layers.npz", **arrays)
+    return {"layers": images, "arrays": "layers.npz"}
+
+
+def save_map_folder(fmap: MagneticFieldMap, folder) -> Path:
+    """Writes `fmap` to `folder` (see the module text): a temporary folder beside it, renamed
+    into place; an existing map folder (or an empty folder) is replaced, anything else
+    refused."""
+    if not isinstance(fmap, MagneticFieldMap):
+        raise ValueError(f"expected a MagneticFieldMap, got {type(fmap).__name__}")
+    folder = check_map_destination(folder)
+    tmp = Path(tempfile.mkdtemp(dir=folder.parent, prefix=f".{folder.name}."))
+    try:
+        if fmap.dimension == 2:
+            files = _write_layers_2d(fmap, tmp)
+        else:
+            np.savez(
+                tmp / "voxels.npz",
+                mean=fmap.mean,
+                variance=fmap.variance,
+                origin=fmap.origin,
+                resolution=np.float64(fmap.resolution),
+            )
+            files = {"arrays": "voxels.npz"}
+        if fmap.training is not None:
+            np.savez(tmp / "training.npz", X=fmap.training.inputs, Y=fmap.training.outputs)
+            files["training"] = "training.npz"
+        text = yaml.safe_dump(_document(fmap, files), sort_keys=False, default_flow_style=None)
+        (tmp / MAP_FILE).write_text(text, encoding="utf-8")
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o777 & ~mask)
+        _swap_into_place(tmp, folder)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return folder
+
+
+def _swap_into_place(tmp: Path, folder: Path) -> None:
+    if not folder.exists() or not any(folder.iterdir()):
+        os.replace(tmp, folder)  # an empty folder is replaced in one step
+        return
+    old = Path(tempfile.mkdtemp(dir=folder.parent, prefix=f".{folder.name}.old."))
+    os.replace(folder, old / "map")
+    try:
+        os.replace(tmp, folder)
+    except BaseException:
+        os.replace(old / "map", folder)
+        raise
+    finally:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def _fail(path: Path, message: str) -> MapFormatError:
+    return MapFormatError(f"{path}: {message}")
+
+
+def _number(doc: dict, key: str, meta: Path, positive: bool = False) -> float:
+    value = doc.get(key)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
+        raise _fail(meta, f"'{key}' must be a finite number, got {value!r}")
+    if positive and value <= 0:
+        raise _fail(meta, f"'{key}' must be positive, got {value!r}")
+    return float(value)
+
+
+def _numbers(doc: dict, key: str, n: int, meta: Path) -> np.ndarray:
+    value = doc.get(key)
+    if not isinstance(value, list) or len(value) != n:
+        raise _fail(meta, f"'{key}' must be a list of {n} numbers, got {value!r}")
+    return np.array([_number({key: v}, key, meta) for v in value])
+
+
+def _kernel_from(value, meta: Path):
+    def one(entry) -> SquaredExponential:
+        if not isinstance(entry, dict):
+            raise _fail(meta, f"'kernel' must hold sigma_f, length_scale, sigma_n, got {entry!r}")
+        try:
+            args = [_number(entry, k, meta, True) for k in ("sigma_f", "length_scale", "sigma_n")]
+            return SquaredExponential(*args)
+        except ValueError as err:
+            raise _fail(meta, f"'kernel': {err}") from None
+
+    if isinstance(value, dict) and set(value) == set(COMPONENTS):
+        return tuple(one(value[c]) for c in COMPONENTS)
+    return one(value)
+
+
+def _file(folder: Path, files: dict, key: str, meta: Path) -> Path:
+    name = files.get(key) if isinstance(files, dict) else None
+    if not isinstance(name, str) or not name or Path(name).name != name:
+        raise _fail(meta, f"'files' must name the {key} file (a plain file name), got {name!r}")
+    path = folder / name
+    if not path.is_file():
+        raise _fail(path, f"missing {key} file of the magnetic field map")
+    return path
+
+
+def _read_npz(path: Path, shapes: dict[str, tuple]) -> dict[str, np.ndarray]:
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            found = {k: npz[k] for k in npz.files}
+    except (OSError, ValueError, EOFError) as err:
+        raise _fail(path, f"not a readable .npz file ({err})") from None
+    for key, shape in shapes.items():
+        if key not in found:
+            raise _fail(path, f"missing array '{key}'")
+        a = found[key]
+        if len(a.shape) != len(shape) or any(
+            e not in (None, n) for n, e in zip(a.shape, shape, strict=False)
+        ):
+            raise _fail(path, f"'{key}' has shape {a.shape}, expected {shape} (see the YAML)")
+        if a.dtype.kind not in "fiu" or not np.all(np.isfinite(a)):
+            raise _fail(path, f"'{key}' holds NaN, infinity or non-numbers")
+    return found
+
+
+def _check_grid(path: Path, arrays: dict, origin: np.ndarray, resolution: float) -> None:
+    if not np.array_equal(arrays["origin"], origin) or float(arrays["resolution"]) != resolution:
+        raise _fail(path, "origin or resolution disagrees with the YAML")
+
+
+def _read_2d(folder: Path, doc: dict, meta: Path, origin, resolution, shape) -> tuple:
+    from kiseki import _core
+
+    files = doc.get("files")
+    layers = files.get("layers") if isinstance(files, dict) else None
+    if not isinstance(layers, dict):
+        raise _fail(meta, "'files' must list the layer images under 'layers'")
+    for name in LAYERS:
+        entry = layers.get(name)
+        if not isinstance(entry, dict):
+            raise _fail(meta, f"layer '{name}' is not listed under files: layers")
+        image = _file(folder, entry, "image", meta)
+        try:
+            pixels = _core.read_image(str(image))
+        except RuntimeError as err:
+            raise _fail(image, f"unreadable layer image ({err})") from None
+        if pixels.shape != shape:
+            raise _fail(
+                image, f"image is {pixels.shape} pixels, the YAML says {shape} (rows, columns)"
+            )
+    path = _file(folder, files, "arrays", meta)
+    arrays = _read_npz(path, {**dict.fromkeys(LAYERS, shape), "origin": (2,), "resolution": ()})
+    _check_grid(path, arrays, origin, resolution)
+    stack = {
+        q: np.stack([arrays[f"{c}_{q}"] for c in COMPONENTS], axis=-1) for q in ("mean", "variance")
+    }
+    return stack["mean"], stack["variance"]
+
+
+def _read_3d(folder: Path, doc: dict, meta: Path, origin, resolution, shape) -> tuple:
+    path = _file(folder, doc.get("files"), "arrays", meta)
+    full = (*shape, 3)
+    arrays = _read_npz(path, {"mean": full, "variance": full, "origin": (3,), "resolution": ()})
+    _check_grid(path, arrays, origin, resolution)
+    return arrays["mean"], arrays["variance"]
+
+
+def _read_training(folder: Path, doc: dict, meta: Path, d: int) -> TrainingData | None:
+    files = doc.get("files")
+    if not (isinstance(files, dict) and "training" in files):
+        return None
+    info = doc.get("training")
+    if not isinstance(info, dict):
+        raise _fail(meta, "'training' must describe the stored training data")
+    path = _file(folder, files, "training", meta)
+    n = info.get("points")
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise _fail(meta, f"'training: points' must be a positive integer, got {n!r}")
+    arrays = _read_npz(path, {"X": (n, None), "Y": (n, 3)})
+    try:
+        return TrainingData(
+            arrays["X"], arrays["Y"], info.get("method"), info.get("mean"), info.get("hilbert")
+        )
+    except ValueError as err:
+        raise _fail(path, str(err)) from None
+
+
+def load_map_folder(folder) -> MagneticFieldMap:
+    """Reads a map folder written by :func:`save_map_folder`. Raises FileNotFoundError when the
+    folder is absent, MapFormatError naming the file for another kind of folder, a missing
+    layer, shapes that disagree, NaN or a malformed description."""
+    from kiseki._yaml import read_yaml_file
+
+    folder = Path(folder)
+    if not folder.exists():
+        raise FileNotFoundError(f"{folder}: no such magnetic field map folder")
+    if not folder.is_dir():
+        raise _fail(folder, f"not a magnetic field map (a folder holding {MAP_FILE})")
+    meta = folder / MAP_FILE
+    if not meta.is_file():
+        raise _fail(meta, "missing: the folder is not a magnetic field map")
+    try:
+        doc = read_yaml_file(meta, "magnetic field map description")
+    except ValueError as err:
+        raise MapFormatError(str(err)) from None
+    if not isinstance(doc, dict):
+        raise _fail(meta, "not a magnetic field map description (not a YAML mapping)")
+    if doc.get("kind") != KIND:
+        raise _fail(meta, f"kind is {doc.get('kind')!r}, not {KIND}")
+    if doc.get("format_version") != FORMAT_VERSION:
+        raise _fail(meta, f"format_version {doc.get('format_version')!r} is not {FORMAT_VERSION}")
+    d = doc.get("dimension")
+    if d not in (2, 3) or isinstance(d, bool):
+        raise _fail(meta, f"'dimension' must be 2 or 3, got {d!r}")
+    origin = _numbers(doc, "origin", d, meta)
+    resolution = _number(doc, "resolution", meta, positive=True)
+    size = doc.get("shape")
+    axes = "xyz"[:d]
+    if not (isinstance(size, dict) and set(size) == set(axes)) or not all(
+        isinstance(size[a], int) and not isinstance(size[a], bool) and size[a] > 0 for a in axes
+    ):
+        raise _fail(
+            meta, f"'shape' must give positive cell counts for {', '.join(axes)}, got {size!r}"
+        )
+    shape = tuple(size[a] for a in reversed(axes))
+    read = _read_2d if d == 2 else _read_3d
+    mean, variance = read(folder, doc, meta, origin, resolution, shape)
+    height = doc.get("height")
+    if d == 2 and height is not None:
+        height = _number(doc, "height", meta)
+    try:
+        return MagneticFieldMap(
+            origin=origin,
+            resolution=resolution,
+            mean=mean,
+            variance=variance,
+            prior_mean=_numbers(doc, "prior_mean", 3, meta),
+            prior_variance=_numbers(doc, "prior_variance", 3, meta),
+            kernel=_kernel_from(doc.get("kernel"), meta),
+            units=doc.get("units"),
+            height=height if d == 2 else None,
+            provenance=doc.get("provenance") or {},
+            training=_read_training(folder, doc, meta, d),
+        )
+    except ValueError as err:
+        if isinstance(err, MapFormatError):
+            raise
+        raise _fail(meta, str(err)) from None

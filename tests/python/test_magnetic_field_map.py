@@ -1,0 +1,289 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Magnetic field maps: the folder round trip, interpolation against closed forms, the prior
+outside, OctoMap's voxel layout (liboctomap through kiseki's octree bindings), bad folders."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import yaml
+
+from kiseki import _core
+from kiseki.errors import MapFormatError
+from kiseki.gp import ExactGP, SquaredExponential
+from kiseki.magnetic import field_map as field_map_module
+from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
+from kiseki.magnetic.map_folder import MAP_FILE
+
+KERNEL = SquaredExponential(2.0, 0.5, 0.1)
+
+
+def linear_field(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A field and a variance linear in the coordinates: what (bi/tri)linear interpolation
+    reproduces exactly."""
+    p = np.asarray(points)
+    a = np.array([[1.5, -0.5, 2.0], [0.25, 3.0, -1.0], [-0.75, 0.5, 0.125]])[: p.shape[1]]
+    mean = np.array([10.0, -20.0, 45.0]) + p @ a
+    var = 0.5 + p @ np.abs(a) * 0.1
+    return mean, var
+
+
+def linear_map(dimension: int, cells=(7, 5, 4), origin=(-1.0, 2.0, 0.5), resolution=0.25):
+    shape = tuple(reversed(cells[:dimension]))
+    index = np.indices(shape).reshape(dimension, -1)[::-1].T  # x, y[, z] of each cell
+    centres = np.asarray(origin[:dimension]) + (index + 0.5) * resolution
+    mean, var = linear_field(centres)
+    return MagneticFieldMap(
+        origin=origin[:dimension],
+        resolution=resolution,
+        mean=mean.reshape(*shape, 3),
+        variance=var.reshape(*shape, 3),
+        prior_mean=[1.0, 2.0, 3.0],
+        prior_variance=[4.0, 4.0, 4.0],
+        kernel=KERNEL,
+        units="uT",
+        height=0.2 if dimension == 2 else None,
+        provenance={"data": {"sources": ["run/1"], "points": 12}},
+        training=TrainingData(np.zeros((3, dimension)) + [[0], [1], [2]], np.ones((3, 3))),
+    )
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_save_load_round_trip_is_exact(tmp_path, dimension):
+    rng = np.random.default_rng(dimension)
+    fmap = linear_map(dimension)
+    noisy = MagneticFieldMap(
+        origin=fmap.origin,
+        resolution=fmap.resolution,
+        mean=fmap.mean + rng.normal(0, 1e-7, fmap.mean.shape),  # digits a PNG would lose
+        variance=fmap.variance,
+        prior_mean=fmap.prior_mean,
+        prior_variance=fmap.prior_variance,
+        kernel=(KERNEL, SquaredExponential(1.0, 0.3, 0.2), KERNEL),
+        units="uT",
+        height=fmap.height,
+        provenance=fmap.provenance,
+        training=fmap.training,
+    )
+    noisy.save(tmp_path / "map")
+    back = MagneticFieldMap.load(tmp_path / "map")
+    for name in ("origin", "mean", "variance", "prior_mean", "prior_variance"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(noisy, name))
+    assert back.resolution == noisy.resolution and back.kernel == noisy.kernel
+    assert (back.units, back.height, back.dimension) == ("uT", noisy.height, dimension)
+    assert back.provenance["data"] == {"sources": ["run/1"], "points": 12}
+    np.testing.assert_array_equal(back.training.inputs, noisy.training.inputs)
+    np.testing.assert_array_equal(back.training.outputs, noisy.training.outputs)
+    doc = yaml.safe_load((tmp_path / "map" / MAP_FILE).read_text())
+    assert (doc["kind"], doc["dimension"], doc["frame"]) == (
+        "magnetic_field_map",
+        dimension,
+        "world",
+    )
+    assert doc["shape"] == dict(zip("xyz", (7, 5, 4)[:dimension], strict=False))
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temporary left
+
+
+def test_layer_images_are_16_bit_pngs_with_the_top_row_at_the_highest_y(tmp_path):
+    fmap = linear_map(2)
+    fmap.save(tmp_path / "map")
+    doc = yaml.safe_load((tmp_path / "map" / MAP_FILE).read_text())
+    for k, component in enumerate(("mx", "my", "mz")):
+        for quantity in ("mean", "variance"):
+            entry = doc["files"]["layers"][f"{component}_{quantity}"]
+            image = _core.read_image(str(tmp_path / "map" / entry["image"]))
+            assert image.dtype == np.uint16 and image.shape == (5, 7)
+            decoded = entry["offset"] + entry["scale"] * image.astype(float)
+            layer = getattr(fmap, quantity)[..., k]
+            np.testing.assert_allclose(decoded[::-1], layer, rtol=0, atol=entry["scale"] * 0.51)
+            assert image.max() == 65535 and image.min() == 0  # the full 16-bit range used
+
+
+@pytest.mark.parametrize("dimension", [2, 3])
+def test_interpolation_matches_a_linear_field_and_the_prior_outside(dimension):
+    fmap = linear_map(dimension)
+    rng = np.random.default_rng(7)
+    first = fmap.origin + 0.5 * fmap.resolution  # the cell centres' hull
+    last = fmap.upper - 0.5 * fmap.resolution
+    inside = rng.uniform(first, last, (500, dimension))
+    mean, var = fmap.value_at(inside)
+    expected_mean, expected_var = linear_field(inside)
+    np.testing.assert_allclose(mean, expected_mean, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(var, expected_var, rtol=0, atol=1e-12)
+    # the outer half cell keeps the edge cells' values: the closed form at the clamped point
+    rim = rng.uniform(fmap.lower, fmap.upper, (200, dimension))
+    np.testing.assert_allclose(
+        fmap.value_at(rim)[0], linear_field(np.clip(rim, first, last))[0], atol=1e-12
+    )
+    outside = np.vstack([fmap.lower - 1e-9, fmap.upper + np.r_[0.01, np.zeros(dimension - 1)]])
+    mean, var = fmap.value_at(outside)
+    np.testing.assert_array_equal(mean, np.tile(fmap.prior_mean, (2, 1)))
+    np.testing.assert_array_equal(var, np.tile(fmap.prior_variance, (2, 1)))
+    edge = fmap.value_at(fmap.upper[None])[0]  # the upper corner is still on the map
+    np.testing.assert_allclose(edge, linear_field(last[None])[0], atol=1e-12)
+    with pytest.raises(ValueError, match=rf"shape \(m, {dimension}\)"):
+        fmap.value_at(np.zeros((2, 5 - dimension)))
+    with pytest.raises(ValueError, match="finite"):
+        fmap.value_at(np.full((1, dimension), np.nan))
+
+
+def test_a_map_one_cell_thick_interpolates_along_its_other_axes():
+    fmap = linear_map(3, cells=(4, 3, 1))
+    p = np.array([[-0.5, 2.4, 0.55], [-0.2, 2.6, 0.74]])
+    clamped = p.copy()
+    clamped[:, 2] = 0.625  # the single layer's centre
+    np.testing.assert_allclose(fmap.value_at(p)[0], linear_field(clamped)[0], atol=1e-12)
+
+
+def small_gp(dimension: int, seed: int = 0):
+    rng = np.random.default_rng(seed)
+    x = rng.uniform(-1, 1, (40, dimension))
+    y = np.column_stack([np.sin(2 * x[:, 0]), np.cos(x[:, 1]), x.sum(axis=1)])
+    return ExactGP.fit(x, y, KERNEL), x, y
+
+
+def test_from_gp_evaluates_the_gp_on_octomap_aligned_cells(monkeypatch):
+    gp, _, _ = small_gp(3)
+    monkeypatch.setattr(field_map_module, "_CHUNK", 7)  # several chunks
+    fmap = MagneticFieldMap.from_gp(gp, [-0.33, 0.12, -0.05], [0.4, 0.5, 0.25], 0.1)
+    np.testing.assert_allclose(fmap.origin, [-0.4, 0.1, -0.1], atol=1e-12)
+    assert fmap.cells == (8, 4, 4)
+    assert np.all(fmap.lower <= [-0.33, 0.12, -0.05]) and np.all(fmap.upper >= [0.4, 0.5, 0.25])
+    mean, var = gp.predict(fmap.cell_centres())
+    np.testing.assert_allclose(fmap.mean.reshape(-1, 3), mean, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(fmap.variance.reshape(-1, 3), np.maximum(var, 0), atol=1e-12)
+    np.testing.assert_allclose(fmap.prior_mean, gp.prior_mean)
+    np.testing.assert_allclose(fmap.prior_variance, [KERNEL.sigma_f**2] * 3)
+    # cell (i, j, k) centre = origin + ((i, j, k) + 0.5) * resolution, x fastest in memory
+    np.testing.assert_allclose(fmap.cell_centres()[8 * 4 + 8 + 1], [-0.25, 0.25, 0.05], atol=1e-12)
+    assert list(fmap.octomap_key_origin()) == [32764, 32769, 32767]
+
+
+def test_voxel_centres_are_octomap_key_centres():
+    """liboctomap (through kiseki's OctreeWorld) marks the voxel holding a point: its centre
+    must be the centre of the map's voxel holding that point, at the same resolution."""
+    fmap = linear_map(3, cells=(6, 5, 4), origin=(-0.3, -0.2, -0.1), resolution=0.1)
+    rng = np.random.default_rng(3)
+    centres = fmap.cell_centres()
+    for index in rng.choice(len(centres), 6, replace=False):
+        point = centres[index] + rng.uniform(-0.4, 0.4, 3) * fmap.resolution
+        world = _core.BoxWorld(point[None], np.full((1, 3), 1e-4), np.eye(3)[None])
+        tree = _core.OctreeWorld.from_boxes(world, fmap.resolution)
+        assert tree.occupied_leaves == 1
+        lo, hi = tree.bounds
+        np.testing.assert_allclose((lo + hi) / 2, centres[index], atol=1e-6)  # floats inside
+        np.testing.assert_allclose(hi - lo, fmap.resolution, atol=1e-6)
+
+
+def test_a_2d_slice_of_a_3d_gp_and_exact_predictions():
+    gp, x, y = small_gp(3, seed=1)
+    training = TrainingData(x, y)
+    fmap = MagneticFieldMap.from_gp(gp, [-1, -1], [1, 1], 0.2, height=0.3, training=training)
+    assert fmap.dimension == 2 and fmap.height == 0.3
+    at = np.column_stack([fmap.cell_centres(), np.full(fmap.mean.size // 3, 0.3)])
+    np.testing.assert_allclose(fmap.mean.reshape(-1, 3), gp.predict(at)[0], atol=1e-12)
+    points = np.array([[0.13, -0.41], [2.5, 0.0]])  # the second off the map
+    mean, var = fmap.predict(points)
+    expected = gp.predict(np.column_stack([points, [0.3, 0.3]]))
+    np.testing.assert_allclose(mean, expected[0], atol=1e-9)
+    np.testing.assert_allclose(var, np.maximum(expected[1], 0), atol=1e-9)
+    with pytest.raises(ValueError, match="height"):
+        MagneticFieldMap.from_gp(gp, [-1, -1], [1, 1], 0.2)
+
+
+def test_bad_maps_are_refused():
+    good = linear_map(2)
+    fields = dict(
+        origin=good.origin,
+        resolution=0.25,
+        mean=good.mean,
+        variance=good.variance,
+        prior_mean=good.prior_mean,
+        prior_variance=good.prior_variance,
+        kernel=KERNEL,
+    )
+    nan = good.mean.copy()
+    nan[1, 2, 0] = np.nan
+    for change, match in [
+        ({"mean": nan}, "mean must be finite"),
+        ({"variance": -good.variance}, "variance must be >= 0"),
+        ({"variance": good.variance[:, :3]}, "variance must have shape"),
+        ({"origin": [0.0, 0.0, 0.0]}, "origin must have shape"),
+        ({"resolution": 0.0}, "resolution"),
+        ({"mean": good.mean[..., :2]}, "mean must have shape"),
+        ({"kernel": "se"}, "kernel"),
+        ({"prior_variance": [1.0, 0.0, 1.0]}, "prior_variance"),
+    ]:
+        with pytest.raises(ValueError, match=match):
+            MagneticFieldMap(**{**fields, **change})
+
+
+def _edit_yaml(folder, **changes):
+    path = folder / MAP_FILE
+    doc = yaml.safe_load(path.read_text())
+    doc.update(changes)
+    path.write_text(yaml.safe_dump(doc))
+
+
+def _nan_layer(folder):
+    with np.load(folder / "layers.npz") as npz:
+        arrays = dict(npz)
+    arrays["my_variance"][0, 0] = np.nan
+    np.savez(folder / "layers.npz", **arrays)
+
+
+@pytest.mark.parametrize(
+    ("spoil", "culprit", "match"),
+    [
+        (lambda f: (f / MAP_FILE).unlink(), MAP_FILE, "not a magnetic field map"),
+        (lambda f: _edit_yaml(f, kind="occupancy_grid"), MAP_FILE, "kind is 'occupancy_grid'"),
+        (lambda f: (f / MAP_FILE).write_bytes(b"\x89\xff\x00"), MAP_FILE, "not UTF-8"),
+        (lambda f: (f / "mz_variance.png").unlink(), "mz_variance.png", "missing"),
+        (lambda f: (f / "layers.npz").unlink(), "layers.npz", "missing"),
+        (lambda f: _edit_yaml(f, shape={"x": 7, "y": 6}), "mx_mean.png", "the YAML says"),
+        (lambda f: _nan_layer(f), "layers.npz", "NaN"),
+        (lambda f: (f / "training.npz").write_text("x"), "training.npz", "not a readable"),
+        (lambda f: _edit_yaml(f, dimension=4), MAP_FILE, "'dimension' must be 2 or 3"),
+    ],
+)
+def test_bad_folders_are_refused_naming_the_file(tmp_path, spoil, culprit, match):
+    folder = tmp_path / "map"
+    linear_map(2).save(folder)
+    spoil(folder)
+    with pytest.raises(MapFormatError, match=match) as caught:
+        MagneticFieldMap.load(folder)
+    assert str(caught.value).startswith(str(folder / culprit))
+
+
+def test_3d_voxels_that_disagree_with_the_yaml_are_refused(tmp_path):
+    folder = tmp_path / "voxels"
+    fmap = linear_map(3)
+    fmap.save(folder)
+    np.savez(
+        folder / "voxels.npz",
+        mean=fmap.mean,
+        variance=fmap.variance[:-1],
+        origin=fmap.origin,
+        resolution=fmap.resolution,
+    )
+    with pytest.raises(MapFormatError, match=r"voxels.npz: 'variance' has shape \(3, 5, 7, 3\)"):
+        MagneticFieldMap.load(folder)
+
+
+def test_saving_replaces_a_map_but_never_another_folder(tmp_path):
+    fmap = linear_map(2)
+    fmap.save(tmp_path / "map")
+    linear_map(3).save(tmp_path / "map")  # a map folder is replaced whole
+    assert MagneticFieldMap.load(tmp_path / "map").dimension == 3
+    assert not (tmp_path / "map" / "layers.npz").exists()
+    (tmp_path / "photos").mkdir()
+    (tmp_path / "photos" / "cat.jpg").write_bytes(b"meow")
+    with pytest.raises(FileExistsError, match="not a magnetic field map folder"):
+        fmap.save(tmp_path / "photos")
+    assert (tmp_path / "photos" / "cat.jpg").read_bytes() == b"meow"
+    with pytest.raises(FileNotFoundError, match="does not exist"):
+        fmap.save(tmp_path / "no" / "map")
+    with pytest.raises(FileNotFoundError, match="no such magnetic field map folder"):
+        MagneticFieldMap.load(tmp_path / "absent")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["map", "photos"]
