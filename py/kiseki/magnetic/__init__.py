@@ -12,6 +12,7 @@ from kiseki.magnetic.calibration import (
     fit_ellipsoid,
     fit_sphere,
 )
+from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
 from kiseki.magnetic.localization import (
     MagneticLocalization,
     MagneticMapModel,
@@ -21,10 +22,12 @@ from kiseki.magnetic.localization import (
 
 __all__ = [
     "EllipsoidCalibration",
+    "MagneticFieldMap",
     "MagneticLocalization",
     "MagneticMapModel",
     "MagneticMclConfig",
     "SphereCalibration",
+    "TrainingData",
     "calibrated_magnitude",
     "fit_ellipsoid",
     "fit_sphere",
