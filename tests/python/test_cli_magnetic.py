@@ -73,6 +73,18 @@ def test_fit_prints_its_hyperparameters_and_times_and_writes_a_map_folder(synthe
     assert doc["origin"][0] <= -0.45 and doc["origin"][0] + 0.05 * doc["shape"]["x"] >= 4.45
 
 
+def test_bin_averages_the_readings_per_cell_before_the_fit(synthetic):
+    folder, _ = synthetic
+    done = run(
+        "fit", "floor.csv", "-o", "binned", "--bin", "1.0", "--kernel", "1,1,0.1", cwd=folder
+    )
+    assert done.returncode == 0, done.stderr
+    # 300 random points on a 4 x 4 m floor fill its sixteen 1 m cells.
+    assert "from 16 of 300 measurements" in done.stdout
+    doc = yaml.safe_load((folder / "binned" / "magnetic_map.yaml").read_text())
+    assert doc["provenance"]["data"]["bin"] == 1.0
+
+
 def test_predict_at_held_out_points_is_accurate_and_reports_its_variance(synthetic):
     folder, _ = synthetic
     rng = np.random.default_rng(1)
@@ -187,6 +199,7 @@ def inputs(tmp_path_factory):
         (["fit", "d.csv", "-o", "x", "--method", "sparse"], "--method"),
         (["fit", "d.csv", "-o", "x", "--dimension", "3"], "2-D positions"),
         (["fit", "d.csv", "-o", "x", "--margin", "-1"], "--margin"),
+        (["fit", "d.csv", "-o", "x", "--bin", "0"], "--bin"),
         (["fit", "d.csv", "-o", "d.csv"], "not a folder"),
         (["fit", "d.csv", "-o", "stuff"], "not a magnetic field map folder"),
         (["fit", "m/training.npz", "-o", "m"], "holding the input"),
