@@ -19,8 +19,8 @@ __all__ = ["HyperparameterFit", "SquaredExponential", "fit_hyperparameters"]
 
 @dataclass(frozen=True)
 class SquaredExponential:
-    """k(p, q) = sigma_f^2 exp(-|p - q|^2 / (2 l^2)) (thesis eq. 6.5), plus independent noise
-    sigma_n^2 on every reading (eq. 6.7). Units: sigma_f and sigma_n those of the field, l those
+    """k(p, q) = sigma_f^2 exp(-|p - q|^2 / (2 l^2)) (thesis eq. 6.2), plus independent noise
+    sigma_n^2 on every reading (eq. 6.3). Units: sigma_f and sigma_n those of the field, l those
     of the positions (m). The thesis' Table 6.1 found sigma_f 1.738, l 0.475 m, sigma_n 0.420."""
 
     sigma_f: float

@@ -10,9 +10,9 @@ namespace kiseki {
 /// the layout numpy hands over without a copy.
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-/// The squared-exponential covariance of the magnetic-navigation thesis (chapter 6, eq. 6.5):
+/// The squared-exponential covariance of the magnetic-navigation thesis (chapter 6, eq. 6.2):
 /// k(p, q) = sigma_f^2 exp(-|p - q|^2 / (2 l^2)), with independent measurement noise sigma_n^2
-/// added on the diagonal of the training covariance (eq. 6.7).
+/// added on the diagonal of the training covariance (eqs. 6.3-6.4).
 struct SquaredExponential {
   double sigma_f = 1.0;       ///< signal standard deviation (the targets' units)
   double length_scale = 1.0;  ///< l (the inputs' units, metres)
