@@ -128,9 +128,27 @@ HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
   };
 
   Random random(options.seed);
-  for (int start = 0; start <= options.restarts; ++start) {
-    Eigen::Vector3d p = to_log(initial).cwiseMax(lower).cwiseMin(upper);
-    if (start > 0) {
+  // Start 1: the best point of a coarse scan of length scales (1 % to 100 % of the extent) and
+  // noise shares (1 % and 10 % of the RMS), with sigma_f the RMS. Smooth fields surveyed
+  // densely have a second optimum at l -> 0 where everything is noise; a start from the wrong
+  // side of it never leaves it, so the scan looks at the whole range first.
+  Eigen::Vector3d scanned = to_log(initial);
+  {
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= 8; ++i) {
+      for (const double noise : {0.01, 0.1}) {
+        const Eigen::Vector3d q(std::log(s), std::log(e) + std::log(1e-2) * (1.0 - i / 8.0), std::log(noise * s));
+        const double v = evaluate(q, nullptr);
+        if (v < best) {
+          best = v;
+          scanned = q;
+        }
+      }
+    }
+  }
+  for (int start = 0; start <= options.restarts + 1; ++start) {
+    Eigen::Vector3d p = (start == 1 ? scanned : to_log(initial)).cwiseMax(lower).cwiseMin(upper);
+    if (start > 1) {
       // Random starts: sigma_f within a decade of the RMS, l between 1 % and 100 % of the extent,
       // sigma_n between 0.1 % and 100 % of sigma_f.
       p(0) = std::log(s) + random.uniform(-1.0, 1.0) * std::log(10.0);

@@ -43,8 +43,9 @@ struct HyperparameterFit {
 };
 
 /// Maximises eq. 6.11 over (sigma_f, l, sigma_n) by BFGS in log-parameters with a backtracking
-/// (Armijo) line search, from `initial` and from `restarts` random starts (log-uniform within
-/// the bounds below, drawn from kiseki::Random(seed)); the best start wins. Bounds, from the
+/// (Armijo) line search, from `initial`, from the best point of a coarse scan of length scales
+/// and noise levels (18 evaluations), and from `restarts` random starts (log-uniform within the
+/// bounds below, drawn from kiseki::Random(seed)); the best start wins. Bounds, from the
 /// data: sigma_f and sigma_n in [1e-6, 1e3] x the targets' RMS, l in [1e-3, 1e2] x the inputs'
 /// largest extent. Targets are used as given (remove a mean first).
 HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
