@@ -41,6 +41,12 @@ from typing import Any
 import numpy as np
 
 from kiseki.core import Random, check_seed, normalize_angle
+from kiseki.sim._values import finite_array as _finite_array
+from kiseki.sim._values import finite_scalar as _finite_scalar
+from kiseki.sim._values import float_array as _float_array
+from kiseki.sim._values import points as _points
+from kiseki.sim._values import poses as _poses
+from kiseki.sim._values import times as _times
 
 __all__ = [
     "DEFAULT_DECLINATION_DEG",
@@ -113,70 +119,6 @@ _TWO_PI = 2.0 * math.pi
 
 # --------------------------------------------------------------------------------------------
 # input checks
-
-
-def _float_array(value: Any, name: str) -> np.ndarray:
-    try:
-        return np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name}: expected numbers, got {value!r}") from exc
-
-
-def _finite_array(value: Any, shape: tuple[int | None, ...], name: str) -> np.ndarray:
-    """``value`` as a float array of ``shape`` (None = any length), finite, or ValueError."""
-    a = _float_array(value, name)
-    if a.ndim != len(shape) or any(
-        s is not None and s != d for s, d in zip(shape, a.shape, strict=True)
-    ):
-        want = "x".join("n" if s is None else str(s) for s in shape) or "a scalar"
-        raise ValueError(f"{name}: expected shape ({want}), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name}: must be finite, got {value!r}")
-    return a
-
-
-def _finite_scalar(
-    value: Any, name: str, *, minimum: float | None = None, strict: bool = False
-) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ValueError(f"{name}: expected a number, got {value!r}")
-    v = float(value)
-    if not math.isfinite(v):
-        raise ValueError(f"{name}: must be finite, got {value!r}")
-    if minimum is not None and (v <= minimum if strict else v < minimum):
-        rel = ">" if strict else ">="
-        raise ValueError(f"{name}: must be {rel} {minimum}, got {value!r}")
-    return v
-
-
-def _points(points: Any, name: str = "points") -> tuple[np.ndarray, bool]:
-    """Points as (n, 3) and whether a single (3,) point was given."""
-    a = _float_array(points, name)
-    single = a.shape == (3,)
-    a = _finite_array(a.reshape(1, 3) if single else a, (None, 3), name)
-    return a, single
-
-
-def _poses(poses: Any, name: str = "poses") -> tuple[np.ndarray, bool]:
-    """Planar poses as (n, 3) rows (x, y, theta) and whether a single pose was given."""
-    if hasattr(poses, "to_array") and not isinstance(poses, np.ndarray):
-        poses = poses.to_array()  # kiseki.core.Pose2
-    a = _float_array(poses, name)
-    single = a.shape == (3,)
-    a = _finite_array(a.reshape(1, 3) if single else a, (None, 3), name)
-    return a, single
-
-
-def _times(times: Any, n: int, name: str = "times") -> np.ndarray:
-    t = _float_array(times, name)
-    if t.ndim == 0:
-        t = np.full(n, float(t))
-    t = _finite_array(t, (n,), name)
-    return t
-
-
-# --------------------------------------------------------------------------------------------
-# dipoles
 
 
 def dipole_field(points: Any, positions: Any, moments: Any, radii: Any) -> np.ndarray:

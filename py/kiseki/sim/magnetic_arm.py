@@ -42,15 +42,15 @@ from typing import Any
 import numpy as np
 
 from kiseki.core import derive_seed
+from kiseki.sim._values import finite_array as _finite_array
+from kiseki.sim._values import finite_scalar as _finite_scalar
+from kiseki.sim._values import poses as _poses
+from kiseki.sim._values import times as _times
 from kiseki.sim.magnetic import (
     DEFAULT_NOISE_SD,
     Dipole,
     MagneticWorld,
     Magnetometer,
-    _finite_array,
-    _finite_scalar,
-    _poses,
-    _times,
     dipole_field,
 )
 

@@ -24,7 +24,10 @@ from typing import Any
 import numpy as np
 
 from kiseki.core import Random
-from kiseki.sim.magnetic import _finite_array, _finite_scalar, _points, dipole_field
+from kiseki.sim._values import finite_array as _finite_array
+from kiseki.sim._values import finite_scalar as _finite_scalar
+from kiseki.sim._values import points as _points
+from kiseki.sim.magnetic import dipole_field
 
 __all__ = ["MAX_LATTICE_DIPOLES", "DipoleLattice"]
 
