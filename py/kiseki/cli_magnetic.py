@@ -87,21 +87,18 @@ def _read_data(data: list[Path], units: str | None, dimension: int | None):
 
 def _fit_gps(x, y, kernel, per_component: bool, method: str, seed: int):
     """(GPs, kernels, seconds for the hyperparameters, seconds for the fit)."""
-    from kiseki.gp import ExactGP, HilbertGP, fit_hyperparameters
+    from kiseki.gp import fit_hyperparameters
+    from kiseki.magnetic.field_map import fit_component_gps
 
     columns = [slice(k, k + 1) for k in range(3)] if per_component else [slice(0, 3)]
     start = time.perf_counter()
     if kernel is not None:
         kernels = [kernel] * len(columns)
     else:  # maximise the log marginal likelihood (eqs. 6.11-6.15)
-        fits = [fit_hyperparameters(x, y[:, c], seed=seed) for c in columns]
-        kernels = [f.kernel for f in fits]
+        kernels = [fit_hyperparameters(x, y[:, c], seed=seed).kernel for c in columns]
     hyper = time.perf_counter() - start
     start = time.perf_counter()
-    if method == "exact":
-        gps = [ExactGP.fit(x, y[:, c], k) for c, k in zip(columns, kernels, strict=True)]
-    else:
-        gps = [HilbertGP.fit(x, y[:, c], k) for c, k in zip(columns, kernels, strict=True)]
+    gps = fit_component_gps(x, y, kernels, method)
     return gps, kernels, hyper, time.perf_counter() - start
 
 
@@ -171,8 +168,10 @@ def fit(
         from kiseki.magnetic.binning import bin_readings
 
         x, y, _ = bin_readings(x, y, bin_size)
-    if max_points is not None and n_read > max_points:
-        keep = np.sort(np.random.default_rng(seed).choice(n_read, max_points, replace=False))
+    if max_points is not None and len(x) > max_points:  # after --bin: of the cells' readings
+        from kiseki.gp.kernel import subsample
+
+        keep = subsample(len(x), max_points, seed)
         x, y = x[keep], y[keep]
     method = method or ("exact" if len(x) <= EXACT_LIMIT else "hilbert")
     gps, kernels, t_hyper, t_fit = _fit_gps(x, y, fixed, per_component, method, seed)

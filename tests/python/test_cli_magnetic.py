@@ -85,6 +85,15 @@ def test_bin_averages_the_readings_per_cell_before_the_fit(synthetic):
     assert doc["provenance"]["data"]["bin"] == 1.0
 
 
+def test_max_points_subsamples_the_binned_readings(synthetic):
+    # --max-points after --bin draws from the 16 cells' readings, not from the 300 read.
+    folder, _ = synthetic
+    args = ("fit", "floor.csv", "-o", "both", "--bin", "1.0", "--max-points", "10")
+    done = run(*args, "--kernel", "1,1,0.1", cwd=folder)
+    assert done.returncode == 0, done.stderr
+    assert "from 10 of 300 measurements" in done.stdout
+
+
 def test_predict_at_held_out_points_is_accurate_and_reports_its_variance(synthetic):
     folder, _ = synthetic
     rng = np.random.default_rng(1)

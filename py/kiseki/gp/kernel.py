@@ -41,12 +41,6 @@ class SquaredExponential:
                 )
             object.__setattr__(self, name, float(v))
 
-    def __call__(self, p: Any, q: Any) -> np.ndarray:
-        """The kernel matrix between rows of p and q (a reference; the C++ core has its own)."""
-        a, b = inputs_array(p, "p"), inputs_array(q, "q")
-        d2 = ((a[:, None, :] - b[None, :, :]) ** 2).sum(axis=-1)
-        return self.sigma_f**2 * np.exp(-0.5 * d2 / self.length_scale**2)
-
     def to_dict(self) -> dict[str, float]:
         return asdict(self)
 

@@ -378,18 +378,21 @@ def _evaluate(gps, origin, resolution, shape, height, progress):
     return mean.reshape(*shape, 3), var.reshape(*shape, 3)
 
 
-def _rebuild(training: TrainingData, kernel) -> list:
-    """The GP(s) of the stored training data with the stored hyperparameters."""
+def fit_component_gps(x, y, kernels, method: str, *, mean: str = "constant", domain=None) -> list:
+    """GPs of the field's three columns: one GP of all three with one kernel, or one GP per
+    column with three; exact or reduced-rank ("hilbert", on `domain` or its default box)."""
     from kiseki.gp import ExactGP, HilbertGP
 
-    x, y = training.inputs, training.outputs
-    kernels = [kernel] if isinstance(kernel, SquaredExponential) else list(kernel)
+    kernels = [kernels] if isinstance(kernels, SquaredExponential) else list(kernels)
     columns = [slice(0, 3)] if len(kernels) == 1 else [slice(k, k + 1) for k in range(3)]
-    gps = []
-    for k, cols in zip(kernels, columns, strict=True):
-        if training.method == "exact":
-            gps.append(ExactGP.fit(x, y[:, cols], k, mean=training.mean))
-        else:
-            domain = (training.hilbert or {}).get("domain")
-            gps.append(HilbertGP.fit(x, y[:, cols], k, domain=domain, mean=training.mean))
-    return gps
+    pairs = zip(kernels, columns, strict=True)
+    if method == "exact":
+        return [ExactGP.fit(x, y[:, c], k, mean=mean) for k, c in pairs]
+    return [HilbertGP.fit(x, y[:, c], k, domain=domain, mean=mean) for k, c in pairs]
+
+
+def _rebuild(training: TrainingData, kernel) -> list:
+    """The GP(s) of the stored training data with the stored hyperparameters."""
+    domain = (training.hilbert or {}).get("domain")
+    x, y = training.inputs, training.outputs
+    return fit_component_gps(x, y, kernel, training.method, mean=training.mean, domain=domain)
