@@ -4,7 +4,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <limits>
+#include <string>
 
 #include <opencv2/core.hpp>
 
@@ -130,10 +133,30 @@ TEST(OctreeWorld, VoxelisedBoxesCastWithinAVoxelAndRoundTripThroughBt) {
   const OctreeWorld back = OctreeWorld::read_binary(path);
   EXPECT_EQ(back.occupied_leaves(), octree.occupied_leaves());
   EXPECT_DOUBLE_EQ(back.resolution(), 0.05);
-  FILE* f = std::fopen(path.c_str(), "r+b");
-  std::fseek(f, 60, SEEK_SET);
-  std::fputs("garbage", f);
-  std::fclose(f);
+  // Corrupt the tree data and read it back. Octomap writes a comment line after its first line
+  // (offset 60 falls in it, and a file "corrupted" there still reads); the two bytes right after
+  // the header's "data" line hold the root's child bits: zeroed, the root has no children and
+  // the node count no longer matches the header's "size", which the reader must refuse.
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::size_t data = bytes.find("\ndata\n");
+  ASSERT_NE(data, std::string::npos);
+  ASSERT_GT(bytes.size(), data + 8);
+  bytes[data + 6] = '\0';
+  bytes[data + 7] = '\0';
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  try {
+    (void)OctreeWorld::read_binary(path);
+    ADD_FAILURE() << "a .bt file whose root lost its children was read";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("corrupt or truncated"), std::string::npos) << e.what();
+  }
   std::FILE* g = std::fopen((path + ".txt").c_str(), "wb");
   std::fputs("not an octree\n", g);
   std::fclose(g);
