@@ -12,8 +12,10 @@ interrupted save never leaves a half-written map behind.
 
 from __future__ import annotations
 
+import errno
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -21,13 +23,20 @@ import numpy as np
 import yaml
 
 from kiseki import _core
-from kiseki._atomic import atomic_write
+from kiseki._atomic import atomic_write_all
 from kiseki._yaml import safe_load_12
 from kiseki.core import Pose2
 from kiseki.errors import MapFormatError
 from kiseki.grid import OCCUPIED, UNKNOWN, OccupancyGrid
 
-__all__ = ["MapMetadata", "load_map", "read_map_metadata", "save_map"]
+__all__ = [
+    "MapMetadata",
+    "load_map",
+    "map_files",
+    "read_map_metadata",
+    "save_map",
+    "write_image",
+]
 
 MODES = ("trinary", "scale", "raw")
 
@@ -145,6 +154,23 @@ def load_map(path: str | os.PathLike) -> OccupancyGrid:
     return _load_ros_map(path)
 
 
+def write_image(path: str | os.PathLike, image: np.ndarray) -> None:
+    """Writes an image file (OpenCV; format by extension) and reads it back: OpenCV reports
+    success for a file it could not finish (on a full disk the PGM is cut short), which an
+    atomic rename would then put over a good map."""
+    from PIL import Image  # matplotlib's dependency; it reads back silently, OpenCV prints
+
+    _core.write_image(str(path), image)
+    try:
+        with Image.open(path) as back:
+            back.load()  # raises on a file cut short
+            whole = back.size == (image.shape[1], image.shape[0])
+    except OSError:
+        whole = False
+    if not whole:
+        raise OSError(errno.EIO, "the image was cut short (is the disk full?)", str(path))
+
+
 def save_map(
     grid: OccupancyGrid,
     path: str | os.PathLike,
@@ -154,7 +180,23 @@ def save_map(
     free_thresh: float = 0.196,
 ) -> Path:
     """Saves a grid as ROS map YAML + image (``<stem>.pgm``, or ``.png`` in scale mode, which
-    needs an alpha channel). Returns the YAML path."""
+    needs an alpha channel). Returns the YAML path. Both files are written before either
+    replaces a previous map, so a failed save leaves the previous map whole."""
+    path = Path(path)
+    atomic_write_all(map_files(grid, path, mode, image_format, occupied_thresh, free_thresh))
+    return path
+
+
+def map_files(
+    grid: OccupancyGrid,
+    path: str | os.PathLike,
+    mode: str = "trinary",
+    image_format: str | None = None,
+    occupied_thresh: float = 0.65,
+    free_thresh: float = 0.196,
+) -> list[tuple[Path, Callable[[str], object]]]:
+    """The checked files of :func:`save_map`, image first, each with its writer, for
+    `kiseki._atomic.atomic_write_all` (to save them together with other files)."""
     path = Path(path)
     if path.suffix.lower() not in (".yaml", ".yml"):
         raise ValueError(f"{path}: a ROS map must be saved to a .yaml file")
@@ -179,7 +221,6 @@ def save_map(
         grid, mode=mode, occupied_thresh=occupied_thresh, free_thresh=free_thresh
     )
     image_path = path.with_suffix(f".{image_format}")
-    atomic_write(image_path, lambda tmp: _core.write_image(tmp, image))
     origin = grid.origin
     doc = {
         "image": image_path.name,
@@ -191,5 +232,7 @@ def save_map(
         "free_thresh": float(free_thresh),
     }
     text = yaml.safe_dump(doc, sort_keys=False, default_flow_style=None)
-    atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-    return path
+    return [
+        (image_path, lambda tmp: write_image(tmp, image)),
+        (path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8")),
+    ]
