@@ -89,10 +89,26 @@ def test_alignment_recovers_a_known_similarity():
     np.testing.assert_allclose(r, rot, atol=1e-12)
     np.testing.assert_allclose(t, [1.0, -2.0, 0.5], atol=1e-12)
     assert s == pytest.approx(2.5)
+    # without noise, a rigidly moved reference is moved back exactly (closed form)
+    _, ref = trajectories(4)
+    c, s = np.cos(0.4), np.sin(0.4)
+    moved = np.column_stack(
+        [c * ref[:, 0] - s * ref[:, 1] + 2.0, s * ref[:, 0] + c * ref[:, 1] - 1.0, ref[:, 2] + 0.4]
+    )
+    np.testing.assert_allclose(align_trajectory(moved, ref, "se3"), as_se3(ref), atol=1e-9)
+    # with noise and drift, every alignment gives evo's aligned poses
     est, ref = trajectories(4)
-    aligned = align_trajectory(est, ref, "se3")
-    assert ape(aligned, ref).rmse < ape(est, ref).rmse / 5  # the 2 m / 0.4 rad offset is gone
-    assert ape(est, est, "rotation_deg").max == pytest.approx(0.0, abs=1e-6)
+    for alignment in ("se3", "sim3", "scale", "origin"):
+        e = evo_traj(est)
+        if alignment == "origin":
+            e.align_origin(evo_traj(ref))
+        else:
+            e.align(evo_traj(ref), alignment == "sim3", alignment == "scale")
+        ours = align_trajectory(est, ref, alignment)
+        np.testing.assert_allclose(ours, np.stack(e.poses_se3), atol=1e-9, err_msg=alignment)
+    # a heading off by 0.1 rad everywhere is a 5.73 deg rotation error at every pose
+    turned = ref + [0.0, 0.0, 0.1]
+    np.testing.assert_allclose(ape(turned, ref, "rotation_deg").errors, np.degrees(0.1))
 
 
 def test_stop_error_in_goal_frame():
