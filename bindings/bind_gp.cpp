@@ -150,11 +150,11 @@ void bind_gp(py::module_& m) {
           fit = fit_hyperparameters(x.map(), y.map(), initial, o);
         }
         return py::make_tuple(fit.kernel.sigma_f, fit.kernel.length_scale, fit.kernel.sigma_n,
-                              fit.log_marginal_likelihood, fit.evaluations, fit.start_values);
+                              fit.log_marginal_likelihood, fit.evaluations, fit.gradients, fit.start_values);
       },
       "inputs"_a, "targets"_a, "sigma_f"_a, "length_scale"_a, "sigma_n"_a, "restarts"_a = 3, "seed"_a = 0,
       "max_iterations"_a = 100, "tolerance"_a = 1e-6,
-      "(sigma_f, l, sigma_n, LML, evaluations, best LML per start); targets used as given.");
+      "(sigma_f, l, sigma_n, LML, likelihood values, gradients, best LML per start); targets used as given.");
 }
 
 }  // namespace kiseki::bindings

@@ -39,6 +39,14 @@ Eigen::MatrixXd inverse_from_cholesky(const Eigen::MatrixXd& l) {
   return inv;
 }
 
+void invert_from_cholesky_lower(Eigen::MatrixXd& l) {
+  const lapack_int n = checked_size(l.rows());
+  if (n == 0) return;
+  if (LAPACKE_dpotri(LAPACK_COL_MAJOR, 'L', n, l.data(), n) != 0) {
+    throw std::runtime_error("Gaussian process: the covariance matrix could not be inverted");
+  }
+}
+
 void cholesky_solve(const Eigen::MatrixXd& l, Eigen::MatrixXd& b) {
   const lapack_int n = checked_size(l.rows());
   if (n == 0 || b.cols() == 0) return;

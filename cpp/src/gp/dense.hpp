@@ -14,6 +14,8 @@ namespace kiseki::gp_detail {
 bool cholesky(Eigen::MatrixXd& a);
 /// From L: the full inverse (L L^T)^-1, symmetric.
 Eigen::MatrixXd inverse_from_cholesky(const Eigen::MatrixXd& l);
+/// In place, the lower triangle only (the upper is left as it was).
+void invert_from_cholesky_lower(Eigen::MatrixXd& l);
 /// In place: b <- (L L^T)^-1 b.
 void cholesky_solve(const Eigen::MatrixXd& l, Eigen::MatrixXd& b);
 /// In place: b <- L^-1 b.

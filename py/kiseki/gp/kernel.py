@@ -57,7 +57,8 @@ class HyperparameterFit:
 
     kernel: SquaredExponential
     log_marginal_likelihood: float  # at the optimum, on the points used
-    evaluations: int  # of the likelihood and its gradient
+    evaluations: int  # likelihood values (one Cholesky factorisation each)
+    gradients: int  # of which also with the gradient (two more n^3 / 3 each)
     start_values: tuple[float, ...]  # the best likelihood reached from each start
     points_used: int
 
@@ -84,8 +85,8 @@ def fit_hyperparameters(
     mean: str = "constant",
 ) -> HyperparameterFit:
     """Hyperparameters that maximise the log marginal likelihood (eq. 6.11) summed over Y's
-    columns (one kernel shared by the field's components), by BFGS in log-parameters with the
-    analytic gradient (eqs. 6.12-6.15), from `initial` (default: from the data's spread) and
+    columns (one kernel shared by the field's components), by projected BFGS in log-parameters
+    with the analytic gradient (eqs. 6.12-6.15), from `initial` (default: from the data's spread) and
     `restarts` seeded random starts. Above `max_points` readings the likelihood is that of a
     seeded random subsample of that size (its cost grows as n^3)."""
     x = inputs_array(x)
@@ -105,7 +106,7 @@ def fit_hyperparameters(
     y = remove_mean(y, constant)
     if initial is None:
         initial = SquaredExponential(*_core.gp_initial_kernel(x, y))
-    sf, ls, sn, lml, evaluations, starts = _core.gp_fit_hyperparameters(
+    sf, ls, sn, lml, evaluations, gradients, starts = _core.gp_fit_hyperparameters(
         x,
         y,
         initial.sigma_f,
@@ -116,7 +117,12 @@ def fit_hyperparameters(
         max_iterations,
     )
     return HyperparameterFit(
-        SquaredExponential(sf, ls, sn), float(lml), int(evaluations), tuple(starts), len(x)
+        SquaredExponential(sf, ls, sn),
+        float(lml),
+        int(evaluations),
+        int(gradients),
+        tuple(starts),
+        len(x),
     )
 
 

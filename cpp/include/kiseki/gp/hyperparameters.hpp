@@ -32,20 +32,25 @@ struct HyperparameterOptions {
   int restarts = 3;           ///< random starts after the first
   std::uint64_t seed = 0;     ///< for the random starts
   int max_iterations = 100;   ///< BFGS iterations per start
-  double tolerance = 1e-6;    ///< on the largest gradient component of LML / (n k)
+  double tolerance = 1e-6;    ///< on the largest projected gradient component of LML / (n k)
+  /// A start stops when an iteration lowers -LML by at most this share of its size: factr x
+  /// machine epsilon with L-BFGS-B's default factr of 1e7 (the setting scikit-learn uses).
+  double function_tolerance = 1e7 * 2.220446049250313e-16;
 };
 
 struct HyperparameterFit {
   SquaredExponential kernel;
   double log_marginal_likelihood = 0.0;
-  int evaluations = 0;                  ///< LML + gradient evaluations, all starts
+  int evaluations = 0;                  ///< likelihood values (one Cholesky factorisation each), all starts
+  int gradients = 0;                    ///< of which also with the gradient (the inverse as well)
   std::vector<double> start_values;     ///< the best LML reached from each start
 };
 
-/// Maximises eq. 6.11 over (sigma_f, l, sigma_n) by BFGS in log-parameters with a backtracking
-/// (Armijo) line search, from `initial`, from the best point of a coarse scan of length scales
-/// and noise levels (18 evaluations), and from `restarts` random starts (log-uniform within the
-/// bounds below, drawn from kiseki::Random(seed)); the best start wins. Bounds, from the
+/// Maximises eq. 6.11 over (sigma_f, l, sigma_n) by projected BFGS in log-parameters with a
+/// backtracking line search on likelihood values (the gradient only at accepted points), from
+/// `initial`, from the best point of a coarse scan of length scales and noise levels (18 values;
+/// skipped as a start when it is `initial`), and from `restarts` random starts (log-uniform
+/// within the bounds below, drawn from kiseki::Random(seed)); the best start wins. Bounds, from the
 /// data: sigma_f and sigma_n in [1e-6, 1e3] x the targets' RMS, l in [1e-3, 1e2] x the inputs'
 /// largest extent. Targets are used as given (remove a mean first).
 HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
