@@ -6,6 +6,7 @@ is deterministic for a seed."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from rich.console import Console
 
 from kiseki import load_map
@@ -36,7 +37,11 @@ def test_demo_teaches_and_plays_back_every_method(tmp_path, project_root):
         assert set(shares) == {"erased_share", "false_occupied_share"}
         assert 0.0 <= shares["erased_share"] < 0.1 and 0.0 <= shares["false_occupied_share"] < 0.1
     for result in summary["playback"].values():
-        assert result["reached"] and result["stop_error_m"] < 0.5  # localized, not lost
+        # the thesis' stop rule (estimate within 0.1 m of G) met, and the estimate right: the
+        # robot truly rests within 0.1 m of where G was taught (measured 0.013-0.045 m)
+        assert result["reached"] and result["stop_error_m"] <= 0.1
+        assert result["estimate_error_m"] <= 0.1
+        assert np.hypot(*result["stop_offset_m"]) == pytest.approx(result["stop_error_m"])
     again = run_demo(scene, tmp_path / "b", seed=3, console=Console(quiet=True), particles=300)
     assert again["playback"] == summary["playback"]  # same seed, same runs
 
