@@ -13,7 +13,10 @@ from pathlib import Path
 
 import yaml
 
-__all__ = ["check_outputs", "files_behind"]
+__all__ = ["FIGURE_SUFFIXES", "check_outputs", "check_suffix", "files_behind"]
+
+# the formats matplotlib writes (with Pillow), chosen by the file's extension
+FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".webp", ".tif", ".tiff", ".eps", ".ps")
 
 
 def files_behind(path: Path) -> list[Path]:
@@ -71,3 +74,12 @@ def check_outputs(
             raise FileNotFoundError(f"{label} {out}: folder {folder} does not exist")
         if not os.access(folder, os.W_OK | os.X_OK):
             raise PermissionError(f"{label} {out}: folder {folder} is not writable")
+
+
+def check_suffix(label: str, path: Path | None, suffixes: tuple[str, ...]) -> None:
+    """Raises ValueError naming the output when its extension is not one of ``suffixes`` (the
+    writers choose the format by extension; without this check the error named a temporary
+    file, after the work)."""
+    if path is not None and path.suffix.lower() not in suffixes:
+        got = f"extension {path.suffix!r}" if path.suffix else "no extension"
+        raise ValueError(f"{label} {path}: {got}; give a file ending in {', '.join(suffixes)}")

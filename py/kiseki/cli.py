@@ -18,7 +18,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from kiseki._outputs import check_outputs
+from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
 from kiseki.cli_magnetic import magnetic_app
 from kiseki.cli_speed import speed_app
 from kiseki.errors import KisekiError
@@ -124,6 +124,8 @@ def map_from_log(
     check_outputs(
         {"--output": [output, output.with_suffix(".pgm")], "--render": render}, {"LOG": log}
     )
+    check_suffix("--output", output, (".yaml", ".yml"))
+    check_suffix("--render", render, FIGURE_SUFFIXES)
     config = MapBuildConfig(
         resolution=_positive("--resolution", resolution),
         usable_range=_positive("--usable-range", usable_range),
@@ -199,6 +201,7 @@ def map_render(
     from kiseki.plots import render_map
 
     check_outputs({"--output": output}, {"MAP": map_file, "--trajectory": trajectory})
+    check_suffix("--output", output, FIGURE_SUFFIXES)
     grid = load_map(map_file)
     path = _read_trajectory(trajectory) if trajectory is not None else None
     render_map(grid, output, trajectory=path, title=map_file.name)
@@ -215,6 +218,7 @@ def map_convert(
     from kiseki.map_io import load_map, save_map
 
     check_outputs({"--output": [output, output.with_suffix(".pgm")]}, {"MAP": map_file})
+    check_suffix("--output", output, (".yaml", ".yml"))
     grid = load_map(map_file)
     save_map(grid, output)
     summary = grid_summary(grid)
@@ -394,6 +398,7 @@ def sim_render(
     from kiseki.sim.scene import load_scene
 
     check_outputs({"--output": output}, {"RUN": run_file, "--scene": scene_file})
+    check_suffix("--output", output, (".gif",))
     run = read_run(run_file)
     path = scene_file or Path(run.metadata.get("scene_file", ""))
     if not str(path) or not path.is_file():
@@ -419,6 +424,7 @@ def sim_show(
     from kiseki.sim.scene import load_scene
 
     check_outputs({"--output": output, "--octree": octree}, {"SCENE": scene_file})
+    check_suffix("--output", output, FIGURE_SUFFIXES)
     scene = load_scene(scene_file)
     if octree is not None:  # checked before anything is written
         if not isinstance(scene.world, _core.BoxWorld):
@@ -466,6 +472,7 @@ def coop_simulate(
     from kiseki.coop.render import render_run
 
     check_outputs({"--plot": plot}, {})
+    check_suffix("--plot", plot, FIGURE_SUFFIXES)
     if not (math.isfinite(sigma) and 0 <= sigma < 10):
         raise ValueError(f"--sigma must lie in [0, 10) deg, got {sigma}")
     if planner and (form, moves, angle) != (None, None, None):
@@ -787,6 +794,7 @@ def localize_command(
         },
         {"LOG": log, "--map": map_file},
     )
+    check_suffix("--plot", plot, FIGURE_SUFFIXES)
     if not global_start:
         for name, value in (("--tracking-particles", tracking_particles), ("--plot", plot)):
             if value is not None:
@@ -836,6 +844,10 @@ def localize_command(
         trajectory, reliability = tracked.estimates, tracked.reliability
     saved_config.update(log=str(log), map=str(map_file))
     _write_trajectory(output, scans.times, trajectory, reliability)
+    if not global_start:
+        _warn_if_off_the_map(grid, trajectory, scans, map_file)
+    elif result.report.converged and result.report.fit is not None:  # from convergence on
+        _warn_if_off_the_map(grid, trajectory, scans, map_file, result.report.fit.within_1_cell)
     config_path = output.with_name(output.stem + ".config.yaml")
     _write_yaml(config_path, saved_config)
     if scans.has_reference_poses:
@@ -856,6 +868,34 @@ def localize_command(
             from kiseki.global_localization import render_global
 
             render_global(grid, result, plot, title=f"{log.name}: global {method}")
+
+
+OFF_MAP_SHARE = 0.5  # below this share of endpoints near a wall the map is not the log's
+
+
+def _warn_if_off_the_map(
+    grid, trajectory: np.ndarray, scans, map_file: Path, share: float | None = None
+) -> None:
+    """One warning line when most scan endpoints, at the estimated poses, miss the map's walls
+    (a map of another building, a 1x1 map): the poses alone look fine in such a case.
+    ``share``: the share already measured (global localization's, from convergence on)."""
+    from kiseki.mapping import endpoint_agreement
+
+    if share is None:
+        finite = np.isfinite(trajectory).all(axis=1)
+        try:
+            share = endpoint_agreement(
+                grid, trajectory[finite], scans.ranges[finite], scans.angles, scans.max_range
+            )
+        except ValueError:  # no estimate, or no endpoint below max_range
+            return
+    if share < OFF_MAP_SHARE:
+        typer.echo(
+            f"kiseki: warning: only {100 * share:.1f} % of the scan endpoints fall on or next to "
+            f"an occupied cell of {map_file} at the estimated poses: the map is probably not "
+            "the log's building, or the localization is lost",
+            err=True,
+        )
 
 
 def _write_trajectory(
@@ -904,11 +944,19 @@ def _terminate(signum, frame) -> None:
     sys.exit(128 + signum)
 
 
+def _warn_in_one_line(message, category, filename, lineno, file=None, line=None) -> None:
+    """Warnings (a truncated MCAP read, ...) as one line for people, not Python's two."""
+    text = str(message).strip().splitlines()
+    typer.echo(f"kiseki: warning: {text[0] if text else category.__name__}", err=True)
+
+
 def main() -> None:
     """Entry point: runs the app and turns input errors into one line and exit status 1."""
     import signal
+    import warnings
 
     signal.signal(signal.SIGTERM, _terminate)
+    warnings.showwarning = _warn_in_one_line
     try:
         app()
     except (KisekiError, ValueError, OSError, RuntimeError, IndexError) as err:

@@ -13,7 +13,7 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from kiseki._outputs import check_outputs
+from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
 
 __all__ = ["magnetic_app"]
 
@@ -315,6 +315,7 @@ def render(
     if slices < 1:
         raise ValueError(f"--slices must be at least 1, got {slices}")
     check_outputs({"-o": output}, _map_files(map_folder))
+    check_suffix("-o", output, FIGURE_SUFFIXES)
     fmap = MagneticFieldMap.load(map_folder)
     render_field_map(fmap, output, slices)
     width, height = picture_size(fmap, slices)

@@ -11,7 +11,7 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from kiseki._outputs import check_outputs
+from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
 
 __all__ = ["speed_app"]
 
@@ -75,6 +75,7 @@ def speed_limits(
     if plot is not None:
         outputs["--plot"] = plot
     check_outputs(outputs, {"LOG": log, "--map": map_file})
+    check_suffix("--plot", plot, FIGURE_SUFFIXES)
     grid = load_map(map_file)
     topics = {"scan_topic": scan_topic}
     if reference_topic is not None:

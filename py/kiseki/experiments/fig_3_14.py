@@ -39,6 +39,30 @@ class Fig314Config:
     offsets: int = 41
     flat_ratio: float = 0.95  # "no difference": off-truth likelihood >= this share of the peak
 
+    def __post_init__(self) -> None:
+        """Refuses settings that make the check meaningless (beams=0 drew every likelihood at
+        1.0 and a claim 'held'), naming the key."""
+        from kiseki.experiments.config import ConfigError
+
+        finite = np.isfinite
+        checks = (
+            ("beams", self.beams >= 2, ">= 2"),
+            ("offsets", self.offsets >= 3, ">= 3"),
+            ("max_offset", finite(self.max_offset) and 0 < self.max_offset <= 3.5,
+             "in (0, 3.5] m (the local map's half width)"),
+            ("field_of_view_deg", 0 < self.field_of_view_deg < 180, "in (0, 180) deg"),
+            ("range_noise_sd", finite(self.range_noise_sd) and 0 <= self.range_noise_sd < 1,
+             "in [0, 1) m"),
+            ("flat_ratio", 0 < self.flat_ratio <= 1, "in (0, 1]"),
+            ("partition_y", finite(self.partition_y) and 0.2 <= self.partition_y <= 3.5,
+             "in [0.2, 3.5] m"),
+            ("partition_start_x", finite(self.partition_start_x)
+             and -3.5 <= self.partition_start_x < 5.5, "in [-3.5, 5.5) m"),
+        )  # fmt: skip
+        for key, ok, limit in checks:
+            if not ok:
+                raise ConfigError(f"fig-3-14: {key} must be {limit}, got {getattr(self, key)}")
+
 
 def _scene(config: Fig314Config) -> OccupancyGrid:
     grid = OccupancyGrid(np.zeros((80, 140), np.int8), 0.1, Pose2(-7.0, -4.0, 0.0))

@@ -76,6 +76,7 @@ from kiseki.scans import LaserScans
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
     "FOXGLOVE_SCHEMAS",
+    "MissingTopicError",
     "ODOMETRY_SCHEMA",
     "ODOMETRY_SCHEMA_NAME",
     "TWIST_SCHEMA",
@@ -105,6 +106,14 @@ _COMPRESSIONS = {
 
 class TruncatedRunWarning(UserWarning):
     """:func:`read_run` read a file without its footer (a writer killed mid-run)."""
+
+
+class MissingTopicError(LogFormatError, KeyError):
+    """A run has no topic of that name: a KeyError for lookups, and a format error of the file
+    (a ValueError naming it) for the commands that read it."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0]) if self.args else ""
 
 
 # --- Foxglove JSON schemas (as in github.com/foxglove/schemas, schemas/jsonschema/*.json) ---
@@ -809,7 +818,9 @@ class SimRun:
 
     def _topic(self, topic: str) -> _Topic:
         if topic not in self._topics:
-            raise KeyError(f"{self.path}: no topic {topic!r} (topics: {sorted(self._topics)})")
+            raise MissingTopicError(
+                f"{self.path}: no topic {topic!r} (topics: {', '.join(sorted(self._topics))})"
+            )
         return self._topics[topic]
 
     def messages(self, topic: str) -> list[tuple[float, dict[str, Any]]]:

@@ -1,0 +1,254 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Issue 17's remaining cases, run from the command line as a user would: a log without the
+scan topic, a truncated log, options that do not apply, outputs without an extension, a map
+that is not the log's building, nonsense experiment settings and cell values outside the ROS
+range. Each is one line (an error and exit 1, or a warning) and leaves every input as it was."""
+
+from __future__ import annotations
+
+import hashlib
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from kiseki import OccupancyGrid, Pose2, save_map
+from kiseki._outputs import FIGURE_SUFFIXES
+from kiseki.sim.mcap_log import RunWriter
+
+STEPS = 40
+ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 91)
+
+
+def run(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", *map(str, args)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+    )
+
+
+def room() -> OccupancyGrid:
+    """A 6 m x 4 m room at 0.05 m with a pillar, free inside."""
+    cells = np.zeros((80, 120), np.int8)
+    cells[[0, -1], :] = 100
+    cells[:, [0, -1]] = 100
+    cells[30:40, 60:66] = 100
+    return OccupancyGrid(cells, 0.05, Pose2(-1.0, -2.0, 0.0))
+
+
+def write_log(path: Path, scan: bool = True, chunk_size: int = 128 * 1024) -> None:
+    """A robot driving along y = -1 in the room: truth, odometry and (with ``scan``) scans."""
+    grid = room()
+    poses = np.column_stack([np.linspace(0.0, 2.0, STEPS), np.full(STEPS, -1.0), np.zeros(STEPS)])
+    ranges = grid.cast_scans(poses, ANGLES, max_range=8.0)
+    with RunWriter(path, chunk_size=chunk_size) as w:
+        for k, pose in enumerate(poses):
+            t = 0.1 * k
+            w.write_pose("/ground_truth", t, pose)
+            w.write_odometry("/odom", t, pose)
+            if scan:
+                w.write_laser_scan("/scan", t, pose, ANGLES, ranges[k], max_range=8.0)
+
+
+def digests(folder: Path) -> dict[str, str]:
+    return {
+        p.name: hashlib.sha1(p.read_bytes()).hexdigest()
+        for p in sorted(folder.iterdir())
+        if p.is_file()
+    }
+
+
+@pytest.fixture
+def inputs(tmp_path: Path) -> Path:
+    save_map(room(), tmp_path / "room.yaml")
+    write_log(tmp_path / "log.mcap")
+    write_log(tmp_path / "noscan.mcap", scan=False)
+    return tmp_path
+
+
+def one_error(done: subprocess.CompletedProcess) -> str:
+    assert done.returncode == 1, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("kiseki: error: "), done.stderr
+    return lines[0]
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["map", "from-log", "noscan.mcap", "-o", "m.yaml"],
+        ["localize", "noscan.mcap", "--map", "room.yaml", "-o", "t.csv"],
+        ["localize", "noscan.mcap", "--map", "room.yaml", "-o", "t.csv", "--global"],
+        ["speed", "limits", "noscan.mcap", "--map", "room.yaml", "-o", "t.csv"],
+    ],
+)
+def test_a_run_without_a_scan_topic_is_one_line_naming_the_file(inputs, args):
+    before = digests(inputs)
+    line = one_error(run(*args, cwd=inputs))
+    assert line.startswith("kiseki: error: noscan.mcap: no topic '/scan' (topics: ")
+    assert "/ground_truth, /odom" in line
+    assert digests(inputs) == before  # nothing written, nothing changed
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["map", "from-log", "cut.mcap", "-o", "m.yaml"],
+        ["localize", "cut.mcap", "--map", "room.yaml", "-o", "t.csv"],
+    ],
+)
+def test_a_truncated_run_is_read_with_a_one_line_warning(inputs, args):
+    write_log(inputs / "full.mcap", chunk_size=2048)
+    data = (inputs / "full.mcap").read_bytes()
+    (inputs / "cut.mcap").write_bytes(data[: len(data) * 2 // 3])
+    before = digests(inputs)
+    done = run(*args, cwd=inputs)
+    assert done.returncode == 0, done.stderr
+    warning = [line for line in done.stderr.splitlines() if line.startswith("kiseki: warning:")]
+    assert len(warning) == 1 and "cut.mcap: truncated MCAP" in warning[0], done.stderr
+    assert "TruncatedRunWarning" not in done.stderr  # not Python's two-line format
+    after = digests(inputs)
+    assert {k: after[k] for k in before} == before
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--tracking-particles", "-5"], "--tracking-particles applies only with --global"),
+        (["--plot", "p.png"], "--plot applies only with --global"),
+    ],
+)
+def test_options_of_global_localization_are_errors_without_it(inputs, args, needle):
+    before = digests(inputs)
+    line = one_error(run("localize", "log.mcap", "--map", "room.yaml", "-o", "t.csv", *args,
+                         cwd=inputs))  # fmt: skip
+    assert line == f"kiseki: error: {needle}"
+    assert digests(inputs) == before
+
+
+@pytest.mark.parametrize("target", ["log.mcap", "room.yaml", "room.pgm"])
+def test_localize_never_writes_over_its_log_or_map(inputs, target):
+    before = digests(inputs)
+    line = one_error(run("localize", "log.mcap", "--map", "room.yaml", "-o", target, cwd=inputs))
+    assert line.startswith(f"kiseki: error: --output {target} would overwrite the input")
+    assert digests(inputs) == before
+
+
+FIG = FIGURE_SUFFIXES
+MAP = (".yaml", ".yml")
+
+
+@pytest.mark.parametrize(
+    ("args", "label", "path", "wanted"),
+    [
+        (["map", "render", "room.yaml", "-o", "out"], "--output", "out", FIG),
+        (["map", "from-log", "log.mcap", "-o", "m.yaml", "--render", "r"], "--render", "r", FIG),
+        (["map", "from-log", "log.mcap", "-o", "m"], "--output", "m", MAP),
+        (["map", "convert", "room.yaml", "-o", "m"], "--output", "m", MAP),
+        (["sim", "show", "WORLD", "-o", "out"], "--output", "out", FIG),
+        (["sim", "render", "log.mcap", "--scene", "WORLD", "-o", "a.png"], "--output", "a.png",
+         (".gif",)),
+        (["localize", "log.mcap", "--map", "room.yaml", "-o", "t.csv", "--global", "--plot", "p"],
+         "--plot", "p", FIG),
+        (["speed", "limits", "log.mcap", "--map", "room.yaml", "-o", "s.csv", "--plot", "p"],
+         "--plot", "p", FIG),
+        (["coop", "simulate", "--runs", "2", "--plot", "p.foo"], "--plot", "p.foo", FIG),
+    ],
+)  # fmt: skip
+def test_an_output_without_a_known_extension_is_refused_before_any_work(
+    inputs, project_root, args, label, path, wanted
+):
+    """The writers choose the format by extension: the old error named a temporary file
+    ('Format 'p1zzedcf' is not supported'), after the work."""
+    world = project_root / "data" / "worlds" / "factory_corridor.yaml"
+    before = digests(inputs)
+    line = one_error(run(*[str(world) if a == "WORLD" else a for a in args], cwd=inputs))
+    got = f"extension '{Path(path).suffix}'" if Path(path).suffix else "no extension"
+    assert line == (
+        f"kiseki: error: {label} {path}: {got}; give a file ending in {', '.join(wanted)}"
+    )
+    assert digests(inputs) == before  # refused before anything was written
+
+
+def test_a_map_that_is_not_the_logs_building_warns(inputs):
+    save_map(OccupancyGrid(np.zeros((1, 1), np.int8), 0.05), inputs / "one.yaml")
+    cells = np.zeros((80, 120), np.int8)
+    cells[10, :] = 100  # one wall only: not the room
+    save_map(OccupancyGrid(cells, 0.05, Pose2(-1.0, -2.0, 0.0)), inputs / "other.yaml")
+    before = digests(inputs)
+    warnings = {}
+    for name in ("room", "one", "other"):
+        done = run("localize", "log.mcap", "--map", f"{name}.yaml", "-o", f"{name}.csv",
+                   cwd=inputs)  # fmt: skip
+        assert done.returncode == 0, done.stderr
+        warnings[name] = [x for x in done.stderr.splitlines() if x.startswith("kiseki: warning")]
+    assert warnings["room"] == []
+    for name in ("one", "other"):
+        assert len(warnings[name]) == 1, warnings
+        assert (
+            f"of the scan endpoints fall on or next to an occupied cell of {name}.yaml"
+            in (warnings[name][0])
+        )
+    assert "only 0.0 %" in warnings["one"][0]  # the 1x1 map: every endpoint off the map
+    after = digests(inputs)
+    assert {k: after[k] for k in before} == before
+
+
+def test_global_localization_on_another_map_warns_and_prints_no_nan(inputs):
+    cells = np.zeros((80, 120), np.int8)
+    cells[10, :] = 100
+    cells[:, 30] = 100
+    save_map(OccupancyGrid(cells, 0.05, Pose2(-1.0, -2.0, 0.0)), inputs / "other.yaml")
+    outs = {}
+    for name in ("room", "other"):
+        outs[name] = run("localize", "log.mcap", "--map", f"{name}.yaml", "-o", f"{name}.csv",
+                         "--global", "--particles", "3000", cwd=inputs)  # fmt: skip
+        assert outs[name].returncode == 0, outs[name].stderr
+        assert "nan" not in (outs[name].stdout + outs[name].stderr).lower()
+    assert "kiseki: warning" not in outs["room"].stderr
+    assert "kiseki: warning: only" in outs["other"].stderr
+    assert "other.yaml" in outs["other"].stderr
+
+
+def test_fig_3_14_refuses_settings_that_make_its_claims_meaningless(tmp_path):
+    from kiseki.experiments.config import ConfigError, apply_overrides
+    from kiseki.experiments.fig_3_14 import Fig314Config
+
+    for setting, needle in (
+        ("beams=0", "beams must be >= 2, got 0"),
+        ("offsets=1", "offsets must be >= 3"),
+        ("max_offset=nan", "max_offset must be in (0, 3.5]"),
+        ("flat_ratio=2", "flat_ratio must be in (0, 1]"),
+    ):
+        with pytest.raises(ConfigError) as err:
+            apply_overrides(Fig314Config(), [setting])
+        assert needle in str(err.value)
+    assert apply_overrides(Fig314Config(), ["beams=2"]).beams == 2  # the least that works
+    line = one_error(run("experiment", "run", "fig-3-14", "--set", "beams=0", "--runs", "1",
+                         "--out", "e", cwd=tmp_path))  # fmt: skip
+    assert line == "kiseki: error: fig-3-14: beams must be >= 2, got 0"
+    assert not (tmp_path / "e").exists()
+
+
+def test_map_from_log_with_a_render_in_a_missing_folder_leaves_no_map(inputs):
+    before = digests(inputs)
+    line = one_error(run("map", "from-log", "log.mcap", "-o", "new.yaml", "--render",
+                         "/nodir/r.png", cwd=inputs))  # fmt: skip
+    assert line == "kiseki: error: --render /nodir/r.png: folder /nodir does not exist"
+    assert digests(inputs) == before and not (inputs / "new.yaml").exists()
+
+
+def test_a_grid_refuses_cell_values_outside_the_ros_range():
+    """-1 unknown, 0..100 occupancy: 120 or -2 were taken (only save_map refused them)."""
+    for bad in (120, -2):
+        with pytest.raises(ValueError, match=rf"values must lie in -1\.\.100.*got {bad}"):
+            OccupancyGrid(np.array([[0, 100], [bad, -1]], np.int8), 0.1)
+        with pytest.raises(ValueError, match="cell values must lie in -1..100"):
+            OccupancyGrid(2, 2, 0.1, Pose2(), bad)
+    grid = OccupancyGrid(np.array([[0, 100], [50, -1]], np.int8), 0.1)
+    assert grid.cells.tolist() == [[0, 100], [50, -1]]
