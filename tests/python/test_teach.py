@@ -181,6 +181,13 @@ def test_experiment_trial_records_the_goal_likelihood_profile():
     along = [record[f"proposal1_goal_like_along_{o:+.2f}"] for o in PROFILE_OFFSETS]
     side = [record[f"proposal1_goal_like_side_{o:+.2f}"] for o in PROFILE_OFFSETS]
     assert all(0 < v <= 1 for v in along + side)
-    assert abs(record["proposal1_goal_peak_along"]) <= 0.4
-    assert abs(record["proposal1_goal_peak_side"]) <= 0.4
+    # the offsets span +-0.4 m, so a peak inside +-0.4 m says nothing. Sideways the likelihood
+    # peaks at the truth (measured -0.03 m) and falls off both ways (0.91 and 0.94 of the peak
+    # at -+0.4 m); along the corridor it hardly changes (>= 0.998 of the peak over +-0.4 m, so
+    # where along it peaks is not asserted)
+    assert abs(record["proposal1_goal_peak_side"]) <= 0.05
+    mid = len(PROFILE_OFFSETS) // 2
+    assert PROFILE_OFFSETS[mid] == 0 and side[mid] >= 0.99
+    assert max(side[0], side[-1]) < side[mid] - 0.03
+    assert min(along) >= 0.99
     assert record["proposal1_reached"]
