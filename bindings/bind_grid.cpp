@@ -28,6 +28,15 @@ OccupancyGrid grid_from_cells(const py::array& cells, double resolution, const P
   require_shape(cells, "cells", 2);
   if (cells.shape(0) == 0 || cells.shape(1) == 0) throw std::invalid_argument("cells: empty array");
   const auto c = Int8Array::ensure(cells);
+  const std::int8_t* v = c.data();
+  for (py::ssize_t i = 0; i < c.size(); ++i) {
+    if (v[i] < kUnknown || v[i] > kOccupied) {
+      throw std::invalid_argument(
+          "cells: values must lie in -1..100 (-1 unknown, 0 free, 100 occupied), got " +
+          std::to_string(static_cast<int>(v[i])) + " at row " + std::to_string(i / c.shape(1)) +
+          ", column " + std::to_string(i % c.shape(1)));
+    }
+  }
   OccupancyGrid grid(static_cast<int>(c.shape(1)), static_cast<int>(c.shape(0)), resolution, origin);
   std::memcpy(grid.cells().data, c.data(), static_cast<std::size_t>(c.size()));
   return grid;

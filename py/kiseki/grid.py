@@ -4,8 +4,10 @@
 
 ``OccupancyGrid`` is implemented in C++ (OpenCV storage). ``grid.cells`` is a writable numpy
 view of the cells without a copy, indexed ``[y, x]`` with row 0 at the map origin (as in the
-ROS message, not as in the image file). Ray casting (``cast_ray``, ``cells_on_ray``,
-``cast_scans``), the distance field and local windows are methods of the grid.
+ROS message, not as in the image file). Cell values outside -1..100 are refused by the
+constructors (and by ``save_map``); writes through the ``cells`` view are not checked. Ray
+casting (``cast_ray``, ``cells_on_ray``, ``cast_scans``), the distance field and local windows
+are methods of the grid.
 """
 
 from __future__ import annotations

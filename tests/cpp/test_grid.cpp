@@ -58,6 +58,19 @@ double brute_force_range(const OccupancyGrid& g, Eigen::Vector2d s, double headi
 
 }  // namespace
 
+TEST(OccupancyGrid, CellValuesOutsideTheRosRangeAreRefused) {
+  EXPECT_THROW(OccupancyGrid(3, 3, 0.1, Pose2(), 120), std::invalid_argument);
+  EXPECT_THROW(OccupancyGrid(3, 3, 0.1, Pose2(), -2), std::invalid_argument);
+  OccupancyGrid g(3, 3, 0.1, Pose2(), kFree);
+  EXPECT_THROW(g.set(1, 1, 101), std::invalid_argument);
+  EXPECT_THROW(g.set(1, 1, -128), std::invalid_argument);
+  EXPECT_EQ(g.at(1, 1), kFree);  // unchanged by the refused writes
+  for (const int v : {-1, 0, 50, 100}) {
+    g.set(1, 1, static_cast<std::int8_t>(v));
+    EXPECT_EQ(g.at(1, 1), v);
+  }
+}
+
 TEST(OccupancyGrid, WorldCellTransformsRoundTripWithRotatedOrigin) {
   const OccupancyGrid g(10, 5, 0.2, Pose2(1.0, -2.0, 0.5));
   for (int y = 0; y < 5; ++y) {

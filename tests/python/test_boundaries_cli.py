@@ -241,3 +241,14 @@ def test_map_from_log_with_a_render_in_a_missing_folder_leaves_no_map(inputs):
                          "/nodir/r.png", cwd=inputs))  # fmt: skip
     assert line == "kiseki: error: --render /nodir/r.png: folder /nodir does not exist"
     assert digests(inputs) == before and not (inputs / "new.yaml").exists()
+
+
+def test_a_grid_refuses_cell_values_outside_the_ros_range():
+    """-1 unknown, 0..100 occupancy: 120 or -2 were taken (only save_map refused them)."""
+    for bad in (120, -2):
+        with pytest.raises(ValueError, match=rf"values must lie in -1\.\.100.*got {bad}"):
+            OccupancyGrid(np.array([[0, 100], [bad, -1]], np.int8), 0.1)
+        with pytest.raises(ValueError, match="cell values must lie in -1..100"):
+            OccupancyGrid(2, 2, 0.1, Pose2(), bad)
+    grid = OccupancyGrid(np.array([[0, 100], [50, -1]], np.int8), 0.1)
+    assert grid.cells.tolist() == [[0, 100], [50, -1]]

@@ -23,6 +23,14 @@ void check_origin(const Pose2& o) {
   }
 }
 
+void check_cell_value(int v) {
+  if (v < kUnknown || v > kOccupied) {
+    throw std::invalid_argument(
+        "OccupancyGrid: cell values must lie in -1..100 (-1 unknown, 0 free, 100 occupied), got " +
+        std::to_string(v));
+  }
+}
+
 }  // namespace
 
 OccupancyGrid::OccupancyGrid(int width, int height, double resolution, const Pose2& origin,
@@ -36,6 +44,7 @@ OccupancyGrid::OccupancyGrid(int width, int height, double resolution, const Pos
     throw std::invalid_argument("OccupancyGrid: more than 1e9 cells requested");
   }
   check_resolution(resolution);
+  check_cell_value(fill);
   cells_ = cv::Mat(height, width, CV_8SC1, cv::Scalar(fill));
   set_origin(origin);
 }
@@ -67,6 +76,7 @@ std::int8_t OccupancyGrid::at(int cx, int cy) const {
 
 void OccupancyGrid::set(int cx, int cy, std::int8_t v) {
   at(cx, cy);  // bounds check
+  check_cell_value(v);
   cells_.ptr<std::int8_t>(cy)[cx] = v;
 }
 

@@ -26,7 +26,7 @@ struct CellIndex {
 /// map origin, yaw included). Cells are stored in a CV_8SC1 cv::Mat indexed (row = y, col = x).
 class OccupancyGrid {
  public:
-  /// A width x height grid filled with one value.
+  /// A width x height grid filled with one value (in -1..100, else std::invalid_argument).
   OccupancyGrid(int width, int height, double resolution, const Pose2& origin = {},
                 std::int8_t fill = kUnknown);
   /// Wraps existing cells (CV_8SC1); the matrix buffer is shared, not copied.
@@ -44,6 +44,7 @@ class OccupancyGrid {
   bool contains(const CellIndex& c) const { return contains(c.x, c.y); }
   /// Cell value; throws std::out_of_range outside the grid.
   std::int8_t at(int cx, int cy) const;
+  /// Sets a cell; std::invalid_argument for a value outside -1..100.
   void set(int cx, int cy, std::int8_t value);
   /// Unchecked access for hot loops (the caller guarantees contains(cx, cy)).
   std::int8_t value(int cx, int cy) const { return cells_.ptr<std::int8_t>(cy)[cx]; }
