@@ -10,10 +10,13 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import shutil
+import signal
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +42,9 @@ fill() { head -c 1G /dev/zero >"$DISK/filler" 2>/dev/null || true; }
 free() { truncate -s -$(( $1 * PAGE )) "$DISK/filler"; }
 snap() { mkdir "$OUT/$1"; tar -C "$DISK" --exclude=./filler -cf - . | tar -C "$OUT/$1" -xf -; }
 """
+
+
+PROGRESS = r"[\w-]+: +(\d+%\|.*\| )?\d+(/\d+)? ?(step|trial)?s? ?\[.*\]"  # a tqdm update
 
 
 def _namespace_refusal() -> str | None:
@@ -84,17 +90,20 @@ class Steps:
         return int((self.out / f"{name}.rc").read_text())
 
     def err(self, name: str) -> str:
-        return (self.out / f"{name}.err").read_text()
+        return (self.out / f"{name}.err").read_bytes().decode()  # keeps the \r of a bar
 
     def stdout(self, name: str) -> str:
         return (self.out / f"{name}.out").read_text()
 
     def one_line_error(self, name: str, *needles: str) -> str:
-        """The step failed with exit status 1 and one line (no traceback) naming `needles`."""
+        """The step failed with exit status 1 and one line (no traceback) naming `needles`;
+        besides it, stderr holds only a progress bar's carriage-return updates."""
         err = self.err(name)
         assert self.rc(name) == 1, err
-        lines = err.strip().splitlines()
-        assert len(lines) == 1 and lines[0].startswith("kiseki: error: "), err
+        lines = re.findall(r"kiseki: error: [^\r\n]*", err)
+        assert len(lines) == 1 and "Traceback" not in err, err
+        rest = re.split(r"[\r\n]+", err.replace(lines[0], ""))
+        assert all(re.fullmatch(PROGRESS, part) for part in rest if part), err
         for needle in needles:
             assert needle in lines[0], lines[0]
         return lines[0]
@@ -170,7 +179,7 @@ def test_a_full_disk_while_saving_a_map_keeps_the_saved_map(tmp_path, namespace)
         "256k",
     )
     assert steps.rc("first") == 0, steps.err("first")
-    line = steps.one_line_error("full", str(steps.disk / "m.pgm"), "disk full")
+    line = steps.one_line_error("full", f"{steps.disk / 'm.pgm'}: no space left on device")
     assert ".m." not in line  # the temporary file is not named
     before = digests(steps.out / "before")
     assert sorted(before) == ["m.pgm", "m.yaml"]
@@ -193,3 +202,224 @@ def test_a_full_disk_while_saving_a_map_keeps_the_saved_map(tmp_path, namespace)
         n = {"n.yaml": old["n.yaml"], "n.pgm": old["n.pgm"]} if r["errors"][1] is None else {}
         assert files == m | n, r["free"]
     assert {r["errors"][0] is None for r in results} == {True, False}  # both outcomes drawn
+
+
+CHUNK = 128 * 1024  # kiseki.sim.mcap_log.DEFAULT_CHUNK_SIZE: the most a kill or full disk loses
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory) -> Path:
+    """The factory corridor with a route of 5 m instead of 13 m (about 110 steps)."""
+    text = (ROOT / "data" / "worlds" / "factory_corridor.yaml").read_text()
+    route = "waypoints: [[0.0, 0.0], [7.4, 0.0], [13.0, 0.0]]"
+    assert route in text
+    path = tmp_path_factory.mktemp("scene") / "short_corridor.yaml"
+    path.write_text(text.replace(route, "waypoints: [[0.0, 0.0], [2.5, 0.0], [5.0, 0.0]]"))
+    return path
+
+
+@pytest.fixture(scope="module")
+def taught(tmp_path_factory, scene) -> dict:
+    """An uninterrupted teaching run with the CLI's default seed: its folder, marks, poses."""
+    from kiseki.sim.mcap_log import read_run
+    from kiseki.sim.scene import load_scene
+    from kiseki.teach import teach
+
+    result = teach(load_scene(scene), tmp_path_factory.mktemp("taught") / "t", seed=0)
+    assert [m["name"] for m in result.marks] == ["P0", "P1", "P2"]
+    poses = read_run(result.log).poses("/ground_truth")[1]
+    return {
+        "folder": result.log.parent,
+        "marks": result.marks,
+        "poses": poses,
+        "steps": result.steps,
+    }
+
+
+def check_taught_prefix(folder: Path, stdout: str, taught: dict) -> int:
+    """A folder rebuilt from a cut teaching log holds the uninterrupted run's first steps: its
+    logged poses and its waypoints exactly; returns the number of steps."""
+    import warnings
+
+    import yaml
+
+    from kiseki.sim.mcap_log import TruncatedRunWarning, read_run
+
+    steps = int(re.search(r"(\d+) steps", stdout.replace("\n", " ")).group(1))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TruncatedRunWarning)
+        poses = read_run(folder / "teach.mcap").poses("/ground_truth")[1]
+    assert steps <= len(poses) <= steps + 1  # a step's pose is logged before its images
+    np.testing.assert_array_equal(poses, taught["poses"][: len(poses)])
+    marks = yaml.safe_load((folder / "waypoints.yaml").read_text())["waypoints"]
+    assert marks == taught["marks"][: len(marks)]
+    # no more than the chunk being written is lost
+    per_step = (taught["folder"] / "teach.mcap").stat().st_size / taught["steps"]
+    assert steps * per_step >= (folder / "teach.mcap").stat().st_size - 2 * CHUNK
+    return steps
+
+
+def test_a_full_disk_while_teaching_keeps_the_steps_taught(tmp_path, namespace, scene, taught):
+    steps = Steps(
+        tmp_path,
+        f"""
+        run teach $KISEKI teach {scene} -o "$DISK/t"
+        snap full
+        mount -o remount,size=64m "$DISK"
+        run resume $KISEKI teach {scene} -o "$DISK/t" --resume
+        snap resumed
+        """,
+        "1m",
+    )
+    steps.one_line_error("teach", f"{steps.disk}/t/teach.mcap: no space left", "--resume")
+    full = digests(steps.out / "full")
+    assert list(full) == ["t/teach.mcap"]  # no map, no temporary file
+    assert steps.rc("resume") == 0, steps.err("resume")
+    resumed = steps.out / "resumed" / "t"
+    assert digests(resumed)["teach.mcap"] == full["t/teach.mcap"]  # --resume only reads it
+    n = check_taught_prefix(resumed, steps.stdout("resume"), taught)
+    assert 0 < n < taught["steps"]
+
+
+def test_a_full_disk_while_rebuilding_a_taught_run_keeps_it(tmp_path, namespace, scene, taught):
+    # --resume --merge evidence rebuilds other maps; with a seeded number of pages free (less
+    # than the 20 its six files take together: one map's image takes 8) it fails part-way and
+    # must leave the run as it was
+    frees = np.random.default_rng(2).choice(20, 2, replace=False)
+    steps = Steps(
+        tmp_path,
+        f"""
+        cp -a {taught["folder"]} "$DISK/t"
+        for free in {" ".join(map(str, frees))}; do
+            rm -f "$DISK/filler"
+            fill
+            free $free
+            run resume$free $KISEKI teach {scene} -o "$DISK/t" --resume --merge evidence
+        done
+        snap after
+        """,
+        "8m",
+    )
+    for free in frees:
+        steps.one_line_error(f"resume{free}", f"{steps.disk}/t/", "no space left on device")
+    assert digests(steps.out / "after" / "t") == digests(taught["folder"])
+
+
+def test_kill_9_while_teaching_keeps_the_steps_taught(tmp_path, scene, taught):
+    # killed once the log has grown to a seeded share of the uninterrupted run's log
+    size = (taught["folder"] / "teach.mcap").stat().st_size
+    share = np.random.default_rng(11).uniform(0.1, 0.8)
+    cli = [*KISEKI.split(), "teach", str(scene), "-o", str(tmp_path / "t")]
+    proc = subprocess.Popen(cli, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    log = tmp_path / "t" / "teach.mcap"
+    deadline = time.monotonic() + 120
+    while proc.poll() is None and time.monotonic() < deadline:
+        if log.exists() and log.stat().st_size >= share * size:
+            break
+        time.sleep(0.01)
+    os.kill(proc.pid, signal.SIGKILL)
+    assert proc.wait() == -signal.SIGKILL  # killed mid-run, not finished
+    killed = digests(tmp_path / "t")
+    assert list(killed) == ["teach.mcap"]
+    done = subprocess.run([*cli, "--resume"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert digests(tmp_path / "t")["teach.mcap"] == killed["teach.mcap"]
+    n = check_taught_prefix(tmp_path / "t", done.stdout, taught)
+    assert n * size / taught["steps"] >= share * size - 2 * CHUNK
+
+
+SWEEP = ["corridor-scans", "--runs", "4", "--seed", "3"]
+
+
+@pytest.fixture(scope="module")
+def swept(tmp_path_factory) -> Path:
+    """An uninterrupted experiment sweep (about 0.4 s a trial)."""
+    out = tmp_path_factory.mktemp("swept") / "e"
+    done = subprocess.run(
+        [*KISEKI.split(), "experiment", "run", *SWEEP, "--out", str(out)],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    return out
+
+
+def same_results(run: Path, reference: Path) -> None:
+    import pandas as pd
+
+    for name in ("trials.parquet", "claims.csv"):
+        assert (run / name).read_bytes() == (reference / name).read_bytes(), name
+    assert not [p.name for p in run.rglob(".*")]  # no temporary file or folder
+    assert sorted(p.name for p in (run / "figures").iterdir()) == ["precision_vs_offset.png"]
+    pd.testing.assert_frame_equal(
+        pd.read_csv(run / "tables" / "summary.csv"),
+        pd.read_csv(reference / "tables" / "summary.csv"),
+    )
+
+
+def test_kill_9_in_an_experiment_sweep_keeps_the_finished_trials(tmp_path, swept):
+    # killed a seeded share of a trial after a seeded number of trials has finished
+    rng = np.random.default_rng(23)
+    after, share = int(rng.integers(1, 4)), rng.uniform(0.0, 1.0)
+    import pandas as pd
+
+    per_trial = pd.read_parquet(swept / "timings.parquet")["trial_seconds"].mean()
+    cli = [*KISEKI.split(), "experiment", "run"]
+    proc = subprocess.Popen(
+        [*cli, *SWEEP, "--out", str(tmp_path / "e")],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    log = tmp_path / "e" / "trials.jsonl"
+    deadline = time.monotonic() + 120
+    while proc.poll() is None and time.monotonic() < deadline:
+        if log.exists() and log.read_bytes().count(b"\n") >= after:
+            time.sleep(share * per_trial)
+            break
+        time.sleep(0.005)
+    os.kill(proc.pid, signal.SIGKILL)
+    assert proc.wait() == -signal.SIGKILL
+    kept = log.read_bytes()
+    finished = kept.count(b"\n")
+    assert after <= finished <= 4
+    resumed = subprocess.run(
+        [*cli, "corridor-scans", "--resume", "--out", str(tmp_path / "e")],
+        capture_output=True,
+        text=True,
+    )
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"({4 - finished} run now" in resumed.stdout.replace("\n", " ")
+    assert log.read_bytes().startswith(kept)  # the finished trials kept as they were
+    same_results(tmp_path / "e", swept)
+
+
+def test_a_full_disk_in_an_experiment_keeps_trials_and_results(tmp_path, namespace, swept):
+    # two pages free: the config and the trial log fit, the results do not; then, with the
+    # results written, a full disk while writing them again must leave them as they were
+    run = '$KISEKI experiment run corridor-scans --resume --out "$DISK/e"'
+    steps = Steps(
+        tmp_path,
+        f"""
+        fill
+        free 2
+        run full $KISEKI experiment run {" ".join(SWEEP)} --out "$DISK/e"
+        snap full
+        rm "$DISK/filler"
+        run resume {run}
+        snap done
+        fill
+        run again {run}
+        snap again
+        """,
+        "1m",
+    )
+    line = steps.one_line_error("full", f"{steps.disk}/e", "No space left on device", "--resume")
+    assert "/." not in line  # no temporary name
+    full = digests(steps.out / "full")
+    assert sorted(full) == ["e/config.yaml", "e/trials.jsonl"]  # nothing half-written
+    assert (steps.out / "full" / "e" / "trials.jsonl").read_bytes().count(b"\n") == 4
+    assert steps.rc("resume") == 0, steps.err("resume")
+    assert "(0 run now" in steps.stdout("resume").replace("\n", " ")
+    same_results(steps.out / "done" / "e", swept)
+    steps.one_line_error("again", f"{steps.disk}/e", "No space left on device")
+    assert digests(steps.out / "again") == digests(steps.out / "done")

@@ -7,6 +7,9 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import shutil
+import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
@@ -15,7 +18,7 @@ import pandas as pd
 from rich.console import Console
 from rich.table import Table
 
-from kiseki._atomic import atomic_write
+from kiseki._atomic import atomic_write, atomic_write_all
 from kiseki.experiments.base import CLAIM_COLUMNS, Analysis, Claim, Experiment
 from kiseki.experiments.registry import all_experiments
 
@@ -85,11 +88,22 @@ def claims_table(title: str, claims: pd.DataFrame) -> Table:
     return table
 
 
+def _frames(trials, timings, run_dir: Path) -> list:
+    return [
+        (run_dir / "trials.parquet", lambda tmp: trials.to_parquet(tmp, index=False)),
+        (run_dir / "timings.parquet", lambda tmp: timings.to_parquet(tmp, index=False)),
+    ]
+
+
+def _texts(items: dict[Path, str]) -> list:
+    return [
+        (path, lambda tmp, text=text: Path(tmp).write_text(text, encoding="utf-8"))
+        for path, text in items.items()
+    ]
+
+
 def _write_frames(trials, timings, run_dir: Path) -> None:
-    trials.to_parquet(run_dir / ".trials.parquet.tmp", index=False)
-    (run_dir / ".trials.parquet.tmp").replace(run_dir / "trials.parquet")
-    timings.to_parquet(run_dir / ".timings.parquet.tmp", index=False)
-    (run_dir / ".timings.parquet.tmp").replace(run_dir / "timings.parquet")
+    atomic_write_all(_frames(trials, timings, run_dir))
 
 
 def write_failed_outputs(experiment, trials, timings, manifest, run_dir: Path) -> str:
@@ -116,17 +130,48 @@ def write_failed_outputs(experiment, trials, timings, manifest, run_dir: Path) -
     return first
 
 
+def _results_error(err: OSError, experiment: Experiment, run_dir: Path) -> OSError:
+    """A failure to write the results, naming the file (or the run) and what is kept."""
+    reason = err.strerror or str(err)
+    where = f"{err.filename}: {reason}" if err.filename else reason
+    if str(run_dir) not in where:
+        where = f"{run_dir}: {where}"
+    out = type(err)(
+        f"{where}; the finished trials are kept in trials.jsonl (kiseki experiment run "
+        f"{experiment.name} --resume --out {run_dir} writes the results once this is fixed)"
+    )
+    out.errno = err.errno
+    return out
+
+
 def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) -> pd.DataFrame:
-    _write_frames(trials, timings, run_dir)
+    """Writes every output to a temporary name (figures to a hidden folder) and moves them
+    into place once all are complete: a failure part-way (a full disk) leaves the previous
+    outputs as they were and nothing half-written."""
+    for stale in run_dir.glob(".figures.*"):  # left by a run killed while drawing
+        shutil.rmtree(stale, ignore_errors=True)
     (run_dir / "tables").mkdir(exist_ok=True)
     (run_dir / "figures").mkdir(exist_ok=True)
-    analysis = experiment.analyze(config, trials, timings, run_dir / "figures")
-    for name, table in analysis.tables.items():
-        _text(run_dir / "tables" / f"{name}.csv", table.to_csv(index=False))
-    claims = _claims_frame(analysis.claims)
-    _text(run_dir / "claims.csv", claims.to_csv(index=False))
-    _text(run_dir / "report.md", _report(experiment, analysis, manifest, claims))
-    _text(run_dir / "manifest.json", json.dumps(manifest, indent=2))
+    drawn = Path(tempfile.mkdtemp(dir=run_dir, prefix=".figures."))
+    try:
+        analysis = experiment.analyze(config, trials, timings, drawn)
+        claims = _claims_frame(analysis.claims)
+        texts = {
+            run_dir / "tables" / f"{n}.csv": t.to_csv(index=False)
+            for n, t in analysis.tables.items()
+        }
+        texts[run_dir / "claims.csv"] = claims.to_csv(index=False)
+        texts[run_dir / "report.md"] = _report(experiment, analysis, manifest, claims)
+        texts[run_dir / "manifest.json"] = json.dumps(manifest, indent=2)
+        atomic_write_all(_frames(trials, timings, run_dir) + _texts(texts))
+        for path in sorted(p for p in drawn.rglob("*") if p.is_file()):
+            target = run_dir / "figures" / path.relative_to(drawn)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(path, target)
+    except OSError as err:
+        raise _results_error(err, experiment, run_dir) from err
+    finally:
+        shutil.rmtree(drawn, ignore_errors=True)
     Console().print(claims_table(f"{experiment.name}: claims ({run_dir})", claims))
     if manifest["trials_failed"]:
         Console().print(

@@ -5,6 +5,7 @@ flushed and synced as soon as the trial ends, so a killed run loses no finished 
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 from pathlib import Path
@@ -42,11 +43,24 @@ class TrialLog:
         return done
 
     def append(self, entry: dict[str, Any]) -> None:
+        """Appends one trial; on a failure (a full disk) the log is cut back to its finished
+        trials and the error names it."""
         line = json.dumps(entry, allow_nan=True) + "\n"  # keeps the record's key order
-        with self.path.open("a", encoding="utf-8") as f:
-            f.write(line)
-            f.flush()
-            os.fsync(f.fileno())
+        size = self.path.stat().st_size if self.path.exists() else 0
+        try:
+            with self.path.open("a", encoding="utf-8") as f:
+                f.write(line)
+                f.flush()
+                os.fsync(f.fileno())
+        except OSError as err:
+            with contextlib.suppress(OSError):
+                os.truncate(self.path, size)
+            out = type(err)(
+                f"{self.path}: {err.strerror or err}; the trials finished before are kept "
+                "(--resume runs the others)"
+            )
+            out.errno = err.errno
+            raise out from err
 
     @staticmethod
     def frames(entries: dict[int, dict[str, Any]]) -> tuple[pd.DataFrame, pd.DataFrame]:

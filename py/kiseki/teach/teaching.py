@@ -10,6 +10,7 @@ under a second at 10 Hz).
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import math
@@ -21,12 +22,12 @@ import numpy as np
 import yaml
 from tqdm import tqdm
 
-from kiseki._atomic import atomic_write
+from kiseki._atomic import atomic_write_all
 from kiseki._yaml import read_yaml_file
 from kiseki.control import PurePursuit
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
-from kiseki.map_io import save_map
+from kiseki.map_io import map_files
 from kiseki.metrics import taught_map_truth
 from kiseki.sim.mcap_log import RunWriter, read_run
 from kiseki.sim.scene import Scene
@@ -124,21 +125,36 @@ def _write_outputs(
     merge: str,
     truth: dict | None,
 ) -> TeachResult:
-    paths = {band: save_map(grid, out / f"map_{band}.yaml") for band, grid in maps.items()}
+    """Every file is written before any replaces its previous version (a full disk leaves the
+    previous maps and waypoint file as they were, consistent with one another)."""
+    paths = {band: out / f"map_{band}.yaml" for band in maps}
+    writes, digests = [], {}
+    for band, grid in maps.items():
+        (image, write_image), yaml_file = map_files(grid, paths[band])
+
+        def hashed(tmp: str, band=band, write_image=write_image) -> None:
+            write_image(tmp)
+            digests[band] = hashlib.sha1(Path(tmp).read_bytes()).hexdigest()
+
+        writes += [(image, hashed), yaml_file]
     if truth is not None:
-        text = json.dumps({"merge": merge, "maps": truth}, indent=2)
-        atomic_write(out / "map_truth.json", lambda tmp: Path(tmp).write_text(text, "utf-8"))
-    doc = {
-        "log": log.name,
-        "merge": merge,
-        "maps": {
-            band: {"file": p.name, "image_sha1": waypoints_file_hash(p)}
-            for band, p in paths.items()
-        },
-        "waypoints": marks,
-    }
-    text = yaml.safe_dump(doc, sort_keys=False)
-    atomic_write(out / "waypoints.yaml", lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+        truth_text = json.dumps({"merge": merge, "maps": truth}, indent=2)
+        writes.append(
+            (out / "map_truth.json", lambda tmp: Path(tmp).write_text(truth_text, "utf-8"))
+        )
+
+    def waypoints(tmp: str) -> None:  # after the images: it records their digests
+        doc = {
+            "log": log.name,
+            "merge": merge,
+            "maps": {
+                band: {"file": p.name, "image_sha1": digests[band]} for band, p in paths.items()
+            },
+            "waypoints": marks,
+        }
+        Path(tmp).write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
+
+    atomic_write_all([*writes, (out / "waypoints.yaml", waypoints)])
     return TeachResult(paths, out / "waypoints.yaml", log, steps, marks, merge, truth)
 
 
@@ -195,7 +211,7 @@ class TeachingRun:
         try:
             self._record()
         except BaseException:
-            self._writer.close()
+            self._close_after_error()
             raise
 
     @property
@@ -224,11 +240,14 @@ class TeachingRun:
 
     def _record(self) -> None:
         t, truth, odom = self.steps * self.dt, self.truth, self.odom
-        self._writer.write_pose("/ground_truth", t, truth)
-        self._writer.write_odometry("/odom", t, odom)
         images = [c.device.render(self.scene.world, truth) for c in self.cameras]
-        for c, image in zip(self.cameras, images, strict=True):
-            self._writer.write_depth_image(f"/{c.name}", t, image, c.name)
+        try:
+            self._writer.write_pose("/ground_truth", t, truth)
+            self._writer.write_odometry("/odom", t, odom)
+            for c, image in zip(self.cameras, images, strict=True):
+                self._writer.write_depth_image(f"/{c.name}", t, image, c.name)
+        except OSError as err:  # a full disk: what was logged before stays readable
+            raise self._log_error(err) from err
         _integrate(self.maps, self.makers, images, odom)
         self.truths.append(truth)
         self.steps += 1
@@ -248,8 +267,27 @@ class TeachingRun:
         self._writer.write_json("/waypoints", self.t, "kiseki.WaypointMark", mark, MARK_SCHEMA)
         return mark
 
+    def _log_error(self, err: OSError) -> OSError:
+        """The error of writing the log, naming it and saying what is kept."""
+        reason = err.strerror or str(err)
+        out = type(err)(
+            f"{self.log}: {reason[:1].lower()}{reason[1:]}; the steps logged before are kept "
+            "(kiseki teach --resume rebuilds the maps from them once there is space)"
+        )
+        out.errno = err.errno
+        return out
+
+    def _close_after_error(self) -> None:
+        """Closes the log after an error without hiding it (on a full disk, closing fails
+        too)."""
+        with contextlib.suppress(OSError):
+            self._writer.close()
+
     def close(self) -> None:
-        self._writer.close()
+        try:
+            self._writer.close()
+        except OSError as err:
+            raise self._log_error(err) from err
 
     def finish(self) -> TeachResult:
         """Closes the log and writes the maps, the waypoint file and the maps measured
@@ -262,8 +300,11 @@ class TeachingRun:
     def __enter__(self) -> TeachingRun:
         return self
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    def __exit__(self, exc_type, *exc) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self._close_after_error()
 
 
 def teach(
