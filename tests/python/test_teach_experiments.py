@@ -1,0 +1,85 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The exp1-corridor and exp3-boxes experiments from the CLI, with few trials on a 3 m
+corridor (the factory corridor's route shortened, P0 -> P1 -> P2): every claim and table
+recomputed from the raw trials, the 0.1 m stop rule met in every run, and the unknown boxes
+really in the played-back world."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+
+import pandas as pd
+import pytest
+import yaml
+
+from kiseki.core import derive_seed
+
+
+@pytest.fixture
+def short_corridor(tmp_path, project_root):
+    doc = yaml.safe_load((project_root / "data" / "worlds" / "factory_corridor.yaml").read_text())
+    doc["route"]["waypoints"] = [[0.0, 0.0], [1.5, 0.0], [3.0, 0.0]]
+    path = tmp_path / "short_corridor.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    return path
+
+
+def run(name: str, runs: int, scene, cwd) -> tuple[pd.DataFrame, pd.DataFrame]:
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "experiment", "run", name, "--runs", str(runs)]
+        + ["--seed", "0", "--set", f"scene={scene}", "--set", "particles=200", "--out", "r"],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    trials = pd.read_parquet(cwd / "r" / "trials.parquet")
+    assert trials["error"].isna().all() and len(trials) == runs
+    assert list(trials["seed"]) == [derive_seed(0, i) for i in range(runs)]
+    return trials, pd.read_csv(cwd / "r" / "claims.csv").set_index("claim")
+
+
+def test_exp1_corridor_claims_follow_from_its_trials(tmp_path, short_corridor):
+    trials, claims = run("exp1-corridor", 2, short_corridor, tmp_path)
+    stop = trials["proposal2_stop_error"]
+    assert (stop <= 0.1).all() and (trials["proposal2_reached"]).all()  # the thesis' rule
+    # the stop error is the distance of the true rest from where P2 was taught
+    dx, dy = trials["proposal2_stop_dx"], trials["proposal2_stop_dy"]
+    assert stop.tolist() == pytest.approx((dx**2 + dy**2) ** 0.5)
+    row = claims.loc["all stops within 0.1 m of P2"]
+    assert row["measured_value"] == f"{(stop <= 0.1).sum()}/2" and row["holds"]
+    loc = [trials[f"proposal2_P2_loc_{a}"].mean() for a in ("dx", "dy")]
+    odo = [trials[f"proposal2_P2_odo_{a}"].mean() for a in ("dx", "dy")]
+    row = claims.loc["localization error at P2 smaller than odometry error"]
+    assert row["measured_value"] == (
+        f"({loc[0]:+.3f}, {loc[1]:+.3f}) vs ({odo[0]:+.3f}, {odo[1]:+.3f})"
+    )
+    assert row["holds"] == (math.hypot(*loc) < math.hypot(*odo))
+    row = claims.loc["odometry error at P2 is mostly sideways"]
+    assert row["holds"] == (abs(odo[1]) > abs(odo[0]))
+    table = pd.read_csv(tmp_path / "r" / "tables" / "errors_at_waypoints.csv").set_index("point")
+    for point in ("P1", "P2"):
+        for kind in ("loc", "odo"):
+            for axis in ("dx", "dy"):
+                mean = trials[f"proposal2_{point}_{kind}_{axis}"].mean()
+                assert table.loc[point, f"{kind}_{axis}_mean"] == pytest.approx(mean, abs=1e-12)
+
+
+def test_exp3_boxes_are_in_the_played_back_world(tmp_path, short_corridor):
+    trials, claims = run("exp3-boxes", 1, short_corridor, tmp_path)
+    t = trials.iloc[0]
+    assert t["proposal2_stop_error"] <= 0.1 and t["proposal2_reached"]
+    assert 0 <= t["final_leg_boxes_left"] + t["final_leg_boxes_right"] <= 3
+    # the control run (same teaching and seeds, no boxes) stops elsewhere: the cameras saw them
+    with_boxes = (t["proposal2_stop_dx"], t["proposal2_stop_dy"])
+    without = (t["proposal2_nobox_stop_dx"], t["proposal2_nobox_stop_dy"])
+    assert with_boxes != without
+    row = claims.loc["proposal 2 with unknown boxes: stop error mean"]
+    assert row["measured_value"].startswith(f"{t['proposal2_stop_error']:.3f} ")
+    assert row["holds"] == (t["proposal2_stop_error"] <= 0.09)
+    row = claims.loc["proposal 2 with unknown boxes: estimate error mean"]
+    assert row["measured_value"] == f"{t['proposal2_estimate_error']:.3f}"
+    assert row["holds"] == (t["proposal2_estimate_error"] <= 0.08)
