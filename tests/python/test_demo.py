@@ -5,8 +5,14 @@ is deterministic for a seed."""
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
+import yaml
 from rich.console import Console
 
 from kiseki import load_map
@@ -54,3 +60,40 @@ def test_corridor_laser_noise_is_seeded_and_has_its_sd(project_data):
     assert np.array_equal(r1, r2) and not np.array_equal(r1, r3)
     noise = (r1 - r3)[(r1 < 30) & (r3 < 30)]
     assert abs(noise.std() - np.sqrt(2) * 0.01) < 0.001  # two independent N(0, 0.01) draws
+
+
+def test_demo_from_the_cli_prints_what_it_saved(tmp_path, project_root):
+    """`kiseki demo` on the corridor shortened to 3 m (P0, P1, P2), 200 particles: every printed
+    figure is the saved summary's, every stop within the 0.1 m rule."""
+    doc = yaml.safe_load((project_root / "data" / "worlds" / "factory_corridor.yaml").read_text())
+    doc["route"]["waypoints"] = [[0.0, 0.0], [1.5, 0.0], [3.0, 0.0]]
+    (tmp_path / "short.yaml").write_text(yaml.safe_dump(doc))
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "demo", "--scene", "short.yaml", "--out", "d"]
+        + ["--particles", "200", "--seed", "3"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        env={**os.environ, "COLUMNS": "200"},
+    )
+    assert done.returncode == 0, done.stderr
+    summary = json.loads((tmp_path / "d" / "summary.json").read_text())
+    config = yaml.safe_load((tmp_path / "d" / "config.yaml").read_text())
+    assert (config["particles"], config["seed"], config["scene"]) == (200, 3, "short.yaml")
+    assert summary["waypoints"] == ["P0", "P1", "P2"] and summary["teaching_steps"] > 0
+    rows = {
+        cells[0]: cells[1:]
+        for line in done.stdout.splitlines()
+        if line.startswith("│")
+        for cells in [[c.strip() for c in line.strip("│").split("│")]]
+    }
+    for method, r in summary["playback"].items():
+        assert r["reached"] and r["stop_error_m"] <= 0.1 and r["estimate_error_m"] <= 0.1
+        # method | stop (thesis) | kiseki | estimate (thesis) | kiseki | within (thesis) | kiseki
+        printed = rows[method]
+        assert printed[1] == f"{r['stop_error_m']:.3f}"
+        assert printed[3] == f"{r['estimate_error_m']:.3f}" and printed[5] == "yes"
+    for band, shares in summary["taught_map_truth"].items():
+        printed = rows[band]  # map | obstacle cells | erased | visible free cells | occupied
+        assert printed[1] == f"{100 * shares['erased_share']:.1f} %"
+        assert printed[3] == f"{100 * shares['false_occupied_share']:.1f} %"
