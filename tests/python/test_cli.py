@@ -13,6 +13,7 @@ import yaml
 
 import kiseki
 from kiseki import OccupancyGrid, Pose2, save_map
+from pixels import largest_blob, rgb
 
 
 def run(*args: str, cwd=None) -> subprocess.CompletedProcess:
@@ -30,21 +31,31 @@ def test_version():
 
 def test_map_info_and_render(tmp_path):
     cells = np.zeros((20, 30), dtype=np.int8)
-    cells[5, :] = 100
+    cells[5, 3:27] = 100  # a wall 2.4 m long, clear of the map edges (and the frame)
     cells[15:, :3] = -1
     path = save_map(OccupancyGrid(cells, 0.1, Pose2(1.0, 2.0, 0.0)), tmp_path / "m.yaml")
     done = run("map", "info", str(path))
     assert done.returncode == 0, done.stderr
     assert "30" in done.stdout and "occupied" in done.stdout
     occupied_row = [line for line in done.stdout.splitlines() if " occupied " in line]
-    assert occupied_row and occupied_row[0].split("│")[2].strip() == "30"
-    (tmp_path / "path.csv").write_text("t,x,y,theta\n0,1.5,2.5,0\n1,3.0,3.0,0.5\n")
+    assert occupied_row and occupied_row[0].split("│")[2].strip() == "24"
+    (tmp_path / "path.csv").write_text("t,x,y,theta\n0,1.5,3.0,0\n1,3.0,3.2,0.5\n")
     png = tmp_path / "m.png"
     done = run(
         "map", "render", str(path), "-o", str(png), "--trajectory", str(tmp_path / "path.csv")
     )
     assert done.returncode == 0, done.stderr
-    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # what is drawn: the wall (2.4 x 0.1 m, y 2.5-2.6) black, the unknown corner (x 1.0-1.3,
+    # y 3.5-4.0) grey, both at one scale and the corner up and left of the wall's middle
+    image = rgb(png)
+    wall, wall_size = largest_blob(image, (0, 0, 0))
+    corner, corner_size = largest_blob(image, (199, 199, 199), tol=3)
+    scale = wall_size[0] / 2.4
+    assert scale > 100 and wall_size[1] == pytest.approx(0.1 * scale, abs=2)
+    np.testing.assert_allclose(corner_size, scale * np.array([0.3, 0.5]), atol=3)
+    np.testing.assert_allclose(
+        corner, wall + scale * np.array([1.15 - 2.5, -(3.75 - 2.55)]), atol=3
+    )
 
 
 @pytest.mark.parametrize(
