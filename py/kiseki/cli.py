@@ -358,6 +358,8 @@ def sim_run(
     if (controller == "commands") != (commands is not None):
         raise ValueError("--commands FILE goes with --controller commands, and only with it")
     check_outputs({"--output": output}, {"SCENE": scene_file, "--commands": commands})
+    if output.exists() and not overwrite:
+        raise FileExistsError(f"--output {output} exists: give --overwrite to replace it")
     script = read_commands(commands) if commands is not None else None
     scene = load_scene(scene_file, variant)
     try:
@@ -614,7 +616,6 @@ def playback_command(
     """Play a taught route back on the particle filter's estimate; stop within 0.1 m of the goal.
     Give the teaching folder (--taught) or its waypoint file (--waypoints, and --map for a map
     other than the one named there)."""
-    import math
 
     from kiseki.map_io import load_map
     from kiseki.sim.scene import load_scene
@@ -641,16 +642,7 @@ def playback_command(
     scene, environment = load_scene(scene_file, "playback"), load_map(map_path)
     limiter = _speed_limiter(speed_limit, scene, environment, config.speed)
     result = playback(scene, environment, marks, config, limiter, log)
-    goal = marks[-1]
-    tx, ty, _ = result.stop_true
-    ex, ey, _ = result.stop_estimate
-    console.print(
-        f"{method}: stopped after {result.steps} steps; estimated stop ({ex:.3f}, {ey:.3f}) in the "
-        f"map, {math.hypot(ex - goal['x'], ey - goal['y']):.3f} m from {goal['name']}; true stop "
-        f"({tx:.3f}, {ty:.3f}), {math.hypot(tx - goal['truth'][0], ty - goal['truth'][1]):.3f} m "
-        f"from where {goal['name']} was taught; goal reached: {result.reached}"
-        f" ({result.duration:.1f} s)"
-    )
+    console.print(_stop_summary(method, result, marks[-1]))
     if result.speed_limits is not None:
         limits = result.speed_limits
         console.print(
@@ -663,6 +655,26 @@ def playback_command(
 
 
 SPEED_LIMITS = ("none", "occlusion", "occlusion-width")
+
+
+def _stop_summary(method: str, result, goal: dict) -> str:
+    """Where a playback stopped: estimated, against the goal, and true, against where the goal
+    was taught when the waypoint file records it ('truth' is optional: a hand-made file or a
+    real robot has none)."""
+    import math
+
+    tx, ty, _ = result.stop_true
+    ex, ey, _ = result.stop_estimate
+    if "truth" in goal:
+        taught_at = f"{math.hypot(tx - goal['truth'][0], ty - goal['truth'][1]):.3f} m from"
+    else:
+        taught_at = "no true pose recorded for"
+    return (
+        f"{method}: stopped after {result.steps} steps; estimated stop ({ex:.3f}, {ey:.3f}) in the "
+        f"map, {math.hypot(ex - goal['x'], ey - goal['y']):.3f} m from {goal['name']}; true stop "
+        f"({tx:.3f}, {ty:.3f}), {taught_at} where {goal['name']} was taught; goal reached: "
+        f"{result.reached} ({result.duration:.1f} s)"
+    )
 
 
 def _speed_limiter(name: str, scene, grid, v_max: float):

@@ -252,3 +252,30 @@ def test_a_grid_refuses_cell_values_outside_the_ros_range():
             OccupancyGrid(2, 2, 0.1, Pose2(), bad)
     grid = OccupancyGrid(np.array([[0, 100], [50, -1]], np.int8), 0.1)
     assert grid.cells.tolist() == [[0, 100], [50, -1]]
+
+
+def test_sim_run_names_the_option_that_replaces_an_existing_output(inputs, project_root):
+    world = project_root / "data" / "worlds" / "factory_corridor.yaml"
+    before = digests(inputs)
+    line = one_error(run("sim", "run", world, "-o", "log.mcap", cwd=inputs))
+    assert line == "kiseki: error: --output log.mcap exists: give --overwrite to replace it"
+    assert digests(inputs) == before  # the old message named a Python argument (overwrite=True)
+
+
+def test_a_playback_to_a_waypoint_without_truth_reports_its_stop():
+    """'truth' is optional in a waypoint file: the summary printed after the whole playback
+    raised KeyError: 'truth' (a traceback after the work)."""
+    from types import SimpleNamespace
+
+    from kiseki.cli import _stop_summary
+
+    result = SimpleNamespace(
+        steps=120, stop_true=(7.43, 0.04, 0.0), stop_estimate=(7.38, 0.0, 0.0), reached=True,
+        duration=12.0,
+    )  # fmt: skip
+    goal = {"name": "P1", "x": 7.4, "y": 0.0, "theta": 0.0}
+    text = _stop_summary("proposal2", result, goal)
+    assert "0.020 m from P1" in text and "no true pose recorded for where P1 was taught" in text
+    goal["truth"] = [7.4, 0.0, 0.0]
+    text = _stop_summary("proposal2", result, goal)
+    assert f"{np.hypot(0.03, 0.04):.3f} m from where P1 was taught" in text  # 0.050
