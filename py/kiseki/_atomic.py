@@ -12,7 +12,7 @@ import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-__all__ = ["atomic_write", "atomic_write_all"]
+__all__ = ["atomic_write", "atomic_write_all", "check_writable_folder"]
 
 
 def _umask() -> int:
@@ -74,3 +74,19 @@ def atomic_write(target: str | os.PathLike, write: Callable[[str], object]) -> P
     """Calls ``write(tmp_path)`` on a temporary file beside ``target`` (same suffix, so that
     writers choosing the format by extension work), then renames it onto ``target``."""
     return atomic_write_all([(target, write)])[0]
+
+
+def check_writable_folder(folder: str | os.PathLike, what: str = "output") -> None:
+    """Raises PermissionError naming the folder when it, or the nearest folder above it while
+    it does not exist yet, cannot be written (a read-only filesystem, missing permission):
+    for the commands to refuse before their work rather than fail at its end."""
+    folder = Path(folder).absolute()
+    probe = folder
+    while not probe.exists() and probe.parent != probe:
+        probe = probe.parent
+    if not probe.is_dir():
+        raise NotADirectoryError(f"{folder}: {probe} is not a folder")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        read_only = bool(os.statvfs(probe).f_flag & os.ST_RDONLY)
+        why = "on a read-only filesystem" if read_only else "no write permission"
+        raise PermissionError(f"{folder}: the {what} folder is not writable ({why})")

@@ -15,6 +15,7 @@ from __future__ import annotations
 import errno
 import math
 import os
+import shutil
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -168,7 +169,11 @@ def write_image(path: str | os.PathLike, image: np.ndarray) -> None:
     except OSError:
         whole = False
     if not whole:
-        raise OSError(errno.EIO, "the image was cut short (is the disk full?)", str(path))
+        if shutil.disk_usage(Path(path).parent).free < image.nbytes:
+            raise OSError(
+                errno.ENOSPC, "No space left on device (the image was cut short)", str(path)
+            )
+        raise OSError(errno.EIO, "the image was cut short", str(path))
 
 
 def save_map(

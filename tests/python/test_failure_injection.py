@@ -245,7 +245,7 @@ def check_taught_prefix(folder: Path, stdout: str, taught: dict) -> int:
 
     from kiseki.sim.mcap_log import TruncatedRunWarning, read_run
 
-    steps = int(re.search(r"(\d+) steps", stdout.replace("\n", " ")).group(1))
+    steps = int(re.search(r"(\d+) steps", " ".join(stdout.split())).group(1))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TruncatedRunWarning)
         poses = read_run(folder / "teach.mcap").poses("/ground_truth")[1]
@@ -388,7 +388,7 @@ def test_kill_9_in_an_experiment_sweep_keeps_the_finished_trials(tmp_path, swept
         text=True,
     )
     assert resumed.returncode == 0, resumed.stderr
-    assert f"({4 - finished} run now" in resumed.stdout.replace("\n", " ")
+    assert f"({4 - finished} run now" in " ".join(resumed.stdout.split())  # rich wraps at 80
     assert log.read_bytes().startswith(kept)  # the finished trials kept as they were
     same_results(tmp_path / "e", swept)
 
@@ -419,7 +419,40 @@ def test_a_full_disk_in_an_experiment_keeps_trials_and_results(tmp_path, namespa
     assert sorted(full) == ["e/config.yaml", "e/trials.jsonl"]  # nothing half-written
     assert (steps.out / "full" / "e" / "trials.jsonl").read_bytes().count(b"\n") == 4
     assert steps.rc("resume") == 0, steps.err("resume")
-    assert "(0 run now" in steps.stdout("resume").replace("\n", " ")
+    assert "(0 run now" in " ".join(steps.stdout("resume").split())
     same_results(steps.out / "done" / "e", swept)
     steps.one_line_error("again", f"{steps.disk}/e", "No space left on device")
     assert digests(steps.out / "again") == digests(steps.out / "done")
+
+
+def test_a_read_only_results_folder_is_refused_before_any_work(
+    tmp_path, namespace, scene, taught, swept
+):
+    # a read-only filesystem (root ignores a folder's mode bits, not a read-only mount) holding
+    # a finished experiment run and a taught run, and an empty folder for new results
+    steps = Steps(
+        tmp_path,
+        f"""
+        cp -a {taught["folder"]} "$DISK/t"
+        cp -a {swept} "$DISK/e"
+        mkdir "$DISK/empty"
+        snap before
+        mount -o remount,ro "$DISK"
+        run new $KISEKI experiment run {" ".join(SWEEP)} --out "$DISK/empty/e"
+        run resume $KISEKI experiment run corridor-scans --resume --out "$DISK/e"
+        cd "$DISK/empty"
+        run default $KISEKI experiment run {" ".join(SWEEP)}
+        cd -
+        run teach $KISEKI teach {scene} -o "$DISK/empty/t"
+        run reteach $KISEKI teach {scene} -o "$DISK/t" --resume
+        run map $KISEKI map convert {MAP} -o "$DISK/empty/m.yaml"
+        snap after
+        """,
+        "16m",
+    )
+    for name in ("new", "resume", "default", "teach", "reteach", "map"):
+        line = steps.one_line_error(name, "not writable")
+        assert str(steps.disk) in line, line
+        # refused before the work: no progress bar was drawn
+        assert steps.err(name).strip() == line, steps.err(name)
+    assert digests(steps.out / "after") == digests(steps.out / "before")

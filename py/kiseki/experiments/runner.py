@@ -22,7 +22,7 @@ from typing import Any
 import yaml
 from tqdm import tqdm
 
-from kiseki._atomic import atomic_write
+from kiseki._atomic import atomic_write, check_writable_folder
 from kiseki.core import derive_seed
 from kiseki.errors import KisekiError
 from kiseki.experiments.config import (
@@ -138,6 +138,7 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
     if resume:
         run_dir = Path(out) if out else results_root / name / "latest"
         saved = _saved_run(run_dir)
+        check_writable_folder(run_dir, "results")
         if saved.get("experiment") != name:
             raise KisekiError(
                 f"{run_dir}: holds a run of {saved.get('experiment')!r}, not {name!r}"
@@ -166,6 +167,7 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
     run_dir = Path(out) if out else _results_dir(name, results_root)
     if (run_dir / "trials.jsonl").exists():
         raise KisekiError(f"{run_dir}: already holds trials: use --resume or another --out")
+    check_writable_folder(run_dir, "results")
     run_dir.mkdir(parents=True, exist_ok=True)
     saved = {"experiment": name, "runs": runs, "seed": seed, "config": config_to_dict(config)}
     text = yaml.safe_dump(saved, sort_keys=False)

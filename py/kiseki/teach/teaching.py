@@ -22,7 +22,7 @@ import numpy as np
 import yaml
 from tqdm import tqdm
 
-from kiseki._atomic import atomic_write_all
+from kiseki._atomic import atomic_write_all, check_writable_folder
 from kiseki._yaml import read_yaml_file
 from kiseki.control import PurePursuit
 from kiseki.core import Pose2
@@ -185,6 +185,7 @@ class TeachingRun:
         self.merge = merge
         self.scene, self.dt = scene, float(dt)
         self.out = Path(out)
+        check_writable_folder(self.out, "teaching")
         self.setup = build_robot(scene, seed)
         if self.setup.kind != "diff_drive":
             raise ValueError(f"{scene.path}: teaching pushes a diff_drive robot")
@@ -391,6 +392,7 @@ def recover(
 ) -> TeachResult:
     """Rebuilds the maps and waypoints of a teaching run from its MCAP log (after a crash),
     with the merge rule the run was taught with (or `merge`)."""
+    check_writable_folder(out, "teaching")
     run = read_run(log)
     _check_same_scene(run.metadata, scene, log)
     topics = run.topics()
