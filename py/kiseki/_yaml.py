@@ -23,8 +23,13 @@ _Loader12.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT_12, list("-+01
 
 
 def safe_load_12(text: str):
-    """``yaml.safe_load`` with YAML 1.2 floats (``5e-2``, ``1E3``) read as numbers."""
-    return yaml.load(text, Loader=_Loader12)  # noqa: S506 (a SafeLoader subclass)
+    """``yaml.safe_load`` with YAML 1.2 floats (``5e-2``, ``1E3``) read as numbers. A document
+    nested deeper than Python's recursion limit (``[[[[...``) raises a ``yaml.YAMLError`` like
+    any other invalid YAML (PyYAML's parser recurses once per level)."""
+    try:
+        return yaml.load(text, Loader=_Loader12)  # noqa: S506 (a SafeLoader subclass)
+    except RecursionError:
+        raise yaml.YAMLError("nested too deeply") from None
 
 
 def read_yaml_file(path, what: str):

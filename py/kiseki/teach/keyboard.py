@@ -116,7 +116,11 @@ class KeyScript:
         if not path.is_file():
             raise FileNotFoundError(f"{path}: key script not found")
         self._events: list[tuple[float, str]] = []
-        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+        try:
+            text = path.read_text(encoding="utf-8")
+        except UnicodeDecodeError:
+            raise ValueError(f"{path}: not a key script (not UTF-8 text)") from None
+        for number, line in enumerate(text.splitlines(), 1):
             fields = line.split("#", 1)[0].split()
             if not fields:
                 continue

@@ -442,7 +442,11 @@ def _check_waypoints(doc: dict, path: Path) -> None:
         raise ValueError(f"{path}: 'waypoints' must be a non-empty list")
     maps = doc["maps"]
     if not isinstance(maps, dict) or not all(
-        isinstance(m, dict) and {"file", "image_sha1"} <= set(m) for m in maps.values()
+        isinstance(m, dict)
+        and {"file", "image_sha1"} <= set(m)
+        and isinstance(m["file"], str)
+        and m["file"]
+        for m in maps.values()
     ):
         raise ValueError(f"{path}: 'maps' must map each band to its file and image_sha1")
 
@@ -492,7 +496,8 @@ def load_route(
         raise ValueError(f"{path}: no {band!r} map was taught")
     map_path = path.parent / doc["maps"][band]["file"] if map_file is None else Path(map_file)
     if not map_path.is_file():
-        raise FileNotFoundError(f"{map_path}: the taught map is missing")
+        named = f" (named in {path})" if map_file is None else ""
+        raise FileNotFoundError(f"{map_path}: the taught map is missing{named}")
     try:
         digest = waypoints_file_hash(map_path)
     except (OSError, yaml.YAMLError, KeyError, TypeError) as e:
