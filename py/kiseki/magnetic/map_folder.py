@@ -140,7 +140,7 @@ def _document(fmap: MagneticFieldMap, files: dict) -> dict:
 
 
 def _write_layers_2d(fmap: MagneticFieldMap, tmp: Path) -> dict:
-    from kiseki import _core
+    from kiseki.map_io import write_image
 
     arrays = {"origin": fmap.origin, "resolution": np.float64(fmap.resolution)}
     images = {}
@@ -152,7 +152,7 @@ def _write_layers_2d(fmap: MagneticFieldMap, tmp: Path) -> dict:
         scale = (hi - lo) / _LEVELS
         pixels = np.zeros(layer.shape) if scale == 0 else np.rint((layer - lo) / scale)
         image = np.clip(pixels, 0, _LEVELS).astype(np.uint16)[::-1]  # row 0 = highest y
-        _core.write_image(str(tmp / f"{name}.png"), np.ascontiguousarray(image))
+        write_image(tmp / f"{name}.png", np.ascontiguousarray(image))  # checked: a full disk
         images[name] = {"image": f"{name}.png", "scale": scale, "offset": lo}
     np.savez(tmp / "layers.npz", **arrays)
     return {"layers": images, "arrays": "layers.npz"}

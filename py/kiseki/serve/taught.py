@@ -20,7 +20,7 @@ from kiseki import _core
 from kiseki._atomic import atomic_write
 from kiseki._yaml import read_yaml_file
 from kiseki.grid import OccupancyGrid
-from kiseki.map_io import load_map
+from kiseki.map_io import load_map, write_image
 from kiseki.teach.local_maps import METHODS
 from kiseki.teach.teaching import load_route
 
@@ -130,7 +130,7 @@ class TaughtRun:
             image = _core.image_from_occupancy(self.environment, mode="trinary")
             with tempfile.TemporaryDirectory(prefix="kiseki-map-") as tmp:
                 target = Path(tmp) / "map.png"
-                _core.write_image(str(target), image)
+                write_image(target, image)
                 self._png = target.read_bytes()
         return self._png
 
