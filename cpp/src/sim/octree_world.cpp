@@ -4,9 +4,12 @@
 
 #include <octomap/OcTree.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <stdexcept>
+#include <utility>
 
 namespace kiseki {
 
@@ -105,15 +108,44 @@ void OctreeWorld::write_binary(const std::string& path) const {
 void OctreeWorld::rasterize_band(double z_min, double z_max, OccupancyGrid& grid) const {
   if (!(z_max > z_min)) throw std::invalid_argument("rasterize_band: need z_max > z_min");
   grid.cells().setTo(kUnknown);
-  const Eigen::AlignedBox3d b = bounds();
-  const octomap::point3d lo(b.min().x(), b.min().y(), z_min), hi(b.max().x(), b.max().y(), z_max);
-  for (auto it = tree_->begin_leafs_bbx(lo, hi); it != tree_->end_leafs_bbx(); ++it) {
+  // The leaves in the band under the grid (its corners' box: the grid may be rotated), queried
+  // by keys clamped to OctoMap's addressable range: the coordinate form of begin_leafs_bbx
+  // hands out an iterator on a null tree when a corner lies outside that range, as the upper
+  // face of a tree's last voxel does (a fuzzed .bt crashed here).
+  const double w = grid.width(), h = grid.height();
+  Eigen::Vector2d lo = grid.grid_to_world({0.0, 0.0}), hi = lo;
+  for (const Eigen::Vector2d& corner :
+       {grid.grid_to_world({w, 0.0}), grid.grid_to_world({0.0, h}), grid.grid_to_world({w, h})}) {
+    lo = lo.cwiseMin(corner);
+    hi = hi.cwiseMax(corner);
+  }
+  const auto clamped_key = [this](double x, double y, double z) {
+    octomap::OcTreeKey key;
+    const double coords[3] = {x, y, z};
+    for (int i = 0; i < 3; ++i) {
+      if (!tree_->coordToKeyChecked(coords[i], key[i])) {
+        key[i] = coords[i] < 0.0 ? 0 : std::numeric_limits<octomap::key_type>::max();
+      }
+    }
+    return key;
+  };
+  const octomap::OcTreeKey lo_key = clamped_key(lo.x(), lo.y(), z_min);
+  const octomap::OcTreeKey hi_key = clamped_key(hi.x(), hi.y(), z_max);
+  for (auto it = tree_->begin_leafs_bbx(lo_key, hi_key); it != tree_->end_leafs_bbx(); ++it) {
     const double half = 0.5 * it.getSize();
     const bool occ = tree_->isNodeOccupied(*it);
-    // A leaf may be a large pruned node: mark every grid cell its footprint covers.
+    // A leaf may be a large pruned node: mark every grid cell its footprint covers, walking
+    // its sample lattice only where it meets the grid (a step of margin for rounding).
     const double step = std::min(grid.resolution(), it.getSize()) * 0.5;
-    for (double x = it.getX() - half + 0.5 * step; x < it.getX() + half; x += step)
-      for (double y = it.getY() - half + 0.5 * step; y < it.getY() + half; y += step) {
+    const auto range = [&](double centre, double low, double high) {
+      const double first = centre - half + 0.5 * step;
+      const double skip = std::max(0.0, std::floor((low - step - first) / step));
+      return std::make_pair(first + skip * step, std::min(centre + half, high + step));
+    };
+    const auto [x0, x1] = range(it.getX(), lo.x(), hi.x());
+    const auto [y0, y1] = range(it.getY(), lo.y(), hi.y());
+    for (double x = x0; x < x1; x += step)
+      for (double y = y0; y < y1; y += step) {
         const CellIndex c = grid.world_to_cell({x, y});
         if (!grid.contains(c)) continue;
         std::int8_t& v = grid.cells().ptr<std::int8_t>(c.y)[c.x];
