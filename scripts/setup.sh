@@ -20,6 +20,7 @@ APT_PACKAGES=(
   libopenblas-dev liblapacke-dev  # the Gaussian processes' Cholesky factorisations (kiseki/gp)
   libgtest-dev googletest
   chromium  # the serve page's browser tests (Playwright drives it; it downloads no browser)
+  clang libclang-rt-dev  # libFuzzer targets of the C++ readers (tests/fuzz/cpp)
 )
 
 log() { printf '[setup] %s\n' "$*" >&2; }

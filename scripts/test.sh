@@ -3,7 +3,8 @@
 # Copyright (c) 2026 the kiseki authors
 #
 # The whole test suite: set-up, ruff, C++ GoogleTest suites with ctest (warnings as errors),
-# the same suites under AddressSanitizer + UndefinedBehaviorSanitizer, then pytest.
+# the same suites under AddressSanitizer + UndefinedBehaviorSanitizer, the libFuzzer targets of
+# the C++ readers, then pytest (with the atheris targets of the Python readers).
 # Fails when any step fails. Extra arguments go to pytest.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
@@ -24,6 +25,11 @@ cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DKISEKI_SANITIZE=ON 
 cmake --build build/asan
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
   ctest --test-dir build/asan --output-on-failure --timeout 600
+
+echo "== C++ readers under libFuzzer + ASan + UBSan (fixed runs and seed)"
+cmake -S tests/fuzz/cpp -B build/fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ >/dev/null
+cmake --build build/fuzz
+tests/fuzz/cpp/run.sh build/fuzz "${KISEKI_FUZZ_CPP_RUNS:-20000}"
 
 echo "== pytest"
 python -m pytest "$@"
