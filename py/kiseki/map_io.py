@@ -122,10 +122,44 @@ def read_map_metadata(path: str | os.PathLike) -> MapMetadata:
     )
 
 
+def _check_binary_pgm(path: Path, image: Path) -> None:
+    """A binary PGM (P5) cut short is refused here, naming both files: OpenCV would print its
+    own 'can't read data' line on stderr before failing."""
+    with open(image, "rb") as f:
+        head = f.read(512)
+        if not head.startswith(b"P5"):
+            return  # other formats: the decoder's error
+        fields: list[bytes] = []
+        at = 2
+        while len(fields) < 3 and at < len(head):
+            if head[at : at + 1] == b"#":  # a comment runs to the end of its line
+                end = head.find(b"\n", at)
+                at = len(head) if end < 0 else end + 1
+            elif head[at : at + 1].isspace():
+                at += 1
+            else:
+                end = at
+                while end < len(head) and not head[end : end + 1].isspace():
+                    end += 1
+                fields.append(head[at:end])
+                at = end
+        if len(fields) < 3 or not all(x.isdigit() for x in fields):
+            return  # a malformed header: the decoder's error
+        width, height, maxval = (int(x) for x in fields)
+        need = width * height * (1 if maxval < 256 else 2)
+        have = os.fstat(f.fileno()).st_size - (at + 1)  # one whitespace byte after maxval
+    if have < need:
+        raise MapFormatError(
+            f"{path}: cannot decode image {image}: a truncated PGM ({max(have, 0)} of the {need} "
+            f"pixel bytes of {width} x {height})"
+        )
+
+
 def _load_ros_map(path: Path) -> OccupancyGrid:
     meta = read_map_metadata(path)
     if not meta.image.is_file():
         raise FileNotFoundError(f"{path}: image file {meta.image} not found")
+    _check_binary_pgm(path, meta.image)
     try:
         image = _core.read_image(str(meta.image))
     except RuntimeError as err:

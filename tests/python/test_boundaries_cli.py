@@ -279,3 +279,20 @@ def test_a_playback_to_a_waypoint_without_truth_reports_its_stop():
     goal["truth"] = [7.4, 0.0, 0.0]
     text = _stop_summary("proposal2", result, goal)
     assert f"{np.hypot(0.03, 0.04):.3f} m from where P1 was taught" in text  # 0.050
+
+
+@pytest.mark.parametrize("keep", [0.5, 0.99])
+def test_a_truncated_pgm_is_one_line_naming_the_map_and_its_image(inputs, keep):
+    """OpenCV printed its own "imread_(...): can't read data" line before kiseki's error."""
+    image = (inputs / "room.pgm").read_bytes()
+    (inputs / "cut.pgm").write_bytes(image[: int(len(image) * keep)])
+    meta = (inputs / "room.yaml").read_text().replace("room.pgm", "cut.pgm")
+    (inputs / "cut.yaml").write_text(meta)
+    before = digests(inputs)
+    line = one_error(run("map", "info", "cut.yaml", cwd=inputs))
+    have = int(len(image) * keep) - (len(image) - 120 * 80)  # the header is what is not pixels
+    assert line == (
+        f"kiseki: error: cut.yaml: cannot decode image cut.pgm: a truncated PGM ({have} of the "
+        "9600 pixel bytes of 120 x 80)"
+    )
+    assert digests(inputs) == before
