@@ -68,7 +68,10 @@ def _parse_yaml(path: Path) -> dict:
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as err:
-        raise MapFormatError(f"{path}: not a text YAML file ({err})") from err
+        raise MapFormatError(
+            f"{path}: not a map YAML file (not UTF-8 text: byte {err.start} is "
+            f"0x{err.object[err.start]:02x})"
+        ) from err
     try:
         doc = safe_load_12(text)  # resolution: 5e-2 is a number, as nav2 reads it
     except yaml.YAMLError as err:
@@ -190,16 +193,21 @@ def load_map(path: str | os.PathLike) -> OccupancyGrid:
 
 
 def write_image(path: str | os.PathLike, image: np.ndarray) -> None:
-    """Writes an image file (OpenCV; format by extension) and reads it back: OpenCV reports
-    success for a file it could not finish (on a full disk the PGM is cut short), which an
-    atomic rename would then put over a good map."""
+    """Writes an image file (OpenCV; format by extension) and reads it back: a file cut short
+    (a full disk) must never be renamed over a good map. The C++ writer checks its stream
+    (cv::imwrite reports success for a PGM a full disk has cut short); the read-back is a
+    second check, from another decoder."""
     from PIL import Image  # matplotlib's dependency; it reads back silently, OpenCV prints
 
-    _core.write_image(str(path), image)
     try:
+        _core.write_image(str(path), image)
         with Image.open(path) as back:
             back.load()  # raises on a file cut short
             whole = back.size == (image.shape[1], image.shape[0])
+    except RuntimeError as err:
+        if "the write failed" not in str(err):
+            raise  # not a write cut short (an unknown extension, say): as it is
+        whole = False
     except OSError:
         whole = False
     if not whole:

@@ -296,3 +296,11 @@ def test_a_truncated_pgm_is_one_line_naming_the_map_and_its_image(inputs, keep):
         "9600 pixel bytes of 120 x 80)"
     )
     assert digests(inputs) == before
+
+
+def test_a_map_yaml_of_random_bytes_is_named_without_a_codec_message(inputs):
+    (inputs / "junk.yaml").write_bytes(bytes(range(128, 256)) * 4)
+    before = digests(inputs)
+    line = one_error(run("map", "info", "junk.yaml", cwd=inputs))
+    assert line == "kiseki: error: junk.yaml: not a map YAML file (not UTF-8 text: byte 0 is 0x80)"
+    assert digests(inputs) == before  # the old line quoted "'utf-8' codec can't decode byte"
