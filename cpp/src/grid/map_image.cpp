@@ -3,6 +3,7 @@
 #include "kiseki/grid/map_image.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
@@ -124,13 +125,26 @@ cv::Mat read_image(const std::string& path) {
 }
 
 void write_image(const std::string& path, const cv::Mat& image) {
+  // Encoded in memory, then written through a checked stream: cv::imwrite reports success for a
+  // file that a full disk has cut short.
+  const auto dot = path.find_last_of('.');
+  const auto slash = path.find_last_of('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) {
+    throw std::runtime_error(path + ": cannot write image (no file extension to choose a format by)");
+  }
+  std::vector<std::uint8_t> bytes;
   bool ok = false;
   try {
-    ok = cv::imwrite(path, image);
+    ok = cv::imencode(path.substr(dot), image, bytes);
   } catch (const cv::Exception& e) {
     throw std::runtime_error(path + ": cannot write image (" + e.what() + ")");
   }
-  if (!ok) throw std::runtime_error(path + ": cannot write image");
+  if (!ok) throw std::runtime_error(path + ": cannot write image (encoding failed)");
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw std::runtime_error(path + ": cannot write image (cannot open the file)");
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.close();
+  if (out.fail()) throw std::runtime_error(path + ": cannot write image (the write failed: disk full?)");
 }
 
 }  // namespace kiseki
