@@ -28,7 +28,7 @@ TARGETS = {
     "wean-log": ("fuzz_wean.py", ["--target", "log"], 5000),
     "ros-map-yaml": ("fuzz_map.py", ["--target", "yaml"], 2000),
     "ros-map-image": ("fuzz_map.py", ["--target", "image"], 1000),
-    "scene": ("fuzz_scene.py", [], 150),
+    "scene": ("fuzz_scene.py", [], 500),
     "waypoints": ("fuzz_waypoints.py", [], 1000),
     "key-script": ("fuzz_keys.py", [], 10000),
     "mcap": ("fuzz_mcap.py", [], 1000),
