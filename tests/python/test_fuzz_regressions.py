@@ -102,3 +102,21 @@ def test_an_octree_whose_last_voxel_reaches_the_key_limit_rasterizes(tmp_path):
     assert done.returncode == 0, done.stderr[-2000:]
     occupied, hit, covered = done.stdout.split()[-3:]
     assert int(hit) > 0 and covered == "True" and int(occupied) >= int(hit)
+
+
+@pytest.mark.parametrize(
+    ("thresh", "pixels", "expected"), [(0, (255, 0), [-1, 100]), (1, (0, 255), [-1, 0])]
+)
+def test_scale_mode_with_equal_thresholds_leaves_the_pixel_on_them_unknown(
+    tmp_path, thresh, pixels, expected
+):
+    """fuzz_map_image (libFuzzer, UBSan): in scale mode with occupied_thresh == free_thresh a
+    pixel exactly on the thresholds divided 0 by 0 and cast NaN to int8 (undefined; it read as
+    free here). It is neither free nor occupied: unknown, as in trinary mode."""
+    (tmp_path / "m.pgm").write_bytes(b"P5\n2 1\n255\n" + bytes(pixels))
+    path = tmp_path / "m.yaml"
+    path.write_text(
+        "image: m.pgm\nmode: scale\nresolution: 0.1\norigin: [0, 0, 0]\n"
+        f"occupied_thresh: {thresh}\nfree_thresh: {thresh}\n"
+    )
+    assert load_map(path).cells.tolist() == [expected]

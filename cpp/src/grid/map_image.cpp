@@ -44,7 +44,9 @@ std::int8_t cell_from_pixel(const PixelReader& px, int row, int col, const MapIm
   if (p.mode == MapMode::Scale && opacity < 1.0) return kUnknown;
   if (p.occupied_thresh < occ) return kOccupied;
   if (occ < p.free_thresh) return kFree;
-  if (p.mode == MapMode::Trinary) return kUnknown;
+  // Trinary, or scale with equal thresholds and occ exactly on them (0/0: a fuzzed map's NaN
+  // cast to int8, undefined behaviour): neither free nor occupied.
+  if (p.mode == MapMode::Trinary || !(p.occupied_thresh > p.free_thresh)) return kUnknown;
   return static_cast<std::int8_t>(
       std::rint((occ - p.free_thresh) / (p.occupied_thresh - p.free_thresh) * 100.0));
 }
