@@ -304,3 +304,38 @@ def test_a_map_yaml_of_random_bytes_is_named_without_a_codec_message(inputs):
     line = one_error(run("map", "info", "junk.yaml", cwd=inputs))
     assert line == "kiseki: error: junk.yaml: not a map YAML file (not UTF-8 text: byte 0 is 0x80)"
     assert digests(inputs) == before  # the old line quoted "'utf-8' codec can't decode byte"
+
+
+def test_a_hand_edited_run_config_is_refused_naming_the_file_and_the_key(tmp_path):
+    """--resume reads the run's config.yaml: random bytes gave a codec error without the file,
+    a list or a missing 'config' a traceback, a bad key or value no file name."""
+    import re
+    import shutil
+
+    from kiseki.errors import KisekiError
+    from kiseki.experiments import run_experiment
+
+    run_experiment("fig-3-14", runs=1, out=tmp_path / "run", progress=False)
+    text = (tmp_path / "run" / "config.yaml").read_text()
+    edits = {
+        "bytes": (bytes(range(128, 256)), "not a run's config (not UTF-8 text)"),
+        "list": (b"[1, 2]\n", "not a run's config (a mapping), got list"),
+        "no-config": (re.sub(r"config:\n(  .*\n)+", "", text).encode(), "'config' must be a"),
+        "key": (text.replace("  beams: 60\n", "  beams: 60\n  bogus: 3\n").encode(),
+                "unknown config key(s): bogus"),
+        "value": (text.replace("  beams: 60\n", "  beams: 0\n").encode(),
+                  "fig-3-14: beams must be >= 2, got 0"),
+    }  # fmt: skip
+    for name, (content, needle) in edits.items():
+        folder = tmp_path / name
+        shutil.copytree(tmp_path / "run", folder)
+        (folder / "config.yaml").write_bytes(content)
+        before = digests(folder)
+        with pytest.raises(KisekiError) as err:
+            run_experiment("fig-3-14", out=folder, resume=True, progress=False)
+        assert str(err.value).startswith(str(folder)) and "config.yaml: " in str(err.value)
+        assert needle in str(err.value), (name, str(err.value))
+        assert digests(folder) == before
+    line = one_error(run("experiment", "run", "fig-3-14", "--out", "list", "--resume",
+                         cwd=tmp_path))  # fmt: skip
+    assert line == "kiseki: error: list/config.yaml: not a run's config (a mapping), got list"

@@ -85,7 +85,21 @@ def _saved_run(run_dir: Path) -> dict[str, Any]:
     path = run_dir / "config.yaml"
     if not path.is_file():
         raise KisekiError(f"{run_dir}: no config.yaml here: not a run that can be resumed")
-    return yaml.safe_load(path.read_text(encoding="utf-8"))
+    try:
+        saved = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise KisekiError(f"{path}: not a run's config (not UTF-8 text)") from None
+    except yaml.YAMLError as err:
+        raise KisekiError(f"{path}: not a run's config (invalid YAML: {err})") from None
+    if not isinstance(saved, dict):
+        raise KisekiError(f"{path}: not a run's config (a mapping), got {type(saved).__name__}")
+    for key, kind in (("experiment", str), ("runs", int), ("seed", int), ("config", dict)):
+        if not isinstance(saved.get(key), kind) or isinstance(saved.get(key), bool):
+            raise KisekiError(
+                f"{path}: '{key}' must be {'a mapping' if kind is dict else kind.__name__}, "
+                f"got {saved.get(key)!r}"
+            )
+    return saved
 
 
 def _serial(jobs, name, values) -> Iterator[dict[str, Any]]:
@@ -150,7 +164,10 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
         ):
             raise KisekiError("--resume continues a run as it was: drop --set, --runs and --seed")
         run_dir = run_dir.resolve()
-        config = config_from_dict(experiment.config_type, saved["config"])
+        try:
+            config = config_from_dict(experiment.config_type, saved["config"])
+        except (ConfigError, TypeError, ValueError) as err:  # edited by hand since the run
+            raise ConfigError(f"{run_dir / 'config.yaml'}: {err}") from None
         return experiment, run_dir, config, saved["runs"], saved["seed"]
     config = apply_overrides(experiment.config_type(), list(overrides))
     settings = experiment.trial_count(config) if experiment.trial_count else None
