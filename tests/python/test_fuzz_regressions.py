@@ -120,3 +120,16 @@ def test_scale_mode_with_equal_thresholds_leaves_the_pixel_on_them_unknown(
         f"occupied_thresh: {thresh}\nfree_thresh: {thresh}\n"
     )
     assert load_map(path).cells.tolist() == [expected]
+
+
+@pytest.mark.parametrize("kind", ["[3.6, 1.9]", "{box: 1}"])
+def test_a_scene_object_whose_type_is_not_a_name_is_refused(tmp_path, kind):
+    """fuzz_scene: `type: [3.6, 1.9]` (a hand edit gone wrong) raised TypeError: unhashable."""
+    path = tmp_path / "scene.yaml"
+    path.write_text(
+        "objects:\n  - {type: wall, from: [0, 0], to: [6, 0], height: 2.5}\n"
+        f"  - {{type: {kind}, size: [0.6, 0.3, 0.2]}}\n"
+    )
+    with pytest.raises(ValueError, match=r"objects\[1\]: unknown type") as err:
+        load_scene(path)
+    assert str(path) in str(err.value)

@@ -256,7 +256,7 @@ def expand(spec: dict, where: str) -> BoxList:
     if not isinstance(spec, dict) or "type" not in spec:
         raise ValueError(f"{where}: each object needs a 'type'")
     kind = spec["type"]
-    if kind not in PRIMITIVES:
+    if not isinstance(kind, str) or kind not in PRIMITIVES:  # a list is not hashable
         raise ValueError(f"{where}: unknown type {kind!r} (known: {', '.join(sorted(PRIMITIVES))})")
     allowed, expander = PRIMITIVES[kind]
     return expander(_Fields(spec, f"{where} ({kind})", allowed))
