@@ -100,9 +100,12 @@ def test_a_run_without_a_scan_topic_is_one_line_naming_the_file(inputs, args):
     [
         ["map", "from-log", "cut.mcap", "-o", "m.yaml"],
         ["localize", "cut.mcap", "--map", "room.yaml", "-o", "t.csv"],
+        ["sim", "render", "cut.mcap", "--scene", "WORLD", "-o", "a.gif"],
     ],
 )
-def test_a_truncated_run_is_read_with_a_one_line_warning(inputs, args):
+def test_a_truncated_run_is_read_with_a_one_line_warning(inputs, project_root, args):
+    world = project_root / "data" / "worlds" / "factory_corridor.yaml"
+    args = [str(world) if a == "WORLD" else a for a in args]
     write_log(inputs / "full.mcap", chunk_size=2048)
     data = (inputs / "full.mcap").read_bytes()
     (inputs / "cut.mcap").write_bytes(data[: len(data) * 2 // 3])
@@ -339,3 +342,35 @@ def test_a_hand_edited_run_config_is_refused_naming_the_file_and_the_key(tmp_pat
     line = one_error(run("experiment", "run", "fig-3-14", "--out", "list", "--resume",
                          cwd=tmp_path))  # fmt: skip
     assert line == "kiseki: error: list/config.yaml: not a run's config (a mapping), got list"
+
+
+SEED = "kiseki: error: --seed must be an integer in 0..2^64-1, got -1"
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (["serve", "--taught", ".", "--seed", "-1"], SEED),
+        (["magnetic", "fit", "mag.csv", "-o", "mm", "--seed", "-1"], SEED),
+        (["sim", "run", "WORLD", "-o", "r.mcap", "--controller", "commands", "--commands",
+          "nan.csv"], "kiseki: error: nan.csv: every row needs 3 finite numbers (no NaN)"),
+        (["sim", "run", "WORLD", "-o", "r.mcap", "--controller", "commands", "--commands",
+          "back.csv"], "kiseki: error: back.csv: times must start at >= 0 and not decrease"),
+        (["map", "render", "room.yaml", "-o", "x.png", "--trajectory", "nan.csv"],
+         "kiseki: error: nan.csv: rows must have 2 finite numbers"),
+        (["map", "info", "self.yaml"], "kiseki: error: self.yaml: self.yaml: cannot decode image"),
+        (["localize", "log.mcap", "--map", "room.yaml", "-o", "t.csv", "--beams", "-3"],
+         "kiseki: error: beams must be an integer >= 0 (0 = every beam), got -3"),
+    ],
+)  # fmt: skip
+def test_more_bad_inputs_are_one_line_and_change_nothing(inputs, project_root, args, expected):
+    (inputs / "mag.csv").write_text("x,y,mx,my,mz\n0,0,1,2,3\n1,0,1,2,3\n0,1,1,2,3\n")
+    (inputs / "nan.csv").write_text("t,v,w\n0,nan,0\n1,0,0\n" if "sim" in args else "x,y\nnan,1\n")
+    (inputs / "back.csv").write_text("t,v,w\n1,0.2,0\n0,0,0\n")
+    (inputs / "self.yaml").write_text("image: self.yaml\nresolution: 0.05\norigin: [0, 0, 0]\n")
+    world = project_root / "data" / "worlds" / "factory_corridor.yaml"
+    before = digests(inputs)
+    assert one_error(run(*[str(world) if a == "WORLD" else a for a in args], cwd=inputs)) == (
+        expected
+    )
+    assert digests(inputs) == before
