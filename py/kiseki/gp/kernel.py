@@ -85,9 +85,10 @@ def fit_hyperparameters(
     mean: str = "constant",
 ) -> HyperparameterFit:
     """Hyperparameters that maximise the log marginal likelihood (eq. 6.11) summed over Y's
-    columns (one kernel shared by the field's components), by projected BFGS in log-parameters
-    with the analytic gradient (eqs. 6.12-6.15), from `initial` (default: from the data's spread) and
-    `restarts` seeded random starts. Above `max_points` readings the likelihood is that of a
+    columns (one kernel shared by the field's components), by projected L-BFGS in
+    log-parameters with the analytic gradient (eqs. 6.12-6.15), from `initial` (default: from
+    the data's spread), from the best of a coarse scan of l and sigma_n, and from `restarts`
+    seeded random starts. Above `max_points` readings the likelihood is that of a
     seeded random subsample of that size (its cost grows as n^3)."""
     x = inputs_array(x)
     y, _ = targets_array(y, x.shape[0])
