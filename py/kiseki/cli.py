@@ -3,7 +3,9 @@
 """The ``kiseki`` command line: one command with subcommands.
 
 Errors in what the user gave (a missing or corrupt file, a bad value) print one line
-``kiseki: error: ...`` on stderr and exit with status 1.
+``kiseki: error: ...`` on stderr and exit with status 1; usage errors (an unknown option, a
+missing argument) exit with status 2; an internal error (a bug) prints its traceback and exits
+with status 3.
 """
 
 from __future__ import annotations
@@ -112,7 +114,9 @@ def map_from_log(
         None, help="ROS bags: a nav_msgs/Odometry topic of reference poses, e.g. /ground_truth."
     ),
 ) -> None:
-    """Build an occupancy grid from a log's poses and scans and save it as a ROS map."""
+    """Build an occupancy grid from a log's poses and scans and save it as a ROS map.
+
+    Example: kiseki map from-log run.mcap -o map.yaml --render map.png"""
     from kiseki.datasets import open_scans
     from kiseki.map_io import load_map, save_map
     from kiseki.mapping import MapBuildConfig, endpoint_agreement, map_of_log
@@ -196,7 +200,9 @@ def map_render(
         None, help="Trajectory to overlay: CSV with x,y columns, or a CARMEN log."
     ),
 ) -> None:
-    """Draw a map (and a trajectory over it) to a PNG."""
+    """Draw a map (and a trajectory over it) to a PNG.
+
+    Example: kiseki map render data/maps/factory_corridor.yaml -o corridor.png"""
     from kiseki.map_io import load_map
     from kiseki.plots import render_map
 
@@ -213,7 +219,9 @@ def map_convert(
     map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat(.gz) map."),
     output: Path = typer.Option(..., "-o", "--output", help="ROS map YAML to write (PGM beside)."),
 ) -> None:
-    """Save a map (e.g. the CMU Wean .dat.gz) as a ROS map YAML + PGM (trinary)."""
+    """Save a map (e.g. the CMU Wean .dat.gz) as a ROS map YAML + PGM (trinary).
+
+    Example: kiseki map convert data/maps/factory_corridor.yaml -o corridor.yaml"""
     from kiseki.grid import grid_summary
     from kiseki.map_io import load_map, save_map
 
@@ -231,18 +239,18 @@ def map_convert(
 @map_app.command("info")
 def map_info(
     map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat map."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
-    """Print a map's size, resolution, origin and cell counts."""
+    """Print a map's size, resolution, origin and cell counts: a table on a terminal,
+    tab-separated field/value lines when piped, or JSON with --json.
+
+    Example: kiseki map info data/maps/factory_corridor.yaml --json"""
+    from kiseki._table import show_fields
     from kiseki.grid import grid_summary
     from kiseki.map_io import load_map
 
     summary = grid_summary(load_map(map_file))
-    table = Table(title=str(map_file))
-    table.add_column("field")
-    table.add_column("value", justify="right")
-    for key, value in summary.items():
-        table.add_row(key, f"{value:.4g}" if isinstance(value, float) else str(value))
-    console.print(table)
+    show_fields(str(map_file), summary, as_json=as_json, console=console)
 
 
 @app.command("demo")
@@ -261,7 +269,9 @@ def demo(
 ) -> None:
     """The main job: teach the factory route with a turn, measure the taught maps against the
     scene's truth, play the route back with each method, and print the thesis' Table 4.5-style
-    comparison."""
+    comparison.
+
+    Example: kiseki demo --out results/demo --seed 0"""
     from kiseki.demo import run_demo
 
     run_demo(scene, out, seed, console, particles, _merge_rule(merge))
@@ -349,7 +359,9 @@ def sim_run(
     variant: str = typer.Option("teach", help="Scene variant: teach or playback."),
     overwrite: bool = typer.Option(False, help="Replace an existing output file."),
 ) -> None:
-    """Simulate a scene and log the run (ground truth, odometry, sensors) to MCAP."""
+    """Simulate a scene and log the run (ground truth, odometry, sensors) to MCAP.
+
+    Example: kiseki sim run data/worlds/factory_corridor.yaml -o run.mcap --seed 0"""
     from kiseki.sim.run import SimConfig, read_commands, simulate
     from kiseki.sim.scene import load_scene
 
@@ -394,7 +406,9 @@ def sim_render(
     output: Path = typer.Option(..., "-o", "--output", help="GIF to write."),
     scene_file: Path | None = typer.Option(None, "--scene", help="Scene (default: from run)."),
 ) -> None:
-    """Animate a recorded run over its scene (GIF)."""
+    """Animate a recorded run over its scene (GIF).
+
+    Example: kiseki sim render run.mcap -o run.gif"""
     from kiseki.sim.mcap_log import read_run
     from kiseki.sim.render import render_run
     from kiseki.sim.scene import load_scene
@@ -420,7 +434,9 @@ def sim_show(
     octree: Path | None = typer.Option(None, help="Also export the world as an OctoMap .bt."),
     resolution: float = typer.Option(0.05, help="Voxel size of the .bt export (m)."),
 ) -> None:
-    """Draw a scene from above (and export its OctoMap)."""
+    """Draw a scene from above (and export its OctoMap).
+
+    Example: kiseki sim show data/worlds/factory_corridor.yaml -o corridor.png"""
     from kiseki import _core
     from kiseki.sim.render import render_scene
     from kiseki.sim.scene import load_scene
@@ -534,7 +550,9 @@ def teach_command(
     """Teach a route: push the robot along the scene's route (simulated) or from the keyboard,
     build the environment maps with the thesis' merge rules (or --merge evidence), record the
     waypoints and measure the maps against the scene's truth (map_truth.json); the run is
-    logged as it goes."""
+    logged as it goes.
+
+    Example: kiseki teach data/worlds/factory_corridor.yaml -o taught"""
     from kiseki.sim.scene import load_scene
     from kiseki.teach.teaching import recover, teach
 
@@ -615,7 +633,9 @@ def playback_command(
 ) -> None:
     """Play a taught route back on the particle filter's estimate; stop within 0.1 m of the goal.
     Give the teaching folder (--taught) or its waypoint file (--waypoints, and --map for a map
-    other than the one named there)."""
+    other than the one named there).
+
+    Example: kiseki playback data/worlds/factory_corridor.yaml --taught taught --route P0,P1,P2"""
 
     from kiseki.map_io import load_map
     from kiseki.sim.scene import load_scene
@@ -711,7 +731,9 @@ def serve_command(
     """Serve the route-instruction page and its JSON API over a taught run: a worker picks
     start, via and goal waypoints, the simulated AGV drives there, stops within 0.1 m, dwells
     and returns home, watched live over a websocket. Binding beyond loopback prints an access
-    token that every API request must carry (Authorization: Bearer TOKEN)."""
+    token that every API request must carry (Authorization: Bearer TOKEN).
+
+    Example: kiseki serve --taught results/demo/teach"""
     import secrets
 
     from kiseki.serve import LOOPBACK, build_server
@@ -788,11 +810,17 @@ def localize_command(
     reference_topic: str | None = typer.Option(
         None, help="ROS bags: a nav_msgs/Odometry topic of reference poses, e.g. /ground_truth."
     ),
+    as_json: bool = typer.Option(
+        False, "--json", help="Print the errors (and the convergence report) as one JSON object."
+    ),
 ) -> None:
     """Localize along a log: position tracking from its first reference pose, or with --global
     from a uniform start. Prints the absolute pose error against the log's reference poses when
-    it has them; with --global also the convergence report (written to OUTPUT.json too). The
-    settings it ran with are written beside the output as OUTPUT-STEM.config.yaml."""
+    it has them; with --global also the convergence report (written to OUTPUT.json too); with
+    --json the same numbers as one JSON object. The settings it ran with are written beside the
+    output as OUTPUT-STEM.config.yaml.
+
+    Example: kiseki localize run.mcap --map data/maps/factory_corridor.yaml -o track.csv --json"""
     from kiseki.datasets import open_scans
     from kiseki.map_io import load_map
     from kiseki.metrics import ape
@@ -862,24 +890,43 @@ def localize_command(
         _warn_if_off_the_map(grid, trajectory, scans, map_file, result.report.fit.within_1_cell)
     config_path = output.with_name(output.stem + ".config.yaml")
     _write_yaml(config_path, saved_config)
+    summary: dict = {"output": str(output), "poses": len(scans), "method": method}
+    lines = [f"{output}: {len(scans)} poses; the log has no reference poses"]
     if scans.has_reference_poses:
         position = ape(trajectory, scans.poses)
         heading = ape(trajectory, scans.poses, "rotation_deg")
-        console.print(
+        summary.update(position_rmse_m=position.rmse, position_max_m=position.max)
+        summary.update(heading_rmse_deg=heading.rmse)
+        lines = [
             f"{output}: {len(scans)} poses; {method}: position RMSE {position.rmse:.3f} m "
             f"(max {position.max:.3f} m), heading RMSE {heading.rmse:.2f} deg"
-        )
-    else:
-        console.print(f"{output}: {len(scans)} poses; the log has no reference poses")
+        ]
     if global_start:
         from kiseki.global_localization import describe, write_report
 
         report_path = write_report(result, output.with_suffix(".json"))
-        console.print(describe(result.report) + f" (report: {report_path})")
-        if plot is not None:
-            from kiseki.global_localization import render_global
+        lines.append(describe(result.report) + f" (report: {report_path})")
+        summary.update(report_file=str(report_path), convergence=result.report.to_dict())
+    _print_report(lines, summary, as_json)
+    if global_start and plot is not None:
+        from kiseki.global_localization import render_global
 
-            render_global(grid, result, plot, title=f"{log.name}: global {method}")
+        render_global(grid, result, plot, title=f"{log.name}: global {method}")
+
+
+def _print_report(lines: list[str], summary: dict, as_json: bool) -> None:
+    """A command's report: its sentences for people (never wrapped when piped, so each stays
+    one line for grep), or the same numbers as one JSON object with --json."""
+    if as_json:
+        from kiseki._table import show_fields
+
+        show_fields("", summary, as_json=True)
+    elif sys.stdout.isatty():
+        for line in lines:
+            console.print(line)
+    else:
+        for line in lines:
+            typer.echo(line)
 
 
 OFF_MAP_SHARE = 0.5  # below this share of endpoints near a wall the map is not the log's
@@ -942,12 +989,19 @@ def _write_yaml(path: Path, doc: dict) -> None:
 def report(
     results: Path = typer.Option(Path("results"), help="Results folder of the experiments."),
     output: Path = typer.Option(Path("REPRODUCTION.md"), "-o", "--output", help="File to write."),
+    as_json: bool = typer.Option(False, "--json", help="Print the summary as one JSON object."),
 ) -> None:
-    """Gather the latest result of every experiment into REPRODUCTION.md."""
+    """Gather the latest result of every experiment into REPRODUCTION.md and print a summary
+    (claims, how many hold, the experiments without a result): a table on a terminal,
+    tab-separated field/value lines when piped, or JSON with --json.
+
+    Example: kiseki report --results results -o REPRODUCTION.md"""
+    from kiseki._table import show_fields
     from kiseki.experiments import write_reproduction
 
     total, held, missing = write_reproduction(results, output)
-    console.print(f"{output}: {total} claims, {held} hold; {len(missing)} experiments missing")
+    summary = {"output": str(output), "claims": total, "hold": held, "missing": missing}
+    show_fields(str(output), summary, as_json=as_json, console=console)
 
 
 def _terminate(signum, frame) -> None:
@@ -962,8 +1016,13 @@ def _warn_in_one_line(message, category, filename, lineno, file=None, line=None)
     typer.echo(f"kiseki: warning: {text[0] if text else category.__name__}", err=True)
 
 
+EXIT_OK, EXIT_BAD_INPUT, EXIT_USAGE, EXIT_INTERNAL = 0, 1, 2, 3
+
+
 def main() -> None:
-    """Entry point: runs the app and turns input errors into one line and exit status 1."""
+    """Entry point: runs the app and turns input errors into one line and exit status 1.
+    Usage errors (an unknown option, a missing argument) exit 2 (click's own); anything else
+    is a bug in kiseki: its traceback, one line asking for a report, and exit status 3."""
     import signal
     import warnings
 
@@ -974,7 +1033,17 @@ def main() -> None:
     except (KisekiError, ValueError, OSError, RuntimeError, IndexError) as err:
         message = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
         typer.echo(f"kiseki: error: {message}", err=True)
-        sys.exit(1)
+        sys.exit(EXIT_BAD_INPUT)
+    except Exception as err:  # the last resort: a bug, not the user's input
+        import traceback
+
+        traceback.print_exc()
+        typer.echo(
+            f"kiseki: internal error: {type(err).__name__} (a bug in kiseki: please report it "
+            "with the lines above)",
+            err=True,
+        )
+        sys.exit(EXIT_INTERNAL)
 
 
 if __name__ == "__main__":

@@ -276,7 +276,9 @@ def predict(
     """Mean and variance of the field at points: columns x,y[,z],mx,my,mz,var_mx,var_my,var_mz
     (variances of the noise-free field, in the map's units squared). A map that keeps its
     measurements re-evaluates the GP exactly at each point (eqs. 6.8-6.9); otherwise, or with
-    --interpolate, the grid is interpolated (the GP prior outside the map)."""
+    --interpolate, the grid is interpolated (the GP prior outside the map).
+
+    Example: kiseki magnetic predict hall-map --at points.csv -o field.csv"""
     from kiseki._atomic import atomic_write
     from kiseki.magnetic.field_map import MagneticFieldMap
 
@@ -306,7 +308,9 @@ def render(
     slices: int = typer.Option(4, help="3-D maps: horizontal slices drawn (one row each)."),
 ) -> None:
     """Draw the mean and variance of mx, my, mz as six panels with colour bars (the thesis'
-    Fig. 6.13: 1500 x 800 px); a 3-D map as one row of six per slice height (Fig. 6.14)."""
+    Fig. 6.13: 1500 x 800 px); a 3-D map as one row of six per slice height (Fig. 6.14).
+
+    Example: kiseki magnetic render hall-map -o hall-map.png"""
     from kiseki.magnetic.field_map import MagneticFieldMap
     from kiseki.magnetic.render import picture_size, render_field_map
 

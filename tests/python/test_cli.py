@@ -36,9 +36,8 @@ def test_map_info_and_render(tmp_path):
     path = save_map(OccupancyGrid(cells, 0.1, Pose2(1.0, 2.0, 0.0)), tmp_path / "m.yaml")
     done = run("map", "info", str(path))
     assert done.returncode == 0, done.stderr
-    assert "30" in done.stdout and "occupied" in done.stdout
-    occupied_row = [line for line in done.stdout.splitlines() if " occupied " in line]
-    assert occupied_row and occupied_row[0].split("│")[2].strip() == "24"
+    fields = dict(line.split("\t") for line in done.stdout.splitlines())  # piped: plain lines
+    assert fields["width"] == "30" and fields["occupied"] == "24" and fields["unknown"] == "15"
     (tmp_path / "path.csv").write_text("t,x,y,theta\n0,1.5,3.0,0\n1,3.0,3.2,0.5\n")
     png = tmp_path / "m.png"
     done = run(
