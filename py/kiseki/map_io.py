@@ -15,7 +15,6 @@ from __future__ import annotations
 import errno
 import math
 import os
-import shutil
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -193,29 +192,19 @@ def load_map(path: str | os.PathLike) -> OccupancyGrid:
 
 
 def write_image(path: str | os.PathLike, image: np.ndarray) -> None:
-    """Writes an image file (OpenCV; format by extension) and reads it back: a file cut short
-    (a full disk) must never be renamed over a good map. The C++ writer checks its stream
-    (cv::imwrite reports success for a PGM a full disk has cut short); the read-back is a
-    second check, from another decoder."""
-    from PIL import Image  # matplotlib's dependency; it reads back silently, OpenCV prints
-
+    """Writes an image file (OpenCV's encoders; the format by the extension). Raises OSError
+    naming `path` when the file cannot be written whole, with the system's reason (a full disk:
+    ENOSPC): the C++ writer checks every step, since cv::imwrite reports success for a PGM that
+    a full disk has cut short, which an atomic rename would then put over a good map."""
     try:
         _core.write_image(str(path), image)
-        with Image.open(path) as back:
-            back.load()  # raises on a file cut short
-            whole = back.size == (image.shape[1], image.shape[0])
     except RuntimeError as err:
-        if "the write failed" not in str(err):
-            raise  # not a write cut short (an unknown extension, say): as it is
-        whole = False
-    except OSError:
-        whole = False
-    if not whole:
-        if shutil.disk_usage(Path(path).parent).free < image.nbytes:
-            raise OSError(
-                errno.ENOSPC, "No space left on device (the image was cut short)", str(path)
-            )
-        raise OSError(errno.EIO, "the image was cut short", str(path))
+        text = str(err)
+        text = text.removeprefix(f"{path}: ")
+        for code in (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.ENOENT):
+            if text.endswith(os.strerror(code)):
+                raise OSError(code, os.strerror(code), str(path)) from err
+        raise OSError(errno.EIO, text, str(path)) from err
 
 
 def save_map(

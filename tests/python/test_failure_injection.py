@@ -44,15 +44,21 @@ snap() { mkdir "$OUT/$1"; tar -C "$DISK" --exclude=./filler -cf - . | tar -C "$O
 """
 
 
+TIMEOUT = 600  # s, for any one command: a hang fails the test instead of holding up the suite
 PROGRESS = r"[\w-]+: +(\d+%\|.*\| )?\d+(/\d+)? ?(step|trial)?s? ?\[.*\]"  # a tqdm update
 
 
 def _namespace_refusal() -> str | None:
     if shutil.which("unshare") is None:
         return "unshare (util-linux) is not installed"
+    # the probe mounts a tmpfs, as the tests do: some hosts allow the namespaces but not mounts
     probe = subprocess.run(
-        ["unshare", "--user", "--map-root-user", "--mount", "true"], capture_output=True, text=True
-    )
+        ["unshare", "--user", "--map-root-user", "--mount", "mount", "-t", "tmpfs", "-o",
+         "size=64k", "tmpfs", "/mnt"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )  # fmt: skip
     if probe.returncode != 0:
         return f"user + mount namespaces are not permitted here: {probe.stderr.strip()}"
     return None
@@ -82,6 +88,7 @@ class Steps:
             cwd=ROOT,
             capture_output=True,
             text=True,
+            timeout=TIMEOUT,
         )
         assert done.returncode == 0, done.stderr
         self.disk = disk
@@ -317,11 +324,12 @@ def test_kill_9_while_teaching_keeps_the_steps_taught(tmp_path, scene, taught):
         if log.exists() and log.stat().st_size >= share * size:
             break
         time.sleep(0.01)
-    os.kill(proc.pid, signal.SIGKILL)
+    assert proc.poll() is None, "the teaching run ended before the kill point"
+    proc.kill()
     assert proc.wait() == -signal.SIGKILL  # killed mid-run, not finished
     killed = digests(tmp_path / "t")
     assert list(killed) == ["teach.mcap"]
-    done = subprocess.run([*cli, "--resume"], capture_output=True, text=True)
+    done = subprocess.run([*cli, "--resume"], capture_output=True, text=True, timeout=TIMEOUT)
     assert done.returncode == 0, done.stderr
     assert digests(tmp_path / "t")["teach.mcap"] == killed["teach.mcap"]
     n = check_taught_prefix(tmp_path / "t", done.stdout, taught)
@@ -339,6 +347,7 @@ def swept(tmp_path_factory) -> Path:
         [*KISEKI.split(), "experiment", "run", *SWEEP, "--out", str(out)],
         capture_output=True,
         text=True,
+        timeout=TIMEOUT,
     )
     assert done.returncode == 0, done.stderr
     return out
@@ -377,7 +386,8 @@ def test_kill_9_in_an_experiment_sweep_keeps_the_finished_trials(tmp_path, swept
             time.sleep(share * per_trial)
             break
         time.sleep(0.005)
-    os.kill(proc.pid, signal.SIGKILL)
+    assert proc.poll() is None, "the sweep ended before the kill point"
+    proc.kill()
     assert proc.wait() == -signal.SIGKILL
     kept = log.read_bytes()
     finished = kept.count(b"\n")
@@ -386,6 +396,7 @@ def test_kill_9_in_an_experiment_sweep_keeps_the_finished_trials(tmp_path, swept
         [*cli, "corridor-scans", "--resume", "--out", str(tmp_path / "e")],
         capture_output=True,
         text=True,
+        timeout=TIMEOUT,
     )
     assert resumed.returncode == 0, resumed.stderr
     assert f"({4 - finished} run now" in " ".join(resumed.stdout.split())  # rich wraps at 80

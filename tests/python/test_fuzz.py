@@ -51,8 +51,11 @@ def test_reader_survives_fuzzing(tmp_path, name):
         "-print_final_stats=1",
         f"-artifact_prefix={tmp_path}/",
     ]
-    env = {**os.environ, "KISEKI_FUZZ_DIR": str(tmp_path / "work")}
-    done = subprocess.run(command, env=env, capture_output=True, text=True, errors="replace")
+    # PYTHONHASHSEED: set and dict order, hence the coverage feedback, the same on every run
+    env = {**os.environ, "KISEKI_FUZZ_DIR": str(tmp_path / "work"), "PYTHONHASHSEED": "0"}
+    done = subprocess.run(
+        command, env=env, capture_output=True, text=True, errors="replace", timeout=1800
+    )
     log = done.stdout + done.stderr
     crashes = sorted(p.name for kind in FINDINGS for p in tmp_path.glob(f"{kind}-*"))
     tail = "\n".join(line for line in log.splitlines() if not line.startswith("#"))[-3000:]

@@ -2,8 +2,11 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/grid/map_image.hpp"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
@@ -127,8 +130,8 @@ cv::Mat read_image(const std::string& path) {
 }
 
 void write_image(const std::string& path, const cv::Mat& image) {
-  // Encoded in memory, then written through a checked stream: cv::imwrite reports success for a
-  // file that a full disk has cut short.
+  // Encoded in memory, then written with every step checked: cv::imwrite reports success for a
+  // file that a full disk has cut short. The error ends with the system's reason.
   const auto dot = path.find_last_of('.');
   const auto slash = path.find_last_of('/');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) {
@@ -142,11 +145,14 @@ void write_image(const std::string& path, const cv::Mat& image) {
     throw std::runtime_error(path + ": cannot write image (" + e.what() + ")");
   }
   if (!ok) throw std::runtime_error(path + ": cannot write image (encoding failed)");
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw std::runtime_error(path + ": cannot write image (cannot open the file)");
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  out.close();
-  if (out.fail()) throw std::runtime_error(path + ": cannot write image (the write failed: disk full?)");
+  errno = 0;
+  std::FILE* out = std::fopen(path.c_str(), "wb");
+  if (out == nullptr) throw std::runtime_error(path + ": cannot write image: " + std::strerror(errno));
+  const std::size_t written = std::fwrite(bytes.data(), 1, bytes.size(), out);
+  int error = written == bytes.size() ? 0 : errno;
+  if (std::fclose(out) != 0 && error == 0) error = errno;  // a full disk shows at the flush
+  if (written != bytes.size() && error == 0) error = EIO;
+  if (error != 0) throw std::runtime_error(path + ": cannot write image: " + std::strerror(error));
 }
 
 }  // namespace kiseki

@@ -23,6 +23,7 @@ import yaml
 from tqdm import tqdm
 
 from kiseki._atomic import atomic_write, check_writable_folder
+from kiseki._yaml import read_yaml_file
 from kiseki.core import derive_seed
 from kiseki.errors import KisekiError
 from kiseki.experiments.config import (
@@ -85,12 +86,10 @@ def _saved_run(run_dir: Path) -> dict[str, Any]:
     path = run_dir / "config.yaml"
     if not path.is_file():
         raise KisekiError(f"{run_dir}: no config.yaml here: not a run that can be resumed")
-    try:
-        saved = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError:
-        raise KisekiError(f"{path}: not a run's config (not UTF-8 text)") from None
-    except yaml.YAMLError as err:
-        raise KisekiError(f"{path}: not a run's config (invalid YAML: {err})") from None
+    try:  # the shared reader: also refuses YAML nested too deeply for the parser
+        saved = read_yaml_file(path, "run's config")
+    except ValueError as err:
+        raise KisekiError(str(err)) from None
     if not isinstance(saved, dict):
         raise KisekiError(f"{path}: not a run's config (a mapping), got {type(saved).__name__}")
     for key, kind in (("experiment", str), ("runs", int), ("seed", int), ("config", dict)):
