@@ -45,7 +45,7 @@ coop_app = typer.Typer(
 app.add_typer(coop_app, name="coop")
 app.add_typer(speed_app, name="speed")
 app.add_typer(magnetic_app, name="magnetic")
-console = Console()
+console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
 
 
 def _version_callback(value: bool) -> None:

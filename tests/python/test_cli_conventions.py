@@ -159,6 +159,9 @@ def test_localize_json_holds_the_errors_of_its_csv(tmp_path: Path):
         f"u.csv: {STEPS} poses; likelihood-field: position RMSE {doc['position_rmse_m']:.3f} m "
         f"(max {doc['position_max_m']:.3f} m), heading RMSE {doc['heading_rmse_deg']:.2f} deg"
     ]  # one line, not wrapped at 80 columns when piped
+    done = run("map", "from-log", "log.mcap", "-o", "rebuilt.yaml", cwd=tmp_path)
+    lines = done.stdout.splitlines()  # a sentence longer than 80 columns stays one line
+    assert len(lines) == 1 and len(lines[0]) > 80 and lines[0].endswith("occupied cells")
     done = run("localize", "log.mcap", "--map", "room.yaml", "-o", "g.csv", "--global",
                "--particles", "3000", "--json", cwd=tmp_path)  # fmt: skip
     assert done.returncode == 0, done.stderr
