@@ -8,15 +8,37 @@ output folder is checked to exist and be writable."""
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
+from functools import cached_property
 from pathlib import Path
 
 import yaml
 
 __all__ = ["FIGURE_SUFFIXES", "check_outputs", "check_suffix", "files_behind"]
 
-# the formats matplotlib writes (with Pillow), chosen by the file's extension
-FIGURE_SUFFIXES = (".png", ".pdf", ".svg", ".jpg", ".jpeg", ".webp", ".tif", ".tiff", ".eps", ".ps")
+
+class _FigureSuffixes(Sequence[str]):
+    """The extensions matplotlib's ``savefig`` writes (it chooses the format by extension),
+    matplotlib's own list, sorted: read on first use, since importing matplotlib takes about
+    0.3 s and ``import kiseki.cli`` does not otherwise need it."""
+
+    @cached_property
+    def _suffixes(self) -> tuple[str, ...]:
+        from matplotlib.backend_bases import FigureCanvasBase
+
+        return tuple(sorted(f".{ext}" for ext in FigureCanvasBase.get_supported_filetypes()))
+
+    def __getitem__(self, index):  # type: ignore[override]
+        return self._suffixes[index]
+
+    def __len__(self) -> int:
+        return len(self._suffixes)
+
+    def __repr__(self) -> str:
+        return repr(self._suffixes)
+
+
+FIGURE_SUFFIXES: Sequence[str] = _FigureSuffixes()
 
 
 def files_behind(path: Path) -> list[Path]:
@@ -76,7 +98,7 @@ def check_outputs(
             raise PermissionError(f"{label} {out}: folder {folder} is not writable")
 
 
-def check_suffix(label: str, path: Path | None, suffixes: tuple[str, ...]) -> None:
+def check_suffix(label: str, path: Path | None, suffixes: Sequence[str]) -> None:
     """Raises ValueError naming the output when its extension is not one of ``suffixes`` (the
     writers choose the format by extension; without this check the error named a temporary
     file, after the work)."""

@@ -7,6 +7,7 @@ range. Each is one line (an error and exit 1, or a warning) and leaves every inp
 
 from __future__ import annotations
 
+import gzip
 import hashlib
 import subprocess
 import sys
@@ -176,6 +177,19 @@ def test_an_output_without_a_known_extension_is_refused_before_any_work(
         f"kiseki: error: {label} {path}: {got}; give a file ending in {', '.join(wanted)}"
     )
     assert digests(inputs) == before  # refused before anything was written
+
+
+def test_a_figure_takes_every_extension_matplotlib_writes(inputs):
+    """The list is matplotlib's own (the hand-written one refused .svgz, .pgf, .raw, .rgba), read
+    on first use: importing the CLI does not import matplotlib."""
+    assert {".png", ".pdf", ".svgz", ".pgf", ".raw", ".rgba"} <= set(FIGURE_SUFFIXES)
+    assert ".foo" not in FIGURE_SUFFIXES and ".yaml" not in FIGURE_SUFFIXES
+    done = run("map", "render", "room.yaml", "-o", "room.svgz", cwd=inputs)
+    assert done.returncode == 0, done.stderr
+    assert gzip.decompress((inputs / "room.svgz").read_bytes()).lstrip().startswith(b"<?xml")
+    probe = "import sys, kiseki.cli; print('matplotlib' in sys.modules)"
+    imported = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    assert imported.stdout.split() == ["False"], imported.stderr
 
 
 def test_a_map_that_is_not_the_logs_building_warns(inputs):
