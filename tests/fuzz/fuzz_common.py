@@ -17,19 +17,22 @@ Usage (libFuzzer flags, see https://llvm.org/docs/LibFuzzer.html#options)::
 
 The seeds are small real files: heads of the recorded logs in ``../shared/data`` (left out when
 the folder is absent) and the project's ``data/``, written to ``$KISEKI_FUZZ_DIR/corpus``
-(a temporary folder by default), which libFuzzer then grows.
+(by default a temporary folder, removed when the run ends), which libFuzzer then grows.
 """
 
 from __future__ import annotations
 
+import functools
 import gc
 import gzip
 import os
+import shutil
+import signal
 import sys
 import tempfile
 import types
 import warnings
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
 import atheris
@@ -93,11 +96,53 @@ def instrument(packages: Iterable[str]) -> int:
     return count
 
 
+_TEMPORARY: list[Path] = []
+
+
+@functools.cache
 def workdir() -> Path:
+    """``$KISEKI_FUZZ_DIR`` (kept), else a temporary folder, the same for every call, that
+    :func:`main` removes when the fuzzer ends."""
     folder = os.environ.get("KISEKI_FUZZ_DIR")
-    path = Path(folder) if folder else Path(tempfile.mkdtemp(prefix="kiseki-fuzz-"))
-    path.mkdir(parents=True, exist_ok=True)
+    if folder:
+        path = Path(folder)
+        path.mkdir(parents=True, exist_ok=True)
+        return path
+    path = Path(tempfile.mkdtemp(prefix="kiseki-fuzz-"))
+    _TEMPORARY.append(path)
     return path
+
+
+def remove_when_done(folder: Path) -> None:
+    """Returns in a child process, which fuzzes; this process waits for it, removes ``folder``
+    and exits with its status. libFuzzer ends the process with exit() or _Exit() from C (after
+    -runs, a finding, Ctrl-C), which skip Python's atexit handlers."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:
+        return
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C reaches the child, which reports
+    _, status = os.waitpid(pid, 0)
+    shutil.rmtree(folder, ignore_errors=True)
+    code = os.waitstatus_to_exitcode(status)
+    sys.exit(code if code >= 0 else 128 - code)  # killed by a signal: 128 + its number
+
+
+def pick_target(choices: Sequence[str]) -> str:
+    """The reader named by ``--target NAME`` for a script that fuzzes several (the option is
+    removed from ``sys.argv`` before libFuzzer reads it); ``choices[0]`` when absent. Exits
+    with a message when the name is missing or not one of ``choices``."""
+    if "--target" not in sys.argv:
+        return choices[0]
+    at = sys.argv.index("--target")
+    if at + 1 == len(sys.argv):
+        sys.exit(f"--target needs a name: {' or '.join(choices)}")
+    target = sys.argv[at + 1]
+    del sys.argv[at : at + 2]
+    if target not in choices:
+        sys.exit(f"--target must be {' or '.join(choices)}, got {target!r}")
+    return target
 
 
 def write_corpus(folder: Path, seeds: Iterable[bytes]) -> int:
@@ -124,6 +169,8 @@ def main(
     count = instrument(packages)
     print(f"[fuzz] {count} functions of {', '.join(packages)} instrumented", file=sys.stderr)
     folder = workdir()
+    if folder in _TEMPORARY:
+        remove_when_done(folder)
     files = folder / "files"
     files.mkdir(exist_ok=True)
     if prepare is not None:

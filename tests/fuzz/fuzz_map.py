@@ -7,11 +7,10 @@ by the C++ core's OpenCV reader, with a fixed YAML); see fuzz_common.py."""
 from __future__ import annotations
 
 import io
-import sys
 from pathlib import Path
 
 import numpy as np
-from fuzz_common import PROJECT_DATA, main
+from fuzz_common import PROJECT_DATA, main, pick_target
 from PIL import Image
 
 from kiseki.map_io import load_map
@@ -80,16 +79,9 @@ def read_image_map(path: Path) -> object:
 
 
 if __name__ == "__main__":
-    target = "yaml"
-    if "--target" in sys.argv:
-        at = sys.argv.index("--target")
-        target = sys.argv[at + 1]
-        del sys.argv[at : at + 2]
-    if target == "yaml":
+    if pick_target(("yaml", "image")) == "yaml":
         main(
             load_map, yaml_seeds, suffix=".yaml", prepare=prepare_yaml, packages=("kiseki", "yaml")
         )
-    elif target == "image":
-        main(read_image_map, image_seeds, suffix=".img", prepare=prepare_image)
     else:
-        sys.exit(f"--target must be yaml or image, got {target!r}")
+        main(read_image_map, image_seeds, suffix=".img", prepare=prepare_image)

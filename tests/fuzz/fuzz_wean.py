@@ -7,10 +7,9 @@ kiseki.datasets.read_wean_log); see fuzz_common.py."""
 from __future__ import annotations
 
 import gzip
-import sys
 from pathlib import Path
 
-from fuzz_common import head_lines, main, shared_data
+from fuzz_common import head_lines, main, pick_target, shared_data
 
 from kiseki.datasets.wean_log import read_wean_log
 from kiseki.map_io import load_map
@@ -59,14 +58,7 @@ def log_seeds(_folder: Path):
 
 
 if __name__ == "__main__":
-    target = "map"
-    if "--target" in sys.argv:
-        at = sys.argv.index("--target")
-        target = sys.argv[at + 1]
-        del sys.argv[at : at + 2]
-    if target == "map":
+    if pick_target(("map", "log")) == "map":
         main(load_map, map_seeds, suffix=".dat")
-    elif target == "log":
-        main(read_wean_log, log_seeds, suffix=".log")
     else:
-        sys.exit(f"--target must be map or log, got {target!r}")
+        main(read_wean_log, log_seeds, suffix=".log")

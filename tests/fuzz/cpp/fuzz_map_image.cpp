@@ -7,29 +7,14 @@
 // file. std::runtime_error (undecodable file) and std::invalid_argument (refused image) are
 // the documented refusals; anything else, a sanitizer report or a cell outside -1..100 is a
 // finding.
-#include <unistd.h>
-
 #include <cstdint>
-#include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <stdexcept>
-#include <string>
 
 #include "kiseki/grid/map_image.hpp"
+#include "temp_input.hpp"
 
 namespace {
-
-const std::string& input_path() {
-  static const std::string path = [] {
-    char name[] = "/tmp/kiseki-fuzz-map-image-XXXXXX";
-    const int fd = mkstemp(name);
-    if (fd < 0) std::abort();
-    close(fd);
-    return std::string(name);
-  }();
-  return path;
-}
 
 kiseki::MapImageParams params_from(std::uint8_t byte) {
   static constexpr double kThresholds[4][2] = {{0.65, 0.196}, {0.65, 0.65}, {1.0, 0.0}, {0.0, 0.0}};
@@ -45,13 +30,10 @@ kiseki::MapImageParams params_from(std::uint8_t byte) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
-  {
-    std::ofstream out(input_path(), std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(data + 1), static_cast<std::streamsize>(size - 1));
-  }
   cv::Mat image;
   try {
-    image = kiseki::read_image(input_path());
+    const kiseki_fuzz::TempInput input(data + 1, size - 1);  // removed after the read
+    image = kiseki::read_image(input.path());
   } catch (const std::runtime_error&) {
     return 0;
   }

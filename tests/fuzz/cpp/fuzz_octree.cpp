@@ -6,39 +6,20 @@
 // ray casts and a rasterised height band. std::runtime_error is the documented refusal;
 // anything else, a sanitizer report, a hang (-timeout) or a cast outside [0, max_range] is a
 // finding.
-#include <unistd.h>
-
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <fstream>
 #include <stdexcept>
-#include <string>
 
 #include "kiseki/sim/octree_world.hpp"
-
-namespace {
-
-const std::string& input_path() {
-  static const std::string path = [] {
-    char name[] = "/tmp/kiseki-fuzz-octree-XXXXXX";
-    const int fd = mkstemp(name);
-    if (fd < 0) std::abort();
-    close(fd);
-    return std::string(name);
-  }();
-  return path;
-}
-
-}  // namespace
+#include "temp_input.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  {
-    std::ofstream out(input_path(), std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
-  }
   try {
-    const kiseki::OctreeWorld world = kiseki::OctreeWorld::read_binary(input_path());
+    const kiseki::OctreeWorld world = [&] {
+      const kiseki_fuzz::TempInput input(data, size);  // removed after the read
+      return kiseki::OctreeWorld::read_binary(input.path());
+    }();
     (void)world.bounds();
     (void)world.occupied_leaves();
     const Eigen::Vector3d origin(0.1, 0.2, 0.5);
