@@ -942,12 +942,15 @@ def _warn_if_off_the_map(
 
     if share is None:
         finite = np.isfinite(trajectory).all(axis=1)
-        try:
-            share = endpoint_agreement(
-                grid, trajectory[finite], scans.ranges[finite], scans.angles, scans.max_range
-            )
-        except ValueError:  # no estimate, or no endpoint below max_range
+        # endpoint_agreement's endpoints: finite readings in (0, max_range), float32 as the core
+        # reads them, compared in double as it does; with none (no estimate, or every reading
+        # at max_range) the share is undefined and there is nothing to warn about
+        ranges = np.asarray(scans.ranges, dtype=np.float32)[finite].astype(np.float64)
+        if not (np.isfinite(ranges) & (ranges > 0.0) & (ranges < scans.max_range)).any():
             return
+        share = endpoint_agreement(
+            grid, trajectory[finite], scans.ranges[finite], scans.angles, scans.max_range
+        )
     if share < OFF_MAP_SHARE:
         typer.echo(
             f"kiseki: warning: only {100 * share:.1f} % of the scan endpoints fall on or next to "
