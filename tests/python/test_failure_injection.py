@@ -227,7 +227,8 @@ def scene(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="module")
 def taught(tmp_path_factory, scene) -> dict:
-    """An uninterrupted teaching run with the CLI's default seed: its folder, marks, poses."""
+    """An uninterrupted teaching run with seed 0 (the CLI runs compared with it pass --seed 0):
+    its folder, marks, poses."""
     from kiseki.sim.mcap_log import read_run
     from kiseki.sim.scene import load_scene
     from kiseki.teach import teach
@@ -270,7 +271,7 @@ def test_a_full_disk_while_teaching_keeps_the_steps_taught(tmp_path, namespace, 
     steps = Steps(
         tmp_path,
         f"""
-        run teach $KISEKI teach {scene} -o "$DISK/t"
+        run teach $KISEKI teach {scene} -o "$DISK/t" --seed 0
         snap full
         mount -o remount,size=64m "$DISK"
         run resume $KISEKI teach {scene} -o "$DISK/t" --resume
@@ -316,7 +317,7 @@ def test_kill_9_while_teaching_keeps_the_steps_taught(tmp_path, scene, taught):
     # killed once the log has grown to a seeded share of the uninterrupted run's log
     size = (taught["folder"] / "teach.mcap").stat().st_size
     share = np.random.default_rng(11).uniform(0.1, 0.8)
-    cli = [*KISEKI.split(), "teach", str(scene), "-o", str(tmp_path / "t")]
+    cli = [*KISEKI.split(), "teach", str(scene), "-o", str(tmp_path / "t"), "--seed", "0"]
     proc = subprocess.Popen(cli, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     log = tmp_path / "t" / "teach.mcap"
     deadline = time.monotonic() + 120
