@@ -5,6 +5,7 @@ recorded, results folder, reproduction report, and bad input."""
 
 from __future__ import annotations
 
+import errno
 import os
 import signal
 import subprocess
@@ -288,3 +289,36 @@ def test_a_run_whose_every_trial_fails_says_so_and_resumes_after_the_fix(tmp_pat
     assert (result.runs, result.failed, result.executed) == (3, 0, 3)
     assert frame(out)["value"].tolist() == [0.0, 1.0, 2.0]
     assert pd.read_csv(out / "claims.csv")["measured_value"].tolist() == [3]
+
+
+def test_an_analysis_error_is_raised_as_it_is_not_as_a_disk_problem(tmp_path, monkeypatch):
+    missing = tmp_path / "inputs" / "reference.csv"
+
+    def trial(config, index, seed):
+        return base.TrialOutput({"value": float(index)})
+
+    disk_full = {"yes": False}
+
+    def analyze(config, trials, timings, figures):  # reads an input that is not there
+        if disk_full["yes"]:  # or draws a figure on a full disk
+            raise OSError(errno.ENOSPC, "No space left on device", str(figures / "a.png"))
+        raise FileNotFoundError(errno.ENOENT, "No such file or directory", str(missing))
+
+    experiment = base.Experiment(
+        "needs_input", "test paper", "Table 0", "reads an input", CorridorScansConfig, trial,
+        analyze, default_runs=2,
+    )  # fmt: skip
+    real = registry._registry()
+    monkeypatch.setattr(registry, "_registry", lambda: {**real, "needs_input": experiment})
+    with pytest.raises(FileNotFoundError) as err:
+        run_experiment("needs_input", out=tmp_path / "run", progress=False)
+    assert (err.value.errno, err.value.filename) == (errno.ENOENT, str(missing))
+    assert str(err.value) == f"[Errno 2] No such file or directory: '{missing}'"  # not reworded
+    log = (tmp_path / "run" / "trials.jsonl").read_text(encoding="utf-8")
+    assert len(log.splitlines()) == 2  # the trials are logged all the same
+    assert not (tmp_path / "run" / "claims.csv").exists()
+    assert not list((tmp_path / "run").glob(".figures.*"))
+    disk_full["yes"] = True  # a full disk while drawing is the results' problem: --resume
+    with pytest.raises(OSError, match=r"trials are kept .* --resume") as full:
+        run_experiment("needs_input", out=tmp_path / "run", resume=True, progress=False)
+    assert full.value.errno == errno.ENOSPC and str(tmp_path / "run") in str(full.value)

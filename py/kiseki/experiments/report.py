@@ -5,6 +5,7 @@ project-wide REPRODUCTION.md that gathers the latest run of every experiment."""
 
 from __future__ import annotations
 
+import errno
 import json
 import math
 import os
@@ -18,7 +19,7 @@ import pandas as pd
 from rich.console import Console
 from rich.table import Table
 
-from kiseki._atomic import atomic_write, atomic_write_all
+from kiseki._atomic import atomic_write, atomic_write_all, reworded
 from kiseki.experiments.base import CLAIM_COLUMNS, Analysis, Claim, Experiment
 from kiseki.experiments.registry import all_experiments
 
@@ -136,25 +137,40 @@ def _results_error(err: OSError, experiment: Experiment, run_dir: Path) -> OSErr
     where = f"{err.filename}: {reason}" if err.filename else reason
     if str(run_dir) not in where:
         where = f"{run_dir}: {where}"
-    out = type(err)(
+    return reworded(
+        err,
         f"{where}; the finished trials are kept in trials.jsonl (kiseki experiment run "
-        f"{experiment.name} --resume --out {run_dir} writes the results once this is fixed)"
+        f"{experiment.name} --resume --out {run_dir} writes the results once this is fixed)",
     )
-    out.errno = err.errno
-    return out
+
+
+def _drawing_error(err: OSError, drawn: Path) -> bool:
+    """Whether an OSError of the analysis is one of drawing its figures into ``drawn`` (a
+    full disk), not of reading its inputs."""
+    if err.errno in (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EFBIG):
+        return True
+    name = os.fsdecode(err.filename) if isinstance(err.filename, str | bytes) else ""
+    return bool(name) and Path(name).absolute().is_relative_to(drawn.absolute())
 
 
 def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) -> pd.DataFrame:
     """Writes every output to a temporary name (figures to a hidden folder) and moves them
     into place once all are complete: a failure part-way (a full disk) leaves the previous
-    outputs as they were and nothing half-written."""
+    outputs as they were and nothing half-written. An OSError of writing or moving them says
+    the trials are kept, as does one of drawing the figures; any other raised by the
+    experiment's analysis (a missing input) is raised as it is."""
     for stale in run_dir.glob(".figures.*"):  # left by a run killed while drawing
         shutil.rmtree(stale, ignore_errors=True)
     (run_dir / "tables").mkdir(exist_ok=True)
     (run_dir / "figures").mkdir(exist_ok=True)
     drawn = Path(tempfile.mkdtemp(dir=run_dir, prefix=".figures."))
     try:
-        analysis = experiment.analyze(config, trials, timings, drawn)
+        try:
+            analysis = experiment.analyze(config, trials, timings, drawn)
+        except OSError as err:
+            if not _drawing_error(err, drawn):
+                raise  # the analysis's own (a missing input file): as it is
+            raise _results_error(err, experiment, run_dir) from err
         claims = _claims_frame(analysis.claims)
         texts = {
             run_dir / "tables" / f"{n}.csv": t.to_csv(index=False)
@@ -163,13 +179,14 @@ def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) 
         texts[run_dir / "claims.csv"] = claims.to_csv(index=False)
         texts[run_dir / "report.md"] = _report(experiment, analysis, manifest, claims)
         texts[run_dir / "manifest.json"] = json.dumps(manifest, indent=2)
-        atomic_write_all(_frames(trials, timings, run_dir) + _texts(texts))
-        for path in sorted(p for p in drawn.rglob("*") if p.is_file()):
-            target = run_dir / "figures" / path.relative_to(drawn)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(path, target)
-    except OSError as err:
-        raise _results_error(err, experiment, run_dir) from err
+        try:
+            atomic_write_all(_frames(trials, timings, run_dir) + _texts(texts))
+            for path in sorted(p for p in drawn.rglob("*") if p.is_file()):
+                target = run_dir / "figures" / path.relative_to(drawn)
+                target.parent.mkdir(parents=True, exist_ok=True)
+                os.replace(path, target)
+        except OSError as err:
+            raise _results_error(err, experiment, run_dir) from err
     finally:
         shutil.rmtree(drawn, ignore_errors=True)
     Console().print(claims_table(f"{experiment.name}: claims ({run_dir})", claims))

@@ -13,6 +13,8 @@ from typing import Any
 
 import pandas as pd
 
+from kiseki._atomic import reworded
+
 __all__ = ["TrialLog"]
 
 
@@ -55,12 +57,11 @@ class TrialLog:
         except OSError as err:
             with contextlib.suppress(OSError):
                 os.truncate(self.path, size)
-            out = type(err)(
+            message = (
                 f"{self.path}: {err.strerror or err}; the trials finished before are kept "
                 "(--resume runs the others)"
             )
-            out.errno = err.errno
-            raise out from err
+            raise reworded(err, message) from err
 
     @staticmethod
     def frames(entries: dict[int, dict[str, Any]]) -> tuple[pd.DataFrame, pd.DataFrame]:

@@ -22,7 +22,7 @@ import numpy as np
 import yaml
 from tqdm import tqdm
 
-from kiseki._atomic import atomic_write_all, check_writable_folder
+from kiseki._atomic import atomic_write_all, check_writable_folder, reworded
 from kiseki._yaml import read_yaml_file
 from kiseki.control import PurePursuit
 from kiseki.core import Pose2
@@ -271,12 +271,11 @@ class TeachingRun:
     def _log_error(self, err: OSError) -> OSError:
         """The error of writing the log, naming it and saying what is kept."""
         reason = err.strerror or str(err)
-        out = type(err)(
+        return reworded(
+            err,
             f"{self.log}: {reason[:1].lower()}{reason[1:]}; the steps logged before are kept "
-            "(kiseki teach --resume rebuilds the maps from them once there is space)"
+            "(kiseki teach --resume rebuilds the maps from them once there is space)",
         )
-        out.errno = err.errno
-        return out
 
     def _close_after_error(self) -> None:
         """Closes the log after an error without hiding it (on a full disk, closing fails
