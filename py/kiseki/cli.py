@@ -630,6 +630,12 @@ def playback_command(
         help="MCAP file to write the run to (poses, /cmd_vel; with a limiter /scan and "
         "/speed_limit as nav2_msgs/SpeedLimit fields).",
     ),
+    variant: str | None = typer.Option(
+        None,
+        help="Label of a deliberately changed copy of the taught scene (its SHA-1 differs from "
+        "the one the teaching recorded): played back instead of refused, the label and both "
+        "SHA-1s printed and in --log's metadata.",
+    ),
 ) -> None:
     """Play a taught route back on the particle filter's estimate; stop within 0.1 m of the goal.
     Give the teaching folder (--taught) or its waypoint file (--waypoints, and --map for a map
@@ -641,6 +647,7 @@ def playback_command(
     from kiseki.sim.scene import load_scene
     from kiseki.teach import PlaybackConfig, playback
     from kiseki.teach.local_maps import METHODS
+    from kiseki.teach.scene_identity import check_scene, taught_scene_of
     from kiseki.teach.teaching import load_route
 
     if (taught is None) == (waypoints is None):
@@ -655,14 +662,25 @@ def playback_command(
     if taught is not None:
         waypoints = taught / "waypoints.yaml"
     map_path, marks = load_route(waypoints, band, names, map_file)
+    if not scene_file.is_file():
+        raise FileNotFoundError(f"{scene_file}: scene file not found")
+    taught_scene = taught_scene_of(waypoints)
+    identity = check_scene(taught_scene, scene_file, variant)
     inputs = {"SCENE": scene_file, "the waypoint file": waypoints, "the map": map_path}
     check_outputs({"--log": log}, inputs)
     if log is not None and log.exists():
         raise FileExistsError(f"--log {log} exists; give a new file")
     scene, environment = load_scene(scene_file, "playback"), load_map(map_path)
     limiter = _speed_limiter(speed_limit, scene, environment, config.speed)
-    result = playback(scene, environment, marks, config, limiter, log)
+    result = playback(scene, environment, marks, config, limiter, log, taught_scene, variant)
     console.print(_stop_summary(method, result, marks[-1]))
+    if variant is not None:
+        console.print(
+            f"  scene variant {variant!r}: {scene_file} (SHA-1 {identity['scene_sha1']}), taught "
+            f"in {identity.get('taught_scene_file') or 'an unrecorded scene'} (SHA-1 "
+            f"{identity.get('taught_scene_sha1', 'not recorded')})",
+            soft_wrap=True,
+        )
     if result.speed_limits is not None:
         limits = result.speed_limits
         console.print(

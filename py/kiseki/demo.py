@@ -87,6 +87,7 @@ def run_demo(
             maps[band],
             taught.marks,
             PlaybackConfig(method=method, particles=particles, seed=derive_seed(seed, 2)),
+            taught_scene=taught.scene,
         )
         tx, ty = r.stop_true[0] - goal["truth"][0], r.stop_true[1] - goal["truth"][1]
         ex, ey = r.stop_estimate[0] - goal["x"], r.stop_estimate[1] - goal["y"]

@@ -198,7 +198,7 @@ def test_refusals(taught, tmp_path):
         str(folder),
     ]
     cases = [
-        ([str(blind), "--speed-limit", "occlusion"], "has no laser"),
+        ([str(blind), "--speed-limit", "occlusion", "--variant", "no-laser"], "has no laser"),
         ([str(scene_file), "--speed-limit", "fast"], "--speed-limit must be none, occlusion"),
         ([str(scene_file), "--log", str(scene_file)], "would overwrite the input SCENE"),
         ([str(scene_file), "--log", str(folder / "map_band.pgm")], "would overwrite the input"),

@@ -211,6 +211,8 @@ def trial(config: Exp1Config, index: int, seed: int) -> TrialOutput:
                 PlaybackConfig(
                     method=method, particles=config.particles, seed=derive_seed(seed, 2)
                 ),
+                taught_scene=taught.scene,
+                variant="exp3-boxes" if config.boxes else None,  # the copy with the boxes
             )
             for k, v in _errors(result, goal).items():
                 record[f"{method}_{k}"] = v
@@ -224,6 +226,7 @@ def trial(config: Exp1Config, index: int, seed: int) -> TrialOutput:
                     PlaybackConfig(
                         method=method, particles=config.particles, seed=derive_seed(seed, 2)
                     ),
+                    taught_scene=taught.scene,
                 )
                 for k, v in _errors(control, goal).items():
                     if k.startswith("stop_"):

@@ -32,6 +32,7 @@ from kiseki.sim.scene import Scene
 from kiseki.sim.setup import SensorSetup, build_robot, build_sensors
 from kiseki.teach.local_maps import METHODS, LocalMapMaker
 from kiseki.teach.playback_log import PlaybackLog
+from kiseki.teach.scene_identity import TaughtScene, check_scene
 
 __all__ = ["PlaybackConfig", "PlaybackResult", "PlaybackRun", "check_route", "playback"]
 
@@ -100,6 +101,7 @@ class PlaybackResult:
     estimates: np.ndarray | None = None
     times: np.ndarray | None = None  # s, of each step (truth[k] and estimates[k] at times[k])
     speed_limits: np.ndarray | None = None  # m/s the limiter allowed at each step, if any
+    scene_identity: dict = field(default_factory=dict)  # scene_sha1, taught_scene_sha1, variant
 
     @property
     def duration(self) -> float:
@@ -118,14 +120,23 @@ def playback(
     config: PlaybackConfig | None = None,
     speed_limiter: SpeedLimitSource | None = None,
     log: str | os.PathLike | None = None,
+    taught_scene: TaughtScene | None = None,
+    variant: str | None = None,
 ) -> PlaybackResult:
     """Runs the route through `waypoints` (taught marks, map frame) in the scene; the follower's
     speed is capped by `speed_limiter` when given (the scene needs a laser), and the run is
     written to the MCAP file `log` (which must not exist) when given. A loop over
-    :class:`PlaybackRun`'s steps, for at most ``config.max_duration``."""
+    :class:`PlaybackRun`'s steps, for at most ``config.max_duration``.
+
+    `taught_scene` (a :class:`TeachResult`'s ``scene``) is the scene the route was taught in: a
+    scene file whose bytes differ is refused (ValueError) unless `variant` labels the change;
+    the scene's and the taught scene's SHA-1s and the label go into the log's metadata and the
+    result's ``scene_identity``."""
     config = config or PlaybackConfig()
+    identity = check_scene(taught_scene, scene.path, variant)
     run = PlaybackRun(scene, environment, waypoints, config, speed_limiter)
     meta = {
+        **identity,
         "scene_file": str(scene.path),
         "route": ",".join(str(w["name"]) for w in waypoints),
         "method": config.method,
@@ -138,7 +149,9 @@ def playback(
         for _ in range(int(config.max_duration / config.dt)):
             if not run.step():
                 break
-    return run.result()
+    result = run.result()
+    result.scene_identity = identity
+    return result
 
 
 class PlaybackRun:

@@ -34,6 +34,7 @@ from kiseki.sim.scene import Scene
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import MERGE_RULES, EnvironmentMap
 from kiseki.teach.local_maps import BANDS, LocalMapMaker
+from kiseki.teach.scene_identity import TaughtScene, scene_digest
 
 __all__ = [
     "TeachResult",
@@ -68,6 +69,7 @@ class TeachResult:
     marks: list[dict]
     merge: str = "thesis"  # the merge rule the maps were built with
     truth: dict | None = None  # band -> the map against the scene's truth (map_truth.json)
+    scene: TaughtScene | None = None  # the scene file taught in and its SHA-1
 
 
 def _environment(scene: Scene, resolution: float = 0.1, margin: float = 4.0) -> OccupancyGrid:
@@ -124,6 +126,7 @@ def _write_outputs(
     steps: int,
     merge: str,
     truth: dict | None,
+    scene: TaughtScene,
 ) -> TeachResult:
     """Every file is written before any replaces its previous version (a full disk leaves the
     previous maps and waypoint file as they were, consistent with one another)."""
@@ -147,6 +150,8 @@ def _write_outputs(
         doc = {
             "log": log.name,
             "merge": merge,
+            "scene_file": scene.file,
+            "scene_sha1": scene.sha1,
             "maps": {
                 band: {"file": p.name, "image_sha1": digests[band]} for band, p in paths.items()
             },
@@ -155,7 +160,7 @@ def _write_outputs(
         Path(tmp).write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
 
     atomic_write_all([*writes, (out / "waypoints.yaml", waypoints)])
-    return TeachResult(paths, out / "waypoints.yaml", log, steps, marks, merge, truth)
+    return TeachResult(paths, out / "waypoints.yaml", log, steps, marks, merge, truth, scene)
 
 
 class TeachingRun:
@@ -201,9 +206,10 @@ class TeachingRun:
         self.steps = 0  # steps logged
         self.out.mkdir(parents=True, exist_ok=True)
         self.log = self.out / "teach.mcap"
+        self.scene_id = TaughtScene(str(scene.path), scene_digest(scene.path))
         meta = {
-            "scene_file": str(scene.path),
-            "scene_sha1": scene_digest(scene.path),
+            "scene_file": self.scene_id.file,
+            "scene_sha1": self.scene_id.sha1,
             "seed": str(seed),
             "dt": str(dt),
             "merge": merge,
@@ -295,7 +301,9 @@ class TeachingRun:
         self.close()
         maps = {b: m.map() for b, m in self.maps.items()}
         truth = measure_taught_maps(self.scene, maps, np.array(self.truths), self.cameras)
-        return _write_outputs(self.out, maps, self.marks, self.log, self.steps, self.merge, truth)
+        return _write_outputs(
+            self.out, maps, self.marks, self.log, self.steps, self.merge, truth, self.scene_id
+        )
 
     def __enter__(self) -> TeachingRun:
         return self
@@ -367,11 +375,6 @@ def _mark(run: TeachingRun, names, controller: PurePursuit, resting: bool) -> No
     run.mark(names[i])
 
 
-def scene_digest(path: str | os.PathLike) -> str:
-    """SHA-1 of a scene file's bytes: ties a teaching log to the scene it was taught in."""
-    return hashlib.sha1(Path(path).read_bytes()).hexdigest()
-
-
 def _check_same_scene(metadata: dict, scene: Scene, log) -> None:
     """Refuses to rebuild a log in a scene other than the one it was taught in: by the scene
     file's SHA-1 when the log records it, else by the recorded file when it still exists."""
@@ -424,7 +427,8 @@ def recover(
     Path(out).mkdir(parents=True, exist_ok=True)
     grids = {b: m.map() for b, m in maps.items()}
     measured = measure_taught_maps(scene, grids, np.array(truths), cameras) if truths else None
-    return _write_outputs(Path(out), grids, marks, Path(log), steps, merge, measured)
+    scene_id = TaughtScene(str(scene.path), scene_digest(scene.path))
+    return _write_outputs(Path(out), grids, marks, Path(log), steps, merge, measured, scene_id)
 
 
 def load_taught(folder: str | os.PathLike, band: str, route: list[str]) -> tuple[Path, list[dict]]:
