@@ -13,7 +13,8 @@
 - ``GET /api/state``: ``{"status": "idle"|"running"|"finished"|"stopped", "route", "leg":
   {"phase": "outbound"|"dwell"|"return", "index", "from", "to"}, "pose", "estimate",
   "speed", "command", "t", "stop_error_m", "dwell_left_s", "detail", "history": [...]}``
-- ``POST /api/stop``: the robot brakes at once; ``{"stopping": bool, "status"}``
+- ``POST /api/stop``: the robot brakes at once; ``{"stopping": bool, "status", "t", "speed"}``
+  (the route's clock and the robot's speed when the stop was taken)
 - ``PATCH /api/waypoints/{name}`` ``{"name": NEW}``: 200 ``{"waypoint"}``; 404 unknown, 409 a
   duplicate name or a route running, 422 a bad name
 - ``/ws``: the state (``"type": "state"``, ``"seq"``, ``"particles"`` [[x, y, theta], ...]) on

@@ -179,7 +179,10 @@ class RouteRunner:
             if running:
                 self._stop.set()
                 self._state["detail"] = "stopping"
-            return {"stopping": running, "status": self._state["status"]}
+            # t and speed: the route's clock and the robot's speed when the stop was taken
+            state = self._state
+            return {"stopping": running, "status": state["status"], "t": state["t"],
+                    "speed": state["speed"]}  # fmt: skip
 
     def state(self) -> dict:
         """The state (a deep copy) with the sequence number of the last message sent, so a page
