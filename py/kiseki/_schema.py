@@ -1,0 +1,132 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The one typed validation layer for the files kiseki reads (scene YAML, waypoint files, ROS map
+YAML, experiment configs, key scripts, command CSVs): pydantic v2 models, checked by
+:func:`parse`, whose errors name the file, the field and the value in one line.
+
+Conventions every model follows (so that every file reads the same way):
+
+- models derive from :class:`FileModel` (unknown keys are errors) and use this module's number
+  types: strict (a number is not a string, ``true`` is not 1; an int is a float) and finite;
+- YAML is read with YAML 1.2's numbers (:mod:`kiseki._yaml`), so ``5e-2`` is a number;
+- everything that sizes memory or time has a limit (``Field(le=...)``) and the limit is in the
+  message; seeds are :data:`Seed` (0 <= seed < 2**64, as :func:`kiseki.core.check_seed`);
+- a section checked by its own model inside a bigger file passes its location as ``at``
+  (``parse(Robot, doc["robots"][0], path, at=("robots", 0))``), so the message shows the whole
+  path ``robots[0].sensors[1].rate_hz``.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from typing import Annotated, Any, TypeVar
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
+
+from kiseki.errors import KisekiError
+
+__all__ = [
+    "FileModel",
+    "FiniteFloat",
+    "NonNegativeFloat",
+    "PositiveFloat",
+    "PositiveInt",
+    "SEED_LIMIT",
+    "Seed",
+    "SchemaError",
+    "location_text",
+    "parse",
+]
+
+SEED_LIMIT = 2**64
+"""Seeds are any integer in [0, 2**64): numpy's and the C++ core's 64-bit generators take them."""
+
+# numbers are strict (``"1.5"`` and ``true`` are not numbers; an int is a float) and finite
+FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]
+PositiveFloat = Annotated[float, Field(strict=True, gt=0, allow_inf_nan=False)]
+NonNegativeFloat = Annotated[float, Field(strict=True, ge=0, allow_inf_nan=False)]
+PositiveInt = Annotated[int, Field(strict=True, gt=0)]
+
+
+def _seed(value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < SEED_LIMIT:
+        raise ValueError("must be an integer in [0, 2**64)")
+    return value
+
+
+Seed = Annotated[int, BeforeValidator(_seed)]
+
+_M = TypeVar("_M", bound=BaseModel)
+
+
+class SchemaError(KisekiError, ValueError):
+    """A file or config that does not match its model: the message names the file, the field
+    and the value. ``errors`` holds every problem found (the message shows the first)."""
+
+    def __init__(self, message: str, errors: Sequence[str] = ()) -> None:
+        super().__init__(message)
+        self.errors = list(errors) or [message]
+
+
+class FileModel(BaseModel):
+    """Base of the models of kiseki's files: unknown keys are errors, frozen. Use the strict
+    number types of this module (a YAML list is accepted where a model says tuple)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+def location_text(loc: Sequence[str | int]) -> str:
+    """``("robots", 0, "sensors", 1, "rate_hz")`` -> ``"robots[0].sensors[1].rate_hz"``."""
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _problem(err: dict[str, Any], at: Sequence[str | int]) -> str:
+    # pydantic puts the name of a tagged-union member or a function validator in the location:
+    # only the keys and indices of the document are shown
+    loc = [
+        p
+        for p in (*at, *err.get("loc", ()))
+        if isinstance(p, int) or not str(p).startswith("function-")
+    ]
+    where = location_text(loc)
+    message = err.get("msg", "invalid value")
+    if message.startswith("Value error, "):
+        message = message[len("Value error, ") :]
+    if message.startswith("Input should be "):
+        message = "must be " + message[len("Input should be ") :]
+    if err.get("type") == "missing":
+        text = "missing"
+    elif err.get("type") == "extra_forbidden":
+        text = "unknown key"
+    else:
+        text = f"{message[:1].lower()}{message[1:]}, got {_short(err.get('input'))}"
+    return f"{where}: {text}" if where else text
+
+
+def parse(
+    model: type[_M],
+    data: Any,
+    source: str | os.PathLike[str],
+    *,
+    at: Sequence[str | int] = (),
+) -> _M:
+    """``data`` (a parsed YAML document, a CSV row, ...) checked against ``model``; a
+    :class:`SchemaError` ``"SOURCE: field.path: problem, got VALUE"`` when it does not match."""
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        problems = [_problem(e, at) for e in exc.errors(include_url=False)]
+        more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
+        raise SchemaError(f"{source}: {problems[0]}{more}", problems) from None
