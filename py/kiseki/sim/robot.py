@@ -49,11 +49,22 @@ give each robot's odometry its own stream.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
-from typing import Any, TypeVar
+from dataclasses import dataclass
+from typing import Annotated, Any, TypeVar
 
+from pydantic import ConfigDict, Field, RootModel
+from pydantic.dataclasses import dataclass as pydantic_dataclass
+
+from kiseki._schema import (
+    FiniteFloat,
+    NonNegativeFloat,
+    PositiveFloat,
+    PositiveInt,
+    parse,
+)
 from kiseki.core import Pose2, Random, check_seed, normalize_angle
 
 __all__ = [
@@ -72,83 +83,42 @@ __all__ = [
 PoseLike = Pose2 | Sequence[float]
 
 # --------------------------------------------------------------------------------------------
-# Parameter validation shared by every parameter dataclass
+# Parameter checking shared by every parameter class
 # --------------------------------------------------------------------------------------------
+
+# The parameter classes are pydantic dataclasses: still frozen dataclasses (dataclasses.fields,
+# replace and asdict work), checked on construction by pydantic with kiseki._schema's strict
+# number types (an int is a float, a float is not an int, a bool is not a number, NaN and
+# infinities are errors). A relative error e gives a physical value nominal * (1 + e), so it
+# must lie in (-1, 1) for the value to stay positive.
+_params = pydantic_dataclass(frozen=True, config=ConfigDict(extra="forbid"))
+RelativeError = Annotated[float, Field(strict=True, gt=-1.0, lt=1.0, allow_inf_nan=False)]
+Flag = Annotated[bool, Field(strict=True)]
 
 _P = TypeVar("_P", bound="_Params")
 
-# Field kinds: what a value must be. "relative" is a relative error e with a physical value
-# nominal * (1 + e), so it must lie in (-1, 1) for the value to stay positive.
-_KIND_TEXT = {
-    "positive": "a finite number > 0",
-    "nonnegative": "a finite number >= 0",
-    "finite": "a finite number",
-    "relative": "a finite relative error in (-1, 1)",
-    "count": "an integer > 0",
-    "flag": "true or false",
-}
 
-
-def _param(default: Any, kind: str) -> Any:
-    return field(default=default, metadata={"kind": kind})
-
-
-def _coerce(kind: str, value: Any, where: str, name: str) -> float | int | bool:
-    """Checks one parameter value and returns it as float, int or bool (ValueError if bad)."""
-    problem = f"{where}: {name} must be {_KIND_TEXT[kind]}, got {value!r}"
-    if kind == "flag":
-        if not isinstance(value, bool):
-            raise ValueError(problem)
-        return value
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ValueError(problem)
-    if kind == "count":
-        if isinstance(value, float) and not value.is_integer():
-            raise ValueError(problem)
-        if not math.isfinite(value) or value <= 0:
-            raise ValueError(problem)
-        return int(value)
-    number = float(value)
-    ok = math.isfinite(number) and (
-        (kind == "positive" and number > 0)
-        or (kind == "nonnegative" and number >= 0)
-        or kind == "finite"
-        or (kind == "relative" and -1.0 < number < 1.0)
-    )
-    if not ok:
-        raise ValueError(problem)
-    return number
+@functools.cache
+def _document(cls: type) -> type[RootModel]:
+    """A model whose document is one parameter section (``parse`` needs a pydantic model)."""
+    return RootModel[cls]  # type: ignore[valid-type]
 
 
 class _Params:
-    """Validation on construction, ``from_dict`` and ``to_dict`` for the parameter classes."""
-
-    def __post_init__(self) -> None:
-        name = type(self).__name__
-        for f in dataclasses.fields(self):  # type: ignore[arg-type]
-            value = _coerce(f.metadata["kind"], getattr(self, f.name), name, f.name)
-            object.__setattr__(self, f.name, value)
+    """``from_dict`` and ``to_dict`` of the parameter classes."""
 
     @classmethod
-    def from_dict(cls: type[_P], d: Mapping[str, Any], source: str = "<dict>") -> _P:
+    def from_dict(
+        cls: type[_P], d: Mapping[str, Any], source: str = "<dict>", at: Sequence[str | int] = ()
+    ) -> _P:
         """Builds the parameters from a mapping (a parsed YAML/TOML/JSON section).
 
         Missing keys keep their documented defaults. Unknown keys, non-numeric values, NaN or
         infinite values and values out of range (sizes and limits must be > 0) raise
-        :class:`ValueError` naming ``source`` (e.g. the config file) and the offending key.
+        :class:`kiseki._schema.SchemaError` (a ValueError) naming ``source`` (e.g. the config
+        file), the key (after the path ``at`` of the section in its file) and the value.
         """
-        if not isinstance(d, Mapping):
-            raise ValueError(f"{source}: {cls.__name__} needs a mapping, got {type(d).__name__}")
-        fields = {f.name: f for f in dataclasses.fields(cls)}  # type: ignore[arg-type]
-        values: dict[str, Any] = {}
-        for key, value in d.items():
-            if key not in fields:
-                known = ", ".join(sorted(fields))
-                raise ValueError(
-                    f"{source}: unknown key {key!r} for {cls.__name__} (known keys: {known})"
-                )
-            values[key] = _coerce(fields[key].metadata["kind"], value, source, key)
-        return cls(**values)
+        return parse(_document(cls), d, source, at=at).root
 
     def to_dict(self) -> dict[str, Any]:
         """The parameters as a plain dict (``from_dict(p.to_dict()) == p``)."""
@@ -160,7 +130,7 @@ class _Params:
 # --------------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@_params
 class DiffDriveParams(_Params):
     """The factory AGV of paper 000 (CARTIS Type B, a differential-drive cart).
 
@@ -190,18 +160,18 @@ class DiffDriveParams(_Params):
             edges, giving 4 x 500 = 2000 counts per motor turn. Set False for x1 counting.
     """
 
-    length: float = _param(1.05, "positive")
-    width: float = _param(0.58, "positive")
-    height: float = _param(0.99, "positive")
-    wheel_radius: float = _param(0.075, "positive")
-    track_width: float = _param(0.50, "positive")
-    max_speed: float = _param(1.0, "positive")
-    max_yaw_rate: float = _param(1.0, "positive")
-    max_accel: float = _param(0.5, "positive")
-    max_yaw_accel: float = _param(1.0, "positive")
-    encoder_counts_per_rev: int = _param(500, "count")
-    gear_ratio: float = _param(70.0, "positive")
-    quadrature: bool = _param(True, "flag")
+    length: PositiveFloat = 1.05
+    width: PositiveFloat = 0.58
+    height: PositiveFloat = 0.99
+    wheel_radius: PositiveFloat = 0.075
+    track_width: PositiveFloat = 0.50
+    max_speed: PositiveFloat = 1.0
+    max_yaw_rate: PositiveFloat = 1.0
+    max_accel: PositiveFloat = 0.5
+    max_yaw_accel: PositiveFloat = 1.0
+    encoder_counts_per_rev: PositiveInt = 500
+    gear_ratio: PositiveFloat = 70.0
+    quadrature: Flag = True
 
     @property
     def counts_per_wheel_rev(self) -> float:
@@ -217,7 +187,7 @@ class DiffDriveParams(_Params):
         return 2.0 * math.pi * self.wheel_radius / self.counts_per_wheel_rev
 
 
-@dataclass(frozen=True)
+@_params
 class OmniParams(_Params):
     """The omnidirectional hospital transport robot of paper 004 (MKR-003).
 
@@ -234,15 +204,15 @@ class OmniParams(_Params):
             0.35 m/s^2, below a_max.
     """
 
-    length: float = _param(0.70, "positive")
-    width: float = _param(0.70, "positive")
-    max_speed: float = _param(0.5, "positive")
-    max_accel: float = _param(0.5, "positive")
-    max_yaw_rate: float = _param(1.0, "positive")
-    max_yaw_accel: float = _param(1.0, "positive")
+    length: PositiveFloat = 0.70
+    width: PositiveFloat = 0.70
+    max_speed: PositiveFloat = 0.5
+    max_accel: PositiveFloat = 0.5
+    max_yaw_rate: PositiveFloat = 1.0
+    max_yaw_accel: PositiveFloat = 1.0
 
 
-@dataclass(frozen=True)
+@_params
 class OdometryErrorParams(_Params):
     """Systematic and random odometry errors of the differential-drive AGV.
 
@@ -278,13 +248,13 @@ class OdometryErrorParams(_Params):
             k_r * |true rotation| (1.0 deg SD per full turn). Stated assumption.
     """
 
-    left_radius_error: float = _param(-0.0015, "relative")
-    right_radius_error: float = _param(-0.0005, "relative")
-    track_width_error: float = _param(0.005, "relative")
-    initial_heading_offset: float = _param(math.radians(-0.2), "finite")
-    initial_heading_sd: float = _param(math.radians(0.7), "nonnegative")
-    slip_distance_coeff: float = _param(4e-6, "nonnegative")
-    slip_rotation_coeff: float = _param(5e-5, "nonnegative")
+    left_radius_error: RelativeError = -0.0015
+    right_radius_error: RelativeError = -0.0005
+    track_width_error: RelativeError = 0.005
+    initial_heading_offset: FiniteFloat = math.radians(-0.2)
+    initial_heading_sd: NonNegativeFloat = math.radians(0.7)
+    slip_distance_coeff: NonNegativeFloat = 4e-6
+    slip_rotation_coeff: NonNegativeFloat = 5e-5
 
     @classmethod
     def none(cls) -> OdometryErrorParams:
@@ -292,7 +262,7 @@ class OdometryErrorParams(_Params):
         return cls(**{f.name: 0.0 for f in dataclasses.fields(cls)})
 
 
-@dataclass(frozen=True)
+@_params
 class OmniOdometryErrorParams(_Params):
     """Random odometry error of the omnidirectional robot (a simple, documented model).
 
@@ -310,9 +280,9 @@ class OmniOdometryErrorParams(_Params):
             (assumption).
     """
 
-    translation_coeff: float = _param(1e-4, "nonnegative")
-    heading_distance_coeff: float = _param(1e-4, "nonnegative")
-    heading_rotation_coeff: float = _param(5e-4, "nonnegative")
+    translation_coeff: NonNegativeFloat = 1e-4
+    heading_distance_coeff: NonNegativeFloat = 1e-4
+    heading_rotation_coeff: NonNegativeFloat = 5e-4
 
     @classmethod
     def none(cls) -> OmniOdometryErrorParams:
