@@ -18,10 +18,31 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-__all__ = ["atomic_write", "atomic_write_all", "check_writable_folder", "reworded"]
+__all__ = [
+    "atomic_write",
+    "atomic_write_all",
+    "check_writable_folder",
+    "record_written",
+    "reworded",
+    "written_files",
+]
 
 # a temporary file older than this is left by a killed writer (a live one is being written)
 STALE_SECONDS = 60.0
+
+# every target this process has put in place, in order (what an interrupted command reports)
+_WRITTEN: list[Path] = []
+
+
+def written_files() -> list[Path]:
+    """The files this process has written completely (renamed into place), oldest first."""
+    return list(_WRITTEN)
+
+
+def record_written(path: str | os.PathLike) -> None:
+    """Records a file or folder put in place by other means than :func:`atomic_write_all` (a
+    map folder swapped in whole), for :func:`written_files`."""
+    _WRITTEN.append(Path(path))
 
 
 def _umask() -> int:
@@ -123,6 +144,7 @@ def atomic_write_all(
                 raise _naming_target(err, target, tmp) from err
         for tmp, target in zip(temps, targets, strict=True):
             os.replace(tmp, target)
+            _WRITTEN.append(target)
         for folder in dict.fromkeys(target.parent for target in targets):
             _fsync_folder(folder)
     except BaseException:

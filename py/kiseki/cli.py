@@ -20,6 +20,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from kiseki._interrupt import interruptible
 from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
 from kiseki.cli_magnetic import magnetic_app
 from kiseki.cli_speed import speed_app
@@ -90,6 +91,7 @@ def _merge_rule(value: str) -> str:
 
 
 @map_app.command("from-log")
+@interruptible()
 def map_from_log(
     log: Path = typer.Argument(
         ...,
@@ -193,6 +195,7 @@ def _read_trajectory(path: Path) -> np.ndarray:
 
 
 @map_app.command("render")
+@interruptible()
 def map_render(
     map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat map."),
     output: Path = typer.Option(..., "-o", "--output", help="PNG to write."),
@@ -215,6 +218,7 @@ def map_render(
 
 
 @map_app.command("convert")
+@interruptible()
 def map_convert(
     map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat(.gz) map."),
     output: Path = typer.Option(..., "-o", "--output", help="ROS map YAML to write (PGM beside)."),
@@ -254,6 +258,7 @@ def map_info(
 
 
 @app.command("demo")
+@interruptible()
 def demo(
     out: Path = typer.Option(Path("results/demo"), help="Folder for the run, maps and figures."),
     scene: Path = typer.Option(
@@ -311,6 +316,7 @@ def experiment_list(
 
 
 @experiment_app.command("run")
+@interruptible("the finished trials are kept: --resume --out RUN_FOLDER runs only the missing ones")
 def experiment_run(
     name: str = typer.Argument(..., help="Experiment name (see: kiseki experiment list)."),
     runs: int | None = typer.Option(None, "--runs", help="Number of trials."),
@@ -401,6 +407,7 @@ def sim_run(
 
 
 @sim_app.command("render")
+@interruptible()
 def sim_render(
     run_file: Path = typer.Argument(..., metavar="RUN", help="MCAP file of a run."),
     output: Path = typer.Option(..., "-o", "--output", help="GIF to write."),
@@ -428,6 +435,7 @@ MAX_OCTREE_VOXELS = 5e7  # a few GB of OcTree nodes; the factory fills 2.6e5 at 
 
 
 @sim_app.command("show")
+@interruptible()
 def sim_show(
     scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML."),
     output: Path = typer.Option(..., "-o", "--output", help="PNG to write."),
@@ -463,6 +471,7 @@ def sim_show(
 
 
 @coop_app.command("simulate")
+@interruptible()
 def coop_simulate(
     form: int | None = typer.Option(
         None, help="Movement form: 1 (pair and scout, the default) or 2 (leapfrog)."
@@ -608,6 +617,7 @@ def teach_command(
 
 
 @app.command("playback")
+@interruptible()
 def playback_command(
     scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML (playback variant)."),
     route: str = typer.Option(..., help="Waypoint names, start, via, goal: P0,P1,P2."),
@@ -777,6 +787,7 @@ def serve_command(
 
 
 @app.command("localize")
+@interruptible()
 def localize_command(
     log: Path = typer.Argument(
         ...,
@@ -1007,6 +1018,7 @@ def _write_yaml(path: Path, doc: dict) -> None:
 
 
 @app.command("report")
+@interruptible()
 def report(
     results: Path = typer.Option(Path("results"), help="Results folder of the experiments."),
     output: Path = typer.Option(Path("REPRODUCTION.md"), "-o", "--output", help="File to write."),

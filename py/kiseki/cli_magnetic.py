@@ -13,6 +13,7 @@ import numpy as np
 import typer
 from rich.console import Console
 
+from kiseki._interrupt import interruptible
 from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
 
 __all__ = ["magnetic_app"]
@@ -110,6 +111,7 @@ def _hilbert_settings(gp) -> dict | None:
 
 
 @magnetic_app.command("fit")
+@interruptible()
 def fit(
     data: list[Path] = typer.Argument(
         ...,
@@ -265,6 +267,7 @@ def _read_points(path: Path, d: int) -> tuple[np.ndarray, bool]:
 
 
 @magnetic_app.command("predict")
+@interruptible()
 def predict(
     map_folder: Path = typer.Argument(..., metavar="MAP", help="Map folder (kiseki magnetic fit)."),
     at: Path = typer.Option(..., "--at", help="CSV with a header and columns x,y[,z]."),
@@ -302,6 +305,7 @@ def predict(
 
 
 @magnetic_app.command("render")
+@interruptible()
 def render(
     map_folder: Path = typer.Argument(..., metavar="MAP", help="Map folder (kiseki magnetic fit)."),
     output: Path = typer.Option(..., "-o", "--output", help="PNG to write."),

@@ -11,6 +11,7 @@ import numpy as np
 import typer
 from rich.console import Console
 
+from kiseki._interrupt import interruptible
 from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
 
 __all__ = ["speed_app"]
@@ -23,6 +24,7 @@ METHODS = ("occlusion", "occlusion-width", "width")
 
 
 @speed_app.command("limits")
+@interruptible()
 def speed_limits(
     log: Path = typer.Argument(
         ...,

@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from kiseki._atomic import record_written
 from kiseki.errors import MapFormatError
 from kiseki.gp import SquaredExponential
 from kiseki.magnetic.field_map import COMPONENTS, MagneticFieldMap, TrainingData
@@ -187,6 +188,7 @@ def save_map_folder(fmap: MagneticFieldMap, folder) -> Path:
         os.umask(mask)
         os.chmod(tmp, 0o777 & ~mask)
         _swap_into_place(tmp, folder)
+        record_written(folder)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
