@@ -196,9 +196,9 @@ def test_reproduction_report_with_carmen_maps(shared_data, tmp_path):
 def test_overrides_are_typed():
     c = apply_overrides(CorridorScansConfig(), ["range_noise_sd=0.02", "scan_spacing=0.2"])
     assert (c.range_noise_sd, c.scan_spacing) == (0.02, 0.2)
-    with pytest.raises(ConfigError, match="unknown config key 'noise'"):
+    with pytest.raises(ConfigError, match="--set: noise: unknown config key"):
         apply_overrides(CorridorScansConfig(), ["noise=1"])
-    with pytest.raises(ConfigError, match="range_noise_sd: expected float"):
+    with pytest.raises(ConfigError, match="range_noise_sd: must be a valid number, got 'loud'"):
         apply_overrides(CorridorScansConfig(), ["range_noise_sd=loud"])
 
 
@@ -207,7 +207,10 @@ def test_overrides_are_typed():
     [
         (["experiment", "run", "no-such-thing"], "unknown experiment 'no-such-thing'"),
         (["experiment", "run", "corridor-scans", "--set", "noise=1"], "unknown config key"),
-        (["experiment", "run", "corridor-scans", "--set", "scan_spacing=wide"], "expected float"),
+        (
+            ["experiment", "run", "corridor-scans", "--set", "scan_spacing=wide"],
+            "scan_spacing: must be a valid number, got 'wide'",
+        ),
         (["experiment", "run", "corridor-scans", "--set", "scan_spacing"], "key=value"),
         (["experiment", "run", "corridor-scans", "--runs", "0"], "--runs"),
         (

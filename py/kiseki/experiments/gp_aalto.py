@@ -41,6 +41,7 @@ from pathlib import Path
 
 from kiseki.experiments import gp_aalto_tasks as work
 from kiseki.experiments.base import Experiment, TrialOutput
+from kiseki.experiments.config import Particles, Runs, Seed
 
 __all__ = ["EXPERIMENT", "GpAaltoConfig", "data_dir", "tasks"]
 
@@ -61,7 +62,7 @@ class GpAaltoConfig:
     per_component: bool = True  # one GP per field component, as the thesis fits mx, my, mz
     max_points: int = 1000  # hyperparameters on at most this many readings (seeded subsample)
     restarts: int = 2  # seeded restarts of the hyperparameter search
-    gp_seed: int = 0  # seed of the hyperparameter search (shared by every task)
+    gp_seed: Seed = 0  # seed of the hyperparameter search (shared by every task)
     offset_calibration: bool = True  # remove a residual hard-iron offset fixed to the robot
     sweep: list[int] = field(default_factory=lambda: [1, 5, 10, 25, 50, 100])
     sweep_raw: bool = True  # the sweep also on the readings as recorded
@@ -71,8 +72,8 @@ class GpAaltoConfig:
     change_sigma: float = 3.0  # a reading departs from the map beyond this many sigma
     change_factor: float = 2.0  # changed: share above factor x the largest static share
     # magnetic-map MCL on the test run
-    mcl_seeds: int = 5
-    particles: int = 1000
+    mcl_seeds: Runs = 5
+    particles: Particles = 1000
     mcl_step: float = 0.1  # m of travel between filter updates
     map_resolution: float = 0.05  # m, the MCL's field map
     odometry_scale_sd: float = 0.02  # SD of the per-run distance scale error

@@ -27,6 +27,7 @@ from scipy.spatial import cKDTree
 from kiseki.control import PurePursuit
 from kiseki.core import derive_seed, normalize_angle
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.config import Particles, Runs, Seed
 from kiseki.experiments.gp_common import (
     FLOOR,
     floor_map_2d,
@@ -62,11 +63,11 @@ POSITION_BOUND, HEADING_BOUND = 0.8, 0.14  # m, rad: Fig. 6.16 (sec. 6.8)
 class MagneticMclExperimentConfig:
     scene: str = str(FLOOR)
     routes: list[str] = field(default_factory=lambda: list(ROUTES))
-    runs_per_route: int = 3
+    runs_per_route: Runs = 3
     speed: float = 0.3  # m/s (the thesis does not state its speed)
     dt: float = 0.1  # s, a step of the robot, the odometry, the readings and the filter
-    particles: int = 1000  # sec. 6.7
-    map_seed: int = 0  # the survey's noise (the map is shared by every trial)
+    particles: Particles = 1000  # sec. 6.7
+    map_seed: Seed = 0  # the survey's noise (the map is shared by every trial)
     resolution: float = 0.1  # m
     hyper_points: int = 1000
     restarts: int = 2

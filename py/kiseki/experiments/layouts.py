@@ -35,6 +35,7 @@ from matplotlib.colors import ListedColormap
 from kiseki.core import derive_seed
 from kiseki.experiments import teach_playback as tp
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.config import Particles, Runs
 from kiseki.metrics import wilson_interval
 from kiseki.plots import new_figure
 from kiseki.sim.layouts import generate_layout, write_layout
@@ -65,11 +66,11 @@ class LayoutsConfig:
     # 2 is the fewest with a mean over runs and an SD (Exp. 3). One run of both experiments
     # took 63 s of CPU (1000 particles; 89 s when a refused route makes exp2 run per method),
     # so 20 layouts x 2 runs take about 42 min on one core; 3 runs would take over an hour.
-    runs_per_layout: int = 2
+    runs_per_layout: Runs = 2
     methods: list[str] = field(
         default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
     )
-    particles: int = 1000
+    particles: Particles = 1000
     boxes: int = 3
     merge: str = "thesis"
 

@@ -26,6 +26,7 @@ import pandas as pd
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.experiments.carmen_maps import LOGS
 from kiseki.experiments.carmen_maps import data_dir as _carmen_dir
+from kiseki.experiments.config import Particles
 from kiseki.localization import (
     RECOVERY_MODES,
     LocalizeConfig,
@@ -46,7 +47,7 @@ class ExcursionsConfig:
     logs: list[str] = field(default_factory=lambda: list(LOGS))
     methods: list[str] = field(default_factory=lambda: list(METHODS))
     recoveries: list[str] = field(default_factory=lambda: ["resetting"])
-    particles: int = 500
+    particles: Particles = 500
     odometry_noise: float = 0.1
     excursion_distance: float = 0.5  # m
     max_return_scans: int = 20  # the claim: every excursion ends within this many scans

@@ -37,6 +37,7 @@ from kiseki.core import Pose2, derive_seed
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.experiments.carmen_maps import LOGS
 from kiseki.experiments.carmen_maps import data_dir as _carmen_dir
+from kiseki.experiments.config import Particles
 from kiseki.localization import RECOVERY_MODES, LocalizeConfig, localize
 from kiseki.plots import new_figure
 from kiseki.scans import LaserScans
@@ -50,7 +51,7 @@ class KidnapConfig:
     data_dir: str = ""  # mcl-kidnapping-carmen: folder of the logs; "" = ../shared/data/carmen
     logs: list[str] = field(default_factory=lambda: list(LOGS))
     method: str = "likelihood-field"
-    particles: int = 1000
+    particles: Particles = 1000
     beams: int = 90
     # "resetting+injection": resetting with Augmented MCL's injection as well
     recoveries: list[str] = field(default_factory=lambda: [*RECOVERY_MODES, "resetting+injection"])

@@ -23,6 +23,7 @@ import pandas as pd
 
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.experiments.carmen_maps import data_dir as _carmen_dir
+from kiseki.experiments.config import Particles
 from kiseki.localization import noisy_odometry
 from kiseki.metrics import ape
 from kiseki.plots import new_figure
@@ -34,8 +35,8 @@ WAYS = ("kld", "fixed", "cut")
 class KldConfig:
     data_dir: str = ""  # folder of the .log.gz files; "" = ../shared/data/carmen
     logs: list[str] = field(default_factory=lambda: ["intel-corrected", "aces-corrected"])
-    max_particles: int = 50_000
-    min_particles: int = 1000
+    max_particles: Particles = 50_000
+    min_particles: Particles = 1000
     odometry_noise: float = 0.1
     max_scans: int = 0  # 0 = whole logs
 

@@ -30,6 +30,7 @@ from kiseki.datasets import read_carmen_log
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.experiments.carmen_maps import LOGS
 from kiseki.experiments.carmen_maps import data_dir as _carmen_dir
+from kiseki.experiments.config import Particles
 from kiseki.localization import LocalizeConfig, localize
 from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
 from kiseki.metrics import ape
@@ -43,7 +44,7 @@ class MergeRulesConfig:
     logs: list[str] = field(default_factory=lambda: list(LOGS))
     resolution: float = 0.1  # m: the thesis' local map cells
     odometry_noise: float = 0.1  # of each odometry increment (as in the README's runs)
-    particles: int = 500
+    particles: Particles = 500
     max_scans: int = 0  # 0 = the whole log; otherwise its first max_scans scans
 
 

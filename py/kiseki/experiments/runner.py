@@ -163,10 +163,12 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
         ):
             raise KisekiError("--resume continues a run as it was: drop --set, --runs and --seed")
         run_dir = run_dir.resolve()
-        try:
-            config = config_from_dict(experiment.config_type, saved["config"])
-        except (ConfigError, TypeError, ValueError) as err:  # edited by hand since the run
-            raise ConfigError(f"{run_dir / 'config.yaml'}: {err}") from None
+        path = run_dir / "config.yaml"
+        try:  # edited by hand since the run: the message names the file and the key
+            config = config_from_dict(experiment.config_type, saved["config"], path, ("config",))
+        except (TypeError, ValueError) as err:  # the model's message names the file already
+            text = str(err) if str(err).startswith(f"{path}: ") else f"{path}: {err}"
+            raise ConfigError(text) from None
         return experiment, run_dir, config, saved["runs"], saved["seed"]
     config = apply_overrides(experiment.config_type(), list(overrides))
     settings = experiment.trial_count(config) if experiment.trial_count else None

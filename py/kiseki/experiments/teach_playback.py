@@ -32,6 +32,7 @@ from matplotlib.patches import Circle
 
 from kiseki.core import Random, derive_seed
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.config import Particles
 from kiseki.map_io import load_map
 from kiseki.models import SpaceObservationModel
 from kiseki.plots import new_figure
@@ -48,7 +49,7 @@ WORLDS = Path(__file__).resolve().parents[3] / "data" / "worlds"
 class Exp1Config:
     scene: str = str(WORLDS / "factory_corridor.yaml")
     methods: list[str] = field(default_factory=lambda: ["proposal2"])
-    particles: int = 1000
+    particles: Particles = 1000
     boxes: int = 0  # unknown boxes placed at random for playback (Exp. 3)
     merge: str = "thesis"  # the taught maps' merge rule: thesis or evidence
 
@@ -59,7 +60,7 @@ class Exp2Config:
     methods: list[str] = field(
         default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
     )
-    particles: int = 1000
+    particles: Particles = 1000
     boxes: int = 0
     merge: str = "thesis"
 
@@ -68,7 +69,7 @@ class Exp2Config:
 class Exp3Config:
     scene: str = str(WORLDS / "factory_turn.yaml")
     methods: list[str] = field(default_factory=lambda: ["proposal2"])
-    particles: int = 1000
+    particles: Particles = 1000
     boxes: int = 3
     merge: str = "thesis"
 

@@ -1,0 +1,126 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Experiment configs checked by the model built from their dataclass: overrides and saved
+configs read to the same objects as built by hand, types are strict and finite, limits on
+particles, runs, seeds and list lengths are enforced with the limit in the message, and
+every message names the key, the value (and the file)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from kiseki.experiments.config import (
+    LIST_LIMIT,
+    PARTICLE_LIMIT,
+    RUN_LIMIT,
+    ConfigError,
+    apply_overrides,
+    config_from_dict,
+    config_to_dict,
+)
+from kiseki.experiments.coop_forms import CoopFormsConfig
+from kiseki.experiments.corridor_scans import CorridorScansConfig
+from kiseki.experiments.gp_aalto import GpAaltoConfig
+from kiseki.experiments.gp_mcl import MagneticMclExperimentConfig
+from kiseki.experiments.registry import all_experiments
+
+
+def _message(call, *args) -> str:
+    with pytest.raises(ConfigError) as info:
+        call(*args)
+    return str(info.value)
+
+
+def test_overrides_read_as_a_config_built_by_hand():
+    got = apply_overrides(
+        GpAaltoConfig(),
+        ["sensors=nexus, invensense", "train_runs=1,3", "hilbert=false", "alphas=5e-2,1,0.5",
+         "data_dir=123", "grid_resolution=2E-1", "gp_seed=18446744073709551615"],
+    )  # fmt: skip
+    want = dataclasses.replace(
+        GpAaltoConfig(),
+        sensors=["nexus", "invensense"],
+        train_runs=[1, 3],
+        hilbert=False,
+        alphas=[0.05, 1.0, 0.5],
+        data_dir="123",  # a string field takes the text as it is
+        grid_resolution=0.2,
+        gp_seed=2**64 - 1,
+    )
+    assert got == want
+    assert isinstance(got.alphas[1], float)
+
+
+def test_every_experiments_default_config_round_trips_through_its_dict():
+    for name, experiment in all_experiments().items():
+        config = experiment.config_type()
+        assert config_from_dict(experiment.config_type, config_to_dict(config)) == config, name
+    # only the keys given are set; the others keep their defaults
+    assert config_from_dict(CoopFormsConfig, {"runs": 7}) == CoopFormsConfig(runs=7)
+
+
+@pytest.mark.parametrize(
+    ("setting", "message"),
+    [
+        ("particles=0", "particles: must be greater than 0, got 0"),
+        (
+            f"particles={PARTICLE_LIMIT + 1}",
+            f"particles: must be less than or equal to {PARTICLE_LIMIT}, got {PARTICLE_LIMIT + 1}",
+        ),
+        (
+            f"runs_per_route={RUN_LIMIT + 1}",
+            f"runs_per_route: must be less than or equal to {RUN_LIMIT}, got {RUN_LIMIT + 1}",
+        ),
+        ("map_seed=-1", "map_seed: must be an integer in [0, 2**64), got -1"),
+        (f"map_seed={2**64}", f"map_seed: must be an integer in [0, 2**64), got {2**64}"),
+        ("speed=nan", "speed: must be a finite number, got nan"),
+        ("speed=.inf", "speed: must be a finite number, got inf"),
+        ("speed=fast", "speed: must be a valid number, got 'fast'"),
+        ("particles=1e3", "particles: must be a valid integer, got 1000.0"),
+        ("particles=true", "particles: must be a valid integer, got True"),
+        ("bogus=1", "bogus: unknown config key (known: dt, hyper_points,"),
+    ],
+)
+def test_a_bad_override_names_the_key_the_value_and_the_limit(setting, message):
+    text = _message(apply_overrides, MagneticMclExperimentConfig(), [setting])
+    assert text.startswith(f"--set: {message}")
+
+
+def test_the_limits_themselves_are_accepted():
+    config = apply_overrides(
+        MagneticMclExperimentConfig(),
+        [f"particles={PARTICLE_LIMIT}", f"runs_per_route={RUN_LIMIT}", "map_seed=0"],
+    )
+    assert (config.particles, config.runs_per_route, config.map_seed) == (
+        PARTICLE_LIMIT,
+        RUN_LIMIT,
+        0,
+    )
+    moves = ",".join(["1"] * LIST_LIMIT)
+    assert len(apply_overrides(CoopFormsConfig(), [f"form1_moves={moves}"]).form1_moves) == (
+        LIST_LIMIT
+    )
+    text = _message(apply_overrides, CoopFormsConfig(), [f"form1_moves={moves},1"])
+    assert f"form1_moves: list should have at most {LIST_LIMIT} items" in text
+
+
+@pytest.mark.parametrize(
+    ("values", "message"),
+    [
+        ({"scan_spacing": "0.1"}, "config.scan_spacing: must be a valid number, got '0.1'"),
+        ({"scan_spacing": True}, "config.scan_spacing: must be a valid number, got True"),
+        ({"scan_spacing": float("nan")}, "config.scan_spacing: must be a finite number, got nan"),
+        ({"map_file": 5}, "config.map_file: must be a valid string, got 5"),
+        ({"noise": 1}, "config.noise: unknown key"),
+    ],
+)
+def test_a_bad_saved_config_names_the_file_the_key_and_the_value(values, message):
+    text = _message(config_from_dict, CorridorScansConfig, values, "run/config.yaml", ("config",))
+    assert text == f"run/config.yaml: {message}"
+
+
+def test_a_bad_list_item_is_named_with_its_index():
+    text = _message(config_from_dict, GpAaltoConfig, {"train_runs": [1, 2, "3"]})
+    assert text == "config: train_runs[2]: must be a valid integer, got '3'"
