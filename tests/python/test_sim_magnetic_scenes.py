@@ -362,7 +362,7 @@ def _floor_with(tmp_path, edit) -> Path:
     [
         (
             lambda d: d.update(measurement_grid={"lower": [0, 0, 0], "upper": [1, 1, 0.1]}),
-            "missing spacing",
+            r"measurement_grid\.spacing: missing",
         ),
         (lambda d: d["measurement_grid"].update(spacing=0.3), "not a whole number of 0.3 m"),
         (lambda d: d["measurement_grid"].update(upper=[29.9, 14.9, 0.1]), "upper z .* below"),
@@ -370,9 +370,15 @@ def _floor_with(tmp_path, edit) -> Path:
             lambda d: d["measurement_grid"].update(lower=[-1.1, 0.1, 0.15]),
             "leaves the scene's bounds",
         ),
-        (lambda d: d["measurement_grid"].update(spacing="0.2"), "spacing must be a positive"),
-        (lambda d: d["measurement_grid"].update(step=2), "unknown key"),
-        (lambda d: d.update(measurement_grid=[0, 1]), "expected {lower"),
+        (
+            lambda d: d["measurement_grid"].update(spacing="0.2"),
+            r"measurement_grid\.spacing: must be a valid number, got '0\.2'",
+        ),
+        (lambda d: d["measurement_grid"].update(step=2), r"measurement_grid\.step: unknown key"),
+        (
+            lambda d: d.update(measurement_grid=[0, 1]),
+            r"measurement_grid: must be a valid dictionary.*, got \[0, 1\]",
+        ),
     ],
 )
 def test_bad_measurement_grids_are_named(tmp_path, edit, match):
@@ -394,14 +400,17 @@ def _arm_spec(doc, index=2):
         (lambda d: _arm_spec(d)["arm"].update(reach=2.0), "arm: unknown key"),
         (lambda d: _arm_spec(d)["arm"].update(heights=[0.1, 3.0]), "arm.heights: 3.0 m is out"),
         (lambda d: _arm_spec(d)["arm"].pop("inner"), "arm.inner: missing"),
-        (lambda d: _arm_spec(d, 0).update(arm={"sensor": "near"}), "only magnetometers ride"),
+        (
+            lambda d: _arm_spec(d, 0).update(arm={"sensor": "near"}),
+            r"sensors\[0\]\.arm: unknown key",
+        ),
     ],
 )
 def test_bad_arms_are_named(tmp_path, edit, match):
     scene = load_scene(_floor_with(tmp_path, edit))
     with pytest.raises(ValueError, match=match) as info:
         build_sensors(scene, build_robot(scene, 0, 1), 0, 0.1, 1)
-    assert "bad.yaml: sensors[" in str(info.value)
+    assert "bad.yaml: robots[1].sensors[" in str(info.value)
 
 
 def test_route_stops_every_0_1_m_along_the_legs():

@@ -3,7 +3,7 @@
 """Pedestrians of a scene: discs that stand at their start until their start time, then walk at
 a constant velocity (and stop after a given distance). A scene's ``pedestrians:`` key lists
 them as {name, radius (m, default 0.25), start: [x, y], velocity: [vx, vy] m/s, start_time: s
-(default 0), stop_after: m travelled (optional)}.
+(default 0), stop_after: m travelled (optional)}, checked by kiseki.sim.scene_schema.
 
 The 2-D lasers see them (:class:`DiscStamp` marks the cells whose centres lie within a disc in
 the laser's ground-truth grid for one scan, then restores them), the collision check of
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["PEDESTRIANS_SCHEMA", "DiscStamp", "Pedestrian", "parse_pedestrians"]
+__all__ = ["PEDESTRIANS_SCHEMA", "DiscStamp", "Pedestrian"]
 
 PEDESTRIANS_SCHEMA = {
     "type": "object",
@@ -27,7 +27,6 @@ PEDESTRIANS_SCHEMA = {
         "positions": {"type": "array", "description": "(x, y) m of each pedestrian"},
     },
 }
-KEYS = {"name", "radius", "start", "velocity", "start_time", "stop_after"}
 
 
 def _finite(value, what: str, n: int = 1) -> tuple[float, ...]:
@@ -81,30 +80,6 @@ class Pedestrian:
             self.start[0] + self.velocity[0] * walked,
             self.start[1] + self.velocity[1] * walked,
         )
-
-
-def parse_pedestrians(value, where: str) -> list[Pedestrian]:
-    """The scene's ``pedestrians`` list; ValueError naming the file and the entry."""
-    if value is None:
-        return []
-    if not isinstance(value, list):
-        raise ValueError(f"{where}: 'pedestrians' must be a list")
-    out = []
-    for i, spec in enumerate(value):
-        label = f"{where}: pedestrians[{i}]"
-        if not isinstance(spec, dict) or not {"name", "start", "velocity"} <= set(spec):
-            raise ValueError(f"{label}: needs name, start: [x, y] and velocity: [vx, vy]")
-        unknown = sorted(set(spec) - KEYS)
-        if unknown:
-            raise ValueError(f"{label}: unknown key(s) {', '.join(unknown)}")
-        try:
-            out.append(Pedestrian(**{**spec, "name": str(spec["name"])}))
-        except (TypeError, ValueError) as err:
-            raise ValueError(f"{label}: {err}") from None
-    names = [p.name for p in out]
-    if len(set(names)) != len(names):
-        raise ValueError(f"{where}: pedestrian names must be unique, got {names}")
-    return out
 
 
 class DiscStamp:

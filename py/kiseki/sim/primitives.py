@@ -2,8 +2,9 @@
 # Copyright (c) 2026 the kiseki authors
 """Scene primitives (walls, workbenches, shelves, rubble, ...) expanded into solid boxes.
 
-Every primitive is a mapping from a scene file. Lengths in metres, angles in degrees. Each
-expander checks its keys and values and raises ValueError naming the object.
+Every primitive is an entry of a scene file's ``objects:``, checked by its model in
+:mod:`kiseki.sim.primitives_schema` (lengths in metres, angles in degrees); the expanders here
+build the boxes of a checked entry.
 """
 
 from __future__ import annotations
@@ -11,12 +12,27 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from os import PathLike
+from typing import Any
 
 import numpy as np
 
+from kiseki._schema import parse
 from kiseki.core import Random
+from kiseki.sim.primitives_schema import (
+    Beam,
+    Box,
+    ObjectEntry,
+    ObjectModel,
+    Pillar,
+    Rubble,
+    Shelf,
+    Slope,
+    Wall,
+    Workbench,
+)
 
-__all__ = ["PRIMITIVES", "BoxList", "expand"]
+__all__ = ["PRIMITIVES", "BoxList", "boxes_of", "expand", "rotation"]
 
 
 @dataclass
@@ -59,87 +75,38 @@ def rotation(yaw: float, pitch: float = 0.0, roll: float = 0.0) -> np.ndarray:
     return rz @ ry @ rx
 
 
-class _Fields:
-    """Typed access to one primitive's mapping, with errors that name the object."""
-
-    def __init__(self, spec: dict, where: str, allowed: set[str]) -> None:
-        unknown = sorted(set(spec) - allowed - {"type", "id", "only_in"})
-        if unknown:
-            raise ValueError(f"{where}: unknown key(s) {', '.join(unknown)}")
-        self.spec, self.where = spec, where
-
-    def vec(self, key: str, n: int, default=None, positive: bool = False) -> np.ndarray:
-        value = self.spec.get(key, default)
-        if value is None:
-            raise ValueError(f"{self.where}: missing '{key}'")
-        try:
-            arr = np.asarray(value, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
-            raise ValueError(f"{self.where}: '{key}' must be {n} numbers, got {value!r}") from None
-        if arr.size != n or not np.isfinite(arr).all():
-            raise ValueError(f"{self.where}: '{key}' must be {n} finite numbers, got {value!r}")
-        if positive and (arr <= 0).any():
-            raise ValueError(f"{self.where}: '{key}' must be positive, got {value!r}")
-        return arr
-
-    def num(self, key: str, default=None, positive: bool = False, minimum=None) -> float:
-        value = self.vec(key, 1, None if default is None else [default], positive)[0]
-        if minimum is not None and value < minimum:
-            raise ValueError(f"{self.where}: '{key}' must be >= {minimum}, got {value}")
-        return float(value)
-
-    def int(self, key: str, default: int, minimum: int = 0, maximum: int | None = None) -> int:
-        value = self.spec.get(key, default)
-        if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-            raise ValueError(f"{self.where}: '{key}' must be an integer >= {minimum}")
-        if maximum is not None and value > maximum:
-            raise ValueError(f"{self.where}: '{key}' must be at most {maximum:,}, got {value:,}")
-        return value
+def _rad(deg: float) -> float:
+    return math.radians(deg)
 
 
-# Limits on what sizes a world (every box is ray cast by every sensor): a shelf of 50 boards and
-# 100 items per board is far beyond a real one; a heap of 100,000 pieces is ten times the largest
-# rubble scene.
-MAX_SHELF_LEVELS = 50
-MAX_SHELF_ITEMS = 100
-MAX_RUBBLE_PIECES = 100_000
-
-
-def _wall(f: _Fields) -> BoxList:
-    a, b = f.vec("from", 2), f.vec("to", 2)
+def _wall(o: Wall) -> BoxList:
+    a, b = np.asarray(o.start), np.asarray(o.to)
     length = float(np.hypot(*(b - a)))
-    if length <= 0:
-        raise ValueError(f"{f.where}: 'from' and 'to' must differ")
-    height, thickness = f.num("height", 2.5, True), f.num("thickness", 0.1, True)
-    z0 = f.num("z", 0.0)
     out = BoxList.empty()
     mid = (a + b) / 2
     out.add(
-        [mid[0], mid[1], z0 + height / 2], [length, thickness, height], math.atan2(*(b - a)[::-1])
+        [mid[0], mid[1], o.z + o.height / 2],
+        [length, o.thickness, o.height],
+        math.atan2(*(b - a)[::-1]),
     )
     return out
 
 
-def _box(f: _Fields) -> BoxList:
+def _box(o: Box) -> BoxList:
     out = BoxList.empty()
-    size = f.vec("size", 3, positive=True)
-    raw = f.spec.get("center")
-    if isinstance(raw, list | tuple) and len(raw) == 2:  # standing on the floor
-        xy = f.vec("center", 2)
-        center = np.array([xy[0], xy[1], size[2] / 2])
+    size = np.asarray(o.size)
+    if len(o.center) == 2:  # standing on the floor
+        center = np.array([o.center[0], o.center[1], size[2] / 2])
     else:
-        center = f.vec("center", 3)
-    out.add(center, size, *(math.radians(f.num(k, 0.0)) for k in ("yaw", "pitch", "roll")))
+        center = np.asarray(o.center)
+    out.add(center, size, _rad(o.yaw), _rad(o.pitch), _rad(o.roll))
     return out
 
 
-def _workbench(f: _Fields) -> BoxList:
-    c, (length, width) = f.vec("center", 2), f.vec("size", 2, positive=True)
-    height, top = f.num("height", 0.85, True), f.num("top_thickness", 0.04, True)
-    leg = f.num("leg", 0.05, True)
-    if height > 1.5 or top >= height or 2 * leg >= min(length, width):
-        raise ValueError(f"{f.where}: workbench proportions are impossible")
-    yaw = math.radians(f.num("yaw", 0.0))
+def _workbench(o: Workbench) -> BoxList:
+    c, (length, width) = o.center, o.size
+    height, top, leg = o.height, o.top_thickness, o.leg
+    yaw = _rad(o.yaw)
     rot = rotation(yaw)[:2, :2]
     out = BoxList.empty()
     out.add([c[0], c[1], height - top / 2], [length, width, top], yaw)
@@ -152,13 +119,12 @@ def _workbench(f: _Fields) -> BoxList:
     return out
 
 
-def _shelf(f: _Fields) -> BoxList:
-    c, (length, depth) = f.vec("center", 2), f.vec("size", 2, positive=True)
-    height, levels = f.num("height", 1.8, True), f.int("levels", 4, 1, MAX_SHELF_LEVELS)
-    items, post, board = f.int("items", 0, 0, MAX_SHELF_ITEMS), f.num("post", 0.04, True), 0.02
-    yaw = math.radians(f.num("yaw", 0.0))
+def _shelf(o: Shelf) -> BoxList:
+    c, (length, depth) = o.center, o.size
+    height, levels, items, post, board = o.height, o.levels, o.items, o.post, 0.02
+    yaw = _rad(o.yaw)
     rot = rotation(yaw)[:2, :2]
-    rng = Random(f.int("seed", 0))
+    rng = Random(o.seed)
     out = BoxList.empty()
 
     def at(dx: float, dy: float, z: float, size) -> None:
@@ -172,7 +138,7 @@ def _shelf(f: _Fields) -> BoxList:
     for k in range(levels):
         z = 0.1 + k * gap
         at(0, 0, z, [length, depth, board])
-        for _ in range(items if k < levels - 1 or levels == 1 else 0):
+        for _ in range(items if k < o.item_levels else 0):
             s = rng.uniform(0.1, min(0.4, gap * 0.8), 3)
             x = rng.uniform(-(length - s[0]) / 2, (length - s[0]) / 2, 1)[0]
             y = rng.uniform(-(depth - s[1]) / 2, (depth - s[1]) / 2, 1)[0]
@@ -180,30 +146,26 @@ def _shelf(f: _Fields) -> BoxList:
     return out
 
 
-def _slope(f: _Fields) -> BoxList:
-    c, (length, width) = f.vec("center", 2), f.vec("size", 2, positive=True)
-    rise, thickness = f.num("rise", None, True), f.num("thickness", 0.05, True)
+def _slope(o: Slope) -> BoxList:
+    c, (length, width), rise = o.center, o.size, o.rise
     pitch = math.atan2(rise, length)
     out = BoxList.empty()
     out.add(
         [c[0], c[1], rise / 2],
-        [math.hypot(length, rise), width, thickness],
-        math.radians(f.num("yaw", 0.0)),
+        [math.hypot(length, rise), width, o.thickness],
+        _rad(o.yaw),
         -pitch,
     )
     return out
 
 
-def _rubble(f: _Fields) -> BoxList:
+def _rubble(o: Rubble) -> BoxList:
     """A heap of slabs and blocks: random sizes and tilts, seeded."""
-    c, radius = f.vec("center", 2), f.num("radius", None, True)
-    count, rng = f.int("count", 20, 1, MAX_RUBBLE_PIECES), Random(f.int("seed", 0))
-    smin, smax = f.vec("size_range", 2, [0.1, 0.6], positive=True)
-    if smin > smax:
-        raise ValueError(f"{f.where}: size_range must be [min, max]")
-    max_tilt = math.radians(f.num("max_tilt", 30.0, minimum=0.0))
+    c, radius, rng = o.center, o.radius, Random(o.seed)
+    smin, smax = o.size_range
+    max_tilt = _rad(o.max_tilt)
     out = BoxList.empty()
-    for _ in range(count):
+    for _ in range(o.count):
         r, a = radius * math.sqrt(rng.uniform(0, 1, 1)[0]), rng.uniform(-math.pi, math.pi, 1)[0]
         size = rng.uniform(smin, smax, 3)
         if rng.uniform(0, 1, 1)[0] < 0.5:  # a slab: thin in one dimension
@@ -217,46 +179,44 @@ def _rubble(f: _Fields) -> BoxList:
     return out
 
 
-def _beam(f: _Fields) -> BoxList:
-    a, b = f.vec("from", 2), f.vec("to", 2)
-    width, height = f.vec("size", 2, positive=True)
+def _beam(o: Beam) -> BoxList:
+    a, b = np.asarray(o.start), np.asarray(o.to)
+    width, height = o.size
     out = BoxList.empty()
     mid = (a + b) / 2
     out.add(
-        [mid[0], mid[1], f.num("z", None)],
+        [mid[0], mid[1], o.z],
         [float(np.hypot(*(b - a))), width, height],
         math.atan2(*(b - a)[::-1]),
     )
     return out
 
 
-def _pillar(f: _Fields) -> BoxList:
-    c, (sx, sy) = f.vec("center", 2), f.vec("size", 2, positive=True)
-    height = f.num("height", 2.5, True)
+def _pillar(o: Pillar) -> BoxList:
+    c, (sx, sy) = o.center, o.size
     out = BoxList.empty()
-    out.add([c[0], c[1], height / 2], [sx, sy, height], math.radians(f.num("yaw", 0.0)))
+    out.add([c[0], c[1], o.height / 2], [sx, sy, o.height], _rad(o.yaw))
     return out
 
 
-PRIMITIVES: dict[str, tuple[set[str], Callable[[_Fields], BoxList]]] = {
-    "wall": ({"from", "to", "height", "thickness", "z"}, _wall),
-    "partition": ({"from", "to", "height", "thickness", "z"}, _wall),
-    "box": ({"center", "size", "yaw", "pitch", "roll"}, _box),
-    "workbench": ({"center", "size", "height", "top_thickness", "leg", "yaw"}, _workbench),
-    "shelf": ({"center", "size", "height", "levels", "items", "post", "yaw", "seed"}, _shelf),
-    "slope": ({"center", "size", "rise", "thickness", "yaw"}, _slope),
-    "rubble": ({"center", "radius", "count", "seed", "size_range", "max_tilt"}, _rubble),
-    "beam": ({"from", "to", "size", "z"}, _beam),
-    "pillar": ({"center", "size", "height", "yaw"}, _pillar),
+PRIMITIVES: dict[type[ObjectModel], Callable[[Any], BoxList]] = {
+    Wall: _wall,
+    Box: _box,
+    Workbench: _workbench,
+    Shelf: _shelf,
+    Slope: _slope,
+    Rubble: _rubble,
+    Beam: _beam,
+    Pillar: _pillar,
 }
 
 
-def expand(spec: dict, where: str) -> BoxList:
-    """The boxes of one primitive mapping."""
-    if not isinstance(spec, dict) or "type" not in spec:
-        raise ValueError(f"{where}: each object needs a 'type'")
-    kind = spec["type"]
-    if not isinstance(kind, str) or kind not in PRIMITIVES:  # a list is not hashable
-        raise ValueError(f"{where}: unknown type {kind!r} (known: {', '.join(sorted(PRIMITIVES))})")
-    allowed, expander = PRIMITIVES[kind]
-    return expander(_Fields(spec, f"{where} ({kind})", allowed))
+def boxes_of(obj: ObjectModel) -> BoxList:
+    """The boxes of one checked object (a model of kiseki.sim.primitives_schema)."""
+    return PRIMITIVES[type(obj)](obj)
+
+
+def expand(spec: Any, source: str | PathLike[str], at: tuple[str | int, ...] = ()) -> BoxList:
+    """The boxes of one primitive mapping; a SchemaError naming ``source`` and the path ``at``
+    (``("objects", 3)``) when the mapping does not match its model."""
+    return boxes_of(parse(ObjectEntry, spec, source, at=at).root)
