@@ -8,16 +8,24 @@ seeded generator. Every parameter names its source (datasheet, paper, or stated 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
+from typing import Annotated
 
 import numpy as np
+from pydantic import ConfigDict, Field, model_validator
+from pydantic.dataclasses import dataclass as pydantic_dataclass
 
+from kiseki._schema import FiniteFloat, NonNegativeFloat, PositiveFloat
 from kiseki.core import Random, check_seed
 from kiseki.grid import OccupancyGrid, beam_angles
 from kiseki.sim.primitives import rotation
 
 __all__ = [
     "LASER_PRESETS",
+    "MAX_BEAMS",
+    "MAX_IMAGE_SIDE",
+    "MAX_RANGE",
+    "MAX_TILT_RAYS",
     "DepthCamera",
     "DepthCameraParams",
     "Laser2D",
@@ -26,6 +34,24 @@ __all__ = [
     "TiltingLaser",
     "TiltingLaserParams",
 ]
+
+
+# Limits on what sizes memory and time: rays cast per reading and how far each goes.
+MAX_BEAMS = 10_000
+"""Beams of one planar scan (the densest 2-D scanners have a few thousand)."""
+MAX_IMAGE_SIDE = 4096
+"""Pixels along each side of a depth image."""
+MAX_TILT_RAYS = 1_000_000
+"""Rays of one tilting-laser sweep (the paper's 1 deg grid has 151 x 181 = 27,331)."""
+MAX_RANGE = 1000.0
+"""Metres a range sensor's ray is cast."""
+
+# The parameter classes are pydantic dataclasses (kiseki._schema's strict number types): checked
+# on construction, on dataclasses.replace and as a section of a scene file (kiseki.sim.setup).
+_params = pydantic_dataclass(frozen=True, config=ConfigDict(extra="forbid"))
+Range = Annotated[float, Field(strict=True, gt=0, le=MAX_RANGE, allow_inf_nan=False)]
+Probability = Annotated[float, Field(strict=True, ge=0, lt=1, allow_inf_nan=False)]
+ImageSide = Annotated[int, Field(strict=True, ge=1, le=MAX_IMAGE_SIDE)]
 
 
 @dataclass(frozen=True)
@@ -64,27 +90,19 @@ class Mount:
         )
 
 
-@dataclass(frozen=True)
+@_params
 class LaserParams:
     """A planar laser scanner. Range noise: Gaussian, SD = max(noise_sd, noise_fraction * r);
     a beam that hits nothing, or drops out, returns max_range (the CARMEN convention)."""
 
-    name: str
-    field_of_view_deg: float
-    beams: int
-    max_range: float
-    noise_sd: float  # m
-    noise_fraction: float = 0.0  # of the range
-    dropout_probability: float = 0.0
-    period: float = 0.025  # s per scan
-
-    def __post_init__(self) -> None:
-        if not (0 < self.field_of_view_deg <= 360 and self.beams >= 1 and self.max_range > 0):
-            raise ValueError(f"laser {self.name}: need 0 < fov <= 360, beams >= 1, max_range > 0")
-        if min(self.noise_sd, self.noise_fraction, self.dropout_probability) < 0 or not (
-            self.dropout_probability < 1 and self.period > 0
-        ):
-            raise ValueError(f"laser {self.name}: noise and dropout must be >= 0, dropout < 1")
+    name: Annotated[str, Field(strict=True)]
+    field_of_view_deg: Annotated[float, Field(strict=True, gt=0, le=360, allow_inf_nan=False)]
+    beams: Annotated[int, Field(strict=True, ge=1, le=MAX_BEAMS)]
+    max_range: Range
+    noise_sd: NonNegativeFloat  # m
+    noise_fraction: NonNegativeFloat = 0.0  # of the range
+    dropout_probability: Probability = 0.0
+    period: PositiveFloat = 0.025  # s per scan
 
     @property
     def angles(self) -> np.ndarray:
@@ -123,7 +141,7 @@ class Laser2D:
         return sensor, ranges.astype(np.float32)
 
 
-@dataclass(frozen=True)
+@_params
 class DepthCameraParams:
     """An Xtion-like structured-light depth camera (ASUS Xtion PRO: 58 x 45 deg, 0.8 (0.5 in
     near mode) to 3.5 m nominal, used to 10 m in the thesis; 640 x 480 native).
@@ -133,25 +151,29 @@ class DepthCameraParams:
     disparity noise sigma_d = 0.07 px (their 1.5 cm at 3 m) and quantisation to 1/8 px, so the
     depth error grows with z squared and the depth step exceeds 5 cm beyond about 4.2 m."""
 
-    width: int = 160
-    height: int = 120
-    hfov_deg: float = 58.0
-    vfov_deg: float = 45.0
-    min_range: float = 0.5
-    max_range: float = 10.0
-    native_width: int = 640
-    baseline: float = 0.075
-    disparity_sd: float = 0.07  # px
-    disparity_step: float = 1 / 8  # px
-    period: float = 1 / 30
+    width: ImageSide = 160
+    height: ImageSide = 120
+    hfov_deg: Annotated[float, Field(strict=True, gt=0, lt=180, allow_inf_nan=False)] = 58.0
+    vfov_deg: Annotated[float, Field(strict=True, gt=0, lt=180, allow_inf_nan=False)] = 45.0
+    min_range: NonNegativeFloat = 0.5
+    max_range: Range = 10.0
+    native_width: ImageSide = 640
+    baseline: PositiveFloat = 0.075
+    disparity_sd: NonNegativeFloat = 0.07  # px
+    disparity_step: NonNegativeFloat = 1 / 8  # px
+    period: PositiveFloat = 1 / 30
 
-    def __post_init__(self) -> None:
-        if self.width < 1 or self.height < 1 or self.width > self.native_width:
-            raise ValueError("depth camera: image size must be 1..native_width")
-        if not (0 <= self.min_range < self.max_range) or self.baseline <= 0:
-            raise ValueError("depth camera: need 0 <= min_range < max_range and baseline > 0")
-        if self.disparity_sd < 0 or self.disparity_step < 0:
-            raise ValueError("depth camera: disparity noise and step must be >= 0")
+    @model_validator(mode="after")
+    def _consistent(self) -> DepthCameraParams:
+        if self.width > self.native_width:
+            raise ValueError(
+                f"width must be at most native_width {self.native_width}, got {self.width}"
+            )
+        if self.min_range >= self.max_range:
+            raise ValueError(
+                f"min_range must be below max_range {self.max_range} m, got {self.min_range}"
+            )
+        return self
 
     @property
     def native_focal(self) -> float:
@@ -204,21 +226,50 @@ class DepthCamera:
         return out.astype(np.float32)
 
 
-@dataclass(frozen=True)
+@_params
 class TiltingLaserParams:
     """The rubble paper's tilting laser: tilt theta -120..30 deg, scan phi -90..90 deg, 1 deg
     steps, 5 mm accuracy (taken as 1 sigma), 8 m range of which r < 5 m is used; attitude from
     a 3-axis gyro whose error per axis is a stated assumption (0.5 deg, 1 sigma)."""
 
-    tilt_min_deg: float = -120.0
-    tilt_max_deg: float = 30.0
-    scan_min_deg: float = -90.0
-    scan_max_deg: float = 90.0
-    step_deg: float = 1.0
-    noise_sd: float = 0.005
-    max_range: float = 8.0
-    usable_range: float = 5.0
-    gyro_sd_deg: float = 0.5
+    tilt_min_deg: FiniteFloat = -120.0
+    tilt_max_deg: FiniteFloat = 30.0
+    scan_min_deg: FiniteFloat = -90.0
+    scan_max_deg: FiniteFloat = 90.0
+    step_deg: Annotated[float, Field(strict=True, gt=0, le=360, allow_inf_nan=False)] = 1.0
+    noise_sd: NonNegativeFloat = 0.005
+    max_range: Range = 8.0
+    usable_range: PositiveFloat = 5.0
+    gyro_sd_deg: NonNegativeFloat = 0.5
+
+    @model_validator(mode="after")
+    def _consistent(self) -> TiltingLaserParams:
+        for name in ("tilt", "scan"):
+            low, high = getattr(self, f"{name}_min_deg"), getattr(self, f"{name}_max_deg")
+            if not -360.0 <= low <= high <= 360.0:
+                raise ValueError(
+                    f"{name}_min_deg <= {name}_max_deg must lie in [-360, 360] deg, "
+                    f"got {low} and {high}"
+                )
+        rays = self.ray_count
+        if rays > MAX_TILT_RAYS:
+            raise ValueError(
+                f"step_deg {self.step_deg} gives {rays:,} rays per sweep, "
+                f"above the limit of {MAX_TILT_RAYS:,}"
+            )
+        return self
+
+    @property
+    def ray_count(self) -> int:
+        """Rays of one sweep: the sizes of :meth:`grid` (as numpy's arange counts them), without
+        making the grid."""
+
+        def count(low: float, high: float) -> int:
+            return max(0, math.ceil((high + 1e-9 - low) / self.step_deg))
+
+        return count(self.tilt_min_deg, self.tilt_max_deg) * count(
+            self.scan_min_deg, self.scan_max_deg
+        )
 
     def grid(self) -> tuple[np.ndarray, np.ndarray]:
         tilt = np.arange(self.tilt_min_deg, self.tilt_max_deg + 1e-9, self.step_deg)
@@ -259,19 +310,7 @@ class TiltingLaser:
         return r.reshape(len(tilt), len(scan)), gyro
 
 
-def with_overrides(params, overrides: dict, where: str):
-    """A dataclass copy with overrides, rejecting unknown keys (for scene files)."""
-    known = set(params.__dataclass_fields__)
-    unknown = sorted(set(overrides) - known)
-    if unknown:
-        raise ValueError(f"{where}: unknown sensor parameter(s) {', '.join(unknown)}")
-    try:
-        return replace(params, **overrides)
-    except (TypeError, ValueError) as err:
-        raise ValueError(f"{where}: {err}") from err
-
-
-@dataclass(frozen=True)
+@_params
 class BearingParams:
     """A bearing sensor: the direction to another robot's marker (cooperative positioning,
     paper 001), horizontally (bearing, in the sensor's frame) and vertically (elevation above
@@ -286,18 +325,10 @@ class BearingParams:
             its centre (about the size of the paper's robots; assumption).
     """
 
-    noise_sd_deg: float = 0.1
-    elevation_noise_sd_deg: float = 0.1
-    max_range: float = 20.0
-    robot_radius: float = 0.3
-
-    def __post_init__(self) -> None:
-        for name in ("noise_sd_deg", "elevation_noise_sd_deg", "robot_radius"):
-            value = getattr(self, name)
-            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
-        if not (isinstance(self.max_range, int | float) and 0 < self.max_range < 1e6):
-            raise ValueError(f"max_range must lie in (0, 1e6) m, got {self.max_range!r}")
+    noise_sd_deg: NonNegativeFloat = 0.1
+    elevation_noise_sd_deg: NonNegativeFloat = 0.1
+    max_range: Range = 20.0
+    robot_radius: NonNegativeFloat = 0.3
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,12 @@ in free space and that every sensor sits on the robot.
 A magnetometer with an ``arm`` mapping is one of the two sensors on the bar of the 3-D mapping
 robot's 2-DOF arm (kiseki.sim.magnetic_arm): its ``mount`` is the arm's pivot, and the arm
 carries it up to ``heights[1]`` whatever the robot's height. Both sensors of one arm (same
-pivot) must give the same bar."""
+pivot) must give the same bar.
+
+Each robot and sensor entry is checked first by its model (kiseki.sim.setup_schema), so a
+problem reads ``FILE: robots[1].sensors[0].rate_hz: must be ..., got VALUE``; what depends on
+the rest of the scene (the mount on the robot, bearing targets, unique names, one bar per
+pivot) is checked here with the same form of message."""
 
 from __future__ import annotations
 
@@ -16,41 +21,35 @@ from typing import Any
 
 import numpy as np
 
-from kiseki.core import derive_seed
+from kiseki._schema import SchemaError, location_text, parse
+from kiseki.core import check_seed, derive_seed
 from kiseki.sim import robot as robots
 from kiseki.sim.collisions import check_free_start
 from kiseki.sim.magnetic import MagneticWorld, Magnetometer
 from kiseki.sim.magnetic_arm import arm_sensor_from_spec
 from kiseki.sim.scene import Scene
 from kiseki.sim.sensors import (
-    LASER_PRESETS,
-    BearingParams,
     BearingSensor,
     DepthCamera,
-    DepthCameraParams,
     Laser2D,
     Mount,
     TiltingLaser,
-    TiltingLaserParams,
-    with_overrides,
+)
+from kiseki.sim.setup_schema import (
+    MAX_SENSORS,
+    ROBOT_MODELS,
+    SENSOR_MODELS,
+    BearingSpec,
+    DepthCameraSpec,
+    DiffDriveSpec,
+    LaserSpec,
+    MagnetometerSpec,
+    RobotKind,
+    SensorKind,
+    TiltingLaserSpec,
 )
 
 __all__ = ["RobotSetup", "SensorSetup", "build_robot", "build_sensors"]
-
-ROBOT_KEYS = {"type", "start", "params", "odometry_errors"}
-SENSOR_KEYS = {
-    "type",
-    "name",
-    "mount",
-    "preset",
-    "params",
-    "rate_hz",
-    "width",
-    "height",
-    "pitch",
-    "targets",
-    "arm",
-}
 
 
 @dataclass
@@ -74,30 +73,32 @@ class SensorSetup:
     targets: tuple[str, ...] = ()  # bearing sensors: the robots they measure
 
 
-def _start(scene: Scene, spec: dict) -> np.ndarray:
-    start = spec.get("start", [0.0, 0.0, 0.0])
-    try:
-        x, y, yaw = (float(v) for v in start)
-    except (TypeError, ValueError):
-        raise ValueError(f"{scene.path}: robot.start must be [x, y, yaw_deg]") from None
-    if not all(math.isfinite(v) for v in (x, y, yaw)):
-        raise ValueError(f"{scene.path}: robot.start must be finite")
-    return np.array([x, y, math.radians(yaw)])
+def _robot_at(scene: Scene, index: int) -> tuple[str | int, ...]:
+    """Where robot ``index`` is in the scene file: ``robot`` or ``robots[index]``."""
+    if not isinstance(index, int) or not 0 <= index < len(scene.robot_specs):
+        raise ValueError(
+            f"{scene.path}: robot index must be in 0..{len(scene.robot_specs) - 1}, got {index!r}"
+        )
+    single = len(scene.robot_specs) == 1 and scene.robot_specs[0]["name"] == "robot"
+    return ("robot",) if single else ("robots", index)
+
+
+def _fail(scene: Scene, at: tuple[str | int, ...], problem: str) -> SchemaError:
+    return SchemaError(f"{scene.path}: {location_text(at)}: {problem}")
 
 
 def build_robot(scene: Scene, seed: int, index: int = 0) -> RobotSetup:
     """The robot `index` of the scene (its true motion and its odometry)."""
+    seed = check_seed(seed)
+    at = _robot_at(scene, index)
     name, spec = scene.robot_specs[index]["name"], scene.robot_specs[index]["robot"]
-    where = f"{scene.path}: robot" + (f" {name}" if len(scene.robot_specs) > 1 else "")
-    unknown = sorted(set(spec) - ROBOT_KEYS)
-    if unknown:
-        raise ValueError(f"{where}: unknown key(s) {', '.join(unknown)}")
-    kind = spec.get("type", "diff_drive")
-    pose = _start(scene, spec)
+    kind = parse(RobotKind, spec, scene.path, at=at).type
+    checked = parse(ROBOT_MODELS[kind], spec, scene.path, at=at)
+    x, y, yaw_deg = checked.start
+    pose = np.array([x, y, math.radians(yaw_deg)])
     odo_seed = derive_seed(seed, 1000 + index)
-    if kind == "diff_drive":
-        params = robots.DiffDriveParams.from_dict(spec.get("params") or {}, where)
-        errors = robots.OdometryErrorParams.from_dict(spec.get("odometry_errors") or {}, where)
+    if isinstance(checked, DiffDriveSpec):
+        params, errors = checked.params, checked.odometry_errors
         setup = RobotSetup(
             name,
             kind,
@@ -107,148 +108,112 @@ def build_robot(scene: Scene, seed: int, index: int = 0) -> RobotSetup:
             params.width,
             params.height,
         )
-    elif kind == "omni":
-        params = robots.OmniParams.from_dict(spec.get("params") or {}, where)
-        errors = robots.OmniOdometryErrorParams.from_dict(spec.get("odometry_errors") or {}, where)
+    else:
+        omni, omni_errors = checked.params, checked.odometry_errors
         setup = RobotSetup(
             name,
             kind,
-            robots.OmniRobot(params, pose),
-            robots.OmniOdometry(errors, odo_seed, pose),
-            params.length,
-            params.width,
+            robots.OmniRobot(omni, pose),
+            robots.OmniOdometry(omni_errors, odo_seed, pose),
+            omni.length,
+            omni.width,
             1.2,
         )
-    else:
-        raise ValueError(f"{where}: type must be diff_drive or omni, got {kind!r}")
     check_free_start(scene, pose, setup.length, setup.width, setup.height)
     return setup
 
 
-def _mount(spec: dict, where: str, robot: RobotSetup) -> Mount:
-    m = spec.get("mount", [0.0, 0.0, 0.5])
-    try:
-        values = [float(v) for v in m]
-    except (TypeError, ValueError):
-        raise ValueError(f"{where}: mount must be [x, y, z] or [x, y, z, yaw_deg]") from None
-    if len(values) not in (3, 4) or not all(math.isfinite(v) for v in values):
-        raise ValueError(f"{where}: mount must be 3 or 4 finite numbers")
-    mount = Mount(
-        *values[:3], values[3] if len(values) == 4 else 0.0, float(spec.get("pitch", 0.0))
-    )
+def _mount(spec: Any, scene: Scene, at: tuple[str | int, ...], robot: RobotSetup) -> Mount:
+    values = list(spec.mount)
+    mount = Mount(*values[:3], values[3] if len(values) == 4 else 0.0, spec.pitch)
     margin = 0.1
     if (
         abs(mount.x) > robot.length / 2 + margin
         or abs(mount.y) > robot.width / 2 + margin
         or not 0.0 <= mount.z <= robot.height + 0.5
     ):
-        raise ValueError(
-            f"{where}: mount ({mount.x}, {mount.y}, {mount.z}) lies outside the robot "
-            f"({robot.length} x {robot.width} x {robot.height} m)"
+        raise _fail(
+            scene,
+            (*at, "mount"),
+            f"lies outside the robot ({robot.length} x {robot.width} x {robot.height} m, "
+            f"{margin} m around it and 0.5 m above), got {values}",
         )
     return mount
 
 
-def _same_bar(arms: dict, mount: Mount, arm: dict, where: str) -> None:
+def _same_bar(arms: dict, mount: Mount, arm: dict, fail) -> None:
     """Both sensors on one pivot share one bar and are its near and its far sensor."""
     pivot = (mount.x, mount.y, mount.z, mount.yaw_deg)
     bar = {k: v for k, v in arm.items() if k != "sensor"}
     seen, names = arms.setdefault(pivot, (bar, set()))
     if seen != bar:
-        raise ValueError(f"{where}: arm differs from the other sensor's on the same pivot")
+        raise fail("differs from the other sensor's on the same pivot")
     if arm["sensor"] in names:
-        raise ValueError(f"{where}: arm: a second {arm['sensor']} sensor on the same pivot")
+        raise fail(f"a second {arm['sensor']} sensor on the same pivot")
     names.add(arm["sensor"])
-
-
-def _period(spec: dict, default: float, where: str) -> float:
-    rate = spec.get("rate_hz")
-    if rate is None:
-        return default
-    if isinstance(rate, bool) or not isinstance(rate, int | float) or not rate > 0:
-        raise ValueError(f"{where}: rate_hz must be positive")
-    return 1.0 / float(rate)
 
 
 def build_sensors(
     scene: Scene, robot: RobotSetup, seed: int, dt: float, index: int = 0
 ) -> list[SensorSetup]:
     """The sensors of robot `index`; each gets its own seeded stream."""
+    seed = check_seed(seed)
+    if isinstance(dt, bool) or not isinstance(dt, int | float) or not 0 < dt < math.inf:
+        raise ValueError(f"{scene.path}: dt must be a finite number of seconds > 0, got {dt!r}")
+    robot_at = _robot_at(scene, index)
     out: list[SensorSetup] = []
     magnetic = MagneticWorld.from_dict(scene.magnetic, str(scene.path)) if scene.magnetic else None
     others = {s["name"] for s in scene.robot_specs} - {robot.name}
     arms: dict[tuple, tuple[dict, set]] = {}  # pivot -> (bar, sensors on it)
-    for i, spec in enumerate(scene.robot_specs[index]["sensors"]):
-        where = f"{scene.path}: sensors[{i}]" + (
-            f" of {robot.name}" if len(scene.robot_specs) > 1 else ""
-        )
-        if not isinstance(spec, dict):
-            raise ValueError(f"{where}: each sensor must be a mapping")
-        unknown = sorted(set(spec) - SENSOR_KEYS)
-        if unknown:
-            raise ValueError(f"{where}: unknown key(s) {', '.join(unknown)}")
-        kind, name = spec.get("type"), str(spec.get("name", f"sensor{i}"))
-        mount = _mount(spec, where, robot)
+    sensors_at = (*robot_at, "sensors") if robot_at != ("robot",) else ("sensors",)
+    specs = scene.robot_specs[index]["sensors"]
+    if len(specs) > MAX_SENSORS:
+        raise _fail(scene, sensors_at, f"at most {MAX_SENSORS} sensors per robot, got {len(specs)}")
+    for i, raw in enumerate(specs):
+        at = (*sensors_at, i)
+        kind = parse(SensorKind, raw, scene.path, at=at).type
+        spec = parse(SENSOR_MODELS[kind], raw, scene.path, at=at)
+        name = spec.name if spec.name is not None else f"sensor{i}"
+        mount = _mount(spec, scene, at, robot)
         s = derive_seed(seed, 100 * index + i)
         targets: tuple[str, ...] = ()
-        overrides = dict(spec.get("params") or {})
-        if kind == "laser":
-            preset = spec.get("preset", "hokuyo_utm30lx")
-            if preset not in LASER_PRESETS:
-                raise ValueError(f"{where}: unknown preset {preset!r} ({', '.join(LASER_PRESETS)})")
-            params = with_overrides(LASER_PRESETS[preset], overrides, where)
-            device = Laser2D(params, mount, s)
-            period = _period(spec, max(dt, params.period), where)
-        elif kind == "depth_camera":
-            for key in ("width", "height"):
-                if key in spec:
-                    overrides[key] = spec[key]
-            params = with_overrides(DepthCameraParams(), overrides, where)
-            device = DepthCamera(params, mount, s)
-            period = _period(spec, max(dt, params.period), where)
-        elif kind == "magnetometer":
+        if isinstance(spec, LaserSpec):
+            assert spec.params is not None  # the preset's when not given
+            device: Any = Laser2D(spec.params, mount, s)
+            default = max(dt, spec.params.period)
+        elif isinstance(spec, DepthCameraSpec):
+            camera = spec.camera
+            device, default = DepthCamera(camera, mount, s), max(dt, camera.period)
+        elif isinstance(spec, MagnetometerSpec):
             if magnetic is None:
-                raise ValueError(f"{where}: a magnetometer needs the scene's 'magnetic' section")
-            if "arm" in spec:
+                raise _fail(scene, at, "a magnetometer needs the scene's 'magnetic' section")
+            position, yaw = (mount.x, mount.y, mount.z), math.radians(mount.yaw_deg)
+            if spec.arm is not None:
+                where = f"{scene.path}: {location_text((*at, 'arm'))}"
                 device = arm_sensor_from_spec(
-                    spec["arm"],
-                    magnetic,
-                    (mount.x, mount.y, mount.z),
-                    math.radians(mount.yaw_deg),
-                    s,
-                    f"{where}: arm",
-                    **overrides,
+                    spec.arm, magnetic, position, yaw, s, where, **spec.params
                 )
-                _same_bar(arms, mount, spec["arm"], where)
+                _same_bar(arms, mount, spec.arm, lambda p, a=at: _fail(scene, (*a, "arm"), p))
             else:
-                device = Magnetometer(
-                    magnetic,
-                    (mount.x, mount.y, mount.z),
-                    math.radians(mount.yaw_deg),
-                    seed=s,
-                    **overrides,
-                )
-            period = _period(spec, dt, where)
-        elif kind == "bearing":
-            targets = tuple(str(t) for t in spec.get("targets") or sorted(others))
+                device = Magnetometer(magnetic, position, yaw, seed=s, **spec.params)
+            default = dt
+        elif isinstance(spec, BearingSpec):
+            targets = tuple(spec.targets or sorted(others))
             if not targets or not set(targets) <= others:
-                raise ValueError(
-                    f"{where}: bearing targets must be other robots of the scene "
-                    f"({', '.join(sorted(others)) or 'none'}), got {list(targets)}"
+                raise _fail(
+                    scene,
+                    (*at, "targets"),
+                    f"must be other robots of the scene ({', '.join(sorted(others)) or 'none'}), "
+                    f"got {list(targets)}",
                 )
-            device = BearingSensor(with_overrides(BearingParams(), overrides, where), s)
-            period = _period(spec, dt, where)
-        elif kind == "tilting_laser":
-            device = TiltingLaser(with_overrides(TiltingLaserParams(), overrides, where), s)
-            period = _period(spec, 1e9, where)  # by default once, at the start
+            device, default = BearingSensor(spec.params, s), dt
         else:
-            raise ValueError(f"{where}: unknown sensor type {kind!r}")
-        if "targets" in spec and kind != "bearing":
-            raise ValueError(f"{where}: only bearing sensors take targets")
-        if "arm" in spec and kind != "magnetometer":
-            raise ValueError(f"{where}: only magnetometers ride on an arm")
+            assert isinstance(spec, TiltingLaserSpec)
+            device = TiltingLaser(spec.params, s)
+            default = 1e9  # by default once, at the start
+        period = default if spec.rate_hz is None else 1.0 / spec.rate_hz
         out.append(SensorSetup(kind, name, device, period, mount, targets))
     names = [s.name for s in out]
     if len(set(names)) != len(names):
-        raise ValueError(f"{scene.path}: sensor names must be unique, got {names}")
+        raise _fail(scene, sensors_at, f"sensor names must be unique, got {names}")
     return out
