@@ -108,3 +108,28 @@ def test_the_api_refuses_a_changed_scene_without_a_label(taught):
         check_scene(known, moved)
     assert check_scene(known, moved, "exp3-boxes")["variant"] == "exp3-boxes"
     assert check_scene(None, moved) == {"scene_sha1": sha1(moved)}  # a hand-made waypoint file
+
+
+def test_serve_knows_the_taught_scene_by_its_sha1_when_the_file_is_gone(tmp_path, project_root):
+    """The taught scene file moved away: a byte-identical copy is accepted, a changed copy of
+    the same name is refused (a name alone once let it through)."""
+    from kiseki.serve import scene_of
+
+    doc = yaml.safe_load((project_root / "data" / "worlds" / "factory_corridor.yaml").read_text())
+    doc["route"]["waypoints"] = [[0.0, 0.0], [1.5, 0.0], [3.0, 0.0]]
+    text = yaml.safe_dump(doc)
+    for sub in ("taught_in", "copy", "changed"):
+        (tmp_path / sub).mkdir()
+    scene = tmp_path / "taught_in" / "corridor.yaml"
+    scene.write_text(text)
+    teach(load_scene(scene), tmp_path / "t", seed=1)
+    scene.unlink()
+    copy = tmp_path / "copy" / "corridor.yaml"
+    copy.write_text(text)
+    changed = tmp_path / "changed" / "corridor.yaml"
+    bench = next(o for o in doc["objects"] if o["type"] == "workbench")
+    bench["center"] = [bench["center"][0] + 0.4, bench["center"][1]]
+    changed.write_text(yaml.safe_dump(doc))
+    assert scene_of(tmp_path / "t", copy) == copy
+    with pytest.raises(ValueError, match="not this scene"):
+        scene_of(tmp_path / "t", changed)

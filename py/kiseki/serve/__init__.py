@@ -60,14 +60,26 @@ def scene_of(folder: str | os.PathLike, scene: str | os.PathLike | None) -> Path
     if recorded is None:
         return scene
     taught_in = Path(recorded)
-    same = (
-        (scene.samefile(taught_in) or scene.read_bytes() == taught_in.read_bytes())
-        if taught_in.is_file()
-        else scene.name == taught_in.name
-    )
+    from kiseki.teach.scene_identity import scene_digest
+
+    identity = _taught_identity(folder)
+    if identity is not None:  # the scene's SHA-1, as teaching recorded it
+        same = scene_digest(scene) == identity.sha1
+    elif taught_in.is_file():
+        same = scene.samefile(taught_in) or scene.read_bytes() == taught_in.read_bytes()
+    else:  # an old run whose scene file is gone: only its name can be compared
+        same = scene.name == taught_in.name
     if not same:
         raise ValueError(f"{scene}: the run in {folder} was taught in {recorded}, not this scene")
     return scene
+
+
+def _taught_identity(folder: Path):
+    """The taught scene's SHA-1 as the run's waypoint file (or its log) records it, or None."""
+    from kiseki.teach.scene_identity import taught_scene_of
+
+    waypoints = folder / "waypoints.yaml"
+    return taught_scene_of(waypoints) if waypoints.is_file() else None
 
 
 def build_server(
