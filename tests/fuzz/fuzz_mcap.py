@@ -3,14 +3,17 @@
 """Fuzz the MCAP run reader kiseki.sim.mcap_log.read_run and the decoders of its topics
 (laser scans, poses, grid, depth images, velocities); see fuzz_common.py.
 
-An input that starts with the MCAP magic is the file itself. Any other input is one message:
-its first byte picks a topic of the sample run, the rest is that message's JSON payload, and
-the file is the sample run with the message added (the MCAP framing and CRCs are then valid,
-so the fuzzer reaches the message decoders instead of the CRC check).
+An input that starts with the MCAP magic is the file itself (the seeds: the sample run as
+kiseki writes it, protobuf and JSON, and its messages in the older all-JSON layout). Any other
+input is one message: its first byte picks a topic of the sample run, the rest is that
+message's JSON payload, and the file is the sample run in the JSON layout with the message
+added (the MCAP framing and CRCs are then valid, so the fuzzer reaches the message decoders
+instead of the CRC check).
 """
 
 from __future__ import annotations
 
+import base64
 import json
 from pathlib import Path
 
@@ -57,12 +60,20 @@ def write_sample(path: Path, compression: str) -> None:
         w.write_depth_image("/depth", 0.3, np.full((2, 3), 1.5, dtype=np.float32), "camera")
 
 
+def _old_json(value: object) -> object:
+    """A decoded protobuf value as the older JSON layout wrote it: bytes as base64 text."""
+    if isinstance(value, bytes):
+        return base64.b64encode(value).decode("ascii")
+    return list(value)  # protobuf's repeated numbers
+
+
 def sample_messages(path: Path) -> list[tuple[str, str, dict, bytes]]:
-    """(topic, schema name, channel metadata, first payload) of each topic of a sample run."""
+    """(topic, schema name, channel metadata, first payload as JSON) of each topic of a sample
+    run."""
     run = read_run(path)
     out = []
     for topic, (schema, _) in run.topics().items():
-        payload = json.dumps(run.messages(topic)[0][1]).encode()
+        payload = json.dumps(run.messages(topic)[0][1], default=_old_json).encode()
         out.append((topic, schema, run.channel_metadata(topic), payload))
     return out
 
@@ -94,6 +105,7 @@ def sample_topics(folder: Path) -> list[tuple[str, str, dict, bytes]]:
 
 def seeds(folder: Path):
     topics = sample_topics(folder)
+    yield (folder / "sample.mcap").read_bytes()  # protobuf (Foxglove) and JSON (kiseki) topics
     for compression in (CompressionType.NONE, CompressionType.ZSTD):
         small_run(folder / "seed.mcap", topics, compression)
         yield (folder / "seed.mcap").read_bytes()

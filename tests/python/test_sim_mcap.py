@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Tests of the MCAP run log: Foxglove JSON messages checked with the plain mcap reader,
-read-back as a CARMEN-like dataset, truncated files (cut and really killed), bad input."""
+"""Tests of the MCAP run log: Foxglove protobuf messages checked with the plain mcap reader and
+Foxglove's own classes, read-back as a CARMEN-like dataset (also of a run in the older JSON
+layout), truncated files (cut and really killed), bad input."""
 
 from __future__ import annotations
 
@@ -18,15 +19,23 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
+from foxglove_schemas_protobuf.Grid_pb2 import Grid
+from foxglove_schemas_protobuf.LaserScan_pb2 import LaserScan
+from foxglove_schemas_protobuf.PoseInFrame_pb2 import PoseInFrame
+from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
+from google.protobuf.descriptor_pb2 import FileDescriptorSet
 from mcap.reader import NonSeekingReader, make_reader
 from mcap.records import Chunk, ChunkIndex, Message
 from mcap.stream_reader import ReadDataStream, breakup_chunk
+from mcap.writer import CompressionType, Writer
 
 import kiseki
 from kiseki.errors import LogFormatError
 from kiseki.scans import LaserScans
 from kiseki.sim.mcap_log import (
-    FOXGLOVE_SCHEMAS,
+    FOXGLOVE_MESSAGES,
+    ODOMETRY_SCHEMA,
     ODOMETRY_SCHEMA_NAME,
     RunWriter,
     TruncatedRunWarning,
@@ -113,29 +122,39 @@ def plain_messages(path: Path) -> dict[str, list]:
 # --- the file as any MCAP reader sees it ---
 
 
-def test_plain_mcap_reader_sees_foxglove_json_channels(sample: Path) -> None:
+FOXGLOVE_TOPICS = {
+    "/map": "foxglove.Grid",
+    "/ground_truth": "foxglove.PoseInFrame",
+    "/tf": "foxglove.FrameTransform",
+    "/scan": "foxglove.LaserScan",
+    "/depth": "foxglove.RawImage",
+}
+
+
+def test_plain_mcap_reader_sees_foxglove_protobuf_channels(sample: Path) -> None:
     with open(sample, "rb") as f:
         reader = make_reader(f, validate_crcs=True)
         summary = reader.get_summary()
         metadata = {m.name: m.metadata for m in reader.iter_metadata()}
     assert summary is not None and summary.statistics is not None
     channels = {c.topic: c for c in summary.channels.values()}
-    expected = {
-        "/map": "foxglove.Grid",
-        "/odom": ODOMETRY_SCHEMA_NAME,
-        "/ground_truth": "foxglove.PoseInFrame",
-        "/tf": "foxglove.FrameTransform",
-        "/scan": "foxglove.LaserScan",
-        "/depth": "foxglove.RawImage",
-        "/magnetometer": "kiseki.Magnetometer",
-    }
+    expected = {**FOXGLOVE_TOPICS, "/odom": ODOMETRY_SCHEMA_NAME}
+    expected["/magnetometer"] = "kiseki.Magnetometer"
     assert set(channels) == set(expected)
     for topic, name in expected.items():
         schema = summary.schemas[channels[topic].schema_id]
         assert schema.name == name
-        assert schema.encoding == "jsonschema"
-        assert channels[topic].message_encoding == "json"
-        assert json.loads(schema.data)["title"] == name
+        if topic in FOXGLOVE_TOPICS:  # Foxglove's protobuf messages
+            assert schema.encoding == "protobuf"
+            assert channels[topic].message_encoding == "protobuf"
+            files = FileDescriptorSet.FromString(schema.data).file
+            proto = name.split(".")[1]
+            assert files[-1].name == f"foxglove/{proto}.proto" and files[-1].package == "foxglove"
+            assert [m.name for m in files[-1].message_type] == [proto]
+        else:  # kiseki's own: JSON
+            assert schema.encoding == "jsonschema"
+            assert channels[topic].message_encoding == "json"
+            assert json.loads(schema.data)["title"] == name
     # each schema registered once, one channel per topic
     assert len(summary.schemas) == len(expected) and len(summary.channels) == len(expected)
     assert channels["/scan"].metadata == {"max_range": "12.5"}
@@ -169,56 +188,64 @@ def test_small_chunks_are_used(sample: Path) -> None:
 
 
 def test_message_values_are_exact(sample: Path) -> None:
+    """Each message decoded with Foxglove's published protobuf class, not kiseki's reader."""
     msgs = plain_messages(sample)
 
     # laser scans: times, sensor pose, angles, float32 ranges
     scans = msgs["/scan"]
     for k, (_, _, message) in enumerate(scans):
-        body = json.loads(message.data)
+        body = LaserScan.FromString(message.data)
         ns = round(0.1 * k * 1e9)
         assert message.log_time == message.publish_time == ns
-        assert body["timestamp"] == {"sec": ns // 10**9, "nsec": ns % 10**9}
-        assert body["frame_id"] == "world"
+        assert (body.timestamp.seconds, body.timestamp.nanos) == (ns // 10**9, ns % 10**9)
+        assert body.frame_id == "world"
         x, y, theta = laser_pose(k)
-        assert body["pose"]["position"] == {"x": x, "y": y, "z": 0.0}
-        q = body["pose"]["orientation"]
-        assert (q["x"], q["y"]) == (0.0, 0.0)
-        assert q["z"] == pytest.approx(math.sin(theta / 2), abs=1e-15)
-        assert q["w"] == pytest.approx(math.cos(theta / 2), abs=1e-15)
-        assert body["start_angle"] == ANGLES[0] and body["end_angle"] == ANGLES[-1]
-        ranges = np.array(body["ranges"], dtype=np.float32)
-        np.testing.assert_array_equal(ranges, scan_ranges(k))
-        assert body["intensities"] == []
+        p, q = body.pose.position, body.pose.orientation
+        assert (p.x, p.y, p.z) == (x, y, 0.0)
+        assert (q.x, q.y) == (0.0, 0.0)
+        assert q.z == pytest.approx(math.sin(theta / 2), abs=1e-15)
+        assert q.w == pytest.approx(math.cos(theta / 2), abs=1e-15)
+        assert body.start_angle == ANGLES[0] and body.end_angle == ANGLES[-1]
+        ranges = np.array(body.ranges, dtype=np.float64)
+        np.testing.assert_array_equal(ranges, scan_ranges(k).astype(np.float64))
+        assert list(body.intensities) == []
 
-    # depth image: base64 little-endian float32, NaN and inf preserved
+    # depth image: the raw little-endian float32 bytes, NaN and inf preserved
     (_, _, message) = msgs["/depth"][0]
-    body = json.loads(message.data)
-    assert (body["width"], body["height"], body["step"]) == (5, 4, 20)
-    assert body["encoding"] == "32FC1" and body["frame_id"] == "camera"
-    depth = np.frombuffer(base64.b64decode(body["data"]), dtype="<f4").reshape(4, 5)
-    np.testing.assert_array_equal(depth, DEPTH)  # NaN == NaN for assert_array_equal
+    body = RawImage.FromString(message.data)
+    assert (body.width, body.height, body.step) == (5, 4, 20)
+    assert body.encoding == "32FC1" and body.frame_id == "camera"
+    assert body.data == DEPTH.astype("<f4").tobytes()
+    assert (body.timestamp.seconds, body.timestamp.nanos) == (1, 500_000_000)
 
     # grid: INT8 cells, row 0 at the origin, pose of the origin corner
     (_, _, message) = msgs["/map"][0]
-    body = json.loads(message.data)
+    body = Grid.FromString(message.data)
     grid = make_grid()
-    assert body["column_count"] == 9 and body["row_stride"] == 9 and body["cell_stride"] == 1
-    assert body["cell_size"] == {"x": 0.05, "y": 0.05}
-    assert body["fields"] == [{"name": "occupancy", "offset": 0, "type": 2}]
-    cells = np.frombuffer(base64.b64decode(body["data"]), dtype=np.int8).reshape(-1, 9)
-    np.testing.assert_array_equal(cells, grid.cells)
+    assert body.column_count == 9 and body.row_stride == 9 and body.cell_stride == 1
+    assert (body.cell_size.x, body.cell_size.y) == (0.05, 0.05)
+    [packed] = body.fields
+    assert (packed.name, packed.offset, packed.type) == ("occupancy", 0, 2)  # 2: INT8
+    assert body.data == grid.cells.tobytes()
+    cells = np.frombuffer(body.data, dtype=np.int8).reshape(-1, 9)
     assert cells[0, 0] == 0 and cells[5, 8] == 100 and cells[1, 0] == -1
-    assert body["pose"]["position"] == {"x": -1.5, "y": 2.0, "z": 0.0}
-    assert body["pose"]["orientation"]["z"] == pytest.approx(math.sin(0.125), abs=1e-15)
+    p = body.pose.position
+    assert (p.x, p.y, p.z) == (-1.5, 2.0, 0.0)
+    assert body.pose.orientation.z == pytest.approx(math.sin(0.125), abs=1e-15)
 
-    # transform of base_link in world
+    # ground truth and the transform of base_link in world
+    (_, _, message) = msgs["/ground_truth"][3]
+    body = PoseInFrame.FromString(message.data)
+    assert body.frame_id == "world" and body.pose.position.x == truth_pose(3)[0]
+    assert body.pose.orientation.z == pytest.approx(math.sin(0.45), abs=1e-15)
     (_, _, message) = msgs["/tf"][3]
-    body = json.loads(message.data)
-    assert body["parent_frame_id"] == "world" and body["child_frame_id"] == "base_link"
-    assert body["translation"] == {"x": 0.75, "y": 0.625, "z": 0.0}
-    assert body["rotation"]["w"] == pytest.approx(math.cos(0.45), abs=1e-15)
+    body = FrameTransform.FromString(message.data)
+    assert body.parent_frame_id == "world" and body.child_frame_id == "base_link"
+    t = body.translation
+    assert (t.x, t.y, t.z) == (0.75, 0.625, 0.0)
+    assert body.rotation.w == pytest.approx(math.cos(0.45), abs=1e-15)
 
-    # kiseki odometry and a custom message
+    # kiseki odometry and a custom message: JSON
     (_, _, message) = msgs["/odom"][3]
     body = json.loads(message.data)
     assert message.log_time == 155_000_000
@@ -262,33 +289,28 @@ EXPECTED_FIELDS = {
 }
 
 
-def test_foxglove_schema_texts(sample: Path) -> None:
-    assert set(FOXGLOVE_SCHEMAS) == set(EXPECTED_FIELDS)
+def test_foxglove_schemas_are_the_published_descriptors(sample: Path) -> None:
+    """The schema of each Foxglove topic describes the message with the fields Foxglove
+    publishes, and the pool it builds decodes the message as Foxglove's class does."""
+    from google.protobuf.descriptor_pool import DescriptorPool
+    from google.protobuf.message_factory import GetMessageClass
+
+    assert set(FOXGLOVE_MESSAGES) == set(EXPECTED_FIELDS)
     with open(sample, "rb") as f:
         summary = make_reader(f).get_summary()
     assert summary is not None
-    stored = {s.name: json.loads(s.data) for s in summary.schemas.values()}
-    for name, fields in EXPECTED_FIELDS.items():
-        schema = stored[name]
-        assert schema["title"] == name and schema["type"] == "object"
-        props = schema["properties"]
-        assert set(props) == fields
-        assert props["timestamp"]["properties"]["nsec"]["maximum"] == 999_999_999
-        for key in ("pose", "translation", "rotation"):
-            if key in props:
-                inner = props[key]["properties"]
-                sub = inner.get("position", props[key])["properties"]
-                assert set(sub) >= {"x", "y", "z"}
-        if "pose" in props:
-            orientation = props["pose"]["properties"]["orientation"]["properties"]
-            assert set(orientation) == {"x", "y", "z", "w"}
-    assert stored["foxglove.RawImage"]["properties"]["data"]["contentEncoding"] == "base64"
-    grid = stored["foxglove.Grid"]["properties"]
-    assert grid["data"]["contentEncoding"] == "base64"
-    numeric = grid["fields"]["items"]["properties"]["type"]["oneOf"]
-    assert {"title": "INT8", "const": 2} in numeric and len(numeric) == 9
-    assert set(grid["cell_size"]["properties"]) == {"x", "y"}
-    assert stored["foxglove.LaserScan"]["properties"]["ranges"]["items"] == {"type": "number"}
+    stored = {s.name: s for s in summary.schemas.values()}
+    first = {t: m for t, [(_, _, m), *_] in plain_messages(sample).items()}
+    for topic, name in FOXGLOVE_TOPICS.items():
+        pool = DescriptorPool()
+        for proto in FileDescriptorSet.FromString(stored[name].data).file:
+            pool.Add(proto)  # in dependency order, as mcap-protobuf-support writes them
+        descriptor = pool.FindMessageTypeByName(name)
+        assert {f.name for f in descriptor.fields} == EXPECTED_FIELDS[name]
+        built = GetMessageClass(descriptor).FromString(first[topic].data)
+        published = FOXGLOVE_MESSAGES[name].FromString(first[topic].data)
+        assert built.SerializeToString() == published.SerializeToString()
+        assert built.ListFields() and str(built) == str(published)
 
 
 # --- read_run ---
@@ -331,6 +353,138 @@ def test_read_run_helpers(sample: Path) -> None:
         run.messages("/nope")
     with pytest.raises(LogFormatError, match="not foxglove.LaserScan"):
         run.laser_scans(scan_topic="/odom")
+
+
+def _old_stamp(ns: int) -> dict[str, int]:
+    return {"sec": ns // 10**9, "nsec": ns % 10**9}
+
+
+def _old_pose(x: float, y: float, theta: float) -> dict:
+    return {
+        "position": {"x": x, "y": y, "z": 0.0},
+        "orientation": {"x": 0.0, "y": 0.0, "z": math.sin(theta / 2), "w": math.cos(theta / 2)},
+    }
+
+
+def write_old_json_sample(path: Path) -> None:
+    """write_sample's run in the layout kiseki wrote before its protobuf messages: every
+    message JSON ("json" channels, "jsonschema" schemas), images and grids as base64 text."""
+    with open(path, "wb") as file:
+        writer = Writer(file, chunk_size=4096, compression=CompressionType.ZSTD)
+        writer.start(profile="", library="kiseki")
+        writer.add_metadata("kiseki.run", {"seed": "42", "world": "corridor"})
+        channels: dict[str, int] = {}
+
+        def add(topic: str, name: str, ns: int, body: dict, meta: dict | None = None) -> None:
+            if topic not in channels:
+                schema = ODOMETRY_SCHEMA if name == ODOMETRY_SCHEMA_NAME else {"title": name}
+                sid = writer.register_schema(name, "jsonschema", json.dumps(schema).encode())
+                channels[topic] = writer.register_channel(topic, "json", sid, meta or {})
+            data = json.dumps(body, separators=(",", ":")).encode()
+            writer.add_message(channels[topic], log_time=ns, data=data, publish_time=ns)
+
+        grid = make_grid()
+        origin = (grid.origin.x, grid.origin.y, grid.origin.theta)
+        add("/map", "foxglove.Grid", 0, {
+            "timestamp": _old_stamp(0), "frame_id": "world", "pose": _old_pose(*origin),
+            "column_count": 9, "cell_size": {"x": 0.05, "y": 0.05}, "row_stride": 9,
+            "cell_stride": 1, "fields": [{"name": "occupancy", "offset": 0, "type": 2}],
+            "data": base64.b64encode(grid.cells.tobytes()).decode(),
+        })  # fmt: skip
+        for j in range(2 * N_STEPS):
+            ns = round((0.05 * j + 0.005) * 1e9)
+            x, y, theta = odom_pose(j)
+            add("/odom", ODOMETRY_SCHEMA_NAME, ns, {
+                "timestamp": _old_stamp(ns), "frame_id": "odom", "x": x, "y": y, "theta": theta,
+                "linear_velocity": 0.5, "angular_velocity": 0.1,
+            })  # fmt: skip
+        for k in range(N_STEPS):
+            ns, (x, y, theta) = round(k / 10 * 1e9), truth_pose(k)
+            pose = {
+                "timestamp": _old_stamp(ns),
+                "frame_id": "world",
+                "pose": _old_pose(x, y, theta),
+            }
+            add("/ground_truth", "foxglove.PoseInFrame", ns, pose)
+            add("/tf", "foxglove.FrameTransform", ns, {
+                "timestamp": _old_stamp(ns), "parent_frame_id": "world",
+                "child_frame_id": "base_link", "translation": {"x": x, "y": y, "z": 0.0},
+                "rotation": _old_pose(x, y, theta)["orientation"],
+            })  # fmt: skip
+            add("/scan", "foxglove.LaserScan", ns, {
+                "timestamp": _old_stamp(ns), "frame_id": "world", "pose": _old_pose(*laser_pose(k)),
+                "start_angle": ANGLES[0], "end_angle": ANGLES[-1],
+                "ranges": scan_ranges(k).astype(np.float64).tolist(), "intensities": [],
+            }, {"max_range": "12.5"})  # fmt: skip
+        add("/depth", "foxglove.RawImage", 1_500_000_000, {
+            "timestamp": _old_stamp(1_500_000_000), "frame_id": "camera", "width": 5, "height": 4,
+            "encoding": "32FC1", "step": 20, "data": base64.b64encode(DEPTH.tobytes()).decode(),
+        })  # fmt: skip
+        add("/magnetometer", "kiseki.Magnetometer", 2_000_000_000, {"heading": 0.5})
+        writer.finish()
+
+
+def _raw_data(message: dict) -> dict:
+    """A message with its bytes field as bytes (base64 text in the JSON layout)."""
+    if isinstance(message.get("data"), str):
+        return {**message, "data": base64.b64decode(message["data"])}
+    return message
+
+
+def test_older_json_run_reads_as_the_protobuf_run(sample: Path, tmp_path: Path) -> None:
+    old_path = tmp_path / "old.mcap"
+    write_old_json_sample(old_path)
+    with open(old_path, "rb") as f:
+        encodings = {c.message_encoding for c in make_reader(f).get_summary().channels.values()}
+    assert encodings == {"json"}
+    old, new = read_run(old_path), read_run(sample)
+    assert old.topics() == new.topics() and old.metadata == new.metadata
+    a, b = old.laser_scans(), new.laser_scans()
+    for name in ("times", "poses", "odometry", "ranges", "angles"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    assert a.max_range == b.max_range == MAX_RANGE and a.ranges.dtype == b.ranges.dtype
+    np.testing.assert_array_equal(old.poses()[1], new.poses()[1])
+    [(t_old, d_old)], [(t_new, d_new)] = old.depth_images("/depth"), new.depth_images("/depth")
+    assert t_old == t_new == 1.5 and d_old.tobytes() == d_new.tobytes() == DEPTH.tobytes()
+    g_old, g_new = old.grid("/map"), new.grid("/map")
+    np.testing.assert_array_equal(g_old.cells, g_new.cells)
+    assert g_old.resolution == g_new.resolution
+    assert (g_old.origin.x, g_old.origin.y, g_old.origin.theta) == (
+        g_new.origin.x, g_new.origin.y, g_new.origin.theta
+    )  # fmt: skip
+    for topic in old.topics():  # the messages themselves, decoded to the same dicts
+        got = [(t, _raw_data(m)) for t, m in old.messages(topic)]
+        assert got == new.messages(topic), topic
+
+
+def test_other_encodings_and_protobuf_schemas(tmp_path: Path) -> None:
+    """A protobuf message kiseki has no class for is decoded from the file's schema; a bad
+    protobuf message and an unknown encoding are LogFormatErrors naming the file."""
+    from foxglove_schemas_protobuf.Vector2_pb2 import Vector2
+    from mcap_protobuf.schema import build_file_descriptor_set
+
+    path = tmp_path / "other.mcap"
+    with open(path, "wb") as file:
+        writer = Writer(file)
+        writer.start(profile="", library="test")
+        data = build_file_descriptor_set(Vector2).SerializeToString()
+        vector = writer.register_schema("foxglove.Vector2", "protobuf", data)
+        data = build_file_descriptor_set(LaserScan).SerializeToString()
+        scan = writer.register_schema("foxglove.LaserScan", "protobuf", data)
+        for topic, sid, encoding, payload in (
+            ("/v", vector, "protobuf", Vector2(x=1.5, y=-2.0).SerializeToString()),
+            ("/scan", scan, "protobuf", b"\xff\xff\xff"),
+            ("/c", vector, "cbor", b"\xa0"),
+        ):
+            channel = writer.register_channel(topic, encoding, sid)
+            writer.add_message(channel, log_time=7, data=payload, publish_time=7)
+        writer.finish()
+    run = read_run(path)
+    assert run.messages("/v") == [(7e-9, {"x": 1.5, "y": -2.0})]
+    with pytest.raises(LogFormatError, match="other.mcap: bad protobuf message on '/scan'"):
+        run.laser_scans(truth_topic=None, odom_topic=None)
+    with pytest.raises(LogFormatError, match="'cbor', not JSON or protobuf"):
+        run.messages("/c")
 
 
 def test_scans_in_the_robot_frame_are_composed_with_ground_truth(tmp_path: Path) -> None:
@@ -477,7 +631,7 @@ os.kill(os.getpid(), signal.SIGKILL)
 @pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="needs SIGKILL")
 def test_killed_writer_keeps_every_complete_chunk(tmp_path: Path) -> None:
     path = tmp_path / "killed.mcap"
-    steps = 300
+    steps = 301  # 300 steps happen to fill the last chunk exactly: nothing would be lost
     proc = subprocess.run(
         [sys.executable, "-c", KILLED_WRITER, str(path), str(steps)],
         capture_output=True,
@@ -489,9 +643,9 @@ def test_killed_writer_keeps_every_complete_chunk(tmp_path: Path) -> None:
     assert run.truncated and run.metadata == {"run": "killed"}
     poses = run.messages("/ground_truth")
     scans = run.messages("/scan")
-    # Only the last, unfinished chunk is lost: a step (pose ~145 B + scan ~410 B of JSON + 2
-    # message headers of 31 B) takes ~615 B, so a 4 KiB chunk holds fewer than 7 steps.
-    assert steps - 7 <= len(poses) < steps
+    # Only the last, unfinished chunk is lost: a step (pose ~41 B + scan ~462 B of protobuf + 2
+    # message headers of 31 B) takes ~565 B, so a 4 KiB chunk holds fewer than 8 steps.
+    assert steps - 8 <= len(poses) <= steps and len(scans) < steps
     assert len(scans) in (len(poses), len(poses) - 1)  # the chunk may end between the two
     assert [m["pose"]["position"]["x"] for _, m in poses] == list(range(len(poses)))
     assert [m["ranges"][0] for _, m in scans] == [k % 7 + 1.0 for k in range(len(scans))]

@@ -1,19 +1,23 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Simulated runs logged to MCAP with Foxglove JSON messages, and read back as kiseki datasets.
+"""Simulated runs logged to MCAP with Foxglove's protobuf messages, read back as kiseki datasets.
 
 Writing (:class:`RunWriter`)
-    Every message is JSON (channel ``message_encoding`` ``"json"``) described by a JSON schema
-    stored in the MCAP Schema record (encoding ``"jsonschema"``), so Foxglove shows the run with
-    no extra setup: ``foxglove.PoseInFrame`` (poses), ``foxglove.FrameTransform`` (the robot's
-    ``base_link`` in ``world``, so the 3-D panel follows the robot), ``foxglove.LaserScan``,
-    ``foxglove.RawImage`` (depth images, ``32FC1`` little-endian metres) and ``foxglove.Grid``
-    (the occupancy map, one INT8 field ``occupancy`` in the ROS convention, row 0 at the grid
-    origin). kiseki's own messages (odometry, magnetometer, bearings, commands) go through
-    :meth:`RunWriter.write_json` with a schema given by the caller; :meth:`RunWriter.write_odometry`
-    writes ``kiseki.Odometry2D`` (:data:`ODOMETRY_SCHEMA`); velocities are ``kiseki.Twist``
-    (:data:`TWIST_SCHEMA`, read back by :meth:`SimRun.velocities`). Each schema and each channel is
-    registered once, on the first message of its name/topic; a topic keeps its schema.
+    Foxglove's messages are protobuf (channel ``message_encoding`` ``"protobuf"``), with the
+    classes and schemas Foxglove publishes in ``foxglove-schemas-protobuf``: each Schema record
+    (encoding ``"protobuf"``) holds the message's ``FileDescriptorSet`` as ``mcap-protobuf-support``
+    builds it, so Foxglove shows the run with no extra setup: ``foxglove.PoseInFrame`` (poses),
+    ``foxglove.FrameTransform`` (the robot's ``base_link`` in ``world``, so the 3-D panel follows
+    the robot), ``foxglove.LaserScan``, ``foxglove.RawImage`` (depth images, ``32FC1``
+    little-endian metres, the raw bytes in ``data``) and ``foxglove.Grid`` (the occupancy map, one
+    INT8 field ``occupancy`` in the ROS convention, row 0 at the grid origin); see
+    :data:`FOXGLOVE_MESSAGES`. kiseki's own messages (odometry, magnetometer, bearings, commands),
+    which no Foxglove message fits, stay JSON (``"json"`` channels, ``"jsonschema"`` schemas; an
+    MCAP file can mix encodings) and go through :meth:`RunWriter.write_json` with a schema given
+    by the caller; :meth:`RunWriter.write_odometry` writes ``kiseki.Odometry2D``
+    (:data:`ODOMETRY_SCHEMA`); velocities are ``kiseki.Twist`` (:data:`TWIST_SCHEMA`, read back by
+    :meth:`SimRun.velocities`). Each schema and each channel is registered once, on the first
+    message of its name/topic; a topic keeps its schema.
 
     Times are seconds (float, >= 0, any order) stored as nanoseconds in ``log_time``,
     ``publish_time`` and the message ``timestamp``. A laser topic's ``max_range`` (readings
@@ -41,6 +45,10 @@ Reading (:func:`read_run`)
     Header record, or whose complete records do not parse (bad CRC, bad JSON, ...) raises
     :class:`~kiseki.errors.LogFormatError` naming the file.
 
+    Messages are decoded by their channel's message encoding: ``protobuf`` (the runs written now)
+    and ``json`` (runs written before kiseki used protobuf, whose images and grids hold base64
+    text) both read to the same scans, poses, images and grids.
+
     :meth:`SimRun.laser_scans` returns the same :class:`~kiseki.scans.LaserScans` as
     the CARMEN reader, so simulated runs replay through the interface of real logs.
 """
@@ -62,11 +70,22 @@ from types import TracebackType
 from typing import IO, Any
 
 import numpy as np
-from mcap.exceptions import EndOfFile
+from foxglove_schemas_protobuf.FrameTransform_pb2 import FrameTransform
+from foxglove_schemas_protobuf.Grid_pb2 import Grid
+from foxglove_schemas_protobuf.LaserScan_pb2 import LaserScan
+from foxglove_schemas_protobuf.PackedElementField_pb2 import PackedElementField
+from foxglove_schemas_protobuf.PoseInFrame_pb2 import PoseInFrame
+from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
+from google.protobuf.descriptor import FieldDescriptor
+from google.protobuf.message import DecodeError
+from google.protobuf.message import Message as ProtobufMessage
+from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
 from mcap.records import Channel, Header, Message, Metadata, Schema, Statistics
 from mcap.stream_reader import StreamReader
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
+from mcap_protobuf.decoder import DecoderFactory
+from mcap_protobuf.schema import build_file_descriptor_set
 
 from kiseki.core import Pose2
 from kiseki.errors import LogFormatError
@@ -75,7 +94,7 @@ from kiseki.scans import LaserScans
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
-    "FOXGLOVE_SCHEMAS",
+    "FOXGLOVE_MESSAGES",
     "MissingTopicError",
     "ODOMETRY_SCHEMA",
     "ODOMETRY_SCHEMA_NAME",
@@ -88,8 +107,9 @@ __all__ = [
 ]
 
 DEFAULT_CHUNK_SIZE = 128 * 1024
-SCHEMA_ENCODING = "jsonschema"
+SCHEMA_ENCODING = "jsonschema"  # kiseki's own messages
 MESSAGE_ENCODING = "json"
+PROTOBUF = "protobuf"  # Foxglove's messages: the schema and the message encoding
 _MAGIC = b"\x89MCAP0\r\n"
 _NS_PER_S = 1_000_000_000
 _MAX_NS = 2**64 - 1
@@ -102,6 +122,10 @@ _COMPRESSIONS = {
     "lz4": CompressionType.LZ4,
     "none": CompressionType.NONE,
 }
+FOXGLOVE_MESSAGES: dict[str, type[ProtobufMessage]] = {
+    cls.DESCRIPTOR.full_name: cls
+    for cls in (PoseInFrame, FrameTransform, LaserScan, RawImage, Grid)
+}  # the Foxglove messages RunWriter writes, by schema name: foxglove-schemas-protobuf classes
 
 
 class TruncatedRunWarning(UserWarning):
@@ -116,7 +140,7 @@ class MissingTopicError(LogFormatError, KeyError):
         return str(self.args[0]) if self.args else ""
 
 
-# --- Foxglove JSON schemas (as in github.com/foxglove/schemas, schemas/jsonschema/*.json) ---
+# --- kiseki's own JSON schemas (no Foxglove message fits them) ---
 
 
 def _time_schema(description: str) -> dict[str, Any]:
@@ -130,195 +154,6 @@ def _time_schema(description: str) -> dict[str, Any]:
         "description": description,
     }
 
-
-def _vector3_schema(description: str) -> dict[str, Any]:
-    axes = {a: {"type": "number", "description": f"{a} coordinate length"} for a in "xyz"}
-    return {
-        "title": "foxglove.Vector3",
-        "description": description,
-        "type": "object",
-        "properties": axes,
-    }
-
-
-def _quaternion_schema(description: str) -> dict[str, Any]:
-    values = {a: {"type": "number", "description": f"{a} value"} for a in "xyzw"}
-    return {
-        "title": "foxglove.Quaternion",
-        "description": description,
-        "type": "object",
-        "properties": values,
-    }
-
-
-def _pose_schema(description: str) -> dict[str, Any]:
-    return {
-        "title": "foxglove.Pose",
-        "description": description,
-        "type": "object",
-        "properties": {
-            "position": _vector3_schema("Point denoting position in 3D space"),
-            "orientation": _quaternion_schema("Quaternion denoting orientation in 3D space"),
-        },
-    }
-
-
-def _message_schema(name: str, description: str, properties: dict[str, Any]) -> dict[str, Any]:
-    return {
-        "title": name,
-        "description": description,
-        "$comment": "Generated by https://github.com/foxglove/schemas",
-        "type": "object",
-        "properties": properties,
-    }
-
-
-_NUMERIC_TYPES = ["UNKNOWN", "UINT8", "INT8", "UINT16", "INT16", "UINT32", "INT32"]
-_NUMERIC_TYPES += ["FLOAT32", "FLOAT64"]
-
-FOXGLOVE_SCHEMAS: dict[str, dict[str, Any]] = {
-    "foxglove.PoseInFrame": _message_schema(
-        "foxglove.PoseInFrame",
-        "A timestamped pose for an object or reference frame in 3D space",
-        {
-            "timestamp": _time_schema("Timestamp of pose"),
-            "frame_id": {
-                "type": "string",
-                "description": "Frame of reference for pose position and orientation",
-            },
-            "pose": _pose_schema("Pose in 3D space"),
-        },
-    ),
-    "foxglove.FrameTransform": _message_schema(
-        "foxglove.FrameTransform",
-        "A transform between two reference frames in 3D space",
-        {
-            "timestamp": _time_schema("Timestamp of transform"),
-            "parent_frame_id": {"type": "string", "description": "Name of the parent frame"},
-            "child_frame_id": {"type": "string", "description": "Name of the child frame"},
-            "translation": _vector3_schema("Translation component of the transform"),
-            "rotation": _quaternion_schema("Rotation component of the transform"),
-        },
-    ),
-    "foxglove.LaserScan": _message_schema(
-        "foxglove.LaserScan",
-        "A single scan from a planar laser range-finder",
-        {
-            "timestamp": _time_schema("Timestamp of scan"),
-            "frame_id": {"type": "string", "description": "Frame of reference"},
-            "pose": _pose_schema(
-                "Origin of scan relative to frame of reference; points are positioned in the"
-                " x-y plane relative to this origin; angles are interpreted as counterclockwise"
-                " rotations around the z axis with 0 rad being in the +x direction"
-            ),
-            "start_angle": {"type": "number", "description": "Bearing of first point, in radians"},
-            "end_angle": {"type": "number", "description": "Bearing of last point, in radians"},
-            "ranges": {
-                "type": "array",
-                "items": {"type": "number"},
-                "description": "Distance of detections from origin; assumed to be at"
-                " equally-spaced angles between `start_angle` and `end_angle`",
-            },
-            "intensities": {
-                "type": "array",
-                "items": {"type": "number"},
-                "description": "Intensity of detections",
-            },
-        },
-    ),
-    "foxglove.RawImage": _message_schema(
-        "foxglove.RawImage",
-        "A raw image",
-        {
-            "timestamp": _time_schema("Timestamp of image"),
-            "frame_id": {
-                "type": "string",
-                "description": "Frame of reference for the image. The origin of the frame is the"
-                " optical center of the camera. +x points to the right in the image, +y points"
-                " down, and +z points into the plane of the image.",
-            },
-            "width": {"type": "integer", "minimum": 0, "description": "Image width"},
-            "height": {"type": "integer", "minimum": 0, "description": "Image height"},
-            "encoding": {"type": "string", "description": "Encoding of the raw image data"},
-            "step": {"type": "integer", "minimum": 0, "description": "Byte length of a single row"},
-            "data": {
-                "type": "string",
-                "contentEncoding": "base64",
-                "description": "Raw image data",
-            },
-        },
-    ),
-    "foxglove.Grid": _message_schema(
-        "foxglove.Grid",
-        "A 2D grid of data",
-        {
-            "timestamp": _time_schema("Timestamp of grid"),
-            "frame_id": {"type": "string", "description": "Frame of reference"},
-            "pose": _pose_schema(
-                "Origin of grid's corner relative to frame of reference; grid is positioned in"
-                " the x-y plane relative to this origin"
-            ),
-            "column_count": {
-                "type": "integer",
-                "minimum": 0,
-                "description": "Number of grid columns",
-            },
-            "cell_size": {
-                "title": "foxglove.Vector2",
-                "description": "Size of single grid cell along x and y axes, relative to `pose`",
-                "type": "object",
-                "properties": {
-                    "x": {"type": "number", "description": "x coordinate length"},
-                    "y": {"type": "number", "description": "y coordinate length"},
-                },
-            },
-            "row_stride": {
-                "type": "integer",
-                "minimum": 0,
-                "description": "Number of bytes between rows in `data`",
-            },
-            "cell_stride": {
-                "type": "integer",
-                "minimum": 0,
-                "description": "Number of bytes between cells within a row in `data`",
-            },
-            "fields": {
-                "type": "array",
-                "items": {
-                    "title": "foxglove.PackedElementField",
-                    "description": "A field present within each element in a byte array of"
-                    " packed elements.",
-                    "type": "object",
-                    "properties": {
-                        "name": {"type": "string", "description": "Name of the field"},
-                        "offset": {
-                            "type": "integer",
-                            "minimum": 0,
-                            "description": "Byte offset from start of data buffer",
-                        },
-                        "type": {
-                            "title": "foxglove.NumericType",
-                            "description": "Type of data in the field. Integers are stored"
-                            " using little-endian byte order.",
-                            "oneOf": [
-                                {"title": name, "const": value}
-                                for value, name in enumerate(_NUMERIC_TYPES)
-                            ],
-                        },
-                    },
-                },
-                "description": "Fields in `data`. `red`, `green`, `blue`, and `alpha` are"
-                " optional for customizing the grid's color.",
-            },
-            "data": {
-                "type": "string",
-                "contentEncoding": "base64",
-                "description": "Grid cell data, interpreted using `fields`, in row-major"
-                " (y-major) order",
-            },
-        },
-    ),
-}
 
 ODOMETRY_SCHEMA_NAME = "kiseki.Odometry2D"
 ODOMETRY_SCHEMA: dict[str, Any] = {
@@ -404,12 +239,73 @@ def _pose7(pose: Any, what: str = "pose") -> tuple[float, ...]:
     return tuple(values.tolist())
 
 
-def _pose_json(pose7: Sequence[float]) -> dict[str, Any]:
-    x, y, z, qx, qy, qz, qw = pose7
-    return {
-        "position": {"x": x, "y": y, "z": z},
-        "orientation": {"x": qx, "y": qy, "z": qz, "w": qw},
-    }
+def _set_pose(pose: Any, pose7: Sequence[float]) -> None:
+    """Fills a foxglove.Pose (protobuf) from (x, y, z, qx, qy, qz, qw)."""
+    p, q = pose.position, pose.orientation
+    p.x, p.y, p.z, q.x, q.y, q.z, q.w = pose7
+
+
+_SCHEMA_DATA: dict[str, bytes] = {}
+
+
+def _protobuf_schema(name: str) -> bytes:
+    """The serialized FileDescriptorSet of a Foxglove message (built once)."""
+    data = _SCHEMA_DATA.get(name)
+    if data is None:
+        data = build_file_descriptor_set(FOXGLOVE_MESSAGES[name]).SerializeToString()
+        _SCHEMA_DATA[name] = data
+    return data
+
+
+_TIMESTAMP = "google.protobuf.Timestamp"
+_FIELDS: dict[str, list[tuple[str, int]]] = {}  # message name -> (field, kind)
+_SCALAR, _REPEATED, _MESSAGE, _MESSAGES, _STAMP = range(5)
+
+
+def _fields(descriptor: Any) -> list[tuple[str, int]]:
+    kinds = _FIELDS.get(descriptor.full_name)
+    if kinds is None:
+        kinds = []
+        for f in descriptor.fields:
+            nested = f.type == FieldDescriptor.TYPE_MESSAGE
+            # protobuf >= 5.29 has is_repeated; 7 has no label
+            repeated = f.is_repeated if hasattr(f, "is_repeated") else f.label == f.LABEL_REPEATED
+            if repeated:
+                kinds.append((f.name, _MESSAGES if nested else _REPEATED))
+            elif nested:
+                stamp = f.message_type.full_name == _TIMESTAMP
+                kinds.append((f.name, _STAMP if stamp else _MESSAGE))
+            else:
+                kinds.append((f.name, _SCALAR))
+        _FIELDS[descriptor.full_name] = kinds
+    return kinds
+
+
+def _as_dict(message: Any) -> dict[str, Any]:
+    """A protobuf message as a dict of the JSON layout: timestamps {"sec", "nsec"}, nested
+    messages as dicts, enums as ints, bytes as bytes, repeated numbers as protobuf's own
+    (read-only) sequence, which numpy reads at once."""
+    out: dict[str, Any] = {}
+    for name, kind in _fields(message.DESCRIPTOR):
+        value = getattr(message, name)
+        if kind == _STAMP:
+            out[name] = {"sec": value.seconds, "nsec": value.nanos}
+        elif kind == _MESSAGE:
+            out[name] = _as_dict(value)
+        elif kind == _MESSAGES:
+            out[name] = [_as_dict(v) for v in value]
+        else:
+            out[name] = value
+    return out
+
+
+def _payload_bytes(value: Any) -> bytes:
+    """A bytes field: raw bytes (protobuf) or base64 text (older JSON runs)."""
+    if isinstance(value, bytes):
+        return value
+    if not isinstance(value, str):
+        raise TypeError(f"data must be bytes or base64 text, got {type(value).__name__}")
+    return base64.b64decode(value, validate=True)
 
 
 def _name(value: str, what: str) -> str:
@@ -518,9 +414,11 @@ class RunWriter:
         self,
         topic: str,
         schema_name: str,
-        schema: Mapping[str, Any],
+        schema: Mapping[str, Any] | None,
         channel_metadata: dict[str, str] | None = None,
     ) -> int:
+        """The channel of ``topic``: JSON with the JSON schema ``schema``, or (``schema`` None)
+        the Foxglove protobuf message ``schema_name``."""
         if self._file is None:
             raise ValueError(f"{self.path}: the run writer is closed")
         _name(topic, "topic")
@@ -538,24 +436,28 @@ class RunWriter:
                     f" not {channel_metadata}"
                 )
             return channel_id
-        if not isinstance(schema, Mapping):
+        if schema is None:
+            schema_encoding, encoding = PROTOBUF, PROTOBUF
+            text = _protobuf_schema(schema_name)
+        elif isinstance(schema, Mapping):
+            schema_encoding, encoding = SCHEMA_ENCODING, MESSAGE_ENCODING
+            text = json.dumps(schema, indent=2, allow_nan=False).encode("utf-8")
+        else:
             raise ValueError(f"schema of {schema_name} must be a dict (a JSON schema)")
-        text = json.dumps(schema, indent=2, allow_nan=False).encode("utf-8")
         if schema_name in self._schemas:
             schema_id, known_text = self._schemas[schema_name]
             if known_text != text:
                 raise ValueError(f"schema {schema_name} was registered with a different text")
         else:
-            schema_id = self._writer.register_schema(schema_name, SCHEMA_ENCODING, text)
+            schema_id = self._writer.register_schema(schema_name, schema_encoding, text)
             self._schemas[schema_name] = (schema_id, text)
         meta = dict(channel_metadata or {})
-        channel_id = self._writer.register_channel(topic, MESSAGE_ENCODING, schema_id, meta)
+        channel_id = self._writer.register_channel(topic, encoding, schema_id, meta)
         self._channels[topic] = (channel_id, schema_name, meta)
         self._sequence[channel_id] = 0
         return channel_id
 
-    def _write(self, channel_id: int, ns: int, payload: Mapping[str, Any] | bytes) -> None:
-        data = payload if isinstance(payload, bytes) else _dumps(payload)
+    def _write(self, channel_id: int, ns: int, data: bytes) -> None:
         assert self._file is not None
         self._sequence[channel_id] += 1
         self._writer.add_message(
@@ -569,8 +471,13 @@ class RunWriter:
         # the operating system at once so that a killed process keeps every complete chunk.
         self._file.flush()
 
-    def _foxglove(self, topic: str, name: str, meta: dict[str, str] | None = None) -> int:
-        return self._channel(topic, name, FOXGLOVE_SCHEMAS[name], meta)
+    def _foxglove(
+        self, topic: str, ns: int, message: Any, meta: dict[str, str] | None = None
+    ) -> None:
+        """Writes a Foxglove protobuf message on ``topic``, its ``timestamp`` set to ``ns``."""
+        channel = self._channel(topic, message.DESCRIPTOR.full_name, None, meta)
+        message.timestamp.seconds, message.timestamp.nanos = divmod(ns, _NS_PER_S)
+        self._write(channel, ns, message.SerializeToString())
 
     # messages
 
@@ -580,10 +487,9 @@ class RunWriter:
         ns = _time_ns(t)
         pose7 = _pose7(pose)
         _name(frame_id, "frame_id")
-        channel = self._foxglove(topic, "foxglove.PoseInFrame")
-        self._write(
-            channel, ns, {"timestamp": _stamp(ns), "frame_id": frame_id, "pose": _pose_json(pose7)}
-        )
+        message = PoseInFrame(frame_id=frame_id)
+        _set_pose(message.pose, pose7)
+        self._foxglove(topic, ns, message)
 
     def write_transform(
         self, t: float, parent: str, child: str, pose: Any, topic: str = "/tf"
@@ -596,15 +502,10 @@ class RunWriter:
         _name(child, "child frame")
         if parent == child:
             raise ValueError(f"a transform needs two different frames, got {parent!r} twice")
-        channel = self._foxglove(topic, "foxglove.FrameTransform")
-        message = {
-            "timestamp": _stamp(ns),
-            "parent_frame_id": parent,
-            "child_frame_id": child,
-            "translation": {"x": x, "y": y, "z": z},
-            "rotation": {"x": qx, "y": qy, "z": qz, "w": qw},
-        }
-        self._write(channel, ns, message)
+        message = FrameTransform(parent_frame_id=parent, child_frame_id=child)
+        shift, turn = message.translation, message.rotation
+        shift.x, shift.y, shift.z, turn.x, turn.y, turn.z, turn.w = x, y, z, qx, qy, qz, qw
+        self._foxglove(topic, ns, message)
 
     def write_laser_scan(
         self,
@@ -660,17 +561,15 @@ class RunWriter:
             if inten.shape != beam.shape or not np.all(np.isfinite(inten)):
                 raise ValueError(f"intensities must be finite with shape {beam.shape}")
             strength = inten.tolist()
-        channel = self._foxglove(topic, "foxglove.LaserScan", meta)
-        message = {
-            "timestamp": _stamp(ns),
-            "frame_id": frame_id,
-            "pose": _pose_json(pose7),
-            "start_angle": float(beam[0]),
-            "end_angle": float(beam[-1]),
-            "ranges": values.astype(np.float64).tolist(),
-            "intensities": strength,
-        }
-        self._write(channel, ns, message)
+        message = LaserScan(
+            frame_id=frame_id,
+            start_angle=float(beam[0]),
+            end_angle=float(beam[-1]),
+            ranges=values.astype(np.float64).tolist(),
+            intensities=strength,
+        )
+        _set_pose(message.pose, pose7)
+        self._foxglove(topic, ns, message, meta)
 
     def write_depth_image(
         self, topic: str, t: float, depth: np.ndarray, frame_id: str = "camera"
@@ -686,17 +585,15 @@ class RunWriter:
             raise ValueError(f"depth must be floating-point metres, got dtype {image.dtype}")
         height, width = image.shape
         data = np.ascontiguousarray(image, dtype="<f4").tobytes()
-        channel = self._foxglove(topic, "foxglove.RawImage")
-        message = {
-            "timestamp": _stamp(ns),
-            "frame_id": frame_id,
-            "width": width,
-            "height": height,
-            "encoding": "32FC1",
-            "step": 4 * width,
-            "data": base64.b64encode(data).decode("ascii"),
-        }
-        self._write(channel, ns, message)
+        message = RawImage(
+            frame_id=frame_id,
+            width=width,
+            height=height,
+            encoding="32FC1",
+            step=4 * width,
+            data=data,
+        )
+        self._foxglove(topic, ns, message)
 
     def write_grid(self, topic: str, t: float, grid: Any, frame_id: str = "world") -> None:
         """``foxglove.Grid`` of an occupancy grid (``kiseki.OccupancyGrid`` or anything with
@@ -712,19 +609,17 @@ class RunWriter:
             raise ValueError(f"grid resolution must be positive, got {resolution}")
         pose7 = _pose7(grid.origin, "grid origin")
         width = int(cells.shape[1])
-        channel = self._foxglove(topic, "foxglove.Grid")
-        message = {
-            "timestamp": _stamp(ns),
-            "frame_id": frame_id,
-            "pose": _pose_json(pose7),
-            "column_count": width,
-            "cell_size": {"x": resolution, "y": resolution},
-            "row_stride": width,
-            "cell_stride": 1,
-            "fields": [{"name": "occupancy", "offset": 0, "type": _INT8}],
-            "data": base64.b64encode(np.ascontiguousarray(cells).tobytes()).decode("ascii"),
-        }
-        self._write(channel, ns, message)
+        message = Grid(
+            frame_id=frame_id,
+            column_count=width,
+            row_stride=width,
+            cell_stride=1,
+            fields=[PackedElementField(name="occupancy", offset=0, type=_INT8)],
+            data=np.ascontiguousarray(cells).tobytes(),
+        )
+        message.cell_size.x = message.cell_size.y = resolution
+        _set_pose(message.pose, pose7)
+        self._foxglove(topic, ns, message)
 
     def write_json(
         self,
@@ -781,6 +676,7 @@ class _Topic:
     schema_name: str
     message_encoding: str
     metadata: dict[str, str]
+    schema: Schema | None = None
     raw: list[tuple[int, int, bytes]] = field(default_factory=list)  # (log_time, order, data)
     decoded: list[tuple[int, dict[str, Any]]] | None = None  # (log_time ns, message)
 
@@ -824,31 +720,67 @@ class SimRun:
         return self._topics[topic]
 
     def messages(self, topic: str) -> list[tuple[float, dict[str, Any]]]:
-        """(t seconds from ``log_time``, decoded JSON) of the topic, sorted by time (stable: file
-        order for equal times). KeyError for a topic not in the file."""
+        """(t seconds from ``log_time``, decoded message) of the topic, sorted by time (stable:
+        file order for equal times). KeyError for a topic not in the file. A JSON message is
+        its JSON object; a protobuf message is a dict of the same layout (timestamps as
+        ``{"sec", "nsec"}``, nested messages as dicts, enums as ints), except that repeated
+        numbers are protobuf's read-only sequences and ``bytes`` fields are bytes (base64 text in
+        older JSON runs)."""
         return [(ns / _NS_PER_S, message) for ns, message in self._decoded(topic)]
 
     def _decoded(self, topic: str) -> list[tuple[int, dict[str, Any]]]:
         entry = self._topic(topic)
         if entry.decoded is None:
-            if entry.message_encoding != MESSAGE_ENCODING:
+            rows = sorted(entry.raw, key=lambda r: (r[0], r[1]))
+            if entry.message_encoding == MESSAGE_ENCODING:
+                entry.decoded = [(ns, self._json(topic, ns, data)) for ns, _, data in rows]
+            elif entry.message_encoding == PROTOBUF:
+                parse = self._protobuf_parser(topic, entry)
+                entry.decoded = [
+                    (ns, self._protobuf(topic, ns, data, parse)) for ns, _, data in rows
+                ]
+            else:
                 raise LogFormatError(
                     f"{self.path}: topic {topic!r} has message encoding"
-                    f" {entry.message_encoding!r}, not JSON"
+                    f" {entry.message_encoding!r}, not JSON or protobuf"
                 )
-            decoded = []
-            for log_time, _, data in sorted(entry.raw, key=lambda r: (r[0], r[1])):
-                try:
-                    message = json.loads(data)
-                except (UnicodeDecodeError, ValueError) as exc:
-                    raise LogFormatError(
-                        f"{self.path}: bad JSON message on {topic!r} at {log_time} ns ({exc})"
-                    ) from exc
-                if not isinstance(message, dict):
-                    raise LogFormatError(f"{self.path}: {topic!r} message is not a JSON object")
-                decoded.append((log_time, message))
-            entry.decoded = decoded
         return entry.decoded
+
+    def _json(self, topic: str, ns: int, data: bytes) -> dict[str, Any]:
+        try:
+            message = json.loads(data)
+        except (UnicodeDecodeError, ValueError) as exc:
+            raise LogFormatError(
+                f"{self.path}: bad JSON message on {topic!r} at {ns} ns ({exc})"
+            ) from exc
+        if not isinstance(message, dict):
+            raise LogFormatError(f"{self.path}: {topic!r} message is not a JSON object")
+        return message
+
+    def _protobuf_parser(self, topic: str, entry: _Topic) -> Any:
+        """The protobuf class's FromString: Foxglove's own class for its messages, else a
+        class built from the schema's FileDescriptorSet."""
+        known = FOXGLOVE_MESSAGES.get(entry.schema_name)
+        if known is not None:
+            return known.FromString
+        decoder = None
+        try:
+            decoder = DecoderFactory().decoder_for(PROTOBUF, entry.schema)
+        except Exception as exc:  # a corrupt FileDescriptorSet: DecodeError, TypeError, ...
+            raise LogFormatError(
+                f"{self.path}: bad protobuf schema {entry.schema_name!r} of {topic!r} ({exc})"
+            ) from exc
+        if decoder is None:
+            raise LogFormatError(f"{self.path}: protobuf topic {topic!r} has no protobuf schema")
+        return decoder
+
+    def _protobuf(self, topic: str, ns: int, data: bytes, parse: Any) -> dict[str, Any]:
+        try:
+            return _as_dict(parse(data))
+        except (DecodeError, McapError) as exc:  # McapError: the mcap-protobuf decoder's
+            raise LogFormatError(
+                f"{self.path}: bad protobuf message on {topic!r} at {ns} ns ({exc})"
+            ) from exc
 
     def _typed(self, topic: str, schema_name: str) -> list[tuple[int, dict[str, Any]]]:
         """(log_time ns, message) of a topic that must carry ``schema_name`` messages."""
@@ -881,7 +813,7 @@ class SimRun:
             try:
                 width, height, step = int(m["width"]), int(m["height"]), int(m["step"])
                 encoding = m["encoding"]
-                data = base64.b64decode(m["data"], validate=True)
+                data = _payload_bytes(m["data"])
             except (KeyError, TypeError, ValueError) as exc:
                 raise LogFormatError(f"{self.path}: bad RawImage on {topic!r} ({exc})") from exc
             if encoding != "32FC1" or step < 4 * width or len(data) < step * height:
@@ -906,7 +838,7 @@ class SimRun:
             row_stride, cell_stride = int(m["row_stride"]), int(m["cell_stride"])
             size_x, size_y = float(m["cell_size"]["x"]), float(m["cell_size"]["y"])
             fields = m["fields"]
-            data = base64.b64decode(m["data"], validate=True)
+            data = _payload_bytes(m["data"])
         except (KeyError, TypeError, ValueError) as exc:
             raise LogFormatError(f"{self.path}: bad Grid on {topic!r} ({exc})") from exc
         kind = [f.get("type") for f in fields if f.get("offset") == 0]
@@ -960,7 +892,8 @@ class SimRun:
         try:
             starts = np.array([m["start_angle"] for _, m in scans], dtype=np.float64)
             ends = np.array([m["end_angle"] for _, m in scans], dtype=np.float64)
-            ranges = np.array([m["ranges"] for _, m in scans], dtype=np.float32)
+            rows = [np.asarray(m["ranges"], dtype=np.float32) for _, m in scans]
+            ranges = np.stack(rows) if rows[0].ndim == 1 else np.empty((0, 0), np.float32)
         except (KeyError, TypeError, ValueError) as exc:
             raise LogFormatError(
                 f"{self.path}: laser scans on {scan_topic!r} are malformed or do not all have"
@@ -1111,9 +1044,10 @@ def _complete_prefix(path: Path, file: IO[bytes]) -> tuple[int, bool]:
 
 
 def read_run(path: str | os.PathLike) -> SimRun:
-    """Reads an MCAP run written by :class:`RunWriter` (or any MCAP; Foxglove JSON topics are
-    decoded). FileNotFoundError if missing, LogFormatError if not an MCAP or corrupt; a file
-    without its footer (writer killed) gives the complete chunks with a TruncatedRunWarning."""
+    """Reads an MCAP run written by :class:`RunWriter` (or any MCAP; its JSON and protobuf
+    topics are decoded, older kiseki runs' all-JSON ones too). FileNotFoundError if missing,
+    LogFormatError if not an MCAP or corrupt; a file without its footer (writer killed) gives
+    the complete chunks with a TruncatedRunWarning."""
     path = Path(path)
     topics: dict[str, _Topic] = {}
     metadata: dict[str, str] = {}
@@ -1144,7 +1078,12 @@ def read_run(path: str | os.PathLike) -> SimRun:
                     name = schemas[record.schema_id].name if record.schema_id else ""
                     entry = topics.get(record.topic)
                     if entry is None:
-                        entry = _Topic(name, record.message_encoding, dict(record.metadata))
+                        entry = _Topic(
+                            name,
+                            record.message_encoding,
+                            dict(record.metadata),
+                            schemas.get(record.schema_id),
+                        )
                         topics[record.topic] = entry
                     channels[record.id] = entry
                 elif isinstance(record, Message):
