@@ -36,13 +36,29 @@ def _edited(change) -> dict:
 @pytest.mark.parametrize(
     ("doc", "needle"),
     [
-        (_edited(lambda d: d.update(waypoints=None)), "'waypoints' must be a non-empty list"),
-        (_edited(lambda d: d["waypoints"].__setitem__(1, "G")), "waypoints[1] must be a mapping"),
-        (_edited(lambda d: d["waypoints"][1].update(x="abc")), "waypoints[1] (G): 'x' must be"),
-        (_edited(lambda d: d["waypoints"][0].pop("name")), "waypoints[0]: 'name' must be"),
-        (_edited(lambda d: d["waypoints"][0].update(truth=[0, 0])), "'truth' must be [x, y,"),
-        (_edited(lambda d: d["waypoints"][1].update(name="P0")), "names must be unique"),
-        (_edited(lambda d: d.update(maps={"band": "map.yaml"})), "'maps' must map each band"),
+        (_edited(lambda d: d.update(waypoints=None)), "waypoints: must be a valid list, got None"),
+        (_edited(lambda d: d.update(waypoints=[])), "waypoints: list should have at least 1 item"),
+        (
+            _edited(lambda d: d["waypoints"].__setitem__(1, "G")),
+            "waypoints[1]: must be a mapping of name, x, y, theta, got 'G'",
+        ),
+        (
+            _edited(lambda d: d["waypoints"][1].update(x="abc")),
+            "waypoints[1].x: must be a valid number, got 'abc' (waypoint 'G')",
+        ),
+        (_edited(lambda d: d["waypoints"][0].pop("name")), "waypoints[0].name: missing"),
+        (
+            _edited(lambda d: d["waypoints"][0].update(truth=[0, 0])),
+            "waypoints[0].truth: must be the true pose [x, y, theta], got [0, 0] (waypoint 'P0')",
+        ),
+        (
+            _edited(lambda d: d["waypoints"][1].update(name="P0")),
+            "waypoints: waypoint names must be unique (P0 repeat)",
+        ),
+        (
+            _edited(lambda d: d.update(maps={"band": "map.yaml"})),
+            "maps.band: must be a mapping of file and image_sha1, got 'map.yaml'",
+        ),
     ],
 )
 def test_hand_edited_waypoint_files_are_refused_by_entry_and_field(tmp_path, doc, needle):

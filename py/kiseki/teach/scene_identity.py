@@ -36,15 +36,12 @@ def taught_scene_of(waypoints: str | os.PathLike) -> TaughtScene | None:
     """The taught scene recorded in a waypoint file (one :func:`kiseki.teach.teaching.load_route`
     accepted), else in the metadata of the teaching log it names (waypoint files written before
     the scene was recorded in them); None when neither records it (a hand-made file)."""
-    from kiseki._yaml import read_yaml_file
+    from kiseki.teach.waypoint_schema import read_waypoint_file
 
-    doc = read_yaml_file(waypoints, "kiseki waypoint file")
-    if not isinstance(doc, dict):
-        raise ValueError(f"{waypoints}: not a kiseki waypoint file")
-    if isinstance(doc.get("scene_sha1"), str):
-        return TaughtScene(str(doc.get("scene_file", "")), doc["scene_sha1"])
-    log = Path(waypoints).parent / str(doc.get("log", ""))
-    if not doc.get("log") or not log.is_file():
+    doc = read_waypoint_file(waypoints)
+    if doc.scene_sha1 is not None:
+        return TaughtScene(doc.scene_file or "", doc.scene_sha1)
+    if not doc.log or not (log := Path(waypoints).parent / doc.log).is_file():
         return None
     from kiseki.sim.mcap_log import read_run
 

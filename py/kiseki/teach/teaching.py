@@ -35,6 +35,7 @@ from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import MERGE_RULES, EnvironmentMap
 from kiseki.teach.local_maps import BANDS, LocalMapMaker
 from kiseki.teach.scene_identity import TaughtScene, scene_digest
+from kiseki.teach.waypoint_schema import read_waypoint_file
 
 __all__ = [
     "TeachResult",
@@ -437,48 +438,6 @@ def load_taught(folder: str | os.PathLike, band: str, route: list[str]) -> tuple
     return load_route(Path(folder) / "waypoints.yaml", band, route)
 
 
-def _check_waypoints(doc: dict, path: Path) -> None:
-    """A waypoint file's entries as kiseki wrote them, or a ValueError naming the file, the entry
-    and the field (the file may have been edited by hand)."""
-    marks = doc["waypoints"]
-    if not isinstance(marks, list) or not marks:
-        raise ValueError(f"{path}: 'waypoints' must be a non-empty list")
-    maps = doc["maps"]
-    if not isinstance(maps, dict) or not all(
-        isinstance(m, dict)
-        and {"file", "image_sha1"} <= set(m)
-        and isinstance(m["file"], str)
-        and m["file"]
-        for m in maps.values()
-    ):
-        raise ValueError(f"{path}: 'maps' must map each band to its file and image_sha1")
-
-    def number(value) -> bool:
-        return (
-            isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
-        )
-
-    for i, w in enumerate(marks):
-        where = f"{path}: waypoints[{i}]"
-        if not isinstance(w, dict):
-            raise ValueError(f"{where} must be a mapping of name, x, y, theta, got {w!r}")
-        if not isinstance(w.get("name"), str) or not w["name"]:
-            raise ValueError(f"{where}: 'name' must be a non-empty string")
-        for key in ("x", "y", "theta"):
-            if not number(w.get(key)):
-                raise ValueError(
-                    f"{where} ({w['name']}): '{key}' must be a number, got {w.get(key)!r}"
-                )
-        truth = w.get("truth")
-        if truth is not None and not (
-            isinstance(truth, list) and len(truth) == 3 and all(number(v) for v in truth)
-        ):
-            raise ValueError(f"{where} ({w['name']}): 'truth' must be [x, y, theta], got {truth!r}")
-    names = [w["name"] for w in marks]
-    if len(set(names)) != len(names):
-        raise ValueError(f"{path}: waypoint names must be unique, got {names}")
-
-
 def load_route(
     waypoints: str | os.PathLike,
     band: str,
@@ -489,15 +448,10 @@ def load_route(
     or the `band` map named in the waypoint file. The map must be the one the waypoints were
     taught with (its image's SHA-1 is in the waypoint file), and of the method's band."""
     path = Path(waypoints)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: no waypoint file (run kiseki teach first)")
-    doc = read_yaml_file(path, "kiseki waypoint file")
-    if not isinstance(doc, dict) or "waypoints" not in doc or "maps" not in doc:
-        raise ValueError(f"{path}: not a kiseki waypoint file")
-    _check_waypoints(doc, path)
-    if band not in doc["maps"]:
+    doc = read_waypoint_file(path)
+    if band not in doc.maps:
         raise ValueError(f"{path}: no {band!r} map was taught")
-    map_path = path.parent / doc["maps"][band]["file"] if map_file is None else Path(map_file)
+    map_path = path.parent / doc.maps[band].file if map_file is None else Path(map_file)
     if not map_path.is_file():
         named = f" (named in {path})" if map_file is None else ""
         raise FileNotFoundError(f"{map_path}: the taught map is missing{named}")
@@ -505,15 +459,15 @@ def load_route(
         digest = waypoints_file_hash(map_path)
     except (OSError, yaml.YAMLError, KeyError, TypeError) as e:
         raise ValueError(f"{map_path}: not a ROS map YAML with its image beside it ({e})") from e
-    if digest != doc["maps"][band]["image_sha1"]:
-        others = [b for b, m in doc["maps"].items() if m.get("image_sha1") == digest]
+    if digest != doc.maps[band].image_sha1:
+        others = [b for b, m in doc.maps.items() if m.image_sha1 == digest]
         if others:
             raise ValueError(
                 f"{map_path}: this is the {others[0]!r} map of {path}; the method needs the "
                 f"{band!r} map"
             )
         raise ValueError(f"{map_path}: this map is not the one {path} was taught with")
-    by_name = {w["name"]: w for w in doc["waypoints"]}
+    by_name = doc.by_name()
     unknown = [n for n in route if n not in by_name]
     if unknown:
         raise ValueError(
