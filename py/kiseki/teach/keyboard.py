@@ -26,10 +26,10 @@ import select
 import signal
 import sys
 import time
-from pathlib import Path
 from typing import TextIO
 
 from kiseki.sim.scene import Scene
+from kiseki.teach.key_script_schema import KEYS, read_key_script
 from kiseki.teach.teaching import TeachingRun, TeachResult
 
 __all__ = [
@@ -43,7 +43,6 @@ __all__ = [
 
 LINEAR_STEP = 0.1  # m/s per key press
 ANGULAR_STEP = 0.1  # rad/s per key press
-KEYS = ("w", "a", "s", "d", "up", "down", "left", "right", "space", "m", "q")
 HELP = (
     f"keyboard teaching: w/Up s/Down speed +-{LINEAR_STEP} m/s, a/Left d/Right turn "
     f"+-{ANGULAR_STEP} rad/s,\n"
@@ -112,33 +111,7 @@ class KeyScript:
     at a simulated time at once, without waiting for the wall clock."""
 
     def __init__(self, path: str | os.PathLike) -> None:
-        path = Path(path)
-        if not path.is_file():
-            raise FileNotFoundError(f"{path}: key script not found")
-        self._events: list[tuple[float, str]] = []
-        try:
-            text = path.read_text(encoding="utf-8")
-        except UnicodeDecodeError:
-            raise ValueError(f"{path}: not a key script (not UTF-8 text)") from None
-        for number, line in enumerate(text.splitlines(), 1):
-            fields = line.split("#", 1)[0].split()
-            if not fields:
-                continue
-            where = f"{path}:{number}"
-            try:
-                t = float(fields[0])
-            except ValueError:
-                raise ValueError(f"{where}: a line is TIME KEY [KEY ...], got {line!r}") from None
-            if not (math.isfinite(t) and t >= 0) or len(fields) < 2:
-                raise ValueError(f"{where}: a line is TIME KEY [KEY ...] with TIME >= 0 seconds")
-            if self._events and t < self._events[-1][0]:
-                raise ValueError(f"{where}: times must not decrease")
-            for key in fields[1:]:
-                if key.lower() not in KEYS:
-                    raise ValueError(f"{where}: unknown key {key!r} (known: {', '.join(KEYS)})")
-                self._events.append((t, key.lower()))
-        if not self._events or self._events[-1][1] != "q":
-            raise ValueError(f"{path}: a key script must end with q (finish)")
+        self._events = read_key_script(path)
         self._next = 0
 
     def wait(self, t: float) -> list[str]:
