@@ -13,8 +13,8 @@ interrupted save never leaves a half-written map behind.
 from __future__ import annotations
 
 import errno
-import math
 import os
+import struct
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,10 +24,13 @@ import yaml
 
 from kiseki import _core
 from kiseki._atomic import atomic_write_all
+from kiseki._schema import SchemaError, parse
 from kiseki._yaml import safe_load_12
 from kiseki.core import Pose2
 from kiseki.errors import MapFormatError
 from kiseki.grid import OCCUPIED, UNKNOWN, OccupancyGrid
+from kiseki.map_schema import MODES, RosMapYaml
+from kiseki.mapping import MAX_MAP_CELLS
 
 __all__ = [
     "MapMetadata",
@@ -37,8 +40,6 @@ __all__ = [
     "save_map",
     "write_image",
 ]
-
-MODES = ("trinary", "scale", "raw")
 
 
 @dataclass(frozen=True)
@@ -54,16 +55,7 @@ class MapMetadata:
     free_thresh: float = 0.196
 
 
-def _number(doc: dict, key: str, path: Path) -> float:
-    value = doc[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise MapFormatError(f"{path}: '{key}' must be a number, got {value!r}")
-    if not math.isfinite(value):
-        raise MapFormatError(f"{path}: '{key}' must be finite, got {value!r}")
-    return float(value)
-
-
-def _parse_yaml(path: Path) -> dict:
+def _parse_yaml(path: Path) -> RosMapYaml:
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as err:
@@ -77,58 +69,50 @@ def _parse_yaml(path: Path) -> dict:
         raise MapFormatError(f"{path}: invalid YAML ({err})") from err
     if not isinstance(doc, dict):
         raise MapFormatError(f"{path}: expected a YAML mapping with image, resolution and origin")
-    missing = [k for k in ("image", "resolution", "origin") if k not in doc]
-    if missing:
-        raise MapFormatError(f"{path}: missing field(s) {', '.join(missing)}")
-    return doc
+    try:
+        return parse(RosMapYaml, doc, path)
+    except SchemaError as err:
+        raise MapFormatError(str(err)) from None
 
 
 def read_map_metadata(path: str | os.PathLike) -> MapMetadata:
-    """Reads and checks a ROS map YAML file (the image path is resolved next to it)."""
+    """Reads and checks a ROS map YAML file (:class:`kiseki.map_schema.RosMapYaml`; the image
+    path is resolved next to it). MapFormatError names the file, the key and the value."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: map YAML file not found")
     doc = _parse_yaml(path)
-    resolution = _number(doc, "resolution", path)
-    if resolution <= 0:
-        raise MapFormatError(f"{path}: 'resolution' must be positive, got {resolution}")
-    origin = doc["origin"]
-    if not isinstance(origin, list) or len(origin) != 3:
-        raise MapFormatError(f"{path}: 'origin' must be a list [x, y, yaw], got {origin!r}")
-    origin_values = tuple(_number({"origin": v}, "origin", path) for v in origin)
-    mode = doc.get("mode", "trinary")
-    if mode not in MODES:
-        raise MapFormatError(f"{path}: 'mode' must be one of {', '.join(MODES)}, got {mode!r}")
-    negate = doc.get("negate", 0)
-    if negate not in (0, 1, True, False):
-        raise MapFormatError(f"{path}: 'negate' must be 0 or 1, got {negate!r}")
-    thresholds = {
-        key: _number(doc, key, path) if key in doc else default
-        for key, default in (("occupied_thresh", 0.65), ("free_thresh", 0.196))
-    }
-    for key, value in thresholds.items():
-        if not 0.0 <= value <= 1.0:
-            raise MapFormatError(f"{path}: '{key}' must lie in [0, 1], got {value}")
-    if thresholds["free_thresh"] > thresholds["occupied_thresh"]:
-        raise MapFormatError(f"{path}: 'free_thresh' exceeds 'occupied_thresh'")
-    if not isinstance(doc["image"], str) or not doc["image"]:
-        raise MapFormatError(f"{path}: 'image' must be a file name, got {doc['image']!r}")
-    image = Path(doc["image"])
+    image = Path(doc.image)
     return MapMetadata(
         image=image if image.is_absolute() else path.parent / image,
-        resolution=resolution,
-        origin=origin_values,  # type: ignore[arg-type]
-        mode=mode,
-        negate=bool(negate),
-        **thresholds,
+        resolution=doc.resolution,
+        origin=doc.origin,
+        mode=doc.mode,
+        negate=doc.negate,
+        occupied_thresh=doc.occupied_thresh,
+        free_thresh=doc.free_thresh,
     )
+
+
+_PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def _check_cells(path: Path, image: Path, width: int, height: int) -> None:
+    if width * height > MAX_MAP_CELLS:
+        raise MapFormatError(
+            f"{path}: image {image.name} is {width} x {height} pixels: more than the limit of "
+            f"{MAX_MAP_CELLS:.0e} map cells"
+        )
 
 
 def _check_binary_pgm(path: Path, image: Path) -> None:
     """A binary PGM (P5) cut short is refused here, naming both files: OpenCV would print its
-    own 'can't read data' line on stderr before failing."""
+    own 'can't read data' line on stderr before failing. A PGM or PNG whose header states more
+    than MAX_MAP_CELLS pixels is refused before it is decoded."""
     with open(image, "rb") as f:
         head = f.read(512)
+        if head.startswith(_PNG) and head[12:16] == b"IHDR":
+            _check_cells(path, image, *struct.unpack(">II", head[16:24]))
         if not head.startswith(b"P5"):
             return  # other formats: the decoder's error
         fields: list[bytes] = []
@@ -148,6 +132,7 @@ def _check_binary_pgm(path: Path, image: Path) -> None:
         if len(fields) < 3 or not all(x.isdigit() for x in fields):
             return  # a malformed header: the decoder's error
         width, height, maxval = (int(x) for x in fields)
+        _check_cells(path, image, width, height)
         need = width * height * (1 if maxval < 256 else 2)
         have = os.fstat(f.fileno()).st_size - (at + 1)  # one whitespace byte after maxval
     if have < need:

@@ -7,13 +7,15 @@ from logs by the thesis' merge rules is `kiseki.teach.environment_map.build_teac
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass
 
 import numpy as np
 from tqdm import tqdm
 
 from kiseki import _core
+from kiseki._schema import parse
 from kiseki.grid import OccupancyGrid
+from kiseki.map_schema import MapBuildSettings
 from kiseki.scans import LaserScans
 
 __all__ = [
@@ -73,13 +75,12 @@ class MapBuildConfig:
         return asdict(self)
 
     @classmethod
-    def from_dict(cls, values: dict) -> MapBuildConfig:
-        known = {f.name for f in fields(cls)}
-        unknown = sorted(set(values) - known)
-        if unknown:
-            raise ValueError(f"unknown map-building parameter(s): {', '.join(unknown)}")
-        kinds = {f.name: f.type for f in fields(cls)}
-        return cls(**{k: (bool(v) if kinds[k] == "bool" else float(v)) for k, v in values.items()})
+    def from_dict(cls, values: dict, source: str = "map-building config") -> MapBuildConfig:
+        """The config of a mapping of its parameters (unset ones keep their defaults), checked
+        by :class:`kiseki.map_schema.MapBuildSettings`: a SchemaError (a ValueError) names
+        ``source`` (the file), the key and the value."""
+        settings = parse(MapBuildSettings, values, source)
+        return cls(**{k: getattr(settings, k) for k in settings.model_fields_set})
 
     def core_params(self, max_range: float) -> _core.LogOddsParams:
         p = _core.LogOddsParams()

@@ -233,7 +233,7 @@ def test_yaml_1_2_numbers_are_numbers_as_nav2_reads_them(tmp_path, text, value):
     assert meta.free_thresh == 0.2
     assert load_map(tmp_path / "m.yaml").resolution == value
     (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: '5e-2'\norigin: [0, 0, 0]\n")
-    with pytest.raises(MapFormatError, match="'resolution' must be a number, got '5e-2'"):
+    with pytest.raises(MapFormatError, match="resolution: must be a valid number, got '5e-2'"):
         read_map_metadata(tmp_path / "m.yaml")  # quoted: a string in YAML 1.2 too
 
 
