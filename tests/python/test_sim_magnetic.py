@@ -232,9 +232,18 @@ def test_from_dict_builds_the_scene_and_round_trips():
     ("d", "match"),
     [
         ({"earth_feld": [0, 0.3, -0.4]}, r"scene\.yaml: earth_feld: unknown key"),
-        ({"earth_field": [0, 0.3]}, r"scene\.yaml: earth_field: expected shape \(3\)"),
-        ({"earth_field": [0, float("nan"), 0]}, r"scene\.yaml: earth_field: must be finite"),
-        ({"earth_field": {"total": 0.4, "dip": 3}}, r"earth_field\.dip: unknown key"),
+        (
+            {"earth_field": [0, 0.3]},
+            r"scene\.yaml: earth_field: must be a list of 3 numbers \[x, y, z\], got \[0, 0\.3\]",
+        ),
+        (
+            {"earth_field": [0, float("nan"), 0]},
+            r"scene\.yaml: earth_field\[1\]: must be a finite number, got nan",
+        ),
+        (
+            {"earth_field": {"total": 0.4, "inclination_deg": 40, "dip": 3}},
+            r"earth_field\.dip: unknown key",
+        ),
         ({"earth_field": {"total": 0.4, "inclination_deg": 95}}, r"inclination_deg: must be"),
         ({"dipoles": [{"position": [0, 0, 0]}]}, r"dipoles\[0\]\.moment: missing"),
         ({"dipoles": [{"position": [0, 0], "moment": [0, 0, 1]}]}, r"dipoles\[0\]\.position"),
@@ -242,7 +251,7 @@ def test_from_dict_builds_the_scene_and_round_trips():
             {"dipoles": [{"position": [0, 0, 0], "moment": [0, 0, 1], "mass": 1}]},
             r"dipoles\[0\]\.mass: unknown key",
         ),
-        ({"dipoles": {"position": [0, 0, 0]}}, r"dipoles: expected a list"),
+        ({"dipoles": {"position": [0, 0, 0]}}, r"dipoles: must be a valid list, got \{'position'"),
         (
             {
                 "lines": [
@@ -254,19 +263,28 @@ def test_from_dict_builds_the_scene_and_round_trips():
                     }
                 ]
             },
-            r"lines\[0\]\.spacing: must be > 0",
+            r"lines\[0\]\.spacing: must be greater than 0, got -0\.1",
         ),
         (
             {"lines": [{"start": [0, 0, 0], "end": [0, 0, 0], "moment_per_metre": [0, 0, 1]}]},
-            r"lines\[0\]\.end: equals start",
+            r"lines\[0\]\.end: must differ from start \(a zero-length line\), got \[0, 0, 0\]",
         ),
-        ({"gradient": [[0, 0, 0], [0, 0, 0]]}, r"gradient: expected shape \(3x3\)"),
-        ({"drift": {"amplitude": -0.01}}, r"drift\.amplitude: must be >= 0"),
-        ({"drift": {"amplitude": 0.01, "period": 0}}, r"drift\.period: must be > 0"),
-        ({"drift": {"amplitude": "large"}}, r"drift\.amplitude: expected a number"),
+        ({"gradient": [[0, 0, 0], [0, 0, 0]]}, r"gradient: must be a 3 x 3 list of lists"),
+        (
+            {"drift": {"amplitude": -0.01}},
+            r"drift\.amplitude: must be greater than or equal to 0, got -0\.01",
+        ),
+        (
+            {"drift": {"amplitude": 0.01, "period": 0}},
+            r"drift\.period: must be greater than 0, got 0",
+        ),
+        (
+            {"drift": {"amplitude": "large"}},
+            r"drift\.amplitude: must be a valid number, got 'large'",
+        ),
         ({"drift": {"amplitud": 0.01}}, r"drift\.amplitud: unknown key"),
-        ({"earth_field": [True, 0, 0]}, r"earth_field: expected numbers"),
-        ([1, 2, 3], r"scene\.yaml: expected a mapping"),
+        ({"earth_field": [True, 0, 0]}, r"earth_field\[0\]: must be a valid number, got True"),
+        ([1, 2, 3], r"scene\.yaml: must be a mapping of earth_field, .*, got \[1, 2, 3\]"),
     ],
 )
 def test_from_dict_rejects_bad_scenes(d, match):

@@ -40,6 +40,7 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._schema import parse
 from kiseki.core import Random, check_seed, normalize_angle
 from kiseki.sim._values import finite_array as _finite_array
 from kiseki.sim._values import finite_scalar as _finite_scalar
@@ -417,156 +418,51 @@ class MagneticWorld:
         }
 
     @classmethod
-    def from_dict(cls, d: Mapping[str, Any], source: str = "<scene>") -> MagneticWorld:
-        """Build from a scene-YAML mapping; every key is optional (defaults as the constructor).
-
-        ``earth_field``: ``[x, y, z]`` G, or ``{total, inclination_deg, declination_deg}``;
-        ``dipoles``: ``[{position, moment, radius?}]``; ``lines``:
+    def from_dict(
+        cls, d: Mapping[str, Any], source: str = "<scene>", at: Sequence[str | int] = ()
+    ) -> MagneticWorld:
+        """Build from a scene file's ``magnetic:`` mapping, checked by
+        :class:`kiseki.sim.magnetic_schema.MagneticSection`; every key is optional (defaults as
+        the constructor). ``earth_field``: ``[x, y, z]`` G, or ``{total, inclination_deg,
+        declination_deg?}``; ``dipoles``: ``[{position, moment, radius?}]``; ``lines``:
         ``[{start, end, moment_per_metre, spacing?, radius?}]``; ``lattices``:
         ``[{lower, upper, spacing, moment_sd, moment_mean?, seed?, radius?}]`` (see
         :class:`~kiseki.sim.magnetic_lattice.DipoleLattice`); ``gradient``: 3x3 G/m;
         ``gradient_origin``: ``[x, y, z]``; ``drift``: ``{amplitude?, period?, phase?}``.
-        Unknown keys, wrong shapes, non-numbers, NaN or out-of-range values raise ValueError
-        naming ``source`` and the key.
-        """
+        Unknown keys, wrong shapes, non-numbers, NaN, out-of-range values and sections with
+        too many dipoles raise a SchemaError (a ValueError) naming ``source``, the key path
+        (after ``at``, e.g. ``("magnetic",)``) and the value."""
+        from kiseki.sim.magnetic_lattice import DipoleLattice  # it builds on this module
+        from kiseki.sim.magnetic_schema import EarthAngles, MagneticSection
 
-        def fail(key: str, message: str) -> ValueError:
-            return ValueError(f"{source}: {key}: {message}")
-
-        def mapping(value: Any, key: str, allowed: Sequence[str]) -> Mapping[str, Any]:
-            if not isinstance(value, Mapping):
-                got = f"expected a mapping, got {type(value).__name__}"
-                raise fail(key, got) if key else ValueError(f"{source}: {got}")
-            for k in value:
-                if k not in allowed:
-                    where = f"{key}.{k}" if key else str(k)
-                    raise fail(where, f"unknown key (allowed: {', '.join(allowed)})")
-            return value
-
-        def required(m: Mapping[str, Any], k: str, key: str) -> Any:
-            if k not in m:
-                raise fail(f"{key}.{k}", "missing")
-            return m[k]
-
-        def vector(value: Any, key: str, shape: tuple[int, ...]) -> np.ndarray:
-            if isinstance(value, (str, bytes, bool)) or _has_bool(value):
-                raise fail(key, f"expected numbers, got {value!r}")
-            try:
-                return _finite_array(value, shape, "value")
-            except ValueError as exc:
-                raise fail(key, str(exc).removeprefix("value: ")) from None
-
-        def scalar(value: Any, key: str, **limits: Any) -> float:
-            try:
-                return _finite_scalar(value, "value", **limits)
-            except ValueError as exc:
-                raise fail(key, str(exc).removeprefix("value: ")) from None
-
-        def sequence(value: Any, key: str) -> list[Any]:
-            if isinstance(value, (str, bytes, Mapping)) or not isinstance(value, Sequence):
-                raise fail(key, f"expected a list, got {type(value).__name__}")
-            return list(value)
-
-        top = mapping(
-            d,
-            "",
-            ("earth_field", "dipoles", "lines", "lattices", "gradient", "gradient_origin", "drift"),
-        )
-        kwargs: dict[str, Any] = {}
-        if "earth_field" in top:
-            ef = top["earth_field"]
-            if isinstance(ef, Mapping):
-                ef = mapping(ef, "earth_field", ("total", "inclination_deg", "declination_deg"))
-                total = scalar(
-                    required(ef, "total", "earth_field"), "earth_field.total", minimum=0.0
+        spec = parse(MagneticSection, d, source, at=at)
+        given = spec.model_fields_set
+        kwargs: dict[str, Any] = {
+            "dipoles": [Dipole(x.position, x.moment, x.radius) for x in spec.dipoles],
+            "lines": [
+                DipoleLine(x.start, x.end, x.moment_per_metre, x.spacing, x.radius)
+                for x in spec.lines
+            ],
+            "lattices": [
+                DipoleLattice(
+                    x.lower, x.upper, x.spacing, x.moment_sd, x.moment_mean, x.seed, x.radius
                 )
-                inc = scalar(
-                    required(ef, "inclination_deg", "earth_field"), "earth_field.inclination_deg"
-                )
-                if abs(inc) > 90:
-                    raise fail(
-                        "earth_field.inclination_deg", f"must be within [-90, 90], got {inc!r}"
-                    )
-                dec = scalar(ef.get("declination_deg", 0.0), "earth_field.declination_deg")
-                kwargs["earth_field"] = earth_field_from_angles(total, inc, dec)
-            else:
-                kwargs["earth_field"] = vector(ef, "earth_field", (3,))
-        dipoles = []
-        for i, item in enumerate(sequence(top.get("dipoles", []), "dipoles")):
-            key = f"dipoles[{i}]"
-            item = mapping(item, key, ("position", "moment", "radius"))
-            radius = scalar(
-                item.get("radius", DEFAULT_DIPOLE_RADIUS), f"{key}.radius", minimum=0.0, strict=True
+                for x in spec.lattices
+            ],
+        }
+        earth = spec.earth_field
+        if isinstance(earth, EarthAngles):
+            earth = earth_field_from_angles(
+                earth.total, earth.inclination_deg, earth.declination_deg
             )
-            dipoles.append(
-                Dipole(
-                    vector(required(item, "position", key), f"{key}.position", (3,)),
-                    vector(required(item, "moment", key), f"{key}.moment", (3,)),
-                    radius,
-                )
-            )
-        lines = []
-        for i, item in enumerate(sequence(top.get("lines", []), "lines")):
-            key = f"lines[{i}]"
-            item = mapping(item, key, ("start", "end", "moment_per_metre", "spacing", "radius"))
-            start = vector(required(item, "start", key), f"{key}.start", (3,))
-            end = vector(required(item, "end", key), f"{key}.end", (3,))
-            if np.array_equal(start, end):
-                raise fail(f"{key}.end", "equals start (zero-length line)")
-            spacing = scalar(item.get("spacing", 0.1), f"{key}.spacing", minimum=0.0, strict=True)
-            radius = item.get("radius")
-            if radius is not None:
-                radius = scalar(radius, f"{key}.radius", minimum=0.0, strict=True)
-            mpm = vector(required(item, "moment_per_metre", key), f"{key}.moment_per_metre", (3,))
-            lines.append(DipoleLine(start, end, mpm, spacing, radius))
-        kwargs["dipoles"] = dipoles
-        kwargs["lines"] = lines
-        kwargs["lattices"] = _lattices(top.get("lattices", []), source, sequence, mapping)
-        if "gradient" in top:
-            kwargs["gradient"] = vector(top["gradient"], "gradient", (3, 3))
-        if "gradient_origin" in top:
-            kwargs["gradient_origin"] = vector(top["gradient_origin"], "gradient_origin", (3,))
-        if "drift" in top:
-            dr = mapping(top["drift"], "drift", ("amplitude", "period", "phase"))
-            if "amplitude" in dr:
-                kwargs["drift_amplitude"] = scalar(dr["amplitude"], "drift.amplitude", minimum=0.0)
-            if "period" in dr:
-                kwargs["drift_period"] = scalar(
-                    dr["period"], "drift.period", minimum=0.0, strict=True
-                )
-            if "phase" in dr:
-                kwargs["drift_phase"] = scalar(dr["phase"], "drift.phase")
+        if "earth_field" in given:
+            kwargs["earth_field"] = earth
+        for key in ("gradient", "gradient_origin"):
+            if key in given:
+                kwargs[key] = np.array(getattr(spec, key), dtype=float)
+        for key in spec.drift.model_fields_set:
+            kwargs[f"drift_{key}"] = getattr(spec.drift, key)
         return cls(**kwargs)
-
-
-def _lattices(value: Any, source: str, sequence, mapping) -> list[Any]:
-    """The ``lattices`` of a scene mapping as DipoleLattice objects; errors name the entry."""
-    from kiseki.sim.magnetic_lattice import DipoleLattice  # it builds on this module
-
-    keys = ("lower", "upper", "spacing", "moment_sd", "moment_mean", "seed", "radius")
-    out = []
-    for i, item in enumerate(sequence(value, "lattices")):
-        key = f"lattices[{i}]"
-        item = mapping(item, key, keys)
-        for k in ("lower", "upper", "spacing", "moment_sd"):
-            if k not in item:
-                raise ValueError(f"{source}: {key}.{k}: missing")
-        for k in keys:
-            if k in item and (_has_bool(item[k]) or isinstance(item[k], (str, bytes))):
-                raise ValueError(f"{source}: {key}.{k}: expected numbers, got {item[k]!r}")
-        try:
-            out.append(DipoleLattice(**item))
-        except ValueError as exc:
-            raise ValueError(f"{source}: {key}.{exc}") from None
-    return out
-
-
-def _has_bool(value: Any) -> bool:
-    if isinstance(value, bool):
-        return True
-    if isinstance(value, (list, tuple)):
-        return any(_has_bool(v) for v in value)
-    return False
 
 
 # --------------------------------------------------------------------------------------------

@@ -1,0 +1,155 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The model of a scene's ``magnetic:`` section: the thesis scenes read to the same field as
+the objects built by hand from their YAML, the dipole limits (a line's length / spacing, a
+lattice's volume / spacing^3, the whole section) are enforced with the limit in the message,
+and a bad type, NaN or unknown key is named with the file and its whole key path."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from kiseki.sim.magnetic import (
+    Dipole,
+    DipoleLine,
+    MagneticWorld,
+    default_earth_field,
+    earth_field_from_angles,
+)
+from kiseki.sim.magnetic_lattice import MAX_LATTICE_DIPOLES, DipoleLattice
+from kiseki.sim.magnetic_schema import MAX_LINE_DIPOLES, MAX_WORLD_DIPOLES
+
+WORLDS = Path(__file__).resolve().parents[2] / "data" / "worlds"
+
+
+def _by_hand(section: dict) -> MagneticWorld:
+    """The world built from the YAML's values with the constructors, without the model."""
+    earth = section.get("earth_field")
+    if isinstance(earth, dict):
+        earth = earth_field_from_angles(
+            earth["total"], earth["inclination_deg"], earth.get("declination_deg", 0.0)
+        )
+    drift = section.get("drift", {})
+    return MagneticWorld(
+        earth_field=earth,
+        dipoles=[Dipole(**d) for d in section.get("dipoles", [])],
+        lines=[DipoleLine(**ln) for ln in section.get("lines", [])],
+        lattices=[DipoleLattice(**lat) for lat in section.get("lattices", [])],
+        gradient=section.get("gradient"),
+        gradient_origin=section.get("gradient_origin", (0.0, 0.0, 0.0)),
+        **{f"drift_{k}": v for k, v in drift.items()},
+    )
+
+
+@pytest.mark.parametrize("name", ["magnetic_floor", "magnetic_hall", "magnetic_path"])
+def test_the_thesis_scenes_read_to_the_field_of_the_objects_built_by_hand(name):
+    section = yaml.safe_load((WORLDS / f"{name}.yaml").read_text())["magnetic"]
+    world = MagneticWorld.from_dict(section, f"{name}.yaml")
+    reference = _by_hand(section)
+    points = np.random.default_rng(3).uniform([-2, -2, 0], [30, 15, 2.5], (200, 3))
+    np.testing.assert_array_equal(
+        world.field_at(points, 5000.0), reference.field_at(points, 5000.0)
+    )
+    assert len(world._positions) == len(reference._positions) > 0
+    assert world.drift_period == reference.drift_period
+
+
+def test_unset_keys_keep_the_constructors_defaults():
+    world = MagneticWorld.from_dict({"drift": {"phase": 1.0}}, "s.yaml")
+    np.testing.assert_array_equal(world.earth_field, default_earth_field())
+    assert (world.drift_amplitude, world.drift_period, world.drift_phase) == (
+        MagneticWorld().drift_amplitude,
+        MagneticWorld().drift_period,
+        1.0,
+    )
+
+
+def _line(length: float, spacing: float) -> dict:
+    return {"start": [0, 0, 0], "end": [length, 0, 0], "moment_per_metre": [0, 0, 1],
+            "spacing": spacing}  # fmt: skip
+
+
+def _lattice(side: float, spacing: float) -> dict:
+    return {"lower": [0, 0, 0], "upper": [side, side, 0], "spacing": spacing,
+            "moment_sd": [1, 1, 1]}  # fmt: skip
+
+
+def _error(section: dict) -> str:
+    with pytest.raises(ValueError) as info:
+        MagneticWorld.from_dict(section, "scene.yaml", at=("magnetic",))
+    return str(info.value)
+
+
+def test_a_line_of_more_dipoles_than_the_limit_is_refused_with_the_limit():
+    assert len(MagneticWorld.from_dict({"lines": [_line(100.0, 0.002)]}).lines[0].positions) == (
+        MAX_LINE_DIPOLES
+    )
+    assert _error({"lines": [_line(100.0, 0.0019)]}) == (
+        f"scene.yaml: magnetic.lines[0].spacing: makes 52632 dipoles over the line's 100 m, "
+        f"more than the limit of {MAX_LINE_DIPOLES} (spacing >= 0.002 m), got 0.0019"
+    )
+
+
+def test_a_lattice_of_more_dipoles_than_the_limit_is_refused_with_the_limit():
+    # 100 x 100 m at 0.5 m: 200 x 200 = 40,000 dipoles; at 0.4 m: 250 x 250 = 62,500
+    assert len(MagneticWorld.from_dict({"lattices": [_lattice(100, 0.5)]})._positions) == 40_000
+    text = _error({"lattices": [{}, _lattice(100, 0.4)]})
+    assert text.startswith("scene.yaml: magnetic.lattices[0].lower: missing (and ")
+    text = _error({"lattices": [_lattice(100, 0.4)]})
+    assert text.startswith("scene.yaml: magnetic.lattices[0].spacing: makes 62500 dipoles")
+    assert text.endswith(f"more than the limit of {MAX_LATTICE_DIPOLES}, got 0.4")
+
+
+def test_a_section_of_more_dipoles_than_the_limit_is_refused_with_the_limit():
+    # four lattices of 40,000 and a line of 40,001 make 200,001
+    section = {"lines": [_line(40_001 * 0.1, 0.1)], "lattices": [_lattice(100, 0.5)] * 4}
+    assert _error(section).startswith(
+        f"scene.yaml: magnetic.lattices: with the dipoles and lines: 200001 dipoles in all, "
+        f"more than the limit of {MAX_WORLD_DIPOLES}, got ["
+    )
+    section["lines"] = [_line(40_000 * 0.1, 0.1)]
+    assert len(MagneticWorld.from_dict(section)._positions) == MAX_WORLD_DIPOLES
+
+
+@pytest.mark.parametrize(
+    ("section", "message"),
+    [
+        ({"dipoles": [{"position": [0, 0, "1"], "moment": [0, 0, 1]}]},
+         "dipoles[0].position[2]: must be a valid number, got '1'"),
+        ({"dipoles": [{"position": [0, 0, 0], "moment": [0, 0, 1], "radius": 0}]},
+         "dipoles[0].radius: must be greater than 0, got 0"),
+        ({"dipoles": [5]}, "dipoles[0]: must be a mapping of position, moment, radius, got 5"),
+        ({"lines": [{**_line(1, 0.1), "spacing": float("nan")}]},
+         "lines[0].spacing: must be a finite number, got nan"),
+        ({"lines": [{**_line(1, 0.1), "colour": "red"}]}, "lines[0].colour: unknown key"),
+        ({"lattices": [{**_lattice(1, 0.1), "seed": 2**64}]},
+         "lattices[0].seed: must be an integer in [0, 2**64), got 18446744073709551616"),
+        ({"lattices": [{**_lattice(1, 0.1), "moment_sd": [1, 1, -1]}]},
+         "lattices[0].moment_sd[2]: must be greater than or equal to 0, got -1"),
+        ({"earth_field": {"total": -1, "inclination_deg": 0}},
+         "earth_field.total: must be greater than or equal to 0, got -1"),
+        ({"earth_field": {"total": 0.4, "inclination_deg": -91}},
+         "earth_field.inclination_deg: must be greater than or equal to -90, got -91"),
+        ({"earth_field": "north"},
+         "earth_field: must be a list of 3 numbers [x, y, z], got 'north'"),
+        ({"gradient": [[0, 0, 0], [0, 0, 0], [0, float("inf"), 0]]},
+         "gradient[2][1]: must be a finite number, got inf"),
+        ({"gradient_origin": [0, 0, None]}, "gradient_origin[2]: must be a valid number, got None"),
+        ({"drift": [1]}, "drift: must be a mapping of amplitude, period, phase, got [1]"),
+        ({"drift": {"period": True}}, "drift.period: must be a valid number, got True"),
+    ],
+)  # fmt: skip
+def test_a_bad_value_is_named_with_the_file_and_its_whole_key_path(section, message):
+    assert _error(section) == f"scene.yaml: magnetic.{message}"
+
+
+def test_the_round_trip_of_to_dict_reads_back_the_same_field():
+    section = yaml.safe_load((WORLDS / "magnetic_hall.yaml").read_text())["magnetic"]
+    world = MagneticWorld.from_dict(section, "hall.yaml")
+    again = MagneticWorld.from_dict(world.to_dict(), "round trip")
+    points = np.random.default_rng(4).uniform(0, 10, (50, 3))
+    np.testing.assert_array_equal(again.field_at(points, 10.0), world.field_at(points, 10.0))
