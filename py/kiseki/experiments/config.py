@@ -65,9 +65,8 @@ def _strict(kind: Any) -> Any:
     origin = typing.get_origin(kind)
     if origin in (list, tuple):
         (item,) = set(typing.get_args(kind)) - {Ellipsis} or {str}
-        container = list if origin is list else tuple[_strict(item), ...]
-        inner = list[_strict(item)] if origin is list else container
-        return Annotated[inner, Field(max_length=LIST_LIMIT)]
+        items = list[_strict(item)] if origin is list else tuple[_strict(item), ...]
+        return Annotated[items, Field(max_length=LIST_LIMIT)]
     if kind in _SCALARS:
         return _SCALARS[kind]
     raise TypeError(f"unsupported config field type {kind!r}")
