@@ -22,6 +22,7 @@ from tqdm import tqdm
 from kiseki.control import PurePursuit
 from kiseki.core import check_seed
 from kiseki.sim.collisions import COLLISION_SCHEMA, Collision, CollisionCheck
+from kiseki.sim.command_schema import MAX_COMMAND_SECONDS, read_command_rows
 from kiseki.sim.mcap_log import TWIST_SCHEMA, TWIST_SCHEMA_NAME, RunWriter, read_run
 from kiseki.sim.pedestrians import PEDESTRIANS_SCHEMA
 from kiseki.sim.recorder import Recorder, planar_pose
@@ -32,7 +33,7 @@ from kiseki.sim.turns import Turns
 __all__ = ["RunSummary", "SimConfig", "read_commands", "simulate"]
 
 
-MAX_SIM_SECONDS = 86_400.0  # a run is at most a day of simulated time
+MAX_SIM_SECONDS = MAX_COMMAND_SECONDS  # a run is at most a day of simulated time
 
 
 @dataclass(frozen=True)
@@ -76,30 +77,10 @@ class RunSummary:
 
 def read_commands(path: str | os.PathLike) -> np.ndarray:
     """A velocity-command script: CSV with header t,v,w (diff drive) or t,vx,vy,w (omni); each
-    row holds from its time until the next row."""
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: command file not found")
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except UnicodeDecodeError:
-        raise ValueError(f"{path}: not a command CSV (not UTF-8 text)") from None
-    if not lines:
-        raise ValueError(f"{path}: empty command file (header t,v,w or t,vx,vy,w)")
-    header = lines[0].strip().split(",")
-    if header not in (["t", "v", "w"], ["t", "vx", "vy", "w"]):
-        raise ValueError(f"{path}: header must be t,v,w or t,vx,vy,w, got {','.join(header)}")
-    if not any(line.strip() for line in lines[1:]):
-        raise ValueError(f"{path}: no commands below the header")
-    try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    except ValueError as err:
-        raise ValueError(f"{path}: not a numeric CSV ({err})") from err
-    if data.shape[1] != len(header) or not np.isfinite(data).all():
-        raise ValueError(f"{path}: every row needs {len(header)} finite numbers (no NaN)")
-    if (np.diff(data[:, 0]) < 0).any() or data[0, 0] < 0:
-        raise ValueError(f"{path}: times must start at >= 0 and not decrease")
-    if len(header) == 3:
+    row holds from its time until the next row (see :mod:`kiseki.sim.command_schema`). Returns
+    (n, 4) rows of t, vx, vy, w (vy 0 for a diff-drive script)."""
+    data = read_command_rows(path)
+    if data.shape[1] == 3:
         data = np.column_stack([data[:, :2], np.zeros(len(data)), data[:, 2]])
     return data
 

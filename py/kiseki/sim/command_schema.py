@@ -1,0 +1,119 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The model of a velocity-command script (``kiseki sim run --controller commands --commands
+FILE``): a CSV whose header is ``t,v,w`` (diff drive: m/s, rad/s) or ``t,vx,vy,w`` (omni), one
+command a row, each holding from its time (s) until the next row's::
+
+    t,v,w
+    0,0.5,0        # '#' starts a comment; blank lines are skipped
+    4.0,0.3,0.25
+
+A problem is one line naming the file, the line number, the column and the value
+(``cmd.csv:3: v: must be a finite number, got 'nan'``); the script is limited to
+:data:`MAX_COMMANDS` rows and :data:`MAX_COMMAND_SECONDS` of simulated time, with the limit in
+the message."""
+
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+from pydantic import BeforeValidator, Field
+
+from kiseki._schema import FileModel, parse
+
+__all__ = [
+    "HEADERS",
+    "MAX_COMMANDS",
+    "MAX_COMMAND_SECONDS",
+    "DiffDriveCommand",
+    "OmniCommand",
+    "read_command_rows",
+]
+
+MAX_COMMANDS = 1_000_000  # rows: 32 MB of commands, a day at 10 Hz is 864,000
+MAX_COMMAND_SECONDS = 86_400.0  # a run is at most a day of simulated time (kiseki.sim.run)
+
+
+def _number(text: Any) -> Any:
+    """A CSV cell (``0.5``, `` 1e-1 ``) as a number: ``nan`` and ``inf`` are numbers that are
+    not finite, anything else that is not a number is refused as it was written."""
+    if isinstance(text, str):
+        try:
+            value = float(text)
+        except ValueError:
+            raise ValueError("must be a number") from None
+        if not math.isfinite(value):
+            raise ValueError("must be a finite number")
+        return value
+    return text
+
+
+Number = Annotated[float, BeforeValidator(_number), Field(strict=True, allow_inf_nan=False)]
+Seconds = Annotated[
+    float,
+    BeforeValidator(_number),
+    Field(strict=True, ge=0, le=MAX_COMMAND_SECONDS, allow_inf_nan=False),
+]
+
+
+class DiffDriveCommand(FileModel):
+    """A row of ``t,v,w``: from time t (s), forward speed v (m/s) and turn rate w (rad/s)."""
+
+    t: Seconds
+    v: Number
+    w: Number
+
+
+class OmniCommand(FileModel):
+    """A row of ``t,vx,vy,w``: from time t (s), body velocity (vx, vy) (m/s), turn rate w."""
+
+    t: Seconds
+    vx: Number
+    vy: Number
+    w: Number
+
+
+HEADERS: dict[str, type[FileModel]] = {"t,v,w": DiffDriveCommand, "t,vx,vy,w": OmniCommand}
+
+
+def read_command_rows(path: str | os.PathLike) -> np.ndarray:
+    """The command script at `path` as an (n, len(header)) array in the header's column order:
+    FileNotFoundError when there is none, ValueError naming the file (and the line, the column
+    and the value) otherwise."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: command file not found")
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a command CSV (not UTF-8 text)") from None
+    if not lines:
+        raise ValueError(f"{path}: empty command file (header t,v,w or t,vx,vy,w)")
+    header = ",".join(cell.strip() for cell in lines[0].split(","))
+    if header not in HEADERS:
+        raise ValueError(f"{path}: header must be t,v,w or t,vx,vy,w, got {lines[0][:60]!r}")
+    model, columns = HEADERS[header], header.split(",")
+    rows: list[list[float]] = []
+    for number, line in enumerate(lines[1:], 2):
+        cells = line.split("#", 1)[0].split(",")
+        if not "".join(cells).strip():
+            continue
+        where = f"{path}:{number}"
+        if len(cells) != len(columns):
+            raise ValueError(f"{where}: a row is {header} ({len(columns)} values), got {line!r}")
+        if len(rows) == MAX_COMMANDS:
+            raise ValueError(f"{where}: a command script holds at most {MAX_COMMANDS:,} rows")
+        row = parse(model, dict(zip(columns, cells, strict=True)), where)
+        if rows and row.t < rows[-1][0]:
+            raise ValueError(
+                f"{where}: t: must not decrease (the row before is at {rows[-1][0]:g} s), "
+                f"got {row.t:g}"
+            )
+        rows.append([getattr(row, c) for c in columns])
+    if not rows:
+        raise ValueError(f"{path}: no commands below the header")
+    return np.array(rows, dtype=np.float64)
