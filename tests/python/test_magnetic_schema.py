@@ -153,3 +153,42 @@ def test_the_round_trip_of_to_dict_reads_back_the_same_field():
     again = MagneticWorld.from_dict(world.to_dict(), "round trip")
     points = np.random.default_rng(4).uniform(0, 10, (50, 3))
     np.testing.assert_array_equal(again.field_at(points, 10.0), world.field_at(points, 10.0))
+
+
+_BAR = {"inner": 0.35, "sensors_apart": 0.6, "heights": [0.1, 2.0], "period": 20.0,
+        "yaw_deg": [-20.0, 20.0], "yaw_period": 60.0}  # fmt: skip
+
+
+def test_an_arm_mapping_reads_to_the_arm_built_by_hand():
+    from kiseki.sim.magnetic_arm import ArmMagnetometers, arm_sensor_from_spec
+
+    world = MagneticWorld()
+    pivot = (0.4, 0.0, 1.05)
+    reference = ArmMagnetometers(world, pivot, 0.35, 0.6, (0.1, 2.0), 20.0, (-20, 20), 60.0)
+    far = arm_sensor_from_spec({**_BAR, "sensor": "far"}, world, pivot, where="s.yaml: arm")
+    poses, times = np.zeros((7, 3)), np.linspace(0.0, 90.0, 7)
+    np.testing.assert_array_equal(
+        far.sensor_positions(poses, times), reference.sensor_positions(poses, times)[:, 1]
+    )
+
+
+@pytest.mark.parametrize(
+    ("arm", "message"),
+    [
+        ({**_BAR, "sensor": "far", "heights": [2.0, 0.1]},
+         "heights: must be [zmin, zmax] m with 0 <= zmin < zmax, got [2.0, 0.1]"),
+        ({**_BAR, "sensor": "far", "yaw_period": None},
+         "yaw_period: must be a valid number, got None"),
+        ({k: v for k, v in _BAR.items() if k != "yaw_period"} | {"sensor": "near"},
+         "yaw_deg: sweeps (lo != hi): yaw_period is needed, got [-20.0, 20.0]"),
+        ({**_BAR, "sensor": "far", "period": float("nan")},
+         "period: must be a finite number, got nan"),
+        (_BAR, "sensor: missing (near or far)"),
+    ],
+)  # fmt: skip
+def test_a_bad_arm_is_named_with_the_file_and_its_key_path(arm, message):
+    from kiseki.sim.magnetic_arm import arm_sensor_from_spec
+
+    with pytest.raises(ValueError) as info:
+        arm_sensor_from_spec(arm, MagneticWorld(), (0.4, 0.0, 1.05), where="s.yaml: robots[1].arm")
+    assert str(info.value).startswith(f"s.yaml: robots[1].arm.{message}")

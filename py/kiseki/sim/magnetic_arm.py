@@ -41,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._schema import SchemaError, parse
 from kiseki.core import derive_seed
 from kiseki.sim._values import finite_array as _finite_array
 from kiseki.sim._values import finite_scalar as _finite_scalar
@@ -53,11 +54,12 @@ from kiseki.sim.magnetic import (
     Magnetometer,
     dipole_field,
 )
+from kiseki.sim.magnetic_schema import ArmSpec
 
 __all__ = ["ARM_KEYS", "ArmMagnetometer", "ArmMagnetometers", "arm_sensor_from_spec"]
 
 #: Keys of a scene sensor's ``arm`` mapping.
-ARM_KEYS = ("inner", "sensors_apart", "heights", "period", "yaw_deg", "yaw_period", "sensor")
+ARM_KEYS = tuple(ArmSpec.model_fields)
 SENSOR_NAMES = ("near", "far")
 
 
@@ -168,30 +170,22 @@ class ArmMagnetometers:
         cls, d: Mapping[str, Any], world: MagneticWorld, where: str = "arm", **kwargs: Any
     ) -> ArmMagnetometers:
         """From a scene's ``arm`` mapping (``inner``, ``sensors_apart`` (0.6), ``heights``,
-        ``period``, ``yaw_deg`` ([0, 0]), ``yaw_period``; ``sensor`` is ignored here);
-        ``kwargs`` (pivot, mount_yaw, noise_sd, seed, self_sources) go to the constructor.
-        ValueError naming ``where`` and the key."""
-        if not isinstance(d, Mapping):
-            raise ValueError(f"{where}: expected a mapping, got {type(d).__name__}")
-        unknown = sorted(set(d) - set(ARM_KEYS))
-        if unknown:
-            raise ValueError(
-                f"{where}: unknown key(s) {', '.join(map(str, unknown))} "
-                f"(allowed: {', '.join(ARM_KEYS)})"
-            )
-        for key in ("inner", "heights", "period"):
-            if key not in d:
-                raise ValueError(f"{where}.{key}: missing")
-        args = {k: d[k] for k in ARM_KEYS[:-1] if k in d}
-        for k, v in args.items():
-            if isinstance(v, (bool, str, bytes)) or (
-                isinstance(v, (list, tuple)) and any(isinstance(e, (bool, str)) for e in v)
-            ):
-                raise ValueError(f"{where}.{k}: expected numbers, got {v!r}")
+        ``period``, ``yaw_deg`` ([0, 0]), ``yaw_period``; ``sensor`` is ignored here), checked
+        by :class:`kiseki.sim.magnetic_schema.ArmSpec`; ``kwargs`` (pivot, mount_yaw, noise_sd,
+        seed, self_sources) go to the constructor. ValueError naming ``where`` (``"FILE:
+        key.path"`` of the mapping) and the key."""
+        spec = _arm_spec(d, where)
+        args = spec.model_dump(exclude={"sensor"}, exclude_unset=True)
         try:
             return cls(world, **args, **kwargs)
-        except ValueError as exc:
+        except ValueError as exc:  # the reach of the bar from the pivot (kwargs)
             raise ValueError(f"{where}.{exc}") from None
+
+
+def _arm_spec(d: Any, where: str) -> ArmSpec:
+    """``d`` checked by ArmSpec; ``where`` is ``"FILE: key.path"`` (or just a path)."""
+    source, sep, path = where.rpartition(": ")
+    return parse(ArmSpec, d, source if sep else where, at=(path,) if sep else ())
 
 
 class ArmMagnetometer(Magnetometer):
@@ -258,11 +252,9 @@ def arm_sensor_from_spec(
     """The sensor a scene's magnetometer entry names in its ``arm`` mapping (``sensor: near``
     or ``far``), on the arm whose pivot is the entry's mount. ``kwargs``: noise_sd,
     self_sources."""
-    if not isinstance(spec, Mapping):
-        raise ValueError(f"{where}: expected a mapping, got {type(spec).__name__}")
-    name = spec.get("sensor")
-    if name not in SENSOR_NAMES:
-        raise ValueError(f"{where}.sensor: expected near or far, got {name!r}")
+    name = _arm_spec(spec, where).sensor
+    if name is None:
+        raise SchemaError(f"{where}.sensor: missing (near or far)")
     arm = ArmMagnetometers.from_dict(
         spec, world, where, pivot=pivot, mount_yaw=mount_yaw, seed=seed, **kwargs
     )

@@ -24,7 +24,7 @@ naming the file, the key path and the value (``scene.yaml: magnetic.lines[2].spa
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, Union
+from typing import Annotated, Any, Literal, Union
 
 from pydantic import (
     BeforeValidator,
@@ -42,6 +42,7 @@ from kiseki.sim.magnetic_lattice import MAX_LATTICE_DIPOLES
 __all__ = [
     "MAX_LINE_DIPOLES",
     "MAX_WORLD_DIPOLES",
+    "ArmSpec",
     "DipoleSpec",
     "EarthAngles",
     "LatticeSpec",
@@ -75,6 +76,15 @@ NonNegativeVector = Annotated[
     tuple[NonNegativeFloat, NonNegativeFloat, NonNegativeFloat], BeforeValidator(_vector)
 ]
 Matrix = Annotated[tuple[Vector, Vector, Vector], BeforeValidator(_matrix)]
+
+
+def _pair(value: Any) -> Any:
+    if not isinstance(value, list | tuple) or len(value) != 2:
+        raise ValueError("must be a list of 2 numbers [low, high]")
+    return value
+
+
+Pair = Annotated[tuple[FiniteFloat, FiniteFloat], BeforeValidator(_pair)]
 Inclination = Annotated[float, Field(strict=True, ge=-90, le=90, allow_inf_nan=False)]
 
 
@@ -241,4 +251,35 @@ class MagneticSection(_Section):
                 f"with the dipoles and lines: {n} dipoles in all, more than the limit of "
                 f"{MAX_WORLD_DIPOLES}"
             )
+        return value
+
+
+class ArmSpec(_Section):
+    """A magnetometer's ``arm`` mapping in a scene's robot sensors: the bar of the 2-DOF arm
+    (:class:`kiseki.sim.magnetic_arm.ArmMagnetometers`) and which of its two sensors this
+    entry is. Whether ``heights`` lie within the bar's reach of the pivot (the entry's mount)
+    is checked where the arm is built."""
+
+    inner: PositiveFloat
+    sensors_apart: PositiveFloat = 0.6
+    heights: Pair
+    period: PositiveFloat
+    yaw_period: PositiveFloat = None  # type: ignore[assignment]  (needed when the yaw sweeps)
+    yaw_deg: Pair = (0.0, 0.0)
+    sensor: Literal["near", "far"] = None  # type: ignore[assignment]
+
+    @field_validator("heights")
+    @classmethod
+    def _rising(cls, value: tuple[float, float]) -> tuple[float, float]:
+        if not 0.0 <= value[0] < value[1]:
+            raise ValueError("must be [zmin, zmax] m with 0 <= zmin < zmax")
+        return value
+
+    @field_validator("yaw_deg")
+    @classmethod
+    def _ordered(cls, value: tuple[float, float], info: ValidationInfo) -> tuple[float, float]:
+        if value[1] < value[0]:
+            raise ValueError("must be [lo, hi] degrees with lo <= hi")
+        if value[0] != value[1] and info.data.get("yaw_period") is None:
+            raise ValueError("sweeps (lo != hi): yaw_period is needed")
         return value
