@@ -14,6 +14,8 @@ from pathlib import Path
 
 import yaml
 
+from kiseki._yaml import safe_load_12
+
 __all__ = ["FIGURE_SUFFIXES", "check_outputs", "check_suffix", "files_behind"]
 
 
@@ -46,7 +48,7 @@ def files_behind(path: Path) -> list[Path]:
     out = [path]
     if path.suffix.lower() in (".yaml", ".yml") and path.is_file():
         try:
-            doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+            doc = safe_load_12(path.read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, yaml.YAMLError):
             return out  # the reader itself reports what is wrong with it
         if isinstance(doc, dict) and isinstance(doc.get("image"), str) and doc["image"]:

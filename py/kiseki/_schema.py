@@ -93,7 +93,7 @@ def _short(value: Any, limit: int = 60) -> str:
 
 
 def _problem(err: dict[str, Any], at: Sequence[str | int]) -> str:
-    # pydantic puts the name of a tagged-union member or a function validator in the location:
+    # pydantic puts the name of a function validator in the location (function-after[...]):
     # only the keys and indices of the document are shown
     loc = [
         p
@@ -104,11 +104,13 @@ def _problem(err: dict[str, Any], at: Sequence[str | int]) -> str:
     message = err.get("msg", "invalid value")
     if message.startswith("Value error, "):
         message = message[len("Value error, ") :]
-    if message.startswith("Input should be "):
+    if err.get("type") in ("dict_type", "model_type", "dataclass_type"):
+        message = "must be a mapping"  # pydantic names the Python class here
+    elif message.startswith("Input should be "):
         message = "must be " + message[len("Input should be ") :]
     if err.get("type") == "missing":
         text = "missing"
-    elif err.get("type") == "extra_forbidden":
+    elif err.get("type") in ("extra_forbidden", "unexpected_keyword_argument"):
         text = "unknown key"
     else:
         text = f"{message[:1].lower()}{message[1:]}, got {_short(err.get('input'))}"

@@ -68,3 +68,8 @@ def test_a_valid_document_reads_with_yaml_lists_as_tuples_and_ints_as_floats():
     robot = parse(_Robot, {"sensors": [{"name": "a", "seed": 2**64 - 1}], "start": [1, 2, 3]}, "s")
     assert robot.start == (1.0, 2.0, 3.0) and all(isinstance(v, float) for v in robot.start)
     assert robot.sensors[0].seed == 2**64 - 1 and robot.sensors[0].rate_hz == 10.0
+
+
+def test_a_list_where_a_mapping_belongs_says_mapping_not_a_python_class():
+    err = _error({"sensors": [["name", "a"]], "start": [0, 0, 0]})
+    assert str(err) == "scene.yaml: robots[2].sensors[0]: must be a mapping, got ['name', 'a']"

@@ -190,7 +190,7 @@ def test_a_sweep_at_the_limit_is_taken(tmp_path):
         ),
         (
             lambda d: d["robot"].update(type="omni", odometry_errors={"slip_distance_coeff": 1}),
-            r"robot\.odometry_errors\.slip_distance_coeff: unexpected keyword argument",
+            r"robot\.odometry_errors\.slip_distance_coeff: unknown key",
         ),
         (_sensor(type="sonar"), r"sensors\[0\]\.type: unknown sensor type, must be one of laser"),
         (_sensor(rate_hz="10"), r"sensors\[0\]\.rate_hz: must be a valid number, got '10'"),

@@ -92,7 +92,7 @@ def test_from_dict_round_trip_and_defaults():
 @pytest.mark.parametrize(
     ("cls", "key", "value", "needle"),
     [
-        (DiffDriveParams, "wheel_radiuss", 0.1, "wheel_radiuss: unexpected keyword argument"),
+        (DiffDriveParams, "wheel_radiuss", 0.1, "wheel_radiuss: unknown key"),
         (DiffDriveParams, "wheel_radius", 0.0, "wheel_radius: must be greater than 0, got 0.0"),
         (DiffDriveParams, "track_width", -0.5, "track_width: must be greater than 0, got -0.5"),
         (DiffDriveParams, "max_speed", float("nan"), "max_speed: must be a finite number, got nan"),
@@ -104,7 +104,7 @@ def test_from_dict_round_trip_and_defaults():
         (DiffDriveParams, "encoder_counts_per_rev", 0, "encoder_counts_per_rev: must be greater"),
         (DiffDriveParams, "quadrature", 1, "quadrature: must be a valid boolean, got 1"),
         (OmniParams, "max_yaw_rate", 0, "max_yaw_rate: must be greater than 0, got 0"),
-        (OmniParams, "v_max", 0.5, "v_max: unexpected keyword argument, got 0.5"),
+        (OmniParams, "v_max", 0.5, "v_max: unknown key"),
         (
             OdometryErrorParams,
             "left_radius_error",
@@ -175,7 +175,7 @@ def test_direct_construction_is_validated_too():
         DiffDriveParams(wheel_radius=float("nan"))
     with pytest.raises(ValueError, match=r"OdometryErrorParams\nslip_rotation_coeff"):
         dataclasses.replace(OdometryErrorParams(), slip_rotation_coeff=-1.0)
-    with pytest.raises(ValueError, match="^x.yaml: must be a dictionary"):
+    with pytest.raises(ValueError, match="^x.yaml: must be a mapping"):
         OmniParams.from_dict([("width", 1.0)], "x.yaml")  # type: ignore[arg-type]
 
 

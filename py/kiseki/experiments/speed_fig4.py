@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import yaml
 
+from kiseki._yaml import safe_load_12
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.experiments.speed_common import WORLDS, laser_mount, prior_map
 from kiseki.plots import draw_map, new_figure
@@ -41,7 +41,7 @@ def _sweep(config: Fig4Config) -> tuple[list, tuple[float, float]]:
     scene = load_scene(config.scene)
     if not scene.poses:
         raise ValueError(f"{config.scene}: speed-fig4 needs a scene with 'poses'")
-    corner = yaml.safe_load(Path(config.scene).read_text(encoding="utf-8"))["poses"]["corner"]
+    corner = safe_load_12(Path(config.scene).read_text(encoding="utf-8"))["poses"]["corner"]
     return scene.poses, (float(corner[0]), float(corner[1]))
 
 

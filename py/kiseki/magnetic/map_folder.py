@@ -38,6 +38,7 @@ import numpy as np
 import yaml
 
 from kiseki._atomic import record_written
+from kiseki._yaml import safe_load_12
 from kiseki.errors import MapFormatError
 from kiseki.gp import SquaredExponential
 from kiseki.magnetic.field_map import COMPONENTS, MagneticFieldMap, TrainingData
@@ -53,7 +54,7 @@ _LEVELS = 65535
 
 def _is_map_folder(path: Path) -> bool:
     try:
-        doc = yaml.safe_load((path / MAP_FILE).read_text(encoding="utf-8"))
+        doc = safe_load_12((path / MAP_FILE).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError):
         return False
     return isinstance(doc, dict) and doc.get("kind") == KIND

@@ -57,6 +57,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from kiseki._yaml import safe_load_12
 from kiseki.core import Random, derive_seed
 from kiseki.sim.collisions import FootprintChecker, body_grid
 from kiseki.sim.scene import Scene, load_scene
@@ -326,7 +327,7 @@ def route_contact(scene: Scene, margin: float = ROUTE_MARGIN):
 
 
 def _base(path: Path) -> dict:
-    doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    doc = safe_load_12(path.read_text(encoding="utf-8"))
     return {k: doc[k] for k in ("robot", "sensors", "route") if k in doc}
 
 
