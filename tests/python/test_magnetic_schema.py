@@ -192,3 +192,24 @@ def test_a_bad_arm_is_named_with_the_file_and_its_key_path(arm, message):
     with pytest.raises(ValueError) as info:
         arm_sensor_from_spec(arm, MagneticWorld(), (0.4, 0.0, 1.05), where="s.yaml: robots[1].arm")
     assert str(info.value).startswith(f"s.yaml: robots[1].arm.{message}")
+
+
+def test_a_scene_file_names_its_bad_magnetic_key_at_load_and_when_sensors_are_built(tmp_path):
+    """A bad magnetic section is refused by load_scene even when no magnetometer would build the
+    field, and the message has the section's prefix when the sensors build it."""
+    from kiseki.sim.scene import load_scene
+    from kiseki.sim.setup import build_robot, build_sensors
+
+    doc = yaml.safe_load((WORLDS / "magnetic_path.yaml").read_text())
+    doc["magnetic"]["lines"][0]["moment_per_metre"] = [0.0, float("nan"), 1.0]
+    no_magnetometer = dict(doc, sensors=[s for s in doc["sensors"] if s["type"] == "laser"])
+    (tmp_path / "a.yaml").write_text(yaml.safe_dump(no_magnetometer))
+    expected = r"magnetic\.lines\[0\]\.moment_per_metre\[1\]: must be a finite number, got nan"
+    with pytest.raises(ValueError, match=r"a\.yaml: " + expected):
+        load_scene(tmp_path / "a.yaml")
+    good = yaml.safe_load((WORLDS / "magnetic_path.yaml").read_text())
+    (tmp_path / "b.yaml").write_text(yaml.safe_dump(good))
+    scene = load_scene(tmp_path / "b.yaml")
+    scene.magnetic["lines"][0]["moment_per_metre"] = [0.0, float("nan"), 1.0]  # past the loader
+    with pytest.raises(ValueError, match=r"b\.yaml: " + expected):
+        build_sensors(scene, build_robot(scene, seed=0), seed=0, dt=0.1)

@@ -41,6 +41,7 @@ from kiseki._schema import SchemaError, parse
 from kiseki._yaml import safe_load_12
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
+from kiseki.sim.magnetic_schema import MagneticSection
 from kiseki.sim.magnetic_survey import MeasurementGrid
 from kiseki.sim.pedestrians import Pedestrian
 from kiseki.sim.primitives import BoxList, boxes_of
@@ -129,6 +130,8 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
     if not isinstance(raw, dict):
         raise ValueError(f"{path}: a scene file must be a YAML mapping")
     doc = parse(SceneDoc, raw, path)
+    if raw.get("magnetic") is not None:  # checked now; the field is built when a sensor needs it
+        parse(MagneticSection, raw["magnetic"], path, at=("magnetic",))
     boxes = _boxes(doc, variant)
     if doc.octomap is not None:
         bt = (path.parent / doc.octomap).resolve()

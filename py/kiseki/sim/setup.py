@@ -162,7 +162,11 @@ def build_sensors(
         raise ValueError(f"{scene.path}: dt must be a finite number of seconds > 0, got {dt!r}")
     robot_at = _robot_at(scene, index)
     out: list[SensorSetup] = []
-    magnetic = MagneticWorld.from_dict(scene.magnetic, str(scene.path)) if scene.magnetic else None
+    magnetic = (
+        MagneticWorld.from_dict(scene.magnetic, str(scene.path), at=("magnetic",))
+        if scene.magnetic
+        else None
+    )
     others = {s["name"] for s in scene.robot_specs} - {robot.name}
     arms: dict[tuple, tuple[dict, set]] = {}  # pivot -> (bar, sensors on it)
     sensors_at = (*robot_at, "sensors") if robot_at != ("robot",) else ("sensors",)
