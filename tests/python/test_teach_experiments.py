@@ -7,6 +7,7 @@ really in the played-back world."""
 
 from __future__ import annotations
 
+import hashlib
 import math
 import subprocess
 import sys
@@ -44,6 +45,8 @@ def run(name: str, runs: int, scene, cwd) -> tuple[pd.DataFrame, pd.DataFrame]:
 
 def test_exp1_corridor_claims_follow_from_its_trials(tmp_path, short_corridor):
     trials, claims = run("exp1-corridor", 2, short_corridor, tmp_path)
+    taught = hashlib.sha1(short_corridor.read_bytes()).hexdigest()
+    assert (trials["scene_sha1"] == taught).all() and (trials["scene_variant"] == "").all()
     stop = trials["proposal2_stop_error"]
     assert (stop <= 0.1).all() and (trials["proposal2_reached"]).all()  # the thesis' rule
     # the stop error is the distance of the true rest from where P2 was taught
@@ -71,6 +74,9 @@ def test_exp1_corridor_claims_follow_from_its_trials(tmp_path, short_corridor):
 def test_exp3_boxes_are_in_the_played_back_world(tmp_path, short_corridor):
     trials, claims = run("exp3-boxes", 1, short_corridor, tmp_path)
     t = trials.iloc[0]
+    # the trial records that it played back in a named, changed copy of the taught scene
+    assert t["scene_variant"] == "exp3-boxes"
+    assert t["scene_sha1"] != hashlib.sha1(short_corridor.read_bytes()).hexdigest()
     assert t["proposal2_stop_error"] <= 0.1 and t["proposal2_reached"]
     assert 0 <= t["final_leg_boxes_left"] + t["final_leg_boxes_right"] <= 3
     # the control run (same teaching and seeds, no boxes) stops elsewhere: the cameras saw them

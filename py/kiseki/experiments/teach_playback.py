@@ -216,6 +216,9 @@ def trial(config: Exp1Config, index: int, seed: int) -> TrialOutput:
                 taught_scene=taught.scene,
                 variant="exp3-boxes" if config.boxes else None,  # the copy with the boxes
             )
+            # which scene file it played in: its SHA-1 and the variant label of a changed copy
+            record["scene_sha1"] = result.scene_identity["scene_sha1"]
+            record["scene_variant"] = result.scene_identity.get("variant", "")
             for k, v in _errors(result, goal).items():
                 record[f"{method}_{k}"] = v
             for k, v in _goal_profile(scene, maps[band], goal, method).items():
