@@ -107,3 +107,21 @@ def check_suffix(label: str, path: Path | None, suffixes: Sequence[str]) -> None
     if path is not None and path.suffix.lower() not in suffixes:
         got = f"extension {path.suffix!r}" if path.suffix else "no extension"
         raise ValueError(f"{label} {path}: {got}; give a file ending in {', '.join(suffixes)}")
+    if path is not None and path.suffix.lower() == ".pgf" and suffixes is FIGURE_SUFFIXES:
+        _check_tex(label, path)
+
+
+def _check_tex(label: str, path: Path) -> None:
+    """matplotlib's pgf backend measures text with a LaTeX engine (``pgf.texsystem``, xelatex
+    by default): without one installed a .pgf figure fails after all the work, so it is refused
+    before."""
+    import shutil
+
+    from matplotlib import rcParams
+
+    engine = rcParams["pgf.texsystem"]
+    if shutil.which(engine) is None:
+        raise ValueError(
+            f"{label} {path}: a .pgf figure needs {engine} (a LaTeX engine, matplotlib's "
+            "pgf.texsystem), which is not installed; give .pdf, .svg or .png"
+        )
