@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 from rich.console import Console
-from rich.table import Table
 
 from kiseki._atomic import atomic_write
+from kiseki._table import show
 from kiseki.core import derive_seed
 from kiseki.map_io import load_map
 from kiseki.plots import render_map
@@ -112,28 +112,28 @@ def run_demo(
     _write_text(out / "config.yaml", yaml.safe_dump(asdict(config), sort_keys=False))
     _write_text(out / "summary.json", json.dumps(summary, indent=2))
     _print_truth(taught.truth, taught.merge, console)
-    _print(results, out, console)
+    _print(results, scene.name, out, console)
     return summary
 
 
 def _print_truth(truth: dict, merge: str, console: Console) -> None:
-    table = Table(title=f"Taught maps against the scene's truth ({merge} merge)")
-    for column in ("map", "obstacle cells in reach", "erased", "visible free cells", "occupied"):
-        table.add_column(column, justify="left" if column == "map" else "right")
-    for band, t in truth.items():
-        table.add_row(
+    columns = ("map", "obstacle cells in reach", "erased", "visible free cells", "occupied")
+    rows = [
+        (
             band,
-            str(t["obstacle_cells"]),
+            t["obstacle_cells"],
             f"{100 * t['erased_share']:.1f} %",
-            str(t["visible_free_cells"]),
+            t["visible_free_cells"],
             f"{100 * t['false_occupied_share']:.1f} %",
         )
-    console.print(table)
+        for band, t in truth.items()
+    ]
+    title = f"Taught maps against the scene's truth ({merge} merge)"
+    show(title, columns, rows, as_json=False, data=None, console=console)
 
 
-def _print(results: dict, out: Path, console: Console) -> None:
-    table = Table(title="Route with a turn (thesis Exp. 2, Table 4.5): one run per method")
-    for column in (
+def _print(results: dict, scene_name: str, out: Path, console: Console) -> None:
+    columns = (
         "method",
         "stop error m (thesis)",
         "kiseki",
@@ -141,18 +141,21 @@ def _print(results: dict, out: Path, console: Console) -> None:
         "kiseki",
         "within 0.1 m (thesis)",
         "kiseki",
-    ):
-        table.add_column(column, justify="left" if column == "method" else "right")
+    )
+    rows = []
     for method, r in results.items():
         stop, est, within = THESIS[method]
-        table.add_row(
-            method,
-            "-" if stop is None else f"{stop:.2f}",
-            f"{r['stop_error_m']:.3f}",
-            "-" if est is None else f"{est:.2f}",
-            f"{r['estimate_error_m']:.3f}",
-            within,
-            "yes" if r["stop_error_m"] <= 0.1 else "no",
+        rows.append(
+            (
+                method,
+                "-" if stop is None else f"{stop:.2f}",
+                f"{r['stop_error_m']:.3f}",
+                "-" if est is None else f"{est:.2f}",
+                f"{r['estimate_error_m']:.3f}",
+                within,
+                "yes" if r["stop_error_m"] <= 0.1 else "no",
+            )
         )
-    console.print(table)
+    title = f"{scene_name}: one run per method, beside the thesis' Exp. 2 (Table 4.5)"
+    show(title, columns, rows, as_json=False, data=None, console=console)
     console.print(f"teaching log, taught maps, waypoints, figures and summary in {out}/")

@@ -206,3 +206,16 @@ def test_an_internal_error_exits_3_with_its_traceback(grid_file, monkeypatch, ca
     err = capsys.readouterr().err
     assert "Traceback" in err and "KeyError: 'a bug'" in err
     assert err.strip().splitlines()[-1].startswith("kiseki: internal error: KeyError")
+
+
+def test_experiment_run_prints_its_claims_as_plain_lines_when_piped(tmp_path: Path):
+    import pandas as pd
+
+    done = run("experiment", "run", "speed-fig4", "--seed", "0", "--out", "r", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    lines = [line.split("\t") for line in done.stdout.splitlines() if "\t" in line]
+    assert lines[0] == ["claim", "paper_value", "measured_value", "unit", "holds"]
+    claims = pd.read_csv(tmp_path / "r" / "claims.csv", keep_default_na=False)
+    assert [row[0] for row in lines[1:]] == list(claims["claim"])
+    assert [row[4] == "yes" for row in lines[1:]] == [bool(h) for h in claims["holds"]]
+    assert "│" not in done.stdout and "━" not in done.stdout

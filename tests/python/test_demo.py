@@ -81,12 +81,11 @@ def test_demo_from_the_cli_prints_what_it_saved(tmp_path, project_root):
     config = yaml.safe_load((tmp_path / "d" / "config.yaml").read_text())
     assert (config["particles"], config["seed"], config["scene"]) == (200, 3, "short.yaml")
     assert summary["waypoints"] == ["P0", "P1", "P2"] and summary["teaching_steps"] > 0
-    rows = {
-        cells[0]: cells[1:]
-        for line in done.stdout.splitlines()
-        if line.startswith("│")
-        for cells in [[c.strip() for c in line.strip("│").split("│")]]
-    }
+    # piped: each table is a header line and one tab-separated line a row, never wrapped
+    rows = {cells[0]: cells[1:] for line in done.stdout.splitlines() if "\t" in line
+            for cells in [line.split("\t")]}  # fmt: skip
+    assert "│" not in done.stdout
+    assert rows["method"][0] == "stop error m (thesis)" and rows["map"][1] == "erased"
     for method, r in summary["playback"].items():
         assert r["reached"] and r["stop_error_m"] <= 0.1 and r["estimate_error_m"] <= 0.1
         # method | stop (thesis) | kiseki | estimate (thesis) | kiseki | within (thesis) | kiseki

@@ -17,14 +17,14 @@ from typing import Any
 
 import pandas as pd
 from rich.console import Console
-from rich.table import Table
 
 from kiseki._atomic import atomic_write, atomic_write_all, reworded
+from kiseki._table import show
 from kiseki.experiments.base import CLAIM_COLUMNS, Analysis, Claim, Experiment
 from kiseki.experiments.registry import all_experiments
 
 __all__ = [
-    "claims_table",
+    "print_claims",
     "markdown_table",
     "write_failed_outputs",
     "write_outputs",
@@ -79,14 +79,13 @@ def _report(experiment: Experiment, analysis: Analysis, manifest: dict, claims: 
     return "\n".join(lines) + "\n"
 
 
-def claims_table(title: str, claims: pd.DataFrame) -> Table:
-    table = Table(title=title)
-    for column in CLAIM_COLUMNS[:5]:
-        table.add_column(column, justify="right" if column.endswith("value") else "left")
-    for row in claims.itertuples(False):
-        mark = "[green]yes[/green]" if row.holds else "[red]no[/red]"
-        table.add_row(row.claim, str(row.paper_value), str(row.measured_value), row.unit, mark)
-    return table
+def print_claims(title: str, claims: pd.DataFrame) -> None:
+    """The claims as a table on a terminal, tab-separated lines when piped."""
+    rows = [
+        (row.claim, row.paper_value, row.measured_value, row.unit, "yes" if row.holds else "no")
+        for row in claims.itertuples(False)
+    ]
+    show(title, CLAIM_COLUMNS[:5], rows, as_json=False, data=None)
 
 
 def _frames(trials, timings, run_dir: Path) -> list:
@@ -189,7 +188,7 @@ def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) 
             raise _results_error(err, experiment, run_dir) from err
     finally:
         shutil.rmtree(drawn, ignore_errors=True)
-    Console().print(claims_table(f"{experiment.name}: claims ({run_dir})", claims))
+    print_claims(f"{experiment.name}: claims ({run_dir})", claims)
     if manifest["trials_failed"]:
         Console().print(
             f"[red]{manifest['trials_failed']} of {manifest['trials']} trials failed[/red]"
