@@ -176,22 +176,9 @@ def _read_trajectory(path: Path) -> np.ndarray:
         from kiseki.datasets import read_carmen_log
 
         return read_carmen_log(path).scans.poses
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: trajectory file not found")
-    try:
-        with path.open(encoding="utf-8") as f:
-            header = f.readline().strip().split(",")
-    except UnicodeDecodeError:
-        raise ValueError(f"{path}: not a trajectory CSV (not UTF-8 text)") from None
-    if "x" not in header or "y" not in header:
-        raise ValueError(f"{path}: a trajectory CSV needs a header with columns x and y")
-    try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
-    except ValueError as err:  # UnicodeDecodeError too
-        raise ValueError(f"{path}: not a numeric CSV ({err})") from None
-    if data.shape[1] != len(header) or not np.isfinite(data).all():
-        raise ValueError(f"{path}: rows must have {len(header)} finite numbers")
-    return data[:, [header.index("x"), header.index("y")]]
+    from kiseki.trajectory_csv import read_trajectory_csv
+
+    return read_trajectory_csv(path)
 
 
 @map_app.command("render")

@@ -395,7 +395,7 @@ SEED = "kiseki: error: --seed must be an integer in 0..2^64-1, got -1"
           "back.csv"],
          "kiseki: error: back.csv:3: t: must not decrease (the row before is at 1 s), got 0"),
         (["map", "render", "room.yaml", "-o", "x.png", "--trajectory", "nan.csv"],
-         "kiseki: error: nan.csv: rows must have 2 finite numbers"),
+         "kiseki: error: nan.csv:2: x: must be a finite number, got 'nan'"),
         (["map", "info", "self.yaml"], "kiseki: error: self.yaml: self.yaml: cannot decode image"),
         (["localize", "log.mcap", "--map", "room.yaml", "-o", "t.csv", "--beams", "-3"],
          "kiseki: error: beams must be an integer >= 0 (0 = every beam), got -3"),

@@ -15,14 +15,14 @@ the message."""
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import numpy as np
-from pydantic import BeforeValidator, Field
+from pydantic import Field
 
+from kiseki._csv import CsvNumber
 from kiseki._schema import FileModel, parse
 
 __all__ = [
@@ -38,26 +38,8 @@ MAX_COMMANDS = 1_000_000  # rows: 32 MB of commands, a day at 10 Hz is 864,000
 MAX_COMMAND_SECONDS = 86_400.0  # a run is at most a day of simulated time (kiseki.sim.run)
 
 
-def _number(text: Any) -> Any:
-    """A CSV cell (``0.5``, `` 1e-1 ``) as a number: ``nan`` and ``inf`` are numbers that are
-    not finite, anything else that is not a number is refused as it was written."""
-    if isinstance(text, str):
-        try:
-            value = float(text)
-        except ValueError:
-            raise ValueError("must be a number") from None
-        if not math.isfinite(value):
-            raise ValueError("must be a finite number")
-        return value
-    return text
-
-
-Number = Annotated[float, BeforeValidator(_number), Field(strict=True, allow_inf_nan=False)]
-Seconds = Annotated[
-    float,
-    BeforeValidator(_number),
-    Field(strict=True, ge=0, le=MAX_COMMAND_SECONDS, allow_inf_nan=False),
-]
+Number = CsvNumber
+Seconds = Annotated[CsvNumber, Field(ge=0, le=MAX_COMMAND_SECONDS)]
 
 
 class DiffDriveCommand(FileModel):

@@ -1,0 +1,33 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The number type of the CSV files kiseki reads (command scripts, trajectories): a cell's text
+(``0.5``, `` 1e-1 ``) read as a finite number inside a pydantic model, so that a problem names
+the column and the cell as it was written (``v: must be a finite number, got 'nan'``)."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any
+
+from pydantic import BeforeValidator, Field
+
+__all__ = ["CsvNumber", "number_text"]
+
+
+def number_text(text: Any) -> Any:
+    """A CSV cell's text as a number: ``nan`` and ``inf`` are numbers that are not finite,
+    anything else that is not a number is refused as it was written."""
+    if isinstance(text, str):
+        try:
+            value = float(text)
+        except ValueError:
+            raise ValueError("must be a number") from None
+        if not math.isfinite(value):
+            raise ValueError("must be a finite number")
+        return value
+    return text
+
+
+CsvNumber = Annotated[float, BeforeValidator(number_text), Field(strict=True, allow_inf_nan=False)]
+"""A finite number from a CSV cell; bounds go in a further ``Field`` (``Annotated[CsvNumber,
+Field(ge=0)]``)."""
