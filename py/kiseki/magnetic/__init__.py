@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Magnetic maps and magnetometers (thesis chapter 6): calibration of the sensors (eq. 6.16),
-field maps from Gaussian-process regression, and localization on them (eqs. 6.17-6.18)."""
+"""Magnetic maps and magnetometers: the linear magnetic map along a taught path (thesis
+chapters 3-4), calibration of the sensors (eq. 6.16), field maps from Gaussian-process
+regression, and localization on them (eqs. 6.17-6.18) (thesis chapter 6)."""
 
 from __future__ import annotations
 
@@ -13,6 +14,14 @@ from kiseki.magnetic.calibration import (
     fit_sphere,
 )
 from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
+from kiseki.magnetic.linear_map import (
+    LinearMagneticMap,
+    build_linear_map,
+    geometric_features,
+    path_identity,
+)
+from kiseki.magnetic.linear_map_folder import OtherPathError, load_linear_map, save_linear_map
+from kiseki.magnetic.linear_map_run import TeachingSamples, linear_map_from_run, teaching_samples
 from kiseki.magnetic.localization import (
     MagneticLocalization,
     MagneticMapModel,
@@ -22,14 +31,24 @@ from kiseki.magnetic.localization import (
 
 __all__ = [
     "EllipsoidCalibration",
+    "LinearMagneticMap",
     "MagneticFieldMap",
     "MagneticLocalization",
     "MagneticMapModel",
     "MagneticMclConfig",
+    "OtherPathError",
     "SphereCalibration",
+    "TeachingSamples",
     "TrainingData",
+    "build_linear_map",
     "calibrated_magnitude",
     "fit_ellipsoid",
     "fit_sphere",
+    "geometric_features",
+    "linear_map_from_run",
+    "load_linear_map",
     "localize_on_magnetic_map",
+    "path_identity",
+    "save_linear_map",
+    "teaching_samples",
 ]

@@ -46,6 +46,7 @@ from kiseki.magnetic.field_map import COMPONENTS, MagneticFieldMap, TrainingData
 __all__ = ["MAP_FILE", "KIND", "check_map_destination", "load_map_folder", "save_map_folder"]
 
 MAP_FILE = "magnetic_map.yaml"
+LINEAR_MAP_FILE = "linear_map.yaml"  # kiseki.magnetic.linear_map_folder.MAP_FILE: refused here
 KIND = "magnetic_field_map"
 FORMAT_VERSION = 1
 LAYERS = tuple(f"{c}_{q}" for q in ("mean", "variance") for c in COMPONENTS)
@@ -349,6 +350,8 @@ def load_map_folder(folder) -> MagneticFieldMap:
     if not folder.is_dir():
         raise _fail(folder, f"not a magnetic field map (a folder holding {MAP_FILE})")
     meta = folder / MAP_FILE
+    if not meta.is_file() and (folder / LINEAR_MAP_FILE).is_file():
+        raise _fail(folder, f"a linear magnetic map ({LINEAR_MAP_FILE}), not a GP one")
     if not meta.is_file():
         raise _fail(meta, "missing: the folder is not a magnetic field map")
     try:
