@@ -26,8 +26,15 @@ from kiseki.sim.magnetic_schema import MAX_LINE_DIPOLES, MAX_WORLD_DIPOLES
 WORLDS = Path(__file__).resolve().parents[2] / "data" / "worlds"
 
 
-def _by_hand(section: dict) -> MagneticWorld:
-    """The world built from the YAML's values with the constructors, without the model."""
+def _by_hand(section: dict, variant: str = "teach") -> MagneticWorld:
+    """The world built from the YAML's values with the constructors, without the model: the
+    sources marked ``only_in`` the other variant left out."""
+
+    def here(key: str) -> list[dict]:
+        items = section.get(key, [])
+        kept = [x for x in items if x.get("only_in", variant) == variant]
+        return [{k: v for k, v in x.items() if k != "only_in"} for x in kept]
+
     earth = section.get("earth_field")
     if isinstance(earth, dict):
         earth = earth_field_from_angles(
@@ -36,9 +43,9 @@ def _by_hand(section: dict) -> MagneticWorld:
     drift = section.get("drift", {})
     return MagneticWorld(
         earth_field=earth,
-        dipoles=[Dipole(**d) for d in section.get("dipoles", [])],
-        lines=[DipoleLine(**ln) for ln in section.get("lines", [])],
-        lattices=[DipoleLattice(**lat) for lat in section.get("lattices", [])],
+        dipoles=[Dipole(**d) for d in here("dipoles")],
+        lines=[DipoleLine(**ln) for ln in here("lines")],
+        lattices=[DipoleLattice(**lat) for lat in here("lattices")],
         gradient=section.get("gradient"),
         gradient_origin=section.get("gradient_origin", (0.0, 0.0, 0.0)),
         **{f"drift_{k}": v for k, v in drift.items()},
@@ -122,7 +129,8 @@ def test_a_section_of_more_dipoles_than_the_limit_is_refused_with_the_limit():
          "dipoles[0].position[2]: must be a valid number, got '1'"),
         ({"dipoles": [{"position": [0, 0, 0], "moment": [0, 0, 1], "radius": 0}]},
          "dipoles[0].radius: must be greater than 0, got 0"),
-        ({"dipoles": [5]}, "dipoles[0]: must be a mapping of position, moment, radius, got 5"),
+        ({"dipoles": [5]},
+         "dipoles[0]: must be a mapping of position, moment, radius, only_in, got 5"),
         ({"lines": [{**_line(1, 0.1), "spacing": float("nan")}]},
          "lines[0].spacing: must be a finite number, got nan"),
         ({"lines": [{**_line(1, 0.1), "colour": "red"}]}, "lines[0].colour: unknown key"),

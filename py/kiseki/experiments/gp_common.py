@@ -61,7 +61,9 @@ SENSOR_NOISE = DEFAULT_NOISE_SD
 def magnetic_world(scene: Scene) -> MagneticWorld:
     if not scene.magnetic:
         raise ValueError(f"{scene.path}: the scene has no 'magnetic' section")
-    return MagneticWorld.from_dict(scene.magnetic, str(scene.path), at=("magnetic",))
+    return MagneticWorld.from_dict(
+        scene.magnetic, str(scene.path), at=("magnetic",), variant=scene.variant
+    )
 
 
 def sensor_to_world(readings: np.ndarray, headings: np.ndarray) -> np.ndarray:

@@ -419,7 +419,11 @@ class MagneticWorld:
 
     @classmethod
     def from_dict(
-        cls, d: Mapping[str, Any], source: str = "<scene>", at: Sequence[str | int] = ()
+        cls,
+        d: Mapping[str, Any],
+        source: str = "<scene>",
+        at: Sequence[str | int] = (),
+        variant: str = "teach",
     ) -> MagneticWorld:
         """Build from a scene file's ``magnetic:`` mapping, checked by
         :class:`kiseki.sim.magnetic_schema.MagneticSection`; every key is optional (defaults as
@@ -431,23 +435,31 @@ class MagneticWorld:
         ``gradient_origin``: ``[x, y, z]``; ``drift``: ``{amplitude?, period?, phase?}``.
         Unknown keys, wrong shapes, non-numbers, NaN, out-of-range values and sections with
         too many dipoles raise a SchemaError (a ValueError) naming ``source``, the key path
-        (after ``at``, e.g. ``("magnetic",)``) and the value."""
+        (after ``at``, e.g. ``("magnetic",)``) and the value. ``variant`` (``teach`` or
+        ``playback``, as :func:`kiseki.sim.scene.load_scene`'s) keeps the sources marked
+        ``only_in`` that variant and drops those marked with the other one."""
         from kiseki.sim.magnetic_lattice import DipoleLattice  # it builds on this module
         from kiseki.sim.magnetic_schema import EarthAngles, MagneticSection
 
+        if variant not in ("teach", "playback"):
+            raise ValueError(f"{source}: variant must be teach or playback, got {variant!r}")
         spec = parse(MagneticSection, d, source, at=at)
         given = spec.model_fields_set
+
+        def here(items: Iterable[Any]) -> list[Any]:
+            return [x for x in items if x.only_in is None or x.only_in == variant]
+
         kwargs: dict[str, Any] = {
-            "dipoles": [Dipole(x.position, x.moment, x.radius) for x in spec.dipoles],
+            "dipoles": [Dipole(x.position, x.moment, x.radius) for x in here(spec.dipoles)],
             "lines": [
                 DipoleLine(x.start, x.end, x.moment_per_metre, x.spacing, x.radius)
-                for x in spec.lines
+                for x in here(spec.lines)
             ],
             "lattices": [
                 DipoleLattice(
                     x.lower, x.upper, x.spacing, x.moment_sd, x.moment_mean, x.seed, x.radius
                 )
-                for x in spec.lattices
+                for x in here(spec.lattices)
             ],
         }
         earth = spec.earth_field

@@ -15,6 +15,10 @@
       gradient_origin: [0, 0, 0]
       drift: {amplitude: 0.01, period: 86400, phase: 0}
 
+A dipole, line or lattice may carry ``only_in: teach`` or ``only_in: playback``, as a scene's
+objects do: the source is then in that variant's field only (steel added or moved after
+teaching, the time-varying field of the thesis' Table 4.2).
+
 What sizes time is limited, the limit in the message: a line's dipoles (its length over its
 spacing, :data:`MAX_LINE_DIPOLES`), a lattice's (its volume over spacing^3,
 :data:`~kiseki.sim.magnetic_lattice.MAX_LATTICE_DIPOLES`) and the whole section's
@@ -86,6 +90,8 @@ def _pair(value: Any) -> Any:
 
 Pair = Annotated[tuple[FiniteFloat, FiniteFloat], BeforeValidator(_pair)]
 Inclination = Annotated[float, Field(strict=True, ge=-90, le=90, allow_inf_nan=False)]
+#: The variant a source is in (None: both), as a scene object's ``only_in``.
+OnlyIn = Literal["teach", "playback"] | None
 
 
 class _Section(FileModel):
@@ -128,6 +134,7 @@ class DipoleSpec(_Section):
     position: Vector
     moment: Vector
     radius: PositiveFloat = 0.02  # kiseki.sim.magnetic.DEFAULT_DIPOLE_RADIUS
+    only_in: OnlyIn = None
 
 
 def line_dipoles(length: float, spacing: float) -> int:
@@ -150,6 +157,7 @@ class LineSpec(_Section):
     moment_per_metre: Vector
     spacing: PositiveFloat = 0.1
     radius: PositiveFloat | None = None
+    only_in: OnlyIn = None
 
     @field_validator("end")
     @classmethod
@@ -187,6 +195,7 @@ class LatticeSpec(_Section):
     moment_mean: Vector = (0.0, 0.0, 0.0)
     seed: Seed = 0
     radius: PositiveFloat | None = None
+    only_in: OnlyIn = None
 
     @field_validator("upper")
     @classmethod

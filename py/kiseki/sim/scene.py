@@ -6,7 +6,8 @@ meaningful run.
 
 Top-level keys: name, description, source, bounds {min: [x, y, z], max: [x, y, z]}, floor,
 octomap (a .bt file instead of, or beside, objects), objects (list of primitives, see
-kiseki.sim.primitives; an object may carry ``only_in: teach`` or ``only_in: playback``),
+kiseki.sim.primitives; an object, and a magnetic source, may carry ``only_in: teach`` or
+``only_in: playback``),
 grid_resolution, robot {type, start [x, y, yaw_deg], params, odometry_errors}, sensors (list),
 route {waypoints [[x, y], ...], speed}, magnetic (see kiseki.sim.magnetic), measurement_grid
 {lower: [x, y, z], upper: [x, y, z], spacing} (where the field is surveyed or scored, see
@@ -64,7 +65,8 @@ class Scene:
     robot: dict = field(default_factory=dict)
     sensors: list = field(default_factory=list)
     route: dict = field(default_factory=dict)
-    magnetic: dict | None = None
+    magnetic: dict | None = None  # the file's section; its sources may carry only_in
+    variant: str = "teach"  # which objects and magnetic sources marked only_in are in
     measurement_grid: MeasurementGrid | None = None  # where the magnetic field is surveyed
     description: str = ""
     source: str = ""
@@ -114,8 +116,10 @@ def _boxes(doc: SceneDoc, variant: str) -> BoxList:
 
 def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
     """Reads a scene file. ``variant`` selects objects marked ``only_in`` (a bicycle park that
-    changes between teaching and playback). A :class:`~kiseki._schema.SchemaError` (a
-    ValueError) names the file, the field and the value of what does not match."""
+    changes between teaching and playback), and magnetic sources so marked (``Scene.variant``:
+    build the field with ``MagneticWorld.from_dict(scene.magnetic, variant=scene.variant)``).
+    A :class:`~kiseki._schema.SchemaError` (a ValueError) names the file, the field and the
+    value of what does not match."""
     path = Path(path)
     if variant not in VARIANTS:
         raise ValueError(f"variant must be teach or playback, got {variant!r}")
@@ -163,6 +167,7 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
         sensors=specs[0]["sensors"],
         route=specs[0]["route"],
         magnetic=raw.get("magnetic"),
+        variant=variant,
         measurement_grid=_measurement_grid(doc, path),
         description=doc.description,
         source=doc.source,

@@ -163,7 +163,9 @@ def build_sensors(
     robot_at = _robot_at(scene, index)
     out: list[SensorSetup] = []
     magnetic = (
-        MagneticWorld.from_dict(scene.magnetic, str(scene.path), at=("magnetic",))
+        MagneticWorld.from_dict(
+            scene.magnetic, str(scene.path), at=("magnetic",), variant=scene.variant
+        )
         if scene.magnetic
         else None
     )
