@@ -283,3 +283,25 @@ def test_simulated_teaching_run_matches_the_simulator_field(tmp_path, project_da
     assert 0.7 < np.mean(z**2) < 1.35  # the averaging divides the noise variance by the count
     # the walls 3.85 m either side until x = 20 m (the minimum of noisy beams reads a bit short)
     np.testing.assert_allclose(lmap.g[filled][lmap.position[filled, 0] < 15], 3.8, atol=0.1)
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (("nodes: 3", "nodes: 4"), r"nodes\.npz: 's' is float64 \(3,\), expected \(4,\)"),
+        (("units: G", "units: uT"), r"linear_map\.yaml: units: must be 'G'"),
+        (("node_spacing: 0.1", "node_spacing: -0.1"), "node_spacing: must be greater than 0"),
+        (("first_node_s: 0.0", "first_node_s: 1.0"), "'s' disagrees with first_node_s"),
+        (("kind: linear_magnetic_map", "kind: magnetic_field_map"), "a GP magnetic map"),
+        (("files:", "colour: red\nfiles:"), "colour: unknown key"),
+    ],
+)
+def test_malformed_folder_is_refused(tmp_path, edit, message):
+    lmap = build_linear_map([0.0, 0.1, 0.2], [[0.1, 0.2, 0.3]] * 3, [0, 0, 0], path_id=PATH)
+    folder = save_linear_map(lmap, tmp_path / "map")
+    meta = folder / "linear_map.yaml"
+    text = meta.read_text()
+    assert edit[0] in text
+    meta.write_text(text.replace(edit[0], edit[1]))
+    with pytest.raises(ValueError, match=message):
+        load_linear_map(folder)
