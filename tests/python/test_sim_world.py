@@ -151,18 +151,22 @@ def test_depth_camera_sees_table_tops_sideways():
 
 
 def test_tilting_laser_follows_equation_two():
-    params = TiltingLaserParams(noise_sd=0.0, gyro_sd_deg=0.0)
+    # eq. 2's magnitudes with theta < 0 looking down (kiseki.sim.tilting_laser says why)
+    exact = dict(noise_sd=0.0, gyro_sd_deg=0.0, gyro_bias_sd_deg_s=0.0, gyro_arw_deg_rt_s=0.0)
+    params = TiltingLaserParams(**exact)
     laser = TiltingLaser(params, seed=0)
     sensor = np.eye(4)
     sensor[2, 3] = 1.0  # 1 m above the floor, looking along +x at a wall at x = 3
-    ranges, gyro = laser.scan(wall_world(3.0), sensor)
+    ranges, gyro = laser.scan(wall_world(3.0), sensor, 100.0)
     tilt, scan = params.grid()
     i0, j0 = int(np.argmin(np.abs(tilt))), int(np.argmin(np.abs(scan)))
     assert ranges[i0, j0] == pytest.approx(3.0, abs=1e-9)  # horizontal ray hits the wall
-    i30 = int(np.argmin(np.abs(tilt - math.radians(30))))
+    i30 = int(np.argmin(np.abs(tilt + math.radians(30))))
     assert ranges[i30, j0] == pytest.approx(1.0 / math.sin(math.radians(30)), abs=1e-9)  # floor
-    up = int(np.argmin(np.abs(tilt + math.radians(90))))
-    assert np.isnan(ranges[up, j0])  # straight up: nothing within the usable 5 m
+    down = int(np.argmin(np.abs(tilt + math.radians(90))))
+    assert ranges[down, j0] == pytest.approx(1.0, abs=1e-9)  # straight down
+    up = int(np.argmin(np.abs(tilt - math.radians(30))))
+    assert ranges[up, j0] == pytest.approx(3.0 / math.cos(math.radians(30)), abs=1e-9)  # wall
     np.testing.assert_allclose(gyro, 0.0, atol=1e-12)
 
 

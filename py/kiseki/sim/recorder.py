@@ -148,7 +148,7 @@ class Recorder:
             )
         elif s.kind == "tilting_laser":
             sensor = s.mount.world(pose)
-            ranges, gyro = s.device.scan(self.scene.world, sensor)
+            ranges, gyro = s.device.scan(self.scene.world, sensor, t)
             tilt, scan = s.device.params.grid()
             w.write_json(
                 topic,

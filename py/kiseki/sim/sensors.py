@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """Range sensors of the papers: 2-D laser scanners, the Xtion-like depth camera and the tilting
-laser of the rubble paper. Geometry is ray cast in C++; noise is applied here with kiseki's
-seeded generator. Every parameter names its source (datasheet, paper, or stated assumption).
+laser of the rubble paper (kiseki.sim.tilting_laser, importable from here too). Geometry is ray
+cast in C++; noise is applied here with kiseki's seeded generator. Every parameter names its
+source (datasheet, paper, or stated assumption).
 """
 
 from __future__ import annotations
@@ -15,9 +16,10 @@ import numpy as np
 from pydantic import ConfigDict, Field, model_validator
 from pydantic.dataclasses import dataclass as pydantic_dataclass
 
-from kiseki._schema import FiniteFloat, NonNegativeFloat, PositiveFloat
+from kiseki._schema import NonNegativeFloat, PositiveFloat
 from kiseki.core import Random, check_seed
 from kiseki.grid import OccupancyGrid, beam_angles
+from kiseki.sim.pose6 import pose_matrix
 from kiseki.sim.primitives import rotation
 
 __all__ = [
@@ -25,15 +27,24 @@ __all__ = [
     "MAX_BEAMS",
     "MAX_IMAGE_SIDE",
     "MAX_RANGE",
-    "MAX_TILT_RAYS",
     "DepthCamera",
     "DepthCameraParams",
     "Laser2D",
     "LaserParams",
     "Mount",
-    "TiltingLaser",
-    "TiltingLaserParams",
 ]
+
+
+_TILTING = ("MAX_TILT_RAYS", "TiltingLaser", "TiltingLaserParams")
+
+
+def __getattr__(name: str):
+    """The tilting laser moved to kiseki.sim.tilting_laser (which imports this module)."""
+    if name in _TILTING:
+        from kiseki.sim import tilting_laser
+
+        return getattr(tilting_laser, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 # Limits on what sizes memory and time: rays cast per reading and how far each goes.
@@ -41,8 +52,6 @@ MAX_BEAMS = 10_000
 """Beams of one planar scan (the densest 2-D scanners have a few thousand)."""
 MAX_IMAGE_SIDE = 4096
 """Pixels along each side of a depth image."""
-MAX_TILT_RAYS = 1_000_000
-"""Rays of one tilting-laser sweep (the paper's 1 deg grid has 151 x 181 = 27,331)."""
 MAX_RANGE = 1000.0
 """Metres a range sensor's ray is cast."""
 
@@ -56,27 +65,34 @@ ImageSide = Annotated[int, Field(strict=True, ge=1, le=MAX_IMAGE_SIDE)]
 
 @dataclass(frozen=True)
 class Mount:
-    """A sensor's pose on the robot: body frame x forward, y left, z up (metres, degrees)."""
+    """A sensor's pose on the robot: body frame x forward, y left, z up (metres, degrees);
+    rotation Rz(yaw) Ry(pitch) Rx(roll)."""
 
     x: float = 0.0
     y: float = 0.0
     z: float = 0.0
     yaw_deg: float = 0.0
     pitch_deg: float = 0.0
+    roll_deg: float = 0.0
 
     def matrix(self) -> np.ndarray:
         m = np.eye(4)
-        m[:3, :3] = rotation(math.radians(self.yaw_deg), math.radians(self.pitch_deg))
+        m[:3, :3] = rotation(
+            *(math.radians(a) for a in (self.yaw_deg, self.pitch_deg, self.roll_deg))
+        )
         m[:3, 3] = [self.x, self.y, self.z]
         return m
 
     def world(self, robot_pose) -> np.ndarray:
-        """The mount's 4x4 pose in the world for a planar robot pose (x, y, theta)."""
-        x, y, th = (float(v) for v in robot_pose)
-        body = np.eye(4)
-        body[:3, :3] = rotation(th)
-        body[:2, 3] = [x, y]
-        return body @ self.matrix()
+        """The mount's 4x4 pose in the world for a planar robot pose (x, y, theta) on level
+        ground at z = 0, or a 6-DOF pose (x, y, z, roll, pitch, yaw; radians, see
+        kiseki.sim.pose6)."""
+        values = [float(v) for v in robot_pose]
+        if len(values) == 3:
+            values = [values[0], values[1], 0.0, 0.0, 0.0, values[2]]
+        if len(values) != 6:
+            raise ValueError(f"robot_pose: expected (x, y, theta) or 6 values, got {len(values)}")
+        return pose_matrix(*values) @ self.matrix()
 
     def planar(self, robot_pose) -> np.ndarray:
         x, y, th = (float(v) for v in robot_pose)
@@ -224,90 +240,6 @@ class DepthCamera:
         out = np.where(valid & (disparity > 0), fb / np.where(disparity > 0, disparity, 1.0), 0.0)
         out[(out < p.min_range) | (out >= p.max_range)] = 0.0
         return out.astype(np.float32)
-
-
-@_params
-class TiltingLaserParams:
-    """The rubble paper's tilting laser: tilt theta -120..30 deg, scan phi -90..90 deg, 1 deg
-    steps, 5 mm accuracy (taken as 1 sigma), 8 m range of which r < 5 m is used; attitude from
-    a 3-axis gyro whose error per axis is a stated assumption (0.5 deg, 1 sigma)."""
-
-    tilt_min_deg: FiniteFloat = -120.0
-    tilt_max_deg: FiniteFloat = 30.0
-    scan_min_deg: FiniteFloat = -90.0
-    scan_max_deg: FiniteFloat = 90.0
-    step_deg: Annotated[float, Field(strict=True, gt=0, le=360, allow_inf_nan=False)] = 1.0
-    noise_sd: NonNegativeFloat = 0.005
-    max_range: Range = 8.0
-    usable_range: PositiveFloat = 5.0
-    gyro_sd_deg: NonNegativeFloat = 0.5
-
-    @model_validator(mode="after")
-    def _consistent(self) -> TiltingLaserParams:
-        for name in ("tilt", "scan"):
-            low, high = getattr(self, f"{name}_min_deg"), getattr(self, f"{name}_max_deg")
-            if not -360.0 <= low <= high <= 360.0:
-                raise ValueError(
-                    f"{name}_min_deg <= {name}_max_deg must lie in [-360, 360] deg, "
-                    f"got {low} and {high}"
-                )
-        rays = self.ray_count
-        if rays > MAX_TILT_RAYS:
-            raise ValueError(
-                f"step_deg {self.step_deg} gives {rays:,} rays per sweep, "
-                f"above the limit of {MAX_TILT_RAYS:,}"
-            )
-        return self
-
-    @property
-    def ray_count(self) -> int:
-        """Rays of one sweep: the sizes of :meth:`grid` (as numpy's arange counts them), without
-        making the grid."""
-
-        def count(low: float, high: float) -> int:
-            return max(0, math.ceil((high + 1e-9 - low) / self.step_deg))
-
-        return count(self.tilt_min_deg, self.tilt_max_deg) * count(
-            self.scan_min_deg, self.scan_max_deg
-        )
-
-    def grid(self) -> tuple[np.ndarray, np.ndarray]:
-        tilt = np.arange(self.tilt_min_deg, self.tilt_max_deg + 1e-9, self.step_deg)
-        scan = np.arange(self.scan_min_deg, self.scan_max_deg + 1e-9, self.step_deg)
-        return np.radians(tilt), np.radians(scan)
-
-
-class TiltingLaser:
-    def __init__(self, params: TiltingLaserParams, seed: int) -> None:
-        self.params, self.rng = params, Random(seed)
-
-    @staticmethod
-    def directions(tilt: np.ndarray, scan: np.ndarray) -> np.ndarray:
-        """Unit rays (len(tilt), len(scan), 3) in the sensor frame, the paper's eq. 2:
-        x = cos th cos ph, y = sin ph, z = -sin th cos ph."""
-        th, ph = np.meshgrid(tilt, scan, indexing="ij")
-        return np.stack([np.cos(th) * np.cos(ph), np.sin(ph), -np.sin(th) * np.cos(ph)], axis=-1)
-
-    def scan(self, world, sensor_pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Ranges r(theta, phi) (NaN beyond the usable range) from a 4x4 sensor pose, and the
-        attitude the gyro reports (roll, pitch, yaw in rad, with its error)."""
-        p = self.params
-        tilt, scan = self.params.grid()
-        dirs = self.directions(tilt, scan).reshape(-1, 3) @ sensor_pose[:3, :3].T
-        origins = np.broadcast_to(sensor_pose[:3, 3], dirs.shape)
-        r = world.cast_many(np.ascontiguousarray(origins), dirs, p.max_range)
-        r = r + self.rng.normal(0.0, p.noise_sd, r.size)
-        r[(r >= p.usable_range) | (r <= 0)] = np.nan
-        m = sensor_pose[:3, :3]
-        true = np.array(
-            [
-                math.atan2(m[2, 1], m[2, 2]),
-                -math.asin(max(-1, min(1, m[2, 0]))),
-                math.atan2(m[1, 0], m[0, 0]),
-            ]
-        )
-        gyro = true + np.radians(p.gyro_sd_deg) * self.rng.normal(0.0, 1.0, 3)
-        return r.reshape(len(tilt), len(scan)), gyro
 
 
 @_params

@@ -125,7 +125,7 @@ def build_robot(scene: Scene, seed: int, index: int = 0) -> RobotSetup:
 
 def _mount(spec: Any, scene: Scene, at: tuple[str | int, ...], robot: RobotSetup) -> Mount:
     values = list(spec.mount)
-    mount = Mount(*values[:3], values[3] if len(values) == 4 else 0.0, spec.pitch)
+    mount = Mount(*values[:3], values[3] if len(values) == 4 else 0.0, spec.pitch, spec.roll)
     margin = 0.1
     if (
         abs(mount.x) > robot.length / 2 + margin

@@ -8,7 +8,8 @@ error names the file, the path (``robots[1].sensors[0].rate_hz``) and the value.
 A robot: ``type`` (diff_drive, the default, or omni), ``start`` [x, y, yaw_deg], ``params`` and
 ``odometry_errors`` (the parameter classes of kiseki.sim.robot for that type).
 
-A sensor: ``type``, ``name``, ``mount`` [x, y, z] or [x, y, z, yaw_deg], ``pitch`` (deg),
+A sensor: ``type``, ``name``, ``mount`` [x, y, z] or [x, y, z, yaw_deg], ``pitch`` and ``roll``
+(deg, the mount's rotation Rz(yaw) Ry(pitch) Rx(roll)),
 ``rate_hz`` (at most :data:`MAX_RATE_HZ`), ``params`` (the parameter class of kiseki.sim.sensors
 for that type), and the keys of its type only: ``preset`` (laser), ``width``/``height``
 (depth_camera), ``arm`` (magnetometer), ``targets`` (bearing). A key of another type is an
@@ -128,6 +129,7 @@ class _Sensor(FileModel):
     name: Name | None = None
     mount: MountValues = list(DEFAULT_MOUNT)
     pitch: FiniteFloat = 0.0
+    roll: FiniteFloat = 0.0
     rate_hz: Rate | None = None
 
 
