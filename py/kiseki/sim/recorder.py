@@ -30,10 +30,10 @@ TILT_SCHEMA = {
     "type": "object",
     "title": "kiseki.TiltScan",
     "properties": {
-        "tilt_deg": {"type": "array"},
+        "tilt_deg": {"type": "array", "description": "theta < 0 looks down"},
         "scan_deg": {"type": "array"},
         "ranges": {"type": "array", "description": "row-major (tilt, scan); 0 = no return"},
-        "gyro_rpy": {"type": "array"},
+        "gyro_rpy": {"type": "array", "description": "roll, pitch, yaw (rad) with drift"},
         "sensor_pose": {"type": "array"},
     },
 }
