@@ -15,8 +15,10 @@ import yaml
 
 from kiseki import _core
 from kiseki.sim.gyro import Gyro, error_sd
+from kiseki.sim.mcap_log import read_run
 from kiseki.sim.pose6 import PAPER_MOVES, Pose6, attitude, pose_matrix, terrain_pose
 from kiseki.sim.primitives import BoxList
+from kiseki.sim.run import SimConfig, simulate
 from kiseki.sim.scene import load_scene
 from kiseki.sim.sensors import Mount
 from kiseki.sim.sensors import TiltingLaser as FromSensors
@@ -273,3 +275,36 @@ def test_scene_sets_mount_roll_and_the_new_parameters(tmp_path):
     ):
         with pytest.raises(ValueError, match=rf"rubble\.yaml: {message}"):
             _rubble(tmp_path, params=bad)
+
+
+def test_the_simulated_sweep_rests_on_the_terrain(tmp_path):
+    # a low ramp (3 cm over 2 m, under the 5 cm the planar robot drives over) under the start
+    rise, length, thick = 0.03, 2.0, 0.01
+    doc = {
+        "name": "ramp",
+        "bounds": {"min": [0, 0, -0.1], "max": [4, 4, 2]},
+        "floor": True,
+        "objects": [
+            {
+                "type": "slope",
+                "center": [2, 2],
+                "size": [length, 1.5],
+                "rise": rise,
+                "thickness": thick,
+            },
+        ],  # fmt: skip
+        "robot": {"type": "diff_drive", "start": [2.0, 2.0, 0.0]},
+        "sensors": [{"type": "tilting_laser", "name": "tilt", "mount": [0.2, 0.0, 0.5]}],
+        "route": {"waypoints": [[2, 2], [2.5, 2]], "speed": 0.2},
+    }
+    (tmp_path / "ramp.yaml").write_text(yaml.safe_dump(doc))
+    scene, out = load_scene(tmp_path / "ramp.yaml"), tmp_path / "run.mcap"
+    simulate(scene, out, SimConfig(1.0, seed=2), progress=False)
+    ((_, message),) = read_run(out).messages("/tilt")
+    sensor = np.array(message["sensor_pose"]).reshape(4, 4)
+    alpha = math.atan2(rise, length)  # nose up: pitch -alpha
+    np.testing.assert_allclose(attitude(sensor), [0.0, -alpha, 0.0], atol=1e-9)
+    ground = rise / 2 + thick / (2 * math.cos(alpha))  # the ramp's top under the centre
+    height = ground + 0.2 * math.sin(alpha) + 0.5 * math.cos(alpha)
+    ahead = 0.2 * math.cos(alpha) - 0.5 * math.sin(alpha)
+    np.testing.assert_allclose(sensor[:3, 3], [2.0 + ahead, 2.0, height], atol=1e-9)

@@ -15,6 +15,9 @@ to them by least squares, u along the heading and v to the left; the body's z ax
 plane's normal, so pitch = -atan(g_u) and roll = atan2(g_v, sqrt(1 + g_u^2)), and z = a, the
 plane's height under the centre. A rigid robot on a bump rests on three of its corners, not on
 a plane through four: the fit is a smoothing approximation of a tracked robot's attitude.
+The simulation loop (kiseki.sim.recorder) places each tilting-laser sweep at
+:func:`resting_pose`: on the terrain under the planar robot, cast from the robot's height (the
+planar robot drives only over what is lower than 5 cm, kiseki.sim.collisions.body_grid).
 
 Rotation: R = Rz(yaw) Ry(pitch) Rx(roll) (kiseki.sim.primitives.rotation), right-handed, so a
 positive pitch turns the nose down (x towards -z) and the paper's pitch of -10 deg, on climbing
@@ -30,7 +33,7 @@ import numpy as np
 
 from kiseki.sim.primitives import rotation
 
-__all__ = ["PAPER_MOVES", "Pose6", "attitude", "pose_matrix", "terrain_pose"]
+__all__ = ["PAPER_MOVES", "Pose6", "attitude", "pose_matrix", "resting_pose", "terrain_pose"]
 
 
 def pose_matrix(x: float, y: float, z: float, roll: float, pitch: float, yaw: float) -> np.ndarray:
@@ -122,3 +125,16 @@ def terrain_pose(world, x: float, y: float, yaw: float, length: float, width: fl
     pitch = -math.atan(gu)
     roll = math.atan2(gv, math.sqrt(1.0 + gu * gu))
     return Pose6(float(x), float(y), float(a), roll, pitch, float(yaw))
+
+
+def resting_pose(world, planar_pose, length: float, width: float, height: float) -> Pose6:
+    """The 6-DOF pose of a planar robot (x, y, yaw) of footprint ``length`` x ``width`` and
+    body ``height`` (m): :func:`terrain_pose` cast from ``height``, or level at z = 0 (the
+    planar convention) when some corner has no ground under it (a scene without a floor)."""
+    x, y, yaw = (float(v) for v in planar_pose)
+    try:
+        return terrain_pose(world, x, y, yaw, length, width, from_z=height)
+    except ValueError as exc:
+        if "no ground" not in str(exc):
+            raise
+        return Pose6(x, y, 0.0, 0.0, 0.0, yaw)

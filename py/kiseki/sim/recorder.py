@@ -10,6 +10,7 @@ import numpy as np
 
 from kiseki.sim.mcap_log import RunWriter
 from kiseki.sim.pedestrians import DiscStamp
+from kiseki.sim.pose6 import resting_pose
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import RobotSetup, SensorSetup
 
@@ -147,7 +148,9 @@ class Recorder:
                 BEARING_SCHEMA,
             )
         elif s.kind == "tilting_laser":
-            sensor = s.mount.world(pose)
+            r = self.robot
+            body = resting_pose(self.scene.world, pose, r.length, r.width, r.height)
+            sensor = s.mount.world(body.values)
             ranges, gyro = s.device.scan(self.scene.world, sensor, t)
             tilt, scan = s.device.params.grid()
             w.write_json(
