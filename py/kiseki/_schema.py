@@ -114,6 +114,10 @@ def _problem(err: dict[str, Any], at: Sequence[str | int]) -> str:
         text = "unknown key"
     else:
         text = f"{message[:1].lower()}{message[1:]}, got {_short(err.get('input'))}"
+        value = err.get("input")
+        if err.get("type") == "int_type" and isinstance(value, float) and value.is_integer():
+            # YAML 1.2 reads 1e9 as a float: say how to write the integer
+            text += f" (write it as {int(value)}, without a point or an exponent)"
     return f"{where}: {text}" if where else text
 
 

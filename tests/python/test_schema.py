@@ -73,3 +73,11 @@ def test_a_valid_document_reads_with_yaml_lists_as_tuples_and_ints_as_floats():
 def test_a_list_where_a_mapping_belongs_says_mapping_not_a_python_class():
     err = _error({"sensors": [["name", "a"]], "start": [0, 0, 0]})
     assert str(err) == "scene.yaml: robots[2].sensors[0]: must be a mapping, got ['name', 'a']"
+
+
+def test_an_integer_written_as_a_float_is_told_how_to_write_it():
+    err = _error({"sensors": [{"name": "a", "beams": 1e3}], "start": [0, 0, 0]})
+    assert str(err) == (
+        "scene.yaml: robots[2].sensors[0].beams: must be a valid integer, got 1000.0 "
+        "(write it as 1000, without a point or an exponent)"
+    )
