@@ -18,11 +18,11 @@ import yaml
 
 from kiseki import _core
 from kiseki._atomic import atomic_write
-from kiseki._yaml import read_yaml_file
 from kiseki.grid import OccupancyGrid
 from kiseki.map_io import load_map, write_image
 from kiseki.teach.local_maps import METHODS
 from kiseki.teach.teaching import load_route
+from kiseki.teach.waypoint_schema import read_waypoint_file
 
 __all__ = ["NAME_RULE", "TaughtRun", "WaypointError", "taught_scene"]
 
@@ -44,11 +44,8 @@ def taught_scene(folder: str | os.PathLike) -> str | None:
     when the log is missing or records none)."""
     from kiseki.sim.mcap_log import read_run
 
-    path = Path(folder) / "waypoints.yaml"
-    doc = read_yaml_file(path, "kiseki waypoint file")
-    if not isinstance(doc, dict):
-        raise ValueError(f"{path}: not a kiseki waypoint file")
-    log = Path(folder) / str(doc.get("log", "teach.mcap"))
+    doc = read_waypoint_file(Path(folder) / "waypoints.yaml")
+    log = Path(folder) / (doc.log or "teach.mcap")
     if not log.is_file():
         return None
     return read_run(log).metadata.get("scene_file")
@@ -68,12 +65,10 @@ class TaughtRun:
         self.path = folder / "waypoints.yaml"
         if not self.path.is_file():
             raise FileNotFoundError(f"{self.path}: no waypoint file (run kiseki teach first)")
-        doc = self._read()
-        names = [str(w.get("name")) for w in doc["waypoints"]]
+        doc = self._read()  # names are unique (the model checks it)
+        names = [w["name"] for w in doc["waypoints"]]
         if len(names) < 2:
             raise ValueError(f"{self.path}: {len(names)} waypoint(s); a route needs two")
-        if len(set(names)) != len(names):
-            raise ValueError(f"{self.path}: waypoint names repeat ({', '.join(names)})")
         self.map_path, _ = load_route(self.path, self.band, names)  # checks the map's SHA-1
         self.environment: OccupancyGrid = load_map(self.map_path)
         self.waypoints: list[dict] = [dict(w) for w in doc["waypoints"]]
@@ -81,10 +76,9 @@ class TaughtRun:
         self._png: bytes | None = None
 
     def _read(self) -> dict:
-        doc = read_yaml_file(self.path, "kiseki waypoint file")
-        if not isinstance(doc, dict) or not isinstance(doc.get("waypoints"), list):
-            raise ValueError(f"{self.path}: not a kiseki waypoint file")
-        return doc
+        """The waypoint file checked by its model (:mod:`kiseki.teach.waypoint_schema`: a
+        problem names the file, the field and the value), as plain YAML data."""
+        return read_waypoint_file(self.path).model_dump(mode="json", exclude_none=True)
 
     def by_name(self, name: str) -> dict | None:
         with self._lock:
@@ -154,6 +148,6 @@ class TaughtRun:
             atomic_write(backup, lambda tmp: Path(tmp).write_bytes(previous))
             atomic_write(self.path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
             for w in self.waypoints:
-                if w["id"] == mark["id"]:
+                if w["name"] == old:  # names are unique
                     w["name"] = new
-            return {"id": mark["id"], "name": new, "x": mark["x"], "y": mark["y"]}
+            return {"id": mark.get("id"), "name": new, "x": mark["x"], "y": mark["y"]}
