@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """The files a taught run is read from outside kiseki teach: ``kiseki serve``'s waypoint file
-(kiseki.serve.taught) is read through its model: a valid file reads as before, a hand-edited
-bad one is refused in one line naming the file, the field and the value."""
+(kiseki.serve.taught) and the map YAML a waypoint file is tied to (``--map`` of playback) are
+read through their models: a valid file reads as before, a hand-edited bad one is refused in
+one line naming the file, the field and the value."""
 
 from __future__ import annotations
 
@@ -12,9 +13,11 @@ import hashlib
 import pytest
 import yaml
 
+from kiseki.errors import MapFormatError
 from kiseki.grid import OccupancyGrid
 from kiseki.map_io import save_map
 from kiseki.serve.taught import TaughtRun, taught_scene
+from kiseki.teach.teaching import load_route, waypoints_file_hash
 
 MARKS = [
     {"id": 0, "name": "P0", "x": 0.0, "y": -0.5, "theta": 0.25},
@@ -88,3 +91,29 @@ def test_a_rename_rereads_the_file_through_its_model(tmp_path):
     with pytest.raises(ValueError, match=r"waypoints\[1\]\.y: must be a valid number, got 'north'"):
         run.rename("P0", "Cell A")
     assert path.read_bytes() == before
+
+
+def test_a_map_yaml_is_read_through_its_model(tmp_path):
+    path, _ = _taught(tmp_path)
+    map_yaml = tmp_path / "map_band.yaml"
+    digest = _sha1(tmp_path / yaml.safe_load(map_yaml.read_text())["image"])
+    assert waypoints_file_hash(map_yaml) == digest  # a valid map reads as before
+    meta = yaml.safe_load(map_yaml.read_text())
+    other = tmp_path / "other.yaml"
+    for edit, problem in [
+        (lambda m: m.pop("image"), "image: missing"),
+        (lambda m: m.update(image=3), "image: must be a valid string, got 3"),
+        (lambda m: m.update(resolution=-0.1), "resolution: must be greater than 0, got -0.1"),
+    ]:
+        changed = dict(meta)
+        edit(changed)
+        other.write_text(yaml.safe_dump(changed))
+        with pytest.raises(MapFormatError) as err:
+            waypoints_file_hash(other)
+        assert str(err.value) == f"{other}: {problem}"
+        with pytest.raises(ValueError) as err:  # kiseki playback --map other.yaml
+            load_route(path, "band", ["P0", "P1"], other)
+        assert "\n" not in str(err.value) and f"{other}: {problem}" in str(err.value)
+    other.write_text(yaml.safe_dump({**meta, "image": "gone.pgm"}))
+    with pytest.raises(ValueError, match=r"other.yaml: cannot read the image it names \(.*gone"):
+        load_route(path, "band", ["P0", "P1"], other)

@@ -105,7 +105,7 @@ def _route(scene: Scene, robot: str) -> tuple[np.ndarray, float]:
     route = spec["route"]
     if "waypoints" not in route:
         raise ValueError(f"{scene.path}: robot {robot!r} has no route")
-    return np.asarray(route["waypoints"], dtype=float), float(route.get("speed", 0.5))
+    return np.asarray(route["waypoints"], dtype=float), route["speed"]
 
 
 @dataclass(frozen=True)

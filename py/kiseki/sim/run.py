@@ -121,7 +121,7 @@ def _agents(scene: Scene, config: SimConfig, commands, controller) -> list[_Agen
         if commands is None and controller is None and "waypoints" in route:
             pursuit = PurePursuit(
                 route["waypoints"],
-                float(route.get("speed", 0.5)),
+                route["speed"],
                 config.lookahead,
                 config.goal_tolerance,
                 setup.robot.params.max_accel,

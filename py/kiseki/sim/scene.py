@@ -225,7 +225,7 @@ def _robot_specs(doc: SceneDoc) -> list[dict]:
                 "name": "robot",
                 "robot": dict(doc.robot or {}),
                 "sensors": list(doc.sensors or []),
-                "route": dict(doc.route or {}),
+                "route": doc.route.as_dict() if doc.route else {},
             }
         ]
     specs = []
@@ -237,7 +237,7 @@ def _robot_specs(doc: SceneDoc) -> list[dict]:
                 "name": entry.name,
                 "robot": robot,
                 "sensors": list(entry.sensors or []),
-                "route": dict(entry.route or {}),
+                "route": entry.route.as_dict() if entry.route else {},
             }
         )
     return specs

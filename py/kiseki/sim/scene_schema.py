@@ -4,9 +4,10 @@
 checked by :mod:`kiseki._schema`: name, description, source, bounds, floor, octomap, objects
 (:mod:`kiseki.sim.primitives_schema`), grid_resolution, measurement_grid, robots (their name
 and the sections kiseki.sim.setup and kiseki.sim.robot read), turns, poses, pedestrians and
-point_robots. ``robot``, ``sensors``, ``route`` and each robot's ``type``, ``start``, ``params``,
-``odometry_errors`` are read by kiseki.sim.setup / kiseki.sim.robot, ``magnetic`` by
-kiseki.sim.magnetic: here only their shape (a mapping, a list) is checked.
+point_robots, and ``route`` (:class:`Route`, ``route: {}`` is none). ``robot``, ``sensors`` and
+each robot's ``type``, ``start``, ``params``, ``odometry_errors`` are read by kiseki.sim.setup /
+kiseki.sim.robot, ``magnetic`` by kiseki.sim.magnetic: here only their shape (a mapping, a list)
+is checked.
 
 Limits on what sizes a run: the boxes the objects expand to (every box is ray cast by every
 sensor: 200,000 boxes take about 12 s to build), the ground truth's cells
@@ -19,7 +20,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any
 
-from pydantic import Field, field_validator, model_validator
+from pydantic import BeforeValidator, Field, field_validator, model_validator
 from pydantic_core import PydanticCustomError, ValidationError
 
 from kiseki._schema import FileModel, FiniteFloat, NonNegativeFloat, PositiveFloat
@@ -31,8 +32,11 @@ __all__ = [
     "MAX_POSES",
     "MAX_PEDESTRIANS",
     "MAX_ROBOTS",
+    "MAX_ROUTE_NAME_LENGTH",
+    "MAX_ROUTE_POINTS",
     "MAX_SCENE_BOXES",
     "MAX_TURN_MOVES",
+    "Route",
     "SceneDoc",
     "extent_problem",
 ]
@@ -42,10 +46,13 @@ MAX_ROBOTS = 100  # each renders its sensors every step
 MAX_PEDESTRIANS = 1_000  # each is stamped into every laser's grid every scan
 MAX_TURN_MOVES = 10_000
 MAX_POSES = 10_000
+MAX_ROUTE_POINTS = 10_000  # as a waypoint file's marks (kiseki.teach.waypoint_schema)
+MAX_ROUTE_NAME_LENGTH = 64  # as a waypoint file's names: teaching marks the named points
 
 XY = tuple[FiniteFloat, FiniteFloat]
 XYZ = tuple[FiniteFloat, FiniteFloat, FiniteFloat]
 Name = Annotated[str, Field(strict=True, min_length=1)]
+RouteName = Annotated[str, Field(strict=True, min_length=1, max_length=MAX_ROUTE_NAME_LENGTH)]
 
 
 def fail(loc: tuple[str | int, ...], value: Any, message: str) -> ValidationError:
@@ -84,6 +91,58 @@ class MeasurementGridDoc(FileModel):
         return self
 
 
+def _empty_is_none(value: Any) -> Any:
+    """``route: {}`` is no route."""
+    return None if value == {} else value
+
+
+class Route(FileModel):
+    """``{waypoints: [[x, y], ...], names: [NAME, ...], speed: m/s}``: the path a robot is
+    driven along (pure pursuit, kiseki.control.PurePursuit) at ``speed`` (0.5 m/s when not
+    given); ``names`` (one per waypoint) are the waypoints teaching marks, so they follow the
+    waypoint file's rule for names (kiseki.teach.waypoint_schema: unique, 1 to 64 characters)."""
+
+    waypoints: Annotated[list[XY], Field(min_length=2, max_length=MAX_ROUTE_POINTS)]
+    names: list[RouteName] | None = None
+    speed: Annotated[float, Field(strict=True, gt=0, le=5, allow_inf_nan=False)] = 0.5
+
+    @field_validator("waypoints")
+    @classmethod
+    def _legs(cls, points: list[tuple[float, float]]) -> list[tuple[float, float]]:
+        for i in range(1, len(points)):
+            if points[i] == points[i - 1]:
+                raise fail((i,), list(points[i]), "consecutive waypoints must differ")
+        return points
+
+    @field_validator("names")
+    @classmethod
+    def _unique_names(cls, names: list[str] | None) -> list[str] | None:
+        for i, name in enumerate(names or []):
+            if name in names[:i]:
+                raise fail((i,), name, "waypoint names must be unique")
+        return names
+
+    @model_validator(mode="after")
+    def _one_name_each(self) -> Route:
+        if self.names is not None and len(self.names) != len(self.waypoints):
+            raise fail(
+                ("names",),
+                self.names,
+                f"must give one name per waypoint ({len(self.waypoints)})",
+            )
+        return self
+
+    def as_dict(self) -> dict:
+        """The route as kiseki.sim.scene.Scene holds it: waypoints as lists, names when given."""
+        out: dict[str, Any] = {"waypoints": [list(p) for p in self.waypoints], "speed": self.speed}
+        if self.names is not None:
+            out["names"] = list(self.names)
+        return out
+
+
+RouteSection = Annotated[Route | None, BeforeValidator(_empty_is_none)]
+
+
 class RobotEntry(FileModel):
     """One of ``robots``: its name; the rest is read by kiseki.sim.setup and kiseki.sim.robot."""
 
@@ -93,7 +152,7 @@ class RobotEntry(FileModel):
     params: Any = None
     odometry_errors: Any = None
     sensors: list[Any] | None = None
-    route: dict[str, Any] | None = None
+    route: RouteSection = None
 
 
 class Move(FileModel):
@@ -197,7 +256,7 @@ class SceneDoc(FileModel):
     grid_resolution: PositiveFloat = 0.05
     robot: dict[str, Any] | None = None
     sensors: list[Any] | None = None
-    route: dict[str, Any] | None = None
+    route: RouteSection = None
     magnetic: dict[str, Any] | None = None
     measurement_grid: MeasurementGridDoc | None = None
     robots: Annotated[list[RobotEntry], Field(min_length=1, max_length=MAX_ROBOTS)] | None = None
@@ -235,7 +294,9 @@ class SceneDoc(FileModel):
     def _together(self) -> SceneDoc:
         single = [k for k in ("robot", "sensors", "route") if getattr(self, k) is not None]
         if self.robots is not None and single:
-            raise fail((single[0],), getattr(self, single[0]), "give 'robots' or this, not both")
+            given = getattr(self, single[0])
+            given = given.as_dict() if isinstance(given, Route) else given
+            raise fail((single[0],), given, "give 'robots' or this, not both")
         if self.floor and self.bounds is None:
             raise fail(("floor",), True, "'floor: true' needs 'bounds'")
         if self.point_robots and self.robots is None:
@@ -246,7 +307,8 @@ class SceneDoc(FileModel):
         if self.turns is not None:
             routes = [self.route] if self.robots is None else [r.route for r in self.robots]
             if any(routes):
-                raise fail(("turns",), routes, "a scene with 'turns' gives its robots no routes")
+                given = [r.as_dict() if r else None for r in routes]
+                raise fail(("turns",), given, "a scene with 'turns' gives its robots no routes")
             names = self.robot_names()
             for i, move in enumerate(self.turns.moves):
                 if move.robot not in names:

@@ -23,11 +23,10 @@ import yaml
 from tqdm import tqdm
 
 from kiseki._atomic import atomic_write_all, check_writable_folder, reworded
-from kiseki._yaml import read_yaml_file
 from kiseki.control import PurePursuit
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
-from kiseki.map_io import map_files
+from kiseki.map_io import map_files, read_map_metadata
 from kiseki.metrics import taught_map_truth
 from kiseki.sim.mcap_log import RunWriter, read_run
 from kiseki.sim.scene import Scene
@@ -81,10 +80,10 @@ def _environment(scene: Scene, resolution: float = 0.1, margin: float = 4.0) -> 
 
 
 def waypoints_file_hash(map_yaml: Path) -> str:
-    """SHA-1 of the map image beside a map YAML: ties a waypoint file to the map it was taught
-    with."""
-    meta = read_yaml_file(map_yaml, "ROS map YAML")
-    return hashlib.sha1((Path(map_yaml).parent / meta["image"]).read_bytes()).hexdigest()
+    """SHA-1 of the map image a map YAML names: ties a waypoint file to the map it was taught
+    with. The YAML is read through its model (:func:`kiseki.map_io.read_map_metadata`): a
+    MapFormatError names the file, the key and the value; an OSError the image."""
+    return hashlib.sha1(read_map_metadata(map_yaml).image.read_bytes()).hexdigest()
 
 
 def measure_taught_maps(
@@ -331,11 +330,11 @@ def teach(
     route = scene.route
     if not route.get("waypoints"):
         raise ValueError(f"{scene.path}: scripted teaching needs a route (or use the keyboard)")
-    names = list(route.get("names") or [f"W{i}" for i in range(len(route["waypoints"]))])
+    names = route.get("names") or [f"W{i}" for i in range(len(route["waypoints"]))]
     with TeachingRun(scene, out, seed, dt, overwrite, {"names": ",".join(names)}, merge) as run:
         controller = PurePursuit(
             route["waypoints"],
-            float(route.get("speed", 0.5)),
+            route["speed"],
             0.6,
             0.1,
             run.setup.robot.params.max_accel,
@@ -457,8 +456,10 @@ def load_route(
         raise FileNotFoundError(f"{map_path}: the taught map is missing{named}")
     try:
         digest = waypoints_file_hash(map_path)
-    except (OSError, yaml.YAMLError, KeyError, TypeError) as e:
-        raise ValueError(f"{map_path}: not a ROS map YAML with its image beside it ({e})") from e
+    except OSError as e:  # the image (a bad YAML is a MapFormatError naming file, key, value)
+        raise ValueError(
+            f"{map_path}: cannot read the image it names ({e.filename}: {e.strerror})"
+        ) from e
     if digest != doc.maps[band].image_sha1:
         others = [b for b, m in doc.maps.items() if m.image_sha1 == digest]
         if others:
