@@ -4,7 +4,6 @@
 
 from __future__ import annotations
 
-import csv
 import math
 import time
 from pathlib import Path
@@ -234,38 +233,6 @@ def _report_fit(fmap, output: Path, kernels, lml: list, used: int, read: int, se
     )
 
 
-def _read_points(path: Path, d: int) -> tuple[np.ndarray, bool]:
-    """(points (m, d), whether a z column was dropped) from a CSV whose header names x, y[, z]."""
-    try:
-        with path.open(newline="", encoding="utf-8") as f:
-            rows = [r for r in csv.reader(f) if any(cell.strip() for cell in r)]
-    except UnicodeDecodeError:
-        raise ValueError(f"{path}: not a CSV file (not UTF-8 text)") from None
-    if not rows:
-        raise ValueError(f"{path}: empty file: expected a header x,y[,z] and rows")
-    names = [n.strip().lower() for n in rows[0]]
-    need = ("x", "y", "z")[:d]
-    missing = [n for n in need if n not in names]
-    if missing:
-        raise ValueError(f"{path}: the header has no {', '.join(missing)} column (got {rows[0]})")
-    columns = [names.index(n) for n in need]
-    points = np.empty((len(rows) - 1, d))
-    for i, row in enumerate(rows[1:]):
-        try:
-            points[i] = [float(row[c]) for c in columns]
-        except (ValueError, IndexError):
-            raise ValueError(
-                f"{path}: line {i + 2}: expected numbers in {', '.join(need)}"
-            ) from None
-    if len(points) == 0:
-        raise ValueError(f"{path}: header but no points")
-    if not np.all(np.isfinite(points)):
-        raise ValueError(
-            f"{path}: line {int(np.argmax(~np.isfinite(points).all(1))) + 2}: not finite"
-        )
-    return points, d == 2 and "z" in names
-
-
 @magnetic_app.command("predict")
 @interruptible()
 def predict(
@@ -284,10 +251,11 @@ def predict(
     Example: kiseki magnetic predict hall-map --at points.csv -o field.csv"""
     from kiseki._atomic import atomic_write
     from kiseki.magnetic.field_map import MagneticFieldMap
+    from kiseki.magnetic.points_csv import read_points
 
     check_outputs({"-o": output}, {"--at": at, **_map_files(map_folder)})
     fmap = MagneticFieldMap.load(map_folder)
-    points, dropped = _read_points(at, fmap.dimension)
+    points, dropped = read_points(at, fmap.dimension)
     exact = fmap.training is not None and not interpolate
     start = time.perf_counter()
     mean, var = fmap.predict(points) if exact else fmap.value_at(points)

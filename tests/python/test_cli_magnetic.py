@@ -216,6 +216,10 @@ def inputs(tmp_path_factory):
         (["fit", "runs/9", "-o", "x"], "not an Aalto run"),
         (["fit", "d.csv", "-o", "nodir/x"], "does not exist"),
         (["predict", "m", "--at", "noy.csv", "-o", "o.csv"], "no y column"),
+        (
+            ["predict", "m", "--at", "nan.csv", "-o", "o.csv"],
+            "nan.csv:3: y: must be a finite number, got 'nan'",
+        ),
         (["predict", "m", "--at", "p.csv", "-o", "m/layers.npz"], "would overwrite"),
         (["predict", "m", "--at", "p.csv", "-o", "p.csv"], "would overwrite"),
         (["predict", "stuff", "--at", "p.csv", "-o", "o.csv"], "magnetic_map.yaml"),
