@@ -260,7 +260,8 @@ def test_fig_3_14_refuses_settings_that_make_its_claims_meaningless(tmp_path):
     from kiseki.experiments.fig_3_14 import Fig314Config
 
     for setting, needle in (
-        ("beams=0", "beams must be >= 2, got 0"),
+        ("beams=0", "--set: beams: must be greater than 0, got 0"),  # the model's own limit
+        ("beams=1", "beams must be >= 2, got 1"),
         ("offsets=1", "offsets must be >= 3"),
         ("max_offset=nan", "--set: max_offset: must be a finite number, got nan"),
         ("flat_ratio=2", "flat_ratio must be in (0, 1]"),
@@ -269,9 +270,9 @@ def test_fig_3_14_refuses_settings_that_make_its_claims_meaningless(tmp_path):
             apply_overrides(Fig314Config(), [setting])
         assert needle in str(err.value)
     assert apply_overrides(Fig314Config(), ["beams=2"]).beams == 2  # the least that works
-    line = one_error(run("experiment", "run", "fig-3-14", "--set", "beams=0", "--runs", "1",
+    line = one_error(run("experiment", "run", "fig-3-14", "--set", "beams=1", "--runs", "1",
                          "--out", "e", cwd=tmp_path))  # fmt: skip
-    assert line == "kiseki: error: fig-3-14: beams must be >= 2, got 0"
+    assert line == "kiseki: error: fig-3-14: beams must be >= 2, got 1"
     assert not (tmp_path / "e").exists()
 
 

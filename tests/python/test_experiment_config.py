@@ -124,3 +124,75 @@ def test_a_bad_saved_config_names_the_file_the_key_and_the_value(values, message
 def test_a_bad_list_item_is_named_with_its_index():
     text = _message(config_from_dict, GpAaltoConfig, {"train_runs": [1, 2, "3"]})
     assert text == "config: train_runs[2]: must be a valid integer, got '3'"
+
+
+@pytest.mark.parametrize(
+    ("experiment", "setting", "message"),
+    [
+        ("mcl-kidnapping", "threads=-4", "threads: must be greater than 0, got -4"),
+        ("mcl-kidnapping", "threads=257", "threads: must be less than or equal to 256, got 257"),
+        ("mcl-kidnapping", "after_scans=100000000000",
+         "after_scans: must be less than or equal to 1000000, got 100000000000"),
+        ("mcl-kidnapping", "before_scans=1000001",
+         "before_scans: must be less than or equal to 1000000, got 1000001"),
+        ("mcl-kld", "max_scans=-1", "max_scans: must be greater than or equal to 0, got -1"),
+        ("mcl-excursions", "max_scans=1000001",
+         "max_scans: must be less than or equal to 1000000, got 1000001"),
+        ("layouts-exp2-exp3", "boxes=100000000",
+         "boxes: must be less than or equal to 100, got 100000000"),
+        ("exp3-boxes", "boxes=101", "boxes: must be less than or equal to 100, got 101"),
+        ("speed-pedestrian", "max_duration=1e300",
+         "max_duration: must be less than or equal to 86400, got 1e+300"),
+        ("speed-situations", "max_duration=0", "max_duration: must be greater than 0, got 0"),
+        ("fig-3-14", "beams=1000001", "beams: must be less than or equal to 1000000, got 1000001"),
+        ("fig-3-14", "offsets=0", "offsets: must be greater than 0, got 0"),
+        ("gp-aalto", "max_points=20001",
+         "max_points: must be less than or equal to 20000, got 20001"),
+        ("gp-aalto", "restarts=101", "restarts: must be less than or equal to 100, got 101"),
+        ("gp-aalto", "thinning=0", "thinning: must be greater than 0, got 0"),
+        ("gp-floor-mapping", "truth_voxels=1000001",
+         "truth_voxels: must be less than or equal to 1000000, got 1000001"),
+        ("gp-floor-mapping", "voxel=0.001",
+         "voxel: must be greater than or equal to 0.05, got 0.001"),
+        ("gp-floor-mapping", "resolution=0.001",
+         "resolution: must be greater than or equal to 0.01, got 0.001"),
+        ("gp-mcl", "dt=1e-6", "dt: must be greater than or equal to 0.001, got 1e-06"),
+        ("gp-mcl", "survey_step=0.001",
+         "survey_step: must be greater than or equal to 0.01, got 0.001"),
+        ("gp-mcl", "hyper_points=20001",
+         "hyper_points: must be less than or equal to 20000, got 20001"),
+    ],
+)  # fmt: skip
+def test_every_field_that_sizes_time_or_memory_has_its_limit(experiment, setting, message):
+    config = all_experiments()[experiment].config_type()
+    assert _message(apply_overrides, config, [setting]) == f"--set: {message}"
+
+
+def test_every_registered_config_builds_its_model_and_a_bare_number_is_refused(monkeypatch):
+    import types
+
+    from kiseki.experiments import config as config_module
+
+    for name, experiment in all_experiments().items():
+        model = config_module._model(experiment.config_type)
+        for field in dataclasses.fields(experiment.config_type):
+            assert field.name in model.model_fields, (name, field.name)
+
+    @dataclasses.dataclass(frozen=True)
+    class Unbounded:
+        beams: int = 3
+
+    @dataclasses.dataclass(frozen=True)
+    class UnboundedItems:
+        sizes: list[float] = dataclasses.field(default_factory=list)
+
+    registry = {"fake-exp": types.SimpleNamespace(config_type=Unbounded)}
+    monkeypatch.setattr("kiseki.experiments.registry.all_experiments", lambda: registry)
+    with pytest.raises(TypeError) as err:
+        apply_overrides(Unbounded(), ["beams=2"])
+    assert str(err.value).startswith(
+        "experiment fake-exp (test_every_registered_config_builds_its_model_and_a_bare_number"
+        "_is_refused.<locals>.Unbounded.beams): a bare int has no range"
+    )
+    with pytest.raises(TypeError, match=r"UnboundedItems\.sizes\): a bare float has no range"):
+        config_from_dict(UnboundedItems, {})

@@ -16,6 +16,7 @@ import pandas as pd
 
 from kiseki.datasets import read_carmen_log
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.config import PositiveReal, Resolution, Share
 from kiseki.mapping import MapBuildConfig, endpoint_agreement, map_of_log
 from kiseki.plots import new_figure
 
@@ -27,9 +28,9 @@ LOGS = ["intel-corrected", "aces-corrected", "csail-corrected", "freiburg-079-co
 class CarmenMapsConfig:
     data_dir: str = ""  # folder of the .log.gz files; "" = ../shared/data/carmen
     logs: list[str] = field(default_factory=lambda: list(LOGS))
-    resolution: float = 0.05  # m, as in the foundation issue
-    usable_range: float = 30.0  # m
-    threshold: float = 0.90  # share of endpoints on/next to occupied cells (foundation issue)
+    resolution: Resolution = 0.05  # m, as in the foundation issue
+    usable_range: PositiveReal = 30.0  # m
+    threshold: Share = 0.90  # share of endpoints on/next to occupied cells (foundation issue)
 
 
 def data_dir(config: CarmenMapsConfig) -> Path:

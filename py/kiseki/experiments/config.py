@@ -4,9 +4,13 @@
 run's saved config.yaml, checked by a pydantic model built from the config dataclass's fields
 (strict finite numbers, integers, booleans, strings and lists of them), and YAML round trips.
 
-A field that sizes time declares its limit in its type: :data:`Particles`, :data:`Runs`
-(``Annotated[int, Field(strict=True, gt=0, le=...)]``), and a seed is :data:`Seed`; a limit
-is then in the message ("particles: must be less than or equal to 10000000, got ...")."""
+Every number field declares its range in its type, one of this module's (a bare ``int`` or
+``float`` is refused when the model is built, so no field is left unbounded): a field that
+sizes memory or time has a limit (:data:`Particles`, :data:`Runs`, :data:`Count`,
+:data:`Scans`, :data:`Resolution`, :data:`Seconds`, ...; ``Field(le=...)``), which is then in
+the message ("particles: must be less than or equal to 10000000, got ..."); a seed is
+:data:`Seed`; a length, angle or share that sizes nothing is :data:`Real`,
+:data:`PositiveReal`, :data:`NonNegativeReal` or :data:`Share`."""
 
 from __future__ import annotations
 
@@ -18,17 +22,43 @@ from typing import Annotated, Any
 import yaml
 from pydantic import Field, create_model
 
-from kiseki._schema import FileModel, FiniteFloat, SchemaError, Seed, parse
+from kiseki._schema import (
+    FileModel,
+    FiniteFloat,
+    NonNegativeFloat,
+    PositiveFloat,
+    SchemaError,
+    Seed,
+    parse,
+)
 from kiseki._yaml import safe_load_12
 
 __all__ = [
     "LIST_LIMIT",
     "PARTICLE_LIMIT",
     "RUN_LIMIT",
+    "Boxes",
     "ConfigError",
+    "Count",
+    "FitPoints",
+    "Index",
+    "NonNegativeReal",
     "Particles",
+    "PositiveReal",
+    "Rate",
+    "Real",
+    "Resolution",
+    "Restarts",
     "Runs",
+    "Scans",
+    "Seconds",
     "Seed",
+    "Share",
+    "Spacing",
+    "Speed",
+    "Threads",
+    "TimeStep",
+    "Voxel",
     "apply_overrides",
     "config_from_dict",
     "config_to_dict",
@@ -44,9 +74,57 @@ LIST_LIMIT = 10_000
 Particles = Annotated[int, Field(strict=True, gt=0, le=PARTICLE_LIMIT)]
 Runs = Annotated[int, Field(strict=True, gt=0, le=RUN_LIMIT)]
 
-_SCALARS: dict[Any, Any] = {
+# Counts. Each limit guards what the count sizes; the defaults sit far below them.
+# Things made and scored one by one in a trial (beams, offsets, free voxels scored, scans a
+# claim waits for, moves of a formation, every k-th reading): a million is seconds of work
+# and tens of MB of arrays per trial, orders above every experiment's use.
+Count = Annotated[int, Field(strict=True, gt=0, le=1_000_000)]
+# Readings a GP's hyperparameters are fitted on: the fit holds an n x n kernel matrix, 3.2 GB
+# of float64 at 20 000 points (and O(n^3) time per step of the search).
+FitPoints = Annotated[int, Field(strict=True, gt=0, le=20_000)]
+# Random restarts of a hyperparameter search: each is a whole fit; 0 = the first start only.
+Restarts = Annotated[int, Field(strict=True, ge=0, le=100)]
+# Scans of a log or a run; 0 = all of them where the field says so. A million scans is over a
+# day of a 10 Hz laser (CARMEN's logs hold tens of thousands).
+Scans = Annotated[int, Field(strict=True, ge=0, le=1_000_000)]
+# Threads of one trial: beyond a large machine's cores they only add overhead and memory.
+Threads = Annotated[int, Field(strict=True, gt=0, le=256)]
+# Unknown boxes placed at random (without overlap) into a scene: each is drawn into every
+# scan; 100 boxes of 0.4 m fill the scenes' free floor long before the placement runs out.
+Boxes = Annotated[int, Field(strict=True, ge=0, le=100)]
+# An index naming a data file or a setting (run 5 of a data set): sizes nothing.
+Index = Annotated[int, Field(strict=True, ge=0, le=LIST_LIMIT)]
+
+# Quantities. A lower limit on a step guards the number of steps (memory and time).
+# Simulated seconds of a run: a day of simulated time at the simulators' 10-100 Hz steps.
+Seconds = Annotated[float, Field(strict=True, gt=0, le=86_400.0, allow_inf_nan=False)]
+# A simulation's time step (s): at least 1 ms (a minute of motion is then 60 000 steps).
+TimeStep = Annotated[float, Field(strict=True, ge=0.001, le=10.0, allow_inf_nan=False)]
+# A 2-D grid's cell (m): 1 cm cells over a 100 m x 100 m scene are 10^8 cells (800 MB of
+# float64); 10 m cells hold no detail of any scene.
+Resolution = Annotated[float, Field(strict=True, ge=0.01, le=10.0, allow_inf_nan=False)]
+# A 3-D grid's voxel (m): 5 cm voxels over a 100 m x 100 m x 3 m floor are 2.4 x 10^8.
+Voxel = Annotated[float, Field(strict=True, ge=0.05, le=10.0, allow_inf_nan=False)]
+# Metres of travel between readings, updates or scans: 1 cm = 100 per metre of route.
+Spacing = Annotated[float, Field(strict=True, ge=0.01, le=100.0, allow_inf_nan=False)]
+# A speed (m/s) that sets how long a run lasts: 1 cm/s crosses a 100 m scene in 3 hours.
+Speed = Annotated[float, Field(strict=True, ge=0.01, le=100.0, allow_inf_nan=False)]
+# A sensor rate (Hz): readings per second of a run; 1 kHz is above any sensor simulated.
+Rate = Annotated[float, Field(strict=True, gt=0, le=1000.0, allow_inf_nan=False)]
+# Numbers that size nothing (lengths, angles, noise SDs, thresholds): finite, and signed as
+# their meaning says.
+Real = FiniteFloat
+PositiveReal = PositiveFloat
+NonNegativeReal = NonNegativeFloat
+# A share or probability.
+Share = Annotated[float, Field(strict=True, ge=0, le=1, allow_inf_nan=False)]
+
+# the strict base of an annotated number (its range comes with its annotation)
+_BOUNDED: dict[Any, Any] = {
     float: FiniteFloat,
     int: Annotated[int, Field(strict=True)],
+}
+_SCALARS: dict[Any, Any] = {
     bool: Annotated[bool, Field(strict=True)],
     str: Annotated[str, Field(strict=True)],
 }
@@ -58,15 +136,22 @@ class ConfigError(SchemaError):
 
 
 def _strict(kind: Any) -> Any:
-    """The model type of a dataclass field's type: strict, finite, lists of bounded length."""
+    """The model type of a dataclass field's type: strict, finite, lists of bounded length; a
+    bare ``int`` or ``float`` (no range) is a TypeError."""
     if typing.get_origin(kind) is Annotated:
         base, *meta = typing.get_args(kind)
-        return Annotated[(_strict(base), *meta)]
+        return Annotated[(_BOUNDED.get(base) or _strict(base), *meta)]
     origin = typing.get_origin(kind)
     if origin in (list, tuple):
         (item,) = set(typing.get_args(kind)) - {Ellipsis} or {str}
-        items = list[_strict(item)] if origin is list else tuple[_strict(item), ...]
+        item = _strict(item)
+        items = list[item] if origin is list else tuple[item, ...]
         return Annotated[items, Field(max_length=LIST_LIMIT)]
+    if kind in (int, float):
+        raise TypeError(
+            f"a bare {kind.__name__} has no range: type it with one of "
+            "kiseki.experiments.config's types (Count, Scans, Seconds, Resolution, Real, ...)"
+        )
     if kind in _SCALARS:
         return _SCALARS[kind]
     raise TypeError(f"unsupported config field type {kind!r}")
@@ -76,12 +161,27 @@ def _hints(config_type: type) -> dict[str, Any]:
     return typing.get_type_hints(config_type, include_extras=True)
 
 
+def _field_name(config_type: type, name: str) -> str:
+    """``"experiment mcl-kidnapping (KidnapConfig.threads)"``: the experiments whose config
+    this is (from the registry), and the field."""
+    from kiseki.experiments.registry import all_experiments
+
+    names = sorted(n for n, e in all_experiments().items() if e.config_type is config_type)
+    what = f"experiment {', '.join(names)}" if names else f"config {config_type.__module__}"
+    return f"{what} ({config_type.__qualname__}.{name})"
+
+
 @functools.cache
 def _model(config_type: type) -> type[FileModel]:
     """The model of ``config_type``'s fields: each optional, so only the keys given are
     checked (and set); the dataclass gives the defaults."""
     hints = _hints(config_type)
-    fields = {f.name: (_strict(hints[f.name]), None) for f in dataclasses.fields(config_type)}
+    fields = {}
+    for f in dataclasses.fields(config_type):
+        try:
+            fields[f.name] = (_strict(hints[f.name]), None)
+        except TypeError as err:
+            raise TypeError(f"{_field_name(config_type, f.name)}: {err}") from None
     return create_model(f"{config_type.__name__}Model", __base__=FileModel, **fields)
 
 

@@ -24,7 +24,7 @@ import pandas as pd
 
 from kiseki.coop import GOAL, START, paper_angle, plan, simulate
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
-from kiseki.experiments.config import Runs
+from kiseki.experiments.config import Count, NonNegativeReal, PositiveReal, Runs, Spacing
 from kiseki.plots import new_figure
 
 CPS2_DISTANCE = 21.5  # m, Kurazume and Hirose's CPS-II experiment
@@ -34,14 +34,14 @@ CPS2_ERROR = 0.0012  # 0.12 % of the distance
 @dataclass(frozen=True)
 class CoopFormsConfig:
     runs: Runs = 100  # per setting (the paper's)
-    angle_sigma_deg: float = 0.1  # the paper's
-    form1_moves: list[int] = field(default_factory=lambda: list(range(1, 40, 2)))
-    form2_moves: list[int] = field(default_factory=lambda: list(range(1, 31)))
+    angle_sigma_deg: NonNegativeReal = 0.1  # the paper's
+    form1_moves: list[Count] = field(default_factory=lambda: list(range(1, 40, 2)))
+    form2_moves: list[Count] = field(default_factory=lambda: list(range(1, 31)))
     dead_reckoning_runs: Runs = 1000
-    step: float = 0.05  # m, dead reckoning's odometry step
+    step: Spacing = 0.05  # m, dead reckoning's odometry step
     # the 3-D case: uneven ground z = A sin(2 pi x / L) cos(2 pi y / L), markers 0.5 m above it
-    ground_amplitude: float = 0.5  # m
-    ground_wavelength: float = 4.0  # m
+    ground_amplitude: NonNegativeReal = 0.5  # m
+    ground_wavelength: PositiveReal = 4.0  # m
 
 
 def _settings(config: CoopFormsConfig) -> list[tuple]:

@@ -16,6 +16,7 @@ import pandas as pd
 
 from kiseki.core import Random
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.config import NonNegativeReal, Share, Spacing
 from kiseki.grid import beam_angles
 from kiseki.map_io import load_map
 from kiseki.mapping import build_map, endpoint_agreement
@@ -56,10 +57,10 @@ def simulate_scans(
 @dataclass(frozen=True)
 class CorridorScansConfig:
     map_file: str = str(MAP)
-    range_noise_sd: float = 0.01  # m, UTM-30LX +-30 mm taken as 3 sigma
-    max_lateral_offset: float = 0.5  # m, uniform in [-max, max] per trial
-    scan_spacing: float = 0.1  # m
-    precision_threshold: float = 0.99  # share of rebuilt occupied cells on true obstacles
+    range_noise_sd: NonNegativeReal = 0.01  # m, UTM-30LX +-30 mm taken as 3 sigma
+    max_lateral_offset: NonNegativeReal = 0.5  # m, uniform in [-max, max] per trial
+    scan_spacing: Spacing = 0.1  # m
+    precision_threshold: Share = 0.99  # share of rebuilt occupied cells on true obstacles
 
 
 def preflight(config: CorridorScansConfig) -> None:

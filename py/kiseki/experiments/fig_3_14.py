@@ -23,6 +23,7 @@ import pandas as pd
 
 from kiseki.core import Pose2, Random
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.config import Count, NonNegativeReal, PositiveReal, Real
 from kiseki.grid import OccupancyGrid
 from kiseki.models import LocalMapBuilder, SpaceObservationModel
 from kiseki.plots import new_figure
@@ -30,14 +31,15 @@ from kiseki.plots import new_figure
 
 @dataclass(frozen=True)
 class Fig314Config:
-    partition_y: float = 1.0  # m
-    partition_start_x: float = -0.3  # m, the partition's end seen by the sensor
-    field_of_view_deg: float = 59.0  # Xtion
-    beams: int = 60
-    range_noise_sd: float = 0.01  # m
-    max_offset: float = 1.0  # m, particles displaced along x up to this
-    offsets: int = 41
-    flat_ratio: float = 0.95  # "no difference": off-truth likelihood >= this share of the peak
+    partition_y: Real = 1.0  # m
+    partition_start_x: Real = -0.3  # m, the partition's end seen by the sensor
+    field_of_view_deg: PositiveReal = 59.0  # Xtion
+    beams: Count = 60
+    range_noise_sd: NonNegativeReal = 0.01  # m
+    max_offset: NonNegativeReal = 1.0  # m, particles displaced along x up to this
+    offsets: Count = 41
+    # "no difference": off-truth likelihood >= this share of the peak
+    flat_ratio: PositiveReal = 0.95
 
     def __post_init__(self) -> None:
         """Refuses settings that make the check meaningless (beams=0 drew every likelihood at

@@ -41,7 +41,20 @@ from pathlib import Path
 
 from kiseki.experiments import gp_aalto_tasks as work
 from kiseki.experiments.base import Experiment, TrialOutput
-from kiseki.experiments.config import Particles, Runs, Seed
+from kiseki.experiments.config import (
+    Count,
+    FitPoints,
+    Index,
+    NonNegativeReal,
+    Particles,
+    PositiveReal,
+    Resolution,
+    Restarts,
+    Runs,
+    Seed,
+    Share,
+    Spacing,
+)
 
 __all__ = ["EXPERIMENT", "GpAaltoConfig", "data_dir", "tasks"]
 
@@ -53,35 +66,35 @@ WALKS = ("eight", "square")
 class GpAaltoConfig:
     data_dir: str = ""  # folder with aalto/ and kok_1d/; "" = ../shared/data/magnetic
     sensors: list[str] = field(default_factory=lambda: list(AALTO_SENSORS))
-    train_runs: list[int] = field(default_factory=lambda: [1, 2, 3, 4])
-    test_run: int = 5
-    changed_runs: list[int] = field(default_factory=lambda: [6, 7, 8, 9])
+    train_runs: list[Index] = field(default_factory=lambda: [1, 2, 3, 4])
+    test_run: Index = 5
+    changed_runs: list[Index] = field(default_factory=lambda: [6, 7, 8, 9])
     # every thinning-th reading of the 50 Hz runs: 50 = one a second (about 0.18 m of travel);
     # denser readings repeat the same along-track error (the sweep below shows it)
-    thinning: int = 50
+    thinning: Count = 50
     per_component: bool = True  # one GP per field component, as the thesis fits mx, my, mz
-    max_points: int = 1000  # hyperparameters on at most this many readings (seeded subsample)
-    restarts: int = 2  # seeded restarts of the hyperparameter search
+    max_points: FitPoints = 1000  # hyperparameters on at most this many readings (seeded subsample)
+    restarts: Restarts = 2  # seeded restarts of the hyperparameter search
     gp_seed: Seed = 0  # seed of the hyperparameter search (shared by every task)
     offset_calibration: bool = True  # remove a residual hard-iron offset fixed to the robot
-    sweep: list[int] = field(default_factory=lambda: [1, 5, 10, 25, 50, 100])
+    sweep: list[Count] = field(default_factory=lambda: [1, 5, 10, 25, 50, 100])
     sweep_raw: bool = True  # the sweep also on the readings as recorded
     hilbert: bool = True  # the reduced-rank GP on all readings of the training runs
-    grid_resolution: float = 0.1  # m, the pictures' grid
+    grid_resolution: Resolution = 0.1  # m, the pictures' grid
     # map change detection
-    change_sigma: float = 3.0  # a reading departs from the map beyond this many sigma
-    change_factor: float = 2.0  # changed: share above factor x the largest static share
+    change_sigma: PositiveReal = 3.0  # a reading departs from the map beyond this many sigma
+    change_factor: PositiveReal = 2.0  # changed: share above factor x the largest static share
     # magnetic-map MCL on the test run
     mcl_seeds: Runs = 5
     particles: Particles = 1000
-    mcl_step: float = 0.1  # m of travel between filter updates
-    map_resolution: float = 0.05  # m, the MCL's field map
-    odometry_scale_sd: float = 0.02  # SD of the per-run distance scale error
-    heading_walk: float = 0.1  # rad per sqrt(m): SD of the odometry heading's random walk
-    alphas: list[float] = field(default_factory=lambda: [0.05, 0.1, 0.05, 0.01])
+    mcl_step: Spacing = 0.1  # m of travel between filter updates
+    map_resolution: Resolution = 0.05  # m, the MCL's field map
+    odometry_scale_sd: NonNegativeReal = 0.02  # SD of the per-run distance scale error
+    heading_walk: NonNegativeReal = 0.1  # rad per sqrt(m): SD of the odometry heading's random walk
+    alphas: list[NonNegativeReal] = field(default_factory=lambda: [0.05, 0.1, 0.05, 0.01])
     # hand-held walks (3-D)
     walks: list[str] = field(default_factory=lambda: list(WALKS))
-    walk_train_share: float = 0.5  # the first part of a walk trains, the rest is predicted
+    walk_train_share: Share = 0.5  # the first part of a walk trains, the rest is predicted
     walk_offset_calibration: bool = True  # sensor-frame offset from the training part
 
 

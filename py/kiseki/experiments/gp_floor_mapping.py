@@ -29,6 +29,17 @@ import pandas as pd
 from scipy.spatial import cKDTree
 
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.config import (
+    Count,
+    FitPoints,
+    NonNegativeReal,
+    PositiveReal,
+    Rate,
+    Resolution,
+    Restarts,
+    Share,
+    Voxel,
+)
 from kiseki.experiments.gp_common import (
     FLOOR,
     SENSOR_NOISE,
@@ -61,15 +72,15 @@ BANDS = ((0.0, 0.25, "on the tracks"), (0.25, 0.75, "between lanes"), (0.75, np.
 class FloorMappingConfig:
     scene: str = str(FLOOR)
     maps: list[str] = field(default_factory=lambda: list(MAPS))
-    resolution: float = 0.1  # m, the 2-D map's cells
-    voxel: float = 0.2  # m, the thesis' 3-D voxels
-    top: float = 2.2  # m, the voxel grid's height (11 layers of 0.2 m)
-    rate_hz: float = 10.0  # the arm's sensors (the thesis' 10 Hz)
-    hyper_points: int = 1000  # readings or voxels the hyperparameters are fitted on
-    restarts: int = 2
-    truth_voxels: int = 20000  # free voxels the 3-D map is scored on (seeded)
-    share: float = 1.0  # the part of each route surveyed (tests use less)
-    noise_sd: float = SENSOR_NOISE
+    resolution: Resolution = 0.1  # m, the 2-D map's cells
+    voxel: Voxel = 0.2  # m, the thesis' 3-D voxels
+    top: PositiveReal = 2.2  # m, the voxel grid's height (11 layers of 0.2 m)
+    rate_hz: Rate = 10.0  # the arm's sensors (the thesis' 10 Hz)
+    hyper_points: FitPoints = 1000  # readings or voxels the hyperparameters are fitted on
+    restarts: Restarts = 2
+    truth_voxels: Count = 20000  # free voxels the 3-D map is scored on (seeded)
+    share: Share = 1.0  # the part of each route surveyed (tests use less)
+    noise_sd: NonNegativeReal = SENSOR_NOISE
 
 
 def preflight(config: FloorMappingConfig) -> None:

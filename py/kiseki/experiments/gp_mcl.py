@@ -27,7 +27,18 @@ from scipy.spatial import cKDTree
 from kiseki.control import PurePursuit
 from kiseki.core import derive_seed, normalize_angle
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
-from kiseki.experiments.config import Particles, Runs, Seed
+from kiseki.experiments.config import (
+    FitPoints,
+    Particles,
+    Resolution,
+    Restarts,
+    Runs,
+    Seed,
+    Share,
+    Spacing,
+    Speed,
+    TimeStep,
+)
 from kiseki.experiments.gp_common import (
     FLOOR,
     floor_map_2d,
@@ -64,15 +75,15 @@ class MagneticMclExperimentConfig:
     scene: str = str(FLOOR)
     routes: list[str] = field(default_factory=lambda: list(ROUTES))
     runs_per_route: Runs = 3
-    speed: float = 0.3  # m/s (the thesis does not state its speed)
-    dt: float = 0.1  # s, a step of the robot, the odometry, the readings and the filter
+    speed: Speed = 0.3  # m/s (the thesis does not state its speed)
+    dt: TimeStep = 0.1  # s, a step of the robot, the odometry, the readings and the filter
     particles: Particles = 1000  # sec. 6.7
     map_seed: Seed = 0  # the survey's noise (the map is shared by every trial)
-    resolution: float = 0.1  # m
-    hyper_points: int = 1000
-    restarts: int = 2
-    share: float = 1.0  # the part of the survey route mapped (tests use less)
-    survey_step: float = 0.1  # m of travel between the survey's readings (sec. 6.5.1)
+    resolution: Resolution = 0.1  # m
+    hyper_points: FitPoints = 1000
+    restarts: Restarts = 2
+    share: Share = 1.0  # the part of the survey route mapped (tests use less)
+    survey_step: Spacing = 0.1  # m of travel between the survey's readings (sec. 6.5.1)
 
 
 def preflight(config: MagneticMclExperimentConfig) -> None:

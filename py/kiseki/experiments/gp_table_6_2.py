@@ -27,6 +27,7 @@ import pandas as pd
 
 from kiseki.core import Random
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.config import Count, NonNegativeReal, Real, Restarts
 from kiseki.experiments.gp_common import HALL, SENSOR_NOISE, magnetic_world, pack, unpack
 from kiseki.gp import ExactGP, SquaredExponential, fit_hyperparameters
 from kiseki.plots import new_figure, save_figure
@@ -49,13 +50,13 @@ UT = 0.01  # G per microtesla
 @dataclass(frozen=True)
 class Table62Config:
     scene: str = str(HALL)
-    steps: list[int] = field(default_factory=lambda: [2, 3, 4, 5])  # every k-th grid point
-    noise_sd: float = SENSOR_NOISE  # G, per axis (thesis sec. 6.3.2: "about 0.01 G")
-    restarts: int = 2  # random BFGS starts after the one at the sensor's noise
+    steps: list[Count] = field(default_factory=lambda: [2, 3, 4, 5])  # every k-th grid point
+    noise_sd: NonNegativeReal = SENSOR_NOISE  # G, per axis (thesis sec. 6.3.2: "about 0.01 G")
+    restarts: Restarts = 2  # random BFGS starts after the one at the sensor's noise
     # "<= 0.6 m suffices": SD(0.6) within this share of SD(0.4), and the wider spacings' SDs at
     # least this share above SD(0.6) (the thesis: 8 % and 41-57 %)
-    suffices_margin: float = 0.2
-    slice_height: float = 1.0  # m, the layer drawn (the west column's splice)
+    suffices_margin: NonNegativeReal = 0.2
+    slice_height: Real = 1.0  # m, the layer drawn (the west column's splice)
 
 
 def preflight(config: Table62Config) -> None:

@@ -35,7 +35,7 @@ from matplotlib.colors import ListedColormap
 from kiseki.core import derive_seed
 from kiseki.experiments import teach_playback as tp
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
-from kiseki.experiments.config import Particles, Runs
+from kiseki.experiments.config import Boxes, Particles, Runs
 from kiseki.metrics import wilson_interval
 from kiseki.plots import new_figure
 from kiseki.sim.layouts import generate_layout, write_layout
@@ -71,7 +71,7 @@ class LayoutsConfig:
         default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
     )
     particles: Particles = 1000
-    boxes: int = 3
+    boxes: Boxes = 3
     merge: str = "thesis"
 
 

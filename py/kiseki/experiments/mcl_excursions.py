@@ -26,7 +26,7 @@ import pandas as pd
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.experiments.carmen_maps import LOGS
 from kiseki.experiments.carmen_maps import data_dir as _carmen_dir
-from kiseki.experiments.config import Particles
+from kiseki.experiments.config import NonNegativeReal, Particles, PositiveReal, Scans, Threads
 from kiseki.localization import (
     RECOVERY_MODES,
     LocalizeConfig,
@@ -48,11 +48,11 @@ class ExcursionsConfig:
     methods: list[str] = field(default_factory=lambda: list(METHODS))
     recoveries: list[str] = field(default_factory=lambda: ["resetting"])
     particles: Particles = 500
-    odometry_noise: float = 0.1
-    excursion_distance: float = 0.5  # m
-    max_return_scans: int = 20  # the claim: every excursion ends within this many scans
-    max_scans: int = 0  # 0 = whole logs
-    threads: int = 1
+    odometry_noise: NonNegativeReal = 0.1
+    excursion_distance: PositiveReal = 0.5  # m
+    max_return_scans: Scans = 20  # the claim: every excursion ends within this many scans
+    max_scans: Scans = 0  # 0 = whole logs
+    threads: Threads = 1
 
 
 def preflight(config: ExcursionsConfig) -> None:

@@ -37,7 +37,14 @@ from kiseki.core import Pose2, derive_seed
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.experiments.carmen_maps import LOGS
 from kiseki.experiments.carmen_maps import data_dir as _carmen_dir
-from kiseki.experiments.config import Particles
+from kiseki.experiments.config import (
+    Count,
+    NonNegativeReal,
+    Particles,
+    PositiveReal,
+    Scans,
+    Threads,
+)
 from kiseki.localization import RECOVERY_MODES, LocalizeConfig, localize
 from kiseki.plots import new_figure
 from kiseki.scans import LaserScans
@@ -52,18 +59,18 @@ class KidnapConfig:
     logs: list[str] = field(default_factory=lambda: list(LOGS))
     method: str = "likelihood-field"
     particles: Particles = 1000
-    beams: int = 90
+    beams: Count = 90
     # "resetting+injection": resetting with Augmented MCL's injection as well
     recoveries: list[str] = field(default_factory=lambda: [*RECOVERY_MODES, "resetting+injection"])
-    odometry_noise: float = 0.1  # CARMEN: added to the corrected poses' increments
-    min_jump: float = 2.0  # m between the pose before and after the kidnapping
-    before_scans: int = 200  # scans of tracking before the kidnapping (at most)
-    after_scans: int = 400  # scans after it (at most)
-    min_after: int = 80  # a trial needs at least this many scans after the jump
-    recover_distance: float = 0.5  # m
-    recover_heading: float = 10.0  # deg
-    recover_hold: int = 10  # updates
-    threads: int = 1  # per trial (trials run in parallel)
+    odometry_noise: NonNegativeReal = 0.1  # CARMEN: added to the corrected poses' increments
+    min_jump: NonNegativeReal = 2.0  # m between the pose before and after the kidnapping
+    before_scans: Scans = 200  # scans of tracking before the kidnapping (at most)
+    after_scans: Scans = 400  # scans after it (at most)
+    min_after: Scans = 80  # a trial needs at least this many scans after the jump
+    recover_distance: PositiveReal = 0.5  # m
+    recover_heading: PositiveReal = 10.0  # deg
+    recover_hold: Scans = 10  # updates
+    threads: Threads = 1  # per trial (trials run in parallel)
 
 
 def _check(config: KidnapConfig) -> None:

@@ -23,7 +23,7 @@ import pandas as pd
 
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.experiments.carmen_maps import data_dir as _carmen_dir
-from kiseki.experiments.config import Particles
+from kiseki.experiments.config import NonNegativeReal, Particles, Scans
 from kiseki.localization import noisy_odometry
 from kiseki.metrics import ape
 from kiseki.plots import new_figure
@@ -37,8 +37,8 @@ class KldConfig:
     logs: list[str] = field(default_factory=lambda: ["intel-corrected", "aces-corrected"])
     max_particles: Particles = 50_000
     min_particles: Particles = 1000
-    odometry_noise: float = 0.1
-    max_scans: int = 0  # 0 = whole logs
+    odometry_noise: NonNegativeReal = 0.1
+    max_scans: Scans = 0  # 0 = whole logs
 
 
 def preflight(config: KldConfig) -> None:

@@ -30,7 +30,7 @@ from kiseki.datasets import read_carmen_log
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki.experiments.carmen_maps import LOGS
 from kiseki.experiments.carmen_maps import data_dir as _carmen_dir
-from kiseki.experiments.config import Particles
+from kiseki.experiments.config import NonNegativeReal, Particles, Resolution, Scans
 from kiseki.localization import LocalizeConfig, localize
 from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
 from kiseki.metrics import ape
@@ -42,10 +42,10 @@ from kiseki.teach.environment_map import MERGE_RULES, build_teaching_map
 class MergeRulesConfig:
     data_dir: str = ""  # folder of the .log.gz files; "" = ../shared/data/carmen
     logs: list[str] = field(default_factory=lambda: list(LOGS))
-    resolution: float = 0.1  # m: the thesis' local map cells
-    odometry_noise: float = 0.1  # of each odometry increment (as in the README's runs)
+    resolution: Resolution = 0.1  # m: the thesis' local map cells
+    odometry_noise: NonNegativeReal = 0.1  # of each odometry increment (as in the README's runs)
     particles: Particles = 500
-    max_scans: int = 0  # 0 = the whole log; otherwise its first max_scans scans
+    max_scans: Scans = 0  # 0 = the whole log; otherwise its first max_scans scans
 
 
 def _folder(config: MergeRulesConfig) -> Path:

@@ -21,6 +21,7 @@ import pandas as pd
 
 from kiseki._yaml import safe_load_12
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.config import PositiveReal, Speed
 from kiseki.experiments.speed_common import WORLDS, laser_mount, prior_map
 from kiseki.plots import draw_map, new_figure
 from kiseki.sim.scene import load_scene
@@ -33,8 +34,8 @@ __all__ = ["EXPERIMENT", "Fig4Config"]
 @dataclass(frozen=True)
 class Fig4Config:
     scene: str = str(WORLDS / "speed_corner.yaml")
-    v_max: float = 0.5  # m/s, the paper's
-    half_angle_deg: float = 90.0  # theta, the paper's
+    v_max: Speed = 0.5  # m/s, the paper's
+    half_angle_deg: PositiveReal = 90.0  # theta, the paper's
 
 
 def _sweep(config: Fig4Config) -> tuple[list, tuple[float, float]]:

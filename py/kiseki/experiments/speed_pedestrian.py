@@ -35,6 +35,7 @@ import pandas as pd
 
 from kiseki.core import Random
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.config import NonNegativeReal, PositiveReal, Real, Seconds, Speed
 from kiseki.experiments.speed_common import WORLDS, drive, prior_map, with_pedestrians
 from kiseki.metrics import wilson_interval
 from kiseki.plots import new_figure
@@ -50,15 +51,16 @@ STOPPED = 0.05  # m/s: below this the robot counts as standing
 @dataclass(frozen=True)
 class PedestrianConfig:
     scene: str = str(WORLDS / "speed_crossroad.yaml")
-    goal: list[float] = field(default_factory=lambda: [0.0, 8.0])  # past the crossing
+    goal: list[Real] = field(default_factory=lambda: [0.0, 8.0])  # past the crossing
     methods: list[str] = field(
         default_factory=lambda: ["none", "distance", "polygon", "occlusion", "occlusion-width"]
     )
-    walking_speed: float = 1.4  # m/s
-    radius: float = 0.25  # m, a person's half shoulder width
-    crossing: list[float] = field(default_factory=lambda: [3.85, 6.15])  # y of the arm's faces
-    start_distance: float = 4.0  # m from the robot's corridor axis, out of the laser's sight
-    max_duration: float = 90.0  # s
+    walking_speed: Speed = 1.4  # m/s
+    radius: PositiveReal = 0.25  # m, a person's half shoulder width
+    crossing: list[Real] = field(default_factory=lambda: [3.85, 6.15])  # y of the arm's faces
+    # m from the robot's corridor axis, out of the laser's sight
+    start_distance: NonNegativeReal = 4.0
+    max_duration: Seconds = 90.0  # s
 
 
 def preflight(config: PedestrianConfig) -> None:

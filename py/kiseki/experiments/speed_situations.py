@@ -26,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki.experiments.config import Index, Seconds
 from kiseki.experiments.speed_common import (
     WORLDS,
     RecordingLimiter,
@@ -55,8 +56,8 @@ CORRIDOR_END = 6.0  # y where speed_corridor.yaml's corridor opens into the hall
 @dataclass(frozen=True)
 class SituationsConfig:
     worlds: str = str(WORLDS)
-    max_duration: float = 120.0  # s, a run that has not arrived by then fails
-    runs: list[int] = field(default_factory=lambda: list(range(len(RUNS))))
+    max_duration: Seconds = 120.0  # s, a run that has not arrived by then fails
+    runs: list[Index] = field(default_factory=lambda: list(range(len(RUNS))))
 
 
 class OfflineMapLimiter:

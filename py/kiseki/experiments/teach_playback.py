@@ -33,7 +33,7 @@ from matplotlib.patches import Circle
 from kiseki._yaml import safe_load_12
 from kiseki.core import Random, derive_seed
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
-from kiseki.experiments.config import Particles
+from kiseki.experiments.config import Boxes, Particles
 from kiseki.map_io import load_map
 from kiseki.models import SpaceObservationModel
 from kiseki.plots import new_figure
@@ -51,7 +51,7 @@ class Exp1Config:
     scene: str = str(WORLDS / "factory_corridor.yaml")
     methods: list[str] = field(default_factory=lambda: ["proposal2"])
     particles: Particles = 1000
-    boxes: int = 0  # unknown boxes placed at random for playback (Exp. 3)
+    boxes: Boxes = 0  # unknown boxes placed at random for playback (Exp. 3)
     merge: str = "thesis"  # the taught maps' merge rule: thesis or evidence
 
 
@@ -62,7 +62,7 @@ class Exp2Config:
         default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
     )
     particles: Particles = 1000
-    boxes: int = 0
+    boxes: Boxes = 0
     merge: str = "thesis"
 
 
@@ -71,7 +71,7 @@ class Exp3Config:
     scene: str = str(WORLDS / "factory_turn.yaml")
     methods: list[str] = field(default_factory=lambda: ["proposal2"])
     particles: Particles = 1000
-    boxes: int = 3
+    boxes: Boxes = 3
     merge: str = "thesis"
 
 
