@@ -69,7 +69,7 @@ def _root(
 
 
 def _seed_option(value: int) -> int:
-    """Every --seed: an integer in 0..2^64-1, refused in one line otherwise."""
+    """Every --seed: an integer in [0, 2**64), refused in one line otherwise."""
     from kiseki.core import check_seed
 
     return check_seed(value, "--seed")

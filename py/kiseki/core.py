@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Core types: planar and 3-D poses, angle normalisation, the seeded random generator.
+"""Core types: planar and 3-D poses, angle normalisation, the seeded random generator and
+the seed check.
 
 ``Random`` is the one generator every stochastic part of kiseki uses: the engine is
 mt19937_64 and the distributions are kiseki's own, so a seed gives the same numbers on every
@@ -15,6 +16,7 @@ __all__ = [
     "Pose2",
     "Pose3",
     "Random",
+    "SEED_RULE",
     "check_seed",
     "derive_seed",
     "library_versions",
@@ -22,10 +24,17 @@ __all__ = [
 ]
 
 
+SEED_RULE = "must be an integer in [0, 2**64)"
+"""What a seed is, as every seed error words it (numpy's and the C++ core's 64-bit generators
+take any such integer)."""
+
+
 def check_seed(seed, name: str = "seed") -> int:
-    """A seed as kiseki takes it: an integer in 0..2^64-1 (anything else: a ValueError)."""
+    """A seed as kiseki takes it: an integer in [0, 2**64) (numpy integers too); anything else
+    a ValueError ``"NAME must be an integer in [0, 2**64), got X"``. The one seed check: the
+    file models' ``Seed`` (:mod:`kiseki._schema`) words its problem with :data:`SEED_RULE`."""
     import numbers
 
     if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= seed < 2**64:
-        raise ValueError(f"{name} must be an integer in 0..2^64-1, got {seed!r}")
+        raise ValueError(f"{name} {SEED_RULE}, got {seed!r}")
     return int(seed)

@@ -382,7 +382,7 @@ def test_a_hand_edited_run_config_is_refused_naming_the_file_and_the_key(tmp_pat
     assert line == "kiseki: error: list/config.yaml: not a run's config (a mapping), got list"
 
 
-SEED = "kiseki: error: --seed must be an integer in 0..2^64-1, got -1"
+SEED = "kiseki: error: --seed must be an integer in [0, 2**64), got -1"
 
 
 @pytest.mark.parametrize(

@@ -171,7 +171,7 @@ def test_bad_seeds_are_one_line_before_any_work(tmp_path, command, seed):
     done = run(*command, "--seed", seed, cwd=tmp_path)
     assert done.returncode == 1, done.stderr
     lines = done.stderr.strip().splitlines()
-    assert lines == [f"kiseki: error: --seed must be an integer in 0..2^64-1, got {seed}"]
+    assert lines == [f"kiseki: error: --seed must be an integer in [0, 2**64), got {seed}"]
     assert list(tmp_path.iterdir()) == []  # nothing written
 
 
