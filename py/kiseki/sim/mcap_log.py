@@ -87,6 +87,7 @@ from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 from mcap_protobuf.decoder import DecoderFactory
 from mcap_protobuf.schema import build_file_descriptor_set
 
+from kiseki._signal_hold import SignalHold
 from kiseki.core import Pose2
 from kiseki.errors import LogFormatError
 from kiseki.grid import OccupancyGrid
@@ -380,6 +381,8 @@ class RunWriter:
         self._schemas: dict[str, tuple[int, bytes]] = {}  # name -> (id, schema text)
         self._channels: dict[str, tuple[int, str, dict[str, str]]] = {}  # topic -> (id, schema)
         self._sequence: dict[int, int] = {}
+        # Ctrl-C and SIGTERM wait for the record being written (kiseki._signal_hold)
+        self._hold = SignalHold()
 
     # context manager
 
@@ -404,9 +407,13 @@ class RunWriter:
             return
         file, self._file = self._file, None
         try:
-            self._writer.finish()
+            with self._hold.section():
+                try:
+                    self._writer.finish()
+                finally:
+                    file.close()
         finally:
-            file.close()
+            self._hold.release()
 
     # registration
 
@@ -449,27 +456,31 @@ class RunWriter:
             if known_text != text:
                 raise ValueError(f"schema {schema_name} was registered with a different text")
         else:
-            schema_id = self._writer.register_schema(schema_name, schema_encoding, text)
-            self._schemas[schema_name] = (schema_id, text)
+            with self._hold.section():
+                schema_id = self._writer.register_schema(schema_name, schema_encoding, text)
+                self._schemas[schema_name] = (schema_id, text)
         meta = dict(channel_metadata or {})
-        channel_id = self._writer.register_channel(topic, encoding, schema_id, meta)
-        self._channels[topic] = (channel_id, schema_name, meta)
-        self._sequence[channel_id] = 0
+        with self._hold.section():
+            channel_id = self._writer.register_channel(topic, encoding, schema_id, meta)
+            self._channels[topic] = (channel_id, schema_name, meta)
+            self._sequence[channel_id] = 0
         return channel_id
 
     def _write(self, channel_id: int, ns: int, data: bytes) -> None:
         assert self._file is not None
-        self._sequence[channel_id] += 1
-        self._writer.add_message(
-            channel_id,
-            log_time=ns,
-            data=data,
-            publish_time=ns,
-            sequence=self._sequence[channel_id] & 0xFFFFFFFF,
-        )
-        # The mcap writer hands bytes to the file only when a chunk is full; pass them on to
-        # the operating system at once so that a killed process keeps every complete chunk.
-        self._file.flush()
+        with self._hold.section():  # Ctrl-C or SIGTERM then stop the run between two messages
+            self._sequence[channel_id] += 1
+            self._writer.add_message(
+                channel_id,
+                log_time=ns,
+                data=data,
+                publish_time=ns,
+                sequence=self._sequence[channel_id] & 0xFFFFFFFF,
+            )
+            # The mcap writer hands bytes to the file only when a chunk is full; pass them on
+            # to the operating system at once so that a killed process keeps every complete
+            # chunk.
+            self._file.flush()
 
     def _foxglove(
         self, topic: str, ns: int, message: Any, meta: dict[str, str] | None = None
