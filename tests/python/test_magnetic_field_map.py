@@ -237,14 +237,18 @@ def _nan_layer(folder):
     ("spoil", "culprit", "match"),
     [
         (lambda f: (f / MAP_FILE).unlink(), MAP_FILE, "not a magnetic field map"),
-        (lambda f: _edit_yaml(f, kind="occupancy_grid"), MAP_FILE, "kind is 'occupancy_grid'"),
+        (
+            lambda f: _edit_yaml(f, kind="occupancy_grid"),
+            MAP_FILE,
+            "kind: must be 'magnetic_field_map', got 'occupancy_grid'",
+        ),
         (lambda f: (f / MAP_FILE).write_bytes(b"\x89\xff\x00"), MAP_FILE, "not UTF-8"),
         (lambda f: (f / "mz_variance.png").unlink(), "mz_variance.png", "missing"),
         (lambda f: (f / "layers.npz").unlink(), "layers.npz", "missing"),
         (lambda f: _edit_yaml(f, shape={"x": 7, "y": 6}), "mx_mean.png", "the YAML says"),
         (lambda f: _nan_layer(f), "layers.npz", "NaN"),
         (lambda f: (f / "training.npz").write_text("x"), "training.npz", "not a readable"),
-        (lambda f: _edit_yaml(f, dimension=4), MAP_FILE, "'dimension' must be 2 or 3"),
+        (lambda f: _edit_yaml(f, dimension=4), MAP_FILE, "dimension: must be 2 or 3, got 4"),
     ],
 )
 def test_bad_folders_are_refused_naming_the_file(tmp_path, spoil, culprit, match):
@@ -254,6 +258,64 @@ def test_bad_folders_are_refused_naming_the_file(tmp_path, spoil, culprit, match
     with pytest.raises(MapFormatError, match=match) as caught:
         MagneticFieldMap.load(folder)
     assert str(caught.value).startswith(str(folder / culprit))
+
+
+@pytest.mark.parametrize(
+    ("dimension", "changes", "problem"),
+    [
+        (
+            2,
+            {"shape": {"x": 99_999_999, "y": 6}},
+            "shape.x: must be less than or equal to 10000000, got 99999999",
+        ),
+        (
+            2,
+            {"shape": {"x": 5000, "y": 5000}},
+            "shape: at most 10,000,000 cells in all (here 25,000,000), got {'x': 5000, 'y': 5000}",
+        ),
+        (
+            3,
+            {"shape": {"x": 1000, "y": 1000, "z": 11}},
+            "shape: at most 10,000,000 cells in all (here 11,000,000)",
+        ),
+        (2, {"shape": {"x": 7, "y": True}}, "shape.y: must be a valid integer, got True"),
+        (
+            3,
+            {"shape": {"x": 7, "y": 5}},
+            "shape: must give the cell counts of x, y, z, got {'x': 7, 'y': 5}",
+        ),
+        (2, {"resolution": float("nan")}, "resolution: must be a finite number, got nan"),
+        (
+            2,
+            {"origin": [0.0, 1.0, 2.0]},
+            "origin: must be a list of 2 numbers (the map is 2-D), got [0.0, 1.0, 2.0]",
+        ),
+        (
+            2,
+            {"prior_variance": [1.0, "a", 1.0]},
+            "prior_variance[1]: must be a valid number, got 'a'",
+        ),
+        (
+            2,
+            {"kernel": {"sigma_f": 1.0, "length_scale": -2.0, "sigma_n": 0.1}},
+            "kernel.length_scale: must be greater than 0, got -2.0",
+        ),
+        (2, {"format_version": 2}, "format_version: must be 1, got 2"),
+        (2, {"colour": "red"}, "colour: unknown key"),
+    ],
+)
+def test_a_hand_edited_description_is_refused_naming_the_field_and_value(
+    tmp_path, dimension, changes, problem
+):
+    """magnetic_map.yaml is read through its model (kiseki.magnetic.map_doc): the cell counts
+    are limited before any array is read."""
+    folder = tmp_path / "map"
+    linear_map(dimension).save(folder)
+    _edit_yaml(folder, **changes)
+    with pytest.raises(MapFormatError) as caught:
+        MagneticFieldMap.load(folder)
+    assert str(caught.value).startswith(f"{folder / MAP_FILE}: {problem}"), str(caught.value)
+    assert "\n" not in str(caught.value)
 
 
 def test_3d_voxels_that_disagree_with_the_yaml_are_refused(tmp_path):

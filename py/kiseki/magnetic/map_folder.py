@@ -42,6 +42,7 @@ from kiseki._yaml import safe_load_12
 from kiseki.errors import MapFormatError
 from kiseki.gp import SquaredExponential
 from kiseki.magnetic.field_map import COMPONENTS, MagneticFieldMap, TrainingData
+from kiseki.magnetic.map_doc import Kernel, MagneticMapDoc, read_map_doc
 
 __all__ = ["MAP_FILE", "KIND", "check_map_destination", "load_map_folder", "save_map_folder"]
 
@@ -216,37 +217,6 @@ def _fail(path: Path, message: str) -> MapFormatError:
     return MapFormatError(f"{path}: {message}")
 
 
-def _number(doc: dict, key: str, meta: Path, positive: bool = False) -> float:
-    value = doc.get(key)
-    if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
-        raise _fail(meta, f"'{key}' must be a finite number, got {value!r}")
-    if positive and value <= 0:
-        raise _fail(meta, f"'{key}' must be positive, got {value!r}")
-    return float(value)
-
-
-def _numbers(doc: dict, key: str, n: int, meta: Path) -> np.ndarray:
-    value = doc.get(key)
-    if not isinstance(value, list) or len(value) != n:
-        raise _fail(meta, f"'{key}' must be a list of {n} numbers, got {value!r}")
-    return np.array([_number({key: v}, key, meta) for v in value])
-
-
-def _kernel_from(value, meta: Path):
-    def one(entry) -> SquaredExponential:
-        if not isinstance(entry, dict):
-            raise _fail(meta, f"'kernel' must hold sigma_f, length_scale, sigma_n, got {entry!r}")
-        try:
-            args = [_number(entry, k, meta, True) for k in ("sigma_f", "length_scale", "sigma_n")]
-            return SquaredExponential(*args)
-        except ValueError as err:
-            raise _fail(meta, f"'kernel': {err}") from None
-
-    if isinstance(value, dict) and set(value) == set(COMPONENTS):
-        return tuple(one(value[c]) for c in COMPONENTS)
-    return one(value)
-
-
 def _file(folder: Path, files: dict, key: str, meta: Path) -> Path:
     name = files.get(key) if isinstance(files, dict) else None
     if not isinstance(name, str) or not name or Path(name).name != name:
@@ -281,11 +251,11 @@ def _check_grid(path: Path, arrays: dict, origin: np.ndarray, resolution: float)
         raise _fail(path, "origin or resolution disagrees with the YAML")
 
 
-def _read_2d(folder: Path, doc: dict, meta: Path, origin, resolution, shape) -> tuple:
+def _read_2d(folder: Path, doc: MagneticMapDoc, meta: Path, origin, resolution, shape) -> tuple:
     from kiseki import _core
 
-    files = doc.get("files")
-    layers = files.get("layers") if isinstance(files, dict) else None
+    files = doc.files
+    layers = files.get("layers")
     if not isinstance(layers, dict):
         raise _fail(meta, "'files' must list the layer images under 'layers'")
     for name in LAYERS:
@@ -310,30 +280,24 @@ def _read_2d(folder: Path, doc: dict, meta: Path, origin, resolution, shape) -> 
     return stack["mean"], stack["variance"]
 
 
-def _read_3d(folder: Path, doc: dict, meta: Path, origin, resolution, shape) -> tuple:
-    path = _file(folder, doc.get("files"), "arrays", meta)
+def _read_3d(folder: Path, doc: MagneticMapDoc, meta: Path, origin, resolution, shape) -> tuple:
+    path = _file(folder, doc.files, "arrays", meta)
     full = (*shape, 3)
     arrays = _read_npz(path, {"mean": full, "variance": full, "origin": (3,), "resolution": ()})
     _check_grid(path, arrays, origin, resolution)
     return arrays["mean"], arrays["variance"]
 
 
-def _read_training(folder: Path, doc: dict, meta: Path, d: int) -> TrainingData | None:
-    files = doc.get("files")
-    if not (isinstance(files, dict) and "training" in files):
+def _read_training(folder: Path, doc: MagneticMapDoc, meta: Path) -> TrainingData | None:
+    if "training" not in doc.files:
         return None
-    info = doc.get("training")
-    if not isinstance(info, dict):
-        raise _fail(meta, "'training' must describe the stored training data")
-    path = _file(folder, files, "training", meta)
-    n = info.get("points")
-    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-        raise _fail(meta, f"'training: points' must be a positive integer, got {n!r}")
-    arrays = _read_npz(path, {"X": (n, None), "Y": (n, 3)})
+    info = doc.training
+    if info is None:
+        raise _fail(meta, "training: missing (files names training data it does not describe)")
+    path = _file(folder, doc.files, "training", meta)
+    arrays = _read_npz(path, {"X": (info.points, None), "Y": (info.points, 3)})
     try:
-        return TrainingData(
-            arrays["X"], arrays["Y"], info.get("method"), info.get("mean"), info.get("hilbert")
-        )
+        return TrainingData(arrays["X"], arrays["Y"], info.method, info.mean, info.hilbert)
     except ValueError as err:
         raise _fail(path, str(err)) from None
 
@@ -355,47 +319,31 @@ def load_map_folder(folder) -> MagneticFieldMap:
     if not meta.is_file():
         raise _fail(meta, "missing: the folder is not a magnetic field map")
     try:
-        doc = read_yaml_file(meta, "magnetic field map description")
+        raw = read_yaml_file(meta, "magnetic field map description")
+        if not isinstance(raw, dict):
+            raise _fail(meta, "not a magnetic field map description (not a YAML mapping)")
+        doc = read_map_doc(raw, meta)  # the fields, their values and the cell counts' limits
     except ValueError as err:
         raise MapFormatError(str(err)) from None
-    if not isinstance(doc, dict):
-        raise _fail(meta, "not a magnetic field map description (not a YAML mapping)")
-    if doc.get("kind") != KIND:
-        raise _fail(meta, f"kind is {doc.get('kind')!r}, not {KIND}")
-    if doc.get("format_version") != FORMAT_VERSION:
-        raise _fail(meta, f"format_version {doc.get('format_version')!r} is not {FORMAT_VERSION}")
-    d = doc.get("dimension")
-    if d not in (2, 3) or isinstance(d, bool):
-        raise _fail(meta, f"'dimension' must be 2 or 3, got {d!r}")
-    origin = _numbers(doc, "origin", d, meta)
-    resolution = _number(doc, "resolution", meta, positive=True)
-    size = doc.get("shape")
-    axes = "xyz"[:d]
-    if not (isinstance(size, dict) and set(size) == set(axes)) or not all(
-        isinstance(size[a], int) and not isinstance(size[a], bool) and size[a] > 0 for a in axes
-    ):
-        raise _fail(
-            meta, f"'shape' must give positive cell counts for {', '.join(axes)}, got {size!r}"
-        )
-    shape = tuple(size[a] for a in reversed(axes))
+    d, origin, resolution = doc.dimension, np.array(doc.origin), doc.resolution
     read = _read_2d if d == 2 else _read_3d
-    mean, variance = read(folder, doc, meta, origin, resolution, shape)
-    height = doc.get("height")
-    if d == 2 and height is not None:
-        height = _number(doc, "height", meta)
+    mean, variance = read(folder, doc, meta, origin, resolution, doc.cells())
+    kernel = doc.kernel.kernels()
+    kernels = [kernel] if isinstance(kernel, Kernel) else list(kernel)
+    se = [SquaredExponential(k.sigma_f, k.length_scale, k.sigma_n) for k in kernels]
     try:
         return MagneticFieldMap(
             origin=origin,
             resolution=resolution,
             mean=mean,
             variance=variance,
-            prior_mean=_numbers(doc, "prior_mean", 3, meta),
-            prior_variance=_numbers(doc, "prior_variance", 3, meta),
-            kernel=_kernel_from(doc.get("kernel"), meta),
-            units=doc.get("units"),
-            height=height if d == 2 else None,
-            provenance=doc.get("provenance") or {},
-            training=_read_training(folder, doc, meta, d),
+            prior_mean=np.array(doc.prior_mean),
+            prior_variance=np.array(doc.prior_variance),
+            kernel=se[0] if isinstance(kernel, Kernel) else tuple(se),
+            units=doc.units,
+            height=doc.height if d == 2 else None,
+            provenance=doc.provenance or {},
+            training=_read_training(folder, doc, meta),
         )
     except ValueError as err:
         if isinstance(err, MapFormatError):
