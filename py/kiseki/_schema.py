@@ -50,9 +50,14 @@ PositiveInt = Annotated[int, Field(strict=True, gt=0)]
 
 
 def _seed(value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < SEED_LIMIT:
-        raise ValueError("must be an integer in [0, 2**64)")
-    return value
+    from kiseki.core import SEED_RULE, check_seed
+
+    if not isinstance(value, int):  # strict: a float or a string in a file is not a seed
+        raise ValueError(SEED_RULE)
+    try:
+        return check_seed(value)
+    except ValueError:
+        raise ValueError(SEED_RULE) from None
 
 
 Seed = Annotated[int, BeforeValidator(_seed)]

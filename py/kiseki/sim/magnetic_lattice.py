@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from kiseki.core import Random
+from kiseki.core import Random, check_seed
 from kiseki.sim._values import finite_array as _finite_array
 from kiseki.sim._values import finite_scalar as _finite_scalar
 from kiseki.sim._values import points as _points
@@ -67,11 +67,7 @@ class DipoleLattice:
         if np.any(sd < 0):
             raise ValueError(f"moment_sd: must be >= 0, got {sd}")
         mean = _finite_array(self.moment_mean, (3,), "moment_mean")
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)):
-            raise ValueError(f"seed: expected an integer, got {self.seed!r}")
-        if not 0 <= self.seed < 2**64:
-            raise ValueError(f"seed: must be an integer in 0..2^64-1, got {self.seed!r}")
-        seed = int(self.seed)
+        seed = check_seed(self.seed, "seed:")
         radius = spacing / 2 if self.radius is None else self.radius
         radius = _finite_scalar(radius, "radius", minimum=0.0, strict=True)
         extent = hi - lo
