@@ -269,12 +269,15 @@ def test_options_that_do_not_apply_are_errors(tmp_path, doc, expected):
     assert scene_line(doc, tmp_path).startswith(expected)
 
 
+BEARING = {"type": "bearing", "targets": ["b"]}
+
+
 def test_a_valid_document_reads_to_its_values(tmp_path):
     doc = base(
         name="t",
         floor=True,
         grid_resolution=0.1,
-        robots=[{"name": "a", "type": "omni", "start": [0, 0, 0], "sensors": [{"x": 1}]},
+        robots=[{"name": "a", "type": "omni", "start": [0, 0, 0], "sensors": [BEARING]},
                 {"name": "b", "start": [1, 0, 0]}],
         turns={"goal": [2, 2],
                "moves": [{"robot": "b", "to": [1, 1]}, {"robot": "a", "to": [2, 2]}]},
@@ -284,7 +287,7 @@ def test_a_valid_document_reads_to_its_values(tmp_path):
     scene = load_scene(write(tmp_path, doc))
     assert scene.name == "t" and scene.grid_resolution == 0.1
     assert scene.robot_specs == [
-        {"name": "a", "robot": {"type": "omni", "start": [0, 0, 0]}, "sensors": [{"x": 1}],
+        {"name": "a", "robot": {"type": "omni", "start": [0, 0, 0]}, "sensors": [BEARING],
          "route": {}},
         {"name": "b", "robot": {"start": [1, 0, 0]}, "sensors": [], "route": {}},
     ]  # fmt: skip

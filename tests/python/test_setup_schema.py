@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import copy
 import math
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -259,3 +261,83 @@ def test_seeds_outside_0_to_2_64_are_refused(tmp_path, seed):
 def test_the_largest_seed_is_taken(tmp_path):
     robot, (laser,) = _build(tmp_path, seed=2**64 - 1)
     assert laser.device.params == LASER_PRESETS["hokuyo_utm30lx"]
+
+
+# ------------------------------------------------------- checked when the scene is loaded
+
+
+def _load(tmp_path, edit):
+    doc = copy.deepcopy(BASE)
+    edit(doc)
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    return load_scene(path)
+
+
+def _second_robot_rate(d):
+    _two_robots(d)
+    d["robots"][1]["sensors"][0]["rate_hz"] = -1
+
+
+LASER = {"type": "laser"}
+
+
+def _targets_itself(d):
+    _two_robots(d)
+    d["robots"][1]["sensors"][0]["targets"] = ["b"]
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (_sensor(rate_hz=-1), r"sensors\[0\]\.rate_hz: must be greater than 0, got -1$"),
+        (_second_robot_rate, r"robots\[1\]\.sensors\[0\]\.rate_hz: must be .* than 0, got -1$"),
+        (lambda d: d["robot"].update(type="tank"), r"robot\.type: must be diff_drive or omni"),
+        (
+            lambda d: d.update(sensors=[{"type": "bearing", "name": f"b{i}"} for i in range(51)]),
+            r"sensors: at most 50 sensors per robot, got 51$",
+        ),
+        (
+            lambda d: d["sensors"].append({"type": "laser", "name": "scan"}),
+            r"sensors: sensor names must be unique, got \['scan', 'scan'\]$",
+        ),
+        (  # an unnamed sensor is sensor<index>
+            lambda d: d["sensors"].extend([{"type": "laser", "name": "sensor2"}, LASER]),
+            r"sensors: sensor names must be unique, got \['scan', 'sensor2', 'sensor2'\]$",
+        ),
+        (
+            lambda d: d.update(sensors=[{"type": "bearing", "targets": ["ghost"]}]),
+            r"sensors\[0\]\.targets: must be other robots of the scene \(none\), got \['ghost'\]$",
+        ),
+        (
+            lambda d: d.update(sensors=[{"type": "bearing"}]),  # all others: none here
+            r"sensors\[0\]\.targets: must be other robots of the scene \(none\), got \[\]$",
+        ),
+        (
+            _targets_itself,
+            r"robots\[1\]\.sensors\[0\]\.targets: must be other robots of the scene \(a\), got",
+        ),
+        (
+            lambda d: d.update(sensors=[{"type": "magnetometer"}]),
+            r"sensors\[0\]: a magnetometer needs the scene's 'magnetic' section, got",
+        ),
+    ],
+)
+def test_robots_and_sensors_are_checked_when_the_scene_is_loaded(tmp_path, edit, message):
+    with pytest.raises(ValueError, match=rf"^\S*bad\.yaml: {message}"):
+        _load(tmp_path, edit)
+
+
+def test_sim_show_refuses_a_bad_sensor_in_one_line(tmp_path):
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump({**BASE, "sensors": [{"type": "laser", "rate_hz": -1}]}))
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "sim", "show", str(path), "-o", "s.png"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 1 and not (tmp_path / "s.png").exists()
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and f"{path}: sensors[0].rate_hz: " in lines[0], done.stderr
+    assert lines[0].endswith("must be greater than 0, got -1")

@@ -410,8 +410,8 @@ def _arm_spec(doc, index=2):
     ],
 )
 def test_bad_arms_are_named(tmp_path, edit, match):
-    scene = load_scene(_floor_with(tmp_path, edit))
-    with pytest.raises(ValueError, match=match) as info:
+    with pytest.raises(ValueError, match=match) as info:  # at load (a key) or build (the arm)
+        scene = load_scene(_floor_with(tmp_path, edit))
         build_sensors(scene, build_robot(scene, 0, 1), 0, 0.1, 1)
     assert "bad.yaml: robots[1].sensors[" in str(info.value)
 

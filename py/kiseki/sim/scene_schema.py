@@ -5,9 +5,10 @@ checked by :mod:`kiseki._schema`: name, description, source, bounds, floor, octo
 (:mod:`kiseki.sim.primitives_schema`), grid_resolution, measurement_grid, robots (their name
 and the sections kiseki.sim.setup and kiseki.sim.robot read), turns, poses, pedestrians and
 point_robots, and ``route`` (:class:`Route`, ``route: {}`` is none). ``robot``, ``sensors`` and
-each robot's ``type``, ``start``, ``params``, ``odometry_errors`` are read by kiseki.sim.setup /
-kiseki.sim.robot, ``magnetic`` by kiseki.sim.magnetic: here only their shape (a mapping, a list)
-is checked.
+each robot's ``type``, ``start``, ``params``, ``odometry_errors`` are checked by the models of
+kiseki.sim.setup_schema (:func:`~kiseki.sim.setup_schema.check_robots`, with the rules that
+depend on the rest of the scene), ``magnetic`` by kiseki.sim.magnetic_schema (in
+kiseki.sim.scene.load_scene).
 
 Limits on what sizes a run: the boxes the objects expand to (every box is ray cast by every
 sensor: 200,000 boxes take about 12 s to build), the ground truth's cells
@@ -27,6 +28,7 @@ from kiseki._schema import FileModel, FiniteFloat, NonNegativeFloat, PositiveFlo
 from kiseki.mapping import check_map_size
 from kiseki.sim.magnetic_survey import MeasurementGrid
 from kiseki.sim.primitives_schema import Object
+from kiseki.sim.setup_schema import RobotSections, check_robots
 
 __all__ = [
     "MAX_POSES",
@@ -323,4 +325,27 @@ class SceneDoc(FileModel):
             )
             if problem is not None:
                 raise fail((problem[0],), problem[1], problem[2])
+        return self
+
+    @model_validator(mode="after")
+    def _robots_and_sensors(self) -> SceneDoc:
+        if self.robots is None:
+            robots = [
+                RobotSections(
+                    "robot", ("robot",), dict(self.robot or {}), ("sensors",), self.sensors or []
+                )
+            ]
+        else:
+            keys = ("type", "start", "params", "odometry_errors")
+            robots = [
+                RobotSections(
+                    r.name,
+                    ("robots", i),
+                    {k: getattr(r, k) for k in keys if k in r.model_fields_set},
+                    ("robots", i, "sensors"),
+                    r.sensors or [],
+                )
+                for i, r in enumerate(self.robots)
+            ]
+        check_robots(robots, magnetic=bool(self.magnetic))
         return self

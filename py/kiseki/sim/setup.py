@@ -8,10 +8,12 @@ robot's 2-DOF arm (kiseki.sim.magnetic_arm): its ``mount`` is the arm's pivot, a
 carries it up to ``heights[1]`` whatever the robot's height. Both sensors of one arm (same
 pivot) must give the same bar.
 
-Each robot and sensor entry is checked first by its model (kiseki.sim.setup_schema), so a
-problem reads ``FILE: robots[1].sensors[0].rate_hz: must be ..., got VALUE``; what depends on
-the rest of the scene (the mount on the robot, bearing targets, unique names, one bar per
-pivot) is checked here with the same form of message."""
+Each robot and sensor entry, with the rules that depend on the rest of the scene (the sensor
+count, unique names, bearing targets, a magnetometer's magnetic section), is checked when the
+scene is loaded (kiseki.sim.setup_schema.check_robots), so a problem reads
+``FILE: robots[1].sensors[0].rate_hz: must be ..., got VALUE``; the mount on the robot and one
+bar per pivot are checked here with the same form of message. The entries are read again
+through their models here to build them."""
 
 from __future__ import annotations
 
@@ -36,7 +38,6 @@ from kiseki.sim.sensors import (
     TiltingLaser,
 )
 from kiseki.sim.setup_schema import (
-    MAX_SENSORS,
     ROBOT_MODELS,
     SENSOR_MODELS,
     BearingSpec,
@@ -172,10 +173,7 @@ def build_sensors(
     others = {s["name"] for s in scene.robot_specs} - {robot.name}
     arms: dict[tuple, tuple[dict, set]] = {}  # pivot -> (bar, sensors on it)
     sensors_at = (*robot_at, "sensors") if robot_at != ("robot",) else ("sensors",)
-    specs = scene.robot_specs[index]["sensors"]
-    if len(specs) > MAX_SENSORS:
-        raise _fail(scene, sensors_at, f"at most {MAX_SENSORS} sensors per robot, got {len(specs)}")
-    for i, raw in enumerate(specs):
+    for i, raw in enumerate(scene.robot_specs[index]["sensors"]):
         at = (*sensors_at, i)
         kind = parse(SensorKind, raw, scene.path, at=at).type
         spec = parse(SENSOR_MODELS[kind], raw, scene.path, at=at)
@@ -191,8 +189,7 @@ def build_sensors(
             camera = spec.camera
             device, default = DepthCamera(camera, mount, s), max(dt, camera.period)
         elif isinstance(spec, MagnetometerSpec):
-            if magnetic is None:
-                raise _fail(scene, at, "a magnetometer needs the scene's 'magnetic' section")
+            assert magnetic is not None  # load_scene checks that the scene has a field
             position, yaw = (mount.x, mount.y, mount.z), math.radians(mount.yaw_deg)
             if spec.arm is not None:
                 where = f"{scene.path}: {location_text((*at, 'arm'))}"
@@ -204,14 +201,7 @@ def build_sensors(
                 device = Magnetometer(magnetic, position, yaw, seed=s, **spec.params)
             default = dt
         elif isinstance(spec, BearingSpec):
-            targets = tuple(spec.targets or sorted(others))
-            if not targets or not set(targets) <= others:
-                raise _fail(
-                    scene,
-                    (*at, "targets"),
-                    f"must be other robots of the scene ({', '.join(sorted(others)) or 'none'}), "
-                    f"got {list(targets)}",
-                )
+            targets = tuple(spec.targets or sorted(others))  # checked by load_scene
             device, default = BearingSensor(spec.params, s), dt
         else:
             assert isinstance(spec, TiltingLaserSpec)
@@ -219,7 +209,4 @@ def build_sensors(
             default = 1e9  # by default once, at the start
         period = default if spec.rate_hz is None else 1.0 / spec.rate_hz
         out.append(SensorSetup(kind, name, device, period, mount, targets))
-    names = [s.name for s in out]
-    if len(set(names)) != len(names):
-        raise _fail(scene, sensors_at, f"sensor names must be unique, got {names}")
     return out

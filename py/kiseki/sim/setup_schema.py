@@ -13,16 +13,31 @@ A sensor: ``type``, ``name``, ``mount`` [x, y, z] or [x, y, z, yaw_deg], ``pitch
 ``rate_hz`` (at most :data:`MAX_RATE_HZ`), ``params`` (the parameter class of kiseki.sim.sensors
 for that type), and the keys of its type only: ``preset`` (laser), ``width``/``height``
 (depth_camera), ``arm`` (magnetometer), ``targets`` (bearing). A key of another type is an
-unknown key. Where the mount must lie (on the robot), which targets exist (the scene's other
-robots) and that names are unique depend on the rest of the scene: kiseki.sim.setup checks them.
+unknown key.
+
+:func:`check_robots` checks every robot and sensor of a scene when the scene is loaded
+(kiseki.sim.scene_schema.SceneDoc), with the rules that depend on the rest of the scene: at most
+:data:`MAX_SENSORS` sensors per robot, unique sensor names, a magnetometer only in a scene with
+a ``magnetic`` section, bearing targets among the scene's other robots. Where the mount must lie
+(on the robot) and one bar per arm pivot are checked by kiseki.sim.setup when it builds them.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from typing import Annotated, Any, Literal
+from collections.abc import Sequence
+from typing import Annotated, Any, Literal, TypeVar
 
-from pydantic import BeforeValidator, ConfigDict, Field, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
+from pydantic_core import PydanticCustomError
 
 from kiseki._schema import FileModel, FiniteFloat
 from kiseki.sim.robot import (
@@ -47,7 +62,9 @@ __all__ = [
     "ROBOT_MODELS",
     "SENSOR_MODELS",
     "RobotKind",
+    "RobotSections",
     "SensorKind",
+    "check_robots",
 ]
 
 MAX_RATE_HZ = 1000.0
@@ -211,3 +228,76 @@ SENSOR_MODELS: dict[str, type[_Sensor]] = {
     "bearing": BearingSpec,
     "tilting_laser": TiltingLaserSpec,
 }
+
+
+# ------------------------------------------------------------------- a scene's robots at load
+
+_M = TypeVar("_M", bound=BaseModel)
+Loc = tuple[str | int, ...]
+
+
+def _at(loc: Loc, value: Any, message: str, kind: str = "value_error") -> dict:
+    return {
+        "type": PydanticCustomError(kind, "{message}", {"message": message}),
+        "loc": loc,
+        "input": value,
+    }
+
+
+def _checked(model: type[_M], data: Any, at: Loc) -> _M:
+    """``data`` checked by ``model``; its errors placed at ``at`` in the scene file."""
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        errors = [
+            _at((*at, *e["loc"]), e.get("input"), e["msg"], e["type"])
+            for e in exc.errors(include_url=False)
+        ]
+        raise ValidationError.from_exception_data("scene", errors) from None
+
+
+def _fail(at: Loc, value: Any, message: str) -> ValidationError:
+    return ValidationError.from_exception_data("scene", [_at(at, value, message)])
+
+
+@dataclasses.dataclass(frozen=True)
+class RobotSections:
+    """One robot of a scene file as it is written: its name, where its keys are (``robot``
+    or ``robots[i]``), its robot keys (type, start, params, odometry_errors) and where its
+    sensors are (``sensors`` or ``robots[i].sensors``)."""
+
+    name: str
+    at: Loc
+    robot: dict
+    sensors_at: Loc
+    sensors: Sequence[Any]
+
+
+def check_robots(robots: Sequence[RobotSections], magnetic: bool) -> None:
+    """Every robot's and sensor's section checked by its model, and the rules that depend on the
+    rest of the scene (``magnetic``: the scene has a magnetic section); a pydantic
+    ValidationError at the section's place in the file otherwise."""
+    names = {r.name for r in robots}
+    for r in robots:
+        kind = _checked(RobotKind, r.robot, r.at).type
+        _checked(ROBOT_MODELS[kind], r.robot, r.at)
+        if len(r.sensors) > MAX_SENSORS:
+            raise _fail(r.sensors_at, len(r.sensors), f"at most {MAX_SENSORS} sensors per robot")
+        others = sorted(names - {r.name})
+        sensor_names = []
+        for i, raw in enumerate(r.sensors):
+            at = (*r.sensors_at, i)
+            spec = _checked(SENSOR_MODELS[_checked(SensorKind, raw, at).type], raw, at)
+            sensor_names.append(spec.name if spec.name is not None else f"sensor{i}")
+            if isinstance(spec, MagnetometerSpec) and not magnetic:
+                raise _fail(at, raw, "a magnetometer needs the scene's 'magnetic' section")
+            if isinstance(spec, BearingSpec):
+                targets = list(spec.targets or others)
+                if not targets or not set(targets) <= set(others):
+                    raise _fail(
+                        (*at, "targets"),
+                        targets,
+                        f"must be other robots of the scene ({', '.join(others) or 'none'})",
+                    )
+        if len(set(sensor_names)) != len(sensor_names):
+            raise _fail(r.sensors_at, sensor_names, "sensor names must be unique")
