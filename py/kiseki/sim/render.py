@@ -105,8 +105,8 @@ def _draw_turns(ax, scene: Scene) -> None:
 
 
 def _draw_robot(ax, spec: dict, label: str, colour: str) -> None:
-    route = np.asarray(spec["route"].get("waypoints", []), dtype=float).reshape(-1, 2)
-    if len(route):
+    if spec["route"]:  # checked by the scene's model: two or more [x, y], names one per point
+        route = np.asarray(spec["route"]["waypoints"])
         ax.plot(
             route[:, 0],
             route[:, 1],

@@ -9,7 +9,8 @@ octomap (a .bt file instead of, or beside, objects), objects (list of primitives
 kiseki.sim.primitives; an object, and a magnetic source, may carry ``only_in: teach`` or
 ``only_in: playback``),
 grid_resolution, robot {type, start [x, y, yaw_deg], params, odometry_errors}, sensors (list),
-route {waypoints [[x, y], ...], speed}, magnetic (see kiseki.sim.magnetic), measurement_grid
+route {waypoints [[x, y], ...], names, speed} (kiseki.sim.scene_schema.Route), magnetic (see
+kiseki.sim.magnetic), measurement_grid
 {lower: [x, y, z], upper: [x, y, z], spacing} (where the field is surveyed or scored, see
 kiseki.sim.magnetic_survey; ``Scene.measurement_grid``). Several robots:
 ``robots`` (a list of {name, type, start, params, odometry_errors, sensors, route}) instead of
