@@ -361,11 +361,12 @@ def test_a_hand_edited_run_config_is_refused_naming_the_file_and_the_key(tmp_pat
     edits = {
         "bytes": (bytes(range(128, 256)), "not a run's config (not UTF-8 text)"),
         "list": (b"[1, 2]\n", "not a run's config (a mapping), got list"),
-        "no-config": (re.sub(r"config:\n(  .*\n)+", "", text).encode(), "'config' must be a"),
+        "no-config": (re.sub(r"config:\n(  .*\n)+", "", text).encode(),
+                      "config.yaml: config: missing"),
         "key": (text.replace("  beams: 60\n", "  beams: 60\n  bogus: 3\n").encode(),
                 "config.yaml: config.bogus: unknown key"),
-        "value": (text.replace("  beams: 60\n", "  beams: 0\n").encode(),
-                  "fig-3-14: beams must be >= 2, got 0"),
+        "value": (text.replace("  beams: 60\n", "  beams: 1\n").encode(),
+                  "fig-3-14: beams must be >= 2, got 1"),
     }  # fmt: skip
     for name, (content, needle) in edits.items():
         folder = tmp_path / name
@@ -413,3 +414,58 @@ def test_more_bad_inputs_are_one_line_and_change_nothing(inputs, project_root, a
         expected
     )
     assert digests(inputs) == before
+
+
+@pytest.mark.parametrize(
+    ("edit", "problem"),
+    [
+        ({"runs": -1}, "runs: must be greater than 0, got -1"),
+        ({"runs": 10**12}, "runs: must be less than or equal to 100000, got 1000000000000"),
+        ({"runs": 1e12}, "runs: must be a valid integer, got 1000000000000.0"),
+        ({"runs": True}, "runs: must be a valid integer, got True"),
+        ({"seed": 2**64}, f"seed: must be an integer in [0, 2**64), got {2**64}"),
+        ({"seed": None}, "seed: missing"),
+        ({"experiment": None}, "experiment: missing"),
+        ({"config": [1]}, "config: must be a mapping, got [1]"),
+        ({"extra": 1}, "extra: unknown key"),
+    ],
+)
+def test_a_resumed_runs_config_yaml_is_checked_by_its_model(tmp_path, edit, problem):
+    """--resume reads runs and seed from the run's config.yaml with the limits of --runs and
+    --seed: one line naming the file and the field (runs and seed were unbounded before)."""
+    import yaml
+
+    from kiseki.experiments import run_experiment
+    from kiseki.experiments.config import ConfigError
+
+    saved = {"experiment": "fig-3-14", "runs": 1, "seed": 0, "config": {}}
+    saved = {k: v for k, v in {**saved, **edit}.items() if v is not None}
+    folder = tmp_path / "run"
+    folder.mkdir()
+    (folder / "config.yaml").write_text(yaml.safe_dump(saved))
+    before = digests(folder)
+    with pytest.raises(ConfigError) as err:
+        run_experiment("fig-3-14", out=folder, resume=True, progress=False)
+    text = str(err.value)
+    assert text.startswith(f"{folder / 'config.yaml'}: {problem}") and "\n" not in text, text
+    assert digests(folder) == before
+    if edit == {"runs": -1}:  # the command line: the same line, exit status 1
+        line = one_error(run("experiment", "run", "fig-3-14", "--out", "run", "--resume",
+                             cwd=tmp_path))  # fmt: skip
+        assert line == f"kiseki: error: run/config.yaml: {problem}"
+
+
+def test_the_command_lines_runs_and_seed_have_the_configs_limits(tmp_path):
+    from kiseki.experiments import run_experiment
+    from kiseki.experiments.config import ConfigError
+
+    for runs, seed, message in (
+        (0, 0, "--runs: must be greater than 0, got 0"),
+        (10**12, 0, "--runs: must be less than or equal to 100000, got 1000000000000"),
+        (1, -1, "--seed must be an integer in [0, 2**64), got -1"),  # as every --seed
+        (1, 2**64, f"--seed must be an integer in [0, 2**64), got {2**64}"),
+    ):
+        with pytest.raises(ConfigError) as err:
+            run_experiment("fig-3-14", runs, seed, out=tmp_path / "r", progress=False)
+        assert str(err.value) == message
+        assert not (tmp_path / "r").exists()

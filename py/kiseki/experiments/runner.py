@@ -17,17 +17,20 @@ import traceback
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import yaml
+from pydantic import Field, RootModel
 from tqdm import tqdm
 
 from kiseki._atomic import atomic_write, check_writable_folder
+from kiseki._schema import FileModel, SchemaError, Seed, parse
 from kiseki._yaml import read_yaml_file
-from kiseki.core import derive_seed
+from kiseki.core import check_seed, derive_seed
 from kiseki.errors import KisekiError
 from kiseki.experiments.config import (
     ConfigError,
+    Runs,
     apply_overrides,
     config_from_dict,
     config_to_dict,
@@ -82,7 +85,26 @@ def _link_latest(run_dir: Path) -> None:
     os.replace(tmp, latest)
 
 
-def _saved_run(run_dir: Path) -> dict[str, Any]:
+def _option(kind: Any, value: Any, flag: str) -> Any:
+    """A command-line option checked by its config type: ``"--runs: must be ..., got X"``."""
+    try:
+        return parse(RootModel[kind], value, flag).root
+    except SchemaError as err:
+        raise ConfigError(str(err), err.errors) from None
+
+
+class SavedRun(FileModel):
+    """A run's config.yaml, as written when the run starts and read by ``--resume``: the
+    experiment, the trials, the run seed and the experiment's config (checked by its own
+    model once the experiment is known)."""
+
+    experiment: Annotated[str, Field(strict=True)]
+    runs: Runs
+    seed: Seed
+    config: dict[str, Any]
+
+
+def _saved_run(run_dir: Path) -> SavedRun:
     path = run_dir / "config.yaml"
     if not path.is_file():
         raise KisekiError(f"{run_dir}: no config.yaml here: not a run that can be resumed")
@@ -92,13 +114,10 @@ def _saved_run(run_dir: Path) -> dict[str, Any]:
         raise KisekiError(str(err)) from None
     if not isinstance(saved, dict):
         raise KisekiError(f"{path}: not a run's config (a mapping), got {type(saved).__name__}")
-    for key, kind in (("experiment", str), ("runs", int), ("seed", int), ("config", dict)):
-        if not isinstance(saved.get(key), kind) or isinstance(saved.get(key), bool):
-            raise KisekiError(
-                f"{path}: '{key}' must be {'a mapping' if kind is dict else kind.__name__}, "
-                f"got {saved.get(key)!r}"
-            )
-    return saved
+    try:
+        return parse(SavedRun, saved, path)
+    except SchemaError as err:
+        raise ConfigError(str(err), err.errors) from None
 
 
 def _serial(jobs, name, values) -> Iterator[dict[str, Any]]:
@@ -152,36 +171,34 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
         run_dir = Path(out) if out else results_root / name / "latest"
         saved = _saved_run(run_dir)
         check_writable_folder(run_dir, "results")
-        if saved.get("experiment") != name:
-            raise KisekiError(
-                f"{run_dir}: holds a run of {saved.get('experiment')!r}, not {name!r}"
-            )
+        if saved.experiment != name:
+            raise KisekiError(f"{run_dir}: holds a run of {saved.experiment!r}, not {name!r}")
         if (
             overrides
-            or (runs is not None and runs != saved["runs"])
-            or (seed is not None and seed != saved["seed"])
+            or (runs is not None and runs != saved.runs)
+            or (seed is not None and seed != saved.seed)
         ):
             raise KisekiError("--resume continues a run as it was: drop --set, --runs and --seed")
         run_dir = run_dir.resolve()
         path = run_dir / "config.yaml"
         try:  # edited by hand since the run: the message names the file and the key
-            config = config_from_dict(experiment.config_type, saved["config"], path, ("config",))
+            config = config_from_dict(experiment.config_type, saved.config, path, ("config",))
         except (TypeError, ValueError) as err:  # the model's message names the file already
             text = str(err) if str(err).startswith(f"{path}: ") else f"{path}: {err}"
             raise ConfigError(text) from None
-        return experiment, run_dir, config, saved["runs"], saved["seed"]
+        return experiment, run_dir, config, saved.runs, saved.seed
     config = apply_overrides(experiment.config_type(), list(overrides))
     settings = experiment.trial_count(config) if experiment.trial_count else None
     runs = (experiment.default_runs if settings is None else settings) if runs is None else runs
-    if runs < 1:
-        raise ConfigError(f"--runs must be at least 1, got {runs}")
+    runs = _option(Runs, runs, "--runs")
     if settings is not None and runs > settings:
         raise ConfigError(
             f"{name}: its config has {settings} settings (one trial each), not {runs}"
         )
-    seed = 0 if seed is None else seed
-    if not 0 <= seed < 2**64:
-        raise ConfigError(f"--seed must lie in [0, 2**64), got {seed}")
+    try:  # the one seed check, worded as every --seed
+        seed = check_seed(0 if seed is None else seed, "--seed")
+    except ValueError as err:
+        raise ConfigError(str(err)) from None
     run_dir = Path(out) if out else _results_dir(name, results_root)
     if (run_dir / "trials.jsonl").exists():
         raise KisekiError(f"{run_dir}: already holds trials: use --resume or another --out")
