@@ -100,8 +100,8 @@ _PNG = b"\x89PNG\r\n\x1a\n"
 def _check_cells(path: Path, image: Path, width: int, height: int) -> None:
     if width * height > MAX_MAP_CELLS:
         raise MapFormatError(
-            f"{path}: image {image.name} is {width} x {height} pixels: more than the limit of "
-            f"{MAX_MAP_CELLS:.0e} map cells"
+            f"{image} (the image of {path}) is {width} x {height} pixels: more than the "
+            f"limit of {MAX_MAP_CELLS:.0e} map cells"
         )
 
 

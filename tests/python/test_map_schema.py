@@ -98,8 +98,8 @@ def test_an_image_over_the_cell_limit_is_refused_before_decoding(tmp_path, name,
     with pytest.raises(MapFormatError) as info:
         load_map(_write(tmp_path, image=name))
     assert str(info.value) == (
-        f"{tmp_path / 'm.yaml'}: image {name} is 20000 x 5001 pixels: more than the limit of "
-        f"1e+08 map cells"
+        f"{tmp_path / name} (the image of {tmp_path / 'm.yaml'}) is 20000 x 5001 pixels: "
+        "more than the limit of 1e+08 map cells"
     )
     assert MAX_MAP_CELLS == 20000 * 5000 == 10**8
 
