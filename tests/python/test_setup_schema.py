@@ -254,7 +254,7 @@ def test_several_robots_are_named_by_their_place_in_robots(tmp_path):
 
 @pytest.mark.parametrize("seed", [-1, 2**64, True, 1.0, "1"])
 def test_seeds_outside_0_to_2_64_are_refused(tmp_path, seed):
-    with pytest.raises(ValueError, match="seed must be an integer in 0..2\\^64-1"):
+    with pytest.raises(ValueError, match=r"seed must be an integer in \[0, 2\*\*64\), got "):
         _build(tmp_path, seed=seed)
 
 
