@@ -166,7 +166,9 @@ def test_every_field_has_its_range(cls):
     for name, kind in KINDS[cls].items():
         for bad, good in EDGES[kind]:
             assert getattr(cls.from_dict({name: good}), name) == good
-            with pytest.raises(ValueError, match=rf"^s\.yaml: {name}: .*, got {bad!r}$"):
+            # an integral float given for an integer is told how to write it
+            hint = r"( \(write it as -?\d+, without a point or an exponent\))?"
+            with pytest.raises(ValueError, match=rf"^s\.yaml: {name}: .*, got {bad!r}{hint}$"):
                 cls.from_dict({name: bad}, "s.yaml")
 
 
