@@ -7,11 +7,12 @@ the column and the cell as it was written (``v: must be a finite number, got 'na
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Sequence
 from typing import Annotated, Any
 
 from pydantic import BeforeValidator, Field
 
-__all__ = ["CsvNumber", "number_text"]
+__all__ = ["CsvNumber", "data_rows", "number_text"]
 
 
 def number_text(text: Any) -> Any:
@@ -31,3 +32,12 @@ def number_text(text: Any) -> Any:
 CsvNumber = Annotated[float, BeforeValidator(number_text), Field(strict=True, allow_inf_nan=False)]
 """A finite number from a CSV cell; bounds go in a further ``Field`` (``Annotated[CsvNumber,
 Field(ge=0)]``)."""
+
+
+def data_rows(lines: Sequence[str]) -> Iterator[tuple[int, list[str], str]]:
+    """The data rows under a CSV's header line: (line number from 1, its cells, the line),
+    with ``#`` comments cut off and blank rows skipped."""
+    for number, line in enumerate(lines[1:], 2):
+        cells = line.split("#", 1)[0].split(",")
+        if "".join(cells).strip():
+            yield number, cells, line

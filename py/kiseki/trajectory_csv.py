@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import Field, create_model
 
-from kiseki._csv import CsvNumber
+from kiseki._csv import CsvNumber, data_rows
 from kiseki._schema import FileModel, parse
 
 __all__ = ["MAX_COLUMNS", "MAX_ROWS", "read_trajectory_csv"]
@@ -56,10 +56,7 @@ def read_trajectory_csv(path: str | os.PathLike) -> np.ndarray:
         raise ValueError(f"{path}: the header's column names must be unique and not empty")
     model, x, y = _row_model(columns), columns.index("x"), columns.index("y")
     rows: list[tuple[float, float]] = []
-    for number, line in enumerate(lines[1:], 2):
-        cells = line.split("#", 1)[0].split(",")
-        if not "".join(cells).strip():
-            continue
+    for number, cells, line in data_rows(lines):
         where = f"{path}:{number}"
         if len(cells) != len(columns):
             raise ValueError(

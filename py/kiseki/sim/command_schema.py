@@ -22,7 +22,7 @@ from typing import Annotated
 import numpy as np
 from pydantic import Field
 
-from kiseki._csv import CsvNumber
+from kiseki._csv import CsvNumber, data_rows
 from kiseki._schema import FileModel, parse
 
 __all__ = [
@@ -80,10 +80,7 @@ def read_command_rows(path: str | os.PathLike) -> np.ndarray:
         raise ValueError(f"{path}: header must be t,v,w or t,vx,vy,w, got {lines[0][:60]!r}")
     model, columns = HEADERS[header], header.split(",")
     rows: list[list[float]] = []
-    for number, line in enumerate(lines[1:], 2):
-        cells = line.split("#", 1)[0].split(",")
-        if not "".join(cells).strip():
-            continue
+    for number, cells, line in data_rows(lines):
         where = f"{path}:{number}"
         if len(cells) != len(columns):
             raise ValueError(f"{where}: a row is {header} ({len(columns)} values), got {line!r}")
