@@ -1,0 +1,327 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The travel-distance localization of the magnetic-navigation thesis
+(``002_74cea16d239c028f.txt``, sec. 4.4.1) and its azimuth heading correction (sec. 4.4.2), on
+kiseki's 1-D particle engine :class:`kiseki._core.TravelDistanceFilter`.
+
+Travel distance (sec. 4.4.1), per reading:
+
+* motion, eq. 4.6: ``d_t = d_{t-1} + delta d_t``; the thesis writes no noise term, but a
+  particle filter needs one to spread its particles: each particle adds N(0, sigma^2) with
+  ``sigma = odometry_noise * sqrt(|delta d|)`` (a random walk whose variance grows with the
+  distance travelled, so the spread does not depend on the reading rate);
+* the readings of the last ``l`` metres of travel are kept ("first the magnetometer's readings
+  over l m of travel are accumulated"), indexed by the odometry's travel distance and averaged
+  per 0.1 m bin, the map's own node spacing (sec. 3.3.2);
+* eq. 4.7: ``s_i = int_{d_i - l}^{d_i} |map m(d) - sensor m(d)| dd``, the sum over the window's
+  bins of the absolute difference times the bin width, the map read at particle i's alignment
+  (bin k, k * 0.1 m behind the newest reading, against the map at ``d_i - k * 0.1``, linear
+  between nodes, the end nodes' values beyond the map's ends);
+* eq. 4.8: ``w_i = 1 / (a s_i + 1)``, a = 50; eq. 4.9: normalised. The thesis sets the weights
+  from s alone at each step (eq. 4.8 has no previous weight in it: the window already holds the
+  history), so the engine's weights are set to uniform before ``update(log w)``;
+* eq. 4.10: the estimate is the weighted mean ``sum w_i d_i`` of these weights (computed before
+  the engine resamples);
+* eq. 4.11: ``ESS = 1 / sum w_i^2``; resampling only when ESS < 9n/10 (the engine's
+  ``resample_threshold`` 0.9).
+
+Which field enters |m - m_map|: the z component (down) only. The thesis says so for the same
+linear map in ch. 3: "the x and y components change with the robot's heading, so only the z
+component is used for localization" (sec. 3.3.2); eq. 4.7 writes a scalar |.| of the "field
+strength" plotted as one curve in Fig. 4.5, and the heading correction of sec. 4.4.2 also uses
+m_z for its gate (eq. 4.5). A heading error of a few degrees turns mx and my by
+|m_h| * sin(error), as much as the disturbances the filter looks for.
+
+Units: G, as in the thesis (a = 50 is per G m; the gates' dm_z,max = 1 G). Readings in uT are
+divided by 100 first.
+
+The window length l: the thesis names it ("l m") without a value. We take 6 m, the length of the
+mz window Rahok's travel-distance correction keeps (sec. 3.3.2, "6 m of field strength every
+10 cm"), and say so wherever a result depends on it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from kiseki.magnetic.linear_map import LinearMagneticMap
+
+__all__ = [
+    "GAIN",
+    "R_THETA_GATE",
+    "R_Z_GATE",
+    "WINDOW",
+    "HeadingCorrection",
+    "TravelDistanceConfig",
+    "TravelDistanceLocalizer",
+    "azimuth_heading",
+    "heading_from_map",
+    "window_mismatch",
+]
+
+GAIN = 50.0
+"""a of eq. 4.8, per G m (sec. 4.4.1: "a is a gain, 50 in the implementation")."""
+WINDOW = 6.0
+"""m: l of eq. 4.7 (no value in the thesis; Rahok's 6 m window of sec. 3.3.2)."""
+R_Z_GATE = 0.992
+"""r_z of eq. 4.5 at or above which the heading is corrected (sec. 4.4.2)."""
+R_THETA_GATE = 0.990
+"""r_theta of eq. 4.13 at or above which the heading is corrected (sec. 4.4.2)."""
+DM_Z_MAX = 1.0
+"""G: dm_z,max of eq. 4.5 ("= 1")."""
+DM_THETA_MAX = math.pi
+"""rad: dm_theta,max of eq. 4.13 ("= pi rad")."""
+
+
+def _number(value: Any, name: str, low: float, *, strict: bool, integer: bool = False) -> None:
+    kind = int if integer else (int, float)
+    if isinstance(value, bool) or not isinstance(value, kind):
+        what = "an integer" if integer else "a number"
+        raise ValueError(f"travel distance: {name} must be {what}, got {value!r}")
+    ok = value > low if strict else value >= low
+    if not (math.isfinite(value) and ok):
+        raise ValueError(
+            f"travel distance: {name} must be {'>' if strict else '>='} {low}, got {value}"
+        )
+
+
+@dataclass(frozen=True)
+class TravelDistanceConfig:
+    """The filter's settings (sec. 4.4.1; see the module text)."""
+
+    particles: int = 1000  # sec. 4.5.1, Fig. 4.7: "1000 particles"
+    gain: float = GAIN  # a of eq. 4.8, per G m
+    window: float = WINDOW  # l of eq. 4.7, m
+    odometry_noise: float = 0.1  # m per sqrt(m) of travel, the motion's spread
+    initial_sd: float = 0.0  # m, spread of the particles around the start
+    resample_threshold: float = 0.9  # ESS < 9n/10 (sec. 4.4.1)
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        _number(self.particles, "particles", 0, strict=True, integer=True)
+        if self.particles > 10_000_000:
+            raise ValueError(
+                f"travel distance: particles must be <= 10,000,000, got {self.particles}"
+            )
+        _number(self.gain, "gain a", 0.0, strict=True)
+        _number(self.window, "window l", 0.0, strict=True)
+        _number(self.odometry_noise, "odometry_noise", 0.0, strict=False)
+        _number(self.initial_sd, "initial_sd", 0.0, strict=False)
+        _number(self.resample_threshold, "resample_threshold", 0.0, strict=False)
+        if self.resample_threshold > 1.0:
+            raise ValueError(
+                "travel distance: resample_threshold must be in [0, 1], got "
+                f"{self.resample_threshold}"
+            )
+        _number(self.seed, "seed", 0, strict=False, integer=True)
+        if self.seed >= 2**64:
+            raise ValueError(f"travel distance: seed must be below 2**64, got {self.seed}")
+
+
+def _map_profile(linear_map: Any) -> tuple[np.ndarray, np.ndarray, float]:
+    """(node s, node mz in G, spacing) of a linear map."""
+    if not isinstance(linear_map, LinearMagneticMap):
+        raise ValueError(
+            f"travel distance: the map must be a LinearMagneticMap, got {type(linear_map).__name__}"
+        )
+    if len(linear_map) < 2:
+        raise ValueError(f"travel distance: the map has {len(linear_map)} node(s); 2 are needed")
+    mz = np.asarray(linear_map.field[:, 2], dtype=np.float64)
+    if not np.all(np.isfinite(mz)):
+        raise ValueError("travel distance: the map's mz holds NaN or infinity")
+    return np.asarray(linear_map.s, dtype=np.float64), mz, float(linear_map.spacing)
+
+
+def window_mismatch(
+    node_s: np.ndarray,
+    node_mz: np.ndarray,
+    particles: np.ndarray,
+    offsets: np.ndarray,
+    readings: np.ndarray,
+    bin_width: float,
+) -> np.ndarray:
+    """Eq. 4.7 for every particle: ``sum_k |map mz(d_i - offsets_k) - readings_k| * bin_width``
+    (G m); the map linear between nodes, clamped at its ends. Vectorised over (n, k)."""
+    where = particles[:, None] - offsets[None, :]
+    expected = np.interp(where, node_s, node_mz)
+    return np.abs(expected - readings[None, :]).sum(axis=1) * bin_width
+
+
+class TravelDistanceLocalizer:
+    """Travel distance along a :class:`LinearMagneticMap` from odometry increments and mz
+    readings (G, sensor z down), on the C++ engine. ``start``: the travel distance at the first
+    reading (m). Seeded: the same config and inputs give the same estimates."""
+
+    def __init__(
+        self,
+        linear_map: LinearMagneticMap,
+        config: TravelDistanceConfig | None = None,
+        start: float = 0.0,
+    ) -> None:
+        from kiseki import _core
+
+        self.config = TravelDistanceConfig() if config is None else config
+        if not isinstance(self.config, TravelDistanceConfig):
+            raise ValueError("travel distance: config must be a TravelDistanceConfig")
+        _number(start, "start", -math.inf, strict=True)
+        self._s, self._mz, self._spacing = _map_profile(linear_map)
+        params = _core.TravelDistanceParams()
+        params.particles = self.config.particles
+        params.resample_threshold = self.config.resample_threshold
+        self._filter = _core.TravelDistanceFilter(params, self.config.seed)
+        self._filter.initialize(float(start), self.config.initial_sd)
+        self._bins = int(round(self.config.window / self._spacing))
+        if self._bins < 1:
+            raise ValueError(
+                f"travel distance: window l {self.config.window} m is shorter than the map's "
+                f"{self._spacing} m node spacing"
+            )
+        self._odometry = 0.0
+        self._buffer: deque[tuple[float, float]] = deque()
+        self._uniform = np.full(self.config.particles, 1.0 / self.config.particles)
+        self.estimate = float(start)
+        self.effective_sample_size = float(self.config.particles)
+        self.resampled = False
+        self.weights = self._uniform.copy()
+
+    @property
+    def particles(self) -> np.ndarray:
+        return np.asarray(self._filter.particles)
+
+    def window_readings(self) -> tuple[np.ndarray, np.ndarray]:
+        """(offsets behind the newest reading m, mean mz G) of the window's non-empty 0.1 m bins."""
+        u = np.fromiter((r[0] for r in self._buffer), np.float64, len(self._buffer))
+        m = np.fromiter((r[1] for r in self._buffer), np.float64, len(self._buffer))
+        k = np.floor((self._odometry - u) / self._spacing + 0.5).astype(np.int64)
+        keep = (k >= 0) & (k < self._bins)
+        k, m = k[keep], m[keep]
+        count = np.bincount(k, minlength=self._bins)
+        total = np.bincount(k, weights=m, minlength=self._bins)
+        filled = count > 0
+        return np.flatnonzero(filled) * self._spacing, total[filled] / count[filled]
+
+    def step(self, distance: float, mz: float) -> float:
+        """One reading: the odometry's travel since the last reading (m) and mz (G). Returns
+        the estimate of eq. 4.10."""
+        _number(distance, "the odometry increment", -math.inf, strict=True)
+        _number(mz, "the mz reading", -math.inf, strict=True)
+        sd = self.config.odometry_noise * math.sqrt(abs(distance))
+        self._filter.predict(float(distance), sd)  # eq. 4.6 plus the spread
+        self._odometry += float(distance)
+        self._buffer.append((self._odometry, float(mz)))
+        horizon = self._odometry - self.config.window - self._spacing
+        while self._buffer and self._buffer[0][0] < horizon:
+            self._buffer.popleft()
+        offsets, readings = self.window_readings()
+        particles = self.particles
+        s = window_mismatch(self._s, self._mz, particles, offsets, readings, self._spacing)
+        w = 1.0 / (self.config.gain * s + 1.0)  # eq. 4.8
+        w /= w.sum()  # eq. 4.9
+        self.weights = w
+        self.estimate = float(np.dot(w, particles))  # eq. 4.10
+        self.effective_sample_size = float(1.0 / np.dot(w, w))  # eq. 4.11
+        self.resampled = self.effective_sample_size < self.config.resample_threshold * len(w)
+        self._filter.set_weights(self._uniform)  # eq. 4.8 replaces the weights
+        self._filter.update(np.log(w))
+        return self.estimate
+
+    def run(self, distances: Any, mz: Any) -> np.ndarray:
+        """:meth:`step` over a stream: increments (n,) m and mz (n,) G; the estimates (n,)."""
+        d = _stream(distances, "the odometry increments")
+        m = _stream(mz, "the mz readings")
+        if d.shape != m.shape:
+            raise ValueError(
+                f"travel distance: {d.shape[0]} odometry increments but {m.shape[0]} mz readings"
+            )
+        return np.array([self.step(float(a), float(b)) for a, b in zip(d, m, strict=True)])
+
+
+def _stream(values: Any, name: str) -> np.ndarray:
+    try:
+        a = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"travel distance: {name} must be numbers") from None
+    if a.ndim != 1:
+        raise ValueError(f"travel distance: {name} must be one-dimensional, got shape {a.shape}")
+    bad = ~np.isfinite(a)
+    if bad.any():
+        raise ValueError(f"travel distance: {name}[{int(np.argmax(bad))}] is NaN or infinity")
+    return a
+
+
+class HeadingCorrection(NamedTuple):
+    """The heading after sec. 4.4.2 (rad), whether the gates held, and r_z, r_theta."""
+
+    theta: float
+    applied: bool
+    r_z: float
+    r_theta: float
+
+
+def _wrap(angle: float) -> float:
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
+def azimuth_heading(
+    theta: float,
+    m_theta: float,
+    m_z: float,
+    node_heading: float,
+    node_m_theta: float,
+    node_m_z: float,
+    r_z_gate: float = R_Z_GATE,
+    r_theta_gate: float = R_THETA_GATE,
+) -> HeadingCorrection:
+    """Sec. 4.4.2: the node's azimuth ``theta_(n,m) = theta_n - m_theta,n`` (eq. 4.12 on the
+    map); ``r_z = 1 - |m_z,n - m_z,t| / dm_z,max`` (eq. 4.5, dm_z,max = 1 G) and
+    ``r_theta = 1 - |m_theta,n - m_theta,t| / pi`` (eq. 4.13, the difference wrapped to
+    [0, pi]); when ``r_z >= 0.992`` and ``r_theta >= 0.990`` the heading becomes
+    ``theta_(n,m) + m_theta,t`` (eq. 4.14), otherwise it stays ``theta``. Angles rad, fields G."""
+    values = (theta, m_theta, m_z, node_heading, node_m_theta, node_m_z, r_z_gate, r_theta_gate)
+    names = (
+        "theta",
+        "m_theta",
+        "m_z",
+        "node_heading",
+        "node_m_theta",
+        "node_m_z",
+        "r_z_gate",
+        "r_theta_gate",
+    )
+    for name, value in zip(names, values, strict=True):
+        _number(value, name, -math.inf, strict=True)
+    r_z = 1.0 - abs(node_m_z - m_z) / DM_Z_MAX
+    r_theta = 1.0 - abs(_wrap(node_m_theta - m_theta)) / DM_THETA_MAX
+    if r_z >= r_z_gate and r_theta >= r_theta_gate:
+        return HeadingCorrection(_wrap(node_heading - node_m_theta + m_theta), True, r_z, r_theta)
+    return HeadingCorrection(_wrap(theta), False, r_z, r_theta)
+
+
+def heading_from_map(
+    linear_map: LinearMagneticMap,
+    d: float,
+    theta: float,
+    reading: Any,
+) -> HeadingCorrection:
+    """:func:`azimuth_heading` at the node nearest travel distance ``d`` (the filter's
+    estimate, "after the travel distance is estimated, the robot is at node n"), for a reading
+    (mx, my, mz) G in the sensor frame (x forward, y right, z down)."""
+    _map_profile(linear_map)
+    _number(d, "d", -math.inf, strict=True)
+    m = _stream(reading, "the reading")
+    if m.shape != (3,):
+        raise ValueError(f"travel distance: the reading must be (mx, my, mz), got {m.shape}")
+    n = int(linear_map.index(d))
+    return azimuth_heading(
+        theta,
+        math.atan2(m[1], m[0]),
+        float(m[2]),
+        float(linear_map.heading[n]),
+        float(linear_map.m_theta[n]),
+        float(linear_map.field[n, 2]),
+    )
