@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """One robot's record of a run: each time step its ground truth, odometry and every sensor that
-is due (lasers see the pedestrians' discs); the latest scan of each laser is kept for a
-controller. Used by kiseki.sim.run."""
+is due (lasers see the pedestrians' discs); the latest scan of each laser and the latest reading
+of each magnetometer are kept for a controller. Used by kiseki.sim.run."""
 
 from __future__ import annotations
 
@@ -69,6 +69,7 @@ class Recorder:
         self.prefix = prefix
         self.next_due = {s.name: 0.0 for s in sensors}
         self.latest: dict[str, tuple] = {}  # laser name -> (sensor pose, angles, ranges, max)
+        self.readings: dict[str, tuple[float, np.ndarray]] = {}  # magnetometer -> (t, reading G)
         self.grids = {}
         for s in sensors:
             if s.kind == "laser":
@@ -116,6 +117,7 @@ class Recorder:
             w.write_depth_image(topic, t, s.device.render(self.scene.world, pose), s.name)
         elif s.kind == "magnetometer":
             m = s.device.read(pose, t)
+            self.readings[s.name] = (t, np.array(m, dtype=np.float64))
             w.write_json(
                 topic,
                 t,

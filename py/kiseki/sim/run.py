@@ -158,8 +158,11 @@ def simulate(
     ``controller`` (one robot, no commands, no turns): an object with ``command(t, pose,
     scans) -> (vx, vy, w)``, pose the robot's true (x, y, theta), scans {laser name: (sensor
     pose (3,), beam angles (n,), ranges (n,), max range)} (the latest scan of each laser); the
-    scene's route is then not followed. A ``done`` attribute that turns True ends the run, and
-    RunSummary.reached_goal is its final value.
+    scene's route is then not followed. A controller with an ``observe(t, odometry,
+    readings)`` method is first given, each step, the odometry's (x, y, theta) and
+    {magnetometer name: (time of its latest reading, (3,) reading G in the sensor frame)}: a
+    navigator that must not see the true pose takes its inputs from there. A ``done``
+    attribute that turns True ends the run, and RunSummary.reached_goal is its final value.
 
     A collision (a footprint touching an obstacle, another robot or a pedestrian) ends the run
     at the end of the step that made it: /collision, RunSummary.collision, reached_goal False.
@@ -212,6 +215,9 @@ def simulate(
                 for a, recorder in zip(agents, recorders, strict=True):
                     if controller is not None:
                         pose = _pose(a.setup.robot.pose)
+                        observe = getattr(controller, "observe", None)
+                        if observe is not None:
+                            observe(t, _pose(a.setup.odometry.pose), dict(recorder.readings))
                         command = tuple(controller.command(t, pose, dict(recorder.latest)))
                     elif turns is not None:
                         command = turns.command(a)
