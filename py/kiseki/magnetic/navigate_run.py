@@ -19,7 +19,9 @@ ch. 3-4): the driver that wires the simulator (a data source) to the methods of
   estimates it with its particle filter (sec. 4.4.1) instead; kiseki's is not wired here yet. The
   heading theta_t of the ch. 4 navigators is the odometry's (sec. 4.4.2's azimuth correction is
   not applied). The navigators see odometry, magnetometer and laser only; the true pose is
-  logged for the cross-track error alone.
+  logged for the cross-track error alone. Every method steers with the same PD gains
+  (:data:`GAINS`); the ch. 4 navigators weigh the g terms by 0.3 rad/m (MultiNavigator's
+  default), Rahok's w by :func:`kiseki.magnetic.rahok_navigation.weight_vector`'s defaults.
 """
 
 from __future__ import annotations
@@ -51,6 +53,10 @@ __all__ = ["METHODS", "NavigationResult", "TaughtMaps", "cross_track", "navigate
 METHODS = ("rahok", *NAVIGATORS, "multi")
 OFFSET = 1.0
 """m: the parallel paths' distance from the taught one (Fig. 2.10's y = -1 and +1 m)."""
+GAINS = {"kp": 1.0, "kd": 0.5, "max_rate": 0.5}
+"""PD gains of every method's steering (1/s, s, rad/s); the thesis prints none (sec. 3.3.4)."""
+AVERAGE = 5
+"""Readings averaged by Rahok's navigator before eq. 3.2 (0.3 m of travel; our choice)."""
 
 
 @dataclass(frozen=True)
@@ -170,11 +176,13 @@ class _Controller:
         if method == "rahok":
             s_vec, w_vec = rahok_vectors(maps)
             self.rahok = RahokNavigator(
-                lmap, s_vec, w_vec, PdSteering(1.0, 0.5, 0.5), self.peaks, speed, average=5
+                lmap, s_vec, w_vec, PdSteering(**GAINS), self.peaks, speed, AVERAGE
             )
         else:
             names = NAVIGATORS if method == "multi" else (method,)
-            self.multi = MultiNavigator(lmap, names)
+            self.multi = MultiNavigator(
+                lmap, names, GAINS["kp"], GAINS["kd"], max_rate=GAINS["max_rate"]
+            )
         self.d = float(lmap.s[0])
         self.done = False
         self._odom = None
