@@ -306,6 +306,11 @@ def test_bad_navigation_requests_are_refused(tmp_path, project_data):
     assert METHODS == ("rahok", "magnetic-geometric", "magnetic", "geometric", "odometry", "multi")
     with pytest.raises(ValueError, match="method must be one of"):
         navigate(project_data / "worlds" / "magnetic_path.yaml", None, "lidar", tmp_path / "x")
+    with pytest.raises(ValueError, match="travel must be one of odometry, peaks, filter"):
+        navigate(project_data / "worlds" / "magnetic_path.yaml", None, "rahok", tmp_path / "x",
+                 travel="filter")  # fmt: skip
+    with pytest.raises(ValueError, match="maps must be TaughtMaps"):
+        navigate(project_data / "worlds" / "magnetic_path.yaml", None, "multi", tmp_path / "x")
     with pytest.raises(ValueError, match="offset must be a positive"):
         teach(project_data / "worlds" / "magnetic_path.yaml", tmp_path, offset=-1.0)
     lmap = build_linear_map([0.0, 0.1], [[0.2, 0.0, MZ0]] * 2, [0.0, 0.0], path_id=PATH)

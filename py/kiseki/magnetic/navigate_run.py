@@ -14,11 +14,15 @@ ch. 3-4): the driver that wires the simulator (a data source) to the methods of
 * :func:`navigate`: playback on the ``playback`` variant (the bicycle park moved, the road plate
   laid) steering with one method: ``rahok`` (ch. 3) or the ch. 4 navigators ``odometry``,
   ``geometric``, ``magnetic``, ``magnetic-geometric`` alone, or ``multi`` (all four by
-  priority). The travel distance is the odometry's path length; with ``correct`` (the default
-  except for ``odometry``) it is corrected at the taught peaks (sec. 3.3.3). The thesis' ch. 4
-  estimates it with its particle filter (sec. 4.4.1) instead; kiseki's is not wired here yet. The
-  heading theta_t of the ch. 4 navigators is the odometry's (sec. 4.4.2's azimuth correction is
-  not applied). The navigators see odometry, magnetometer and laser only; the true pose is
+  priority). ``travel`` chooses the travel-distance estimate: ``odometry`` (the odometry's path
+  length; the default of the odometry-only baseline), ``peaks`` (corrected at the taught peaks,
+  sec. 3.3.3; Rahok's default) or ``filter`` (the ch. 4 localization: the travel-distance particle
+  filter of sec. 4.4.1, :class:`kiseki.magnetic.travel_distance.TravelDistanceLocalizer`, and the
+  azimuth heading correction of sec. 4.4.2, :func:`~kiseki.magnetic.travel_distance.
+  heading_from_map`; the default of the other ch. 4 methods). The heading theta_t of the ch. 4
+  navigators is the odometry's, reset by sec. 4.4.2 when its gates hold (``filter`` only) and
+  carried on by the odometry's turns after. The navigators see odometry, magnetometer and laser
+  only; the true pose is
   logged for the cross-track error alone. Every method steers with the same PD gains
   (:data:`GAINS`); the ch. 4 navigators weigh the g terms by 0.3 rad/m (MultiNavigator's
   default), Rahok's w by :func:`kiseki.magnetic.rahok_navigation.weight_vector`'s defaults.
@@ -48,9 +52,18 @@ from kiseki.magnetic.rahok_navigation import (
     weight_vector,
 )
 
-__all__ = ["METHODS", "NavigationResult", "TaughtMaps", "cross_track", "navigate", "teach"]
+__all__ = [
+    "METHODS",
+    "TRAVEL",
+    "NavigationResult",
+    "TaughtMaps",
+    "cross_track",
+    "navigate",
+    "teach",
+]
 
 METHODS = ("rahok", *NAVIGATORS, "multi")
+TRAVEL = ("odometry", "peaks", "filter")
 OFFSET = 1.0
 """m: the parallel paths' distance from the taught one (Fig. 2.10's y = -1 and +1 m)."""
 GAINS = {"kp": 1.0, "kd": 0.5, "max_rate": 0.5}
@@ -80,6 +93,7 @@ class NavigationResult:
     travel_error: np.ndarray  # (n,) m, along the route: the map node at `travel` minus the truth
     drove: list  # (n,) the navigator that drove each step (None: none valid / rahok)
     corrections: list  # (peak s, d before, correction or None, window height) per peak
+    heading_resets: int  # steps where sec. 4.4.2 reset the heading (travel = filter)
     reached_goal: bool
 
 
@@ -168,11 +182,17 @@ def rahok_vectors(maps: TaughtMaps, smooth: float = 1.0) -> tuple[np.ndarray, np
 class _Controller:
     """simulate()'s controller: feeds odometry, magnetometer and laser to one method."""
 
-    def __init__(self, method: str, maps: TaughtMaps, correct: bool, dt: float, speed: float):
+    def __init__(self, method: str, maps: TaughtMaps, travel: str, dt: float, speed: float):
         lmap = maps.center
         self.lmap, self.method, self.dt, self.speed = lmap, method, dt, speed
         peaks = taught_peaks(lmap.s, lmap.field[:, 2])
-        self.peaks = PeakCorrection(peaks, lmap.spacing) if correct else None
+        self.peaks = PeakCorrection(peaks, lmap.spacing) if travel == "peaks" else None
+        self.filter = None
+        if travel == "filter":
+            from kiseki.magnetic.travel_distance import TravelDistanceLocalizer
+
+            self.filter = TravelDistanceLocalizer(lmap, start=float(lmap.s[0]))
+        self._since, self._offset, self.resets = 0.0, 0.0, 0
         if method == "rahok":
             s_vec, w_vec = rahok_vectors(maps)
             self.rahok = RahokNavigator(
@@ -201,6 +221,25 @@ class _Controller:
             self._new = abs(when - t) < 1e-9
             self._reading = value
 
+    def _track(self, new) -> None:
+        """Travel distance (and, with the filter, the heading offset) after this step."""
+        self._since += self._travelled
+        if self.filter is None:
+            self.d += self._travelled
+            if new is not None and self.peaks is not None:
+                self.d += self.peaks.update(self.d, float(new[2]))
+            return
+        if new is None:
+            return
+        from kiseki.magnetic.travel_distance import heading_from_map
+
+        self.d = self.filter.step(self._since, float(new[2]))  # sec. 4.4.1
+        self._since = 0.0
+        fix = heading_from_map(self.lmap, self.d, self.theta + self._offset, new)  # sec. 4.4.2
+        if fix.applied:
+            self._offset = fix.theta - self.theta
+            self.resets += 1
+
     def command(self, t, pose, scans):
         self.log["t"].append(t)
         self.log["truth"].append(pose)
@@ -209,9 +248,7 @@ class _Controller:
             v, w = self.rahok.step(self._travelled, new, self.dt)
             self.d, self.done, drove = self.rahok.d, self.rahok.done, None
         else:
-            self.d += self._travelled
-            if new is not None and self.peaks is not None:
-                self.d += self.peaks.update(self.d, float(new[2]))
+            self._track(new)
             self.done = self.d >= self.lmap.s[-1]
             g_t = np.full(2, np.nan)
             if scans:
@@ -220,7 +257,8 @@ class _Controller:
             drove, w = None, 0.0
             if self._reading is not None and not self.done:
                 node = int(self.lmap.index(self.d))
-                drove, w = self.multi.step(node, self.theta, self._reading, g_t, self.dt)
+                theta_t = math.remainder(self.theta + self._offset, math.tau)
+                drove, w = self.multi.step(node, theta_t, self._reading, g_t, self.dt)
             v = 0.0 if self.done else self.speed
         self.log["d"].append(self.d)
         self.log["drove"].append(drove)
@@ -233,7 +271,7 @@ def navigate(
     method: str,
     out: str | os.PathLike,
     seed: int = 1,
-    correct: bool | None = None,
+    travel: str | None = None,
 ) -> NavigationResult:
     """Playback of the taught route with ``method`` (one of :data:`METHODS`) on the scene's
     ``playback`` variant; the run is written to the MCAP file ``out``."""
@@ -242,12 +280,22 @@ def navigate(
 
     if method not in METHODS:
         raise ValueError(f"navigate: method must be one of {', '.join(METHODS)}, got {method!r}")
+    if travel is None:
+        travel = {"rahok": "peaks", "odometry": "odometry"}.get(method, "filter")
+    if travel not in TRAVEL or (method == "rahok" and travel == "filter"):
+        raise ValueError(
+            f"navigate: travel must be one of {', '.join(TRAVEL)} (rahok: not filter), got"
+            f" {travel!r}"
+        )
+    if not isinstance(maps, TaughtMaps):
+        raise ValueError(
+            f"navigate: maps must be TaughtMaps (see teach), got {type(maps).__name__}"
+        )
     scene = load_scene(scene_path, "playback")
     if path_identity(scene.route["waypoints"]) != maps.center.path_id:
         raise ValueError(f"{scene_path}: the maps were taught on another path")
     config = SimConfig(seed=seed, max_duration=3.0 * maps.center.s[-1] / scene.route["speed"])
-    correct = method != "odometry" if correct is None else bool(correct)
-    controller = _Controller(method, maps, correct, config.dt, float(scene.route["speed"]))
+    controller = _Controller(method, maps, travel, config.dt, float(scene.route["speed"]))
     summary = simulate(scene, out, config, controller=controller, overwrite=True, progress=False)
     log = controller.log
     truth = np.array(log["truth"], dtype=np.float64).reshape(-1, 3)
@@ -265,5 +313,6 @@ def navigate(
         node_along - along,
         log["drove"],
         list(controller.peaks.log) if controller.peaks is not None else [],
+        controller.resets,
         summary.reached_goal,
     )
