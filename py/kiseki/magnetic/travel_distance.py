@@ -43,7 +43,6 @@ mz window Rahok's travel-distance correction keeps (sec. 3.3.2, "6 m of field st
 from __future__ import annotations
 
 import math
-from collections import deque
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -61,7 +60,7 @@ __all__ = [
     "TravelDistanceLocalizer",
     "azimuth_heading",
     "heading_from_map",
-    "window_mismatch",
+    "MapWindows",
 ]
 
 GAIN = 50.0
@@ -137,19 +136,36 @@ def _map_profile(linear_map: Any) -> tuple[np.ndarray, np.ndarray, float]:
     return np.asarray(linear_map.s, dtype=np.float64), mz, float(linear_map.spacing)
 
 
-def window_mismatch(
-    node_s: np.ndarray,
-    node_mz: np.ndarray,
-    particles: np.ndarray,
-    offsets: np.ndarray,
-    readings: np.ndarray,
-    bin_width: float,
-) -> np.ndarray:
-    """Eq. 4.7 for every particle: ``sum_k |map mz(d_i - offsets_k) - readings_k| * bin_width``
-    (G m); the map linear between nodes, clamped at its ends. Vectorised over (n, k)."""
-    where = particles[:, None] - offsets[None, :]
-    expected = np.interp(where, node_s, node_mz)
-    return np.abs(expected - readings[None, :]).sum(axis=1) * bin_width
+class MapWindows:
+    """The map's mz (G, nodes at ``first_s + j * spacing``) padded for windows of ``bins``
+    bins: rows of ``bins + 1`` consecutive node values (the first node's value before the map,
+    the last one's after it, as ``np.interp`` clamps), gathered by a particle's node index."""
+
+    def __init__(self, first_s: float, spacing: float, node_mz: np.ndarray, bins: int) -> None:
+        self.first_s, self.spacing, self.bins, self.nodes = first_s, spacing, bins, len(node_mz)
+        edge = (np.full(bins + 1, node_mz[0]), np.full(bins + 2, node_mz[-1]))
+        padded = np.concatenate([edge[0], node_mz, edge[1]])
+        window = np.lib.stride_tricks.sliding_window_view  # views: no copy of the map
+        self.low = window(padded[:-1], bins)  # row i: padded[i : i + bins]
+        self.slope = window(np.diff(padded), bins)
+
+    def mismatch(self, particles: np.ndarray, readings: np.ndarray, mask: np.ndarray) -> np.ndarray:
+        """Eq. 4.7 for every particle: ``sum_k mask_k |map mz(d_i - k * spacing) - r_k| *
+        spacing`` (G m), k = 0 .. bins - 1, the map linear between nodes. The bins are whole
+        node spacings, so a particle's fraction between nodes is the same for all of them: its
+        window is one row of node values and one of slopes, in reverse order of k."""
+        u = (particles - self.first_s) / self.spacing
+        base = np.floor(u)
+        frac = (u - base)[:, None]
+        # row b + 2 holds nodes b - bins + 1 .. b (k = bins - 1 .. 0); beyond these bounds
+        # every value is an end node's
+        row = np.clip(base, -2, self.nodes + self.bins).astype(np.int64) + 2
+        expected = self.slope[row]
+        expected *= frac
+        expected += self.low[row]
+        expected -= readings[::-1]
+        np.abs(expected, out=expected)
+        return (expected @ mask[::-1]) * self.spacing
 
 
 class TravelDistanceLocalizer:
@@ -181,8 +197,11 @@ class TravelDistanceLocalizer:
                 f"travel distance: window l {self.config.window} m is shorter than the map's "
                 f"{self._spacing} m node spacing"
             )
+        self._windows = MapWindows(float(self._s[0]), self._spacing, self._mz, self._bins)
         self._odometry = 0.0
-        self._buffer: deque[tuple[float, float]] = deque()
+        self._u = np.empty(64)  # the readings' odometry distances, live in [_lo, _hi)
+        self._m = np.empty(64)
+        self._lo = self._hi = 0
         self._uniform = np.full(self.config.particles, 1.0 / self.config.particles)
         self.estimate = float(start)
         self.effective_sample_size = float(self.config.particles)
@@ -194,16 +213,28 @@ class TravelDistanceLocalizer:
         return np.asarray(self._filter.particles)
 
     def window_readings(self) -> tuple[np.ndarray, np.ndarray]:
-        """(offsets behind the newest reading m, mean mz G) of the window's non-empty 0.1 m bins."""
-        u = np.fromiter((r[0] for r in self._buffer), np.float64, len(self._buffer))
-        m = np.fromiter((r[1] for r in self._buffer), np.float64, len(self._buffer))
+        """(mean mz G, 1 where the bin holds readings else 0) of the window's bins k = 0, 1, ...,
+        each k node spacings behind the newest reading."""
+        u, m = self._u[self._lo : self._hi], self._m[self._lo : self._hi]
         k = np.floor((self._odometry - u) / self._spacing + 0.5).astype(np.int64)
         keep = (k >= 0) & (k < self._bins)
         k, m = k[keep], m[keep]
         count = np.bincount(k, minlength=self._bins)
         total = np.bincount(k, weights=m, minlength=self._bins)
-        filled = count > 0
-        return np.flatnonzero(filled) * self._spacing, total[filled] / count[filled]
+        return total / np.maximum(count, 1), (count > 0).astype(np.float64)
+
+    def _keep(self, mz: float) -> None:
+        """Appends the newest reading; drops those more than l + one bin behind."""
+        if self._hi == len(self._u):
+            n = self._hi - self._lo
+            u, m = np.empty(max(64, 2 * n)), np.empty(max(64, 2 * n))
+            u[:n], m[:n] = self._u[self._lo : self._hi], self._m[self._lo : self._hi]
+            self._u, self._m, self._lo, self._hi = u, m, 0, n
+        self._u[self._hi], self._m[self._hi] = self._odometry, mz
+        self._hi += 1
+        horizon = self._odometry - self.config.window - self._spacing
+        while self._lo < self._hi - 1 and self._u[self._lo] < horizon:
+            self._lo += 1
 
     def step(self, distance: float, mz: float) -> float:
         """One reading: the odometry's travel since the last reading (m) and mz (G). Returns
@@ -213,13 +244,10 @@ class TravelDistanceLocalizer:
         sd = self.config.odometry_noise * math.sqrt(abs(distance))
         self._filter.predict(float(distance), sd)  # eq. 4.6 plus the spread
         self._odometry += float(distance)
-        self._buffer.append((self._odometry, float(mz)))
-        horizon = self._odometry - self.config.window - self._spacing
-        while self._buffer and self._buffer[0][0] < horizon:
-            self._buffer.popleft()
-        offsets, readings = self.window_readings()
+        self._keep(float(mz))
+        readings, mask = self.window_readings()
         particles = self.particles
-        s = window_mismatch(self._s, self._mz, particles, offsets, readings, self._spacing)
+        s = self._windows.mismatch(particles, readings, mask)
         w = 1.0 / (self.config.gain * s + 1.0)  # eq. 4.8
         w /= w.sum()  # eq. 4.9
         self.weights = w
