@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""``kiseki magnetic``: magnetic field maps by Gaussian-process regression (thesis ch. 6)."""
+"""``kiseki magnetic``: magnetic field maps by Gaussian-process regression (thesis ch. 6), and
+teaching and navigation along linear magnetic maps (ch. 3-4)."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ __all__ = ["magnetic_app"]
 
 magnetic_app = typer.Typer(
     no_args_is_help=True,
-    help="Magnetic field maps by Gaussian-process regression: fit, predict, render.",
+    help="Magnetic field maps (fit, predict, render), walks, teaching and navigation.",
 )
 console = Console(soft_wrap=True)
 EXACT_LIMIT = 10_000  # beyond this many measurements the default is the reduced-rank GP
@@ -315,7 +316,10 @@ def walk(
     """The thesis' travel-distance particle filter (sec. 4.4.1: 1000 particles, w = 1/(a s + 1),
     a = 50 per G m, l = 6 m of mz, resampling when ESS < 9n/10) on a real walk: the first lap
     (until the walker comes back within 1.5 m of the start after 10 m) is the linear map, the
-    later laps are localized against it. Odometry of the later laps: each horizontal ARKit step
+    later laps are localized against it, each from travel distance 0. The filter compares mz,
+    the vertical field (the walk's quaternions turn the readings to the world frame, so the map
+    and the laps compare the same component however the iPad is held). Odometry of the later
+    laps: each horizontal ARKit step
     |dp| becomes (1 + e) |dp| + N(0, (0.1 |dp|)^2), e drawn once from N(0, 0.05^2) by the seed.
     Writes OUT/trajectory.csv (t,s_true,s_est,s_odom; s_true from the map node nearest the true
     position) and prints the RMSE of s_est and s_odom. Laps that leave the map's path (over
@@ -354,3 +358,52 @@ def walk(
         f"{len(result.linear_map)} nodes; odometry scale error {result.scale_error:+.4f}"
     )
     console.print(f"RMSE s_est {result.rmse('s_est'):.3f} m, s_odom {result.rmse('s_odom'):.3f} m")
+
+
+@magnetic_app.command("teach")
+@interruptible()
+def teach(
+    scene: Path = typer.Argument(..., help="Scene file with a route (its teach variant)."),
+    output: Path = typer.Option(..., "-o", "--output", help="Folder for the linear maps."),
+    seed: int = typer.Option(0, help="Seed of the teaching runs."),
+    offset: float = typer.Option(1.0, help="m between the taught path and its parallel paths."),
+) -> None:
+    """Teaches a route by hand (thesis ch. 3-4): the linear magnetic map of the route (nodes
+    every 0.1 m) and of two paths OFFSET m to its left and right (Rahok's eq. 3.1), written to
+    OUT (a linear-map folder; left/ and right/; the teaching runs in runs/).
+
+    Example: kiseki magnetic teach data/worlds/magnetic_path.yaml -o taught"""
+    from kiseki.core import check_seed
+    from kiseki.magnetic.navigate_outputs import teach_folder
+
+    check_seed(seed, "--seed")
+    maps = teach_folder(scene, output, seed, offset)
+    console.print(f"{output}: {len(maps.center)} nodes over {maps.center.s[-1]:.1f} m")
+
+
+@magnetic_app.command("navigate")
+@interruptible()
+def navigate(
+    scene: Path = typer.Argument(..., help="Scene file (its playback variant is driven)."),
+    map_folder: Path = typer.Option(..., "--map", help="Folder of kiseki magnetic teach."),
+    navigator: str = typer.Option(
+        "multi", help="rahok|magnetic-geometric|magnetic|geometric|odometry|multi."
+    ),
+    output: Path = typer.Option(..., "-o", "--output", help="Folder for the run and plots."),
+    seed: int = typer.Option(1, help="Seed of the playback run."),
+) -> None:
+    """Plays the taught route back steering with one navigator (thesis ch. 3: rahok; ch. 4:
+    the four navigators alone, or multi, arbitrated by priority). Writes OUT/run.mcap,
+    OUT/navigation.csv and OUT/navigation.png (path, cross-track error, priority history).
+
+    Example: kiseki magnetic navigate data/worlds/magnetic_path.yaml --map taught -o nav"""
+    from kiseki.core import check_seed
+    from kiseki.magnetic.navigate_outputs import navigate_folder
+
+    check_seed(seed, "--seed")
+    r = navigate_folder(scene, map_folder, navigator, output, seed)
+    off = np.abs(r.cross_track)
+    console.print(
+        f"{output}: {navigator} {'reached' if r.reached_goal else 'did not reach'} the goal;"
+        f" |cross-track| mean {off.mean():.2f} m, max {off.max():.2f} m"
+    )

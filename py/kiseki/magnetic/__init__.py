@@ -28,6 +28,12 @@ from kiseki.magnetic.localization import (
     MagneticMclConfig,
     localize_on_magnetic_map,
 )
+from kiseki.magnetic.travel_distance import (
+    TravelDistanceConfig,
+    TravelDistanceLocalizer,
+    azimuth_heading,
+    heading_from_map,
+)
 
 __all__ = [
     "EllipsoidCalibration",
@@ -40,11 +46,15 @@ __all__ = [
     "SphereCalibration",
     "TeachingSamples",
     "TrainingData",
+    "TravelDistanceConfig",
+    "TravelDistanceLocalizer",
+    "azimuth_heading",
     "build_linear_map",
     "calibrated_magnitude",
     "fit_ellipsoid",
     "fit_sphere",
     "geometric_features",
+    "heading_from_map",
     "linear_map_from_run",
     "load_linear_map",
     "localize_on_magnetic_map",
