@@ -178,7 +178,10 @@ def test_arbiter_picks_the_highest_valid_priority_and_logs_it():
         {"odo": ("o", True), "geo": ("g", False), "mag": ("m", True), "both": ("b", False)},
         {"odo": ("o", False), "geo": ("g", False), "mag": ("m", False), "both": ("b", False)},
     ]
-    got = [arb.select(p) for p in steps]
+    np.testing.assert_array_equal(arb.last_priorities(), [0, 0, 0, 0])  # before any step
+    got = [arb.select(p) for p in steps[:3]]
+    np.testing.assert_array_equal(arb.last_priorities(), [0, 3, 0, 1])
+    got.append(arb.select(steps[3]))
     assert got == [("both", "b"), ("geo", "g"), ("mag", "m"), (None, None)]
     assert arb.history == ["both", "geo", "mag", None]
     assert arb.names == ("both", "mag", "geo", "odo")

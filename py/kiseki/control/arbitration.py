@@ -88,6 +88,11 @@ class PriorityArbiter:
         """(steps, navigators) effective priorities, columns in the order of ``names``."""
         return np.array(self._effective, dtype=np.float64).reshape(-1, len(self.names))
 
+    def last_priorities(self) -> np.ndarray:
+        """The effective priorities of the latest step (zeros before the first)."""
+        row = self._effective[-1] if self._effective else [0.0] * len(self.names)
+        return np.array(row, dtype=np.float64)
+
     def shares(self) -> dict[str | None, float]:
         """The fraction of steps each navigator drove (None: no valid navigator)."""
         n = max(len(self.history), 1)

@@ -77,8 +77,8 @@ class TaughtMaps:
     """The taught path's map and the maps of its left and right parallel paths."""
 
     center: LinearMagneticMap
-    left: LinearMagneticMap
-    right: LinearMagneticMap
+    left: LinearMagneticMap | None  # None: not taught (only Rahok's method needs them)
+    right: LinearMagneticMap | None
     waypoints: np.ndarray  # (k, 2) the taught route
 
 
@@ -95,6 +95,8 @@ class NavigationResult:
     corrections: list  # (peak s, d before, correction or None, window height) per peak
     heading_resets: int  # steps where sec. 4.4.2 reset the heading (travel = filter)
     reached_goal: bool
+    navigators: tuple = ()  # the arbitrated navigators, highest priority first
+    priorities: np.ndarray | None = None  # (n, navigators) effective priorities per step
 
 
 def _shifted(points: np.ndarray, offset: float) -> np.ndarray:
@@ -173,6 +175,8 @@ def rahok_vectors(maps: TaughtMaps, smooth: float = 1.0) -> tuple[np.ndarray, np
     ``smooth`` m before eq. 3.1 (our choice: a node averages under two readings of 0.01 G
     noise, so the 0.01 G threshold would otherwise flag the noise)."""
     c = maps.center
+    if maps.left is None or maps.right is None:
+        raise ValueError("Rahok's method needs the maps of the left and right parallel paths")
     cells = max(1, int(round(smooth / c.spacing)))
     fields = [moving_average(m.at(c.s).field, cells) for m in (c, maps.left, maps.right)]
     s_vec = identification_vector(*fields)
@@ -208,7 +212,7 @@ class _Controller:
         self._odom = None
         self._reading = None
         self._new = False
-        self.log: dict[str, list] = {"t": [], "truth": [], "d": [], "drove": []}
+        self.log: dict[str, list] = {"t": [], "truth": [], "d": [], "drove": [], "p": []}
 
     def observe(self, t, odometry, readings) -> None:
         x, y, theta = odometry
@@ -262,6 +266,12 @@ class _Controller:
             v = 0.0 if self.done else self.speed
         self.log["d"].append(self.d)
         self.log["drove"].append(drove)
+        if self.method != "rahok":
+            arbiter = self.multi.arbiter
+            fresh = drove is not None
+            self.log["p"].append(
+                arbiter.last_priorities() if fresh else 0 * arbiter.last_priorities()
+            )
         return v, 0.0, w
 
 
@@ -315,4 +325,6 @@ def navigate(
         list(controller.peaks.log) if controller.peaks is not None else [],
         controller.resets,
         summary.reached_goal,
+        () if method == "rahok" else controller.multi.arbiter.names,
+        np.array(log["p"]) if log["p"] else None,
     )
