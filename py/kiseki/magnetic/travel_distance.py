@@ -138,8 +138,9 @@ def _map_profile(linear_map: Any) -> tuple[np.ndarray, np.ndarray, float]:
 
 class MapWindows:
     """The map's mz (G, nodes at ``first_s + j * spacing``) padded for windows of ``bins``
-    bins: rows of ``bins + 1`` consecutive node values (the first node's value before the map,
-    the last one's after it, as ``np.interp`` clamps), gathered by a particle's node index."""
+    bins (the first node's value before the map, the last one's after it, as ``np.interp``
+    clamps): row i of ``low`` holds ``bins`` consecutive node values, row i of ``slope`` the
+    differences to the next node; both are views, gathered by a particle's node index."""
 
     def __init__(self, first_s: float, spacing: float, node_mz: np.ndarray, bins: int) -> None:
         self.first_s, self.spacing, self.bins, self.nodes = first_s, spacing, bins, len(node_mz)
