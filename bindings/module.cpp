@@ -13,6 +13,7 @@ void bind_teach(pybind11::module_& m);
 void bind_coop(pybind11::module_& m);
 void bind_speed(pybind11::module_& m);
 void bind_gp(pybind11::module_& m);
+void bind_terrain(pybind11::module_& m);
 }  // namespace kiseki::bindings
 
 PYBIND11_MODULE(_core, m) {
@@ -27,4 +28,5 @@ PYBIND11_MODULE(_core, m) {
   kiseki::bindings::bind_coop(m);
   kiseki::bindings::bind_speed(m);
   kiseki::bindings::bind_gp(m);
+  kiseki::bindings::bind_terrain(m);
 }

@@ -10,6 +10,10 @@ platform. ``derive_seed(seed, k)`` gives stream ``k`` of a seed (per trial, robo
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
+
 from kiseki._core import Pose2, Pose3, Random, derive_seed, library_versions, normalize_angle
 
 __all__ = [
@@ -21,6 +25,7 @@ __all__ = [
     "derive_seed",
     "library_versions",
     "normalize_angle",
+    "rotation_zyx",
 ]
 
 
@@ -38,3 +43,13 @@ def check_seed(seed, name: str = "seed") -> int:
     if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= seed < 2**64:
         raise ValueError(f"{name} {SEED_RULE}, got {seed!r}")
     return int(seed)
+
+
+def rotation_zyx(yaw: float, pitch: float = 0.0, roll: float = 0.0) -> np.ndarray:
+    """Rz(yaw) Ry(pitch) Rx(roll), radians: the 3-D attitude convention of kiseki (the
+    simulator's bodies and sensors, the gyro's attitude in the terrain area)."""
+    cz, sz, cy, sy, cx, sx = (f(a) for a in (yaw, pitch, roll) for f in (math.cos, math.sin))
+    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    return rz @ ry @ rx

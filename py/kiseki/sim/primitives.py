@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from kiseki._schema import parse
-from kiseki.core import Random
+from kiseki.core import Random, rotation_zyx
 from kiseki.sim.primitives_schema import (
     Beam,
     Box,
@@ -66,13 +66,8 @@ class BoxList:
         )
 
 
-def rotation(yaw: float, pitch: float = 0.0, roll: float = 0.0) -> np.ndarray:
-    """Rz(yaw) Ry(pitch) Rx(roll), radians."""
-    cz, sz, cy, sy, cx, sx = (f(a) for a in (yaw, pitch, roll) for f in (math.cos, math.sin))
-    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
-    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
-    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
-    return rz @ ry @ rx
+rotation = rotation_zyx
+"""Rz(yaw) Ry(pitch) Rx(roll), radians (kiseki.core.rotation_zyx)."""
 
 
 def _rad(deg: float) -> float:

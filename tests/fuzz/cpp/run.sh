@@ -15,9 +15,11 @@ shared="$root/../shared/data"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 
-mkdir -p "$work/map_image" "$work/octree"
+mkdir -p "$work/map_image" "$work/octree" "$work/pcd"
 cp "$here"/seeds/map_image/* "$work/map_image/"
 cp "$here"/seeds/octree/* "$work/octree/"
+cp "$here"/seeds/pcd/* "$work/pcd/"
+[ -f "$shared/pcd/sac_plane_test.pcd" ] && cp "$shared/pcd/sac_plane_test.pcd" "$work/pcd/"
 # map_image inputs start with one byte choosing the YAML fields (0: trinary, nav2's defaults)
 for image in "$root"/data/maps/*.pgm "$shared"/carmen/*.png; do
   [ -f "$image" ] && { printf '\000'; cat "$image"; } > "$work/map_image/$(basename "$image")"
@@ -27,8 +29,9 @@ done
 [ -f "$shared/octomap/geb079.bt" ] && cp "$shared/octomap/geb079.bt" "$work/octree/"
 max_len_map_image=131072
 max_len_octree=16384
+max_len_pcd=65536
 
-for target in map_image octree; do
+for target in map_image octree pcd; do
   echo "== fuzz_$target: $runs runs"
   max_len="max_len_$target"
   "$build/fuzz_$target" -runs="$runs" -seed=1 -max_len="${!max_len}" -timeout=30 \
