@@ -9,6 +9,7 @@
 
 #include "kiseki/io/pcd_file.hpp"
 #include "kiseki/terrain/correlation_search.hpp"
+#include "kiseki/terrain/global_map.hpp"
 #include "kiseki/terrain/hough_line_removal.hpp"
 #include "kiseki/terrain/pcl_plane_removal.hpp"
 #include "kiseki/terrain/sphere_elevation_map.hpp"
@@ -244,6 +245,31 @@ void bind_terrain(py::module_& m) {
         return py::make_tuple(mask_array(r.removed, static_cast<py::ssize_t>(r.removed.size()), 0), planes, inliers);
       },
       "points"_a, "params"_a, "seed"_a, "(removed mask (n,), planes (k, 4) as a x + b y + c z + d = 0, inliers (k,)).");
+
+  py::class_<GlobalVoxelMap>(m, "GlobalVoxelMap")
+      .def(py::init<double, double>(), "resolution"_a, "max_range"_a)
+      .def(
+          "insert",
+          [](GlobalVoxelMap& map, const py::handle& points, const py::handle& pose, bool discretize) {
+            const Eigen::Matrix3Xd p = points_of(points, "points");
+            const DoubleArray a = as_doubles(pose, "sensor_pose");
+            if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4) {
+              throw std::invalid_argument("sensor_pose: expected a 4 x 4 matrix, got shape " + shape_string(a));
+            }
+            require_finite(a, "sensor_pose");
+            Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+            for (int i = 0; i < 3; ++i) {
+              for (int j = 0; j < 4; ++j) t.matrix()(i, j) = a.at(i, j);
+            }
+            py::gil_scoped_release release;
+            map.insert(p, t, discretize);
+          },
+          "points"_a, "sensor_pose"_a, "discretize"_a = true)
+      .def_property_readonly("resolution", &GlobalVoxelMap::resolution)
+      .def_property_readonly("occupied_leaves", &GlobalVoxelMap::occupied_leaves)
+      .def_property_readonly("free_leaves", &GlobalVoxelMap::free_leaves)
+      .def("occupied_centres", [](const GlobalVoxelMap& map) { return points_array(map.occupied_centres()); })
+      .def("write_binary", &GlobalVoxelMap::write_binary, "path"_a);
 
   m.def(
       "read_pcd",

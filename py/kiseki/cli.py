@@ -24,6 +24,7 @@ from kiseki._interrupt import interruptible
 from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
 from kiseki.cli_magnetic import magnetic_app
 from kiseki.cli_speed import speed_app
+from kiseki.cli_terrain import terrain_app
 from kiseki.errors import KisekiError
 
 app = typer.Typer(
@@ -46,6 +47,7 @@ coop_app = typer.Typer(
 app.add_typer(coop_app, name="coop")
 app.add_typer(speed_app, name="speed")
 app.add_typer(magnetic_app, name="magnetic")
+app.add_typer(terrain_app, name="terrain")
 console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
 
 
