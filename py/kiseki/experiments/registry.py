@@ -29,6 +29,8 @@ def _registry() -> dict[str, Experiment]:
         speed_pedestrian,
         speed_situations,
         teach_playback,
+        terrain_corridor,
+        terrain_envs,
     )
 
     experiments = [
@@ -52,6 +54,9 @@ def _registry() -> dict[str, Experiment]:
         teach_playback.EXP1,
         teach_playback.EXP2,
         teach_playback.EXP3,
+        terrain_envs.ENV_A,
+        terrain_envs.ENV_B,
+        terrain_corridor.CORRIDOR,
     ]
     return {e.name: e for e in experiments}
 

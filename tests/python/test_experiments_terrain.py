@@ -1,0 +1,113 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Paper 003's experiments (terrain-env-a, terrain-env-b, terrain-corridor) on tiny configs
+(coarse-to-fine search, one seed), the object-cell labelling against the scene's boxes, and
+the corridor scene against the numbers its file states."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from kiseki.experiments import run_experiment
+from kiseki.experiments.terrain_common import local_maps, object_cells, start_pose
+from kiseki.sim.pose6 import PAPER_MOVES
+from kiseki.sim.scene import load_scene
+
+WORLDS = Path(__file__).resolve().parents[2] / "data" / "worlds"
+TINY = ["search=coarse-to-fine", "exact_gyro_rows=true", "removals=hough"]
+
+
+def _run(name, tmp_path, extra=()):
+    run = run_experiment(name, runs=1, overrides=[*TINY, *extra], out=tmp_path / name,
+                         progress=False)  # fmt: skip
+    assert run.failed == 0
+    trials = pd.read_parquet(run.run_dir / "trials.parquet")
+    return run, trials
+
+
+def test_env_a_finds_the_papers_move_with_an_exact_gyro(tmp_path):
+    run, trials = _run("terrain-env-a", tmp_path)
+    row = trials.iloc[0]
+    # with the gyro's error removed, the frames are right only if the estimate is the move
+    est = np.array([row["exact_hough_x"], row["exact_hough_y"], row["exact_hough_z"]])
+    assert np.linalg.norm(est - [0.35, 0.30, 0.05]) <= 0.06
+    summary = pd.read_csv(run.run_dir / "tables" / "summary.csv")
+    first = summary.iloc[0]
+    assert first["removal"] == "hough" and first["gyro"] == "with error"
+    assert first["error_mean_cm"] == pytest.approx(100 * row["hough_error"])
+    paper = pd.read_csv(run.run_dir / "tables" / "paper_vs_kiseki.csv")
+    assert paper.iloc[1][["x_cm", "y_cm", "z_cm"]].tolist() == [32, 26, 6]
+    claims = pd.read_csv(run.run_dir / "claims.csv")
+    assert claims["holds"].iloc[0] == (100 * row["hough_error"] <= 5.0)
+    assert (run.run_dir / "figures" / "terrain_env_a.png").stat().st_size > 20_000
+
+
+def test_object_cells_lie_on_the_small_objects():
+    scene = str(WORLDS / "rubble_b.yaml")
+    maps = local_maps(scene, PAPER_MOVES["B"], 3, 10.0, exact_gyro=True)
+    mask = object_cells(scene, maps.previous, maps.poses[0], maps.gyro[0])
+    points, cells = maps.previous.to_points()
+    world = points + maps.poses[0][:3, 3]  # level frame, heading 0 at the start
+    on = mask.reshape(-1)[cells]
+    assert on.sum() > 200
+    # object cells are above the floor and below the objects' tops (0.3 m; rubble up to 0.4)
+    assert (world[on, 2] > 0.01).mean() > 0.97 and (world[on, 2] < 0.45).all()
+    # the floor's and the walls' cells are not objects
+    floor = np.abs(world[:, 2]) < 0.005
+    assert floor.sum() > 1000 and on[floor].mean() < 0.02
+    walls = (world[:, 1] < 0.12) | (world[:, 1] > 2.38)
+    assert on[walls & (world[:, 2] > 0.5)].sum() == 0
+
+
+def test_env_b_measures_the_removed_object_cells(tmp_path):
+    run, trials = _run("terrain-env-b", tmp_path, ["removals=hough,none"])
+    row = trials.iloc[0]
+    assert row["object_cells"] > 200
+    assert 0.0 <= row["hough_objects_removed"] <= 1.0
+    assert row["none_objects_removed"] == 0.0 and row["none_others_removed"] == 0.0
+    # the Hough step takes out most of the walls (the other cells), far more than the objects
+    assert row["hough_others_removed"] > 0.5
+    claims = pd.read_csv(run.run_dir / "claims.csv")
+    assert claims["claim"].iloc[0].startswith("environment B")
+
+
+def test_corridor_scene_matches_its_stated_geometry():
+    scene = load_scene(WORLDS / "terrain_corridor.yaml")
+    sensor = start_pose(scene)[:3, 3]
+    np.testing.assert_allclose(sensor, [6.7, 0.7, 0.5])
+    dirs = np.array([[0, 1, 0], [0, -1, 0], [0, 0, 1], [-1, 0, 0], [1, 0, 0.0]])
+    r = np.asarray(scene.world.cast_many(np.tile(sensor, (5, 1)), dirs, 20.0))
+    # 1.2 m wide inside, ceiling underside at 2.4 m, end walls 6.6 and 7.2 m away (beyond 5 m)
+    np.testing.assert_allclose(r, [0.6, 0.6, 1.9, 6.6, 7.2], atol=1e-9)
+    tops = {(4.8, 0.4): 0.10, (5.6, 1.0): 0.06, (7.6, 0.5): 0.15, (8.3, 0.9): 0.08,
+            (9.0, 0.35): 0.12, (9.6, 1.05): 0.07}  # fmt: skip
+    origins = np.array([[x, y, 1.0] for x, y in tops])
+    down = np.tile([0.0, 0.0, -1.0], (len(tops), 1))
+    np.testing.assert_allclose(
+        1.0 - np.asarray(scene.world.cast_many(origins, down, 5.0)), list(tops.values()), atol=1e-9
+    )
+
+
+def test_corridor_reports_the_along_track_error_per_removal(tmp_path):
+    run, trials = _run("terrain-corridor", tmp_path, ["removals=none,hough"])
+    table = pd.read_csv(run.run_dir / "tables" / "along_track.csv")
+    assert table["removal"].tolist() == ["none", "hough", "none", "hough"]
+    row = trials.iloc[0]
+    for m in ("none", "hough"):
+        got = table[(table["removal"] == m) & (table["gyro"] == "with error")]
+        assert got["along_mean_cm"].iloc[0] == pytest.approx(100 * abs(row[f"{m}_along"]))
+        assert row[f"{m}_along"] == pytest.approx(row[f"{m}_x"] - 0.35)
+
+
+@pytest.mark.parametrize(
+    ("override", "message"),
+    [("removals=planes", "removals must be some of"), ("search=random", "search must be")],
+)
+def test_bad_config_is_refused_before_the_trials(tmp_path, override, message):
+    with pytest.raises(ValueError, match=message):
+        run_experiment("terrain-env-a", runs=1, overrides=[override], out=tmp_path / "x",
+                       progress=False)  # fmt: skip
