@@ -12,6 +12,7 @@
 #include "kiseki/terrain/global_map.hpp"
 #include "kiseki/terrain/hough_line_removal.hpp"
 #include "kiseki/terrain/pcl_plane_removal.hpp"
+#include "kiseki/terrain/pcl_registration.hpp"
 #include "kiseki/terrain/sphere_elevation_map.hpp"
 #include "numpy_helpers.hpp"
 
@@ -270,6 +271,35 @@ void bind_terrain(py::module_& m) {
       .def_property_readonly("free_leaves", &GlobalVoxelMap::free_leaves)
       .def("occupied_centres", [](const GlobalVoxelMap& map) { return points_array(map.occupied_centres()); })
       .def("write_binary", &GlobalVoxelMap::write_binary, "path"_a);
+
+  m.def(
+      "register_pcl",
+      [](const py::handle& source, const py::handle& target, const py::handle& initial, const std::string& method,
+         double max_correspondence, int max_iterations) {
+        const Eigen::Matrix3Xd s = points_of(source, "source"), t = points_of(target, "target");
+        const DoubleArray a = as_doubles(initial, "initial");
+        if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4) {
+          throw std::invalid_argument("initial: expected a 4 x 4 matrix, got shape " + shape_string(a));
+        }
+        require_finite(a, "initial");
+        Eigen::Isometry3d guess = Eigen::Isometry3d::Identity();
+        for (int i = 0; i < 3; ++i) {
+          for (int j = 0; j < 4; ++j) guess.matrix()(i, j) = a.at(i, j);
+        }
+        PclRegistrationParams p;
+        p.method = method;
+        p.max_correspondence = max_correspondence;
+        p.max_iterations = max_iterations;
+        PclRegistrationResult r;
+        {
+          py::gil_scoped_release release;
+          r = register_pcl(s, t, guess, p);
+        }
+        return py::make_tuple(Eigen::Matrix4d(r.transform.matrix()), r.converged, r.fitness);
+      },
+      "source"_a, "target"_a, "initial"_a, "method"_a = "gicp", "max_correspondence"_a = 0.5,
+      "max_iterations"_a = 50,
+      "PCL's ICP or GICP: (4x4 transform mapping source onto target, converged, fitness in m^2).");
 
   m.def(
       "read_pcd",

@@ -16,6 +16,7 @@
 #include "kiseki/terrain/global_map.hpp"
 #include "kiseki/terrain/hough_line_removal.hpp"
 #include "kiseki/terrain/pcl_plane_removal.hpp"
+#include "kiseki/terrain/pcl_registration.hpp"
 #include "kiseki/terrain/sphere_elevation_map.hpp"
 
 namespace kiseki {
@@ -239,6 +240,25 @@ TEST(GlobalVoxelMap, RaysMarkTheirEndsOccupiedAndTheWayFree) {
   Eigen::Matrix3Xd nan(3, 1);
   nan << 1.0, std::nan(""), 0.0;
   EXPECT_THROW(map.insert(nan, pose), std::invalid_argument);
+}
+
+TEST(PclRegistration, IcpAndGicpRecoverAKnownMotion) {
+  const auto g = SphereGrid{};
+  const Eigen::Matrix3Xd target = SphereElevationMap::from_points(g, mound_floor(8, 8000)).to_points();
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  motion.rotate(Eigen::AngleAxisd(3 * kDeg, Eigen::Vector3d::UnitZ()));
+  motion.translation() << 0.08, -0.05, 0.02;
+  const Eigen::Matrix3Xd source = motion.inverse() * target;  // the target seen from the moved pose
+  for (const char* method : {"icp", "gicp"}) {
+    PclRegistrationParams p;
+    p.method = method;
+    const auto r = register_pcl(source, target, Eigen::Isometry3d::Identity(), p);
+    EXPECT_TRUE(r.converged) << method;
+    EXPECT_LT((r.transform.translation() - motion.translation()).norm(), 0.01) << method;
+  }
+  PclRegistrationParams bad;
+  bad.method = "ndt";
+  EXPECT_THROW(register_pcl(source, target, Eigen::Isometry3d::Identity(), bad), std::invalid_argument);
 }
 
 TEST(PcdFile, RoundTripAndCorruptFiles) {
