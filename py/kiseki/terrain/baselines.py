@@ -1,0 +1,43 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Scan registration baselines for the rubble paper's search, on the same scan pairs: PCL's
+ICP (point to point) and GICP (plane to plane), through kiseki's core
+(``kiseki/terrain/pcl_registration.hpp``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from kiseki import _core
+
+__all__ = ["Registration", "register_pcl"]
+
+
+@dataclass(frozen=True)
+class Registration:
+    """The transform (4x4) that maps the source points onto the target, whether PCL reports
+    convergence, and its fitness (mean squared distance of matched pairs, m^2)."""
+
+    transform: np.ndarray
+    converged: bool
+    fitness: float
+
+
+def register_pcl(
+    source: Any,
+    target: Any,
+    initial: Any = None,
+    method: Literal["icp", "gicp"] = "gicp",
+    max_correspondence: float = 0.5,
+    max_iterations: int = 50,
+) -> Registration:
+    """Aligns source (n, 3) to target (m, 3) from ``initial`` (4x4; None: identity). Raises
+    ValueError for NaN points, fewer than 10 points or bad parameters."""
+    guess = np.eye(4) if initial is None else np.asarray(initial, dtype=float)
+    m, ok, fit = _core.register_pcl(
+        source, target, guess, method, float(max_correspondence), int(max_iterations)
+    )
+    return Registration(np.asarray(m), bool(ok), float(fit))
