@@ -6,6 +6,8 @@ with its outputs read back by independent readers."""
 
 from __future__ import annotations
 
+import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -76,6 +78,20 @@ def test_run_outputs_read_back_with_independent_readers(rubble_run):
     config = (out / "config.yaml").read_text()
     assert "removal: hough" in config and "seed: 4" in config
     assert (out / "trajectory.png").stat().st_size > 10_000
+
+
+@pytest.mark.skipif(shutil.which("bt2vrml") is None, reason="octomap-tools is not installed")
+def test_octomaps_own_tool_reads_the_global_map(rubble_run, tmp_path):
+    """octomap-tools' bt2vrml (the library's own reader, as octovis uses) reads every occupied
+    voxel that kiseki's reader sees."""
+    out, _ = rubble_run
+    copy = tmp_path / "map.bt"
+    copy.write_bytes((out / "global_map.bt").read_bytes())
+    done = subprocess.run(["bt2vrml", str(copy)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    found = re.search(r"Finished writing (\d+) voxels", done.stdout + done.stderr)
+    assert found, done.stdout
+    assert int(found.group(1)) == _core.OctreeWorld.read_binary(str(copy)).occupied_leaves > 1000
 
 
 def test_the_same_seed_gives_the_same_run(tmp_path, rubble_run):
