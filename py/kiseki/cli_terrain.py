@@ -96,3 +96,42 @@ def terrain_run(
         f"global map {mapper.global_map.occupied_leaves} occupied voxels of "
         f"{mapper.global_map.resolution:g} m"
     )
+
+
+@terrain_app.command("planes")
+@interruptible()
+def terrain_planes(
+    cloud: Path = typer.Argument(
+        ..., help="A PCD file, or a text file of 'x y z' lines (also .bz2 compressed)."
+    ),
+    output: Path = typer.Option(..., "-o", "--output", help="The picture to write (PNG)."),
+    csv: Path | None = typer.Option(None, "--csv", help="Also write the planes as CSV."),
+    method: str = typer.Option("pcl", help="pcl (3-D planes) or hough (lines per tilt scan)."),
+    seed: int = typer.Option(0, help="Seed of the subset and PCL's RANSAC."),
+    max_points: int = typer.Option(
+        20_000, "--max-points", help="PCL fits planes on a seeded subset of this many points."
+    ),
+) -> None:
+    """Finds and removes the planes (floor, walls, tables) of a 3-D cloud and prints each plane
+    (normal, offset, points) and the share of points kept. OUT.png shows a top and a side view:
+    each plane's points in its own pale colour, kept points coloured by height. --csv writes
+    plane,a,b,c,d,inliers (a x + b y + c z + d = 0, unit normal). Hough works on an S-DEM centred
+    on the sensor: PCD's VIEWPOINT, (0, 0, 0) for text files.
+
+    Example: kiseki terrain planes scan.dat.bz2 -o planes.png --csv planes.csv"""
+    from kiseki.terrain.cloud_picture import planes_summary, render_cloud_planes, write_planes_csv
+    from kiseki.terrain.cloud_planes import CLOUD_METHODS, cloud_planes, read_cloud
+
+    if method not in CLOUD_METHODS:
+        raise ValueError(f"--method must be one of {CLOUD_METHODS}, got {method!r}")
+    if output.suffix.lower() != ".png":
+        raise ValueError(f"-o {output}: expected a .png file")
+    if output.is_dir() or (csv is not None and csv.is_dir()):
+        raise ValueError(f"-o {output} / --csv {csv}: is a folder, expected a file")
+    points = read_cloud(cloud)
+    result = cloud_planes(points, method, seed, max_points)
+    for line in planes_summary(points, result):
+        console.print(line, highlight=False)
+    render_cloud_planes(points, result, output, seed)
+    if csv is not None:
+        write_planes_csv(result, csv)
