@@ -16,6 +16,7 @@ from kiseki.experiments import run_experiment
 from kiseki.experiments.terrain_common import local_maps, object_cells, start_pose
 from kiseki.sim.pose6 import PAPER_MOVES
 from kiseki.sim.scene import load_scene
+from kiseki.terrain import attitude_matrix
 
 WORLDS = Path(__file__).resolve().parents[2] / "data" / "worlds"
 TINY = ["search=coarse-to-fine", "exact_gyro_rows=true", "removals=hough"]
@@ -48,19 +49,33 @@ def test_env_a_finds_the_papers_move_with_an_exact_gyro(tmp_path):
 
 def test_object_cells_lie_on_the_small_objects():
     scene = str(WORLDS / "rubble_b.yaml")
-    maps = local_maps(scene, PAPER_MOVES["B"], 3, 10.0, exact_gyro=True)
-    mask = object_cells(scene, maps.previous, maps.poses[0], maps.gyro[0])
-    points, cells = maps.previous.to_points()
-    world = points + maps.poses[0][:3, 3]  # level frame, heading 0 at the start
+    maps = local_maps(scene, PAPER_MOVES["B"], 3, 10.0)  # the current map: tilted, gyro error
+    mask = object_cells(scene, maps.current, maps.poses[1], maps.gyro[1])
+    points, cells = maps.current.to_points()
+    # the level frame back to the sensor's (the gyro's reading), then the true pose
+    pose, level = maps.poses[1], attitude_matrix(*maps.gyro[1])
+    world = points @ level @ pose[:3, :3].T + pose[:3, 3]
     on = mask.reshape(-1)[cells]
     assert on.sum() > 200
-    # object cells are above the floor and below the objects' tops (0.3 m; rubble up to 0.4)
-    assert (world[on, 2] > 0.01).mean() > 0.97 and (world[on, 2] < 0.45).all()
-    # the floor's and the walls' cells are not objects
+    near = _near_small_boxes(scene, world, 0.03)
+    # brute force: every labelled cell's point lies on a small object's box (3 cm margin: the
+    # cell's 1 deg quantisation), and nearly every point on one is labelled
+    assert near[on].mean() > 0.98
+    assert on[near & (world[:, 2] > 0.02)].mean() > 0.9  # the floor beside them is not
     floor = np.abs(world[:, 2]) < 0.005
     assert floor.sum() > 1000 and on[floor].mean() < 0.02
-    walls = (world[:, 1] < 0.12) | (world[:, 1] > 2.38)
-    assert on[walls & (world[:, 2] > 0.5)].sum() == 0
+
+
+def _near_small_boxes(scene_path, points, margin):
+    """Whether each point lies within ``margin`` of a box standing on the floor below 1 m."""
+    boxes = load_scene(scene_path).boxes
+    near = np.zeros(len(points), dtype=bool)
+    for c, h, r in zip(boxes.centers, boxes.half_sizes, boxes.rotations, strict=True):
+        extent = np.abs(r) @ h
+        if c[2] - extent[2] > -0.02 and c[2] + extent[2] < 1.0:
+            local = (points - c) @ r  # r^T (p - c)
+            near |= (np.abs(local) <= h + margin).all(axis=1)
+    return near
 
 
 def test_env_b_measures_the_removed_object_cells(tmp_path):
