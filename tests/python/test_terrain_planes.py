@@ -68,7 +68,9 @@ def synthetic_room(seed: int = 1) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     sides = [np.c_[0.5 + e * 0.1 + 0 * q, -0.5 + q, r] for e in (-1, 1) for q in b for r in bz]
     sides += [np.c_[0.5 + q, -0.5 + e * 0.1 + 0 * q, r] for e in (-1, 1) for q in b for r in bz]
     box = np.vstack([top, *[np.atleast_2d(p) for p in sides]])
-    parts = {"floor": floor, "wall": wall, "ramp": ramp, "box": box}
+    # isolated bumps 5 cm above the floor: on a subset, their nearest point is a floor point
+    bumps = np.c_[rng.uniform(-1.9, 0.2, (150, 2)), np.full(150, 0.05)]
+    parts = {"floor": floor, "wall": wall, "ramp": ramp, "box": box, "bumps": bumps}
     pts = np.vstack(list(parts.values()))
     pts += rng.normal(0, 0.003, pts.shape)
     truth = {
@@ -101,6 +103,7 @@ def test_synthetic_planes_have_closed_form_coefficients_and_the_box_stays(max_po
         assert np.mean(r.label[where[name]] == match[0]) > 0.95, name
     box = r.label[where["box"]]
     assert np.mean(box < 0) > 0.9, f"box kept {np.mean(box < 0):.2f}"
+    assert np.mean(r.label[where["bumps"]] < 0) > 0.95
     assert abs(r.kept_share - np.mean(r.label < 0)) < 1e-12
     assert r.inliers.sum() == np.sum(r.label >= 0)
 
@@ -111,9 +114,12 @@ def test_hough_removes_a_plane_seen_from_the_sensor_and_not_a_rough_blob():
     floor = np.c_[xy, np.full(len(xy), -0.6)]
     d = rng.normal(size=(20_000, 3))
     blob = d / np.linalg.norm(d, axis=1, keepdims=True) * rng.uniform(1.5, 2.5, (len(d), 1))
+    behind = floor[:3000] * 1.3  # seen through the floor (a grate): 18 cm below it
+    floor = np.vstack([floor, behind])
     floor_r = cloud_planes(Cloud(floor, np.zeros(3), 0, "floor"), "hough")
+    assert np.mean(floor_r.label[-len(behind) :] < 0) > 0.95  # off the plane: kept
     blob_r = cloud_planes(Cloud(blob, np.zeros(3), 0, "blob"), "hough")
-    assert floor_r.lines > 0 and floor_r.kept_share < 0.2
+    assert floor_r.lines > 0 and np.mean(floor_r.label[: -len(behind)] < 0) < 0.2
     assert blob_r.kept_share > 0.9
     # the origin matters: the same floor seen from a sensor 10 m away is a different S-DEM
     shifted = cloud_planes(Cloud(floor + 5.0, np.full(3, 5.0), 0, "floor"), "hough")
