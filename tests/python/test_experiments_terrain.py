@@ -86,6 +86,7 @@ def test_env_b_measures_the_removed_object_cells(tmp_path):
     assert row["none_objects_removed"] == 0.0 and row["none_others_removed"] == 0.0
     # the Hough step takes out most of the walls (the other cells), far more than the objects
     assert row["hough_others_removed"] > 0.5
+    assert 0.0 <= row["hough_objects_removed_above_4cm"] <= row["hough_objects_removed"]
     claims = pd.read_csv(run.run_dir / "claims.csv")
     assert claims["claim"].iloc[0].startswith("environment B")
 
