@@ -79,7 +79,7 @@ def analyze(config: CorridorConfig, trials, timings, figures: Path) -> Analysis:
     seed0 = int(ok.sort_values("trial")["seed"].iloc[0])
     maps, _, found = _rows(config, seed0, False)
     path = figures / "terrain_corridor.png"
-    draw_match(path, maps, found, config.step, f"corridor, seed {seed0}")
+    draw_match(path, maps, found, config.step, "corridor, first trial")
     notes = (
         "The corridor's geometry is kiseki's (data/worlds/terrain_corridor.yaml); the paper "
         "states the effect without numbers. The move is level, 35 cm along the corridor (x); "

@@ -194,7 +194,7 @@ def _analyze(env: str, paper_xyz, config, trials, timings, figures: Path) -> Ana
     seed0 = int(ok.sort_values("trial")["seed"].iloc[0])
     path = figures / f"terrain_env_{env.lower()}.png"
     maps, _, found = _rows(config, seed0, False)
-    draw_match(path, maps, found, config.step, f"environment {env}, seed {seed0}")
+    draw_match(path, maps, found, config.step, f"environment {env}, first trial")
     return Analysis(
         {"summary": summary, "paper_vs_kiseki": paper}, [path], claims,
         _notes(config, ok),
