@@ -111,6 +111,12 @@ def terrain_planes(
     max_points: int = typer.Option(
         20_000, "--max-points", help="PCL fits planes on a seeded subset of this many points."
     ),
+    origin: str | None = typer.Option(
+        None,
+        "--origin",
+        help="The sensor's position x,y,z (m) for hough (default: PCD's "
+        "VIEWPOINT, 0,0,0 for text).",
+    ),
 ) -> None:
     """Finds and removes the planes (floor, walls, tables) of a 3-D cloud and prints each plane
     (normal, offset, points) and the share of points kept. OUT.png shows a top and a side view:
@@ -128,7 +134,7 @@ def terrain_planes(
         raise ValueError(f"-o {output}: expected a .png file")
     if output.is_dir() or (csv is not None and csv.is_dir()):
         raise ValueError(f"-o {output} / --csv {csv}: is a folder, expected a file")
-    points = read_cloud(cloud)
+    points = read_cloud(cloud, origin)
     result = cloud_planes(points, method, seed, max_points)
     for line in planes_summary(points, result):
         console.print(line, highlight=False)

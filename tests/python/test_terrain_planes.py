@@ -191,6 +191,10 @@ def test_text_reader_bz2_comments_nan_and_viewpoint(tmp_path):
     c = read_cloud(pcd)
     np.testing.assert_allclose(c.points, [[0.5, -1, 2], [1, 2, 3]])
     np.testing.assert_array_equal(c.origin, [1, 2, 3])
+    np.testing.assert_array_equal(read_cloud(pcd, "0,0,0.5").origin, [0, 0, 0.5])
+    for bad in ("1,2", "1,2,nan", "a,b,c"):
+        with pytest.raises(ValueError, match="--origin"):
+            read_cloud(pcd, bad)
 
 
 @pytest.mark.parametrize(

@@ -37,9 +37,10 @@ def planes_summary(cloud: Cloud, result: CloudPlanes) -> list[str]:
             f"{int(m)} points ({100 * m / n:.1f} %)"
         )
     if result.method == "hough":
+        origin = ", ".join(f"{v:g}" for v in cloud.origin)
         lines.append(
             f"hough: {result.lines} lines over the tilt scans of an S-DEM of "
-            f"{result.extra.get('sdem_cells', 0)} cells (sensor at {tuple(cloud.origin)})"
+            f"{result.extra.get('sdem_cells', 0)} cells (sensor at ({origin}))"
         )
     kept = int(np.sum(~result.removed))
     lines.append(
@@ -66,7 +67,7 @@ def render_cloud_planes(
         pts, label = pts[pick], label[pick]
     fig, axes = plt.subplots(1, 2, figsize=(13, 6), dpi=110)
     colours = plt.get_cmap("tab10")
-    views = (((0, 1), "top view (x-y)"), ((0, 2), "side view (x-z)"))
+    views = (((0, 1), "x-y (top view if z is up)"), ((0, 2), "x-z (side view)"))
     for ax, ((i, j), name) in zip(axes, views, strict=True):
         gone = label >= 0
         if result.method == "pcl" and len(result.planes):

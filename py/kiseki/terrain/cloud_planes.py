@@ -6,18 +6,23 @@ the planes and say which points they take.
 
 * ``"pcl"`` (the design card's choice): PCL's normal-plane RANSAC of
   :mod:`kiseki.terrain.plane_removal` on the 3-D points. A cloud larger than ``max_points`` is
-  fitted on a seeded random subset of that size (PCL's RANSAC costs about
-  iterations x points per plane: 124 s for office1.pcd's 254,456 points on a loaded core, 4 s
-  on 20,000); every point of the full cloud then joins plane k when its nearest subset point is
-  an inlier of plane k and it lies within ``distance`` of the plane, so a box on the floor stays
-  (its nearest subset points are not floor inliers).
+  fitted on a seeded random subset of that size (PCL's RANSAC costs about iterations x points
+  per plane: office1.pcd's 254,456 points took 124 s, the 20,000 subset 9 s with the extension,
+  on two loaded cores; ``min_inliers`` counts subset points). Every point of the full cloud
+  then joins plane k when its nearest subset point is an inlier of plane k and it lies within
+  ``distance`` of the plane, so a box on the floor stays (its nearest subset points are not
+  floor inliers).
 * ``"hough"`` (the paper's): lines per tilt scan need the cloud as one sensor saw it: an S-DEM
   of 1 deg cells over the whole sphere (theta -180..180, phi -90..90 deg, reach beyond the
-  farthest point) centred on the sensor's origin. The origin is PCD's VIEWPOINT translation, and
-  (0, 0, 0) for a text file (true of octomap's scan.dat: its points are in the scanner's frame).
+  farthest point) centred on the sensor's origin. The origin is PCD's VIEWPOINT translation;
+  a text file has none, so (0, 0, 0) is assumed; ``origin`` replaces either. For octomap's
+  scan.dat the floor lies at z = -0.035 m, so (0, 0, 0) is on the floor, below the laser:
+  Hough finds 11 lines and keeps 82 % from there, 50 lines and 58 % from (0, 0, 0.5).
   The S-DEM keeps the nearest point of a cell; a cloud point is removed when its cell's point was
-  removed and its range is within the Hough inlier distance of that point's. Hough finds lines,
-  not planes: no coefficients are given.
+  removed and it lies within the Hough inlier distance of the least-squares plane through the
+  nearest points of that cell and its removed neighbours. Hough finds lines, not planes: no
+  coefficients are given. The paper's parameters (a line needs 30 cells of 1 deg in one tilt
+  scan) suit a wide laser sweep; a camera's cloud (about 57 x 43 deg) gives few such lines.
 """
 
 from __future__ import annotations
@@ -36,7 +41,7 @@ from kiseki.core import check_seed
 from kiseki.terrain.plane_removal import HoughParams, PclParams, remove_planes
 from kiseki.terrain.sdem import sdem_from_points, sphere_grid
 
-__all__ = ["CLOUD_METHODS", "Cloud", "CloudPlanes", "cloud_planes", "read_cloud"]
+__all__ = ["CLOUD_METHODS", "Cloud", "CloudPlanes", "cloud_planes", "parse_origin", "read_cloud"]
 
 CLOUD_METHODS = ("pcl", "hough")
 MAX_POINTS = 20_000
@@ -134,11 +139,23 @@ def _read_text(path: Path) -> np.ndarray:
     return np.asarray(rows, dtype=float).reshape(-1, 3)
 
 
-def read_cloud(path: str | os.PathLike) -> Cloud:
+def parse_origin(text: str) -> np.ndarray:
+    """``"x,y,z"`` (metres) as a finite 3-vector; ValueError otherwise."""
+    try:
+        origin = np.array([float(v) for v in str(text).split(",")])
+    except ValueError:
+        origin = np.zeros(0)
+    if origin.shape != (3,) or not np.all(np.isfinite(origin)):
+        raise ValueError(f"--origin must be three finite numbers x,y,z, got {text!r}")
+    return origin
+
+
+def read_cloud(path: str | os.PathLike, origin: str | None = None) -> Cloud:
     """A PCD file (ascii, binary or binary_compressed), or text of ``x y z`` lines (``#``
-    comments and blank lines skipped; ``.bz2`` decompressed). Raises ValueError naming the
-    file (and line) for a missing file, a file that is not a cloud, and a cloud with no finite
-    point."""
+    comments and blank lines skipped; ``.bz2`` decompressed). ``origin`` ("x,y,z") replaces the
+    sensor's origin (PCD's VIEWPOINT, else 0,0,0). Raises ValueError naming the file (and line)
+    for a missing file, a file that is not a cloud, and a cloud with no finite point."""
+    given = None if origin is None else parse_origin(origin)
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"CLOUD {path}: no such file")
@@ -156,7 +173,7 @@ def read_cloud(path: str | os.PathLike) -> Cloud:
     if len(points) == 0:
         what = f"all {dropped} points are NaN or infinite" if dropped else "it holds no point"
         raise ValueError(f"CLOUD {path}: empty cloud ({what})")
-    return Cloud(points, origin, int(dropped), str(path))
+    return Cloud(points, origin if given is None else given, int(dropped), str(path))
 
 
 def _pcl(points: np.ndarray, params: PclParams, seed: int, max_points: int) -> CloudPlanes:
