@@ -61,6 +61,9 @@ def test_table_4_2_filter_beats_odometry_and_claims_follow_the_table(table):
         assert float(row["measured_value"]) == pytest.approx(got, abs=5e-4)
         want = THESIS_TABLE[case][0]
         assert bool(row["holds"]) == (abs(got - want) <= 0.3 * want)
+    # ... so the time-varying claim is refused, whatever its number
+    dynamic = claims.loc["mean travel-distance error, time-varying field (Table 4.2)"]
+    assert not bool(dynamic["holds"]) and "not a time-varying case" in dynamic["note"]
     report = (table / "report.md").read_text(encoding="utf-8")
     assert "thesis_mean_err_m" in report and "0.678" in report and "0.133" in report
     assert (table / "figures" / "magnav_fig_4_7_ess.png").stat().st_size > 20_000

@@ -42,7 +42,18 @@ def required_noise(share: float, mean_count: float, gate: float = 1.0 - RZ_MIN) 
     return gate / (math.sqrt(2.0) * float(erfinv(share)) * math.sqrt(1.0 + 1.0 / mean_count))
 
 
-def _table(trials: pd.DataFrame, methods) -> pd.DataFrame:
+def _worst_in(trials: pd.DataFrame, method: str, lo: float, hi: float) -> float:
+    """The largest |cross-track| (m) between ``lo`` and ``hi`` m along, over the trials."""
+    worst = float("nan")
+    for text in trials[f"{method}:xte"]:
+        a = unpack(text).reshape(-1, 2)
+        inside = (a[:, 0] >= lo) & (a[:, 0] <= hi)
+        if inside.any():
+            worst = max(0.0 if math.isnan(worst) else worst, float(abs(a[inside, 1]).max()))
+    return worst
+
+
+def _table(config, trials: pd.DataFrame, methods) -> pd.DataFrame:
     rows = []
     for m in methods:
         leave = trials[f"{m}:leave_at"].astype(float)
@@ -51,6 +62,9 @@ def _table(trials: pd.DataFrame, methods) -> pd.DataFrame:
                 "navigator": m,
                 "mean_abs_xte_m": float(trials[f"{m}:mean_xte"].mean()),
                 "max_abs_xte_m": float(trials[f"{m}:max_xte"].mean()),
+                "worst_xte_at_changed_park_m": _worst_in(
+                    trials, m, config.changed_from, config.changed_to
+                ),
                 "left_path_runs": int(leave.notna().sum()),
                 "left_at_m": float(leave.mean()) if leave.notna().any() else float("nan"),
                 "completed_runs": int(trials[f"{m}:completed"].astype(bool).sum()),
@@ -210,7 +224,7 @@ def _plot_paths(config, trials, methods, figures: Path) -> Path:
 
 def analyze_navigators(config, trials, figures: Path, methods, noise_sd: float) -> Analysis:
     ok = trials[trials["error"].isna()].reset_index(drop=True)
-    table = _table(ok, methods)
+    table = _table(config, ok, methods)
     valid = _validity_table(ok, noise_sd)
     figs = [_plot_paths(config, ok, methods, figures)] if len(ok) else []
     return Analysis(
@@ -234,7 +248,7 @@ playback is a single one (m_t of eq. 4.5), so the difference has SD 0.01 sqrt(1 
 gate passes erf(0.002 / (sqrt 2 SD)) of the steps on noise alone: {v["closed_form_quiet"]:.3f}
 over the undisturbed nodes, measured {v["valid_magnetic_quiet"]:.3f} there
 ({v["valid_magnetic"]:.3f} over the whole run; at the disturbances
-{v["valid_magnetic_disturbed"]:.3f}: there the travel-distance error adds to the difference).
+{v["valid_magnetic_disturbed"]:.3f}).
 For the gate to pass 90 % of the undisturbed steps the sensor's noise would have to be
 {v["noise_sd_for_90pct_valid_G"]:.5f} G per reading (50 %: {v["noise_sd_for_50pct_valid_G"]:.5f}
 G), about a tenth of the 0.01 G the thesis states for its sensor; so either its playback readings
@@ -245,15 +259,26 @@ the issue give them (not tuned to make a claim hold).
 Consequences. The multi-navigator system is steered by the odometry navigator most of the time
 (drove_* columns of the validity table) and by the geometric one where buildings are in sight;
 the magnetic navigators drive in short bursts. Alone, a navigator drives whatever its validity,
-so the magnetic navigator alone steers by the field's azimuth at every step and follows the path
-more closely than the multi-navigator system, which gives the steering to the odometry navigator
-whenever the gate fails: the opposite of the thesis' ranking, caused by the gate's share above.
+so the magnetic navigators alone steer by the field's azimuth at every step, while the
+multi-navigator system hands the steering to the odometry navigator whenever the gate fails: it
+then follows the path about as closely as the navigators it hands over to (table navigators),
+not clearly better as in the thesis, whose ranking needs the magnetic navigators valid most of
+the time. At the disturbances the gate passes about as often as elsewhere (validity table): the
+noise already fails it 88 % of the time, so the disturbances cannot lower it visibly.
+
 The odometry navigator runs on the odometry's travel distance (navigate()'s default); the others
 on the travel-distance filter with the azimuth heading reset of sec. 4.4.2 (gates 0.992 and
-0.990: r_z >= 0.992 allows 0.008 G, which noise passes {_share(0.008, v):.0%} of the time), which
-corrects their heading often; this is why the geometric navigator keeps its heading at the
-bicycle park. "Leaving the path": |cross-track| > {config.leave_xte:g} m (the thesis gives no
-figure). Each trial teaches once and plays every method back with the same seed.
+0.990: r_z >= 0.992 allows 0.008 G, which noise passes {_share(0.008, v):.0%} of the time). The
+odometry navigator steers to the taught heading theta_n, itself the teaching run's odometry: the
+same tyres curve both runs alike (scene header: 2e-4 rad/m), so that drift cancels and only the
+wheel slip's random walk and the 0.5 deg start error remain; the robot wanders 0.5-1.2 m off the
+path in the landmark-free stretch and crosses 2 m late or not at all (the scene header's "1.2 m
+after 60 m" is for a robot steered on its odometry pose, not against taught headings). The
+geometric navigator alone is pushed by the rearranged bicycle rows (column
+worst_xte_at_changed_park_m) but not past {config.leave_xte:g} m: the g terms weigh 0.3 rad/m and
+the rows' near ends moved about 0.5 m away (1.6 -> 2.1 m from the path) and along it.
+"Leaving the path": |cross-track| > {config.leave_xte:g} m (the thesis gives no figure). Each
+trial teaches once and plays every method back with the same seed.
 """
 
 

@@ -271,7 +271,7 @@ def analyze(config: Table42Config, trials, timings, figures: Path) -> Analysis:
         {"table_4_2": table, "fig_4_7_ess": ess},
         figs,
         _claims(config, table, ess, stretches, change),
-        _notes(config, stretches, change),
+        _notes(config, stretches, change) + _evidence(ess),
     )
 
 
@@ -281,14 +281,17 @@ def _claims(config, table: pd.DataFrame, ess: pd.DataFrame, stretches, change) -
     claims = []
     for case, label in CASES.items():
         got, want = float(by.loc[label, "mean_err_m"]), THESIS_TABLE[case][0]
+        # the time-varying case stands only where the field the filter reads changed
+        real = case != "dynamic" or change["mz"] > config.change_threshold
         claims.append(
             Claim(
                 f"mean travel-distance error, {label} (Table 4.2)",
                 f"{want:.3f}",
                 f"{got:.3f}",
                 "m",
-                bool(abs(got - want) <= tol * want),
-                f"holds within +-{tol:.0%} of the thesis; SD {by.loc[label, 'sd_err_m']:.3f} m "
+                bool(real and abs(got - want) <= tol * want),
+                ("" if real else f"not a time-varying case: mz changed by {change['mz']:.4f} G; ")
+                + f"holds within +-{tol:.0%} of the thesis; SD {by.loc[label, 'sd_err_m']:.3f} m "
                 f"(thesis {THESIS_TABLE[case][1]:.3f}); end-of-route error "
                 f"{by.loc[label, 'final_err_m']:.3f} m",
             )
@@ -321,6 +324,21 @@ def _claims(config, table: pd.DataFrame, ess: pd.DataFrame, stretches, change) -
         )
     )
     return claims
+
+
+def _evidence(ess: pd.DataFrame) -> str:
+    e = ess.set_index("field").loc[CASES["static"]]
+    return f"""
+Why the static error stays above the thesis' 0.072 m: the weights of eq. 4.8 are nearly even all
+along the path (mean ESS/n {e["ess_over_n_elsewhere"]:.3f} outside the changed stretch,
+{e["resamples_whole_run"]:.1f} resamplings per run): over a 6 m window the reading noise alone
+gives every particle s of about 6 m x 0.009 G = 0.05 G m (bins and nodes of 1.7
+readings: |N(0, 0.011)| has mean 0.009 G), a s = 2.6, so a pipe's mismatch moves
+w by a fraction of itself. The weighted mean of eq. 4.10 then stays near the cloud's mean, which
+follows the odometry's over-count between resamplings (Fig. 4.6: the error climbs between the
+pipes and is pulled back only in part). a = 50, l and the motion spread are the thesis' or the
+filter's documented choices (kiseki.magnetic.travel_distance) and are not tuned here.
+"""
 
 
 def _notes(config: Table42Config, stretches, change) -> str:
