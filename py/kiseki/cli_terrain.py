@@ -132,8 +132,9 @@ def terrain_planes(
         raise ValueError(f"--method must be one of {CLOUD_METHODS}, got {method!r}")
     if output.suffix.lower() != ".png":
         raise ValueError(f"-o {output}: expected a .png file")
-    if output.is_dir() or (csv is not None and csv.is_dir()):
-        raise ValueError(f"-o {output} / --csv {csv}: is a folder, expected a file")
+    for name, path in (("-o", output), ("--csv", csv)):
+        if path is not None and (path.is_dir() or not path.parent.is_dir()):
+            raise ValueError(f"{name} {path}: is a folder or its folder does not exist")
     points = read_cloud(cloud, origin)
     result = cloud_planes(points, method, seed, max_points)
     for line in planes_summary(points, result):

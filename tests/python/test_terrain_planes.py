@@ -230,6 +230,7 @@ def test_bad_clouds_name_the_file_and_problem(tmp_path, content, message):
 
 def test_cli_writes_the_planes_csv_and_picture(tmp_path):
     pts, info = synthetic_room()
+    pts = pts[::3]  # a lighter cloud: the command's run is mostly Python's start and the picture
     src = tmp_path / "room.xyz.bz2"
     src.write_bytes(bz2.compress("".join(f"{a} {b} {c}\n" for a, b, c in pts).encode()))
     out, csv = tmp_path / "room.png", tmp_path / "planes.csv"
@@ -253,3 +254,9 @@ def test_cli_writes_the_planes_csv_and_picture(tmp_path):
         capture_output=True, text=True,
     )  # fmt: skip
     assert bad.returncode == 1 and "--method" in bad.stderr
+    nowhere = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "terrain", "planes", str(src), "-o", str(out),
+         "--csv", str(tmp_path / "no" / "p.csv")],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert nowhere.returncode == 1 and "--csv" in nowhere.stderr and not nowhere.stdout
