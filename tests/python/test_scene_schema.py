@@ -31,6 +31,7 @@ RECORDED = {
     ("factory_turn", "teach"): (57, 73108.07790531844),
     ("magnetic_floor", "teach"): (35, 56167.95),
     ("magnetic_hall", "teach"): (6, 1227.15),
+    ("magnetic_lidar_path", "teach"): (15, 17390.0),  # added after the models (issue 11)
     ("magnetic_path", "teach"): (13, 16545.4),
     ("magnetic_path", "playback"): (11, 12497.138290724795),
     ("rubble_a", "teach"): (59, 52562.36895365919),
@@ -39,6 +40,7 @@ RECORDED = {
     ("speed_corridor", "teach"): (8, 2617.075),
     ("speed_crossroad", "teach"): (9, 3061.3),
     ("speed_crossroad", "playback"): (10, 3597.7),
+    ("terrain_corridor", "teach"): (12, 4016.297543298578),  # added after the models (issue 13)
 }
 
 
