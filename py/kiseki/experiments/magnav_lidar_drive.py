@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 import os
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -106,6 +107,7 @@ class DriveResult:
     ess: np.ndarray  # (n,) before resampling
     resampled: np.ndarray  # (n,) bool
     reached_goal: bool  # see GOAL
+    localizer_s: float = 0.0  # wall time spent in the localizer's steps
 
 
 def drive(
@@ -136,7 +138,8 @@ def drive(
     odo0 = _pose(setup.odometry.pose)
     log: dict[str, list] = {k: [] for k in ("t", "truth", "odo", "est", "sd", "reset", "r")}
     log.update(ess=[], resampled=[])
-    travelled, steps = 0.0, int(4 * pursuit.cum[-1] / (float(scene.route["speed"]) * DT))
+    spent, travelled = 0.0, 0.0
+    steps = int(4 * pursuit.cum[-1] / (float(scene.route["speed"]) * DT))
     for k in range(steps):
         t = k * DT
         truth, odo = _pose(setup.robot.pose), _pose(setup.odometry.pose)
@@ -148,7 +151,10 @@ def drive(
             row = (est, np.full(3, np.nan), False, (math.nan, math.nan), math.nan, False)
         else:
             _, ranges = laser.device.scan(grid, truth)
-            step = mcl.step(odo, (angles, ranges, max_range), mag.device.read(truth, t))
+            reading = mag.device.read(truth, t)
+            t0 = time.perf_counter()
+            step = mcl.step(odo, (angles, ranges, max_range), reading)
+            spent += time.perf_counter() - t0
             est = step.estimate
             row = (est, step.sd, step.reset, (step.r_z, step.r_theta), step.ess, step.resampled)
         for key, value in zip(("est", "sd", "reset", "r", "ess", "resampled"), row, strict=True):
@@ -175,4 +181,5 @@ def drive(
         arrays["ess"],
         arrays["resampled"].astype(bool),
         bool(pursuit.done and np.hypot(*(arrays["truth"][-1, :2] - pursuit.points[-1])) < GOAL),
+        spent,
     )

@@ -1,0 +1,48 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""magnav-fig-5-4 on one seed with a small filter: its tables agree with its own trial records
+and the scene's stated stretch, and the SD claim of Fig. 5.6 holds even with 60 particles."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from kiseki.experiments import run_experiment
+from kiseki.experiments.gp_common import unpack
+from kiseki.experiments.magnav_fig_5_4 import blind_stretch
+from kiseki.experiments.speed_common import WORLDS
+
+
+def test_one_small_run_reports_what_its_trial_measured(tmp_path):
+    run = run_experiment(
+        "magnav-fig-5-4",
+        runs=1,
+        out=tmp_path / "f",
+        overrides=["particles=60", "beams=20", "distance=35"],
+        progress=False,
+    )
+    assert run.failed == 0 and run.runs == 1
+    trials = pd.read_parquet(run.run_dir / "trials.parquet")
+    (record,) = trials.to_dict("records")
+    lo, hi = blind_stretch(str(WORLDS / "magnetic_lidar_path.yaml"))
+    assert (record["blind_lo"], record["blind_hi"]) == (lo, hi) == (-40.45, 29.6)
+    summary = pd.read_csv(run.run_dir / "tables" / "summary.csv").set_index("method")
+    assert list(summary.index) == ["odometry", "laser", "magnetic"]
+    for m in summary.index:
+        truth = unpack(record[f"{m}_truth"])  # every 5th step
+        blind = (truth[:, 0] > lo) & (truth[:, 0] < hi)
+        recorded = summary.loc[m, "blind_max_xt"]
+        assert recorded == pytest.approx(record[f"{m}_blind_max_xt"])
+        assert np.abs(truth[blind, 1]).max() <= recorded + 1e-6
+        assert np.abs(truth[blind, 1]).max() > recorded - 0.05  # 0.5 s at 0.6 m/s apart
+    assert np.isnan(summary.loc["odometry", "blind_sd_y"])
+    assert summary.loc["laser", "resets"] == 0.0 < summary.loc["magnetic", "resets"]
+    claims = pd.read_csv(run.run_dir / "claims.csv")
+    assert len(claims) == 6
+    sd = claims[claims["claim"].str.contains("SD in y and theta")].iloc[0]
+    assert sd["holds"], sd["measured_value"]
+    for name in ("trajectories", "gates", "sd"):
+        (png,) = (run.run_dir / "figures").glob(f"*{name}.png")
+        assert png.stat().st_size > 20_000
