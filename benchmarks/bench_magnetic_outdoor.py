@@ -11,7 +11,7 @@ data/worlds/magnetic_lidar_path.yaml (ch. 5's route with the 70 m landmark-free 
 the localizer's share of the time. On a shared machine the CPU-time ratio is printed beside the
 wall-time one.
 
-Run: python benchmarks/bench_magnetic_outdoor.py [--particles N]
+Run: python benchmarks/bench_magnetic_outdoor.py [--particles N] [--beams B] [--threads T]
 """
 
 from __future__ import annotations
@@ -30,8 +30,10 @@ GOAL = 20.0  # x real time
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--particles", type=int, default=300)
+    parser.add_argument("--beams", type=int, default=60)
+    parser.add_argument("--threads", type=int, default=1, help="the engine's (0: every core)")
     args = parser.parse_args()
-    config = LidarMclConfig(particles=args.particles)
+    config = LidarMclConfig(particles=args.particles, beams=args.beams, threads=args.threads)
     for scene in ("magnetic_path.yaml", "magnetic_lidar_path.yaml"):
         path = WORLDS / scene
         taught = teach_heading_map(path, seed=0)
@@ -47,7 +49,8 @@ def main() -> None:
             f"= {ratio:.1f}x real time ({verdict} the {GOAL:g}x goal; by CPU time {cpu:.2f} s, "
             f"{simulated / cpu:.1f}x); localizer {run.localizer_s:.2f} s "
             f"({100 * run.localizer_s / wall:.0f} %), {len(run.times)} steps, "
-            f"{args.particles} particles, heading resets {int(run.reset.sum())}"
+            f"{args.particles} particles, {args.beams} beams, {args.threads} thread(s), "
+            f"heading resets {int(run.reset.sum())}"
         )
 
 

@@ -134,11 +134,11 @@ def test_resampling_follows_the_ess_rule_at_nine_tenths():
 
 
 def test_one_seed_gives_one_run_and_another_seed_another():
-    def run(seed):
+    def run(seed, threads=1):
         mcl = MagneticLidarMcl(
             _grid(),
             PathHeadingMap(_map()),
-            LidarMclConfig(particles=300, seed=seed),
+            LidarMclConfig(particles=300, seed=seed, threads=threads),
             (5.0, 0.0, 0.0),
             (0.05, 0.05, 0.1),
         )
@@ -150,6 +150,7 @@ def test_one_seed_gives_one_run_and_another_seed_another():
         )
 
     np.testing.assert_array_equal(run(3), run(3))
+    np.testing.assert_array_equal(run(3), run(3, threads=2))  # the engine's promise
     assert not np.array_equal(run(3), run(4))
 
 

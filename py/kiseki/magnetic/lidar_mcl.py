@@ -88,6 +88,7 @@ class LidarMclConfig:
     alphas: tuple[float, ...] = REAL_ODOMETRY_ALPHAS  # the motion noise (eq. 5.3's noise)
     magnetic: bool = True
     seed: int = 0
+    threads: int = 1  # the engine's threads (0: every core); one seed gives one run for any
 
     def __post_init__(self) -> None:
         for name in ("particles", "beams"):
@@ -110,7 +111,7 @@ class LidarMclConfig:
             particles=self.particles,
             alphas=tuple(self.alphas),
             resample_threshold=self.resample_threshold,
-            threads=1,
+            threads=self.threads,
         )
 
 
