@@ -14,6 +14,7 @@ import pytest
 
 from kiseki.experiments import run_experiment
 from kiseki.experiments.terrain_common import local_maps, object_cells, start_pose
+from kiseki.experiments.terrain_envs import _rise
 from kiseki.sim.pose6 import PAPER_MOVES
 from kiseki.sim.scene import load_scene
 from kiseki.terrain import attitude_matrix
@@ -127,3 +128,15 @@ def test_bad_config_is_refused_before_the_trials(tmp_path, override, message):
     with pytest.raises(ValueError, match=message):
         run_experiment("terrain-env-a", runs=1, overrides=[override], out=tmp_path / "x",
                        progress=False)  # fmt: skip
+
+
+def test_cost_rise_matches_a_closed_form():
+    """A quadratic bowl 1 + (x - 0.36)^2 + 100 (y - 0.1)^2 + z^2 on the paper's grid: 10 cm
+    from the minimum the cost rises by 0.01 along x and by 1.0 across (relative to 1)."""
+    x, y, z = np.meshgrid(np.arange(36) * 0.02, np.arange(51) * 0.02 - 0.5,
+                          np.arange(31) * 0.02 - 0.3, indexing="ij")  # fmt: skip
+    costs = 1 + (x - 0.36) ** 2 + 100 * (y - 0.1) ** 2 + z**2
+    np.testing.assert_allclose(_rise(costs, 0.02), (0.01, 1.0), rtol=1e-9)
+    costs[23, :, :] = np.inf  # x = 0.46 m not scored: the other side alone
+    np.testing.assert_allclose(_rise(costs, 0.02), (0.01, 1.0), rtol=1e-9)
+    assert all(np.isnan(v) for v in _rise(None, 0.02))

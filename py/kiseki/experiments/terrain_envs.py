@@ -112,6 +112,26 @@ def _object_shares(maps, labels, m) -> dict[str, float]:
     }
 
 
+def _rise(costs, step: float, reach: float = 0.10) -> tuple[float, float]:
+    """How much the cost rises ``reach`` from its minimum along x and along y (the mean of the
+    two sides, relative to the minimum): a flat valley along x (small first figure) leaves
+    the along-track position to small differences. NaN without a cost surface."""
+    if costs is None or not np.isfinite(costs).any():
+        return float("nan"), float("nan")
+    i, j, k = np.unravel_index(int(np.nanargmin(np.where(np.isfinite(costs), costs, np.nan))),
+                               costs.shape)  # fmt: skip
+    n, low = max(1, round(reach / step)), float(costs[i, j, k])
+
+    def side(values) -> float:
+        finite = [v for v in values if np.isfinite(v)]
+        return float(np.mean(finite) / low - 1.0) if finite and low > 0 else float("nan")
+
+    nx, ny = costs.shape[:2]
+    along = [costs[x, j, k] for x in (i - n, i + n) if 0 <= x < nx]
+    across = [costs[i, y, k] for y in (j - n, j + n) if 0 <= y < ny]
+    return side(along), side(across)
+
+
 def trial(config: EnvAConfig, index: int, seed: int) -> TrialOutput:
     record, timings = {}, {}
     for exact in (False, True) if config.exact_gyro_rows else (False,):
@@ -128,6 +148,8 @@ def trial(config: EnvAConfig, index: int, seed: int) -> TrialOutput:
             record[f"{tag}{m.method}_along"] = float(m.error[0])
             record[f"{tag}{m.method}_kept"] = float(np.mean(m.kept))
             timings[f"{tag}{m.method}_seconds"] = m.seconds
+            rise = _rise(m.costs, config.step)
+            record[f"{tag}{m.method}_rise_along"], record[f"{tag}{m.method}_rise_across"] = rise
             if labels is not None:
                 record.update(_object_shares(maps, labels, m))
     return TrialOutput(record, timings)
@@ -231,7 +253,8 @@ def analyze_b(config, trials, timings, figures):
         measured_value=f"median {first.error_median_cm:.1f} cm, max {first.error_max_cm:.1f} cm",
         unit="cm",
         holds=bool(first.error_median_cm > 100 * TOLERANCE),
-        note="holds when the median error over seeds is above 5 cm",
+        note="holds when the median error over seeds is above 5 cm (environment A's "
+        "tolerance); the paper's estimate was 59 cm off, with y of the wrong sign",
     )
     by = summary[summary["gyro"] == "with error"].set_index("removal")
     if {"hough", "pcl"} <= set(by.index) and "objects_removed" in by:
