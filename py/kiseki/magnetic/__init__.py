@@ -14,6 +14,7 @@ from kiseki.magnetic.calibration import (
     fit_sphere,
 )
 from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
+from kiseki.magnetic.lidar_mcl import LidarMclConfig, MagneticLidarMcl, PathHeadingMap
 from kiseki.magnetic.linear_map import (
     LinearMagneticMap,
     build_linear_map,
@@ -37,12 +38,15 @@ from kiseki.magnetic.travel_distance import (
 
 __all__ = [
     "EllipsoidCalibration",
+    "LidarMclConfig",
     "LinearMagneticMap",
     "MagneticFieldMap",
+    "MagneticLidarMcl",
     "MagneticLocalization",
     "MagneticMapModel",
     "MagneticMclConfig",
     "OtherPathError",
+    "PathHeadingMap",
     "SphereCalibration",
     "TeachingSamples",
     "TrainingData",
