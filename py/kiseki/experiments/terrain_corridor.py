@@ -102,7 +102,9 @@ def analyze(config: CorridorConfig, trials, timings, figures: Path) -> Analysis:
             "and flat surfaces exactly flat, so the valley's floor still has its minimum near "
             "the truth; a real laser's systematic range errors on large flat surfaces (incidence "
             "angle, mixed pixels) are not simulated, which would move the minimum along the "
-            "valley as the paper saw."
+            "valley as the paper saw. Eq. 4 as printed is a sum (--set cost=sum): a candidate "
+            "sharing fewer cells costs less, and along the valley the candidates further along "
+            "the corridor share fewer, so the sum's minimum moves along it."
         )
     return Analysis({"along_track": table}, [path], claims, notes)
 
