@@ -140,3 +140,23 @@ def test_cost_rise_matches_a_closed_form():
     costs[23, :, :] = np.inf  # x = 0.46 m not scored: the other side alone
     np.testing.assert_allclose(_rise(costs, 0.02), (0.01, 1.0), rtol=1e-9)
     assert all(np.isnan(v) for v in _rise(None, 0.02))
+
+
+def test_global_map_reports_the_drift_of_a_multi_move_run(tmp_path):
+    """terrain-global-map on 3 moves: the drift table is the trial's own numbers, the claim
+    follows the 10 % criterion, and the saved global map is a readable OctoMap."""
+    from kiseki import _core
+
+    run = run_experiment(
+        "terrain-global-map", runs=1, overrides=["moves=3", "search=coarse-to-fine"],
+        out=tmp_path / "gm", progress=False,
+    )  # fmt: skip
+    assert run.failed == 0
+    row = pd.read_parquet(run.run_dir / "trials.parquet").iloc[0]
+    assert row["travelled_m"] == pytest.approx(3 * 0.35, abs=0.05)
+    assert row["drift_share"] == pytest.approx(row["final_error_m"] / row["travelled_m"])
+    assert row["final_error_m"] < 0.35  # far better than no motion estimate at all
+    claims = pd.read_csv(run.run_dir / "claims.csv")
+    assert bool(claims["holds"].iloc[0]) == (row["drift_share"] < 0.10)
+    tree = _core.OctreeWorld.read_binary(str(run.run_dir / "figures" / "terrain_global_map.bt"))
+    assert tree.occupied_leaves > 1000

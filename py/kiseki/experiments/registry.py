@@ -34,6 +34,7 @@ def _registry() -> dict[str, Experiment]:
         teach_playback,
         terrain_corridor,
         terrain_envs,
+        terrain_global_map,
     )
 
     experiments = [
@@ -63,6 +64,7 @@ def _registry() -> dict[str, Experiment]:
         terrain_envs.ENV_A,
         terrain_envs.ENV_B,
         terrain_corridor.CORRIDOR,
+        terrain_global_map.GLOBAL_MAP,
     ]
     return {e.name: e for e in experiments}
 
