@@ -195,7 +195,7 @@ void bind_terrain(py::module_& m) {
                r = s.coarse_to_fine(g, coarse, keep);
              }
              return result_dict(std::move(r));
-           }, "grid"_a, "coarse"_a = 8, "keep"_a = 4)
+           }, "grid"_a, "coarse"_a = 8, "keep"_a = 16)
       .def_property_readonly("points", &CorrelationSearch::points);
 
   py::class_<HoughLineParams>(m, "HoughLineParams")

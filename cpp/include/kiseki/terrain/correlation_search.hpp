@@ -77,8 +77,10 @@ class CorrelationSearch {
   /// (blocks of coarse x coarse cells, the nearest range of each), so
   /// that the cost surface is as smooth as the candidates are sparse; then the `keep` best are
   /// refined within one step on a lattice and a map twice as fine, down to the full grid and
-  /// S-DEM. The result says how many candidates were scored.
-  CorrelationResult coarse_to_fine(const TranslationGrid& grid, int coarse = 8, std::size_t keep = 4) const;
+  /// S-DEM. The result says how many candidates were scored. Keeping 16 found the exhaustive
+  /// minimum on 12 of 12 simulated pairs (rubble A, B and the corridor, 4 seeds each), keeping
+  /// 4 on 8 (a flat valley along a corridor misleads the coarse levels).
+  CorrelationResult coarse_to_fine(const TranslationGrid& grid, int coarse = 8, std::size_t keep = 16) const;
 
   std::size_t points() const { return all_.x.size(); }
 
