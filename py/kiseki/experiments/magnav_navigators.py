@@ -60,11 +60,11 @@ class NavigatorsConfig:
 
 def _cut_scene(config: NavigatorsConfig, folder: Path) -> tuple[Path, np.ndarray]:
     """The scene with its route cut to ``length`` m, written to ``folder``."""
-    from kiseki.experiments.magnav_table_4_2 import _cut
+    from kiseki.experiments.magnav_table_4_2 import cut_route
 
     doc = safe_load_12(Path(config.scene).read_text(encoding="utf-8"))
     points = np.asarray(doc["route"]["waypoints"], dtype=np.float64)
-    waypoints = _cut(points, config.length)
+    waypoints = cut_route(points, config.length)
     doc["route"]["waypoints"] = waypoints.tolist()
     path = folder / "scene.yaml"
     path.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")

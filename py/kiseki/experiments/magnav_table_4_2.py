@@ -49,7 +49,7 @@ from kiseki.magnetic.linear_map_run import teaching_samples
 from kiseki.magnetic.navigate_run import cross_track
 from kiseki.magnetic.travel_distance import TravelDistanceConfig, TravelDistanceLocalizer
 
-__all__ = ["EXPERIMENT", "THESIS_TABLE", "Table42Config", "changed_stretches"]
+__all__ = ["EXPERIMENT", "THESIS_TABLE", "Table42Config", "changed_stretches", "cut_route"]
 
 SCENE = Path(__file__).resolve().parents[3] / "data" / "worlds" / "magnetic_path.yaml"
 #: Table 4.2: case -> (mean, SD) of the travel-distance error, m.
@@ -71,7 +71,7 @@ class Table42Config:
     plate_moment: list[Real] = field(default_factory=list)
 
 
-def _cut(points: np.ndarray, length: float) -> np.ndarray:
+def cut_route(points: np.ndarray, length: float) -> np.ndarray:
     """The polyline's first ``length`` m."""
     seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
     ends = np.concatenate([[0.0], np.cumsum(seg)])
@@ -87,7 +87,7 @@ def _scene(config: Table42Config, variant: str):
     from kiseki.sim.scene import load_scene
 
     scene = load_scene(config.scene, variant)
-    waypoints = _cut(np.asarray(scene.route["waypoints"], dtype=np.float64), config.length)
+    waypoints = cut_route(np.asarray(scene.route["waypoints"], dtype=np.float64), config.length)
     route = {**scene.route, "waypoints": waypoints.tolist()}
     sensors = [s for s in scene.sensors if s.get("type") == "magnetometer"]
     specs = [{**scene.robot_specs[0], "sensors": sensors, "route": route}]

@@ -17,7 +17,7 @@ import pandas as pd
 
 from kiseki.experiments.base import Analysis, Claim, Experiment
 from kiseki.experiments.config import Real
-from kiseki.experiments.terrain_envs import WORLDS, EnvAConfig, _rows, preflight, trial
+from kiseki.experiments.terrain_envs import WORLDS, EnvAConfig, preflight, search_move, trial
 from kiseki.experiments.terrain_figures import draw_match
 
 __all__ = ["CORRIDOR", "CorridorConfig"]
@@ -79,7 +79,7 @@ def analyze(config: CorridorConfig, trials, timings, figures: Path) -> Analysis:
             )
         )
     seed0 = int(ok.sort_values("trial")["seed"].iloc[0])
-    maps, _, found = _rows(config, seed0, False)
+    maps, _, found = search_move(config, seed0, False)
     path = figures / "terrain_corridor.png"
     draw_match(path, maps, found, config.step, "corridor, first trial")
     notes = (

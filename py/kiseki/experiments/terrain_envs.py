@@ -31,7 +31,7 @@ from kiseki.experiments.terrain_figures import draw_match
 from kiseki.sim.pose6 import PAPER_MOVES, Pose6
 from kiseki.terrain import attitude_matrix
 
-__all__ = ["ENV_A", "ENV_B", "EnvAConfig", "EnvBConfig"]
+__all__ = ["ENV_A", "ENV_B", "EnvAConfig", "EnvBConfig", "search_move"]
 
 WORLDS = Path(__file__).resolve().parents[3] / "data" / "worlds"
 PAPER = "003_fd335d240f62896b.txt"
@@ -76,7 +76,7 @@ def preflight(config: EnvAConfig) -> None:
         raise FileNotFoundError(f"terrain-env: scene {config.scene} not found")
 
 
-def _rows(config: EnvAConfig, seed: int, exact: bool):
+def search_move(config: EnvAConfig, seed: int, exact: bool):
     maps = local_maps(config.scene, _move(config), seed, config.move_seconds, exact)
     labels = None
     if config.label_objects and not exact:
@@ -135,7 +135,7 @@ def _rise(costs, step: float, reach: float = 0.10) -> tuple[float, float]:
 def trial(config: EnvAConfig, index: int, seed: int) -> TrialOutput:
     record, timings = {}, {}
     for exact in (False, True) if config.exact_gyro_rows else (False,):
-        maps, labels, found = _rows(config, seed, exact)
+        maps, labels, found = search_move(config, seed, exact)
         tag = "exact_" if exact else ""
         if not exact:
             gyro_error = np.degrees(maps.gyro[1] - maps.gyro[0]) - np.asarray(config.attitude_deg)
@@ -215,7 +215,7 @@ def _analyze(env: str, paper_xyz, config, trials, timings, figures: Path) -> Ana
     ]
     seed0 = int(ok.sort_values("trial")["seed"].iloc[0])
     path = figures / f"terrain_env_{env.lower()}.png"
-    maps, _, found = _rows(config, seed0, False)
+    maps, _, found = search_move(config, seed0, False)
     draw_match(path, maps, found, config.step, f"environment {env}, first trial")
     return Analysis(
         {"summary": summary, "paper_vs_kiseki": paper}, [path], claims,
