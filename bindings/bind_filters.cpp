@@ -161,8 +161,8 @@ void bind_filters(py::module_& m) {
       .def_property_readonly("effective_sample_size", &MonteCarloLocalization::effective_sample_size)
       .def_property_readonly("poses", [](const MonteCarloLocalization& f) { return poses_array(f.particles()); })
       .def_property_readonly("weights", [](const MonteCarloLocalization& f) { return array_of(f.weights()); })
-      .def_property_readonly("size", [](const MonteCarloLocalization& f) { return f.particles().size(); })
-      .def_readwrite("max_jump", &MonteCarloLocalization::max_jump);
+      .def_property_readonly("size", [](const MonteCarloLocalization& f) { return f.particles().size(); });
+  m.attr("MAX_ODOMETRY_JUMP") = kMaxOdometryJump;
 
   py::class_<TravelDistanceParams>(m, "TravelDistanceParams")
       .def(py::init<>())

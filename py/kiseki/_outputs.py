@@ -3,12 +3,16 @@
 """Outputs never destroy inputs: before a command starts its work, its output files (and the
 files written beside them) are compared with its input files (and the files they refer to, such
 as a ROS map YAML's image), paths resolved through symlinks and relative parts, and every
-output folder is checked to exist and be writable."""
+output folder is checked to exist and be writable. :func:`check_outputs` holds the rules;
+:mod:`kiseki._guard` applies them to every command from its declared parameters."""
 
 from __future__ import annotations
 
+import functools
+import glob
 import os
 from collections.abc import Iterable, Mapping, Sequence
+from fnmatch import fnmatchcase
 from functools import cached_property
 from pathlib import Path
 
@@ -16,7 +20,14 @@ import yaml
 
 from kiseki._yaml import safe_load_12
 
-__all__ = ["FIGURE_SUFFIXES", "check_outputs", "check_suffix", "files_behind"]
+__all__ = [
+    "FIGURE_SUFFIXES",
+    "check_outputs",
+    "check_suffix",
+    "files_behind",
+    "input_files",
+    "input_folder",
+]
 
 
 class _FigureSuffixes(Sequence[str]):
@@ -43,18 +54,81 @@ class _FigureSuffixes(Sequence[str]):
 FIGURE_SUFFIXES: Sequence[str] = _FigureSuffixes()
 
 
-def files_behind(path: Path) -> list[Path]:
-    """The file itself and the files it refers to: for a ROS map YAML, its image."""
-    out = [path]
-    if path.suffix.lower() in (".yaml", ".yml") and path.is_file():
-        try:
-            doc = safe_load_12(path.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, yaml.YAMLError):
-            return out  # the reader itself reports what is wrong with it
-        if isinstance(doc, dict) and isinstance(doc.get("image"), str) and doc["image"]:
-            image = Path(doc["image"])
-            out.append(image if image.is_absolute() else path.parent / image)
+# an input YAML (a map, a scene, a waypoint file) larger than this is not looked into
+MAX_REFERRING_YAML = 1 << 20
+# the listing of an input folder for links to its files: at most this deep and this many entries
+WALK_DEPTH, WALK_ENTRIES = 3, 5000
+
+
+def _beside(path: Path, name: str) -> Path:
+    named = Path(name)
+    return named if named.is_absolute() else path.parent / named
+
+
+def _yaml_doc(path: Path):
+    """A small YAML input's document, or None (not YAML, too large, unreadable: the reader
+    itself reports what is wrong with it)."""
+    if path.suffix.lower() not in (".yaml", ".yml"):
+        return None
+    try:
+        if not path.is_file() or path.stat().st_size > MAX_REFERRING_YAML:
+            return None
+        return safe_load_12(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return None
+
+
+def _referred(path: Path, depth: int = 0) -> list[tuple[str, Path]]:
+    """The files a YAML input names: a ROS map's ``image``, a scene's ``octomap``, a waypoint
+    file's ``maps.*.file`` (and their images)."""
+    doc = _yaml_doc(path)
+    if not isinstance(doc, dict):
+        return []
+    out = [
+        (key, _beside(path, doc[key]))
+        for key in ("image", "octomap")
+        if isinstance(doc.get(key), str) and doc[key]
+    ]
+    maps = doc.get("maps")
+    if depth == 0 and isinstance(maps, dict):
+        for entry in maps.values():
+            if isinstance(entry, dict) and isinstance(entry.get("file"), str) and entry["file"]:
+                named = _beside(path, entry["file"])
+                out.append(("map", named))
+                out += [(f"map's {what}", p) for what, p in _referred(named, 1)]
     return out
+
+
+def input_files(path: Path) -> list[tuple[str, Path]]:
+    """What an input stands for, as (what, path): the input itself (what ``""``), the files it
+    refers to (:func:`_referred`), and for a name that is no file or folder, an Aalto run prefix
+    ``DIR/N``, its existing ``DIR/N-*.csv`` files (what ``"run file"``)."""
+    path = Path(path)
+    out = [("", path)] + _referred(path)
+    if not path.exists() and path.name and path.parent.is_dir():
+        parts = sorted(path.parent.glob(f"{glob.escape(path.name)}-*.csv"))[:WALK_ENTRIES]
+        out += [("run file", p) for p in parts]
+    return out
+
+
+def files_behind(path: Path) -> list[Path]:
+    """The file itself and the files it refers to (:func:`input_files`)."""
+    return [p for _, p in input_files(path)]
+
+
+def input_folder(path: Path) -> Path | None:
+    """The folder an input is, or belongs to: itself when a folder; for a ROS 2 storage file
+    (``.db3``, ``.mcap``) beside a ``metadata.yaml``, its bag folder; else None."""
+    path = Path(path)
+    if path.is_dir():
+        return path
+    if path.suffix.lower() in (".db3", ".mcap") and (path.parent / "metadata.yaml").is_file():
+        return path.parent
+    return None
+
+
+def _of(label: str, what: str) -> str:
+    return f"{label}'s {what}" if what else label
 
 
 def _same(a: Path, b: Path) -> bool:
@@ -66,28 +140,193 @@ def _same(a: Path, b: Path) -> bool:
     return a.resolve() == b.resolve()
 
 
-def check_outputs(
-    outputs: Mapping[str, Path | Iterable[Path] | None],
-    inputs: Mapping[str, Path | None],
-) -> None:
-    """Raises ValueError naming both when an output is one of the inputs or a file an input
-    refers to, or when two outputs are one file; FileNotFoundError / PermissionError when an
-    output's folder is missing or not writable. ``outputs``: label -> path, or the paths one
-    option writes (a map YAML and its image); ``inputs``: label -> path."""
-    written: list[tuple[str, Path]] = []
-    for label, value in outputs.items():
+def _within(path: Path, folder: Path) -> bool:
+    """Whether ``path`` is ``folder`` or lies inside it, as written or resolved."""
+    for p, f in ((Path(os.path.abspath(path)), Path(os.path.abspath(folder))),
+                 (path.resolve(), folder.resolve())):  # fmt: skip
+        if p == f or f in p.parents:
+            return True
+    return False
+
+
+def _relative(path: Path, folder: Path) -> str | None:
+    """``path`` relative to ``folder`` (POSIX), as written or resolved; None when outside."""
+    for p, f in ((Path(os.path.abspath(path)), Path(os.path.abspath(folder))),
+                 (path.resolve(), folder.resolve())):  # fmt: skip
+        if f in p.parents:
+            return p.relative_to(f).as_posix()
+    return None
+
+
+def _folder_files(folder: Path) -> set[tuple[int, int]]:
+    """(device, inode) of the files in ``folder`` (symlinks followed), listed at most
+    :data:`WALK_DEPTH` folders deep and :data:`WALK_ENTRIES` entries in all."""
+    found: set[tuple[int, int]] = set()
+    stack, seen = [(str(folder), 1)], 0
+    while stack and seen < WALK_ENTRIES:
+        where, depth = stack.pop()
+        try:
+            entries = os.scandir(where)
+        except OSError:
+            continue
+        with entries:
+            for entry in entries:
+                seen += 1
+                if seen > WALK_ENTRIES:
+                    break
+                try:
+                    if entry.is_dir(follow_symlinks=False):
+                        if depth < WALK_DEPTH:
+                            stack.append((entry.path, depth + 1))
+                    else:
+                        st = entry.stat()
+                        found.add((st.st_dev, st.st_ino))
+                except OSError:
+                    continue
+    return found
+
+
+def _written_by(rel: str, writes: Sequence[str], folder: bool) -> str | None:
+    """The pattern of ``writes`` under which the command writes ``rel`` (or, for a folder,
+    anything inside it); None if it writes neither."""
+    for pattern in writes:
+        if pattern == "**" or fnmatchcase(rel, pattern):
+            return pattern
+        if folder and (pattern.startswith(rel + "/") or fnmatchcase(pattern, rel + "/*")):
+            return pattern
+    return None
+
+
+def _labelled(values: Mapping[str, Path | Iterable[Path] | None]) -> list[tuple[str, Path]]:
+    out: list[tuple[str, Path]] = []
+    for label, value in values.items():
         if value is None:
             continue
-        for path in [value] if isinstance(value, Path) else list(value):
-            written.append((label, Path(path)))
-    read: list[tuple[str, Path]] = []
-    for label, path in inputs.items():
-        if path is not None:
-            read += [(label if p == path else f"{label}'s image", p) for p in files_behind(path)]
+        for path in [value] if isinstance(value, str | os.PathLike) else list(value):
+            out.append((label, Path(path)))
+    return out
+
+
+def _refuse_in_input_folder(
+    label: str, out: Path, in_label: str, folder: Path, files, rewritten: Sequence[str]
+) -> None:
+    rel = _relative(out, folder)
+    if rel is not None and any(fnmatchcase(rel, pattern) for pattern in rewritten):
+        return  # a file the command itself rewrites in its input folder
+    if _within(out, folder):
+        if out.exists():
+            raise ValueError(
+                f"{label} {out} exists inside the input folder {in_label} {folder}: writing it "
+                "would overwrite the input"
+            )
+        raise ValueError(
+            f"{label} {out} is inside the input folder {in_label} {folder}: give a file outside it"
+        )
+    if out.is_file():
+        st = out.stat()
+        if (st.st_dev, st.st_ino) in files():
+            raise ValueError(
+                f"{label} {out} is a file of the input folder {in_label} {folder} (a link to "
+                "it): writing it would overwrite the input"
+            )
+
+
+def _refuse_input_in_output_folder(
+    label: str, folder: Path, writes: Sequence[str], in_label: str, read: list[tuple[str, Path]]
+) -> None:
+    if not folder.is_dir():
+        return
+    literal = [w for w in writes if not glob.has_magic(w)]
+    for what, path in read:
+        rel = _relative(path, folder)
+        pattern = None if rel is None else _written_by(rel, writes, path.is_dir())
+        if pattern is None and path.exists():  # a link to a file the command writes
+            pattern = next((w for w in literal if _same(folder / w, path)), None)
+        if pattern == "**":
+            raise ValueError(
+                f"{label} {folder} would overwrite the folder holding the input "
+                f"{_of(in_label, what)} {path}"
+            )
+        if pattern is not None:
+            raise ValueError(
+                f"{label} {folder} would overwrite the input {_of(in_label, what)} {path} (the "
+                f"command writes {pattern} there)"
+            )
+
+
+def _refuse_over_input(
+    in_label: str,
+    src: Path,
+    written: list[tuple[str, Path]],
+    made: list[tuple[str, Path, tuple[str, ...]]],
+    rewritten: Sequence[str],
+) -> None:
+    """:func:`check_outputs`'s rules for one input ``src``."""
+    read = input_files(src)
     for label, out in written:
-        for in_label, src in read:
-            if _same(out, src):
-                raise ValueError(f"{label} {out} would overwrite the input {in_label} {src}")
+        for what, path in read:
+            if _same(out, path):
+                raise ValueError(
+                    f"{label} {out} would overwrite the input {_of(in_label, what)} {path}"
+                )
+    inside = input_folder(src)
+    if inside is not None:
+        files = functools.cache(functools.partial(_folder_files, inside))  # listed once
+        for label, out in written:
+            _refuse_in_input_folder(label, out, in_label, inside, files, rewritten)
+        for label, folder, _ in made:
+            if _within(folder, inside):
+                where = "is" if _same(folder, inside) else "is inside"
+                raise ValueError(
+                    f"{label} {folder} {where} the input folder {in_label} {inside}: give a "
+                    "folder outside it"
+                )
+    for label, folder, writes in made:
+        extra = [] if inside is None or inside == src else [("bag folder", inside)]
+        _refuse_input_in_output_folder(label, folder, writes, in_label, read + extra)
+
+
+def check_outputs(
+    outputs: Mapping[str, Path | Iterable[Path] | None],
+    inputs: Mapping[str, Path | Iterable[Path] | None],
+    folders: Mapping[str, tuple[Path | None, Sequence[str]]] | None = None,
+    rewritten: Mapping[str, Sequence[str]] | None = None,
+) -> None:
+    """Refuses, before any work, outputs that would destroy inputs. ``outputs``: label -> the
+    file(s) written (a map YAML and its image); ``inputs``: label -> the file(s) or folder(s)
+    read; ``folders``: label -> (an output folder, glob patterns relative to it of the files
+    the command writes there; ``**``: anything, all through it); ``rewritten``: input label ->
+    glob patterns, relative to that input folder, of the files the command itself rewrites in
+    it (an output may be one of them: kiseki serve's route history). The rules, paths compared
+    as written and resolved through symlinks, existing files by identity (hard links):
+
+    * an output file is not an existing folder (IsADirectoryError), an output folder not an
+      existing file (NotADirectoryError);
+    * an output file is not an input, nor a file an input refers to (:func:`input_files`: a map
+      YAML's image, a scene's octomap, a waypoint file's maps, an Aalto prefix's ``N-*.csv``),
+      nor inside an input folder (:func:`input_folder`: a ROS 2 bag, a taught run, a map
+      folder), nor a link to a file in it (the folder listed as :func:`_folder_files` says);
+    * an output folder is not an input folder nor inside one;
+    * an input (or a file it refers to) inside an output folder is refused when the command
+      writes it there (matches a pattern; an input folder: when the command writes anything
+      inside it); with ``**``, any input inside the folder;
+    * two outputs are not one file;
+    * an output file's folder exists and is writable (FileNotFoundError, PermissionError); an
+      output folder, or the nearest existing folder above it, is writable.
+
+    ValueError names the output, the input and both paths."""
+    from kiseki._atomic import check_writable_folder
+
+    written = _labelled(outputs)
+    made = [(label, Path(f), tuple(w)) for label, (f, w) in (folders or {}).items() if f]
+    for label, out in written:
+        if out.is_dir():
+            raise IsADirectoryError(f"{label} {out} is a folder: give the file to write")
+    for label, folder, _ in made:
+        if folder.exists() and not folder.is_dir():
+            raise NotADirectoryError(f"{label} {folder}: not a folder")
+    for in_label, src in _labelled(inputs):
+        _refuse_over_input(in_label, src, written, made, (rewritten or {}).get(in_label, ()))
     for i, (label, out) in enumerate(written):
         for other_label, other in written[i + 1 :]:
             if _same(out, other):
@@ -98,6 +337,8 @@ def check_outputs(
             raise FileNotFoundError(f"{label} {out}: folder {folder} does not exist")
         if not os.access(folder, os.W_OK | os.X_OK):
             raise PermissionError(f"{label} {out}: folder {folder} is not writable")
+    for label, folder, _ in made:
+        check_writable_folder(folder, label)
 
 
 def check_suffix(label: str, path: Path | None, suffixes: Sequence[str]) -> None:

@@ -14,6 +14,8 @@ import re
 
 import yaml
 
+from kiseki._inputs import YAML_LIMIT, read_input_text
+
 __all__ = ["read_yaml_file", "safe_load_12"]
 
 _BOOL, _INT, _FLOAT, _TIMESTAMP = (
@@ -64,12 +66,13 @@ def safe_load_12(text: str):
 
 def read_yaml_file(path, what: str):
     """A YAML file's content (YAML 1.2 core schema), or a ValueError naming the file and
-    ``what`` it should be when it is not UTF-8 text or not YAML (random bytes, a binary file)."""
+    ``what`` it should be when it is not UTF-8 text or not YAML (random bytes, a binary file),
+    or not a regular file of at most :data:`kiseki._inputs.YAML_LIMIT` bytes."""
     from pathlib import Path
 
     path = Path(path)
     try:
-        return safe_load_12(path.read_text(encoding="utf-8"))
+        return safe_load_12(read_input_text(path, "YAML files", YAML_LIMIT))
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a {what} (not UTF-8 text)") from None
     except yaml.YAMLError as err:

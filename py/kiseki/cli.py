@@ -20,12 +20,32 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from kiseki._guard import Derived, Rewrites, guarded
 from kiseki._interrupt import interruptible
+from kiseki._options import (
+    BEAM_LIMIT,
+    CELL_LIMITS,
+    PARTICLE_LIMIT,
+    REACH_LIMIT,
+    RUN_LIMIT,
+    SIM_SECONDS_LIMIT,
+    THREAD_LIMIT,
+    WORKER_LIMIT,
+    Count,
+    Degrees,
+    Fraction,
+    Metres,
+    Seconds,
+    Seed,
+    refuse_given,
+)
 from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
 from kiseki.cli_magnetic import magnetic_app
 from kiseki.cli_speed import speed_app
 from kiseki.cli_terrain import terrain_app
 from kiseki.errors import KisekiError
+from kiseki.global_localization import GlobalConfig
+from kiseki.localization import LocalizeConfig
 
 app = typer.Typer(
     no_args_is_help=True,
@@ -70,19 +90,6 @@ def _root(
     """kiseki: mobile-robot localization and navigation toolkit."""
 
 
-def _seed_option(value: int) -> int:
-    """Every --seed: an integer in [0, 2**64), refused in one line otherwise."""
-    from kiseki.core import check_seed
-
-    return check_seed(value, "--seed")
-
-
-def _positive(name: str, value: float) -> float:
-    if not np.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} must be a positive number, got {value}")
-    return value
-
-
 def _merge_rule(value: str) -> str:
     """A checked --merge value (the taught maps' merge rule)."""
     from kiseki.teach.environment_map import MERGE_RULES
@@ -92,17 +99,41 @@ def _merge_rule(value: str) -> str:
     return value
 
 
+# files the commands read or write that no option names (kiseki._guard)
+_MAP_IMAGE = Derived("--output's image", lambda a: a["output"].with_suffix(".pgm"))
+_TAUGHT_WAYPOINTS = Derived(
+    "--taught's waypoint file", lambda a: a["taught"] / "waypoints.yaml" if a["taught"] else None
+)
+_CONFIG_BESIDE = Derived(
+    "its config", lambda a: a["output"].with_name(a["output"].stem + ".config.yaml")
+)
+# kiseki serve rewrites files of its taught run in place (the waypoint file, on a rename, by
+# itself); --history may be the route history there, its default
+_SERVED = Rewrites("taught", ("route_history.json",))
+_GLOBAL_REPORT = Derived(
+    "its report", lambda a: a["output"].with_suffix(".json") if a["global_start"] is True else None
+)
+
+
 @map_app.command("from-log")
+@guarded(inputs=("log",), outputs=("output", _MAP_IMAGE, "render"))
 @interruptible()
 def map_from_log(
+    ctx: typer.Context,
     log: Path = typer.Argument(
         ...,
         help="CARMEN log (.log, .log.gz), kiseki run (.mcap), ROS 1 bag (.bag) or ROS 2 bag "
         "(folder, .db3 or .mcap).",
     ),
     output: Path = typer.Option(..., "-o", "--output", help="Map YAML to write (image beside)."),
-    resolution: float = typer.Option(0.05, help="Cell size in metres."),
-    usable_range: float = typer.Option(30.0, help="Free space is marked at most this far (m)."),
+    resolution: float = typer.Option(
+        0.05, parser=Metres("--resolution", *CELL_LIMITS), help="Cell size in metres."
+    ),
+    usable_range: float = typer.Option(
+        30.0,
+        parser=Metres("--usable-range", 0, REACH_LIMIT, lo_open=True),
+        help="Free space is marked at most this far (m); --rules log-odds only.",
+    ),
     render: Path | None = typer.Option(None, help="Also draw the map and trajectory to this PNG."),
     rules: str = typer.Option(
         "log-odds",
@@ -129,15 +160,11 @@ def map_from_log(
 
     if rules not in ("log-odds", "teaching", "evidence"):
         raise ValueError(f"--rules must be log-odds, teaching or evidence, got {rules!r}")
-    check_outputs(
-        {"--output": [output, output.with_suffix(".pgm")], "--render": render}, {"LOG": log}
-    )
+    if rules != "log-odds":  # teaching maps merge 8 m local maps: they have no usable range
+        refuse_given(ctx, ["usable_range"], f"to --rules {rules} (only to log-odds)")
     check_suffix("--output", output, (".yaml", ".yml"))
     check_suffix("--render", render, FIGURE_SUFFIXES)
-    config = MapBuildConfig(
-        resolution=_positive("--resolution", resolution),
-        usable_range=_positive("--usable-range", usable_range),
-    )
+    config = MapBuildConfig(resolution=resolution, usable_range=usable_range)
     start = time.perf_counter()
     scans = open_scans(log, scan_topic, odom_topic, reference_topic)
     if not scans.has_reference_poses:
@@ -167,8 +194,8 @@ def map_from_log(
         render_map(saved, render, trajectory=scans.poses, title=f"{log.name}")
     console.print(
         f"{output}: {grid.width} x {grid.height} cells at {grid.resolution} m from "
-        f"{len(scans)} scans in {seconds:.2f} s; {100 * share:.1f} % of scan endpoints on or "
-        "next to occupied cells"
+        f"{len(scans)} scans ({scans.invalid_ranges} invalid range readings skipped) in "
+        f"{seconds:.2f} s; {100 * share:.1f} % of scan endpoints on or next to occupied cells"
     )
 
 
@@ -184,6 +211,7 @@ def _read_trajectory(path: Path) -> np.ndarray:
 
 
 @map_app.command("render")
+@guarded(inputs=("map_file", "trajectory"), outputs=("output",))
 @interruptible()
 def map_render(
     map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat map."),
@@ -198,7 +226,6 @@ def map_render(
     from kiseki.map_io import load_map
     from kiseki.plots import render_map
 
-    check_outputs({"--output": output}, {"MAP": map_file, "--trajectory": trajectory})
     check_suffix("--output", output, FIGURE_SUFFIXES)
     grid = load_map(map_file)
     path = _read_trajectory(trajectory) if trajectory is not None else None
@@ -207,6 +234,7 @@ def map_render(
 
 
 @map_app.command("convert")
+@guarded(inputs=("map_file",), outputs=("output", _MAP_IMAGE))
 @interruptible()
 def map_convert(
     map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat(.gz) map."),
@@ -218,7 +246,6 @@ def map_convert(
     from kiseki.grid import grid_summary
     from kiseki.map_io import load_map, save_map
 
-    check_outputs({"--output": [output, output.with_suffix(".pgm")]}, {"MAP": map_file})
     check_suffix("--output", output, (".yaml", ".yml"))
     grid = load_map(map_file)
     save_map(grid, output)
@@ -230,6 +257,7 @@ def map_convert(
 
 
 @map_app.command("info")
+@guarded(inputs=("map_file",))
 def map_info(
     map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat map."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
@@ -247,16 +275,19 @@ def map_info(
 
 
 @app.command("demo")
+@guarded(inputs=("scene",), output_folders=("out",))
 @interruptible()
 def demo(
     out: Path = typer.Option(Path("results/demo"), help="Folder for the run, maps and figures."),
     scene: Path = typer.Option(
         Path("data/worlds/factory_turn.yaml"), "--scene", help="Scene with a taught route."
     ),
-    seed: int = typer.Option(
-        0, callback=_seed_option, help="Seed of every noise source of the run."
+    seed: int = typer.Option(0, parser=Seed(), help="Seed of every noise source of the run."),
+    particles: int = typer.Option(
+        1000,
+        parser=Count("--particles", 1, PARTICLE_LIMIT),
+        help="Particles of the localization filter.",
     ),
-    particles: int = typer.Option(1000, help="Particles of the localization filter."),
     merge: str = typer.Option(
         "thesis", help="Merge rule of the taught maps: thesis or evidence (see kiseki teach)."
     ),
@@ -272,6 +303,7 @@ def demo(
 
 
 @experiment_app.command("list")
+@guarded()  # no file
 def experiment_list(
     as_json: bool = typer.Option(False, "--json", help="Print a JSON list of objects."),
 ) -> None:
@@ -305,13 +337,23 @@ def experiment_list(
 
 
 @experiment_app.command("run")
+@guarded(output_folders=("out",))
 @interruptible("the finished trials are kept: --resume --out RUN_FOLDER runs only the missing ones")
 def experiment_run(
     name: str = typer.Argument(..., help="Experiment name (see: kiseki experiment list)."),
-    runs: int | None = typer.Option(None, "--runs", help="Number of trials."),
-    seed: int | None = typer.Option(None, "--seed", help="Run seed (trial seeds derive from it)."),
+    runs: int | None = typer.Option(
+        None, "--runs", parser=Count("--runs", 1, RUN_LIMIT), help="Number of trials."
+    ),
+    seed: int | None = typer.Option(
+        None, "--seed", parser=Seed(), help="Run seed (trial seeds derive from it)."
+    ),
     overrides: list[str] = typer.Option([], "--set", help="Config override key=value (repeat)."),
-    workers: int | None = typer.Option(None, "--workers", help="Local Dask cluster of N workers."),
+    workers: int | None = typer.Option(
+        None,
+        "--workers",
+        parser=Count("--workers", 1, WORKER_LIMIT),
+        help="Local Dask cluster of N workers.",
+    ),
     scheduler: str | None = typer.Option(None, "--scheduler", help="Dask scheduler tcp://H:P."),
     out: Path | None = typer.Option(None, "--out", help="Results folder (default results/NAME/…)."),
     resume: bool = typer.Option(False, "--resume", help="Run only the missing trials of a run."),
@@ -342,15 +384,18 @@ def experiment_run(
 
 
 @sim_app.command("run")
+@guarded(inputs=("scene_file", "commands"), outputs=("output",))
 def sim_run(
     scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML (data/worlds/...)."),
     output: Path = typer.Option(..., "-o", "--output", help="MCAP file to write."),
     controller: str = typer.Option("route", help="'route' (pure pursuit) or 'commands'."),
     commands: Path | None = typer.Option(None, help="CSV t,v,w or t,vx,vy,w for 'commands'."),
-    duration: float | None = typer.Option(None, help="Seconds to simulate (default: to goal)."),
-    seed: int = typer.Option(
-        0, callback=_seed_option, help="Seed of every noise source of the run."
+    duration: float | None = typer.Option(
+        None,
+        parser=Seconds("--duration", 0, SIM_SECONDS_LIMIT, lo_open=True),
+        help="Seconds to simulate (default: to goal).",
     ),
+    seed: int = typer.Option(0, parser=Seed(), help="Seed of every noise source of the run."),
     variant: str = typer.Option("teach", help="Scene variant: teach or playback."),
     overwrite: bool = typer.Option(False, help="Replace an existing output file."),
 ) -> None:
@@ -364,7 +409,6 @@ def sim_run(
         raise ValueError(f"--controller must be route or commands, got {controller!r}")
     if (controller == "commands") != (commands is not None):
         raise ValueError("--commands FILE goes with --controller commands, and only with it")
-    check_outputs({"--output": output}, {"SCENE": scene_file, "--commands": commands})
     if output.exists() and not overwrite:
         raise FileExistsError(f"--output {output} exists: give --overwrite to replace it")
     script = read_commands(commands) if commands is not None else None
@@ -396,6 +440,7 @@ def sim_run(
 
 
 @sim_app.command("render")
+@guarded(inputs=("run_file", "scene_file"), outputs=("output",))
 @interruptible()
 def sim_render(
     run_file: Path = typer.Argument(..., metavar="RUN", help="MCAP file of a run."),
@@ -408,14 +453,16 @@ def sim_render(
     from kiseki.sim.mcap_log import read_run
     from kiseki.sim.render import render_run
     from kiseki.sim.scene import load_scene
+    from kiseki.teach.scene_identity import resolve_scene_file
 
-    check_outputs({"--output": output}, {"RUN": run_file, "--scene": scene_file})
     check_suffix("--output", output, (".gif",))
     run = read_run(run_file)
-    path = scene_file or Path(run.metadata.get("scene_file", ""))
+    recorded = run.metadata.get("scene_file", "")
+    # a teaching log records its scene from its own folder, a simulated run from the cwd
+    path = scene_file or resolve_scene_file(recorded, run_file.parent) or Path(recorded)
     if not str(path) or not path.is_file():
         raise FileNotFoundError(f"{run_file}: its scene file {path} is not found: give --scene")
-    check_outputs({"--output": output}, {"the run's scene": path})
+    check_outputs({"--output": output}, {"the run's scene": path})  # named inside the run
     render_run(load_scene(path), run, output)
     console.print(f"{output}: animation written")
 
@@ -424,12 +471,18 @@ MAX_OCTREE_VOXELS = 5e7  # a few GB of OcTree nodes; the factory fills 2.6e5 at 
 
 
 @sim_app.command("show")
+@guarded(inputs=("scene_file",), outputs=("output", "octree"))
 @interruptible()
 def sim_show(
+    ctx: typer.Context,
     scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML."),
     output: Path = typer.Option(..., "-o", "--output", help="PNG to write."),
     octree: Path | None = typer.Option(None, help="Also export the world as an OctoMap .bt."),
-    resolution: float = typer.Option(0.05, help="Voxel size of the .bt export (m)."),
+    resolution: float = typer.Option(
+        0.05,
+        parser=Metres("--resolution", *CELL_LIMITS),
+        help="Voxel size of the .bt export (m); with --octree.",
+    ),
 ) -> None:
     """Draw a scene from above (and export its OctoMap).
 
@@ -438,13 +491,13 @@ def sim_show(
     from kiseki.sim.render import render_scene
     from kiseki.sim.scene import load_scene
 
-    check_outputs({"--output": output, "--octree": octree}, {"SCENE": scene_file})
+    if octree is None:
+        refuse_given(ctx, ["resolution"], "without --octree (the voxels of the .bt export)")
     check_suffix("--output", output, FIGURE_SUFFIXES)
     scene = load_scene(scene_file)
     if octree is not None:  # checked before anything is written
         if not isinstance(scene.world, _core.BoxWorld):
             raise ValueError(f"{scene_file}: the world is already an OctoMap")
-        _positive("--resolution", resolution)
         _, half, _ = scene.boxes.arrays()
         voxels = float(np.prod(np.ceil(2 * half / resolution) + 1, axis=1).sum())
         if voxels > MAX_OCTREE_VOXELS:
@@ -454,25 +507,45 @@ def sim_show(
             )
     render_scene(scene, output)
     if octree is not None:
+        from kiseki._atomic import atomic_write
+
         tree = _core.OctreeWorld.from_boxes(scene.world, resolution)
-        tree.write_binary(str(octree))
+        atomic_write(octree, tree.write_binary)
     console.print(f"{output}: scene drawn" + (f"; {octree} written" if octree else ""))
 
 
 @coop_app.command("simulate")
+@guarded(outputs=("plot",))
 @interruptible()
 def coop_simulate(
     form: int | None = typer.Option(
-        None, help="Movement form: 1 (pair and scout, the default) or 2 (leapfrog)."
+        None,
+        parser=Count("--form", 1, 2),
+        help="Movement form: 1 (pair and scout, the default) or 2 (leapfrog).",
     ),
-    moves: int | None = typer.Option(None, help="Moves to the goal (form 1: odd; default 15)."),
+    # kiseki.coop.plan's limits: up to 1000 moves, angles of 5..85 deg (the triangles of the
+    # formation degenerate beyond); an angle SD of 10 deg or more leaves nothing to triangulate
+    moves: int | None = typer.Option(
+        None,
+        parser=Count("--moves", 1, 1000),
+        help="Moves to the goal (form 1: odd; default 15).",
+    ),
     angle: float | None = typer.Option(
-        None, help="Representative angle (deg); default: the start's width kept, as the paper."
+        None,
+        parser=Degrees("--angle", 5, 85),
+        help="Representative angle (deg); default: the start's width kept, as the paper.",
     ),
-    runs: int = typer.Option(100, help="Noisy runs."),
-    sigma: float = typer.Option(0.1, help="SD of each measured angle (deg)."),
-    seed: int = typer.Option(0, callback=_seed_option, help="Seed of the angle noise."),
-    goal: tuple[float, float] = typer.Option((0.0, 10.0), help="Goal x y (m)."),
+    runs: int = typer.Option(100, parser=Count("--runs", 1, 1_000_000), help="Noisy runs."),
+    sigma: float = typer.Option(
+        0.1,
+        parser=Degrees("--sigma", 0, 10, hi_open=True),
+        help="SD of each measured angle (deg).",
+    ),
+    seed: int = typer.Option(0, parser=Seed(), help="Seed of the angle noise."),
+    # a goal within a kilometre: the paper's lies 10 m ahead, and the error grows with the moves
+    goal: tuple[float, float] = typer.Option(
+        (0.0, 10.0), parser=Metres("--goal", -1000, 1000), help="Goal x y (m)."
+    ),
     plot: Path | None = typer.Option(None, help="Draw the paths and error ellipses to this PNG."),
     planner: bool = typer.Option(
         False, "--planner", help="Let the move planner choose the moves (not --form/--moves)."
@@ -487,10 +560,7 @@ def coop_simulate(
     from kiseki.coop import START, plan, simulate
     from kiseki.coop.render import render_run
 
-    check_outputs({"--plot": plot}, {})
     check_suffix("--plot", plot, FIGURE_SUFFIXES)
-    if not (math.isfinite(sigma) and 0 <= sigma < 10):
-        raise ValueError(f"--sigma must lie in [0, 10) deg, got {sigma}")
     if planner and (form, moves, angle) != (None, None, None):
         raise ValueError("--planner chooses the moves itself: drop --form, --moves and --angle")
     form = 1 if form is None else form
@@ -519,12 +589,14 @@ def coop_simulate(
 
 
 @app.command("teach")
+@guarded(inputs=("scene_file", "keys"), output_folders=("out",))
 def teach_command(
+    ctx: typer.Context,
     scene_file: Path = typer.Argument(
         ..., metavar="SCENE", help="Scene YAML (with a route unless --keyboard)."
     ),
     out: Path = typer.Option(..., "-o", "--out", help="Folder for maps, waypoints and the log."),
-    seed: int = typer.Option(0, callback=_seed_option, help="Seed of the run's noise."),
+    seed: int = typer.Option(0, parser=Seed(), help="Seed of the run's noise."),
     resume: bool = typer.Option(False, help="Rebuild maps and waypoints from OUT/teach.mcap."),
     overwrite: bool = typer.Option(False, help="Replace an existing teaching log."),
     keyboard: bool = typer.Option(
@@ -556,6 +628,12 @@ def teach_command(
 
     if merge is not None:
         _merge_rule(merge)
+    if resume:  # the run is rebuilt from its log, as it was taught (a merge rule may be given)
+        refuse_given(
+            ctx,
+            ["seed", "overwrite", "keyboard", "keys"],
+            "with --resume (it rebuilds the maps and waypoints from OUT/teach.mcap)",
+        )
     if keys is not None and not keyboard:
         raise ValueError("--keys FILE goes with --keyboard")
     if keyboard and keys is None and not resume and not sys.stdin.isatty():
@@ -606,6 +684,10 @@ def teach_command(
 
 
 @app.command("playback")
+@guarded(
+    inputs=("scene_file", "taught", _TAUGHT_WAYPOINTS, "waypoints", "map_file"),
+    outputs=("log",),
+)
 @interruptible()
 def playback_command(
     scene_file: Path = typer.Argument(..., metavar="SCENE", help="Scene YAML (playback variant)."),
@@ -618,7 +700,7 @@ def playback_command(
         None, help="Waypoint YAML written by kiseki teach (instead of --taught)."
     ),
     method: str = typer.Option("proposal2", help="conventional, proposal1, proposal2 or both."),
-    seed: int = typer.Option(0, callback=_seed_option, help="Seed of the run's noise."),
+    seed: int = typer.Option(0, parser=Seed(), help="Seed of the run's noise."),
     speed_limit: str = typer.Option(
         "none",
         help="Speed limiter on the scene's laser: occlusion (occluded regions), "
@@ -665,8 +747,6 @@ def playback_command(
         raise FileNotFoundError(f"{scene_file}: scene file not found")
     taught_scene = taught_scene_of(waypoints)
     identity = check_scene(taught_scene, scene_file, variant)
-    inputs = {"SCENE": scene_file, "the waypoint file": waypoints, "the map": map_path}
-    check_outputs({"--log": log}, inputs)
     if log is not None and log.exists():
         raise FileExistsError(f"--log {log} exists; give a new file")
     scene, environment = load_scene(scene_file, "playback"), load_map(map_path)
@@ -732,6 +812,7 @@ def _speed_limiter(name: str, scene, grid, v_max: float):
 
 
 @app.command("serve")
+@guarded(inputs=(_SERVED, "scene"), outputs=("history",))
 def serve_command(
     taught: Path = typer.Option(..., help="Folder written by kiseki teach (or kiseki demo's)."),
     scene: Path | None = typer.Option(
@@ -739,11 +820,30 @@ def serve_command(
     ),
     method: str = typer.Option("both", help="conventional, proposal1, proposal2 or both."),
     host: str = typer.Option("127.0.0.1", help="Address to bind; beyond loopback a token."),
-    port: int = typer.Option(8000, help="TCP port."),
-    dwell: float = typer.Option(5.0, help="Seconds the robot waits at the goal (part taken)."),
-    speed_up: float = typer.Option(1.0, help="Simulated seconds per wall-clock second."),
-    particles: int = typer.Option(1000, help="Particles of the localization filter."),
-    seed: int = typer.Option(0, callback=_seed_option, help="Seed of the run's noise."),
+    port: int = typer.Option(8000, parser=Count("--port", 1, 65_535), help="TCP port."),
+    # at most an hour at the goal (the page waits for the robot's return), and at most 1000x
+    # real time (a 10 Hz robot would step 10,000 times a wall-clock second)
+    dwell: float = typer.Option(
+        5.0,
+        parser=Seconds("--dwell", 0, 3600),
+        help="Seconds the robot waits at the goal (part taken).",
+    ),
+    speed_up: float = typer.Option(
+        1.0,
+        parser=Fraction("--speed-up", 0, 1000, lo_open=True),
+        help="Simulated seconds per wall-clock second.",
+    ),
+    particles: int = typer.Option(
+        1000,
+        parser=Count("--particles", 1, PARTICLE_LIMIT),
+        help="Particles of the localization filter.",
+    ),
+    seed: int = typer.Option(0, parser=Seed(), help="Seed of the run's noise."),
+    history: Path | None = typer.Option(
+        None,
+        help="JSON file of the finished routes: loaded at start, rewritten (atomically) after "
+        "each route (default: route_history.json in the --taught folder).",
+    ),
 ) -> None:
     """Serve the route-instruction page and its JSON API over a taught run: a worker picks
     start, via and goal waypoints, the simulated AGV drives there, stops within 0.1 m, dwells
@@ -753,21 +853,22 @@ def serve_command(
     Example: kiseki serve --taught results/demo/teach"""
     import secrets
 
-    from kiseki.serve import LOOPBACK, build_server
+    from kiseki.serve import HISTORY_FILE, LOOPBACK, build_server
 
-    if not (np.isfinite(dwell) and dwell >= 0):
-        raise ValueError(f"--dwell must be a number of seconds >= 0, got {dwell}")
-    _positive("--speed-up", speed_up)
-    if not 0 < port < 65536:
-        raise ValueError(f"--port must be 1..65535, got {port}")
     token = None if host in LOOPBACK else secrets.token_urlsafe(24)
-    server = build_server(taught, scene, method, token, dwell, speed_up, particles, seed)
+    history = taught / HISTORY_FILE if history is None else history
+    server = build_server(
+        taught, scene, method, token, dwell, speed_up, particles, seed,
+        host=host, port=port, history=history,
+    )  # fmt: skip
     import uvicorn
 
     names = ", ".join(w["name"] for w in server.taught.waypoints)
+    # the token rides in the URL's fragment: the browser never sends it, so no log has it
+    url = f"http://{f'[{host}]' if ':' in host else host}:{port}/"
     console.print(
-        f"kiseki serve: {taught} ({method}, waypoints {names}; scene {server.scene}) on "
-        f"http://{host}:{port}/",
+        f"kiseki serve: {taught} ({method}, waypoints {names}; scene {server.scene}; history "
+        f"{history}) on {url}{'' if token is None else f'#token={token}'}",
         soft_wrap=True,
     )
     if token is not None:
@@ -776,8 +877,13 @@ def serve_command(
 
 
 @app.command("localize")
+@guarded(
+    inputs=("log", "map_file"),
+    outputs=("output", _CONFIG_BESIDE, _GLOBAL_REPORT, "plot"),
+)
 @interruptible()
 def localize_command(
+    ctx: typer.Context,
     log: Path = typer.Argument(
         ...,
         help="CARMEN log (.log, .log.gz), kiseki run (.mcap), CMU Wean robotdata log, ROS 1 bag "
@@ -790,30 +896,49 @@ def localize_command(
         "likelihood-field", help="beam, likelihood-field, space-observation or odometry."
     ),
     seed: int = typer.Option(
-        0, callback=_seed_option, help="Seed of the filter and of the odometry noise."
+        0, parser=Seed(), help="Seed of the filter and of the odometry noise."
     ),
-    odometry_noise: float = typer.Option(0.0, help="Odometry noise SD, fraction of each step."),
+    # the defaults are the configs' (LocalizeConfig; GlobalConfig with --global), shown here
+    # an SD up to the step itself: beyond it the odometry says nothing of the motion
+    odometry_noise: float | None = typer.Option(
+        None,
+        parser=Fraction("--odometry-noise", 0, 1),
+        help="Odometry noise SD, fraction of each step (default "
+        f"{LocalizeConfig.odometry_noise:g}); not with --global.",
+    ),
     particles: int | None = typer.Option(
         None,
-        help="Particles (default 500; 50000 at the start with --global); with --kld the maximum.",
+        parser=Count("--particles", 1, PARTICLE_LIMIT),
+        help=f"Particles (default {LocalizeConfig.particles:,}; {GlobalConfig.particles:,} at the "
+        "start with --global); with --kld the maximum.",
     ),
     kld: bool = typer.Option(False, "--kld", help="Adapt the particle count by KLD sampling."),
     beams: int | None = typer.Option(
-        None, help="Beams used per scan, nav2's max_beams (default 90; 60 with --global)."
+        None,
+        parser=Count("--beams", 0, BEAM_LIMIT, "0 = every beam"),
+        help=f"Beams used per scan, nav2's max_beams (default {LocalizeConfig.beams}; "
+        f"{GlobalConfig.beams} with --global); not with space-observation.",
     ),
-    recovery: str = typer.Option(
-        "none",
+    recovery: str | None = typer.Option(
+        None,
         help="none, augmented (Augmented MCL) or resetting (expansion, then sensor resetting); "
-        "with --global from the cloud's convergence on.",
+        f"with --global from the cloud's convergence on (default {LocalizeConfig.recovery}).",
     ),
-    threads: int = typer.Option(0, help="Threads of the filter (0 = every core)."),
+    threads: int | None = typer.Option(
+        None,
+        parser=Count("--threads", 0, THREAD_LIMIT, "0 = every core"),
+        help=f"Threads of the filter (0 = every core; default {LocalizeConfig.threads}).",
+    ),
     global_start: bool = typer.Option(
         False,
         "--global",
         help="Global localization: start uniformly over the map's free cells (no initial pose).",
     ),
     tracking_particles: int | None = typer.Option(
-        None, help="With --global: particles kept once the cloud has converged (default 1000)."
+        None,
+        parser=Count("--tracking-particles", 1, PARTICLE_LIMIT),
+        help="With --global: particles kept once the cloud has converged (default "
+        f"{GlobalConfig.tracking_particles:,}).",
     ),
     plot: Path | None = typer.Option(
         None, help="With --global: draw the map, the estimates and where they converged (PNG)."
@@ -843,15 +968,8 @@ def localize_command(
     from kiseki.map_io import load_map
     from kiseki.metrics import ape
 
-    check_outputs(
-        {
-            "--output": output,
-            "its config": output.with_name(output.stem + ".config.yaml"),
-            "its report": output.with_suffix(".json") if global_start else None,
-            "--plot": plot,
-        },
-        {"LOG": log, "--map": map_file},
-    )
+    _refuse_unused_by_localize(ctx, method, global_start)
+
     check_suffix("--plot", plot, FIGURE_SUFFIXES)
     if not global_start:
         for name, value in (("--tracking-particles", tracking_particles), ("--plot", plot)):
@@ -859,42 +977,24 @@ def localize_command(
                 raise ValueError(f"{name} applies only with --global")
     if global_start and output.suffix.lower() == ".json":
         raise ValueError(f"{output}: the report goes to OUTPUT.json: give a .csv output")
-    if global_start and odometry_noise != 0.0:
-        raise ValueError("--odometry-noise is for logs with reference poses, not --global")
     scans = open_scans(
         log, scan_topic=scan_topic, odom_topic=odom_topic, reference_topic=reference_topic
     )
     grid = load_map(map_file)
     reliability = np.full(len(scans), np.nan)
+    shared = dict(method=method, seed=seed, particles=particles, kld=kld, beams=beams)
+    shared.update(recovery=recovery, threads=threads)
     if global_start:
-        from kiseki.global_localization import GlobalConfig, global_localize
+        from kiseki.global_localization import global_localize
 
-        gconfig = GlobalConfig(
-            method=method,
-            seed=seed,
-            particles=50_000 if particles is None else particles,
-            tracking_particles=1000 if tracking_particles is None else tracking_particles,
-            recovery=recovery,
-            kld=kld,
-            beams=60 if beams is None else beams,
-            threads=threads,
-        )
+        gconfig = GlobalConfig(**_given(**shared, tracking_particles=tracking_particles))
         saved_config = {"command": "localize --global", **asdict(gconfig)}
         result = global_localize(scans, grid, gconfig, progress=True)
         trajectory, reliability = result.estimates, result.reliability
     else:
-        from kiseki.localization import LocalizeConfig, localize
+        from kiseki.localization import localize
 
-        config = LocalizeConfig(
-            method=method,
-            seed=seed,
-            odometry_noise=odometry_noise,
-            particles=500 if particles is None else particles,
-            kld=kld,
-            beams=90 if beams is None else beams,
-            recovery=recovery,
-            threads=threads,
-        )
+        config = LocalizeConfig(**_given(**shared, odometry_noise=odometry_noise))
         if not scans.has_reference_poses:
             raise ValueError(f"{log}: the log has no reference poses to start from: use --global")
         saved_config = {"command": "localize", **config.to_dict()}
@@ -909,6 +1009,7 @@ def localize_command(
     config_path = output.with_name(output.stem + ".config.yaml")
     _write_yaml(config_path, saved_config)
     summary: dict = {"output": str(output), "poses": len(scans), "method": method}
+    summary["invalid_ranges"] = scans.invalid_ranges  # skipped (kiseki.scans' rule)
     lines = [f"{output}: {len(scans)} poses; the log has no reference poses"]
     if scans.has_reference_poses:
         position = ape(trajectory, scans.poses)
@@ -919,6 +1020,7 @@ def localize_command(
             f"{output}: {len(scans)} poses; {method}: position RMSE {position.rmse:.3f} m "
             f"(max {position.max:.3f} m), heading RMSE {heading.rmse:.2f} deg"
         ]
+    lines[0] += f"; {scans.invalid_ranges} invalid range readings skipped"
     if global_start:
         from kiseki.global_localization import describe, write_report
 
@@ -930,6 +1032,26 @@ def localize_command(
         from kiseki.global_localization import render_global
 
         render_global(grid, result, plot, title=f"{log.name}: global {method}")
+
+
+def _given(**settings) -> dict:
+    """The settings the command line gave (not None): the others keep their config's default,
+    so that each default lives in one place (LocalizeConfig, GlobalConfig)."""
+    return {name: value for name, value in settings.items() if value is not None}
+
+
+def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bool) -> None:
+    """Options the chosen method or start does not use are errors, not silently ignored."""
+    if method == "odometry":  # the odometry alone: no filter, no sensor model, no start
+        refuse_given(
+            ctx,
+            ["particles", "kld", "beams", "recovery", "threads", "global_start"],
+            "to --method odometry (the odometry alone: no particle filter)",
+        )
+    elif method == "space-observation":  # a local map of the whole scan: no beam selection
+        refuse_given(ctx, ["beams"], "to --method space-observation (it weighs the whole scan)")
+    if global_start:
+        refuse_given(ctx, ["odometry_noise"], "with --global (it is for logs with reference poses)")
 
 
 def _print_report(lines: list[str], summary: dict, as_json: bool) -> None:
@@ -1007,6 +1129,7 @@ def _write_yaml(path: Path, doc: dict) -> None:
 
 
 @app.command("report")
+@guarded(inputs=("results",), outputs=("output",))
 @interruptible()
 def report(
     results: Path = typer.Option(Path("results"), help="Results folder of the experiments."),

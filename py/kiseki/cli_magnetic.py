@@ -13,8 +13,10 @@ import numpy as np
 import typer
 from rich.console import Console
 
+from kiseki._guard import Folder, guarded
 from kiseki._interrupt import interruptible
-from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
+from kiseki._options import CELL_LIMITS, Count, Fraction, Metres, Seed, refuse_given
+from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
 
 __all__ = ["magnetic_app"]
 
@@ -23,23 +25,10 @@ magnetic_app = typer.Typer(
     help="Magnetic field maps (fit, predict, render), walks, teaching and navigation.",
 )
 console = Console(soft_wrap=True)
+# what kiseki magnetic navigate writes in its -o folder (kiseki._guard)
+_NAVIGATION = Folder("output", ("run.mcap", "navigation.csv", "navigation.png"))
 EXACT_LIMIT = 10_000  # beyond this many measurements the default is the reduced-rank GP
 METHODS = ("exact", "hilbert")
-
-
-def _data_files(spec: Path) -> list[Path]:
-    """The files DATA stands for: itself, or an Aalto prefix's three files."""
-    if spec.is_file() or spec.suffix.lower() in (".csv", ".mat"):
-        return [spec]
-    return [Path(f"{spec}-{part}.csv") for part in ("loc", "mag", "time")]
-
-
-def _inside(path: Path, folder: Path) -> bool:
-    return folder.resolve() in (path.resolve(), *path.resolve().parents)
-
-
-def _map_files(folder: Path) -> dict[str, Path]:
-    return {f"MAP's {p.name}": p for p in sorted(folder.iterdir())} if folder.is_dir() else {}
 
 
 def _parse_kernel(text: str):
@@ -54,15 +43,12 @@ def _parse_kernel(text: str):
     return SquaredExponential(*values)
 
 
-def _check_fit_options(dimension, resolution, margin, max_points, method, units) -> None:
-    if dimension is not None and dimension not in (2, 3):
-        raise ValueError(f"--dimension must be 2 or 3, got {dimension}")
-    if not (math.isfinite(resolution) and resolution > 0):
-        raise ValueError(f"--resolution must be a positive number of metres, got {resolution}")
-    if not (math.isfinite(margin) and margin >= 0):
-        raise ValueError(f"--margin must be a number of metres >= 0, got {margin}")
-    if max_points is not None and max_points < 4:
-        raise ValueError(f"--max-points must be at least 4, got {max_points}")
+def _check_fit_options(ctx: typer.Context, kernel, max_points, method, units) -> None:
+    """The fit's words and what its numbers do not apply to (the numbers have their ranges)."""
+    if kernel is not None:  # the given hyperparameters: no search, so nothing per component
+        refuse_given(ctx, ["per_component"], "with --kernel (its hyperparameters are given)")
+        if max_points is None:  # no search and no subsample: nothing random
+            refuse_given(ctx, ["seed"], "with --kernel and without --max-points (nothing random)")
     if method is not None and method not in METHODS:
         raise ValueError(f"--method must be exact or hilbert, got {method!r}")
     if units is not None and units not in ("uT", "G"):
@@ -111,8 +97,10 @@ def _hilbert_settings(gp) -> dict | None:
 
 
 @magnetic_app.command("fit")
+@guarded(inputs=("data",), output_folders=("output",))  # replaced whole
 @interruptible()
 def fit(
+    ctx: typer.Context,
     data: list[Path] = typer.Argument(
         ...,
         help="Measurements: Aalto run prefixes DIR/N (DIR/N-loc.csv, -mag.csv, -time.csv), CSV "
@@ -120,20 +108,34 @@ def fit(
     ),
     output: Path = typer.Option(..., "-o", "--output", help="Map folder to write."),
     dimension: int | None = typer.Option(
-        None, help="2 (grid over x, y) or 3 (voxels); default: the data's."
+        None,
+        parser=Count("--dimension", 2, 3),
+        help="2 (grid over x, y) or 3 (voxels); default: the data's.",
     ),
-    resolution: float = typer.Option(0.1, help="Cell (voxel) size in metres."),
-    margin: float = typer.Option(0.5, help="Metres added around the data's bounding box."),
+    resolution: float = typer.Option(
+        0.1, parser=Metres("--resolution", *CELL_LIMITS), help="Cell (voxel) size in metres."
+    ),
+    # a kilometre around the data at most; the cells of the whole box then have their limit
+    margin: float = typer.Option(
+        0.5,
+        parser=Metres("--margin", 0, 1000),
+        help="Metres added around the data's bounding box.",
+    ),
     per_component: bool = typer.Option(
         False, "--per-component", help="Own hyperparameters for each of mx, my, mz."
     ),
     kernel: str | None = typer.Option(
         None, help="sigma_f,l,sigma_n (default: maximise the log marginal likelihood)."
     ),
+    # a GP needs a few points; 10^8 readings of (x, y, z, mx, my, mz) are 4.8 GB of doubles
     max_points: int | None = typer.Option(
-        None, help="Fit on a seeded random subsample of this many measurements."
+        None,
+        parser=Count("--max-points", 4, 100_000_000),
+        help="Fit on a seeded random subsample of this many measurements.",
     ),
-    seed: int = typer.Option(0, help="Seed of the subsample and the optimizer's restarts."),
+    seed: int = typer.Option(
+        0, parser=Seed(), help="Seed of the subsample and the optimizer's restarts."
+    ),
     method: str | None = typer.Option(
         None, help=f"exact or hilbert (default: exact up to {EXACT_LIMIT:,} measurements)."
     ),
@@ -141,6 +143,7 @@ def fit(
     bin_size: float | None = typer.Option(
         None,
         "--bin",
+        parser=Metres("--bin", *CELL_LIMITS),
         help="Average the readings per cell of this size (m) first, one reading per place (the "
         "thesis stores its 3-D survey per 0.2 m voxel); recommended for dense 50 Hz tracks.",
     ),
@@ -150,20 +153,12 @@ def fit(
 
     Example: kiseki magnetic fit aalto/invensense/1 aalto/invensense/2 -o hall-map
     """
-    from kiseki.core import check_seed
     from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
     from kiseki.magnetic.map_folder import check_map_destination
 
-    _check_fit_options(dimension, resolution, margin, max_points, method, units)
-    seed = check_seed(seed, "--seed")
+    _check_fit_options(ctx, kernel, max_points, method, units)
     fixed = _parse_kernel(kernel) if kernel is not None else None
     check_map_destination(output)
-    for spec in data:
-        for f in _data_files(spec):
-            if _inside(f, output):
-                raise ValueError(f"-o {output} would replace the folder holding the input {f}")
-    if bin_size is not None and not (math.isfinite(bin_size) and bin_size > 0):
-        raise ValueError(f"--bin must be a positive number of metres, got {bin_size}")
     x, y, height, units = _read_data(data, units, dimension)
     n_read = len(x)
     if bin_size is not None:
@@ -235,8 +230,10 @@ def _report_fit(fmap, output: Path, kernels, lml: list, used: int, read: int, se
 
 
 @magnetic_app.command("predict")
+@guarded(inputs=("map_folder", "at"), outputs=("output",))
 @interruptible()
 def predict(
+    ctx: typer.Context,
     map_folder: Path = typer.Argument(..., metavar="MAP", help="Map folder (kiseki magnetic fit)."),
     at: Path = typer.Option(..., "--at", help="CSV with a header and columns x,y[,z]."),
     output: Path = typer.Option(..., "-o", "--output", help="CSV to write."),
@@ -254,8 +251,9 @@ def predict(
     from kiseki.magnetic.field_map import MagneticFieldMap
     from kiseki.magnetic.points_csv import read_points
 
-    check_outputs({"-o": output}, {"--at": at, **_map_files(map_folder)})
     fmap = MagneticFieldMap.load(map_folder)
+    if fmap.training is None:
+        refuse_given(ctx, ["interpolate"], f"to {map_folder}: it keeps no data to re-evaluate")
     points, dropped = read_points(at, fmap.dimension)
     exact = fmap.training is not None and not interpolate
     start = time.perf_counter()
@@ -274,11 +272,18 @@ def predict(
 
 
 @magnetic_app.command("render")
+@guarded(inputs=("map_folder",), outputs=("output",))
 @interruptible()
 def render(
+    ctx: typer.Context,
     map_folder: Path = typer.Argument(..., metavar="MAP", help="Map folder (kiseki magnetic fit)."),
     output: Path = typer.Option(..., "-o", "--output", help="PNG to write."),
-    slices: int = typer.Option(4, help="3-D maps: horizontal slices drawn (one row each)."),
+    # a row of six 300 px panels each: 100 rows are a picture 30,060 px high
+    slices: int = typer.Option(
+        4,
+        parser=Count("--slices", 1, 100),
+        help="3-D maps: horizontal slices drawn (one row each).",
+    ),
 ) -> None:
     """Draw the mean and variance of mx, my, mz as six panels with colour bars (the thesis'
     Fig. 6.13: 1500 x 800 px); a 3-D map as one row of six per slice height (Fig. 6.14).
@@ -289,17 +294,17 @@ def render(
 
     if output.suffix.lower() != ".png":
         raise ValueError(f"-o {output}: the picture is a PNG: give a .png file")
-    if slices < 1:
-        raise ValueError(f"--slices must be at least 1, got {slices}")
-    check_outputs({"-o": output}, _map_files(map_folder))
     check_suffix("-o", output, FIGURE_SUFFIXES)
     fmap = MagneticFieldMap.load(map_folder)
+    if fmap.dimension == 2:
+        refuse_given(ctx, ["slices"], f"to {map_folder}: a 2-D map (slices are 3-D maps')")
     render_field_map(fmap, output, slices)
     width, height = picture_size(fmap, slices)
     console.print(f"{output}: {width} x {height} px")
 
 
 @magnetic_app.command("walk")
+@guarded(inputs=("walk_file",), output_folders=(Folder("output", ("trajectory.csv",)),))
 @interruptible()
 def walk(
     walk_file: Path = typer.Argument(
@@ -307,10 +312,13 @@ def walk(
     ),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for trajectory.csv."),
     seed: int = typer.Option(
-        0, help="Seed of the odometry's scale error and noise and the filter."
+        0, parser=Seed(), help="Seed of the odometry's scale error and noise and the filter."
     ),
+    # -100 % stops the odometry; +100 % doubles every step
     scale_error: float | None = typer.Option(
-        None, help="Fixed odometry scale error e (default: drawn from N(0, 0.05^2))."
+        None,
+        parser=Fraction("--scale-error", -1, 1, lo_open=True),
+        help="Fixed odometry scale error e (default: drawn from N(0, 0.05^2)).",
     ),
 ) -> None:
     """The thesis' travel-distance particle filter (sec. 4.4.1: 1000 particles, w = 1/(a s + 1),
@@ -326,20 +334,11 @@ def walk(
     2 m from every map node) are reported and not localized.
 
     Example: kiseki magnetic walk eight.mat -o eight-walk --seed 0"""
-    from kiseki._atomic import atomic_write, check_writable_folder
-    from kiseki.core import check_seed
+    from kiseki._atomic import atomic_write
     from kiseki.datasets.kok import read_kok_walk
     from kiseki.magnetic.travel_distance_walk import WalkOdometry, localize_walk
 
-    seed = check_seed(seed, "--seed")
-    if scale_error is not None and not (math.isfinite(scale_error) and scale_error > -1):
-        raise ValueError(f"--scale-error must be a number > -1, got {scale_error}")
-    if output.exists() and not output.is_dir():
-        raise ValueError(f"-o {output}: not a folder")
     target = output / "trajectory.csv"
-    if output.is_dir():
-        check_outputs({"-o": target}, {"WALK": walk_file})
-    check_writable_folder(output)
     result = localize_walk(read_kok_walk(walk_file), seed, WalkOdometry(scale_error=scale_error))
     for lap, t, metres in result.off_path:
         console.print(
@@ -361,27 +360,32 @@ def walk(
 
 
 @magnetic_app.command("teach")
+@guarded(inputs=("scene",), output_folders=("output",))
 @interruptible()
 def teach(
     scene: Path = typer.Argument(..., help="Scene file with a route (its teach variant)."),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for the linear maps."),
-    seed: int = typer.Option(0, help="Seed of the teaching runs."),
-    offset: float = typer.Option(1.0, help="m between the taught path and its parallel paths."),
+    seed: int = typer.Option(0, parser=Seed(), help="Seed of the teaching runs."),
+    # the thesis' parallel paths are 1 m apart; 10 m is wider than a corridor's route needs
+    offset: float = typer.Option(
+        1.0,
+        parser=Metres("--offset", 0, 10, lo_open=True),
+        help="m between the taught path and its parallel paths.",
+    ),
 ) -> None:
     """Teaches a route by hand (thesis ch. 3-4): the linear magnetic map of the route (nodes
     every 0.1 m) and of two paths OFFSET m to its left and right (Rahok's eq. 3.1), written to
     OUT (a linear-map folder; left/ and right/; the teaching runs in runs/).
 
     Example: kiseki magnetic teach data/worlds/magnetic_path.yaml -o taught"""
-    from kiseki.core import check_seed
     from kiseki.magnetic.navigate_outputs import teach_folder
 
-    check_seed(seed, "--seed")
     maps = teach_folder(scene, output, seed, offset)
     console.print(f"{output}: {len(maps.center)} nodes over {maps.center.s[-1]:.1f} m")
 
 
 @magnetic_app.command("navigate")
+@guarded(inputs=("scene", "map_folder"), output_folders=(_NAVIGATION,))
 @interruptible()
 def navigate(
     scene: Path = typer.Argument(..., help="Scene file (its playback variant is driven)."),
@@ -390,17 +394,15 @@ def navigate(
         "multi", help="rahok|magnetic-geometric|magnetic|geometric|odometry|multi."
     ),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for the run and plots."),
-    seed: int = typer.Option(1, help="Seed of the playback run."),
+    seed: int = typer.Option(1, parser=Seed(), help="Seed of the playback run."),
 ) -> None:
     """Plays the taught route back steering with one navigator (thesis ch. 3: rahok; ch. 4:
     the four navigators alone, or multi, arbitrated by priority). Writes OUT/run.mcap,
     OUT/navigation.csv and OUT/navigation.png (path, cross-track error, priority history).
 
     Example: kiseki magnetic navigate data/worlds/magnetic_path.yaml --map taught -o nav"""
-    from kiseki.core import check_seed
     from kiseki.magnetic.navigate_outputs import navigate_folder
 
-    check_seed(seed, "--seed")
     r = navigate_folder(scene, map_folder, navigator, output, seed)
     off = np.abs(r.cross_track)
     console.print(

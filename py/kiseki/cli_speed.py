@@ -11,8 +11,10 @@ import numpy as np
 import typer
 from rich.console import Console
 
+from kiseki._guard import Derived, guarded
 from kiseki._interrupt import interruptible
-from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
+from kiseki._options import REACH_LIMIT, Degrees, Metres, Quantity, refuse_given
+from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
 
 __all__ = ["speed_app"]
 
@@ -21,11 +23,15 @@ speed_app = typer.Typer(
 )
 console = Console(soft_wrap=True)
 METHODS = ("occlusion", "occlusion-width", "width")
+# the settings written beside the CSV (kiseki._guard)
+_CONFIG = Derived("the config", lambda a: a["output"].with_suffix(".config.yaml"))
 
 
 @speed_app.command("limits")
+@guarded(inputs=("log", "map_file"), outputs=("output", _CONFIG, "plot"))
 @interruptible()
 def speed_limits(
+    ctx: typer.Context,
     log: Path = typer.Argument(
         ...,
         help="Log with reference poses: CARMEN (.log, .log.gz), kiseki run (.mcap), ROS 1 bag "
@@ -36,9 +42,22 @@ def speed_limits(
     method: str = typer.Option(
         "occlusion-width", help="occlusion (eq. 1), width (eq. 2) or occlusion-width (eq. 4)."
     ),
-    reach: float = typer.Option(4.0, help="Sensor range of eq. 1's region (m); the paper's 4 m."),
-    half_angle: float = typer.Option(90.0, help="theta: +-degrees around the motion (paper 90)."),
-    v_max: float = typer.Option(0.5, help="The robot's maximum speed (m/s)."),
+    reach: float = typer.Option(
+        4.0,
+        parser=Metres("--reach", 0, REACH_LIMIT, lo_open=True),
+        help="Sensor range of eq. 1's region (m); the paper's 4 m.",
+    ),
+    half_angle: float = typer.Option(
+        90.0,
+        parser=Degrees("--half-angle", 0, 180, lo_open=True),
+        help="theta: +-degrees around the motion (paper 90); not with --method width.",
+    ),
+    # 10 m/s is faster than any robot that drives among people, which the limit is for
+    v_max: float = typer.Option(
+        0.5,
+        parser=Quantity("--v-max", 0, 10, "m/s", lo_open=True),
+        help="The robot's maximum speed (m/s).",
+    ),
     heading: str = typer.Option(
         "laser", help="Direction of motion: laser (where the robot faces) or motion (its path)."
     ),
@@ -62,10 +81,8 @@ def speed_limits(
 
     if method not in METHODS:
         raise ValueError(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
-    if not (math.isfinite(reach) and reach > 0):
-        raise ValueError(f"--reach must be a positive number of metres, got {reach}")
-    if not 0 < half_angle <= 180:
-        raise ValueError(f"--half-angle must be in (0, 180] degrees, got {half_angle}")
+    if method == "width":  # eq. 2 measures the passage ahead: no region of +-theta
+        refuse_given(ctx, ["half_angle"], "to --method width (eq. 1's region only)")
     config = SpeedLimiterConfig(
         v_max=v_max,
         half_angle=math.radians(half_angle),
@@ -73,10 +90,6 @@ def speed_limits(
         use_width=method != "occlusion",
     )
     side = output.with_suffix(".config.yaml")
-    outputs = {"-o": output, "the config": side}
-    if plot is not None:
-        outputs["--plot"] = plot
-    check_outputs(outputs, {"LOG": log, "--map": map_file})
     check_suffix("--plot", plot, FIGURE_SUFFIXES)
     grid = load_map(map_file)
     topics = {"scan_topic": scan_topic}

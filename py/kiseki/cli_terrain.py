@@ -10,7 +10,9 @@ import numpy as np
 import typer
 from rich.console import Console
 
+from kiseki._guard import Folder, guarded
 from kiseki._interrupt import interruptible
+from kiseki._options import Count, Metres, Seed, refuse_given
 
 __all__ = ["terrain_app"]
 
@@ -21,6 +23,10 @@ terrain_app = typer.Typer(
 )
 console = Console(soft_wrap=True)
 TRAJECTORY_COLUMNS = ("move", "x_true", "y_true", "z_true", "x_est", "y_est", "z_est")
+# what kiseki terrain run writes in its -o folder (kiseki._guard)
+_RUN_FILES = Folder(
+    "output", ("sdem_*.pcd", "trajectory.csv", "global_map.bt", "trajectory.png", "config.yaml")
+)
 
 
 def _destination(out: Path) -> None:
@@ -32,15 +38,24 @@ def _destination(out: Path) -> None:
 
 
 @terrain_app.command("run")
+@guarded(inputs=("world",), output_folders=(_RUN_FILES,))
 @interruptible()
 def terrain_run(
     world: Path = typer.Argument(
         ..., help="A scene YAML with a tilting_laser and a route, or an OctoMap .bt building."
     ),
-    moves: int = typer.Option(..., "--moves", help="Moves after the first stop (1..200)."),
+    # kiseki.sim.terrain_moves' limits: a sweep and a correlation search per stop, and steps
+    # the search reaches (it covers 0.7 m)
+    moves: int = typer.Option(
+        ..., "--moves", parser=Count("--moves", 1, 200), help="Moves after the first stop."
+    ),
     output: Path = typer.Option(..., "-o", "--output", help="Folder to write the run to."),
-    seed: int = typer.Option(0, help="Seed of the laser's noise, the gyro and PCL's RANSAC."),
-    step: float = typer.Option(0.35, help="Metres between stops (0.02..0.6)."),
+    seed: int = typer.Option(
+        0, parser=Seed(), help="Seed of the laser's noise, the gyro and PCL's RANSAC."
+    ),
+    step: float = typer.Option(
+        0.35, parser=Metres("--step", 0.02, 0.6), help="Metres between stops."
+    ),
     removal: str = typer.Option("hough", help="Plane removal: hough (the paper's), pcl, none."),
     search: str = typer.Option(
         "coarse-to-fine", help="exhaustive (the paper's 56,916 candidates) or coarse-to-fine."
@@ -59,11 +74,9 @@ def terrain_run(
 
     from kiseki import _core
     from kiseki._atomic import atomic_write
-    from kiseki.core import check_seed
     from kiseki.sim.terrain_moves import terrain_stops
     from kiseki.terrain.mapper import MapperConfig, SdemMapper
 
-    seed = check_seed(seed, "--seed")
     if not world.exists():
         raise ValueError(f"WORLD {world}: no such file")
     config = MapperConfig(removal=removal, search=search, seed=seed)  # checks both names
@@ -74,13 +87,13 @@ def terrain_run(
     for k, stop in enumerate(tqdm(stops, desc="stops", unit="sweep")):
         pose = mapper.add(stop.ranges, stop.gyro_rpy)
         points, _ = mapper.sweeps[-1].kept.to_points()
-        _core.write_pcd(str(output / f"sdem_{k:03d}.pcd"), points)
+        atomic_write(output / f"sdem_{k:03d}.pcd", lambda tmp, p=points: _core.write_pcd(tmp, p))
         rows.append([k, *stop.sensor[:3, 3], *pose[:3, 3]])
     table = np.asarray(rows)
     text = ",".join(TRAJECTORY_COLUMNS) + "\n"
     text += "".join(f"{int(r[0])}," + ",".join(f"{v:.4f}" for v in r[1:]) + "\n" for r in table)
     atomic_write(output / "trajectory.csv", lambda tmp: Path(tmp).write_text(text))
-    mapper.global_map.write_binary(str(output / "global_map.bt"))
+    atomic_write(output / "global_map.bt", mapper.global_map.write_binary)
     doc = {"world": str(world), "moves": moves, "seed": seed, "step": step, **config.to_dict()}
     doc["hough"], doc["pcl"] = vars(config.hough), vars(config.pcl)
     atomic_write(output / "config.yaml", lambda tmp: Path(tmp).write_text(yaml.safe_dump(doc)))
@@ -99,17 +112,23 @@ def terrain_run(
 
 
 @terrain_app.command("planes")
+@guarded(inputs=("cloud",), outputs=("output", "csv"))
 @interruptible()
 def terrain_planes(
+    ctx: typer.Context,
     cloud: Path = typer.Argument(
         ..., help="A PCD file, or a text file of 'x y z' lines (also .bz2 compressed)."
     ),
     output: Path = typer.Option(..., "-o", "--output", help="The picture to write (PNG)."),
     csv: Path | None = typer.Option(None, "--csv", help="Also write the planes as CSV."),
     method: str = typer.Option("pcl", help="pcl (3-D planes) or hough (lines per tilt scan)."),
-    seed: int = typer.Option(0, help="Seed of the subset and PCL's RANSAC."),
+    seed: int = typer.Option(0, parser=Seed(), help="Seed of the subset and PCL's RANSAC."),
+    # cloud_planes' least (fewer points find no plane reliably); 10^7 points are 240 MB of xyz
     max_points: int = typer.Option(
-        20_000, "--max-points", help="PCL fits planes on a seeded subset of this many points."
+        20_000,
+        "--max-points",
+        parser=Count("--max-points", 100, 10_000_000),
+        help="PCL fits planes on a seeded subset of this many points (pcl only).",
     ),
     origin: str | None = typer.Option(
         None,
@@ -132,9 +151,10 @@ def terrain_planes(
         raise ValueError(f"--method must be one of {CLOUD_METHODS}, got {method!r}")
     if output.suffix.lower() != ".png":
         raise ValueError(f"-o {output}: expected a .png file")
-    for name, path in (("-o", output), ("--csv", csv)):
-        if path is not None and (path.is_dir() or not path.parent.is_dir()):
-            raise ValueError(f"{name} {path}: is a folder or its folder does not exist")
+    if method == "pcl":  # RANSAC on the points: no sensor position
+        refuse_given(ctx, ["origin"], "to --method pcl (hough's S-DEM is centred on it)")
+    else:  # the S-DEM's cells, not a subset of points
+        refuse_given(ctx, ["max_points"], f"to --method {method} (pcl's subset)")
     points = read_cloud(cloud, origin)
     result = cloud_planes(points, method, seed, max_points)
     for line in planes_summary(points, result):

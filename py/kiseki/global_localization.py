@@ -60,7 +60,7 @@ from kiseki.localization import (
     scan_model,
     scan_preparer,
 )
-from kiseki.scans import LaserScans
+from kiseki.scans import LaserScans, check_odometry_jumps
 
 __all__ = [
     "GlobalConfig",
@@ -288,6 +288,7 @@ def global_localize(
         raise ValueError("global localization: the log has no scans")
     if not np.isfinite(scans.odometry).all():
         raise ValueError("global localization: the odometry has NaN or infinite poses")
+    check_odometry_jumps("global localization", scans.times, scans.odometry)
     start = time.perf_counter()
     localizer = MonteCarloLocalizer(config.mcl(), derive_seed(config.seed, 2), grid)
     localizer.initialize_global()

@@ -18,9 +18,11 @@ Python API over it.
 * Every stochastic part takes the seed; the same seed gives the same trajectory for any
   ``threads``.
 
-Invalid readings (NaN, zero, negative) are skipped; readings of +inf or at or beyond the scan's
-max range are "no return": the likelihood field skips them (as nav2), the beam model scores
-them with its z_max term.
+Invalid readings (NaN, zero, negative; the log readers store them as NaN, see
+:mod:`kiseki.scans`) are skipped; readings of +inf or at or beyond the scan's max range are "no
+return": the likelihood field skips them (as nav2), the beam model scores them with its z_max
+term. The odometry may move at most ``MAX_ODOMETRY_JUMP`` (10 m, the engine's
+``kMaxOdometryJump``) between two updates; the log readers check it between consecutive scans.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ from tqdm import tqdm
 from kiseki import _core
 from kiseki.core import Pose2, Random, check_seed, derive_seed
 from kiseki.grid import OccupancyGrid
-from kiseki.scans import LaserScans
+from kiseki.scans import MAX_ODOMETRY_JUMP, LaserScans, check_odometry_jumps
 
 __all__ = [
     "LOCALIZATION_METHODS",
@@ -152,6 +154,11 @@ class MclConfig:
         for name in ("update_min_d", "update_min_a"):
             value = getattr(self, name)
             _check(value >= 0 and math.isfinite(value), f"{name} must be >= 0, got {value}")
+        _check(
+            self.update_min_d < MAX_ODOMETRY_JUMP,
+            f"update_min_d must be below kiseki's limit of {MAX_ODOMETRY_JUMP:g} m for the "
+            f"odometry between two updates, got {self.update_min_d}",
+        )
         self.to_core().validate()  # the engine's own checks, as ValueError
 
     def to_core(self) -> _core.MclParams:
@@ -183,21 +190,18 @@ class MclConfig:
         return p
 
 
-MAX_ODOMETRY_STEP = 1000.0  # metres between two filter updates: more is a broken odometry
-
-
 def _odometry_pose(odometry, last: np.ndarray | None) -> np.ndarray:
     """An odometry pose (x, y, theta) checked before it moves the particles: finite, and at
-    most MAX_ODOMETRY_STEP from the last update (a 1e308 jump would make every particle NaN)."""
+    most MAX_ODOMETRY_JUMP from the last update (the engine's own limit)."""
     pose = np.asarray(odometry, dtype=float)
     if pose.shape != (3,) or not np.isfinite(pose).all():
         raise ValueError(f"odometry must be 3 finite numbers (x, y, theta), got {odometry!r}")
     if last is not None:
         step = math.hypot(*(pose[:2] - last[:2]))
-        if not step <= MAX_ODOMETRY_STEP:
+        if not step <= MAX_ODOMETRY_JUMP:
             raise ValueError(
-                f"odometry step of {step:.6g} m since the last update: more than the "
-                f"{MAX_ODOMETRY_STEP:g} m a robot can move between two updates"
+                f"odometry jumps {step:.4g} m since the last update: more than kiseki's limit "
+                f"of {MAX_ODOMETRY_JUMP:g} m between two updates"
             )
     return pose
 
@@ -534,6 +538,8 @@ def localize(
     over the map's free cells with ``config.global_start``. Estimates are sensor poses."""
     _check_scans(scans, grid)
     odom = noisy_odometry(scans.odometry, config.odometry_noise, derive_seed(config.seed, 1))
+    noise = f" with noise {config.odometry_noise:g}" if config.odometry_noise else ""
+    check_odometry_jumps(f"the odometry{noise}", scans.times, odom)
     n = len(scans)
     if config.method == "odometry":
         return LocalizationResult(

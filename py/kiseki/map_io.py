@@ -24,6 +24,7 @@ import yaml
 
 from kiseki import _core
 from kiseki._atomic import atomic_write_all
+from kiseki._inputs import GIB, YAML_LIMIT, check_input, read_input_text
 from kiseki._schema import SchemaError, parse
 from kiseki._yaml import safe_load_12
 from kiseki.core import Pose2
@@ -33,6 +34,7 @@ from kiseki.map_schema import MODES, RosMapYaml
 from kiseki.mapping import MAX_MAP_CELLS
 
 __all__ = [
+    "MAX_IMAGE_BYTES",
     "MapMetadata",
     "load_map",
     "map_files",
@@ -40,6 +42,11 @@ __all__ = [
     "save_map",
     "write_image",
 ]
+
+
+MAX_IMAGE_BYTES = 1 * GIB
+"""A map image file holds at most this: MAX_MAP_CELLS pixels of 16-bit RGBA (8 bytes each), or
+of a text PGM (at most 6 bytes each), fit; its header's pixel count is checked before decoding."""
 
 
 @dataclass(frozen=True)
@@ -57,7 +64,7 @@ class MapMetadata:
 
 def _parse_yaml(path: Path) -> RosMapYaml:
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_input_text(path, "ROS map YAML files", YAML_LIMIT, MapFormatError)
     except UnicodeDecodeError as err:
         raise MapFormatError(
             f"{path}: not a map YAML file (not UTF-8 text: byte {err.start} is "
@@ -79,6 +86,7 @@ def read_map_metadata(path: str | os.PathLike) -> MapMetadata:
     """Reads and checks a ROS map YAML file (:class:`kiseki.map_schema.RosMapYaml`; the image
     path is resolved next to it). MapFormatError names the file, the key and the value."""
     path = Path(path)
+    check_input(path, error=MapFormatError)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: map YAML file not found")
     doc = _parse_yaml(path)
@@ -113,7 +121,7 @@ def _check_binary_pgm(path: Path, image: Path) -> None:
         head = f.read(512)
         if head.startswith(_PNG) and head[12:16] == b"IHDR":
             _check_cells(path, image, *struct.unpack(">II", head[16:24]))
-        if not head.startswith(b"P5"):
+        if not head.startswith((b"P5", b"P2")):
             return  # other formats: the decoder's error
         fields: list[bytes] = []
         at = 2
@@ -133,6 +141,8 @@ def _check_binary_pgm(path: Path, image: Path) -> None:
             return  # a malformed header: the decoder's error
         width, height, maxval = (int(x) for x in fields)
         _check_cells(path, image, width, height)
+        if head.startswith(b"P2"):
+            return  # a text PGM: its numbers are not counted here
         need = width * height * (1 if maxval < 256 else 2)
         have = os.fstat(f.fileno()).st_size - (at + 1)  # one whitespace byte after maxval
     if have < need:
@@ -144,6 +154,10 @@ def _check_binary_pgm(path: Path, image: Path) -> None:
 
 def _load_ros_map(path: Path) -> OccupancyGrid:
     meta = read_map_metadata(path)
+    try:
+        check_input(meta.image, "map images", MAX_IMAGE_BYTES, MapFormatError)
+    except MapFormatError as err:
+        raise MapFormatError(f"{path}: image {err}") from None
     if not meta.image.is_file():
         raise FileNotFoundError(f"{path}: image file {meta.image} not found")
     _check_binary_pgm(path, meta.image)

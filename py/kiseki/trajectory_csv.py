@@ -22,6 +22,7 @@ import numpy as np
 from pydantic import Field, create_model
 
 from kiseki._csv import CsvNumber, data_rows
+from kiseki._inputs import CSV_LIMIT, check_input, read_input_text
 from kiseki._schema import FileModel, parse
 
 __all__ = ["MAX_COLUMNS", "MAX_ROWS", "read_trajectory_csv"]
@@ -41,10 +42,11 @@ def read_trajectory_csv(path: str | os.PathLike) -> np.ndarray:
     """The (n, 2) x, y columns of the trajectory CSV at `path`: FileNotFoundError when there is
     none, ValueError naming the file (and the line, the column and the value) otherwise."""
     path = Path(path)
+    check_input(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: trajectory file not found")
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
+        lines = read_input_text(path, "trajectory CSV files", CSV_LIMIT).splitlines()
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a trajectory CSV (not UTF-8 text)") from None
     columns = tuple(c.strip() for c in lines[0].split(",")) if lines else ()

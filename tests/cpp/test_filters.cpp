@@ -466,6 +466,22 @@ TEST(MonteCarloLocalization, WeightsCanBeSetAndBadInputIsRefused) {
   EXPECT_THROW(MonteCarloLocalization(bad, 1), std::invalid_argument);
 }
 
+TEST(MonteCarloLocalization, AnOdometryJumpOverTheLimitIsRefusedAndOneJustUnderIsAMotion) {
+  MclParams p;
+  p.particles = 10;
+  MonteCarloLocalization mcl(p, 1);
+  mcl.initialize_gaussian(Pose2(0, 0, 0), 0.0, 0.0, 0.0);
+  EXPECT_DOUBLE_EQ(kMaxOdometryJump, 10.0);
+  const double under = kMaxOdometryJump - 0.01, over = kMaxOdometryJump + 0.01;
+  EXPECT_NO_THROW(mcl.predict(Pose2(0, 0, 0), Pose2(0.6 * under, 0.8 * under, 0)));
+  try {
+    mcl.predict(Pose2(0, 0, 0), Pose2(0.6 * over, 0.8 * over, 0));
+    FAIL() << "a jump of " << over << " m was taken as a motion";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "MCL: odometry jumps 10.01 m between two updates: more than kiseki's limit of 10 m");
+  }
+}
+
 TEST(TravelDistanceFilter, ConvergesOnTheDistanceAGaussianLikelihoodPoints) {
   TravelDistanceParams p;
   p.particles = 2000;

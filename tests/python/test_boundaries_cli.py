@@ -124,7 +124,7 @@ def test_a_truncated_run_is_read_with_a_one_line_warning(inputs, project_root, a
 @pytest.mark.parametrize(
     ("args", "needle"),
     [
-        (["--tracking-particles", "-5"], "--tracking-particles applies only with --global"),
+        (["--tracking-particles", "500"], "--tracking-particles applies only with --global"),
         (["--plot", "p.png"], "--plot applies only with --global"),
     ],
 )
@@ -400,7 +400,7 @@ SEED = "kiseki: error: --seed must be an integer in [0, 2**64), got -1"
          "kiseki: error: nan.csv:2: x: must be a finite number, got 'nan'"),
         (["map", "info", "self.yaml"], "kiseki: error: self.yaml: self.yaml: cannot decode image"),
         (["localize", "log.mcap", "--map", "room.yaml", "-o", "t.csv", "--beams", "-3"],
-         "kiseki: error: beams must be an integer >= 0 (0 = every beam), got -3"),
+         "kiseki: error: --beams must be an integer in 0..100,000 (0 = every beam), got -3"),
     ],
 )  # fmt: skip
 def test_more_bad_inputs_are_one_line_and_change_nothing(inputs, project_root, args, expected):

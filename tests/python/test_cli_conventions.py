@@ -158,6 +158,7 @@ def test_localize_json_holds_the_errors_of_its_csv(tmp_path: Path):
     assert done.stdout.splitlines() == [
         f"u.csv: {STEPS} poses; likelihood-field: position RMSE {doc['position_rmse_m']:.3f} m "
         f"(max {doc['position_max_m']:.3f} m), heading RMSE {doc['heading_rmse_deg']:.2f} deg"
+        f"; {doc['invalid_ranges']} invalid range readings skipped"
     ]  # one line, not wrapped at 80 columns when piped
     done = run("map", "from-log", "log.mcap", "-o", "rebuilt.yaml", cwd=tmp_path)
     lines = done.stdout.splitlines()  # a sentence longer than 80 columns stays one line

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from kiseki.errors import KisekiError
 from kiseki.magnetic import load_linear_map, path_identity
 
 SHORT = [[0.0, 0.0], [16.0, 0.0]]
@@ -101,7 +102,11 @@ def test_navigate_refuses_another_path_in_one_line(taught, tmp_path, project_dat
 
 def refused(*args) -> str:
     code, output, error = invoke(*args)
-    assert code == 1 and isinstance(error, ValueError | OSError), (code, output, error)
+    assert code == 1 and isinstance(error, ValueError | OSError | KisekiError), (
+        code,
+        output,
+        error,
+    )
     return str(error)
 
 

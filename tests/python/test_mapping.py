@@ -135,7 +135,7 @@ def test_map_from_log_refuses_a_resolution_giving_a_one_cell_map(tmp_path):
     (tmp_path / "tiny.log").write_text("\n".join(rows) + "\n")
     args = [sys.executable, "-m", "kiseki.cli", "map", "from-log", "tiny.log", "-o", "m.yaml"]
     done = subprocess.run(
-        [*args, "--resolution", "1e308"], cwd=tmp_path, capture_output=True, text=True
+        [*args, "--resolution", "10"], cwd=tmp_path, capture_output=True, text=True
     )
     assert done.returncode == 1
     lines = done.stderr.strip().splitlines()

@@ -28,6 +28,8 @@ from kiseki.sim.scene import load_scene
 from kiseki.teach import teach
 
 ROUTE = {"start": "P0", "via": ["T1", "T2"], "goal": "G", "home": "P0"}
+BASE = "http://127.0.0.1:8000"  # the server's default address: the Host it answers to
+WS = "ws://127.0.0.1:8000/ws"
 
 
 @pytest.fixture(scope="module")
@@ -50,7 +52,7 @@ def _digests(folder) -> dict:
 
 def _client(folder, **options) -> TestClient:
     options = {"particles": 300, "speed_up": math.inf, "dwell": 0.5, **options}
-    return TestClient(build_server(folder, **options).app)
+    return TestClient(build_server(folder, **options).app, base_url=BASE)
 
 
 def _wait(client: TestClient, done, timeout: float = 120.0, **headers) -> dict:
@@ -117,7 +119,7 @@ def test_malformed_json_gets_422(taught):
     assert response.status_code == 422 and "invalid JSON" in response.json()["detail"]
 
 
-def _collect(client: TestClient, out: list, path: str = "/ws") -> None:
+def _collect(client: TestClient, out: list, path: str = WS) -> None:
     """Reads a page's websocket until the route is over."""
     with client.websocket_connect(path) as ws:
         while True:
@@ -133,7 +135,7 @@ def test_full_route_with_method_both_stops_within_0_1_m_and_returns_home(taught)
     maps = _digests(taught)
     server = build_server(taught, method="both", particles=300, speed_up=math.inf, dwell=0.5)
     pages: list[list] = [[], []]
-    with TestClient(server.app) as client:
+    with TestClient(server.app, base_url=BASE) as client:
         threads = [threading.Thread(target=_collect, args=(client, p)) for p in pages]
         for t in threads:
             t.start()
@@ -201,16 +203,16 @@ def test_full_route_with_method_both_stops_within_0_1_m_and_returns_home(taught)
 def test_second_route_409_and_stop_halts_at_the_acceleration_limit(taught):
     server = build_server(taught, particles=300, speed_up=1.0, dwell=0.5)
     assert isinstance(server.runner.robot, Robot)
-    with TestClient(server.app) as client:
+    with TestClient(server.app, base_url=BASE) as client:
         assert client.post("/api/routes", json=ROUTE).status_code == 202
         busy = client.post("/api/routes", json={**ROUTE, "start": "T1", "via": ["T2"]})
         running = _wait(client, lambda s: s["speed"] > 0.3, 20)
-        halt = client.post("/api/stop")
+        halt = client.post("/api/stop", json={})
         state = _wait(client, lambda s: s["status"] != "running", 10)
         time.sleep(0.3)
         later = client.get("/api/state").json()
         after = client.post("/api/routes", json={"start": "T1", "via": ["T2"], "goal": "G"})
-        client.post("/api/stop")
+        client.post("/api/stop", json={})
         _wait(client, lambda s: s["status"] != "running", 20)
     assert busy.status_code == 409 and "running" in busy.json()["detail"]
     assert halt.json()["stopping"] is True
@@ -280,12 +282,12 @@ def test_token_is_needed_when_set(taught):
         post = client.post("/api/routes", json=ROUTE)
         stop = client.post("/api/stop", headers={"Authorization": "Basic s3cret-token"})
         page = client.get("/")
-        with pytest.raises(WebSocketDenialResponse) as denied, client.websocket_connect("/ws"):
+        with pytest.raises(WebSocketDenialResponse) as denied, client.websocket_connect(WS):
             pass
-        with client.websocket_connect(f"/ws?token={token}") as ws:
+        with client.websocket_connect(f"{WS}?token={token}") as ws:
             by_query = json.loads(ws.receive_text())
         auth = {"Authorization": f"Bearer {token}"}
-        with client.websocket_connect("/ws", headers=auth) as ws:
+        with client.websocket_connect(WS, headers=auth) as ws:
             by_header = json.loads(ws.receive_text())
         state = client.get("/api/state", headers=auth).json()
     for response in (none, wrong, post, stop):

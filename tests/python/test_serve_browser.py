@@ -2,22 +2,23 @@
 # Copyright (c) 2026 the kiseki authors
 """The route-instruction page in a real browser (headless Chromium from Debian, driven by
 Playwright): a worker's route start -> via -> goal -> home with the stop report, two pages on one
-robot, a refused second route, the stop button, a reload during a route, the server's refusal of a
-leg through a wall, and renaming. The server runs as a subprocess on a route taught here."""
+robot, a refused second route, a reload during a route, the server's refusal of a leg through a
+wall, and renaming. The server runs as a subprocess on a route taught here. (The stop button and
+the requests of other sites: test_serve_browser_safety.py.)"""
 
 from __future__ import annotations
 
-import json
 import os
 import shutil
-import socket
 import subprocess
 import sys
 import time
-import urllib.request
 from pathlib import Path
 
 import pytest
+
+from serve_pages import api, free_port, shown_pose
+from serve_pages import pick_route as pick
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 IN_CI = os.environ.get("CI", "").lower() == "true"
@@ -35,23 +36,6 @@ else:
 ROUTE = {"start": "P0", "via": ["T1", "T2"], "goal": "G", "home": "P0"}
 P0 = (0.0, 0.0)  # where factory_turn's route starts
 STOP_TOLERANCE_M = 0.1  # thesis 000, section 2.2
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def api(base: str, method: str, path: str, body: dict | None = None) -> tuple[int, dict]:
-    data = None if body is None else json.dumps(body).encode()
-    request = urllib.request.Request(base + path, data=data, method=method)
-    request.add_header("Content-Type", "application/json")
-    try:
-        with urllib.request.urlopen(request, timeout=10) as response:
-            return response.status, json.loads(response.read() or b"null")
-    except urllib.error.HTTPError as err:
-        return err.code, json.loads(err.read() or b"null")
 
 
 def serve_command(taught: Path, port: int) -> list[str]:
@@ -131,20 +115,12 @@ def open_page(browser, base):
 
 
 def pick_route(page, route=ROUTE):
-    """Taps the markers: Start, the vias in order, Goal, Home (the role moves on by itself)."""
-    page.click(".role[data-role=start]")
-    page.click(f".marker[data-waypoint='{route['start']}']")
-    for name in route["via"]:
-        page.click(f".marker[data-waypoint='{name}']")
-    page.click(".role[data-role=goal]")
-    page.click(f".marker[data-waypoint='{route['goal']}']")
-    page.click(f".marker[data-waypoint='{route['home']}']")
+    pick(page, route)
 
 
 def pose(page) -> tuple[float, float] | None:
-    """The true pose the page shows (None before the robot's first route)."""
-    x, y = page.eval_on_selector("#pose", "e => [e.dataset.x, e.dataset.y]")
-    return (float(x), float(y)) if x else None
+    """The true pose the page shows (None before the route's robot has a pose)."""
+    return shown_pose(page)
 
 
 def wait_moved(page, start, metres=0.3, timeout_s=30.0):
@@ -202,21 +178,6 @@ def test_two_pages_see_the_same_state_and_a_second_route_is_refused(browser, idl
     assert not first.js_errors and not second.js_errors
 
 
-def test_the_stop_button_halts_the_robot(browser, idle):
-    page = open_page(browser, idle)
-    pick_route(page)
-    start = P0
-    page.click("#start-route")
-    wait_moved(page, start)
-    page.click("#stop")
-    expect(page.locator("body")).to_have_attribute("data-status", "stopped", timeout=5000)
-    still = pose(page)
-    page.wait_for_timeout(1000)
-    assert pose(page) == still and still is not None
-    x, y = api(idle, "GET", "api/state")[1]["pose"][:2]
-    assert abs(x - still[0]) < 0.05 and abs(y - still[1]) < 0.05
-
-
 def test_a_reload_reconnects_to_the_running_route(browser, idle):
     page = open_page(browser, idle)
     pick_route(page)
@@ -260,12 +221,15 @@ def test_the_token_beyond_loopback_is_asked_for_once_or_taken_from_the_url(brows
     command = [*serve_command(taught, port), "--host", "0.0.0.0"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     try:
-        token = None
+        token, lines = None, []
         for line in process.stdout:
+            lines.append(line)
             if line.startswith("access token:"):
                 token = line.split()[2]
                 break
         assert token, "kiseki serve printed no access token"
+        # the URL printed carries the token in its fragment, which browsers never send
+        assert f":{port}/#token={token}" in "".join(lines), lines
         base = f"http://127.0.0.1:{port}/"
         deadline = time.monotonic() + 30
         while True:
@@ -290,9 +254,12 @@ def test_the_token_beyond_loopback_is_asked_for_once_or_taken_from_the_url(brows
         context.close()
         context = browser.new_context()
         page = context.new_page()
-        page.goto(f"{base}?token={token}")
+        requested = []
+        page.on("request", lambda r: requested.append(r.url))
+        page.goto(f"{base}#token={token}")
         expect(page.locator("body")).to_have_attribute("data-connection", "live")
         assert "token" not in page.url  # taken out of the address bar
+        assert not [u for u in requested if token in u]  # no URL sent carries it
         context.close()
     finally:
         process.terminate()

@@ -60,7 +60,7 @@ def test_a_taught_file_reads_to_the_marks_it_was_written_from(tmp_path):
     assert map_path == tmp_path / "map_band.yaml"
     assert route == [MARKS[0], MARKS[2], MARKS[1]]  # the old reader returned these dicts
     assert all(type(w["truth"]) is list and type(w["x"]) is float for w in route)
-    assert taught_scene_of(path) == TaughtScene(doc["scene_file"], doc["scene_sha1"])
+    assert taught_scene_of(path) == TaughtScene(doc["scene_file"], doc["scene_sha1"], str(tmp_path))
 
 
 def test_valid_hand_edits_keep_reading(tmp_path):

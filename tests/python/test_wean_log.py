@@ -65,9 +65,9 @@ def test_malformed_lines_name_file_and_line(tmp_path: Path) -> None:
         ),
         "text": (good[:2] + ["O 1 2 x 4"], r"text\.log:3: non-numeric value 'x'"),
         "kind": (good[:1] + ["Q 1 2 3"], r"kind\.log:2: unknown line type 'Q'"),
-        "neg": (
-            [good[0], good[1].replace(" 200.000000", " -200.000000", 1)],
-            r"neg\.log:2: negative",
+        "time": (  # a negative range is an invalid reading (kiseki.scans), a NaN time is not
+            [good[0], good[1].replace(" 200.000000", " -200.000000", 1).rsplit(" ", 1)[0] + " nan"],
+            r"time\.log:2: non-finite",
         ),
         "nan": (["O 1 2 nan 4", good[1]], r"nan\.log:1: non-finite"),
     }

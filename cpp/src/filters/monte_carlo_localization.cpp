@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -143,9 +144,13 @@ void MonteCarloLocalization::check_ready() const {
 
 void MonteCarloLocalization::predict(const Pose2& a, const Pose2& b) {
   check_ready();
-  if (std::isfinite(a.x) && std::isfinite(b.x) && std::hypot(b.x - a.x, b.y - a.y) > max_jump) {
-    throw std::invalid_argument("MCL: odometry jumps " + std::to_string(std::hypot(b.x - a.x, b.y - a.y)) +
-                                " m between two updates (more than max_jump " + std::to_string(max_jump) + " m)");
+  const double step = std::hypot(b.x - a.x, b.y - a.y);
+  if (std::isfinite(a.x) && std::isfinite(b.x) && step > kMaxOdometryJump) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "MCL: odometry jumps %.4g m between two updates: more than kiseki's limit of %g m", step,
+                  kMaxOdometryJump);
+    throw std::invalid_argument(text);
   }
   const std::uint64_t step_seed = rng_.below(~std::uint64_t{0});
   sample_motion(params_.motion, a, b, particles_.data(), particles_.size(), step_seed, params_.threads);

@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from kiseki._inputs import check_input
 from kiseki.datasets.carmen import CarmenLog, OdometryRecords, read_carmen_log
 from kiseki.datasets.kok import read_kok_walk
 from kiseki.datasets.magnetic import (
@@ -22,6 +23,7 @@ from kiseki.datasets.magnetic import (
 from kiseki.datasets.rosbag import BAG_KINDS, is_ros_bag, read_bag_scans, write_bag
 from kiseki.datasets.wean import WeanMap, read_wean_map
 from kiseki.datasets.wean_log import WeanLog, is_wean_log, read_wean_log
+from kiseki.errors import LogFormatError
 from kiseki.scans import LaserScans
 from kiseki.sim.mcap_log import read_run
 
@@ -61,6 +63,7 @@ def open_scans(
     robotdata log (recognised by its content: ``O``/``L`` lines; no reference poses). The topic
     arguments are for bags only: other logs name their own topics or have none."""
     path = Path(path)
+    check_input(path, error=LogFormatError)  # before anything opens it: a FIFO would block
     if is_ros_bag(path) or path.suffix.lower() in (".bag", ".db3"):
         return read_bag_scans(path, scan_topic, odom_topic, reference_topic)
     if (scan_topic, odom_topic, reference_topic) != ("/scan", "/odom", None):

@@ -4,22 +4,16 @@
 
 from __future__ import annotations
 
-import gzip
-import zlib
 from pathlib import Path
 
-__all__ = ["read_maybe_gzipped"]
+from kiseki._inputs import GZIP_MAGIC, read_input
 
-GZIP_MAGIC = b"\x1f\x8b"
+__all__ = ["GZIP_MAGIC", "read_maybe_gzipped"]
 
 
-def read_maybe_gzipped(path: Path, error: type[Exception]) -> str:
-    """The file's text (latin-1), gunzipped when it starts with the gzip magic bytes; a
-    truncated or corrupt stream raises ``error`` naming the file."""
-    data = path.read_bytes()
-    if data.startswith(GZIP_MAGIC):
-        try:
-            data = gzip.decompress(data)
-        except (EOFError, OSError, zlib.error) as exc:
-            raise error(f"{path}: truncated or corrupt gzip stream ({exc})") from exc
-    return data.decode("latin-1")
+def read_maybe_gzipped(path: Path, error: type[Exception], what: str, limit: int) -> str:
+    """The file's text (latin-1), gunzipped when it starts with the gzip magic bytes, read
+    within ``limit`` bytes (decompressed; :func:`kiseki._inputs.read_input`, which states the
+    limit for ``what``); a truncated or corrupt stream, a special file or a text past the limit
+    raises ``error`` naming the file."""
+    return read_input(path, what, limit, error, unzip="gzip").decode("latin-1")

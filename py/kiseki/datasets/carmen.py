@@ -33,6 +33,12 @@ Intel has no PARAM and no returns are 81.83; ACES has no PARAM and readings are 
 CSAIL has ``robot_front_laser_max 50`` and no returns are 81.91 (largest return 35.12);
 Freiburg 079 has ``robot_front_laser_max 80.99`` and no returns are 81.91.
 
+Range readings follow kiseki's rule (``kiseki.scans``): NaN, ``-inf``, negative and zero readings
+are invalid, kept as NaN and counted (``LaserScans.invalid_ranges``), ``+inf`` is a no return
+(stored as ``max_range``), and the largest reading above is the largest finite one. Any other
+field that is NaN or infinite is an error naming the line, and so is an odometry jump of more
+than ``kiseki.scans.MAX_ODOMETRY_JUMP`` between two consecutive laser messages.
+
 Records are returned in file order and as written, with no sorting or filtering. Facts of the
 Radish "-corrected" logs (Intel, ACES, CSAIL, Freiburg 079) that users should know:
 
@@ -53,16 +59,23 @@ from pathlib import Path
 
 import numpy as np
 
+from kiseki._inputs import GIB
 from kiseki.datasets._files import read_maybe_gzipped
 from kiseki.errors import LogFormatError
-from kiseki.scans import LaserScans
+from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps, largest_reading
 
 __all__ = [
+    "MAX_LOG_BYTES",
     "CarmenLog",
     "OdometryRecords",
     "flaser_angles",
     "read_carmen_log",
 ]
+
+MAX_LOG_BYTES = 1 * GIB
+"""A log's text (after gunzip) is read up to this size: the largest Radish logs hold a few hundred
+MB, and parsing takes about 16 times the text's size in memory (Freiburg 079: 9.5 MB of text,
+160 MB)."""
 
 _MAX_RANGE_PARAM = "robot_front_laser_max"
 # Step of CARMEN's FLASER guess for the usual SICK beam counts.
@@ -123,7 +136,7 @@ def read_carmen_log(path: str | os.PathLike) -> CarmenLog:
 
 
 def _read_text(path: Path) -> str:
-    text = read_maybe_gzipped(path, LogFormatError)
+    text = read_maybe_gzipped(path, LogFormatError, "CARMEN logs", MAX_LOG_BYTES)
     if not text.strip():
         raise LogFormatError(f"{path}: empty log")
     return text
@@ -156,8 +169,11 @@ def _int_field(path: Path, lineno: int, token: str, what: str) -> int:
     return value
 
 
-def _to_float(path: Path, rows: Sequence[_Row], fields: list[list[str]], kind: str) -> np.ndarray:
-    """Convert equal-length token lists to a float64 array; errors name the line."""
+def _to_float(
+    path: Path, rows: Sequence[_Row], fields: list[list[str]], kind: str, ranges: slice = slice(0)
+) -> np.ndarray:
+    """Convert equal-length token lists to a float64 array; errors name the line. Columns
+    ``ranges`` (range readings) may be NaN or infinite; any other column may not."""
     try:
         values = np.array(fields, dtype=np.float64)
     except ValueError:
@@ -169,7 +185,9 @@ def _to_float(path: Path, rows: Sequence[_Row], fields: list[list[str]], kind: s
                     msg = f"{path}:{lineno}: non-numeric value {token!r} in {kind}"
                     raise LogFormatError(msg) from None
         raise LogFormatError(f"{path}: unreadable numbers in {kind}") from None
-    bad = ~np.isfinite(values).all(axis=1)
+    finite = np.isfinite(values)
+    finite[:, ranges] = True
+    bad = ~finite.all(axis=1)
     if bad.any():
         lineno = rows[int(np.argmax(bad))][0]
         raise LogFormatError(f"{path}:{lineno}: non-finite value (NaN or inf) in {kind}")
@@ -188,11 +206,35 @@ def _check_min_count(path: Path, lineno: int, tokens: list[str], minimum: int, k
         raise LogFormatError(msg)
 
 
-def _check_ranges(path: Path, rows: Sequence[_Row], ranges: np.ndarray, kind: str) -> None:
-    negative = (ranges < 0).any(axis=1)
-    if negative.any():
-        lineno = rows[int(np.argmax(negative))][0]
-        raise LogFormatError(f"{path}:{lineno}: negative range reading in {kind}")
+def _laser_scans(
+    path: Path,
+    rows: Sequence[_Row],
+    values: np.ndarray,
+    columns: tuple[int, int, int],
+    angles: np.ndarray,
+    max_range: float | None,
+    kind: str,
+) -> LaserScans:
+    """The scans of laser messages whose ``values`` hold, from ``columns``, the ranges, then
+    the laser pose and odometry (6 values), then the timestamp: the ranges by kiseki's rule
+    (``max_range`` None: the largest finite reading), the odometry checked for jumps."""
+    first, pose, time = columns
+    readings = values[:, first : first + len(angles)]
+    if max_range is None:
+        max_range = largest_reading(readings)
+        if max_range is None:
+            raise LogFormatError(f"{path}:{rows[0][0]}: no valid range reading in any {kind}")
+    scans = LaserScans(
+        times=values[:, time].copy(),
+        poses=values[:, pose : pose + 3].copy(),
+        odometry=values[:, pose + 3 : pose + 6].copy(),
+        ranges=apply_range_rule(readings, max_range),
+        angles=angles,
+        max_range=max_range,
+    )
+    lines = [lineno for lineno, _ in rows]
+    check_odometry_jumps(path, scans.times, scans.odometry, lines)
+    return scans
 
 
 def _parse_flaser(path: Path, rows: list[_Row], params: dict[str, str]) -> LaserScans:
@@ -209,23 +251,15 @@ def _parse_flaser(path: Path, rows: list[_Row], params: dict[str, str]) -> Laser
             raise LogFormatError(msg)
         _check_count(path, lineno, tokens, n + 11, "FLASER")
         fields.append(tokens[2 : n + 9] + tokens[n + 10 :])  # skip count and hostname
-    values = _to_float(path, rows, fields, "FLASER")
-    ranges = np.ascontiguousarray(values[:, :n], dtype=np.float32)
-    _check_ranges(path, rows, ranges, "FLASER")
-    return LaserScans(
-        times=values[:, n + 6].copy(),
-        poses=values[:, n : n + 3].copy(),
-        odometry=values[:, n + 3 : n + 6].copy(),
-        ranges=ranges,
-        angles=flaser_angles(n),
-        max_range=_flaser_max_range(path, params, ranges),
-    )
+    values = _to_float(path, rows, fields, "FLASER", ranges=slice(0, n))
+    max_range = _flaser_max_range(path, params)
+    return _laser_scans(path, rows, values, (0, n, n + 6), flaser_angles(n), max_range, "FLASER")
 
 
-def _flaser_max_range(path: Path, params: dict[str, str], ranges: np.ndarray) -> float:
+def _flaser_max_range(path: Path, params: dict[str, str]) -> float | None:
     text = params.get(_MAX_RANGE_PARAM)
     if text is None:
-        return float(ranges.max())
+        return None
     try:
         value = float(np.float32(text))
     except ValueError:
@@ -254,7 +288,7 @@ def _parse_robotlaser(path: Path, rows: list[_Row]) -> LaserScans:
         if len(row) - 11 != n:
             msg = f"{path}:{lineno}: ROBOTLASER1 has {len(row) - 11} beams, the first has {n}"
             raise LogFormatError(msg)
-    values = _to_float(path, rows, fields, "ROBOTLASER1")
+    values = _to_float(path, rows, fields, "ROBOTLASER1", ranges=slice(4, 4 + n))
     config = values[:, :4]  # start_angle, fov, angular_resolution, maximum_range
     changed = (config != config[0]).any(axis=1)
     if changed.any():
@@ -263,16 +297,9 @@ def _parse_robotlaser(path: Path, rows: list[_Row]) -> LaserScans:
     start, _, step, max_range = config[0]
     if n == 0 or max_range <= 0:
         raise LogFormatError(f"{path}:{rows[0][0]}: ROBOTLASER1 with no beams or max range <= 0")
-    ranges = np.ascontiguousarray(values[:, 4 : 4 + n], dtype=np.float32)
-    _check_ranges(path, rows, ranges, "ROBOTLASER1")
-    return LaserScans(
-        times=values[:, n + 10].copy(),
-        poses=values[:, n + 4 : n + 7].copy(),
-        odometry=values[:, n + 7 : n + 10].copy(),
-        ranges=ranges,
-        angles=start + step * np.arange(n, dtype=np.float64),
-        max_range=float(np.float32(max_range)),
-    )
+    angles = start + step * np.arange(n, dtype=np.float64)
+    limit = float(np.float32(max_range))
+    return _laser_scans(path, rows, values, (4, n + 4, n + 10), angles, limit, "ROBOTLASER1")
 
 
 def _parse_odom(path: Path, rows: list[_Row]) -> OdometryRecords:

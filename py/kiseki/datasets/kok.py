@@ -42,14 +42,22 @@ the SD of |m| from 3.7 to 0.9 uT (:mod:`kiseki.magnetic.calibration` fits such o
 from __future__ import annotations
 
 import os
+import struct
 from pathlib import Path
 
 import numpy as np
 
+from kiseki._inputs import MIB, check_input, decompressed_size, describe_bytes
 from kiseki.datasets.magnetic import MagneticSamples
 from kiseki.errors import LogFormatError
 
-__all__ = ["SENSOR_TO_BODY", "quaternion_to_matrix", "read_kok_walk"]
+__all__ = ["MAX_MAT_BYTES", "SENSOR_TO_BODY", "quaternion_to_matrix", "read_kok_walk"]
+
+MAX_MAT_BYTES = 256 * MIB
+"""A walk's ``.mat`` file, and what its compressed variables inflate to, hold at most this
+(``square.mat``: 80 KB; an hour at 10 Hz of its four variables is 1.6 MB)."""
+_MI_COMPRESSED = 15  # MATLAB v5 data element type of a zlib-compressed variable
+_MAT_HEADER = 128
 
 # The magnetometer's axes in the ARKit body frame: a rotation of +90 deg about z.
 SENSOR_TO_BODY = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
@@ -109,10 +117,12 @@ def read_kok_walk(path: str | os.PathLike) -> MagneticSamples:
 def _load_mat(path: Path) -> dict[str, np.ndarray]:
     import scipy.io  # here, so that importing kiseki.datasets does not load scipy
 
+    check_input(path, "MATLAB .mat walks", MAX_MAT_BYTES, LogFormatError)
     if path.is_dir():
         raise LogFormatError(f"{path}: a directory, not a .mat file")
     if not path.is_file():
         raise FileNotFoundError(f"{path}: file not found")
+    _check_inflated_size(path)
     try:
         contents = scipy.io.loadmat(path)
     except NotImplementedError as exc:  # MATLAB v7.3 files are HDF5
@@ -132,3 +142,33 @@ def _load_mat(path: Path) -> dict[str, np.ndarray]:
         except (TypeError, ValueError) as exc:
             raise LogFormatError(f"{path}: {name} is not a numeric array ({exc})") from exc
     return arrays
+
+
+def _check_inflated_size(path: Path) -> None:
+    """Refuses a MATLAB v5 file whose compressed variables inflate to more than MAX_MAT_BYTES
+    (scipy inflates each whole, sized by the header inside it), counted by inflating them in
+    pieces. Anything that is not a v5 file's element list is left to scipy to report."""
+    data = path.read_bytes()  # within MAX_MAT_BYTES: checked by the caller
+    if len(data) < _MAT_HEADER or data[126:128] not in (b"IM", b"MI"):
+        return
+    order = "<" if data[126:128] == b"IM" else ">"
+    total, at = 0, _MAT_HEADER
+    while at + 8 <= len(data):
+        kind, count = struct.unpack_from(f"{order}II", data, at)
+        if kind >> 16:  # a small element: its data sits in the tag's 8 bytes
+            at += 8
+            continue
+        body = data[at + 8 : at + 8 + count]
+        if kind == _MI_COMPRESSED:
+            left = MAX_MAT_BYTES - total
+            try:
+                inflated = decompressed_size(body, "zlib", left)
+            except Exception:  # noqa: BLE001 (a corrupt stream: scipy reports it)
+                return
+            total += inflated
+            if inflated > left:
+                raise LogFormatError(
+                    f"{path}: its variables decompress to more than "
+                    f"{describe_bytes(MAX_MAT_BYTES)} (kiseki's limit for MATLAB .mat walks)"
+                )
+        at += 8 + count

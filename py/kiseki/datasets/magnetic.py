@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from kiseki._inputs import CSV_LIMIT, check_input, read_input
 from kiseki.errors import LogFormatError
 
 __all__ = [
@@ -169,6 +170,8 @@ def read_aalto_run(prefix: str | os.PathLike) -> MagneticSamples:
     already in the motion-capture (world) frame; positions are 2-D."""
     prefix = str(prefix)
     paths = {part: Path(f"{prefix}-{part}.csv") for part, _, _ in _AALTO_PARTS}
+    for path in paths.values():
+        check_input(path, error=LogFormatError)
     missing = [str(p) for p in paths.values() if not p.is_file()]
     if missing:
         raise FileNotFoundError(
@@ -240,12 +243,14 @@ def _check_finite(array: np.ndarray, source: str, what: str) -> None:
 
 
 def _numbered_lines(path: Path) -> list[tuple[int, str]]:
-    """The file's non-blank lines with their 1-based line numbers."""
+    """The file's non-blank lines with their 1-based line numbers (a file of at most
+    :data:`kiseki._inputs.CSV_LIMIT` bytes)."""
+    check_input(path, error=LogFormatError)
     if path.is_dir():
         raise LogFormatError(f"{path}: a directory, not a file")
     if not path.is_file():
         raise FileNotFoundError(f"{path}: file not found")
-    data = path.read_bytes()
+    data = read_input(path, "magnetic sample CSVs", CSV_LIMIT, LogFormatError)
     if b"\x00" in data:
         raise LogFormatError(f"{path}: binary data, not a comma-separated text table")
     try:

@@ -10,8 +10,10 @@ the CARMEN reader, in the laser frame, as kiseki's filters expect:
   ordered by their ``header.stamp``, which gives ``times``. Beam ``i`` is at
   ``angle_min + i * angle_increment`` (float32 fields in the message); ``max_range`` is the
   ``range_max`` of the first scan. Every scan must have the first scan's beam count, angles and
-  ``header.frame_id`` (the laser frame). Ranges stay float32 as recorded, NaN and inf included
-  (the filters take them as invalid / no return).
+  ``header.frame_id`` (the laser frame). Ranges are float32 and follow kiseki's rule
+  (``kiseki.scans``): NaN, ``-inf``, negative and zero readings are invalid, kept as NaN and
+  counted (``LaserScans.invalid_ranges``); ``+inf`` (REP 117's "nothing within range") is a no
+  return, stored as ``max_range``. A ``range_max`` that is not finite and positive is an error.
 * odometry: ``nav_msgs/msg/Odometry`` on ``odom_topic`` (odometry frame = its ``header.frame_id``,
   base frame = its ``child_frame_id``); when the bag has no such topic, the ``/tf`` transform that
   moves the laser frame or the first of its ``/tf_static`` parents (the base frame) relative to
@@ -26,7 +28,10 @@ the CARMEN reader, in the laser frame, as kiseki's filters expect:
 
 Everything is planar: x, y and the yaw of each pose and transform (roll, pitch and z dropped).
 Scans stamped before the first or after the last odometry pose are dropped, since odometry is not
-extrapolated; with a ``reference_topic`` the same holds for the reference poses. Frame names are
+extrapolated; with a ``reference_topic`` the same holds for the reference poses. Odometry or
+reference poses that are NaN or infinite at a scan, and an odometry jump of more than
+``kiseki.scans.MAX_ODOMETRY_JUMP`` between two consecutive scans, are errors naming the scan
+(its index among the scans read, from 0, and its stamp). Frame names are
 compared without a leading ``/`` (ROS 1 style ``/base_link`` is ``base_link``).
 
 Writing (:func:`write_bag`) converts a :class:`LaserScans` (e.g. a CARMEN log) into a bag with
@@ -49,13 +54,43 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 
+from kiseki._chunk_limits import check_mcap_chunks, check_ros1_chunks
+from kiseki._inputs import (
+    GIB,
+    MIB,
+    YAML_LIMIT,
+    check_input,
+    decompressed_size,
+    describe_bytes,
+    read_input_text,
+)
+from kiseki._yaml import safe_load_12
 from kiseki.errors import LogFormatError
-from kiseki.scans import LaserScans
+from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps
 
-__all__ = ["BAG_KINDS", "is_ros_bag", "read_bag_scans", "write_bag"]
+__all__ = [
+    "BAG_KINDS",
+    "MAX_BAG_CHUNK_BYTES",
+    "MAX_BAG_FILE_BYTES",
+    "MAX_BAG_MESSAGE_BYTES",
+    "is_ros_bag",
+    "read_bag_scans",
+    "write_bag",
+]
 
 BAG_KINDS = ("ros1", "ros2-sqlite3", "ros2-mcap")
+
+MAX_BAG_MESSAGE_BYTES = 2 * GIB
+"""The messages read (scans, odometry, transforms; not the bag's other topics) hold at most this
+together: every one is kept, deserialized. A 1081-beam laser at 40 Hz writes 2 GiB in 3.4 hours."""
+MAX_BAG_CHUNK_BYTES = 256 * MIB
+"""A compressed chunk of a bag (ROS 1 bz2 or lz4, ROS 2 MCAP zstd or lz4) decompresses to at most
+this: ``rosbags`` decompresses a chunk whole (recorders write chunks of 768 KB by default)."""
+MAX_BAG_FILE_BYTES = 64 * GIB
+"""A ROS 2 bag compressed file by file (``compression_mode: file``) has storage files that
+decompress to at most this: ``rosbags`` writes them decompressed to a temporary folder."""
 
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
 ODOMETRY = "nav_msgs/msg/Odometry"
@@ -85,8 +120,8 @@ def is_ros_bag(path: str | os.PathLike) -> bool:
     if path.is_dir():
         return (path / "metadata.yaml").is_file()
     suffix = path.suffix.lower()
-    if suffix not in (".bag", ".db3", ".mcap"):
-        return False
+    if suffix not in (".bag", ".db3", ".mcap") or not path.is_file():
+        return False  # a FIFO would block, a device not end
     try:
         with path.open("rb") as f:
             head = f.read(len(_SQLITE_MAGIC))
@@ -116,7 +151,9 @@ def _is_ros2_mcap(path: Path) -> bool:
             profile = reader.get_header().profile
     except (McapError, OSError, ValueError, EOFError):
         profile = None
-    # No summary (a cut file): the first channel record, streamed from the start.
+    # No summary (a cut file): the first channel record, streamed from the start (which
+    # decompresses the chunks before it: first measured, within their limit).
+    check_mcap_chunks(path, "MCAP files", MAX_BAG_CHUNK_BYTES, _NO_LIMIT, LogFormatError)
     try:
         with path.open("rb") as f:
             for record in StreamReader(f, skip_magic=False).records:
@@ -151,13 +188,18 @@ def read_bag_scans(
     """The laser scans of a ROS 1 or ROS 2 bag, with laser-frame odometry and, with
     ``reference_topic``, laser-frame reference poses (see the module docstring)."""
     path = Path(path)
+    check_input(path, error=LogFormatError)
     if not path.exists():
         raise FileNotFoundError(f"{path}: no such bag")
+    if path.is_dir():  # every file of the folder, before rosbags opens one
+        for entry in path.iterdir():
+            check_input(entry, error=LogFormatError)
     if not is_ros_bag(path):
         raise LogFormatError(
             f"{path}: not a ROS bag (a ROS 1 .bag file, or a ROS 2 bag folder with metadata.yaml"
             " or its .db3 / .mcap file with CDR messages)"
         )
+    _check_chunks(path)
     with _open_bag(path) as reader:
         topics = {name: info.msgtype for name, info in reader.topics.items()}
         if reader.message_count == 0:
@@ -189,10 +231,20 @@ def read_bag_scans(
                 wanted.append(tf_topic)
         messages: dict[str, list[Any]] = {topic: [] for topic in wanted}
         connections = [c for c in reader.connections if c.topic in messages]
+        read = 0
         try:
             for connection, _, raw in reader.messages(connections=connections):
+                read += len(raw)
+                if read > MAX_BAG_MESSAGE_BYTES:
+                    raise LogFormatError(
+                        f"{path}: the messages on {', '.join(wanted)} hold more than "
+                        f"{describe_bytes(MAX_BAG_MESSAGE_BYTES)} (kiseki's limit for the "
+                        "messages read from ROS bags)"
+                    )
                 msg = reader.deserialize(raw, connection.msgtype)
                 messages[connection.topic].append(msg)
+        except LogFormatError:
+            raise
         except Exception as exc:  # rosbags raises its own errors for corrupt data
             raise LogFormatError(f"{path}: unreadable messages ({exc})") from exc
 
@@ -217,19 +269,64 @@ def read_bag_scans(
             + (" and the reference poses" if reference_topic is not None else "")
         )
     ns = ns[keep]
+    times = np.array([int(t) / _NS_PER_S for t in ns], dtype=np.float64)
     laser_poses = []
-    for track in tracks:
+    sources = [TF_TOPIC if use_tf else odom_topic, reference_topic][: len(tracks)]
+    for track, source in zip(tracks, sources, strict=True):
         mount = _mount(path, static, track.child, laser)
         laser_poses.append(_compose(_interpolate(track, ns), mount))
+        bad = ~np.isfinite(laser_poses[-1]).all(axis=1)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise LogFormatError(
+                f"{path}: the pose from {source!r} at scan {k} (t = {times[k]:.3f} s) is NaN "
+                "or infinite"
+            )
     poses = laser_poses[1] if reference_topic is not None else np.full((len(ns), 3), np.nan)
-    return LaserScans(
-        times=np.array([int(t) / _NS_PER_S for t in ns], dtype=np.float64),
+    scans = LaserScans(
+        times=times,
         poses=poses,
         odometry=laser_poses[0],
-        ranges=np.ascontiguousarray(ranges[keep]),
+        ranges=apply_range_rule(ranges[keep], max_range),
         angles=angles,
         max_range=max_range,
     )
+    check_odometry_jumps(path, scans.times, scans.odometry)
+    return scans
+
+
+_NO_LIMIT = 1 << 62
+
+
+def _check_chunks(path: Path) -> None:
+    """Measures, within MAX_BAG_CHUNK_BYTES and MAX_BAG_FILE_BYTES, what the bag's compressed
+    chunks and files decompress to, before rosbags decompresses each of them whole."""
+    files, compressed_files = [path], False
+    if path.is_dir():
+        meta = path / "metadata.yaml"
+        text = read_input_text(meta, "ROS 2 bag metadata files", YAML_LIMIT, LogFormatError)
+        try:
+            info = safe_load_12(text)["rosbag2_bagfile_information"]
+            compressed_files = str(info.get("compression_mode", "")).lower() == "file"
+        except (yaml.YAMLError, KeyError, TypeError, AttributeError):
+            pass  # rosbags says what is wrong with it
+        files = sorted(entry for entry in path.iterdir() if entry.is_file() and entry != meta)
+    for file in files:
+        if compressed_files:
+            try:
+                with open(file, "rb") as raw:
+                    size = decompressed_size(raw, "zstd", MAX_BAG_FILE_BYTES)
+            except Exception:  # noqa: BLE001 (not zstd, or corrupt: rosbags reports it)
+                continue
+            if size > MAX_BAG_FILE_BYTES:
+                raise LogFormatError(
+                    f"{file}: decompresses to more than {describe_bytes(MAX_BAG_FILE_BYTES)} "
+                    "(kiseki's limit for the files of ROS 2 bags)"
+                )
+        elif file.suffix.lower() == ".mcap":
+            check_mcap_chunks(file, "ROS bags", MAX_BAG_CHUNK_BYTES, _NO_LIMIT, LogFormatError)
+        elif file.suffix.lower() == ".bag":
+            check_ros1_chunks(file, "ROS bags", MAX_BAG_CHUNK_BYTES, LogFormatError)
 
 
 @contextmanager
@@ -308,7 +405,13 @@ def _scan_arrays(
         ranges[row] = scans[index].ranges
     angle_min = float(first.angle_min)
     angles = angle_min + float(first.angle_increment) * np.arange(beams, dtype=np.float64)
-    return laser, ns[order], ranges, angles, float(np.float32(first.range_max))
+    max_range = float(np.float32(first.range_max))
+    if not (np.isfinite(max_range) and max_range > 0):
+        raise LogFormatError(
+            f"{path}: the first scan on {topic!r} has range_max {first.range_max}: not a "
+            "positive finite number"
+        )
+    return laser, ns[order], ranges, angles, max_range
 
 
 def _odometry_track(path: Path, topic: str, messages: list[Any]) -> _Track:

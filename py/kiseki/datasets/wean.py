@@ -33,10 +33,15 @@ from pathlib import Path
 
 import numpy as np
 
+from kiseki._inputs import MIB
 from kiseki.datasets._files import read_maybe_gzipped
 from kiseki.errors import MapFormatError
 
-__all__ = ["WeanMap", "read_wean_map"]
+__all__ = ["MAX_MAP_BYTES", "WeanMap", "read_wean_map"]
+
+MAX_MAP_BYTES = 256 * MIB
+"""A map's text (after gunzip) is read up to this size: ``wean.dat.gz`` holds 4.3 MB of text for
+its 800 x 800 cells, so 256 MiB is about 40 million cells."""
 
 _HEADER_LINE = re.compile(r"robot_specifications->(\w+)\s+(\S+)")
 _SIZE_LINE = re.compile(r"global_map\[0\]:\s+(\d+)\s+(\d+)")
@@ -72,7 +77,7 @@ def read_wean_map(path: str | os.PathLike) -> WeanMap:
 
 
 def _read_text(path: Path) -> str:
-    return read_maybe_gzipped(path, MapFormatError)
+    return read_maybe_gzipped(path, MapFormatError, "BeeSoft .dat maps", MAX_MAP_BYTES)
 
 
 def _parse_header(path: Path, text: str) -> tuple[float, int, int, str]:

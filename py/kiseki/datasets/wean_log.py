@@ -16,9 +16,13 @@ The scans become a :class:`~kiseki.scans.LaserScans` in metres:
   (``LaserScans.has_reference_poses`` is False), so they are for global localization;
 * the 180 beams start at the right and go counter-clockwise, one degree apart, i.e. the angles
   of a CARMEN FLASER with 180 beams (``-pi/2 + i * pi/180``);
-* ``max_range`` is the largest reading of the log: the SICK's no-return code (8183 cm in
-  robotdata1, 8191 cm in robotdata2 and 3), as the CARMEN reader does for logs without a
-  max-range PARAM.
+* ``max_range`` is the largest (finite) reading of the log: the SICK's no-return code (8183 cm
+  in robotdata1, 8191 cm in robotdata2 and 3), as the CARMEN reader does for logs without a
+  max-range PARAM;
+* ranges follow kiseki's rule (``kiseki.scans``): NaN, ``-inf``, negative and zero readings are
+  invalid, kept as NaN and counted; ``+inf`` is a no return. Any other field that is NaN or
+  infinite is an error naming the line, and so is an odometry jump of more than
+  ``kiseki.scans.MAX_ODOMETRY_JUMP`` between two consecutive ``L`` lines.
 
 Recognised by content: the first non-empty line starts with ``O`` or ``L`` followed by a number.
 The ``O`` lines are returned too (:class:`WeanLog`), but the scans do not need them.
@@ -28,18 +32,24 @@ from __future__ import annotations
 
 import gzip
 import os
+import stat
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from kiseki._inputs import GIB, check_input
 from kiseki.datasets._files import GZIP_MAGIC, read_maybe_gzipped
 from kiseki.datasets.carmen import flaser_angles
 from kiseki.errors import LogFormatError
-from kiseki.scans import LaserScans
+from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps, largest_reading
 
-__all__ = ["WeanLog", "is_wean_log", "read_wean_log"]
+__all__ = ["MAX_LOG_BYTES", "WeanLog", "is_wean_log", "read_wean_log"]
+
+MAX_LOG_BYTES = 1 * GIB
+"""A log's text (after gunzip) is read up to this size (``robotdata2.log.gz`` holds 1.9 MB), as
+for CARMEN logs (:data:`kiseki.datasets.carmen.MAX_LOG_BYTES`)."""
 
 BEAMS = 180
 CM = 0.01  # metres per centimetre
@@ -59,8 +69,10 @@ class WeanLog:
 
 def is_wean_log(path: str | os.PathLike) -> bool:
     """Whether the file looks like a Wean robotdata log: its first non-empty line is an ``O`` or
-    ``L`` line starting with a number. Reads only the head of the file."""
+    ``L`` line starting with a number. Reads only the head of a regular file."""
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):  # a FIFO would block, a device not end
+            return False
         with Path(path).open("rb") as raw:
             magic = raw.read(2)
         opener = gzip.open if magic == GZIP_MAGIC else open
@@ -85,9 +97,10 @@ def is_wean_log(path: str | os.PathLike) -> bool:
 def read_wean_log(path: str | os.PathLike) -> WeanLog:
     """Read a Wean Hall robotdata log; a malformed line raises LogFormatError naming it."""
     path = Path(path)
+    check_input(path, error=LogFormatError)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: log file not found")
-    text = read_maybe_gzipped(path, LogFormatError)
+    text = read_maybe_gzipped(path, LogFormatError, "Wean robotdata logs", MAX_LOG_BYTES)
     lasers: list[list[str]] = []
     laser_lines: list[int] = []
     odoms: list[list[str]] = []
@@ -110,22 +123,21 @@ def read_wean_log(path: str | os.PathLike) -> WeanLog:
             )
     if not lasers:
         raise LogFormatError(f"{path}: no laser (L) lines")
-    values = _numbers(path, laser_lines, lasers)
-    ranges_cm = values[:, 6 : 6 + BEAMS]
-    negative = (ranges_cm < 0).any(axis=1)
-    if negative.any():
-        lineno = laser_lines[int(np.argmax(negative))]
-        raise LogFormatError(f"{path}:{lineno}: negative range reading")
-    ranges = np.ascontiguousarray(ranges_cm * CM, dtype=np.float32)
+    values = _numbers(path, laser_lines, lasers, ranges=slice(6, 6 + BEAMS))
+    readings = values[:, 6 : 6 + BEAMS] * CM
+    max_range = largest_reading(readings)
+    if max_range is None:
+        raise LogFormatError(f"{path}:{laser_lines[0]}: no valid range reading in any L line")
     odometry = np.column_stack([values[:, 3:5] * CM, values[:, 5]])
     scans = LaserScans(
         times=values[:, -1].copy(),
         poses=np.full((len(values), 3), np.nan),
         odometry=odometry,
-        ranges=ranges,
+        ranges=apply_range_rule(readings, max_range),
         angles=flaser_angles(BEAMS),
-        max_range=float(ranges.max()),
+        max_range=max_range,
     )
+    check_odometry_jumps(path, scans.times, scans.odometry, laser_lines)
     odo = _numbers(path, odom_lines, odoms) if odoms else np.empty((0, 4))
     return WeanLog(
         path=path,
@@ -142,7 +154,10 @@ def _check(path: Path, lineno: int, tokens: list[str], expected: int) -> None:
         )
 
 
-def _numbers(path: Path, linenos: list[int], rows: list[list[str]]) -> np.ndarray:
+def _numbers(
+    path: Path, linenos: list[int], rows: list[list[str]], ranges: slice = slice(0)
+) -> np.ndarray:
+    """The lines' numbers; columns ``ranges`` (range readings) may be NaN or infinite."""
     try:
         values = np.array(rows, dtype=np.float64)
     except ValueError:
@@ -155,7 +170,9 @@ def _numbers(path: Path, linenos: list[int], rows: list[list[str]]) -> np.ndarra
                         f"{path}:{lineno}: non-numeric value {token[:20]!r}"
                     ) from None
         raise LogFormatError(f"{path}: unreadable numbers") from None
-    bad = ~np.isfinite(values).all(axis=1)
+    finite = np.isfinite(values)
+    finite[:, ranges] = True
+    bad = ~finite.all(axis=1)
     if bad.any():
         raise LogFormatError(f"{path}:{linenos[int(np.argmax(bad))]}: non-finite value")
     return values

@@ -21,6 +21,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from kiseki._inputs import YAML_LIMIT, read_input_text
 from kiseki.experiments.base import Analysis, Experiment, TrialOutput
 from kiseki.experiments.config import Count, NonNegativeReal, Particles, PositiveReal, Seed
 from kiseki.experiments.gp_common import load_average, pack
@@ -46,7 +47,7 @@ class LidarMclFigureConfig:
 
 def blind_stretch(scene: str) -> tuple[float, float]:
     """The x range without laser landmarks that the scene states (its ``#@ blind`` line)."""
-    lines = Path(scene).read_text(encoding="utf-8").splitlines()
+    lines = read_input_text(scene, "scene files", YAML_LIMIT).splitlines()
     stated = yaml.safe_load("\n".join(ln[2:] for ln in lines if ln.startswith("#@"))) or {}
     try:
         lo, hi = (float(v) for v in stated["blind"]["x"])

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from kiseki._inputs import YAML_LIMIT, read_input_text
 from kiseki._yaml import safe_load_12
 from kiseki.core import derive_seed
 from kiseki.experiments.base import Analysis, Experiment, TrialOutput
@@ -62,7 +63,7 @@ def _cut_scene(config: NavigatorsConfig, folder: Path) -> tuple[Path, np.ndarray
     """The scene with its route cut to ``length`` m, written to ``folder``."""
     from kiseki.experiments.magnav_table_4_2 import cut_route
 
-    doc = safe_load_12(Path(config.scene).read_text(encoding="utf-8"))
+    doc = safe_load_12(read_input_text(config.scene, "scene files", YAML_LIMIT))
     points = np.asarray(doc["route"]["waypoints"], dtype=np.float64)
     waypoints = cut_route(points, config.length)
     doc["route"]["waypoints"] = waypoints.tolist()

@@ -19,6 +19,7 @@ import pandas as pd
 from rich.console import Console
 
 from kiseki._atomic import atomic_write, atomic_write_all, reworded
+from kiseki._inputs import CSV_LIMIT, YAML_LIMIT, check_input, read_input_text
 from kiseki._table import show
 from kiseki.experiments.base import CLAIM_COLUMNS, Analysis, Claim, Experiment
 from kiseki.experiments.registry import all_experiments
@@ -236,6 +237,7 @@ def _read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
     """A run's claims.csv and manifest.json, refused in one line naming the file when unreadable
     or without the columns and fields the report needs."""
     claims_path, manifest_path = latest / "claims.csv", latest / "manifest.json"
+    check_input(claims_path, "claims tables", CSV_LIMIT)
     try:
         claims = pd.read_csv(claims_path, keep_default_na=False)
     except (ValueError, UnicodeDecodeError) as err:
@@ -245,7 +247,7 @@ def _read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
             f"{claims_path}: no column holds (a claims table has {', '.join(CLAIM_COLUMNS)})"
         )
     try:
-        manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
+        manifest = json.loads(read_input_text(manifest_path, "JSON manifests", YAML_LIMIT))
     except (ValueError, UnicodeDecodeError) as err:
         raise ValueError(f"{manifest_path}: not a JSON manifest ({err})") from None
     needed = ("trials", "trials_failed", "git")

@@ -30,6 +30,7 @@ import pandas as pd
 import yaml
 from matplotlib.patches import Circle
 
+from kiseki._inputs import YAML_LIMIT, read_input_text
 from kiseki._yaml import safe_load_12
 from kiseki.core import Random, derive_seed
 from kiseki.experiments.base import Analysis, Claim, Experiment, TrialOutput
@@ -91,7 +92,7 @@ def _errors(result, goal: dict) -> dict:
 def _with_boxes(scene_file: Path, count: int, seed: int, tmp: Path) -> Path:
     """A copy of the scene with `count` unknown 0.4 x 0.4 x 0.6 m boxes, playback only, placed
     at random beside the route (kept 0.6 m clear of it so the robot can pass)."""
-    doc = safe_load_12(scene_file.read_text(encoding="utf-8"))
+    doc = safe_load_12(read_input_text(scene_file, "scene files", YAML_LIMIT))
     rng = Random(seed)
     pts = np.asarray(doc["route"]["waypoints"], dtype=float)
     placed = 0
@@ -168,7 +169,7 @@ def _profile_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
 def _boxes_beside_final_leg(scene_file: Path) -> dict:
     """How many of the playback-only boxes stand beside the route's final leg, left and right
     (the cameras see them on the way to the goal)."""
-    doc = safe_load_12(scene_file.read_text(encoding="utf-8"))
+    doc = safe_load_12(read_input_text(scene_file, "scene files", YAML_LIMIT))
     a, b = (np.asarray(p, dtype=float) for p in doc["route"]["waypoints"][-2:])
     along = (b - a) / np.linalg.norm(b - a)
     left = right = 0

@@ -25,6 +25,7 @@ import yaml
 from pydantic import Field
 
 from kiseki._atomic import atomic_write_all
+from kiseki._inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
 from kiseki._schema import FileModel, FiniteFloat, PositiveFloat, PositiveInt, parse
 from kiseki.errors import KisekiError, MapFormatError
 from kiseki.magnetic.linear_map import LinearMagneticMap
@@ -32,6 +33,7 @@ from kiseki.magnetic.linear_map import LinearMagneticMap
 __all__ = [
     "KIND",
     "MAP_FILE",
+    "MAX_NODES_BYTES",
     "OtherPathError",
     "load_linear_map",
     "save_linear_map",
@@ -39,6 +41,7 @@ __all__ = [
 
 MAP_FILE = "linear_map.yaml"
 NODES_FILE = "nodes.npz"
+MAX_NODES_BYTES = 2 * GIB  # the nodes' arrays: 10 million nodes (the YAML's limit) hold 1.1 GB
 KIND = "linear_magnetic_map"
 FORMAT_VERSION = 1
 GP_MAP_FILE = "magnetic_map.yaml"  # kiseki.magnetic.map_folder.MAP_FILE
@@ -78,8 +81,8 @@ def _is_kind(folder: Path, name: str, kind: str) -> bool:
     from kiseki._yaml import safe_load_12
 
     try:
-        doc = safe_load_12((folder / name).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        doc = safe_load_12(read_input_text(folder / name, "YAML files", YAML_LIMIT))
+    except (OSError, ValueError, yaml.YAMLError):  # UnicodeDecodeError is a ValueError
         return False
     return isinstance(doc, dict) and doc.get("kind") == kind
 
@@ -144,6 +147,7 @@ def save_linear_map(lmap: LinearMagneticMap, folder) -> Path:
 
 
 def _read_nodes(path: Path, n: int) -> dict[str, np.ndarray]:
+    check_npz(path, "linear magnetic map nodes", MAX_NODES_BYTES, MapFormatError)
     try:
         with np.load(path, allow_pickle=False) as npz:
             found = {k: npz[k] for k in npz.files}
@@ -175,6 +179,7 @@ def load_linear_map(folder, path_id: str | None = None) -> LinearMagneticMap:
     if not folder.exists():
         raise FileNotFoundError(f"{folder}: no such linear magnetic map folder")
     meta = folder / MAP_FILE
+    check_input(meta, error=MapFormatError)
     if not folder.is_dir() or not meta.is_file():
         if folder.is_dir() and (folder / GP_MAP_FILE).is_file():
             raise _gp_refusal(folder)
@@ -191,6 +196,7 @@ def load_linear_map(folder, path_id: str | None = None) -> LinearMagneticMap:
             f"{folder}: a linear magnetic map of path {model.path_id}, not of this path {path_id}"
         )
     name = model.files["nodes"]
+    check_input(folder / name, error=MapFormatError)
     if Path(name).name != name or not (folder / name).is_file():
         raise MapFormatError(f"{meta}: files: nodes must name a file in the folder, got {name!r}")
     arrays = _read_nodes(folder / name, model.nodes)

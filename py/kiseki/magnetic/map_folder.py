@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import struct
 import tempfile
 from pathlib import Path
 
@@ -38,26 +39,38 @@ import numpy as np
 import yaml
 
 from kiseki._atomic import record_written
+from kiseki._inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
 from kiseki._yaml import safe_load_12
 from kiseki.errors import MapFormatError
 from kiseki.gp import SquaredExponential
 from kiseki.magnetic.field_map import COMPONENTS, MagneticFieldMap, TrainingData
 from kiseki.magnetic.map_doc import Kernel, MagneticMapDoc, read_map_doc
 
-__all__ = ["MAP_FILE", "KIND", "check_map_destination", "load_map_folder", "save_map_folder"]
+__all__ = [
+    "MAP_FILE",
+    "MAX_FILE_BYTES",
+    "KIND",
+    "check_map_destination",
+    "load_map_folder",
+    "save_map_folder",
+]
 
 MAP_FILE = "magnetic_map.yaml"
 LINEAR_MAP_FILE = "linear_map.yaml"  # kiseki.magnetic.linear_map_folder.MAP_FILE: refused here
 KIND = "magnetic_field_map"
 FORMAT_VERSION = 1
 LAYERS = tuple(f"{c}_{q}" for q in ("mean", "variance") for c in COMPONENTS)
+MAX_FILE_BYTES = 2 * GIB
+"""Each file of a map folder, and the arrays of each ``.npz``, hold at most this: a map of
+MAX_CELLS cells keeps its mean and variance in 960 MB, 10 million training points in 480 MB."""
+_PNG = b"\x89PNG\r\n\x1a\n"
 _LEVELS = 65535
 
 
 def _is_map_folder(path: Path) -> bool:
     try:
-        doc = safe_load_12((path / MAP_FILE).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        doc = safe_load_12(read_input_text(path / MAP_FILE, "YAML files", YAML_LIMIT))
+    except (OSError, ValueError, yaml.YAMLError):  # UnicodeDecodeError is a ValueError
         return False
     return isinstance(doc, dict) and doc.get("kind") == KIND
 
@@ -222,12 +235,14 @@ def _file(folder: Path, files: dict, key: str, meta: Path) -> Path:
     if not isinstance(name, str) or not name or Path(name).name != name:
         raise _fail(meta, f"'files' must name the {key} file (a plain file name), got {name!r}")
     path = folder / name
+    check_input(path, "the files of magnetic field maps", MAX_FILE_BYTES, MapFormatError)
     if not path.is_file():
         raise _fail(path, f"missing {key} file of the magnetic field map")
     return path
 
 
 def _read_npz(path: Path, shapes: dict[str, tuple]) -> dict[str, np.ndarray]:
+    check_npz(path, "the files of magnetic field maps", MAX_FILE_BYTES, MapFormatError)
     try:
         with np.load(path, allow_pickle=False) as npz:
             found = {k: npz[k] for k in npz.files}
@@ -244,6 +259,19 @@ def _read_npz(path: Path, shapes: dict[str, tuple]) -> dict[str, np.ndarray]:
         if a.dtype.kind not in "fiu" or not np.all(np.isfinite(a)):
             raise _fail(path, f"'{key}' holds NaN, infinity or non-numbers")
     return found
+
+
+def _check_png_size(image: Path, shape: tuple) -> None:
+    """A PNG whose header states another size than the YAML's is refused before it is decoded
+    (a small PNG can state a size of gigabytes)."""
+    with open(image, "rb") as f:
+        head = f.read(24)
+    if head.startswith(_PNG) and head[12:16] == b"IHDR":
+        width, height = struct.unpack(">II", head[16:24])
+        if (height, width) != tuple(shape):
+            raise _fail(
+                image, f"image is {(height, width)} pixels, the YAML says {shape} (rows, columns)"
+            )
 
 
 def _check_grid(path: Path, arrays: dict, origin: np.ndarray, resolution: float) -> None:
@@ -263,6 +291,7 @@ def _read_2d(folder: Path, doc: MagneticMapDoc, meta: Path, origin, resolution, 
         if not isinstance(entry, dict):
             raise _fail(meta, f"layer '{name}' is not listed under files: layers")
         image = _file(folder, entry, "image", meta)
+        _check_png_size(image, shape)
         try:
             pixels = _core.read_image(str(image))
         except RuntimeError as err:
@@ -314,6 +343,7 @@ def load_map_folder(folder) -> MagneticFieldMap:
     if not folder.is_dir():
         raise _fail(folder, f"not a magnetic field map (a folder holding {MAP_FILE})")
     meta = folder / MAP_FILE
+    check_input(meta, error=MapFormatError)
     if not meta.is_file() and (folder / LINEAR_MAP_FILE).is_file():
         raise _fail(folder, f"a linear magnetic map ({LINEAR_MAP_FILE}), not a GP one")
     if not meta.is_file():

@@ -15,12 +15,14 @@ A problem is one line naming the file, the line number, the column and the value
 from __future__ import annotations
 
 import csv
+import io
 import os
 from pathlib import Path
 
 import numpy as np
 
 from kiseki._csv import CsvNumber
+from kiseki._inputs import CSV_LIMIT, read_input_text
 from kiseki._schema import FileModel, parse
 
 __all__ = ["MAX_POINTS", "Point2", "Point3", "read_points"]
@@ -53,7 +55,8 @@ def read_points(path: str | os.PathLike, d: int) -> tuple[np.ndarray, bool]:
     model, need = (Point2, ("x", "y")) if d == 2 else (Point3, ("x", "y", "z"))
     points: list[list[float]] = []
     try:
-        with path.open(newline="", encoding="utf-8") as f:
+        text = read_input_text(path, "points CSV files", CSV_LIMIT)
+        with io.StringIO(text, newline="") as f:
             reader = csv.reader(f)
             names = None
             for row in reader:

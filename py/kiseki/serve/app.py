@@ -7,22 +7,30 @@
 - ``GET /api/map``: the taught map as PNG (ROS image: top row = largest y); ``?format=json``:
   the map's metadata and ``cells`` (row-major from the bottom row; -1 unknown, 0 free,
   100 occupied)
-- ``POST /api/routes`` ``{"start", "via": [...], "goal", "home"}`` (``via`` optional, ``home``
-  the start when omitted): 202 ``{"id", "route": {...}}``; 409 while a route runs; 422 for an
-  unknown waypoint, a leg through occupied space or a malformed body
+- ``POST /api/routes`` ``{"start", "via": [...], "goal", "home"}`` (``via`` optional, at most
+  :data:`MAX_VIA` names; ``home`` the start when omitted; names at most 64 characters): 202
+  ``{"id", "route": {...}}``; 409 while a route runs; 422 for an unknown waypoint, a leg
+  through occupied space, a field beyond its limit or a malformed body
 - ``GET /api/state``: ``{"status": "idle"|"running"|"finished"|"stopped", "route", "leg":
   {"phase": "outbound"|"dwell"|"return", "index", "from", "to"}, "pose", "estimate",
-  "speed", "command", "t", "stop_error_m", "dwell_left_s", "detail", "history": [...]}``
-- ``POST /api/stop``: the robot brakes at once; ``{"stopping": bool, "status", "t", "speed"}``
-  (the route's clock and the robot's speed when the stop was taken)
+  "speed", "command", "t", "stop_error_m", "dwell_left_s", "detail", "history": [...] (the
+  last 50 finished routes), "epoch", "seq"}``
+- ``POST /api/stop`` (body ``{}``): the robot brakes at once; ``{"stopping": bool, "status",
+  "route", "t", "speed", "epoch", "seq"}`` (the route's clock and the robot's speed when the
+  stop was taken)
 - ``PATCH /api/waypoints/{name}`` ``{"name": NEW}``: 200 ``{"waypoint"}``; 404 unknown, 409 a
   duplicate name or a route running, 422 a bad name
-- ``/ws``: the state (``"type": "state"``, ``"seq"``, ``"particles"`` [[x, y, theta], ...]) on
-  connecting and at every control period of a route, the same text to every page
+- ``/ws``: the state (``"type": "state"``, ``"epoch"``, ``"seq"``, ``"particles"`` [[x, y,
+  theta], ...]) on connecting and at every control period of a route, the same text to every
+  page; ``seq`` orders the states of one ``epoch`` (a page drops a state older than its own)
 
-With a token (any address but loopback) every ``/api/`` request needs ``Authorization: Bearer
-TOKEN`` and the websocket the header or ``?token=TOKEN``; the page itself (static files, no
-data) loads without it so that it can ask for the token.
+Requests: :mod:`kiseki.serve.guard` first refuses (403) a Host other than the bound loopback
+address and an Origin of another site; then, with a token (any address but loopback), every
+``/api/`` request needs ``Authorization: Bearer TOKEN`` (401) and the websocket the header, the
+subprotocol ``kiseki.token.TOKEN`` (how the page sends it) or ``?token=TOKEN``; a POST, PUT,
+PATCH or DELETE must send ``Content-Type: application/json`` (415: a form cannot) and at most
+64 KiB (413). The page itself (static files, no data) loads without the token so that it can
+ask for it.
 """
 
 from __future__ import annotations
@@ -32,32 +40,41 @@ import contextlib
 import hmac
 from contextlib import asynccontextmanager
 from pathlib import Path
+from typing import Annotated
 
 from fastapi import FastAPI, Request, WebSocket, WebSocketDisconnect
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, Response
 from fastapi.staticfiles import StaticFiles
-from pydantic import BaseModel, ConfigDict
+from pydantic import BaseModel, ConfigDict, Field
 
+from kiseki.serve.guard import RequestGuard
 from kiseki.serve.routes import RouteBusyError, RouteRefusedError, RouteRequest, RouteRunner
 from kiseki.serve.taught import TaughtRun, WaypointError
+from kiseki.teach.waypoint_schema import MAX_NAME_LENGTH
 
-__all__ = ["STATIC", "create_app"]
+__all__ = ["MAX_BODY_BYTES", "MAX_VIA", "STATIC", "create_app"]
 
 STATIC = Path(__file__).resolve().parent / "static"
+MAX_VIA = 100  # via-points of one route
+MAX_BODY_BYTES = 64 * 1024  # a route of MAX_VIA longest names is 7 KiB
+SUBPROTOCOL = "kiseki"  # the websocket's; the page offers it with "kiseki.token.TOKEN"
+_CHANGES = ("POST", "PUT", "PATCH", "DELETE")
+
+Name = Annotated[str, Field(min_length=1, max_length=MAX_NAME_LENGTH)]
 
 
 class RouteBody(BaseModel):
     model_config = ConfigDict(extra="forbid", str_strip_whitespace=True)
-    start: str
-    via: list[str] = []
-    goal: str
-    home: str | None = None
+    start: Name
+    via: Annotated[list[Name], Field(max_length=MAX_VIA)] = []
+    goal: Name
+    home: Name | None = None
 
 
 class RenameBody(BaseModel):
     model_config = ConfigDict(extra="forbid")
-    name: str
+    name: Annotated[str, Field(max_length=MAX_NAME_LENGTH)]
 
 
 def _error(status: int, detail: str, **headers: str) -> JSONResponse:
@@ -80,9 +97,14 @@ def _bearer(value: str | None) -> str | None:
 
 
 def create_app(
-    taught: TaughtRun, runner: RouteRunner, token: str | None = None, static: Path = STATIC
+    taught: TaughtRun,
+    runner: RouteRunner,
+    token: str | None = None,
+    static: Path = STATIC,
+    hosts: frozenset[str] | None = None,
 ) -> FastAPI:
-    """The app; `token` None (loopback) needs no authorization."""
+    """The app; `token` None (loopback) needs no authorization; `hosts`: the Host values it
+    answers to (:func:`kiseki.serve.guard.loopback_hosts`; None: any)."""
 
     def authorized(given: str | None) -> bool:
         return token is None or (given is not None and hmac.compare_digest(given, token))
@@ -99,12 +121,20 @@ def create_app(
         return _error(422, _validation_detail(err))
 
     @app.middleware("http")
-    async def check_token(request: Request, call_next):
+    async def check_request(request: Request, call_next):
         path = request.url.path
-        if (path == "/api" or path.startswith("/api/")) and not authorized(
-            _bearer(request.headers.get("authorization"))
-        ):
+        if not (path == "/api" or path.startswith("/api/")):
+            return await call_next(request)
+        if not authorized(_bearer(request.headers.get("authorization"))):
             return _error(401, "missing or wrong access token", **{"WWW-Authenticate": "Bearer"})
+        if request.method in _CHANGES:
+            kind = request.headers.get("content-type", "").split(";")[0].strip().lower()
+            if kind != "application/json":
+                return _error(415, f"{request.method} takes a JSON body (Content-Type: "
+                              f"application/json), got {kind[:40] or 'none'!r}")  # fmt: skip
+            size = request.headers.get("content-length", "0")
+            if not size.isdigit() or int(size) > MAX_BODY_BYTES:
+                return _error(413, f"the body is limited to {MAX_BODY_BYTES} bytes")
         return await call_next(request)
 
     @app.get("/api/waypoints")
@@ -151,8 +181,11 @@ def create_app(
 
     @app.websocket("/ws")
     async def live(websocket: WebSocket) -> None:
-        given = _bearer(websocket.headers.get("authorization")) or websocket.query_params.get(
-            "token"
+        offered = websocket.scope.get("subprotocols") or []
+        given = (
+            _bearer(websocket.headers.get("authorization"))
+            or next((p[13:] for p in offered if p.startswith("kiseki.token.")), None)
+            or websocket.query_params.get("token")
         )
         if not authorized(given):
             try:
@@ -160,7 +193,7 @@ def create_app(
             except RuntimeError:  # the server cannot send an HTTP response on a websocket
                 await websocket.close(code=1008, reason="missing or wrong access token")
             return
-        await websocket.accept()
+        await websocket.accept(SUBPROTOCOL if SUBPROTOCOL in offered else None)
         key, queue = runner.broadcaster.subscribe()
         reader = asyncio.create_task(_until_closed(websocket))
         try:
@@ -181,6 +214,7 @@ def create_app(
                 await reader
 
     app.mount("/", StaticFiles(directory=static, html=True, check_dir=False), name="page")
+    app.add_middleware(RequestGuard, hosts=hosts)  # outermost: before the token
     return app
 
 

@@ -3,7 +3,13 @@
 """The thesis' use phase (sec. 2.3) as a background worker: a route start -> via... -> goal
 (stop within the goal tolerance), a dwell while the part is taken, then goal -> via reversed ->
 home. One route at a time; every control period's state goes to the subscribers of a
-:class:`Broadcaster` (the websocket pages) as one JSON text, the same for all of them."""
+:class:`Broadcaster` (the websocket pages) as one JSON text, the same for all of them.
+
+Every message and state carries ``epoch`` (this runner's random id) and ``seq`` (the number of
+messages published before it, and it): a page draws a state only when it is newer than the one
+it shows, so a late reply or a message overtaken by another never puts an older pose back. A
+route's first message (published before the robot has started it) carries no pose: the robot
+may be placed elsewhere by the start, so the previous route's pose is not this route's."""
 
 from __future__ import annotations
 
@@ -11,10 +17,12 @@ import asyncio
 import itertools
 import json
 import math
+import secrets
 import threading
 import time
 from dataclasses import dataclass, field
 
+from kiseki.serve.history import RouteHistory
 from kiseki.serve.robot import Robot, RobotState
 from kiseki.serve.taught import TaughtRun
 from kiseki.teach.playback import check_route
@@ -86,22 +94,33 @@ def _pose(values) -> list[float] | None:
     return None if values is None else [round(float(v), 4) for v in values]
 
 
+HISTORY_SHOWN = 50  # the last finished routes in the state and its messages (the file: all)
+
+
 class RouteRunner:
     """Runs routes of `taught`'s waypoints with `robot` in a background thread, paced at
     `speed_up` times real time (math.inf: as fast as the robot steps), with a dwell of
-    `dwell` seconds (of robot time) at the goal."""
+    `dwell` seconds (of robot time) at the goal. Finished routes go to `history` (kept in
+    memory when None); route ids go on from its last."""
 
     def __init__(
-        self, robot: Robot, taught: TaughtRun, dwell: float = 5.0, speed_up: float = 1.0
+        self,
+        robot: Robot,
+        taught: TaughtRun,
+        dwell: float = 5.0,
+        speed_up: float = 1.0,
+        history: RouteHistory | None = None,
     ) -> None:
         if not dwell >= 0 or not speed_up > 0:
             raise ValueError(f"dwell >= 0 s and speed_up > 0 are needed, got {dwell}, {speed_up}")
         self.robot, self.taught, self.dwell, self.speed_up = robot, taught, dwell, speed_up
+        self.history = history if history is not None else RouteHistory()
         self.broadcaster = Broadcaster()
+        self.epoch = secrets.token_hex(4)  # tells this runner's numbering from a restarted one's
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
-        self._ids = itertools.count(1)
+        self._ids = itertools.count(self.history.next_id)
         self._seq = 0
         self._state: dict = {
             "status": "idle",
@@ -115,7 +134,7 @@ class RouteRunner:
             "stop_error_m": None,
             "dwell_left_s": None,
             "detail": None,
-            "history": [],
+            "history": self.history.routes[-HISTORY_SHOWN:],
         }
         self._particles: list = []
 
@@ -146,7 +165,7 @@ class RouteRunner:
     def submit(self, request: RouteRequest) -> dict:
         """Starts the route in the background and returns it; RouteBusyError while one runs."""
         with self._lock:
-            if self._thread is not None and self._thread.is_alive():
+            if self._state["status"] == "running":
                 raise RouteBusyError(
                     f"route {self._state['route']['id']} is running; wait for it to finish or "
                     "stop it (POST /api/stop)"
@@ -161,10 +180,14 @@ class RouteRunner:
                 "outbound": [w["name"] for w in legs["out"]],
                 "return": [w["name"] for w in legs["back"]],
             }
+            if self._thread is not None:  # past its last use of the lock: ends at once
+                self._thread.join()
             self._stop.clear()
             self._state.update(
-                status="running", route=route, leg=None, stop_error_m=None, detail=None, t=0.0
-            )
+                status="running", route=route, leg=None, stop_error_m=None, detail=None, t=0.0,
+                pose=None, estimate=None, speed=0.0, command=[0.0, 0.0], dwell_left_s=None,
+            )  # fmt: skip
+            self._particles = []  # nothing of the previous route's robot is this route's
             self._publish()  # the pages hear of the route before the robot has started it
             self._thread = threading.Thread(
                 target=self._run, args=(route, legs), name=f"route-{route['id']}", daemon=True
@@ -175,20 +198,22 @@ class RouteRunner:
     def stop(self) -> dict:
         """Asks the running route to halt (the robot brakes within one control period)."""
         with self._lock:
-            running = self._thread is not None and self._thread.is_alive()
+            running = self._state["status"] == "running"
             if running:
                 self._stop.set()
                 self._state["detail"] = "stopping"
             # t and speed: the route's clock and the robot's speed when the stop was taken
             state = self._state
-            return {"stopping": running, "status": state["status"], "t": state["t"],
-                    "speed": state["speed"]}  # fmt: skip
+            route = state["route"]["id"] if state["route"] else None
+            return {"stopping": running, "status": state["status"], "route": route,
+                    "t": state["t"], "speed": state["speed"], "epoch": self.epoch,
+                    "seq": self._seq}  # fmt: skip
 
     def state(self) -> dict:
         """The state (a deep copy) with the sequence number of the last message sent, so a page
         can tell a reply that is older than the websocket's latest message and drop it."""
         with self._lock:
-            return {**json.loads(json.dumps(self._state)), "seq": self._seq}
+            return {**json.loads(json.dumps(self._state)), "epoch": self.epoch, "seq": self._seq}
 
     def message(self) -> str:
         """The latest state with the particles, as sent on the websocket."""
@@ -216,14 +241,22 @@ class RouteRunner:
         with self._lock:
             if status == "stopped" and detail is None:
                 detail = "stopped" if self._stop.is_set() else "the goal was not reached in time"
-            self._state.update(status=status, detail=detail, dwell_left_s=None)
-            self._state["history"].append(
-                {
-                    **{k: route[k] for k in ("id", "start", "via", "goal", "home")},
-                    "status": status,
-                    "stop_error_m": self._state["stop_error_m"],
-                    "duration_s": self._state["t"],
-                }
+            try:
+                self.history.append(
+                    {
+                        **{k: route[k] for k in ("id", "start", "via", "goal", "home")},
+                        "status": status,
+                        "stop_error_m": self._state["stop_error_m"],
+                        "duration_s": self._state["t"],
+                    }
+                )
+            except (OSError, ValueError) as err:  # the pages hear that the file is behind
+                detail = f"{detail or status}; the route history was not written: {err}"
+            self._state.update(
+                status=status,
+                detail=detail,
+                dwell_left_s=None,
+                history=self.history.routes[-HISTORY_SHOWN:],
             )
             self._publish()
 
@@ -290,7 +323,13 @@ class RouteRunner:
 
     def _message(self) -> str:
         return json.dumps(
-            {"type": "state", "seq": self._seq, **self._state, "particles": self._particles}
+            {
+                "type": "state",
+                "epoch": self.epoch,
+                "seq": self._seq,
+                **self._state,
+                "particles": self._particles,
+            }
         )
 
     def _publish(self) -> None:

@@ -23,6 +23,7 @@ import numpy as np
 from pydantic import Field
 
 from kiseki._csv import CsvNumber, data_rows
+from kiseki._inputs import CSV_LIMIT, check_input, read_input_text
 from kiseki._schema import FileModel, parse
 
 __all__ = [
@@ -67,10 +68,11 @@ def read_command_rows(path: str | os.PathLike) -> np.ndarray:
     FileNotFoundError when there is none, ValueError naming the file (and the line, the column
     and the value) otherwise."""
     path = Path(path)
+    check_input(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: command file not found")
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
+        lines = read_input_text(path, "command CSV files", CSV_LIMIT).splitlines()
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a command CSV (not UTF-8 text)") from None
     if not lines:

@@ -57,6 +57,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from kiseki._inputs import YAML_LIMIT, read_input_text
 from kiseki._yaml import safe_load_12
 from kiseki.core import Random, derive_seed
 from kiseki.sim.collisions import FootprintChecker, body_grid
@@ -327,7 +328,7 @@ def route_contact(scene: Scene, margin: float = ROUTE_MARGIN):
 
 
 def _base(path: Path) -> dict:
-    doc = safe_load_12(path.read_text(encoding="utf-8"))
+    doc = safe_load_12(read_input_text(path, "scene files", YAML_LIMIT))
     return {k: doc[k] for k in ("robot", "sensors", "route") if k in doc}
 
 

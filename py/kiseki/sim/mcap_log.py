@@ -87,15 +87,19 @@ from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 from mcap_protobuf.decoder import DecoderFactory
 from mcap_protobuf.schema import build_file_descriptor_set
 
+from kiseki._chunk_limits import check_mcap_chunks
+from kiseki._inputs import GIB, MIB, check_input
 from kiseki._signal_hold import SignalHold
 from kiseki.core import Pose2
 from kiseki.errors import LogFormatError
 from kiseki.grid import OccupancyGrid
-from kiseki.scans import LaserScans
+from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps, largest_reading
 
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
     "FOXGLOVE_MESSAGES",
+    "MAX_CHUNK_BYTES",
+    "MAX_RUN_BYTES",
     "MissingTopicError",
     "ODOMETRY_SCHEMA",
     "ODOMETRY_SCHEMA_NAME",
@@ -108,6 +112,12 @@ __all__ = [
 ]
 
 DEFAULT_CHUNK_SIZE = 128 * 1024
+MAX_RUN_BYTES = 4 * GIB
+"""A run is read up to this size, in the file and decompressed: the reader holds every message
+(a minute of a 640 x 480 depth camera at 10 Hz is 700 MB)."""
+MAX_CHUNK_BYTES = 256 * MIB
+"""One chunk decompresses to at most this (the ``mcap`` reader decompresses a chunk whole; kiseki
+writes chunks of :data:`DEFAULT_CHUNK_SIZE`, other tools of a few MB)."""
 SCHEMA_ENCODING = "jsonschema"  # kiseki's own messages
 MESSAGE_ENCODING = "json"
 PROTOBUF = "protobuf"  # Foxglove's messages: the schema and the message encoding
@@ -534,7 +544,8 @@ class RunWriter:
         ``frame_id``; ``angles`` (B,) are evenly spaced beam angles in the laser frame (to 1e-6
         rad) and ``ranges`` (B,) metres, stored as float32 values. ``max_range`` (fixed per
         topic, kept in the channel metadata) is the no-return reading; ``+inf`` readings are
-        written as ``max_range`` and need it."""
+        written as ``max_range`` and need it. Invalid readings (NaN, ``-inf``, negative, zero:
+        kiseki's rule, ``kiseki.scans``) are written as NaN."""
         ns = _time_ns(t)
         pose7 = _pose7(sensor_pose, "sensor pose")
         _name(frame_id, "frame_id")
@@ -559,12 +570,12 @@ class RunWriter:
             if not math.isfinite(limit) or limit <= 0:
                 raise ValueError(f"max_range must be finite and positive, got {max_range}")
             meta = {_MAX_RANGE_KEY: repr(limit)}
-        if np.any(np.isnan(values)) or np.any(values < 0):
-            raise ValueError("ranges must not be NaN or negative")
-        if np.any(np.isinf(values)):
+        if np.any(np.isposinf(values)):
             if meta is None:
                 raise ValueError("ranges have +inf values: pass max_range to write no returns")
-            values = np.where(np.isinf(values), np.float32(limit), values)
+            values = np.where(np.isposinf(values), np.float32(limit), values)
+        with np.errstate(invalid="ignore"):
+            values = np.where(values > 0, values, np.float32(np.nan))  # invalid: NaN
         if intensities is None:
             strength: list[float] = []
         else:
@@ -894,7 +905,12 @@ class SimRun:
           ``odom_topic`` is None.
         * ``angles``: ``linspace(start_angle, end_angle, B)``, equal for every scan (1e-9 rad).
         * ``max_range``: the channel metadata ``max_range`` written by :class:`RunWriter`, else
-          the largest reading (as for CARMEN logs without the PARAM), rounded to float32.
+          the largest finite reading (as for CARMEN logs without the PARAM), rounded to float32.
+        * ``ranges`` follow kiseki's rule (``kiseki.scans``): NaN, ``-inf``, negative and zero
+          readings are invalid, kept as NaN and counted; ``+inf`` is a no return. A NaN or
+          infinite pose or odometry, and an odometry jump of more than
+          ``kiseki.scans.MAX_ODOMETRY_JUMP`` between two consecutive scans, are errors naming
+          the scan (its index from 0, by time) and its time.
         """
         scans = self._typed(scan_topic, "foxglove.LaserScan")
         if not scans:
@@ -922,25 +938,44 @@ class SimRun:
         beams = ranges.shape[1]
         angles = np.linspace(start, end, beams) if beams > 1 else np.array([start])
         poses = np.array([self._xytheta(scan_topic, m.get("pose")) for _, m in scans])
+        self._check_finite(scan_topic, "pose", times, poses)
         frames = [m.get("frame_id") for _, m in scans]
         if truth_topic is not None:
             poses = self._scan_poses_in_world(truth_topic, scans, frames, poses)
         odometry = np.full((len(scans), 3), np.nan)
         if odom_topic is not None:
             odometry = self._nearest_odometry(odom_topic, times)
+            self._check_finite(odom_topic, "odometry", times, odometry)
         limit_text = self._topic(scan_topic).metadata.get(_MAX_RANGE_KEY)
         try:
-            limit = float(limit_text) if limit_text is not None else float(ranges.max())
+            limit = float(limit_text) if limit_text is not None else largest_reading(ranges)
         except ValueError as exc:
             raise LogFormatError(f"{self.path}: bad max_range {limit_text!r}") from exc
-        return LaserScans(
+        if limit is None:
+            raise LogFormatError(f"{self.path}: no valid range reading on {scan_topic!r}")
+        limit = float(np.float32(limit))
+        if not (math.isfinite(limit) and limit > 0):
+            raise LogFormatError(f"{self.path}: bad max_range {limit_text!r}")
+        laser = LaserScans(
             times=times,
             poses=np.ascontiguousarray(poses, dtype=np.float64),
             odometry=odometry,
-            ranges=np.ascontiguousarray(ranges),
+            ranges=apply_range_rule(ranges, limit),
             angles=angles.astype(np.float64),
-            max_range=float(np.float32(limit)),
+            max_range=limit,
         )
+        check_odometry_jumps(self.path, laser.times, laser.odometry)
+        return laser
+
+    def _check_finite(self, topic: str, what: str, times: np.ndarray, rows: np.ndarray) -> None:
+        """A LogFormatError naming the first scan whose pose or odometry is NaN or infinite."""
+        bad = ~np.isfinite(rows).all(axis=1)
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise LogFormatError(
+                f"{self.path}: the {what} on {topic!r} at scan {k} (t = {times[k]:.3f} s) is "
+                "NaN or infinite"
+            )
 
     def _scan_poses_in_world(
         self,
@@ -1060,6 +1095,8 @@ def read_run(path: str | os.PathLike) -> SimRun:
     LogFormatError if not an MCAP or corrupt; a file without its footer (writer killed) gives
     the complete chunks with a TruncatedRunWarning."""
     path = Path(path)
+    if check_input(path, "kiseki run logs", MAX_RUN_BYTES, LogFormatError) is not None:
+        check_mcap_chunks(path, "kiseki run logs", MAX_CHUNK_BYTES, MAX_RUN_BYTES, LogFormatError)
     topics: dict[str, _Topic] = {}
     metadata: dict[str, str] = {}
     schemas: dict[int, Schema] = {}

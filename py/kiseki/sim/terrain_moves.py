@@ -25,9 +25,10 @@ from pathlib import Path
 import numpy as np
 
 from kiseki import _core
+from kiseki._inputs import check_input
 from kiseki.core import check_seed
 from kiseki.sim.pose6 import Pose6, resting_pose
-from kiseki.sim.scene import load_scene
+from kiseki.sim.scene import MAX_OCTOMAP_BYTES, load_scene
 from kiseki.sim.sensors import Mount
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.sim.tilting_laser import TiltingLaser, TiltingLaserParams
@@ -126,6 +127,7 @@ def terrain_stops(
         raise ValueError(f"step must be 0.02..0.6 m (the search reaches 0.7 m), got {step!r}")
     path = Path(world_path)
     if path.suffix == ".bt":
+        check_input(path, "OctoMap files", MAX_OCTOMAP_BYTES)
         world = _core.OctreeWorld.read_binary(str(path))
         x, y, f = free_start(world, world.bounds)
         o = np.tile([x, y, f + 0.5], (32, 1))

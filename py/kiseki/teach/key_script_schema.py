@@ -22,13 +22,22 @@ from typing import Annotated, Any
 
 from pydantic import BeforeValidator, Field, field_validator
 
+from kiseki._inputs import MIB, check_input, read_input_text
 from kiseki._schema import FileModel, parse
 
-__all__ = ["KEYS", "MAX_KEYS", "MAX_SCRIPT_SECONDS", "KeyLine", "read_key_script"]
+__all__ = [
+    "KEYS",
+    "MAX_KEYS",
+    "MAX_KEY_SCRIPT_BYTES",
+    "MAX_SCRIPT_SECONDS",
+    "KeyLine",
+    "read_key_script",
+]
 
 KEYS = ("w", "a", "s", "d", "up", "down", "left", "right", "space", "m", "q")
 MAX_SCRIPT_SECONDS = 3600.0  # an hour of teaching at 10 Hz: 36,000 steps, each rendered and logged
 MAX_KEYS = 100_000
+MAX_KEY_SCRIPT_BYTES = 16 * MIB  # MAX_KEYS lines of a time, keys and a comment fit in far less
 
 
 def _seconds(text: Any) -> Any:
@@ -74,10 +83,11 @@ def read_key_script(path: str | os.PathLike) -> list[tuple[float, str]]:
     """The (time, key) events of the key script at `path`, in order: FileNotFoundError when
     there is none, ValueError naming the file (and the line, the field and the value)."""
     path = Path(path)
+    check_input(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: key script not found")
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_input_text(path, "key scripts", MAX_KEY_SCRIPT_BYTES)
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a key script (not UTF-8 text)") from None
     events: list[tuple[float, str]] = []

@@ -23,17 +23,23 @@ import yaml
 from tqdm import tqdm
 
 from kiseki._atomic import atomic_write_all, check_writable_folder, reworded
+from kiseki._inputs import read_input
 from kiseki.control import PurePursuit
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
-from kiseki.map_io import map_files, read_map_metadata
+from kiseki.map_io import MAX_IMAGE_BYTES, map_files, read_map_metadata
 from kiseki.metrics import taught_map_truth
 from kiseki.sim.mcap_log import RunWriter, read_run
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import MERGE_RULES, EnvironmentMap
 from kiseki.teach.local_maps import BANDS, LocalMapMaker
-from kiseki.teach.scene_identity import TaughtScene, scene_digest
+from kiseki.teach.scene_identity import (
+    TaughtScene,
+    recorded_scene_file,
+    resolve_scene_file,
+    scene_digest,
+)
 from kiseki.teach.waypoint_schema import read_waypoint_file
 
 __all__ = [
@@ -83,7 +89,8 @@ def waypoints_file_hash(map_yaml: Path) -> str:
     """SHA-1 of the map image a map YAML names: ties a waypoint file to the map it was taught
     with. The YAML is read through its model (:func:`kiseki.map_io.read_map_metadata`): a
     MapFormatError names the file, the key and the value; an OSError the image."""
-    return hashlib.sha1(read_map_metadata(map_yaml).image.read_bytes()).hexdigest()
+    image = read_map_metadata(map_yaml).image
+    return hashlib.sha1(read_input(image, "map images", MAX_IMAGE_BYTES)).hexdigest()
 
 
 def measure_taught_maps(
@@ -206,7 +213,10 @@ class TeachingRun:
         self.steps = 0  # steps logged
         self.out.mkdir(parents=True, exist_ok=True)
         self.log = self.out / "teach.mcap"
-        self.scene_id = TaughtScene(str(scene.path), scene_digest(scene.path))
+        # the scene by its path from the taught folder (this log's folder): found from anywhere
+        self.scene_id = TaughtScene(
+            recorded_scene_file(scene.path, self.out), scene_digest(scene.path), str(self.out)
+        )
         meta = {
             "scene_file": self.scene_id.file,
             "scene_sha1": self.scene_id.sha1,
@@ -380,12 +390,13 @@ def _check_same_scene(metadata: dict, scene: Scene, log) -> None:
     file's SHA-1 when the log records it, else by the recorded file when it still exists."""
     taught = metadata.get("scene_file", "")
     recorded = metadata.get("scene_sha1")
-    if recorded is None and taught and Path(taught).is_file():
-        recorded = scene_digest(taught)  # logs from before the digest was recorded
+    found = resolve_scene_file(taught, Path(log).parent)
+    if recorded is None and found is not None:
+        recorded = scene_digest(found)  # logs from before the digest was recorded
     if recorded is not None and recorded != scene_digest(scene.path):
         raise ValueError(
-            f"{log} was taught in {taught or 'another scene'}, not in {scene.path} (the scene "
-            "files differ): give the scene it was taught in"
+            f"{log} was taught in {found or taught or 'another scene'}, not in {scene.path} "
+            "(the scene files differ): give the scene it was taught in"
         )
 
 
@@ -427,7 +438,7 @@ def recover(
     Path(out).mkdir(parents=True, exist_ok=True)
     grids = {b: m.map() for b, m in maps.items()}
     measured = measure_taught_maps(scene, grids, np.array(truths), cameras) if truths else None
-    scene_id = TaughtScene(str(scene.path), scene_digest(scene.path))
+    scene_id = TaughtScene(recorded_scene_file(scene.path, out), scene_digest(scene.path), str(out))
     return _write_outputs(Path(out), grids, marks, Path(log), steps, merge, measured, scene_id)
 
 

@@ -5,8 +5,8 @@ and read by ``kiseki playback`` and ``kiseki serve``; it may have been edited by
 
     log: teach.mcap                  # the teaching log (optional)
     merge: thesis                    # the maps' merge rule (optional)
-    scene_file: data/worlds/x.yaml   # the scene taught in and its SHA-1 (optional: older files)
-    scene_sha1: 0123...
+    scene_file: ../data/worlds/x.yaml  # the scene taught in (from this folder; older files:
+    scene_sha1: 0123...                # from the teaching's working directory) and its SHA-1
     maps:                            # band -> the taught map's YAML and its image's SHA-1
       band: {file: map_band.yaml, image_sha1: 0123...}
     waypoints:                       # the marks: name, odometry pose, true pose (optional)
@@ -25,6 +25,7 @@ from typing import Annotated, Any
 
 from pydantic import AfterValidator, Field, field_validator, model_validator
 
+from kiseki._inputs import check_input
 from kiseki._schema import FileModel, FiniteFloat, SchemaError, parse
 from kiseki._yaml import read_yaml_file
 
@@ -151,6 +152,7 @@ def read_waypoint_file(path: str | os.PathLike) -> WaypointFile:
     """The checked waypoint file at `path`: FileNotFoundError when there is none, ValueError
     (a :class:`~kiseki._schema.SchemaError` for a field) naming the file otherwise."""
     path = Path(path)
+    check_input(path)
     if not path.is_file():
         raise FileNotFoundError(f"{path}: no waypoint file (run kiseki teach first)")
     doc = read_yaml_file(path, "kiseki waypoint file")

@@ -27,23 +27,39 @@ the planes and say which points they take.
 
 from __future__ import annotations
 
-import bz2
 import io
 import math
 import os
+import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from kiseki import _core
+from kiseki._inputs import GIB, MIB, check_input, describe_bytes, read_input
 from kiseki.core import check_seed
 from kiseki.terrain.plane_removal import HoughParams, PclParams, remove_planes
 from kiseki.terrain.sdem import sdem_from_points, sphere_grid
 
-__all__ = ["CLOUD_METHODS", "Cloud", "CloudPlanes", "cloud_planes", "parse_origin", "read_cloud"]
+__all__ = [
+    "CLOUD_METHODS",
+    "MAX_PCD_BYTES",
+    "MAX_TEXT_CLOUD_BYTES",
+    "Cloud",
+    "CloudPlanes",
+    "cloud_planes",
+    "parse_origin",
+    "read_cloud",
+]
 
 CLOUD_METHODS = ("pcl", "hough")
+MAX_PCD_BYTES = 1 * GIB
+"""A PCD file, and the points of a binary_compressed one, hold at most this: 64 million points of
+x y z rgb; reading takes about 3 times the points' size (office1.pcd: 4 MB of points, 12 MB)."""
+MAX_TEXT_CLOUD_BYTES = 256 * MIB
+"""A text cloud (after bunzip2) holds at most this: reading takes about 6 times the text's size
+(the rubble scan ``scan.dat.bz2``: 2.3 MB of text, 14 MB)."""
 MAX_POINTS = 20_000
 
 
@@ -104,13 +120,35 @@ def _is_pcd(path: Path) -> bool:
     return start.startswith((b"# .PCD", b"VERSION", b"FIELDS"))
 
 
+class _CloudError(ValueError):
+    """A text cloud's read refused by :func:`kiseki._inputs.read_input`."""
+
+
+def _check_pcd_size(path: Path) -> None:
+    """A binary_compressed PCD states the size its points decompress to (the reader decompresses
+    exactly that much or fails): refused past MAX_PCD_BYTES before it is read (ValueError)."""
+    with open(path, "rb") as f:
+        head = f.read(64 * 1024)
+    for marker in (b"\nDATA binary_compressed\n", b"\nDATA binary_compressed\r\n"):
+        at = head.find(marker)
+        if at >= 0 and at + len(marker) + 8 <= len(head):
+            _, size = struct.unpack_from("<II", head, at + len(marker))
+            if size > MAX_PCD_BYTES:
+                raise ValueError(
+                    f"{path}: decompresses to more than {describe_bytes(MAX_PCD_BYTES)} "
+                    "(kiseki's limit for PCD files)"
+                )
+
+
 def _read_text(path: Path) -> np.ndarray:
-    opener = bz2.open if path.suffix.lower() == ".bz2" else open
+    unzip = "bz2" if path.suffix.lower() == ".bz2" else None
     rows: list[list[float]] = []
     try:
-        with opener(path, "rt", encoding="utf-8") as f:
-            text = f.read()
-    except (UnicodeDecodeError, EOFError, OSError) as err:
+        data = read_input(path, "text clouds", MAX_TEXT_CLOUD_BYTES, _CloudError, unzip)
+        text = data.decode("utf-8")
+    except _CloudError as err:
+        raise ValueError(f"CLOUD {err}") from None
+    except (UnicodeDecodeError, OSError) as err:
         raise ValueError(
             f"CLOUD {path}: not a point cloud (neither a PCD file nor text of 'x y z' lines: {err})"
         ) from None
@@ -157,9 +195,17 @@ def read_cloud(path: str | os.PathLike, origin: str | None = None) -> Cloud:
     for a missing file, a file that is not a cloud, and a cloud with no finite point."""
     given = None if origin is None else parse_origin(origin)
     path = Path(path)
+    try:
+        check_input(path)
+        pcd = path.is_file() and _is_pcd(path)
+        if pcd:
+            check_input(path, "PCD files", MAX_PCD_BYTES)
+            _check_pcd_size(path)
+    except ValueError as err:
+        raise ValueError(f"CLOUD {err}") from None
     if not path.is_file():
         raise ValueError(f"CLOUD {path}: no such file")
-    if _is_pcd(path):
+    if pcd:
         try:
             points, _, _, dropped = _core.read_pcd(str(path))
         except (RuntimeError, ValueError) as err:

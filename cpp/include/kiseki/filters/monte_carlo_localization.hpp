@@ -45,6 +45,13 @@ enum class Recovery {
 };
 Recovery recovery_from_name(const std::string& name);
 
+/// The longest odometry step, in metres, between two filter updates (and, as kiseki's log
+/// readers apply it, between two consecutive scans): a longer one is a fault of the log (an
+/// odometry reset, a corrupt value), not a motion. Over five times the largest step between
+/// consecutive scans in the recorded logs kiseki reads (CSAIL's 1.78 m).
+/// Python: kiseki._core.MAX_ODOMETRY_JUMP, kiseki.scans.MAX_ODOMETRY_JUMP.
+inline constexpr double kMaxOdometryJump = 10.0;
+
 struct MclParams {
   std::size_t particles = 1000;  ///< the count; with kld the maximum
   bool kld = false;              ///< adapt the count by KLD sampling at each resampling
@@ -118,8 +125,8 @@ class MonteCarloLocalization {
   /// New weights for the current particles (finite, >= 0, positive sum; normalised here).
   void set_weights(const std::vector<double>& weights);
 
-  /// Moves the particles by an odometry increment. An increment longer than max_jump metres is
-  /// refused (an odometry jump is a fault of the log, not a motion).
+  /// Moves the particles by an odometry increment. An increment longer than kMaxOdometryJump
+  /// metres is refused (an odometry jump is a fault of the log, not a motion).
   void predict(const Pose2& odom_before, const Pose2& odom_after);
   /// Weighs the particles with a model that holds the current measurement, then recovers and
   /// resamples as configured.
@@ -148,7 +155,6 @@ class MonteCarloLocalization {
   const std::vector<Pose2>& particles() const { return particles_; }
   const std::vector<double>& weights() const { return weights_; }
   const MclParams& params() const { return params_; }
-  double max_jump = 10.0;  ///< m per predict()
 
  private:
   UpdateReport update_impl(const std::vector<double>& log_l, std::size_t readings, double agreement,

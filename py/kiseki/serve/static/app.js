@@ -23,7 +23,13 @@ const app = {
   updates: 0,
   recent: [],
   seq: -1, // the sequence number of the state shown (the server's message count)
+  epoch: null, // the server's run: a restarted server counts its messages from 1 again
+  starting: null, // {after: the route shown at the click} until the server shows the new one
+  startPending: false, // a start request is on its way
+  stopAgain: false, // STOP was pressed meanwhile: the start may reach the server after the stop
+  drawn: [], // the last states drawn, {seq, epoch, route, status, pose}: what the worker saw
 };
+const DRAWN_KEPT = 2000;
 window.kiseki = app; // for the browser tests and a curious teacher's console
 
 function showMessage(text, kind = "error") {
@@ -101,19 +107,34 @@ function updateButtons() {
 async function startRoute() {
   const t0 = performance.now();
   showMessage("");
+  // until the server shows the new route the page shows "starting" and no robot: the previous
+  // route's status and pose are not this route's (the start may place the robot elsewhere)
+  app.starting = { after: app.state.route ? app.state.route.id : null };
+  app.startPending = true;
+  app.stopAgain = false;
+  draw();
   try {
     const body = await app.api.startRoute(picker.route());
     app.latency = { t0, posted: performance.now() - t0, id: body && body.id };
-    app.state = { ...app.state, status: "running", route: (body && body.route) || picker.route() };
-    app.state.pose = null; // the next pose drawn is the route's
-    app.view.trail = [];
-    renderState();
+    app.startPending = false;
+    if (app.stopAgain) {
+      // the two requests travel on two connections and may be taken in either order: a stop
+      // taken before this start stopped nothing, so it is sent again now
+      app.stopAgain = false;
+      await stopRoute();
+    } else {
+      await refreshState();
+    }
   } catch (err) {
+    app.startPending = false;
+    app.starting = null;
     handleError(err);
+    refreshState().catch(() => {});
   }
 }
 
 async function stopRoute() {
+  if (app.startPending) app.stopAgain = true;
   try {
     await app.api.stop();
     await refreshState();
@@ -163,24 +184,36 @@ function poseText([x, y, theta]) {
   return `${fmt(x)}, ${fmt(y)} m  ${fmt((theta * 180) / Math.PI, 0)}\u00b0`;
 }
 
-function renderState() {
+/** The state as the page shows it: while a start is on its way, no robot and "starting". */
+function shownState() {
   const s = app.state;
+  if (!app.starting) return s;
+  const none = { route: null, leg: null, pose: null, estimate: null, particles: [] };
+  return { ...s, ...none, status: "starting" };
+}
+
+function renderState() {
+  const s = shownState();
   document.body.dataset.status = s.status || "idle";
-  $("status").textContent = s.status || "idle";
+  document.body.dataset.route = s.route ? String(s.route.id) : "";
+  $("status").textContent = s.status === "starting" ? "starting\u2026" : s.status || "idle";
   $("leg").textContent = legText(s);
   $("speed").textContent = Number.isFinite(s.speed) ? `${fmt(s.speed)} m/s` : "-";
   const pose = $("pose");
+  pose.dataset.seq = String(app.seq);
   if (Array.isArray(s.pose)) {
     pose.textContent = poseText(s.pose);
     [pose.dataset.x, pose.dataset.y, pose.dataset.theta] = s.pose.map(String);
+  } else {
+    pose.textContent = "-"; // no robot yet on this route: not the last route's pose
+    [pose.dataset.x, pose.dataset.y, pose.dataset.theta] = ["", "", ""];
   }
-  if (Array.isArray(s.estimate)) {
-    const e = s.estimate;
-    $("estimate").textContent = poseText(e);
-    if (Array.isArray(s.pose)) {
-      $("est-error").textContent = `${fmt(Math.hypot(e[0] - s.pose[0], e[1] - s.pose[1]), 3)} m`;
-    }
-  }
+  const e = s.estimate;
+  $("estimate").textContent = Array.isArray(e) ? poseText(e) : "-";
+  $("est-error").textContent =
+    Array.isArray(e) && Array.isArray(s.pose)
+      ? `${fmt(Math.hypot(e[0] - s.pose[0], e[1] - s.pose[1]), 3)} m`
+      : "-";
   const [stopText, stopClass] = stopErrorCell(s.stop_error_m);
   const stop = $("stop-error");
   stop.textContent = stopText;
@@ -223,25 +256,56 @@ function renderHistory(history) {
   });
 }
 
-async function refreshState() {
-  const previous = app.state.status;
-  const fresh = await app.api.state();
-  // a reply older than the last live message (a stop's reply overtaken by the "stopped"
-  // message) must not put the old state back
-  if (Number.isInteger(fresh.seq) && fresh.seq < app.seq) return;
-  if (Number.isInteger(fresh.seq)) app.seq = fresh.seq;
-  app.state = { history: [], ...fresh };
-  if (previous !== "running" && app.state.status === "running") app.view.trail = [];
-  app.view.setLive(app.state);
+/**
+ * Whether a state (a live message or a reply) is not older than the one shown: by its sequence
+ * number within the server's epoch. A reply overtaken by a live message (a stop's reply by the
+ * "stopped" message), or a message overtaken by a reply, never puts an older state back.
+ */
+function isCurrent(s) {
+  if (s.epoch !== undefined && s.epoch !== app.epoch) return true; // a (re)started server
+  return !Number.isInteger(s.seq) || s.seq >= app.seq;
+}
+
+/** Takes a current state's numbering; a new route starts its own trail and ends "starting". */
+function takeNumbering(s) {
+  if (s.epoch !== undefined && s.epoch !== app.epoch) {
+    app.epoch = s.epoch;
+    app.seq = -1;
+  }
+  if (Number.isInteger(s.seq)) app.seq = s.seq;
+  const shown = app.state.route ? app.state.route.id : null;
+  const route = s.route ? s.route.id : null;
+  if (route !== shown) app.view.trail = [];
+  if (app.starting && route !== null && route !== app.starting.after) app.starting = null;
+}
+
+/** Draws the state shown and notes what was drawn. */
+function draw() {
+  const s = shownState();
+  app.view.setLive(s);
   renderState();
+  app.drawn.push({
+    seq: app.seq,
+    epoch: app.epoch,
+    route: s.route ? s.route.id : null,
+    status: s.status,
+    pose: Array.isArray(s.pose) ? [...s.pose] : null,
+  });
+  if (app.drawn.length > DRAWN_KEPT) app.drawn.shift();
+}
+
+async function refreshState() {
+  const fresh = await app.api.state();
+  if (!isCurrent(fresh)) return;
+  takeNumbering(fresh);
+  app.state = { history: [], ...fresh };
+  draw();
 }
 
 /** Live messages merge at once; the page draws at most once per frame. */
 function onLive(message) {
-  if (Number.isInteger(message.seq)) {
-    if (message.seq < app.seq) return; // an older message than the state shown
-    app.seq = message.seq;
-  }
+  if (!isCurrent(message)) return; // an older message than the state shown
+  takeNumbering(message);
   const before = app.state.status;
   app.state = { ...app.state, ...message };
   app.updates += 1;
@@ -257,10 +321,10 @@ function onLive(message) {
 function drawFrame() {
   app.frame = 0;
   $("map").dataset.updates = String(app.updates);
-  app.view.setLive(app.state);
-  renderState();
+  draw();
   const pending = app.latency;
-  if (pending && app.state.status === "running" && Array.isArray(app.state.pose)) {
+  const shown = shownState();
+  if (pending && shown.status === "running" && Array.isArray(shown.pose)) {
     app.latency = null;
     const ms = performance.now() - pending.t0; // the first pose of the route is on the canvas
     app.lastLatency = { click_to_first_pose_ms: ms, click_to_accepted_ms: pending.posted };
@@ -280,10 +344,7 @@ function connect() {
   if (app.socket) app.socket.close();
   app.socket = new LiveSocket(app.api, {
     onMessage: onLive,
-    onOpen: () => {
-      app.seq = -1; // a new connection (perhaps to a restarted server) starts counting again
-      refreshState().catch(handleError);
-    },
+    onOpen: () => refreshState().catch(handleError), // a restarted server: a new epoch
     onStatus: (status) => {
       document.body.dataset.connection = status;
       $("connection").textContent = status === "live" ? "live" : "reconnecting\u2026";

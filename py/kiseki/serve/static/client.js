@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Copyright (c) 2026 the kiseki authors
-// The JSON API and the live websocket, with the access token kept from ?token=... or typed once.
+// The JSON API and the live websocket, with the access token kept from #token=... or typed once.
+// The token travels in the URL's fragment (never sent to the server, so in no log), then in the
+// Authorization header and the websocket's subprotocol, never in a URL the server sees.
 
 const TOKEN_KEY = "kiseki.token";
 
@@ -11,14 +13,16 @@ export class ApiError extends Error {
   }
 }
 
-/** The token from the URL (then removed from the address bar) or from earlier visits. */
+/** The token from the URL's #token=... (then removed from the address bar) or earlier visits. */
 export function loadToken() {
-  const url = new URL(window.location.href);
-  const fromUrl = url.searchParams.get("token");
+  const fragment = new URLSearchParams(window.location.hash.slice(1));
+  const fromUrl = fragment.get("token");
   if (fromUrl) {
     saveToken(fromUrl);
-    url.searchParams.delete("token");
-    window.history.replaceState(null, "", url.pathname + url.search + url.hash);
+    fragment.delete("token");
+    const rest = fragment.toString();
+    const url = window.location.pathname + window.location.search + (rest ? `#${rest}` : "");
+    window.history.replaceState(null, "", url);
     return fromUrl;
   }
   try {
@@ -73,7 +77,7 @@ export class Api {
   waypoints() { return this.request("GET", "api/waypoints"); }
   state() { return this.request("GET", "api/state"); }
   startRoute(route) { return this.request("POST", "api/routes", route); }
-  stop() { return this.request("POST", "api/stop"); }
+  stop() { return this.request("POST", "api/stop", {}); } // JSON, as every change must be
   rename(name, newName) {
     return this.request("PATCH", `api/waypoints/${encodeURIComponent(name)}`, { name: newName });
   }
@@ -93,8 +97,13 @@ export class Api {
   websocketUrl() {
     const url = new URL("ws", window.location.href);
     url.protocol = url.protocol === "https:" ? "wss:" : "ws:";
-    if (this.token) url.searchParams.set("token", this.token);
+    url.hash = "";
     return url.toString();
+  }
+
+  /** The websocket's subprotocols: the server answers "kiseki"; the token rides along. */
+  websocketProtocols() {
+    return this.token ? ["kiseki", `kiseki.token.${this.token}`] : ["kiseki"];
   }
 }
 
@@ -117,7 +126,7 @@ export class LiveSocket {
   open() {
     this.closed = false;
     clearTimeout(this.timer);
-    const socket = new WebSocket(this.api.websocketUrl());
+    const socket = new WebSocket(this.api.websocketUrl(), this.api.websocketProtocols());
     this.socket = socket;
     socket.onopen = () => {
       this.delay = 500;
