@@ -55,7 +55,7 @@ beams a scan (0.1 deg over 360 deg is 3,600), so this keeps every beam of any re
 THREAD_LIMIT = 1024
 """Threads of the filter (C++ int): MclConfig's limit; beyond the cores they only add overhead."""
 RUN_LIMIT = 100_000
-"""Trials of an experiment: the experiment configs' limit (kiseki.experiments.config)."""
+"""Trials of an experiment: the experiment configs' limit (kiseki_experiments.harness.config)."""
 WORKER_LIMIT = 256
 """Local Dask workers, a process each: beyond a large machine's cores they only add memory."""
 SIM_SECONDS_LIMIT = 86_400.0
@@ -169,7 +169,9 @@ class Quantity(_Bounded):
                 return None
         else:
             return None
-        return number if math.isfinite(number) else None
+        # + 0.0 makes -0.0 (``-0``, ``-0.0``) the zero it means: numpy's samplers refuse a
+        # scale whose sign bit is set ("scale < 0") though -0.0 >= 0 holds
+        return number + 0.0 if math.isfinite(number) else None
 
     def rule(self) -> str:
         left, right = "(" if self.lo_open else "[", ")" if self.hi_open else "]"

@@ -3,22 +3,29 @@
 """Outputs never destroy inputs: before a command starts its work, its output files (and the
 files written beside them) are compared with its input files (and the files they refer to, such
 as a ROS map YAML's image), paths resolved through symlinks and relative parts, and every
-output folder is checked to exist and be writable. :func:`check_outputs` holds the rules;
-:mod:`kiseki._guard` applies them to every command from its declared parameters."""
+output folder is checked to exist and be writable. kiseki writes a file by renaming a new one
+onto its path (:mod:`kiseki._atomic`), so an output must be a regular file or nothing yet: one
+that is a device, a FIFO or a socket (``-o /dev/null``) is refused, and so is an output that is
+a symlink, whatever it points to (the rename would replace the link, not the file it points
+to): give that file instead. :func:`check_outputs` holds the rules; :mod:`kiseki._guard`
+applies them to every command from its declared parameters."""
 
 from __future__ import annotations
 
+import collections
 import functools
 import glob
 import os
-from collections.abc import Iterable, Mapping, Sequence
+import stat
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from fnmatch import fnmatchcase
 from functools import cached_property
 from pathlib import Path
 
 import yaml
 
-from kiseki._yaml import safe_load_12
+from kiseki._inputs import _KINDS, YAML_LIMIT, read_input_text
+from kiseki._yaml import _Loader12, safe_load_12
 
 __all__ = [
     "FIGURE_SUFFIXES",
@@ -54,10 +61,10 @@ class _FigureSuffixes(Sequence[str]):
 FIGURE_SUFFIXES: Sequence[str] = _FigureSuffixes()
 
 
-# an input YAML (a map, a scene, a waypoint file) larger than this is not looked into
-MAX_REFERRING_YAML = 1 << 20
-# the listing of an input folder for links to its files: at most this deep and this many entries
+# the listing of an input folder for links to its files, and of an existing output folder for
+# links to inputs: at most this deep (the folder itself is depth 1) and this many entries in all
 WALK_DEPTH, WALK_ENTRIES = 3, 5000
+_STR = "tag:yaml.org,2002:str"
 
 
 def _beside(path: Path, name: str) -> Path:
@@ -66,16 +73,111 @@ def _beside(path: Path, name: str) -> Path:
 
 
 def _yaml_doc(path: Path):
-    """A small YAML input's document, or None (not YAML, too large, unreadable: the reader
-    itself reports what is wrong with it)."""
+    """What a YAML input's document says under the keys that name files (its top-level
+    mapping with only ``image``, ``octomap`` and ``maps``), or None (not YAML, unreadable: the
+    reader itself reports what is wrong with it). Any YAML file kiseki's readers accept is
+    looked into: read as they read it, in pieces and at most
+    :data:`kiseki._inputs.YAML_LIMIT` bytes (larger, or a device: None, the reader refuses
+    it), then scanned with libyaml's event parser (:func:`_scan`, a fraction of a second a
+    MB), or where that cannot tell (an alias, a merge key), loaded whole as the readers load
+    it."""
     if path.suffix.lower() not in (".yaml", ".yml"):
         return None
     try:
-        if not path.is_file() or path.stat().st_size > MAX_REFERRING_YAML:
+        if not path.is_file():
             return None
-        return safe_load_12(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        text = read_input_text(path, "YAML files", YAML_LIMIT)
+    except (OSError, ValueError, UnicodeDecodeError):
         return None
+    if getattr(yaml, "__with_libyaml__", False):
+        try:
+            return _scan(yaml.parse(text, Loader=yaml.CSafeLoader))
+        except (_NeedsLoadError, yaml.YAMLError, RuntimeError, StopIteration):
+            pass  # an alias or a merge key; or what libyaml refuses: as the readers read it
+    try:
+        return safe_load_12(text)
+    except yaml.YAMLError:
+        return None
+
+
+class _NeedsLoadError(Exception):
+    """The event stream alone cannot tell a key's value (an alias, a merge key ``<<``)."""
+
+
+_STARTS = frozenset((yaml.MappingStartEvent, yaml.SequenceStartEvent))
+_ENDS = frozenset((yaml.MappingEndEvent, yaml.SequenceEndEvent))
+
+
+def _skip(events: Iterator[yaml.Event], first: yaml.Event) -> None:
+    """Consumes the rest of the node that starts with ``first``."""
+    if type(first) not in _STARTS:
+        return
+    depth = 1
+    for event in events:
+        if type(event) in _STARTS:
+            depth += 1
+        elif type(event) in _ENDS:
+            depth -= 1
+            if not depth:
+                return
+    raise yaml.YAMLError("unexpected end of the events")
+
+
+_RESOLVER = _Loader12("")  # the readers' tags for plain scalars (YAML 1.2's core schema)
+
+
+def _string(event: yaml.Event) -> str | None:
+    """A scalar's text when the readers take it as a string, else None; an alias raises."""
+    if isinstance(event, yaml.AliasEvent):
+        raise _NeedsLoadError
+    if not isinstance(event, yaml.ScalarEvent):
+        return None
+    tag = event.tag
+    if tag in (None, "!"):
+        tag = _RESOLVER.resolve(yaml.ScalarNode, event.value, event.implicit)
+    if tag == "tag:yaml.org,2002:merge":
+        raise _NeedsLoadError
+    return event.value if tag == _STR else None
+
+
+def _items(events: Iterator[yaml.Event]) -> Iterator[tuple[str | None, yaml.Event]]:
+    """After a mapping's start: (its key as a string or None, the first event of its value)
+    for each pair; the caller reads or skips the value before the next."""
+    while not isinstance(key := next(events), yaml.MappingEndEvent):
+        name = _string(key)
+        _skip(events, key)  # a key that is a mapping or a list: no file name
+        yield name, next(events)
+
+
+def _scan(events: Iterator[yaml.Event]) -> dict | None:
+    """The top-level mapping's ``image``, ``octomap`` and ``maps`` from a document's events, without
+    building the rest (``maps``' entries by their order: only their ``file`` is kept); a key
+    given twice is taken as the readers take it, the last one."""
+    starts = (yaml.StreamStartEvent, yaml.DocumentStartEvent)
+    root = next(e for e in events if not isinstance(e, starts))
+    if not isinstance(root, yaml.MappingStartEvent):
+        return None
+    doc: dict = {}
+    for key, value in _items(events):
+        if key in ("image", "octomap"):
+            doc[key] = _string(value)
+        elif key == "maps" and isinstance(value, yaml.MappingStartEvent):
+            doc["maps"] = maps = {}
+            for _, entry in _items(events):
+                if isinstance(entry, yaml.MappingStartEvent):
+                    maps[len(maps)] = fields = {}
+                    for field, file in _items(events):
+                        if field == "file":
+                            fields["file"] = _string(file)
+                        _skip(events, file)
+                else:
+                    _string(entry)  # an alias raises
+                    _skip(events, entry)
+            continue  # read to its end
+        elif key == "maps":
+            _string(value)  # an alias raises
+        _skip(events, value)
+    return doc
 
 
 def _referred(path: Path, depth: int = 0) -> list[tuple[str, Path]]:
@@ -158,13 +260,22 @@ def _relative(path: Path, folder: Path) -> str | None:
     return None
 
 
-def _folder_files(folder: Path) -> set[tuple[int, int]]:
-    """(device, inode) of the files in ``folder`` (symlinks followed), listed at most
-    :data:`WALK_DEPTH` folders deep and :data:`WALK_ENTRIES` entries in all."""
-    found: set[tuple[int, int]] = set()
-    stack, seen = [(str(folder), 1)], 0
-    while stack and seen < WALK_ENTRIES:
-        where, depth = stack.pop()
+def _walk(folder: Path, links: bool = False) -> Iterator[tuple[str, os.stat_result, bool]]:
+    """The entries below ``folder``, nearest first, as (path relative to it, POSIX; its
+    ``os.stat``, symlinks followed; whether it is a folder): listed at most :data:`WALK_DEPTH`
+    folders deep (``folder`` itself is the first) and :data:`WALK_ENTRIES` entries in all; a
+    dangling symlink is left out. ``links``: folders reached through symlinks are listed too,
+    each folder once; otherwise a symlink to a folder is an entry, not a folder."""
+    queue = collections.deque([(str(folder), "", 1)])
+    listed, seen = set(), 0
+    if links:
+        try:
+            top = os.stat(folder)
+        except OSError:
+            return
+        listed.add((top.st_dev, top.st_ino))
+    while queue and seen < WALK_ENTRIES:
+        where, prefix, depth = queue.popleft()
         try:
             entries = os.scandir(where)
         except OSError:
@@ -175,14 +286,32 @@ def _folder_files(folder: Path) -> set[tuple[int, int]]:
                 if seen > WALK_ENTRIES:
                     break
                 try:
-                    if entry.is_dir(follow_symlinks=False):
-                        if depth < WALK_DEPTH:
-                            stack.append((entry.path, depth + 1))
-                    else:
-                        st = entry.stat()
-                        found.add((st.st_dev, st.st_ino))
+                    st = entry.stat()
+                    is_dir = entry.is_dir(follow_symlinks=links)
                 except OSError:
                     continue
+                rel = f"{prefix}{entry.name}"
+                if is_dir and depth < WALK_DEPTH and (st.st_dev, st.st_ino) not in listed:
+                    if links:
+                        listed.add((st.st_dev, st.st_ino))
+                    queue.append((entry.path, f"{rel}/", depth + 1))
+                yield rel, st, is_dir
+
+
+def _folder_files(folder: Path) -> set[tuple[int, int]]:
+    """(device, inode) of the files in ``folder`` (symlinks followed), listed by
+    :func:`_walk`."""
+    return {(st.st_dev, st.st_ino) for _, st, is_dir in _walk(folder) if not is_dir}
+
+
+def _folder_entries(folder: Path) -> dict[tuple[int, int], list[tuple[str, bool]]]:
+    """An existing output folder's entries by (device, inode), symlinks followed (as
+    :func:`os.path.samefile` compares files): their paths relative to it and whether each is
+    a folder; listed by :func:`_walk`, folders reached through symlinks too (the command
+    writes through them)."""
+    found: dict[tuple[int, int], list[tuple[str, bool]]] = {}
+    for rel, st, is_dir in _walk(folder, links=True):
+        found.setdefault((st.st_dev, st.st_ino), []).append((rel, is_dir))
     return found
 
 
@@ -231,9 +360,35 @@ def _refuse_in_input_folder(
             )
 
 
+def _identity(path: Path) -> tuple[int, int] | None:
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return st.st_dev, st.st_ino
+
+
+def _refuse_link_in_output_folder(
+    label: str, folder: Path, writes: Sequence[str], in_label: str, what: str, path: Path,
+    entries: dict[tuple[int, int], list[tuple[str, bool]]],
+) -> None:  # fmt: skip
+    """Refuses an entry of the output folder that the command writes and that is ``path``
+    (a hard link, a symlink, or reached through a symlinked folder)."""
+    for rel, is_dir in entries.get(_identity(path), ()):  # type: ignore[arg-type]
+        pattern = _written_by(rel, writes, is_dir)
+        if pattern is not None:
+            writes_it = "" if pattern == "**" else f"; the command writes {pattern} there"
+            kind = "folder" if is_dir else "file"
+            raise ValueError(
+                f"{label} {folder} would overwrite the input {_of(in_label, what)} {path}: "
+                f"{folder / rel} is the same {kind} (a link){writes_it}"
+            )
+
+
 def _refuse_input_in_output_folder(
-    label: str, folder: Path, writes: Sequence[str], in_label: str, read: list[tuple[str, Path]]
-) -> None:
+    label: str, folder: Path, writes: Sequence[str], in_label: str, read: list[tuple[str, Path]],
+    entries: Callable[[], dict[tuple[int, int], list[tuple[str, bool]]]],
+) -> None:  # fmt: skip
     if not folder.is_dir():
         return
     literal = [w for w in writes if not glob.has_magic(w)]
@@ -242,6 +397,10 @@ def _refuse_input_in_output_folder(
         pattern = None if rel is None else _written_by(rel, writes, path.is_dir())
         if pattern is None and path.exists():  # a link to a file the command writes
             pattern = next((w for w in literal if _same(folder / w, path)), None)
+            if pattern is None:  # a file the command writes there is a link to the input
+                _refuse_link_in_output_folder(
+                    label, folder, writes, in_label, what, path, entries()
+                )
         if pattern == "**":
             raise ValueError(
                 f"{label} {folder} would overwrite the folder holding the input "
@@ -254,14 +413,38 @@ def _refuse_input_in_output_folder(
             )
 
 
+def _refuse_not_regular(label: str, out: Path) -> None:
+    """Refuses an output file that exists and is not a regular file (a device, a FIFO, a
+    socket; symlinks followed), and an output that is a symlink: kiseki writes a file by
+    renaming a new one onto its path, which would put a regular file in the device's place,
+    or in the symlink's (the link gone, the file it pointed to left as it was)."""
+    replacing = "not a regular file: kiseki writes files by replacing them"
+    try:
+        mode = os.stat(out).st_mode
+    except (OSError, ValueError):  # nothing there (or a dangling symlink)
+        mode = None
+    link = os.path.islink(out)
+    if mode is not None and not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+        kind = next((name for test, name in _KINDS if test(mode)), "a special file")
+        via = f" (through a symlink to {os.readlink(out)})" if link else ""
+        raise ValueError(f"{label} {out}: {kind}{via}, {replacing}")
+    if link:
+        raise ValueError(
+            f"{label} {out}: a symlink (to {os.readlink(out)}), {replacing}; give the file "
+            "it points to, or remove the link"
+        )
+
+
 def _refuse_over_input(
     in_label: str,
     src: Path,
     written: list[tuple[str, Path]],
     made: list[tuple[str, Path, tuple[str, ...]]],
     rewritten: Sequence[str],
+    listings: Mapping[str, Callable[[], dict[tuple[int, int], list[tuple[str, bool]]]]],
 ) -> None:
-    """:func:`check_outputs`'s rules for one input ``src``."""
+    """:func:`check_outputs`'s rules for one input ``src`` (``listings``: each output folder's
+    entries, :func:`_folder_entries`, listed once for all inputs)."""
     read = input_files(src)
     for label, out in written:
         for what, path in read:
@@ -283,7 +466,9 @@ def _refuse_over_input(
                 )
     for label, folder, writes in made:
         extra = [] if inside is None or inside == src else [("bag folder", inside)]
-        _refuse_input_in_output_folder(label, folder, writes, in_label, read + extra)
+        _refuse_input_in_output_folder(
+            label, folder, writes, in_label, read + extra, listings[label]
+        )
 
 
 def check_outputs(
@@ -309,7 +494,14 @@ def check_outputs(
     * an output folder is not an input folder nor inside one;
     * an input (or a file it refers to) inside an output folder is refused when the command
       writes it there (matches a pattern; an input folder: when the command writes anything
-      inside it); with ``**``, any input inside the folder;
+      inside it); with ``**``, any input inside the folder; and so is an entry of an existing
+      output folder that the command writes (with ``**``: any) and that is an input or a file
+      an input refers to (a hard link, a symlink, a symlinked folder holding it), compared by
+      identity as :func:`os.path.samefile` does over the folder's listing (:func:`_walk`: at
+      most :data:`WALK_DEPTH` folders deep, :data:`WALK_ENTRIES` entries, symlinked folders
+      followed, each folder once);
+    * an output file that exists is a regular file, not a device, a FIFO or a socket (symlinks
+      followed), and is not a symlink (ValueError): the file is replaced by a rename;
     * two outputs are not one file;
     * an output file's folder exists and is writable (FileNotFoundError, PermissionError); an
       output folder, or the nearest existing folder above it, is writable.
@@ -325,8 +517,15 @@ def check_outputs(
     for label, folder, _ in made:
         if folder.exists() and not folder.is_dir():
             raise NotADirectoryError(f"{label} {folder}: not a folder")
+    listings = {
+        label: functools.cache(functools.partial(_folder_entries, folder))
+        for label, folder, _ in made
+    }
     for in_label, src in _labelled(inputs):
-        _refuse_over_input(in_label, src, written, made, (rewritten or {}).get(in_label, ()))
+        again = (rewritten or {}).get(in_label, ())
+        _refuse_over_input(in_label, src, written, made, again, listings)
+    for label, out in written:
+        _refuse_not_regular(label, out)
     for i, (label, out) in enumerate(written):
         for other_label, other in written[i + 1 :]:
             if _same(out, other):

@@ -5,7 +5,6 @@ teaching and navigation along linear magnetic maps (ch. 3-4)."""
 
 from __future__ import annotations
 
-import math
 import time
 from pathlib import Path
 
@@ -31,15 +30,33 @@ EXACT_LIMIT = 10_000  # beyond this many measurements the default is the reduced
 METHODS = ("exact", "hilbert")
 
 
+# --kernel's numbers (kiseki.gp.SquaredExponential): the signal and noise SDs in the data's units
+# (uT or G), the length scale in metres. 1e-6..1e6 spans a picotesla to a tesla (in uT) and a
+# micrometre to 1,000 km, and keeps what the GP computes with, their squares (1e-12..1e12) and
+# d^2 / l^2, far from a double's overflow (1e200 squared is inf) and underflow (1e-200 squared
+# is 0: a noise-free kernel whose matrix cannot be factorised)
+KERNEL_LIMITS = (1e-6, 1e6)  # as the message writes them: [1e-6, 1e6]
+_KERNEL_PARTS = (("sigma_f", "the data's units"), ("l", "m"), ("sigma_n", "the data's units"))
+
+
 def _parse_kernel(text: str):
+    """The kernel --kernel SIGMA_F,L,SIGMA_N gives; a ValueError naming --kernel and the number
+    outside :data:`KERNEL_LIMITS`."""
     from kiseki.gp import SquaredExponential
 
+    parts = text.split(",")
     try:
-        values = [float(v) for v in text.split(",")]
+        values = [float(v) for v in parts]
     except ValueError:
         values = []
-    if len(values) != 3 or not all(math.isfinite(v) and v > 0 for v in values):
-        raise ValueError(f"--kernel must be three positive numbers sigma_f,l,sigma_n, got {text!r}")
+    if len(values) != 3:
+        raise ValueError(f"--kernel must be three numbers sigma_f,l,sigma_n, got {text.strip()}")
+    lo, hi = KERNEL_LIMITS
+    for (name, unit), part, value in zip(_KERNEL_PARTS, parts, values, strict=True):
+        if not lo <= value <= hi:  # a NaN never is
+            raise ValueError(
+                f"--kernel: {name} must be a number in [1e-6, 1e6] ({unit}), got {part.strip()}"
+            )
     return SquaredExponential(*values)
 
 
@@ -125,7 +142,9 @@ def fit(
         False, "--per-component", help="Own hyperparameters for each of mx, my, mz."
     ),
     kernel: str | None = typer.Option(
-        None, help="sigma_f,l,sigma_n (default: maximise the log marginal likelihood)."
+        None,
+        help="sigma_f,l,sigma_n, each in [1e-6, 1e6] (SDs in the data's units, l in m; default: "
+        "maximise the log marginal likelihood).",
     ),
     # a GP needs a few points; 10^8 readings of (x, y, z, mx, my, mz) are 4.8 GB of doubles
     max_points: int | None = typer.Option(

@@ -241,7 +241,7 @@ def test_rename_is_atomic_keeps_a_backup_and_refuses_bad_names(folder, monkeypat
             "unknown": client.patch("/api/waypoints/P7", json={"name": "P8"}),
             "comma": client.patch("/api/waypoints/T1", json={"name": "a,b"}),
             "empty": client.patch("/api/waypoints/T1", json={"name": ""}),
-            "long": client.patch("/api/waypoints/T1", json={"name": "x" * 33}),
+            "long": client.patch("/api/waypoints/T1", json={"name": "x" * 65}),
             "space": client.patch("/api/waypoints/T1", json={"name": " T1"}),
             "missing": client.patch("/api/waypoints/T1", json={}),
         }

@@ -8,8 +8,10 @@ the taught run finds its scene from any working directory."""
 
 from __future__ import annotations
 
+import asyncio
 import json
 import shutil
+import socket
 import subprocess
 import sys
 import time
@@ -25,6 +27,7 @@ from kiseki.sim.scene import load_scene
 from kiseki.teach import teach
 from kiseki.teach.scene_identity import check_scene, scene_digest, taught_scene_of
 from kiseki.teach.teaching import recover
+from kiseki.teach.waypoint_schema import MAX_NAME_LENGTH, read_waypoint_file
 
 BASE = "http://127.0.0.1:8000"  # the address build_server serves by default
 WS = "ws://127.0.0.1:8000/ws"
@@ -147,6 +150,84 @@ def test_the_routes_fields_have_limits_and_a_refusal_says_which(root):
     assert state["status"] == "idle"
 
 
+PIECE = 64 * 1024  # one piece of a chunked upload
+
+
+def padded(spaces: int, pulled: list | None = None):
+    """SHORT as JSON after `spaces` bytes of whitespace, in pieces (httpx sends a generator
+    with Transfer-Encoding: chunked, no Content-Length); `pulled` counts the pieces taken."""
+    for _ in range(spaces // PIECE):
+        if pulled is not None:
+            pulled.append(PIECE)
+        yield b" " * PIECE
+    yield json.dumps(SHORT).encode()
+
+
+def test_the_body_limit_holds_for_a_chunked_body(root):
+    """Was read whole and parsed: the limit looked only at Content-Length."""
+    json_type = {"Content-Type": "application/json"}
+    with client(root / "t") as c:
+        chunked = c.post("/api/routes", content=padded(1 << 20), headers=json_type)
+        state = c.get("/api/state").json()
+        small = c.post("/api/stop", content=iter([b"{}"]), headers=json_type)  # chunked, small
+    assert "content-length" not in chunked.request.headers
+    assert chunked.request.headers["transfer-encoding"] == "chunked"
+    assert chunked.status_code == 413, chunked.text
+    assert chunked.json()["detail"] == "the body is limited to 65536 bytes"
+    assert state["status"] == "idle" and state["route"] is None  # nothing was started
+    assert small.status_code == 200, small.text
+
+
+def test_a_chunked_body_is_not_read_past_the_limit(root):
+    """Uvicorn hands the app a chunked body piece by piece as it arrives: 50 MB of whitespace
+    are refused after the second 64 KiB piece, not read to the end."""
+    server = build_server(root / "t", particles=10)
+    pulled: list[int] = []
+    pieces = padded(50 * 1024 * 1024, pulled)
+    sent: list[dict] = []
+
+    async def receive() -> dict:
+        piece = next(pieces, None)
+        return {"type": "http.request", "body": piece or b"", "more_body": piece is not None}
+
+    async def send(message: dict) -> None:
+        sent.append(message)
+
+    headers = [(b"host", b"127.0.0.1:8000"), (b"content-type", b"application/json"),
+               (b"transfer-encoding", b"chunked")]  # fmt: skip
+    scope = {
+        "type": "http", "asgi": {"version": "3.0"}, "http_version": "1.1", "method": "POST",
+        "scheme": "http", "path": "/api/routes", "raw_path": b"/api/routes", "root_path": "",
+        "query_string": b"", "headers": headers, "client": ("127.0.0.1", 40000),
+        "server": ("127.0.0.1", 8000),
+    }  # fmt: skip
+    try:
+        asyncio.run(server.app(scope, receive, send))
+    finally:
+        server.runner.close()
+    start = next(m for m in sent if m["type"] == "http.response.start")
+    body = b"".join(m.get("body", b"") for m in sent if m["type"] == "http.response.body")
+    assert start["status"] == 413, body
+    assert json.loads(body) == {"detail": "the body is limited to 65536 bytes"}
+    assert sum(pulled) <= 2 * PIECE  # of 50 MiB
+
+
+def test_a_waypoint_name_may_have_64_characters_everywhere(root, tmp_path):
+    """A rename stopped at 32 characters while the waypoint file, a route, the history and the
+    README take names of 64."""
+    folder = shutil.copytree(root / "t", tmp_path / "t")
+    longest = "Cell " + "a" * (MAX_NAME_LENGTH - 5)
+    with client(folder, scene=root / "worlds" / "corridor.yaml") as c:
+        renamed = c.patch("/api/waypoints/P0", json={"name": longest})
+        too_long = c.patch("/api/waypoints/P1", json={"name": longest + "b"})
+        listed = [w["name"] for w in c.get("/api/waypoints").json()["waypoints"]]
+    assert MAX_NAME_LENGTH == 64
+    assert renamed.status_code == 200, renamed.text
+    assert too_long.status_code == 422 and "at most 64 characters" in too_long.json()["detail"]
+    assert listed == [longest, "P1", "P2"]
+    assert read_waypoint_file(folder / "waypoints.yaml").waypoints[0].name == longest
+
+
 def test_the_history_of_finished_routes_survives_a_restart(root, tmp_path):
     history = tmp_path / "routes.json"
     with client(root / "t", history=history) as c:
@@ -186,6 +267,53 @@ def test_a_corrupt_history_stops_the_server_in_one_line_and_is_kept(root, tmp_pa
     assert done.returncode == 1 and len(lines) == 1, done.stderr
     assert str(history) in lines[0] and words in lines[0], lines[0]
     assert history.read_text() == text  # never dropped nor overwritten
+
+
+def serve(root: Path, tmp_path: Path, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "serve", "--taught", str(root / "t"),
+         "--history", str(tmp_path / "routes.json"), *args],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+
+
+def test_a_port_in_use_or_a_bad_host_is_one_line_and_nothing_printed(root, tmp_path):
+    """Were uvicorn's "ERROR: [Errno 98] ..." and exit 3 (kiseki's own bugs), after the URL and
+    the access token had been printed."""
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        in_use = serve(root, tmp_path, "--port", str(port))
+    bad_host = serve(root, tmp_path, "--host", "0.0.0.0.0", "--port", str(port))
+    assert (in_use.returncode, in_use.stdout) == (1, ""), in_use.stdout + in_use.stderr
+    assert in_use.stderr.splitlines() == [
+        f"kiseki: error: --port {port} on 127.0.0.1: address already in use"
+    ]
+    assert (bad_host.returncode, bad_host.stdout) == (1, ""), bad_host.stdout + bad_host.stderr
+    lines = bad_host.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("kiseki: error: --host 0.0.0.0.0: "), lines
+    assert not (tmp_path / "routes.json").exists()
+
+
+def test_serve_listens_on_the_sockets_it_bound(root, tmp_path):
+    """The control: on a free port the server starts, answers and stops on SIGTERM."""
+    from serve_pages import api, free_port, start_server
+
+    port = free_port()
+    command = [sys.executable, "-m", "kiseki.cli", "serve", "--taught", str(root / "t"),
+               "--port", str(port), "--history", str(tmp_path / "routes.json"),
+               "--particles", "10"]  # fmt: skip
+    process, base = start_server(command, tmp_path / "serve.log")
+    try:
+        status, state = api(base, "GET", "api/state")
+    finally:
+        process.terminate()
+        process.wait(30)
+    log = (tmp_path / "serve.log").read_text()
+    assert status == 200 and state["status"] == "idle"
+    assert f"on http://127.0.0.1:{port}/" in log and "ERROR" not in log, log
+    assert process.returncode == 143, log  # SIGTERM, as every command ends on it
 
 
 def test_the_taught_run_finds_its_scene_from_any_folder(root, tmp_path, monkeypatch):

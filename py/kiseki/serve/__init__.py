@@ -14,6 +14,7 @@ from pathlib import Path
 from kiseki.serve.app import STATIC, create_app
 from kiseki.serve.guard import loopback_hosts
 from kiseki.serve.history import RouteHistory
+from kiseki.serve.listen import listening_sockets
 from kiseki.serve.robot import Robot, RobotState, SimulatedAgv
 from kiseki.serve.routes import RouteRequest, RouteRunner
 from kiseki.serve.taught import TaughtRun, taught_scene
@@ -32,6 +33,7 @@ __all__ = [
     "TaughtRun",
     "build_server",
     "create_app",
+    "listening_sockets",
     "scene_of",
 ]
 

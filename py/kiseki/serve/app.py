@@ -29,7 +29,8 @@ address and an Origin of another site; then, with a token (any address but loopb
 ``/api/`` request needs ``Authorization: Bearer TOKEN`` (401) and the websocket the header, the
 subprotocol ``kiseki.token.TOKEN`` (how the page sends it) or ``?token=TOKEN``; a POST, PUT,
 PATCH or DELETE must send ``Content-Type: application/json`` (415: a form cannot) and at most
-64 KiB (413). The page itself (static files, no data) loads without the token so that it can
+64 KiB (413; counted as the body arrives, with Content-Length or chunked: :class:`BodyLimit`).
+The page itself (static files, no data) loads without the token so that it can
 ask for it.
 """
 
@@ -53,7 +54,7 @@ from kiseki.serve.routes import RouteBusyError, RouteRefusedError, RouteRequest,
 from kiseki.serve.taught import TaughtRun, WaypointError
 from kiseki.teach.waypoint_schema import MAX_NAME_LENGTH
 
-__all__ = ["MAX_BODY_BYTES", "MAX_VIA", "STATIC", "create_app"]
+__all__ = ["MAX_BODY_BYTES", "MAX_VIA", "STATIC", "BodyLimit", "create_app"]
 
 STATIC = Path(__file__).resolve().parent / "static"
 MAX_VIA = 100  # via-points of one route
@@ -90,6 +91,49 @@ def _validation_detail(err: RequestValidationError) -> str:
     return "; ".join(parts) or "invalid request"
 
 
+def _too_large() -> JSONResponse:
+    return _error(413, f"the body is limited to {MAX_BODY_BYTES} bytes")
+
+
+class BodyLimit:
+    """Reads the body of a change to the API (a POST, PUT, PATCH or DELETE to ``/api/``) before
+    the app does, counting its bytes as they arrive, with Content-Length or chunked alike: once
+    more than :data:`MAX_BODY_BYTES` have come, 413 and nothing more is read; else the app gets
+    the body as it was read (at most 64 KiB held)."""
+
+    def __init__(self, app) -> None:
+        self.app = app
+
+    async def __call__(self, scope, receive, send) -> None:
+        path = scope.get("path", "")
+        if (
+            scope["type"] != "http"
+            or scope["method"] not in _CHANGES
+            or not (path == "/api" or path.startswith("/api/"))
+        ):
+            return await self.app(scope, receive, send)
+        pieces, size, more = [], 0, True
+        while more:
+            message = await receive()
+            if message["type"] != "http.request":  # the client went away: no one to answer
+                return None
+            pieces.append(message.get("body", b""))
+            size += len(pieces[-1])
+            if size > MAX_BODY_BYTES:
+                return await _too_large()(scope, receive, send)
+            more = message.get("more_body", False)
+        body, given = b"".join(pieces), False
+
+        async def replay():
+            nonlocal given
+            if given:
+                return await receive()  # http.disconnect, once the client goes
+            given = True
+            return {"type": "http.request", "body": body, "more_body": False}
+
+        return await self.app(scope, replay, send)
+
+
 def _bearer(value: str | None) -> str | None:
     if value and value[:7].lower() == "bearer ":
         return value[7:].strip()
@@ -120,6 +164,8 @@ def create_app(
     async def invalid(_request: Request, err: RequestValidationError) -> JSONResponse:
         return _error(422, _validation_detail(err))
 
+    app.add_middleware(BodyLimit)  # inside check_request: after the token and the type
+
     @app.middleware("http")
     async def check_request(request: Request, call_next):
         path = request.url.path
@@ -132,9 +178,9 @@ def create_app(
             if kind != "application/json":
                 return _error(415, f"{request.method} takes a JSON body (Content-Type: "
                               f"application/json), got {kind[:40] or 'none'!r}")  # fmt: skip
-            size = request.headers.get("content-length", "0")
+            size = request.headers.get("content-length", "0")  # chunked: BodyLimit counts
             if not size.isdigit() or int(size) > MAX_BODY_BYTES:
-                return _error(413, f"the body is limited to {MAX_BODY_BYTES} bytes")
+                return _too_large()
         return await call_next(request)
 
     @app.get("/api/waypoints")

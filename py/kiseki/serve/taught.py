@@ -22,12 +22,15 @@ from kiseki.grid import OccupancyGrid
 from kiseki.map_io import load_map, write_image
 from kiseki.teach.local_maps import METHODS
 from kiseki.teach.teaching import load_route
-from kiseki.teach.waypoint_schema import read_waypoint_file
+from kiseki.teach.waypoint_schema import MAX_NAME_LENGTH, read_waypoint_file
 
 __all__ = ["NAME_RULE", "TaughtRun", "WaypointError", "taught_scene"]
 
-# A waypoint name: letters (any script), digits, '_', '.', '-', single inner spaces; <= 32
-NAME_RULE = "letters, digits, '_', '.', '-' and single inner spaces, at most 32 characters"
+# A waypoint name: letters (any script), digits, '_', '.', '-', single inner spaces; as long as
+# the waypoint file, a route and the route history take (MAX_NAME_LENGTH)
+NAME_RULE = (
+    f"letters, digits, '_', '.', '-' and single inner spaces, at most {MAX_NAME_LENGTH} characters"
+)
 _NAME = re.compile(r"\w[\w.\-]*(?: [\w.\-]+)*")
 
 
@@ -131,7 +134,7 @@ class TaughtRun:
     def rename(self, old: str, new: str) -> dict:
         """Renames waypoint `old` to `new` in the waypoint file (the previous file kept as
         waypoints.yaml.bak, both written atomically); WaypointError 404 / 409 / 422."""
-        if not isinstance(new, str) or len(new) > 32 or not _NAME.fullmatch(new):
+        if not isinstance(new, str) or len(new) > MAX_NAME_LENGTH or not _NAME.fullmatch(new):
             raise WaypointError(f"bad waypoint name {new!r}: use {NAME_RULE}", 422)
         with self._lock:
             doc = self._read()  # the file as it is now, not as it was at start
