@@ -55,7 +55,10 @@ from sklearn.gaussian_process import GaussianProcessRegressor
 
 from gp_reference import run_sklearn_limited, sklearn_kernel, start_kernel  # beside this file
 from kiseki.datasets import read_aalto_run
-from kiseki.experiments.gp_common import (
+from kiseki.gp import ExactGP, HilbertGP, fit_hyperparameters
+from kiseki.gp.kernel import log_marginal_likelihood
+from kiseki.sim.scene import load_scene
+from kiseki_experiments.gp.gp_common import (
     FLOOR,
     HALL,
     SENSOR_NOISE,
@@ -64,9 +67,6 @@ from kiseki.experiments.gp_common import (
     survey_2d,
     survey_3d,
 )
-from kiseki.gp import ExactGP, HilbertGP, fit_hyperparameters
-from kiseki.gp.kernel import log_marginal_likelihood
-from kiseki.sim.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 AALTO = ROOT.parent / "shared" / "data" / "magnetic" / "aalto" / "invensense"

@@ -20,8 +20,8 @@ import argparse
 import time
 from pathlib import Path
 
-from kiseki.experiments.magnav_lidar_drive import drive, teach_heading_map
 from kiseki.magnetic.lidar_mcl import LidarMclConfig
+from kiseki_experiments.magnav.magnav_lidar_drive import drive, teach_heading_map
 
 WORLDS = Path(__file__).resolve().parents[1] / "data" / "worlds"
 GOAL = 20.0  # x real time

@@ -2,9 +2,9 @@
 # Copyright (c) 2026 the kiseki authors
 """The rubble paper's S-DEM search beside two point-cloud registration baselines on the same
 scan pairs (issue 13 item 5; printed, never asserted): the pairs of the terrain-env-a,
-terrain-env-b and terrain-corridor experiments (kiseki.experiments.terrain_common: one move of
-the simulated tilting laser, median of 3, both sweeps levelled with the gyro's reading, gyro
-error included), one seed.
+terrain-env-b and terrain-corridor experiments (kiseki_experiments.terrain.terrain_common: one
+move of the simulated tilting laser, median of 3, both sweeps levelled with the gyro's reading,
+gyro error included), one seed.
 
 * S-DEM: Hough plane removal (the paper's) and the exhaustive search over the paper's 56,916
   candidates, then the coarse-to-fine search (all cores);
@@ -29,9 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
-from kiseki.experiments.terrain_common import local_maps
 from kiseki.sim.pose6 import PAPER_MOVES, Pose6
 from kiseki.terrain import correlation_search, remove_planes
+from kiseki_experiments.terrain.terrain_common import local_maps
 
 ROOT = Path(__file__).resolve().parents[1]
 WORLDS = ROOT / "data" / "worlds"

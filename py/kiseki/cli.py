@@ -313,7 +313,7 @@ def experiment_list(
     Example: kiseki experiment list | cut -f1"""
     import json
 
-    from kiseki.experiments import all_experiments
+    from kiseki_experiments.harness.registry import all_experiments  # here: start-up time
 
     columns = ("name", "paper", "table/figure", "description", "default trials")
     rows = [
@@ -365,7 +365,9 @@ def experiment_run(
     Example: kiseki experiment run 'speed-*' --seed 0"""
     import fnmatch
 
-    from kiseki.experiments import all_experiments, run_experiment
+    # here, not at the top: start-up time (the registry imports every experiment)
+    from kiseki_experiments.harness.registry import all_experiments
+    from kiseki_experiments.harness.runner import run_experiment
 
     names, pattern = [name], any(c in name for c in "*?[")
     if pattern:
@@ -853,7 +855,7 @@ def serve_command(
     Example: kiseki serve --taught results/demo/teach"""
     import secrets
 
-    from kiseki.serve import HISTORY_FILE, LOOPBACK, build_server
+    from kiseki.serve import HISTORY_FILE, LOOPBACK, build_server, listening_sockets
 
     token = None if host in LOOPBACK else secrets.token_urlsafe(24)
     history = taught / HISTORY_FILE if history is None else history
@@ -863,6 +865,8 @@ def serve_command(
     )  # fmt: skip
     import uvicorn
 
+    # bound before anything is printed: a port in use or a bad --host is one line, exit 1
+    sockets = listening_sockets(host, port)
     names = ", ".join(w["name"] for w in server.taught.waypoints)
     # the token rides in the URL's fragment: the browser never sends it, so no log has it
     url = f"http://{f'[{host}]' if ':' in host else host}:{port}/"
@@ -873,7 +877,14 @@ def serve_command(
     )
     if token is not None:
         console.print(f"access token: {token}  (Authorization: Bearer TOKEN)", soft_wrap=True)
-    uvicorn.run(server.app, host=host, port=port, log_level="warning")
+    config = uvicorn.Config(server.app, host=host, port=port, log_level="warning")
+    try:
+        uvicorn.Server(config).run(sockets=sockets)
+    except KeyboardInterrupt:  # Ctrl-C: the server has shut down (as uvicorn.run ends)
+        pass
+    finally:
+        for sock in sockets:
+            sock.close()
 
 
 @app.command("localize")
@@ -1142,7 +1153,7 @@ def report(
 
     Example: kiseki report --results results -o REPRODUCTION.md"""
     from kiseki._table import show_fields
-    from kiseki.experiments import write_reproduction
+    from kiseki_experiments.harness.report import write_reproduction  # here: start-up time
 
     total, held, missing = write_reproduction(results, output)
     summary = {"output": str(output), "claims": total, "hold": held, "missing": missing}

@@ -256,8 +256,8 @@ def test_global_localization_on_another_map_warns_and_prints_no_nan(inputs):
 
 
 def test_fig_3_14_refuses_settings_that_make_its_claims_meaningless(tmp_path):
-    from kiseki.experiments.config import ConfigError, apply_overrides
-    from kiseki.experiments.fig_3_14 import Fig314Config
+    from kiseki_experiments.harness.config import ConfigError, apply_overrides
+    from kiseki_experiments.teach.fig_3_14 import Fig314Config
 
     for setting, needle in (
         ("beams=0", "--set: beams: must be greater than 0, got 0"),  # the model's own limit
@@ -354,7 +354,7 @@ def test_a_hand_edited_run_config_is_refused_naming_the_file_and_the_key(tmp_pat
     import shutil
 
     from kiseki.errors import KisekiError
-    from kiseki.experiments import run_experiment
+    from kiseki_experiments.harness.runner import run_experiment
 
     run_experiment("fig-3-14", runs=1, out=tmp_path / "run", progress=False)
     text = (tmp_path / "run" / "config.yaml").read_text()
@@ -435,8 +435,8 @@ def test_a_resumed_runs_config_yaml_is_checked_by_its_model(tmp_path, edit, prob
     --seed: one line naming the file and the field (runs and seed were unbounded before)."""
     import yaml
 
-    from kiseki.experiments import run_experiment
-    from kiseki.experiments.config import ConfigError
+    from kiseki_experiments.harness.config import ConfigError
+    from kiseki_experiments.harness.runner import run_experiment
 
     saved = {"experiment": "fig-3-14", "runs": 1, "seed": 0, "config": {}}
     saved = {k: v for k, v in {**saved, **edit}.items() if v is not None}
@@ -456,8 +456,8 @@ def test_a_resumed_runs_config_yaml_is_checked_by_its_model(tmp_path, edit, prob
 
 
 def test_the_command_lines_runs_and_seed_have_the_configs_limits(tmp_path):
-    from kiseki.experiments import run_experiment
-    from kiseki.experiments.config import ConfigError
+    from kiseki_experiments.harness.config import ConfigError
+    from kiseki_experiments.harness.runner import run_experiment
 
     for runs, seed, message in (
         (0, 0, "--runs: must be greater than 0, got 0"),

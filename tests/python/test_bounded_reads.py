@@ -236,7 +236,7 @@ def test_devices_and_fifos_are_refused_by_every_reader_without_being_opened(tmp_
         {"id": "bag folder fifo", "call": "kiseki.datasets:read_bag_scans", "args": [str(bag)]},
         {
             "id": "magnetic map folder zero",
-            "call": "kiseki.magnetic.map_folder:load_map_folder",
+            "call": "kiseki.magnetic.field_map:load_map_folder",
             "args": [str(magnetic)],
         },
         {

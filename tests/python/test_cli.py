@@ -198,7 +198,7 @@ def test_experiment_list_is_plain_lines_when_piped_json_with_json_and_a_table_on
     import os
     import pty
 
-    from kiseki.experiments import all_experiments
+    from kiseki_experiments.harness.registry import all_experiments
 
     names = sorted(all_experiments())
     done = run("experiment", "list")

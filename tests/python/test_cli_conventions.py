@@ -122,7 +122,7 @@ def write_result(results: Path, name: str, holds: list[bool]) -> None:
 
 
 def test_report_json_counts_the_claims_written(tmp_path: Path):
-    from kiseki.experiments import all_experiments
+    from kiseki_experiments.harness.registry import all_experiments
 
     names = sorted(all_experiments())
     write_result(tmp_path / "results", names[0], [True, False, True])

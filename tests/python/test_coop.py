@@ -216,7 +216,7 @@ def test_coop_experiment_claims_and_cli(tmp_path) -> None:
 
     import pandas as pd
 
-    from kiseki.experiments import run_experiment
+    from kiseki_experiments.harness.runner import run_experiment
 
     with pytest.raises(ValueError, match="12 settings"):
         run_experiment(
@@ -401,7 +401,7 @@ def test_the_scene_takes_the_turns_of_form_2_and_its_bearings_triangulate(tmp_pa
 
 
 def test_the_papers_analytic_optimum_n_equals_tan_theta_e() -> None:
-    from kiseki.experiments.coop_forms import analytic_optimum
+    from kiseki_experiments.coop.coop_forms import analytic_optimum
 
     n, theta, _ = analytic_optimum(10.0, 1.0)
     assert (n, round(theta, 6)) == (10, 45.0)  # eqs. 5-6 for the paper's goal

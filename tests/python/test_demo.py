@@ -17,7 +17,7 @@ from rich.console import Console
 
 from kiseki import load_map
 from kiseki.demo import run_demo
-from kiseki.experiments.corridor_scans import CorridorLaser, simulate_scans
+from kiseki_experiments.mapping.corridor_scans import CorridorLaser, simulate_scans
 
 
 def test_demo_teaches_and_plays_back_every_method(tmp_path, project_root):

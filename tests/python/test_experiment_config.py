@@ -11,7 +11,10 @@ import dataclasses
 
 import pytest
 
-from kiseki.experiments.config import (
+from kiseki_experiments.coop.coop_forms import CoopFormsConfig
+from kiseki_experiments.gp.gp_aalto import GpAaltoConfig
+from kiseki_experiments.gp.gp_mcl import MagneticMclExperimentConfig
+from kiseki_experiments.harness.config import (
     LIST_LIMIT,
     PARTICLE_LIMIT,
     RUN_LIMIT,
@@ -20,11 +23,8 @@ from kiseki.experiments.config import (
     config_from_dict,
     config_to_dict,
 )
-from kiseki.experiments.coop_forms import CoopFormsConfig
-from kiseki.experiments.corridor_scans import CorridorScansConfig
-from kiseki.experiments.gp_aalto import GpAaltoConfig
-from kiseki.experiments.gp_mcl import MagneticMclExperimentConfig
-from kiseki.experiments.registry import all_experiments
+from kiseki_experiments.harness.registry import all_experiments
+from kiseki_experiments.mapping.corridor_scans import CorridorScansConfig
 
 
 def _message(call, *args) -> str:
@@ -168,13 +168,11 @@ def test_every_field_that_sizes_time_or_memory_has_its_limit(experiment, setting
     assert _message(apply_overrides, config, [setting]) == f"--set: {message}"
 
 
-def test_every_registered_config_builds_its_model_and_a_bare_number_is_refused(monkeypatch):
-    import types
-
-    from kiseki.experiments import config as config_module
+def test_every_registered_config_builds_its_model_and_a_bare_number_is_refused():
+    from kiseki_experiments.harness import config as config_module
 
     for name, experiment in all_experiments().items():
-        model = config_module._model(experiment.config_type)
+        model = config_module._model(experiment.config_type, name)
         for field in dataclasses.fields(experiment.config_type):
             assert field.name in model.model_fields, (name, field.name)
 
@@ -186,10 +184,8 @@ def test_every_registered_config_builds_its_model_and_a_bare_number_is_refused(m
     class UnboundedItems:
         sizes: list[float] = dataclasses.field(default_factory=list)
 
-    registry = {"fake-exp": types.SimpleNamespace(config_type=Unbounded)}
-    monkeypatch.setattr("kiseki.experiments.registry.all_experiments", lambda: registry)
-    with pytest.raises(TypeError) as err:
-        apply_overrides(Unbounded(), ["beams=2"])
+    with pytest.raises(TypeError) as err:  # the experiment is named by the caller
+        apply_overrides(Unbounded(), ["beams=2"], "fake-exp")
     assert str(err.value).startswith(
         "experiment fake-exp (test_every_registered_config_builds_its_model_and_a_bare_number"
         "_is_refused.<locals>.Unbounded.beams): a bare int has no range"

@@ -9,10 +9,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from kiseki.experiments import run_experiment
-from kiseki.experiments.gp_common import unpack
-from kiseki.experiments.magnav_fig_5_4 import blind_stretch
-from kiseki.experiments.speed_common import WORLDS
+from kiseki_experiments.harness.paths import WORLDS
+from kiseki_experiments.harness.records import unpack
+from kiseki_experiments.harness.runner import run_experiment
+from kiseki_experiments.magnav.magnav_fig_5_4 import blind_stretch
 
 
 def test_one_small_run_reports_what_its_trial_measured(tmp_path):

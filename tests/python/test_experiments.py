@@ -19,9 +19,11 @@ import yaml
 
 from kiseki.core import derive_seed
 from kiseki.errors import KisekiError
-from kiseki.experiments import base, registry, run_experiment, write_reproduction
-from kiseki.experiments.config import ConfigError, apply_overrides
-from kiseki.experiments.corridor_scans import CorridorScansConfig
+from kiseki_experiments.harness import base, registry
+from kiseki_experiments.harness.config import ConfigError, apply_overrides
+from kiseki_experiments.harness.report import write_reproduction
+from kiseki_experiments.harness.runner import run_experiment
+from kiseki_experiments.mapping.corridor_scans import CorridorScansConfig
 
 
 def cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
@@ -258,6 +260,26 @@ def test_report_refuses_a_missing_folder_and_broken_results_in_one_line(
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], done.stderr
     assert not (tmp_path / "R.md").exists()  # no report of 0 claims
+
+
+def test_report_refuses_a_latest_link_outside_the_results_in_one_line(tmp_path):
+    """Was Python's raw relative_to message ("'/.../elsewhere' is not in the subpath of ...")."""
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    elsewhere.joinpath("claims.csv").write_text("claim,holds\nx,True\n")
+    elsewhere.joinpath("manifest.json").write_text(
+        '{"trials": 1, "trials_failed": 0, "git": {"commit": null}}'
+    )
+    latest = tmp_path / "results" / "exp1-corridor" / "latest"
+    latest.parent.mkdir(parents=True)
+    latest.symlink_to(elsewhere)
+    done = cli("report", "--results", "results", "-o", "R.md", cwd=tmp_path)
+    assert done.returncode == 1, done.stdout + done.stderr
+    assert done.stderr.splitlines() == [
+        f"kiseki: error: {Path('results', 'exp1-corridor', 'latest')}: the link points outside "
+        f"--results ({elsewhere})"
+    ]
+    assert not (tmp_path / "R.md").exists()
 
 
 def test_a_run_whose_every_trial_fails_says_so_and_resumes_after_the_fix(tmp_path, monkeypatch):

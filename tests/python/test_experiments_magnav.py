@@ -14,10 +14,14 @@ import pandas as pd
 import pytest
 
 from kiseki.core import Random
-from kiseki.experiments import run_experiment
-from kiseki.experiments.magnav_navigators import closed_form_validity
-from kiseki.experiments.magnav_navigators_report import required_noise
-from kiseki.experiments.magnav_table_4_2 import THESIS_TABLE, Table42Config, changed_stretches
+from kiseki_experiments.harness.runner import run_experiment
+from kiseki_experiments.magnav.magnav_navigators import closed_form_validity
+from kiseki_experiments.magnav.magnav_navigators_report import required_noise
+from kiseki_experiments.magnav.magnav_table_4_2 import (
+    THESIS_TABLE,
+    Table42Config,
+    changed_stretches,
+)
 
 
 def _claims(run_dir) -> pd.DataFrame:

@@ -12,12 +12,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from kiseki.experiments import run_experiment
-from kiseki.experiments.terrain_common import local_maps, object_cells, start_pose
-from kiseki.experiments.terrain_envs import _rise
 from kiseki.sim.pose6 import PAPER_MOVES
 from kiseki.sim.scene import load_scene
 from kiseki.terrain import attitude_matrix
+from kiseki_experiments.harness.runner import run_experiment
+from kiseki_experiments.terrain.terrain_common import local_maps, object_cells, start_pose
+from kiseki_experiments.terrain.terrain_envs import _rise
 
 WORLDS = Path(__file__).resolve().parents[2] / "data" / "worlds"
 TINY = ["search=coarse-to-fine", "exact_gyro_rows=true", "removals=hough"]

@@ -14,12 +14,12 @@ import pytest
 
 from kiseki.datasets import read_aalto_run
 from kiseki.datasets.kok import quaternion_to_matrix
-from kiseki.experiments import run_experiment
-from kiseki.experiments.gp_aalto import GpAaltoConfig, preflight
-from kiseki.experiments.gp_aalto_steps import robot_to_world, travel_heading
-from kiseki.experiments.gp_aalto_tasks import noisy_odometry, sensor_offset
 from kiseki.gp import fit_hyperparameters
 from kiseki.gp.kernel import log_marginal_likelihood
+from kiseki_experiments.gp.gp_aalto import GpAaltoConfig, preflight
+from kiseki_experiments.gp.gp_aalto_steps import robot_to_world, travel_heading
+from kiseki_experiments.gp.gp_aalto_tasks import noisy_odometry, sensor_offset
+from kiseki_experiments.harness.runner import run_experiment
 
 
 def test_travel_heading_is_the_tangent_of_a_circle_and_holds_while_stopped() -> None:

@@ -10,8 +10,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from kiseki.experiments import run_experiment
-from kiseki.experiments.gp_common import (
+from kiseki.sim.scene import load_scene
+from kiseki_experiments.gp.gp_common import (
     FLOOR,
     HALL,
     arm_to_world,
@@ -19,10 +19,10 @@ from kiseki.experiments.gp_common import (
     sensor_to_world,
     survey_2d,
     survey_3d,
-    unpack,
     voxel_average,
 )
-from kiseki.sim.scene import load_scene
+from kiseki_experiments.harness.records import unpack
+from kiseki_experiments.harness.runner import run_experiment
 
 
 def _rz(theta: float) -> np.ndarray:

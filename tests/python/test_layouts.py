@@ -95,7 +95,7 @@ def test_route_aisle_widths_and_what_lies_behind_as_stated(scenes):
 
 
 def test_the_experiment_runs_on_two_layouts_and_writes_the_table(tmp_path):
-    from kiseki.experiments.runner import run_experiment
+    from kiseki_experiments.harness.runner import run_experiment
 
     result = run_experiment(
         "layouts-exp2-exp3",
@@ -118,7 +118,7 @@ def test_the_experiment_runs_on_two_layouts_and_writes_the_table(tmp_path):
 def test_a_refused_route_fails_only_that_method(monkeypatch, tmp_path):
     """Playback refuses a route through the taught map's occupied cells; exp2 then runs once
     per method, so the refusal is recorded for that method and the others still stop."""
-    from kiseki.experiments import layouts as exp
+    from kiseki_experiments.teach import layouts as exp
 
     def fake_trial(cfg, index, seed):
         if "conventional" in cfg.methods:

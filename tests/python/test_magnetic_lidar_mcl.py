@@ -194,7 +194,7 @@ def test_the_correction_beats_laser_only_without_landmarks():
     small (Fig. 5.6; measured 0.05 m and 1.4 deg against 0.79 m and 5.6 deg). The cross-track
     error is compared over the whole 70 m stretch by magnav-fig-5-4 (22 m is too short: the
     odometry's heading drift there is below the reset's own noise)."""
-    from kiseki.experiments.magnav_lidar_drive import drive, teach_heading_map
+    from kiseki_experiments.magnav.magnav_lidar_drive import drive, teach_heading_map
 
     hmap = teach_heading_map(SCENE, seed=0)
     config = LidarMclConfig(particles=60, beams=20)

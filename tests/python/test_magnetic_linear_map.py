@@ -24,7 +24,7 @@ from kiseki.magnetic import (
     path_identity,
     save_linear_map,
 )
-from kiseki.magnetic.map_folder import load_map_folder, save_map_folder
+from kiseki.magnetic.field_map import load_map_folder, save_map_folder
 
 PATH = path_identity([[0.0, 0.0], [118.0, 0.0]])
 OTHER = path_identity([[0.0, 0.0], [50.0, 5.0]])

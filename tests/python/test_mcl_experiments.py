@@ -10,10 +10,10 @@ import numpy as np
 import pandas as pd
 
 from kiseki.core import Pose2
-from kiseki.experiments import run_experiment
-from kiseki.experiments.mcl_excursions import excursions
-from kiseki.experiments.mcl_kidnapping import splice
 from kiseki.scans import LaserScans
+from kiseki_experiments.harness.runner import run_experiment
+from kiseki_experiments.mcl.mcl_excursions import excursions
+from kiseki_experiments.mcl.mcl_kidnapping import splice
 
 
 def test_splice_carries_the_robot_and_keeps_the_odometry_smooth() -> None:

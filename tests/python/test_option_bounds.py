@@ -3,12 +3,12 @@
 """Issue 27, items 3 and 4, on every command of the command line.
 
 Bounded numbers: every numeric option declares its range (kiseki._options), and a walk feeds
-0, -1, 2**31, 2**63, +-1e308, NaN, +-inf and two non-numbers to every numeric option of every
-command through the command line's parsing alone (click's make_context: the command does not
-run): each value is accepted exactly when it lies in the declared range, and refused otherwise
-with one line naming the option; never another exception. Options that do not apply to the
-chosen mode are errors naming them. Each defect of the issue is run as a user runs it
-(kiseki.cli.main, in this process: no Python start per case)."""
+0, -0, -0.0, -1, 2**31, 2**63, +-1e308, NaN, +-inf and two non-numbers to every numeric option
+of every command through the command line's parsing alone (click's make_context: the command
+does not run): each value is accepted exactly when it lies in the declared range (a zero as
++0.0), and refused otherwise with one line naming the option; never another exception.
+Options that do not apply to the chosen mode are errors naming them. Each defect of the issue
+is run as a user runs it (kiseki.cli.main, in this process: no Python start per case)."""
 
 from __future__ import annotations
 
@@ -36,7 +36,8 @@ from kiseki._options import (
 from kiseki.cli import app, main
 from test_boundaries_cli import room, write_log
 
-PROBES = ("0", "-1", str(2**31), str(2**63), "1e308", "-1e308", "nan", "inf", "-inf")
+PROBES = ("0", "-0", "-0.0", "-1", str(2**31), str(2**63), "1e308", "-1e308", "nan", "inf",
+          "-inf")  # fmt: skip
 NOT_NUMBERS = ("abc", "1.5e")
 WALK_BUDGET_S = 10.0  # every value into every numeric option of every command
 
@@ -132,11 +133,22 @@ def _fillers(command, skip) -> tuple[list[str], list[str]]:
     return positional, options
 
 
+def _negative_zeros(params: dict) -> list[str]:
+    """The parameters holding a -0.0 (numpy's samplers refuse a scale of -0.0: "scale < 0")."""
+    found = []
+    for name, value in params.items():
+        for v in value if isinstance(value, tuple | list) else (value,):
+            if isinstance(v, float) and v == 0 and math.copysign(1.0, v) < 0:
+                found.append(name)
+    return found
+
+
 def _parse(words, command, args) -> str | None:
-    """Parses ``args`` as the command line does (the command does not run): None when accepted,
-    else the refusal's message. Any other exception fails the test."""
+    """Parses ``args`` as the command line does (the command does not run): None when accepted
+    (a zero taken as +0.0), else the refusal's message. Any other exception fails the test."""
     try:
-        with command.make_context(" ".join(words), list(args)):
+        with command.make_context(" ".join(words), list(args)) as ctx:
+            assert _negative_zeros(ctx.params) == [], (words, args)
             return None
     except OptionValueError as err:
         return str(err)
@@ -167,10 +179,10 @@ def test_every_value_is_in_range_or_refused_naming_its_option():
 
 
 def test_the_shared_limits_are_the_libraries_own():
-    from kiseki.experiments.config import PARTICLE_LIMIT as EXPERIMENT_PARTICLES
-    from kiseki.experiments.config import RUN_LIMIT as EXPERIMENT_RUNS
     from kiseki.localization import MclConfig
     from kiseki.sim.run import MAX_SIM_SECONDS
+    from kiseki_experiments.harness.config import PARTICLE_LIMIT as EXPERIMENT_PARTICLES
+    from kiseki_experiments.harness.config import RUN_LIMIT as EXPERIMENT_RUNS
 
     assert (PARTICLE_LIMIT, RUN_LIMIT) == (EXPERIMENT_PARTICLES, EXPERIMENT_RUNS)
     assert SIM_SECONDS_LIMIT == MAX_SIM_SECONDS
@@ -230,6 +242,60 @@ def test_the_issues_defects_are_one_line_and_exit_1(inputs, monkeypatch, capsys,
     assert (code, err.splitlines()) == (1, [f"kiseki: error: {line}"]), err
     assert caught == [] and "warning" not in err.lower()  # numpy's overflow warning was printed
     assert sorted(p.name for p in inputs.iterdir()) == before  # nothing written
+
+
+def test_a_negative_zero_is_zero(tmp_path, monkeypatch, capsys):
+    """Was "kiseki: error: scale < 0" (numpy's, naming no option): -0.0 >= 0 passed the range
+    and reached numpy's sampler with its sign bit set."""
+    monkeypatch.chdir(tmp_path)
+    for zero in ("-0", "-0.0"):
+        code, out, err = kiseki(monkeypatch, capsys, "coop", "simulate", "--runs", "1",
+                                "--sigma", zero)  # fmt: skip
+        assert (code, err) == (0, ""), err
+        assert "0.0 deg: error at the goal mean 0.0 mm" in out
+
+
+MAGNETIC_POINTS = "x,y,mx,my,mz\n0,0,1,2,3\n1,0,1.5,2,3\n0,1,1,2.5,3\n1,1,1,2,3.5\n0.5,0.5,1,2,3\n"
+
+
+@pytest.mark.parametrize(
+    ("kernel", "line"),
+    [
+        # was an OverflowError traceback, exit 3 (sigma_f squared is inf)
+        ("1e200,1,0.5", "--kernel: sigma_f must be a number in [1e-6, 1e6] (the data's units), "
+         "got 1e200"),
+        # were taken: a map from a length scale of 1e308 m and a noise SD of 1e-200
+        ("10,1e308,0.5", "--kernel: l must be a number in [1e-6, 1e6] (m), got 1e308"),
+        ("1,1,1e-200", "--kernel: sigma_n must be a number in [1e-6, 1e6] (the data's units), "
+         "got 1e-200"),
+        ("1,-0,0.5", "--kernel: l must be a number in [1e-6, 1e6] (m), got -0"),
+        ("1,1,nan", "--kernel: sigma_n must be a number in [1e-6, 1e6] (the data's units), "
+         "got nan"),
+        ("1,1", "--kernel must be three numbers sigma_f,l,sigma_n, got 1,1"),
+        ("1,x,1", "--kernel must be three numbers sigma_f,l,sigma_n, got 1,x,1"),
+    ],
+)  # fmt: skip
+def test_the_kernels_numbers_have_limits(tmp_path, monkeypatch, capsys, kernel, line):
+    monkeypatch.chdir(tmp_path)
+    Path("pts.csv").write_text(MAGNETIC_POINTS)
+    code, _, err = kiseki(monkeypatch, capsys, "magnetic", "fit", "pts.csv", "-o", "m",
+                          "--kernel", kernel)  # fmt: skip
+    assert (code, err.splitlines()) == (1, [f"kiseki: error: {line}"]), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pts.csv"]  # nothing written
+
+
+@pytest.mark.parametrize(
+    "kernel", ["1e-6,1e-6,1e-6", "1e6,1e6,1e6", "1e6,1e6,1e-6", "1e-6,1e6,1e6"]
+)
+@pytest.mark.parametrize("method", ["exact", "hilbert"])
+def test_the_kernels_limits_fit_or_say_why_in_one_line(tmp_path, monkeypatch, capsys, kernel,
+                                                        method):  # fmt: skip
+    """The controls: the limits themselves are taken, and the GP fits or refuses in one line."""
+    monkeypatch.chdir(tmp_path)
+    Path("pts.csv").write_text(MAGNETIC_POINTS)
+    code, _, err = kiseki(monkeypatch, capsys, "magnetic", "fit", "pts.csv", "-o", "m",
+                          "--kernel", kernel, "--method", method)  # fmt: skip
+    assert code in (0, 1) and len(err.splitlines()) == code, err
 
 
 def _flat_map_without_data(folder: Path) -> None:

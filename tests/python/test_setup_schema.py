@@ -23,9 +23,9 @@ from kiseki.sim.sensors import (
     BearingParams,
     DepthCameraParams,
     Mount,
-    TiltingLaserParams,
 )
 from kiseki.sim.setup import build_robot, build_sensors
+from kiseki.sim.tilting_laser import TiltingLaserParams
 
 ROOT = Path(__file__).resolve().parents[2]
 WORLDS = ROOT / "data" / "worlds"

@@ -31,9 +31,8 @@ from kiseki.sim.sensors import (
     DepthCameraParams,
     Laser2D,
     Mount,
-    TiltingLaser,
-    TiltingLaserParams,
 )
+from kiseki.sim.tilting_laser import TiltingLaser, TiltingLaserParams
 
 WORLDS = sorted((Path(__file__).resolve().parents[2] / "data" / "worlds").glob("*.yaml"))
 

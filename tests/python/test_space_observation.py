@@ -244,7 +244,7 @@ def plain_local(grid):
 
 
 def test_fig_3_14_claims_hold(tmp_path):
-    from kiseki.experiments import run_experiment
+    from kiseki_experiments.harness.runner import run_experiment
 
     result = run_experiment("fig-3-14", runs=3, out=tmp_path / "f", progress=False)
     claims = pd.read_csv(result.run_dir / "claims.csv")

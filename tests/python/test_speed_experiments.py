@@ -14,11 +14,16 @@ import pandas as pd
 import pytest
 
 from kiseki.core import Random
-from kiseki.experiments import run_experiment
-from kiseki.experiments.speed_common import WORLDS, prior_map
-from kiseki.experiments.speed_pedestrian import HALF_BODY, PedestrianConfig, _encounter, _reference
 from kiseki.grid import OCCUPIED, UNKNOWN
 from kiseki.sim.scene import load_scene
+from kiseki_experiments.harness.runner import run_experiment
+from kiseki_experiments.speed.speed_common import WORLDS, prior_map
+from kiseki_experiments.speed.speed_pedestrian import (
+    HALF_BODY,
+    PedestrianConfig,
+    _encounter,
+    _reference,
+)
 
 
 def test_prior_map_is_the_inside_of_the_building():

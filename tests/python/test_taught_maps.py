@@ -266,7 +266,7 @@ def test_merge_rules_experiment_on_the_intel_log(shared_data, tmp_path):
     """Real scans: the thesis' rule lets stray beams free wall cells, evidence counting keeps
     more of the endpoints on the map; both maps still track the log (a short prefix here;
     `kiseki experiment run merge-rules` runs the four logs whole)."""
-    from kiseki.experiments import run_experiment
+    from kiseki_experiments.harness.runner import run_experiment
 
     run = run_experiment(
         "merge-rules",

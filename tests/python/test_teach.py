@@ -175,7 +175,7 @@ def test_bad_input(tmp_path, project_root):
 
 
 def test_experiment_trial_records_the_goal_likelihood_profile():
-    from kiseki.experiments.teach_playback import PROFILE_OFFSETS, Exp2Config, trial
+    from kiseki_experiments.teach.teach_playback import PROFILE_OFFSETS, Exp2Config, trial
 
     record = trial(Exp2Config(methods=["proposal1"], particles=100), 0, 0).record
     along = [record[f"proposal1_goal_like_along_{o:+.2f}"] for o in PROFILE_OFFSETS]

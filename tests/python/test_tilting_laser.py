@@ -21,7 +21,6 @@ from kiseki.sim.primitives import BoxList
 from kiseki.sim.run import SimConfig, simulate
 from kiseki.sim.scene import load_scene
 from kiseki.sim.sensors import Mount
-from kiseki.sim.sensors import TiltingLaser as FromSensors
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.sim.tilting_laser import TiltingLaser, TiltingLaserParams, median_of_sweeps
 
@@ -87,10 +86,6 @@ def test_eq_two_as_printed_is_the_opposite_sign():
     compare(ranges, expected_ranges(params, flip, 0.5, None), params.usable_range)
     tilt, _ = params.grid()
     assert np.isnan(ranges[np.argmin(np.abs(np.degrees(tilt) + 17))]).all()  # -17: no floor
-
-
-def test_the_laser_is_still_importable_from_sensors():
-    assert FromSensors is TiltingLaser
 
 
 # ------------------------------------------------------------------------------ 2. 6-DOF pose

@@ -48,7 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from kiseki._inputs import MIB, check_input, decompressed_size, describe_bytes
-from kiseki.datasets.magnetic import MagneticSamples
+from kiseki.datasets.magnetic_samples import MagneticSamples
 from kiseki.errors import LogFormatError
 
 __all__ = ["MAX_MAT_BYTES", "SENSOR_TO_BODY", "quaternion_to_matrix", "read_kok_walk"]

@@ -12,8 +12,9 @@ a multiple of the resolution, so every voxel is the cell of one OctoMap key at t
 (OctoMap: ``key = floor(c / resolution) + 32768``, centre ``(key - 32768 + 0.5) *
 resolution``; voxel index i on an axis is key ``origin / resolution + 32768 + i``).
 
-On disk a map is a folder (kind and dimension declared in ``magnetic_map.yaml``): see
-:mod:`kiseki.magnetic.map_folder` for the layout.
+On disk a map is a folder (kind and dimension declared in ``magnetic_map.yaml``):
+:func:`save_map_folder` and :func:`load_map_folder` (and the map's ``save`` and ``load``) write
+and read it through :mod:`kiseki.magnetic.map_folder`, which holds the layout.
 """
 
 from __future__ import annotations
@@ -22,15 +23,24 @@ import itertools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import MappingProxyType
 
 import numpy as np
 
+from kiseki.errors import MapFormatError
 from kiseki.gp import SquaredExponential
+from kiseki.magnetic.map_folder import COMPONENTS, read_map_folder, write_map_folder
 
-__all__ = ["COMPONENTS", "MAX_CELLS", "MagneticFieldMap", "TrainingData"]
+__all__ = [
+    "COMPONENTS",
+    "MAX_CELLS",
+    "MagneticFieldMap",
+    "TrainingData",
+    "load_map_folder",
+    "save_map_folder",
+]
 
-COMPONENTS = ("mx", "my", "mz")
 MAX_CELLS = 20_000_000  # 6 float64 layers: about 1 GB in memory
 OCTOMAP_KEY_OFFSET = 32768  # tree_max_val of OctoMap's default 16-level tree
 _CHUNK = 20_000  # at most this many cells per gp.predict call
@@ -290,18 +300,39 @@ class MagneticFieldMap:
         )
 
     def save(self, folder) -> None:
-        """Writes the map folder (write-then-rename of the whole folder); see map_folder."""
-        from kiseki.magnetic.map_folder import save_map_folder
-
+        """Writes the map folder (write-then-rename of the whole folder): save_map_folder."""
         save_map_folder(self, folder)
 
     @classmethod
     def load(cls, folder) -> MagneticFieldMap:
-        """Reads a map folder, refusing (MapFormatError naming the file) another kind, a
-        missing layer, shapes that disagree and non-finite values."""
-        from kiseki.magnetic.map_folder import load_map_folder
-
+        """Reads a map folder (MapFormatError naming the file): load_map_folder."""
         return load_map_folder(folder)
+
+
+def save_map_folder(fmap: MagneticFieldMap, folder) -> Path:
+    """Writes `fmap` to `folder` (the layout: :mod:`kiseki.magnetic.map_folder`): a temporary
+    folder beside it, renamed into place; an existing map folder (or an empty folder) is
+    replaced, anything else refused. Returns the folder as a Path."""
+    if not isinstance(fmap, MagneticFieldMap):
+        raise ValueError(f"expected a MagneticFieldMap, got {type(fmap).__name__}")
+    return write_map_folder(fmap, folder)
+
+
+def load_map_folder(folder) -> MagneticFieldMap:
+    """The map in a folder written by :func:`save_map_folder`. Raises FileNotFoundError when the
+    folder is absent, MapFormatError naming the file for another kind of folder, a missing
+    layer, shapes that disagree, NaN or a malformed description."""
+    contents = read_map_folder(folder)
+    training = None
+    if contents.training is not None:
+        try:
+            training = TrainingData(**contents.training)
+        except ValueError as err:
+            raise MapFormatError(f"{contents.training_file}: {err}") from None
+    try:
+        return MagneticFieldMap(**contents.fields, training=training)
+    except ValueError as err:
+        raise MapFormatError(f"{contents.description}: {err}") from None
 
 
 def _points(points, d: int) -> np.ndarray:

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """The model of a magnetic field map folder's description, ``magnetic_map.yaml`` (written by
-:func:`kiseki.magnetic.map_folder.save_map_folder`; it may have been edited by hand)::
+:func:`kiseki.magnetic.field_map.save_map_folder`; it may have been edited by hand)::
 
     kind: magnetic_field_map
     format_version: 1

@@ -25,6 +25,9 @@ OctoMap key ``origin / resolution + 32768 + (i, j, k)`` (the YAML's ``octomap_ke
 
 ``training.npz`` (X (n, d), Y (n, 3)), when the map keeps its measurements, lets predictions
 re-evaluate the GP exactly. A folder is written under a temporary name and renamed into place.
+
+The files alone: :func:`write_map_folder` writes a map's fields, :func:`read_map_folder` reads
+them back checked; the map type (:mod:`kiseki.magnetic.field_map`) builds on this module.
 """
 
 from __future__ import annotations
@@ -33,6 +36,7 @@ import os
 import shutil
 import struct
 import tempfile
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -43,17 +47,21 @@ from kiseki._inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_t
 from kiseki._yaml import safe_load_12
 from kiseki.errors import MapFormatError
 from kiseki.gp import SquaredExponential
-from kiseki.magnetic.field_map import COMPONENTS, MagneticFieldMap, TrainingData
 from kiseki.magnetic.map_doc import Kernel, MagneticMapDoc, read_map_doc
 
 __all__ = [
+    "COMPONENTS",
     "MAP_FILE",
     "MAX_FILE_BYTES",
     "KIND",
+    "MapFolderContents",
     "check_map_destination",
-    "load_map_folder",
-    "save_map_folder",
+    "read_map_folder",
+    "write_map_folder",
 ]
+
+COMPONENTS = ("mx", "my", "mz")
+"""The field's components, in the order of the maps' last axis and of the layers' names."""
 
 MAP_FILE = "magnetic_map.yaml"
 LINEAR_MAP_FILE = "linear_map.yaml"  # kiseki.magnetic.linear_map_folder.MAP_FILE: refused here
@@ -118,7 +126,7 @@ def _kernel_doc(kernel) -> dict:
     return {c: one(k) for c, k in zip(COMPONENTS, kernel, strict=True)}
 
 
-def _document(fmap: MagneticFieldMap, files: dict) -> dict:
+def _document(fmap, files: dict) -> dict:
     from kiseki import __version__
 
     d = fmap.dimension
@@ -156,7 +164,7 @@ def _document(fmap: MagneticFieldMap, files: dict) -> dict:
     return doc
 
 
-def _write_layers_2d(fmap: MagneticFieldMap, tmp: Path) -> dict:
+def _write_layers_2d(fmap, tmp: Path) -> dict:
     from kiseki.map_io import write_image
 
     arrays = {"origin": fmap.origin, "resolution": np.float64(fmap.resolution)}
@@ -175,12 +183,11 @@ def _write_layers_2d(fmap: MagneticFieldMap, tmp: Path) -> dict:
     return {"layers": images, "arrays": "layers.npz"}
 
 
-def save_map_folder(fmap: MagneticFieldMap, folder) -> Path:
-    """Writes `fmap` to `folder` (see the module text): a temporary folder beside it, renamed
-    into place; an existing map folder (or an empty folder) is replaced, anything else
-    refused."""
-    if not isinstance(fmap, MagneticFieldMap):
-        raise ValueError(f"expected a MagneticFieldMap, got {type(fmap).__name__}")
+def write_map_folder(fmap, folder) -> Path:
+    """Writes the fields of `fmap` (a :class:`~kiseki.magnetic.field_map.MagneticFieldMap`,
+    checked by :func:`~kiseki.magnetic.field_map.save_map_folder`) to `folder` (see the module
+    text): a temporary folder beside it, renamed into place; an existing map folder (or an empty
+    folder) is replaced, anything else refused."""
     folder = check_map_destination(folder)
     tmp = Path(tempfile.mkdtemp(dir=folder.parent, prefix=f".{folder.name}."))
     try:
@@ -317,22 +324,36 @@ def _read_3d(folder: Path, doc: MagneticMapDoc, meta: Path, origin, resolution, 
     return arrays["mean"], arrays["variance"]
 
 
-def _read_training(folder: Path, doc: MagneticMapDoc, meta: Path) -> TrainingData | None:
+def _read_training(
+    folder: Path, doc: MagneticMapDoc, meta: Path
+) -> tuple[dict | None, Path | None]:
     if "training" not in doc.files:
-        return None
+        return None, None
     info = doc.training
     if info is None:
         raise _fail(meta, "training: missing (files names training data it does not describe)")
     path = _file(folder, doc.files, "training", meta)
     arrays = _read_npz(path, {"X": (info.points, None), "Y": (info.points, 3)})
-    try:
-        return TrainingData(arrays["X"], arrays["Y"], info.method, info.mean, info.hilbert)
-    except ValueError as err:
-        raise _fail(path, str(err)) from None
+    names = ("inputs", "outputs", "method", "mean", "hilbert")
+    values = (arrays["X"], arrays["Y"], info.method, info.mean, info.hilbert)
+    return dict(zip(names, values, strict=True)), path
 
 
-def load_map_folder(folder) -> MagneticFieldMap:
-    """Reads a map folder written by :func:`save_map_folder`. Raises FileNotFoundError when the
+@dataclass(frozen=True, eq=False)
+class MapFolderContents:
+    """A map folder, read and checked: the keyword arguments of ``MagneticFieldMap`` but
+    ``training`` (``fields``) and of ``TrainingData`` (``training``, or None), and the files a
+    problem in them is reported against (``description``, the YAML; ``training_file``)."""
+
+    fields: dict
+    training: dict | None
+    description: Path
+    training_file: Path | None
+
+
+def read_map_folder(folder) -> MapFolderContents:
+    """Reads a map folder written by :func:`write_map_folder` (a map is built from it by
+    :func:`kiseki.magnetic.field_map.load_map_folder`). Raises FileNotFoundError when the
     folder is absent, MapFormatError naming the file for another kind of folder, a missing
     layer, shapes that disagree, NaN or a malformed description."""
     from kiseki._yaml import read_yaml_file
@@ -361,21 +382,17 @@ def load_map_folder(folder) -> MagneticFieldMap:
     kernel = doc.kernel.kernels()
     kernels = [kernel] if isinstance(kernel, Kernel) else list(kernel)
     se = [SquaredExponential(k.sigma_f, k.length_scale, k.sigma_n) for k in kernels]
-    try:
-        return MagneticFieldMap(
-            origin=origin,
-            resolution=resolution,
-            mean=mean,
-            variance=variance,
-            prior_mean=np.array(doc.prior_mean),
-            prior_variance=np.array(doc.prior_variance),
-            kernel=se[0] if isinstance(kernel, Kernel) else tuple(se),
-            units=doc.units,
-            height=doc.height if d == 2 else None,
-            provenance=doc.provenance or {},
-            training=_read_training(folder, doc, meta),
-        )
-    except ValueError as err:
-        if isinstance(err, MapFormatError):
-            raise
-        raise _fail(meta, str(err)) from None
+    fields = {
+        "origin": origin,
+        "resolution": resolution,
+        "mean": mean,
+        "variance": variance,
+        "prior_mean": np.array(doc.prior_mean),
+        "prior_variance": np.array(doc.prior_variance),
+        "kernel": se[0] if isinstance(kernel, Kernel) else tuple(se),
+        "units": doc.units,
+        "height": doc.height if d == 2 else None,
+        "provenance": doc.provenance or {},
+    }
+    training, training_file = _read_training(folder, doc, meta)
+    return MapFolderContents(fields, training, meta, training_file)

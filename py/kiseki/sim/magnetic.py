@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -48,6 +47,15 @@ from kiseki.sim._values import float_array as _float_array
 from kiseki.sim._values import points as _points
 from kiseki.sim._values import poses as _poses
 from kiseki.sim._values import times as _times
+from kiseki.sim.dipoles import (
+    DEFAULT_DIPOLE_RADIUS,
+    MU0_OVER_4PI_GAUSS,
+    Dipole,
+    DipoleLine,
+    dipole_field,
+)
+from kiseki.sim.magnetic_lattice import DipoleLattice
+from kiseki.sim.magnetic_schema import EarthAngles, MagneticSection
 
 __all__ = [
     "DEFAULT_DECLINATION_DEG",
@@ -70,10 +78,6 @@ __all__ = [
     "magnetic_azimuth",
     "robot_self_sources",
 ]
-
-#: mu0 / (4 pi) in G m / A: 1e-7 T m / A (exact in the pre-2019 SI, 1e-10 relative off since)
-#: times 1e4 G / T. A moment of m A m^2 at r metres gives fields of order 1e-3 m / r^3 G.
-MU0_OVER_4PI_GAUSS = 1e-3
 
 #: Total intensity of the Earth's field, G (46.5 uT). Assumption: the thesis' experiments were
 #: at Utsunomiya and Tsukuba (thesis ch. 5, Tsukuba Challenge), near the JMA Kakioka observatory
@@ -112,137 +116,7 @@ DEFAULT_MOUNT = (0.0, 0.0, 0.5)
 #: 0.3 m and varies 2-fold with direction, so the moment must lie in (0.0100, 0.0135).
 ROBOT_SOURCE_MOMENT = 0.012
 
-#: Default radius of the uniformly magnetised sphere a :class:`Dipole` stands for, m.
-DEFAULT_DIPOLE_RADIUS = 0.02
-
 _TWO_PI = 2.0 * math.pi
-
-
-# --------------------------------------------------------------------------------------------
-# input checks
-
-
-def dipole_field(points: Any, positions: Any, moments: Any, radii: Any) -> np.ndarray:
-    """Field in G at ``points`` (n, 3) of dipoles at ``positions`` (k, 3) with ``moments``
-    (k, 3) A m^2, summed over the dipoles.
-
-    Outside radius ``radii[j]`` of dipole j this is the closed form
-    ``B = mu0/(4 pi) (3 (m . r_hat) r_hat - m) / |r|^3`` (Jackson, Classical Electrodynamics,
-    eq. 5.56). Inside it, the source is taken to be a uniformly magnetised sphere of that radius
-    (whose outside field is exactly the dipole field), so the field there is the sphere's uniform
-    interior field ``mu0/(4 pi) 2 m / R^3`` (Jackson eq. 5.104): bounded, and equal to the
-    on-axis outside field at the surface. This guards the 1/r^3 singularity.
-    """
-    p, _ = _points(points)
-    q = np.asarray(positions, dtype=float).reshape(-1, 3)
-    m = np.asarray(moments, dtype=float).reshape(-1, 3)
-    rad = np.broadcast_to(np.asarray(radii, dtype=float), (q.shape[0],))
-    out = np.zeros_like(p)
-    k = q.shape[0]
-    if k == 0 or p.shape[0] == 0:
-        return out
-    block = max(1, 250_000 // k)  # bounds the (block, k) temporaries to ~2 MB each
-    inside_field = 2.0 * m / rad[:, None] ** 3  # (k, 3)
-    rad2 = rad**2
-    for start in range(0, p.shape[0], block):
-        pb = p[start : start + block]
-        r = [pb[:, c : c + 1] - q[:, c] for c in range(3)]  # components of p - q, (b, k) each
-        d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2]
-        inside = d2 < rad2
-        any_inside = bool(inside.any())
-        inv2 = 1.0 / (np.where(inside, 1.0, d2) if any_inside else d2)
-        inv3 = inv2 * np.sqrt(inv2)  # 1 / |r|^3
-        mr3 = (r[0] * m[:, 0] + r[1] * m[:, 1] + r[2] * m[:, 2]) * (3.0 * inv2)  # 3 (m.r) / r^2
-        for c in range(3):
-            b = (mr3 * r[c] - m[:, c]) * inv3
-            if any_inside:
-                b = np.where(inside, inside_field[:, c], b)
-            out[start : start + block, c] = b.sum(axis=1)
-    return MU0_OVER_4PI_GAUSS * out
-
-
-@dataclass(frozen=True, eq=False)
-class Dipole:
-    """A permanent point dipole: a piece of steel, a motor, a battery.
-
-    ``position`` (3,) m and ``moment`` (3,) A m^2 in the frame of whoever holds it (the world
-    for :class:`MagneticWorld`, the body for a :class:`Magnetometer`'s self-sources).
-    ``radius`` m: inside it the source is a uniformly magnetised sphere (see
-    :func:`dipole_field`); default 0.02 m, an assumption (the size of a small motor).
-    """
-
-    position: np.ndarray
-    moment: np.ndarray
-    radius: float = DEFAULT_DIPOLE_RADIUS
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "position", _finite_array(self.position, (3,), "position"))
-        object.__setattr__(self, "moment", _finite_array(self.moment, (3,), "moment"))
-        r = _finite_scalar(self.radius, "radius", minimum=0.0, strict=True)
-        object.__setattr__(self, "radius", r)
-
-    def field_at(self, points: Any) -> np.ndarray:
-        """Field in G at (n, 3) points (or one (3,) point) in the holder's frame."""
-        p, single = _points(points)
-        b = dipole_field(p, self.position, self.moment, self.radius)
-        return b[0] if single else b
-
-
-@dataclass(frozen=True, eq=False)
-class DipoleLine:
-    """A steel beam, pipe or rebar from ``start`` to ``end`` (m) as a row of point dipoles.
-
-    The segment is cut into ``N = max(1, round(L / spacing))`` equal pieces; piece i is a dipole
-    at its midpoint ``start + (i + 1/2) (end - start) / N`` with moment
-    ``moment_per_metre * L / N`` (A m^2), so the total moment is ``moment_per_metre * L``
-    (midpoint rule for a uniformly magnetised line). Sensors more than about one ``spacing``
-    away see a smooth line; closer they see the individual dipoles. ``radius`` (default
-    ``spacing / 2``, neighbouring spheres touching) guards each dipole's singularity.
-    """
-
-    start: np.ndarray
-    end: np.ndarray
-    moment_per_metre: np.ndarray
-    spacing: float = 0.1
-    radius: float | None = None
-    positions: np.ndarray = field(init=False, repr=False)
-    moments: np.ndarray = field(init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        a = _finite_array(self.start, (3,), "start")
-        b = _finite_array(self.end, (3,), "end")
-        mpm = _finite_array(self.moment_per_metre, (3,), "moment_per_metre")
-        spacing = _finite_scalar(self.spacing, "spacing", minimum=0.0, strict=True)
-        length = float(np.linalg.norm(b - a))
-        if length == 0.0:
-            raise ValueError("DipoleLine: start and end coincide (zero length)")
-        radius = spacing / 2 if self.radius is None else self.radius
-        radius = _finite_scalar(radius, "radius", minimum=0.0, strict=True)
-        n = max(1, round(length / spacing))
-        frac = (np.arange(n) + 0.5) / n
-        object.__setattr__(self, "start", a)
-        object.__setattr__(self, "end", b)
-        object.__setattr__(self, "moment_per_metre", mpm)
-        object.__setattr__(self, "spacing", spacing)
-        object.__setattr__(self, "radius", radius)
-        object.__setattr__(self, "positions", a + frac[:, None] * (b - a))
-        object.__setattr__(self, "moments", np.tile(mpm * (length / n), (n, 1)))
-
-    @property
-    def length(self) -> float:
-        return float(np.linalg.norm(self.end - self.start))
-
-    def dipoles(self) -> list[Dipole]:
-        """The line's point dipoles."""
-        return [
-            Dipole(p, m, self.radius) for p, m in zip(self.positions, self.moments, strict=True)
-        ]
-
-    def field_at(self, points: Any) -> np.ndarray:
-        """Field in G at (n, 3) points (or one (3,) point)."""
-        p, single = _points(points)
-        b = dipole_field(p, self.positions, self.moments, self.radius)
-        return b[0] if single else b
 
 
 def robot_self_sources(moment: float = ROBOT_SOURCE_MOMENT) -> list[Dipole]:
@@ -326,8 +200,6 @@ class MagneticWorld:
         drift_phase: float = 0.0,
         lattices: Iterable[Any] = (),
     ) -> None:
-        from kiseki.sim.magnetic_lattice import DipoleLattice  # it builds on this module
-
         self.earth_field = (
             default_earth_field()
             if earth_field is None
@@ -438,9 +310,6 @@ class MagneticWorld:
         (after ``at``, e.g. ``("magnetic",)``) and the value. ``variant`` (``teach`` or
         ``playback``, as :func:`kiseki.sim.scene.load_scene`'s) keeps the sources marked
         ``only_in`` that variant and drops those marked with the other one."""
-        from kiseki.sim.magnetic_lattice import DipoleLattice  # it builds on this module
-        from kiseki.sim.magnetic_schema import EarthAngles, MagneticSection
-
         if variant not in ("teach", "playback"):
             raise ValueError(f"{source}: variant must be teach or playback, got {variant!r}")
         spec = parse(MagneticSection, d, source, at=at)

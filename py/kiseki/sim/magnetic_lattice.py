@@ -27,7 +27,7 @@ from kiseki.core import Random, check_seed
 from kiseki.sim._values import finite_array as _finite_array
 from kiseki.sim._values import finite_scalar as _finite_scalar
 from kiseki.sim._values import points as _points
-from kiseki.sim.magnetic import dipole_field
+from kiseki.sim.dipoles import dipole_field
 
 __all__ = ["MAX_LATTICE_DIPOLES", "DipoleLattice"]
 
@@ -44,7 +44,7 @@ class DipoleLattice:
     A side of length ``L > 0`` holds ``max(1, round(L / spacing))`` cells of equal size. Moments
     (A m^2) are ``moment_mean + moment_sd * n`` with ``n`` standard normals drawn in row order
     (dipole by dipole, x, y, z) from ``Random(seed)``. ``radius`` (default ``spacing / 2``)
-    guards each dipole's singularity as in :class:`kiseki.sim.magnetic.DipoleLine`.
+    guards each dipole's singularity as in :class:`kiseki.sim.dipoles.DipoleLine`.
     """
 
     lower: np.ndarray

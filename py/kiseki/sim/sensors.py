@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Range sensors of the papers: 2-D laser scanners, the Xtion-like depth camera and the tilting
-laser of the rubble paper (kiseki.sim.tilting_laser, importable from here too). Geometry is ray
-cast in C++; noise is applied here with kiseki's seeded generator. Every parameter names its
+"""Range sensors of the papers: 2-D laser scanners and the Xtion-like depth camera (the tilting
+laser of the rubble paper is kiseki.sim.tilting_laser, which builds on this module). Geometry is
+ray cast in C++; noise is applied here with kiseki's seeded generator. Every parameter names its
 source (datasheet, paper, or stated assumption).
 """
 
@@ -33,18 +33,6 @@ __all__ = [
     "LaserParams",
     "Mount",
 ]
-
-
-_TILTING = ("MAX_TILT_RAYS", "TiltingLaser", "TiltingLaserParams")
-
-
-def __getattr__(name: str):
-    """The tilting laser moved to kiseki.sim.tilting_laser (which imports this module)."""
-    if name in _TILTING:
-        from kiseki.sim import tilting_laser
-
-        return getattr(tilting_laser, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 # Limits on what sizes memory and time: rays cast per reading and how far each goes.

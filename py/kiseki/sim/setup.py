@@ -30,13 +30,7 @@ from kiseki.sim.collisions import check_free_start
 from kiseki.sim.magnetic import MagneticWorld, Magnetometer
 from kiseki.sim.magnetic_arm import arm_sensor_from_spec
 from kiseki.sim.scene import Scene
-from kiseki.sim.sensors import (
-    BearingSensor,
-    DepthCamera,
-    Laser2D,
-    Mount,
-    TiltingLaser,
-)
+from kiseki.sim.sensors import BearingSensor, DepthCamera, Laser2D, Mount
 from kiseki.sim.setup_schema import (
     ROBOT_MODELS,
     SENSOR_MODELS,
@@ -49,6 +43,7 @@ from kiseki.sim.setup_schema import (
     SensorKind,
     TiltingLaserSpec,
 )
+from kiseki.sim.tilting_laser import TiltingLaser
 
 __all__ = ["RobotSetup", "SensorSetup", "build_robot", "build_sensors"]
 

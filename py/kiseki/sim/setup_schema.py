@@ -11,9 +11,9 @@ A robot: ``type`` (diff_drive, the default, or omni), ``start`` [x, y, yaw_deg],
 A sensor: ``type``, ``name``, ``mount`` [x, y, z] or [x, y, z, yaw_deg], ``pitch`` and ``roll``
 (deg, the mount's rotation Rz(yaw) Ry(pitch) Rx(roll)),
 ``rate_hz`` (at most :data:`MAX_RATE_HZ`), ``params`` (the parameter class of kiseki.sim.sensors
-for that type), and the keys of its type only: ``preset`` (laser), ``width``/``height``
-(depth_camera), ``arm`` (magnetometer), ``targets`` (bearing). A key of another type is an
-unknown key.
+or kiseki.sim.tilting_laser for that type), and the keys of its type only: ``preset`` (laser),
+``width``/``height`` (depth_camera), ``arm`` (magnetometer), ``targets`` (bearing). A key of
+another type is an unknown key.
 
 :func:`check_robots` checks every robot and sensor of a scene when the scene is loaded
 (kiseki.sim.scene_schema.SceneDoc), with the rules that depend on the rest of the scene: at most
@@ -52,8 +52,8 @@ from kiseki.sim.sensors import (
     DepthCameraParams,
     ImageSide,
     LaserParams,
-    TiltingLaserParams,
 )
+from kiseki.sim.tilting_laser import TiltingLaserParams
 
 __all__ = [
     "DEFAULT_MOUNT",

@@ -1,0 +1,260 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The analysis of gp-aalto: tables, claims and notes from the five tasks' payloads (the
+pictures are drawn by :mod:`kiseki_experiments.gp.gp_aalto_figures`)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from kiseki_experiments.gp.gp_aalto_figures import draw_all
+from kiseki_experiments.gp.gp_aalto_notes import (
+    SOLIN_LENGTH_SCALE,
+    SOLIN_SIGMA_N,
+    THESIS_KERNEL,
+    comparison_table,
+    notes,
+)
+from kiseki_experiments.harness.base import Analysis, Claim
+
+__all__ = ["analyze", "payloads"]
+
+XYZ = ("x", "y", "z")
+
+
+def payloads(trials: pd.DataFrame) -> dict[str, dict]:
+    """task name -> its decoded payload (failed trials left out)."""
+    ok = trials[trials["error"].isna()]
+    return {row.task: json.loads(row.payload) for row in ok.itertuples()}
+
+
+def _fmt(values, digits: int = 2) -> str:
+    return ", ".join(f"{v:.{digits}f}" for v in values)
+
+
+def _held_out_table(maps: dict) -> pd.DataFrame:
+    rows = []
+    for sensor, p in maps.items():
+        variants = [("raw", "exact", p["train_points"], p["raw"])]
+        variants.append(("corrected", "exact", p["train_points"], p["corrected"]))
+        if "hilbert_all" in p:
+            h = p["hilbert_all"]
+            variants.append(("corrected", f"hilbert ({h['basis']} basis)", h["points"], h))
+        for variant, method, points, s in variants:
+            row = {"sensor": sensor, "readings": variant, "method": method, "points": points}
+            row |= {f"rmse_{c}": s["rmse"][i] for i, c in enumerate(XYZ)}
+            if "sd" in s:
+                row |= {f"sd_{c}": s["sd"][i] for i, c in enumerate(XYZ)}
+                row |= {f"in1_{c}": s["in1"][i] for i, c in enumerate(XYZ)}
+                row |= {"in1_all": s["in1_all"]}
+            row |= {"in2_all": s["in2_all"], "mlpd": s["mlpd"]}
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _hyperparameter_table(maps: dict) -> pd.DataFrame:
+    rows = [
+        {"source": "thesis Table 6.1 (its hall, 3-D, its units)", "component": "each"}
+        | THESIS_KERNEL,
+        {
+            "source": "Solin et al.'s example on this data (potential kernel, uT)",
+            "component": "potential",
+            "sigma_f": float("nan"),
+            "length_scale": SOLIN_LENGTH_SCALE,
+            "sigma_n": SOLIN_SIGMA_N,
+        },
+    ]
+    for sensor, p in maps.items():
+        for variant in ("kernels_raw", "kernels"):
+            label = "raw" if variant == "kernels_raw" else "corrected"
+            for c, k in zip(XYZ, p[variant], strict=True):
+                rows.append({"source": f"kiseki {sensor}, {label} (uT)", "component": c} | k)
+    table = pd.DataFrame(rows)
+    table["sigma_n_over_sigma_f"] = table["sigma_n"] / table["sigma_f"]
+    return table
+
+
+def _sweep_table(maps: dict) -> pd.DataFrame:
+    rows = []
+    for sensor, p in maps.items():
+        for r in p["sweep"]:
+            row = {"sensor": sensor, "readings": r.get("readings", "corrected")}
+            row |= {"every": r["step"], "points": r["points"]}
+            row |= {"method": r["method"], "in2_all": r["in2_all"], "mlpd": r["mlpd"]}
+            rows.append(row | {f"rmse_{c}": r["rmse"][i] for i, c in enumerate(XYZ)})
+    return pd.DataFrame(rows)
+
+
+def _change_table(change: dict) -> pd.DataFrame:
+    rows = []
+    for r in change["rows"]:
+        row = {k: r[k] for k in ("run", "role", "coverage", "share", "rms_z", "mlpd")}
+        rows.append(row | {"changed": bool(r["share"] > change["threshold"])})
+    table = pd.DataFrame(rows)
+    table["threshold"] = change["threshold"]
+    return table
+
+
+def _claims(config, maps, change, mcl) -> list[Claim]:
+    claims: list[Claim] = []
+    ref = maps.get("invensense") or next(iter(maps.values()), None)
+    if ref is not None:
+        s = ref["corrected"]
+        ratio = max(r / sd for r, sd in zip(s["rmse"], s["sd"], strict=True))
+        claims.append(
+            Claim(
+                f"{ref['sensor']}: the map of runs {config.train_runs} predicts held-out run "
+                f"{config.test_run} (RMSE per component under half the run's own SD)",
+                "thesis Table 6.2: mean error 0.65-1.44 uT on its hall",
+                f"RMSE {_fmt(s['rmse'])} uT; SD {_fmt(s['sd'])} uT",
+                "uT",
+                bool(ratio < 0.5),
+                "readings less the robot-frame offset fitted on the training runs",
+            )
+        )
+        claims.append(
+            Claim(
+                "... its predictive variance is calibrated: errors inside 2 sigma",
+                "95.4 % (Gaussian)",
+                f"{100 * s['in2_all']:.1f} % ({_fmt(100 * np.asarray(s['in2']), 1)} % x, y, z)",
+                "% of readings",
+                bool(0.90 <= s["in2_all"] <= 0.99),
+                "sigma^2 = variance of the noise-free field + sigma_n^2; bound 90-99 %",
+            )
+        )
+        claims.append(
+            Claim(
+                "... and inside 1 sigma",
+                "68.3 % (Gaussian)",
+                f"{100 * s['in1_all']:.1f} % ({_fmt(100 * np.asarray(s['in1']), 1)} % x, y, z)",
+                "% of readings",
+                bool(0.583 <= s["in1_all"] <= 0.783),
+                "bound 68.3 +- 10 points",
+            )
+        )
+        if "hilbert_same" in ref:
+            h, e = ref["hilbert_same"]["rmse"], s["rmse"]
+            worst = max(abs(a / b - 1) for a, b in zip(h, e, strict=True))
+            claims.append(
+                Claim(
+                    "the reduced-rank GP equals the exact GP on the same readings",
+                    "(issue: accuracy against the exact GP on the same data)",
+                    f"RMSE {_fmt(h)} vs {_fmt(e)} uT; max |mean difference| "
+                    f"{ref['hilbert_same']['max_abs_mean_difference']:.3f} uT",
+                    "uT",
+                    bool(worst < 0.02),
+                    "RMSE within 2 % per component",
+                )
+            )
+    if mcl is not None:
+        rows = pd.DataFrame(mcl["rows"])
+        claims += [
+            Claim(
+                f"magnetic-map MCL on run {config.test_run}: position error < 0.8 m",
+                "< 0.8 m",
+                f"max {rows['mcl_max'].max():.3f} m, mean {rows['mcl_mean'].mean():.3f} m "
+                f"over {len(rows)} odometry seeds",
+                "m",
+                bool(rows["mcl_max"].max() < 0.8),
+                "one sensor (the thesis: three), 0.1 m between updates",
+            ),
+            Claim(
+                "... and better than odometry alone",
+                "beats odometry (Figs. 6.15-6.18)",
+                f"mean {rows['mcl_mean'].mean():.3f} vs {rows['odometry_mean'].mean():.3f} m "
+                f"(worse in {int((rows['mcl_mean'] >= rows['odometry_mean']).sum())} of "
+                f"{len(rows)} seeds)",
+                "m",
+                bool((rows["mcl_mean"] < rows["odometry_mean"]).all()),
+            ),
+            Claim(
+                "... heading error",
+                "<= 0.14 rad",
+                f"mean {rows['heading_mean'].mean():.3f} rad (largest seed "
+                f"{rows['heading_mean'].max():.3f}), max {rows['heading_max'].max():.3f} rad",
+                "rad",
+                bool(rows["heading_mean"].max() <= 0.14),
+                "mean over the run per seed; truth: direction of travel over 0.1 m",
+            ),
+        ]
+    if change is not None:
+        for r in change["rows"]:
+            if r["role"] == "static, held out":
+                continue
+            static = r["role"].startswith("static")
+            detected = r["share"] > change["threshold"]
+            note = f"threshold {100 * change['threshold']:.2f} %"
+            if static == detected:
+                ref = [x["rms_z"] for x in change["rows"] if x["role"] == "static, held out"]
+                note += (
+                    f"; RMS standardized residual {r['rms_z']:.2f} against {min(ref):.2f}-"
+                    f"{max(ref):.2f} for the static runs held out"
+                )
+            claims.append(
+                Claim(
+                    f"run {r['run']} ({r['role']}) is {'not ' if static else ''}detected as a "
+                    "map change",
+                    "static: no; shelves: yes",
+                    f"{100 * r['share']:.2f} % of readings beyond {config.change_sigma:g} sigma",
+                    "% of mapped readings",
+                    bool(detected != static),
+                    note,
+                )
+            )
+    return claims
+
+
+def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) -> Analysis:
+    p = payloads(trials)
+    maps = {k[4:]: v for k, v in p.items() if k.startswith("map-")}
+    change, mcl, walks = p.get("change"), p.get("mcl"), p.get("walks")
+    tables: dict[str, pd.DataFrame] = {}
+    tables["thesis_solin_kiseki"] = comparison_table(config, maps, mcl, timings)
+    if maps:
+        tables["held_out"] = _held_out_table(maps)
+        tables["hyperparameters"] = _hyperparameter_table(maps)
+        tables["denser_training"] = _sweep_table(maps)
+        offsets = [
+            {"sensor": s, "bx_forward": v["offset"][0], "by_left": v["offset"][1]}
+            for s, v in maps.items()
+        ]
+        tables["robot_frame_offset"] = pd.DataFrame(offsets)
+        for s, v in maps.items():
+            if "offset_vs_invensense" in v:
+                rows = [
+                    {"run": r["run"]} | {f"mean_{c}": r["mean"][i] for i, c in enumerate(XYZ)}
+                    for r in v["offset_vs_invensense"]
+                ]
+                tables[f"{s}_minus_invensense"] = pd.DataFrame(rows)
+    if change is not None:
+        tables["change_detection"] = _change_table(change)
+    if mcl is not None:
+        cols = ["noise_seed", "mcl_mean", "mcl_max", "odometry_mean", "odometry_max"]
+        cols += ["heading_mean", "heading_max", "resamplings"]
+        tables["mcl"] = pd.DataFrame(mcl["rows"])[cols]
+    if walks is not None:
+        tables["walks_3d"] = _walks_table(walks)
+    claims = _claims(config, maps, change, mcl)
+    paths = draw_all(config, maps, change, mcl, walks, figures)
+    return Analysis(tables, paths, claims, notes(config, maps, change, mcl, walks))
+
+
+def _walks_table(walks: dict) -> pd.DataFrame:
+    rows = []
+    for w in walks["walks"]:
+        for label in ("raw", "corrected"):
+            if label not in w:
+                continue
+            v, s = w[label], w[label]["score"]
+            row = {"walk": w["walk"], "readings": label, "train": w["train"]}
+            row |= {"test": w["samples"] - w["train"]}
+            row |= {f"offset_{c}": v["offset"][i] for i, c in enumerate(XYZ)}
+            row |= {f"rmse_{c}": s["rmse"][i] for i, c in enumerate(XYZ)}
+            row |= {f"sd_{c}": s["sd"][i] for i, c in enumerate(XYZ)}
+            row |= {"in2_all": s["in2_all"], "length_scale": v["kernels"][0]["length_scale"]}
+            rows.append(row)
+    return pd.DataFrame(rows)

@@ -1,0 +1,259 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Writes a run's outputs (parquet, tables, figures, claims, report.md, manifest) and the
+project-wide REPRODUCTION.md that gathers the latest run of every experiment."""
+
+from __future__ import annotations
+
+import errno
+import json
+import math
+import os
+import shutil
+import tempfile
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+from rich.console import Console
+
+from kiseki._atomic import atomic_write, atomic_write_all, reworded
+from kiseki._inputs import CSV_LIMIT, YAML_LIMIT, check_input, read_input_text
+from kiseki._table import show
+from kiseki_experiments.harness.base import CLAIM_COLUMNS, Analysis, Claim, Experiment
+from kiseki_experiments.harness.registry import all_experiments
+
+__all__ = [
+    "print_claims",
+    "markdown_table",
+    "write_failed_outputs",
+    "write_outputs",
+    "write_reproduction",
+]
+
+
+def _text(path: Path, text: str) -> None:
+    atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+
+
+def _cell(value: Any) -> str:
+    if isinstance(value, float):
+        return "" if math.isnan(value) else f"{value:.4g}"
+    return str(value).replace("|", "\\|").replace("\n", " ")
+
+
+def markdown_table(frame: pd.DataFrame) -> str:
+    head = "| " + " | ".join(map(str, frame.columns)) + " |"
+    rule = "|" + "---|" * len(frame.columns)
+    rows = ["| " + " | ".join(_cell(v) for v in row) + " |" for row in frame.itertuples(False)]
+    return "\n".join([head, rule, *rows])
+
+
+def _claims_frame(claims: Iterable[Claim]) -> pd.DataFrame:
+    rows = [[getattr(c, k) for k in CLAIM_COLUMNS] for c in claims]
+    return pd.DataFrame(rows, columns=CLAIM_COLUMNS)
+
+
+def _report(experiment: Experiment, analysis: Analysis, manifest: dict, claims: pd.DataFrame):
+    held = int(claims["holds"].sum())
+    lines = [
+        f"# {experiment.name}: {experiment.description}",
+        "",
+        f"Source: `{experiment.paper}`, {experiment.artefact}.  ",
+        f"Run: {manifest['finished']}, {manifest['trials']} trials "
+        f"({manifest['trials_failed']} failed), seed {manifest['seed']}, "
+        f"{manifest['execution']}, commit {manifest['git']['commit'] or 'unknown'}"
+        f"{' (with local changes)' if manifest['git']['dirty'] else ''}.",
+        "",
+        f"## Claims: {len(claims)} claims, {held} hold",
+        "",
+        markdown_table(claims),
+    ]
+    for name, table in analysis.tables.items():
+        lines += ["", f"## {name}", "", markdown_table(table)]
+    if analysis.figures:
+        lines += ["", "## Figures", ""]
+        lines += [f"![{p.stem}](figures/{p.name})" for p in analysis.figures]
+    if analysis.notes:
+        lines += ["", "## Notes", "", analysis.notes.strip()]
+    return "\n".join(lines) + "\n"
+
+
+def print_claims(title: str, claims: pd.DataFrame) -> None:
+    """The claims as a table on a terminal, tab-separated lines when piped."""
+    rows = [
+        (row.claim, row.paper_value, row.measured_value, row.unit, "yes" if row.holds else "no")
+        for row in claims.itertuples(False)
+    ]
+    show(title, CLAIM_COLUMNS[:5], rows, as_json=False, data=None)
+
+
+def _frames(trials, timings, run_dir: Path) -> list:
+    return [
+        (run_dir / "trials.parquet", lambda tmp: trials.to_parquet(tmp, index=False)),
+        (run_dir / "timings.parquet", lambda tmp: timings.to_parquet(tmp, index=False)),
+    ]
+
+
+def _texts(items: dict[Path, str]) -> list:
+    return [
+        (path, lambda tmp, text=text: Path(tmp).write_text(text, encoding="utf-8"))
+        for path, text in items.items()
+    ]
+
+
+def _write_frames(trials, timings, run_dir: Path) -> None:
+    atomic_write_all(_frames(trials, timings, run_dir))
+
+
+def write_failed_outputs(experiment, trials, timings, manifest, run_dir: Path) -> str:
+    """A run whose every trial failed: the trials with their errors, the manifest and a
+    report.md saying so and giving the first error; no claims (nothing to analyse). Returns
+    the first error."""
+    _write_frames(trials, timings, run_dir)
+    (run_dir / "claims.csv").unlink(missing_ok=True)
+    first = " ".join(str(trials["error"].iloc[0]).split())  # one line
+    lines = [
+        f"# {experiment.name}: {experiment.description}",
+        "",
+        f"Run: {manifest['finished']}, seed {manifest['seed']}, {manifest['execution']}.",
+        "",
+        f"**Every trial failed** ({manifest['trials']} of {manifest['trials']}): no claims.",
+        "",
+        f"First error (trial {int(trials['trial'].iloc[0])}): `{first}`",
+        "",
+        "Fix the cause, then `kiseki experiment run "
+        f"{experiment.name} --resume --out {run_dir}` runs the failed trials again.",
+    ]
+    _text(run_dir / "report.md", "\n".join(lines) + "\n")
+    _text(run_dir / "manifest.json", json.dumps(manifest, indent=2))
+    return first
+
+
+def _results_error(err: OSError, experiment: Experiment, run_dir: Path) -> OSError:
+    """A failure to write the results, naming the file (or the run) and what is kept."""
+    reason = err.strerror or str(err)
+    where = f"{err.filename}: {reason}" if err.filename else reason
+    if str(run_dir) not in where:
+        where = f"{run_dir}: {where}"
+    return reworded(
+        err,
+        f"{where}; the finished trials are kept in trials.jsonl (kiseki experiment run "
+        f"{experiment.name} --resume --out {run_dir} writes the results once this is fixed)",
+    )
+
+
+def _drawing_error(err: OSError, drawn: Path) -> bool:
+    """Whether an OSError of the analysis is one of drawing its figures into ``drawn`` (a
+    full disk), not of reading its inputs."""
+    if err.errno in (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EFBIG):
+        return True
+    name = os.fsdecode(err.filename) if isinstance(err.filename, str | bytes) else ""
+    return bool(name) and Path(name).absolute().is_relative_to(drawn.absolute())
+
+
+def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) -> pd.DataFrame:
+    """Writes every output to a temporary name (figures to a hidden folder) and moves them
+    into place once all are complete: a failure part-way (a full disk) leaves the previous
+    outputs as they were and nothing half-written. An OSError of writing or moving them says
+    the trials are kept, as does one of drawing the figures; any other raised by the
+    experiment's analysis (a missing input) is raised as it is."""
+    for stale in run_dir.glob(".figures.*"):  # left by a run killed while drawing
+        shutil.rmtree(stale, ignore_errors=True)
+    (run_dir / "tables").mkdir(exist_ok=True)
+    (run_dir / "figures").mkdir(exist_ok=True)
+    drawn = Path(tempfile.mkdtemp(dir=run_dir, prefix=".figures."))
+    try:
+        try:
+            analysis = experiment.analyze(config, trials, timings, drawn)
+        except OSError as err:
+            if not _drawing_error(err, drawn):
+                raise  # the analysis's own (a missing input file): as it is
+            raise _results_error(err, experiment, run_dir) from err
+        claims = _claims_frame(analysis.claims)
+        texts = {
+            run_dir / "tables" / f"{n}.csv": t.to_csv(index=False)
+            for n, t in analysis.tables.items()
+        }
+        texts[run_dir / "claims.csv"] = claims.to_csv(index=False)
+        texts[run_dir / "report.md"] = _report(experiment, analysis, manifest, claims)
+        texts[run_dir / "manifest.json"] = json.dumps(manifest, indent=2)
+        try:
+            atomic_write_all(_frames(trials, timings, run_dir) + _texts(texts))
+            for path in sorted(p for p in drawn.rglob("*") if p.is_file()):
+                target = run_dir / "figures" / path.relative_to(drawn)
+                target.parent.mkdir(parents=True, exist_ok=True)
+                os.replace(path, target)
+        except OSError as err:
+            raise _results_error(err, experiment, run_dir) from err
+    finally:
+        shutil.rmtree(drawn, ignore_errors=True)
+    print_claims(f"{experiment.name}: claims ({run_dir})", claims)
+    if manifest["trials_failed"]:
+        Console().print(
+            f"[red]{manifest['trials_failed']} of {manifest['trials']} trials failed[/red]"
+        )
+    return claims
+
+
+def write_reproduction(results_root: Path, out: Path) -> tuple[int, int, list[str]]:
+    """Gathers the latest run of every registered experiment into one markdown file.
+    Returns (claims, claims that hold, missing experiment names)."""
+    if not results_root.is_dir():
+        raise FileNotFoundError(f"{results_root}: results folder not found")
+    by_paper: dict[str, list[str]] = {}
+    total = held = 0
+    missing: list[str] = []
+    for name, experiment in sorted(all_experiments().items()):
+        section = by_paper.setdefault(experiment.paper, [])
+        latest = results_root / name / "latest"
+        claims_path = latest / "claims.csv"
+        section += ["", f"### {name} ({experiment.artefact}): {experiment.description}", ""]
+        if not claims_path.is_file():
+            missing.append(name)
+            section.append(f"**missing**: no result yet; run `kiseki experiment run {name}`.")
+            continue
+        run_dir = latest.resolve()
+        if not run_dir.is_relative_to(results_root.resolve()):  # a link moved or made by hand
+            raise ValueError(f"{latest}: the link points outside --results ({run_dir})")
+        claims, manifest = _read_result(latest)
+        total += len(claims)
+        held += int(claims["holds"].astype(str).str.lower().eq("true").sum())
+        section += [
+            f"Result: `{run_dir.relative_to(results_root.resolve())}`, "
+            f"{manifest['trials']} trials, {manifest['trials_failed']} failed, "
+            f"commit {manifest['git']['commit'] or 'unknown'}.",
+            "",
+            markdown_table(claims),
+        ]
+    lines = ["# Reproduction report", "", f"{total} claims, {held} hold."]
+    if missing:
+        lines.append(f"Missing experiments ({len(missing)}): {', '.join(missing)}.")
+    for paper, section in by_paper.items():
+        lines += ["", f"## {paper}", *section]
+    _text(out, "\n".join(lines) + "\n")
+    return total, held, missing
+
+
+def _read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
+    """A run's claims.csv and manifest.json, refused in one line naming the file when unreadable
+    or without the columns and fields the report needs."""
+    claims_path, manifest_path = latest / "claims.csv", latest / "manifest.json"
+    check_input(claims_path, "claims tables", CSV_LIMIT)
+    try:
+        claims = pd.read_csv(claims_path, keep_default_na=False)
+    except (ValueError, UnicodeDecodeError) as err:
+        raise ValueError(f"{claims_path}: not a claims table ({err})") from None
+    if "holds" not in claims.columns:
+        raise ValueError(
+            f"{claims_path}: no column holds (a claims table has {', '.join(CLAIM_COLUMNS)})"
+        )
+    try:
+        manifest = json.loads(read_input_text(manifest_path, "JSON manifests", YAML_LIMIT))
+    except (ValueError, UnicodeDecodeError) as err:
+        raise ValueError(f"{manifest_path}: not a JSON manifest ({err})") from None
+    needed = ("trials", "trials_failed", "git")
+    if not isinstance(manifest, dict) or any(k not in manifest for k in needed):
+        raise ValueError(f"{manifest_path}: a manifest needs the fields {', '.join(needed)}")
+    return claims, manifest

@@ -1,0 +1,160 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""mcl-kld: KLD sampling from global localization to tracking, against fixed particle counts.
+
+Global localization along a CARMEN log (odometry rebuilt from the corrected poses with noise
+F = 0.1, the likelihood field on the 0.05 m log-odds map, kiseki.global_localization's settings:
+a uniform start, AMCL's update gate, the tempered likelihood until the cloud converges), three
+ways: KLD sampling (Fox 2003, nav2's pf_err 0.05 and pf_z 0.99) between ``min_particles`` and
+``max_particles``; a fixed ``max_particles`` all along; and the fixed rule kiseki used before
+(``max_particles`` until the cloud has converged, then cut to ``min_particles``). Per way: the
+particle count after each scan, the position RMSE against the corrected poses from the scan at
+which the cloud converged, and the filter's run time. Trial i is log i mod len(logs).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from kiseki.localization import noisy_odometry
+from kiseki.metrics import ape
+from kiseki.plots import new_figure
+from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki_experiments.harness.config import NonNegativeReal, Particles, Scans
+from kiseki_experiments.harness.paths import shared_data
+
+WAYS = ("kld", "fixed", "cut")
+
+
+@dataclass(frozen=True)
+class KldConfig:
+    data_dir: str = ""  # folder of the .log.gz files; "" = ../shared/data/carmen
+    logs: list[str] = field(default_factory=lambda: ["intel-corrected", "aces-corrected"])
+    max_particles: Particles = 50_000
+    min_particles: Particles = 1000
+    odometry_noise: NonNegativeReal = 0.1
+    max_scans: Scans = 0  # 0 = whole logs
+
+
+def preflight(config: KldConfig) -> None:
+    if not (1 <= config.min_particles <= config.max_particles):
+        raise ValueError("mcl-kld: need 1 <= min_particles <= max_particles")
+    folder = shared_data("carmen", config.data_dir)
+    missing = [n for n in config.logs if not (folder / f"{n}.log.gz").is_file()]
+    if missing:
+        raise FileNotFoundError(f"mcl-kld: {folder}: missing {', '.join(missing)}")
+
+
+def trial(config: KldConfig, index: int, seed: int) -> TrialOutput:
+    from kiseki.datasets import read_carmen_log
+    from kiseki.global_localization import GlobalConfig, global_localize
+    from kiseki.mapping import MapBuildConfig, map_of_log
+
+    name = config.logs[index % len(config.logs)]
+    path = shared_data("carmen", config.data_dir) / f"{name}.log.gz"
+    scans = read_carmen_log(path).scans.first(config.max_scans)
+    grid = map_of_log(scans, MapBuildConfig(0.05))
+    noisy = dataclasses.replace(
+        scans, odometry=noisy_odometry(scans.odometry, config.odometry_noise, seed)
+    )
+    record: dict = {"log": name, "scans": len(scans)}
+    timings: dict = {}
+    for way in WAYS:
+        gc = GlobalConfig(
+            seed=seed % 2**63,
+            particles=config.max_particles,
+            tracking_particles=config.max_particles if way == "fixed" else config.min_particles,
+            kld=way == "kld",
+            threads=1,
+        )
+        result = global_localize(noisy, grid, gc)
+        k = result.report.converged_scan
+        rmse = float("nan") if k is None else ape(result.estimates[k:], scans.poses[k:]).rmse
+        counts = result.particle_counts
+        record |= {
+            f"{way}_converged_scan": -1 if k is None else int(k),
+            f"{way}_rmse_m": rmse,
+            f"{way}_final_particles": int(counts[-1]),
+            f"{way}_mean_particles": float(counts.mean()),
+            f"{way}_counts": [int(c) for c in counts[:: max(1, len(counts) // 200)]],
+        }
+        timings[f"{way}_seconds"] = result.report.seconds
+    return TrialOutput(record, timings)
+
+
+def analyze(config: KldConfig, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path):
+    ok = trials[trials["error"].isna()].merge(timings, on="trial")
+    rows = []
+    for log, group in ok.groupby("log", sort=False):
+        for way in WAYS:
+            rows.append(
+                {
+                    "log": log,
+                    "way": way,
+                    "trials": len(group),
+                    "converged": int((group[f"{way}_converged_scan"] >= 0).sum()),
+                    "rmse_after_convergence_m": group[f"{way}_rmse_m"].mean(),
+                    "mean_particles": group[f"{way}_mean_particles"].mean(),
+                    "final_particles": group[f"{way}_final_particles"].mean(),
+                    "seconds": group[f"{way}_seconds"].median(),
+                }
+            )
+    table = pd.DataFrame(rows)
+    claims = []
+    for log, t in table.groupby("log", sort=False):
+        t = t.set_index("way")
+        kld, fixed = t.loc["kld"], t.loc["fixed"]
+        claims.append(
+            Claim(
+                claim=f"{log}: KLD sampling tracks as well as the fixed count with fewer particles",
+                paper_value="(Fox 2003: same accuracy, far fewer samples)",
+                measured_value=(
+                    f"RMSE {kld.rmse_after_convergence_m:.3f} vs "
+                    f"{fixed.rmse_after_convergence_m:.3f} m, mean particles "
+                    f"{kld.mean_particles:.0f} vs {fixed.mean_particles:.0f}"
+                ),
+                unit="m; particles",
+                holds=bool(
+                    kld.converged == fixed.converged
+                    and kld.rmse_after_convergence_m <= 1.5 * fixed.rmse_after_convergence_m + 0.01
+                    and kld.mean_particles < 0.5 * fixed.mean_particles
+                ),
+            )
+        )
+    fig = new_figure(figsize=(8, 3.5), dpi=120)
+    ax = fig.subplots()
+    first = ok.iloc[0]
+    for way, colour in zip(WAYS, ("tab:blue", "tab:red", "tab:orange"), strict=True):
+        counts = np.asarray(first[f"{way}_counts"])
+        ax.plot(np.linspace(0, first["scans"], len(counts)), counts, color=colour, label=way)
+    ax.set_yscale("log")
+    ax.set_xlabel(f"scan ({first['log']})")
+    ax.set_ylabel("particles")
+    ax.legend(fontsize=7)
+    path = figures / "kld_counts.png"
+    fig.savefig(path, bbox_inches="tight")
+    notes = (
+        f"Global localization from a uniform start; KLD between {config.min_particles} and "
+        f"{config.max_particles} particles; 'fixed' keeps {config.max_particles}; 'cut' keeps "
+        f"{config.max_particles} until the cloud converged, then {config.min_particles}. RMSE "
+        "from the scan at which the cloud converged on; time of the filter on one thread."
+    )
+    return Analysis(tables={"kld": table}, figures=[path], claims=claims, notes=notes)
+
+
+EXPERIMENT = Experiment(
+    name="mcl-kld",
+    paper="localization engine (beyond the papers)",
+    artefact="KLD sampling, global localization to tracking",
+    description="KLD sampling against fixed particle counts: count over time, RMSE, time",
+    config_type=KldConfig,
+    trial=trial,
+    analyze=analyze,
+    default_runs=4,
+    preflight=preflight,
+)
