@@ -32,4 +32,4 @@ cmake --build build/fuzz
 tests/fuzz/cpp/run.sh build/fuzz "${KISEKI_FUZZ_CPP_RUNS:-20000}"
 
 echo "== pytest"
-python -m pytest "$@"
+python -m pytest --durations=15 "$@"  # the slowest tests, in every run
