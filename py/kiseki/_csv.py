@@ -12,6 +12,8 @@ from typing import Annotated, Any
 
 from pydantic import BeforeValidator, Field
 
+from kiseki._schema import MAGNITUDE_LIMIT
+
 __all__ = ["CsvNumber", "data_rows", "number_text"]
 
 
@@ -29,9 +31,13 @@ def number_text(text: Any) -> Any:
     return text
 
 
-CsvNumber = Annotated[float, BeforeValidator(number_text), Field(strict=True, allow_inf_nan=False)]
-"""A finite number from a CSV cell; bounds go in a further ``Field`` (``Annotated[CsvNumber,
-Field(ge=0)]``)."""
+CsvNumber = Annotated[
+    float,
+    BeforeValidator(number_text),
+    Field(strict=True, ge=-MAGNITUDE_LIMIT, le=MAGNITUDE_LIMIT, allow_inf_nan=False),
+]
+"""A finite number from a CSV cell, within +-kiseki._schema.MAGNITUDE_LIMIT; tighter bounds
+go in a further ``Field`` (``Annotated[CsvNumber, Field(ge=0)]``)."""
 
 
 def data_rows(lines: Sequence[str]) -> Iterator[tuple[int, list[str], str]]:

@@ -7,7 +7,10 @@ YAML, experiment configs, key scripts, command CSVs): pydantic v2 models, checke
 Conventions every model follows (so that every file reads the same way):
 
 - models derive from :class:`FileModel` (unknown keys are errors) and use this module's number
-  types: strict (a number is not a string, ``true`` is not 1; an int is a float) and finite;
+  types: strict (a number is not a string, ``true`` is not 1; an int is a float), finite and
+  bounded: a float within +-:data:`MAGNITUDE_LIMIT`, an int within int32 (the C++ core's
+  ``int``) unless its field says less; every int and float field of a file states its range
+  (tests/python/test_field_bounds.py walks every model);
 - YAML is read with YAML 1.2's numbers (:mod:`kiseki._yaml`), so ``5e-2`` is a number;
 - everything that sizes memory or time has a limit (``Field(le=...)``) and the limit is in the
   message; seeds are :data:`Seed` (0 <= seed < 2**64, as :func:`kiseki.core.check_seed`);
@@ -27,6 +30,8 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationEr
 from kiseki.errors import KisekiError
 
 __all__ = [
+    "INT32_MAX",
+    "MAGNITUDE_LIMIT",
     "FileModel",
     "FiniteFloat",
     "NonNegativeFloat",
@@ -42,11 +47,25 @@ __all__ = [
 SEED_LIMIT = 2**64
 """Seeds are any integer in [0, 2**64): numpy's and the C++ core's 64-bit generators take them."""
 
-# numbers are strict (``"1.5"`` and ``true`` are not numbers; an int is a float) and finite
-FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]
-PositiveFloat = Annotated[float, Field(strict=True, gt=0, allow_inf_nan=False)]
-NonNegativeFloat = Annotated[float, Field(strict=True, ge=0, allow_inf_nan=False)]
-PositiveInt = Annotated[int, Field(strict=True, gt=0)]
+MAGNITUDE_LIMIT = 1e9
+"""The largest magnitude of any float in kiseki's files (unless its field says less): no
+length (m), time (s), angle (deg), rate or gain of a robot's world comes near (1e9 m is beyond
+the Moon, 1e9 s is 30 years), and it keeps the C++ core's doubles (and float32 copies, which
+end at 3.4e38) finite through products and squares of such numbers."""
+INT32_MAX = 2**31 - 1
+"""The largest int of a file (unless its field says less): the C++ core's ``int`` is int32."""
+
+# numbers are strict (``"1.5"`` and ``true`` are not numbers; an int is a float), finite and
+# bounded (MAGNITUDE_LIMIT, INT32_MAX)
+FiniteFloat = Annotated[
+    float,
+    Field(strict=True, ge=-MAGNITUDE_LIMIT, le=MAGNITUDE_LIMIT, allow_inf_nan=False),
+]
+PositiveFloat = Annotated[float, Field(strict=True, gt=0, le=MAGNITUDE_LIMIT, allow_inf_nan=False)]
+NonNegativeFloat = Annotated[
+    float, Field(strict=True, ge=0, le=MAGNITUDE_LIMIT, allow_inf_nan=False)
+]
+PositiveInt = Annotated[int, Field(strict=True, gt=0, le=INT32_MAX)]
 
 
 def _seed(value: Any) -> int:

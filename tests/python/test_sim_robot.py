@@ -155,7 +155,8 @@ EDGES = {  # a value just outside the range, one just inside
     "count": [(0, 1), (2.0, 2)],
     "sd": [(-1e-12, 0.0)],
     "rel": [(-1.0, -0.999), (1.0, 0.999)],
-    "finite": [(float("-inf"), -1e300), (float("nan"), 0.0)],
+    # finite and within kiseki._schema.MAGNITUDE_LIMIT (1e9)
+    "finite": [(float("-inf"), -1e9), (-2e9, 0.0), (float("nan"), 0.0)],
     "flag": [(0, False), ("yes", True)],
 }
 

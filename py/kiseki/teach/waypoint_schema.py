@@ -26,7 +26,7 @@ from typing import Annotated, Any
 from pydantic import AfterValidator, Field, field_validator, model_validator
 
 from kiseki._inputs import check_input
-from kiseki._schema import FileModel, FiniteFloat, SchemaError, parse
+from kiseki._schema import INT32_MAX, FileModel, FiniteFloat, SchemaError, parse
 from kiseki._yaml import read_yaml_file
 
 __all__ = [
@@ -80,7 +80,8 @@ class Waypoint(FileModel):
     """A mark: its name, the odometry pose where it was marked (map frame) and, in simulation,
     the true pose (optional: a waypoint without it is still a waypoint)."""
 
-    id: Annotated[int, Field(strict=True, ge=0)] | None = None
+    # a label (teach numbers the marks from 0); int32 as every int of kiseki's files
+    id: Annotated[int, Field(strict=True, ge=0, le=INT32_MAX)] | None = None
     name: Name
     x: FiniteFloat
     y: FiniteFloat
