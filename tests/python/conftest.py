@@ -9,12 +9,20 @@ Tests that need ../shared/data skip with a message when it is absent, except und
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
 
 import pytest
 
 PROJECT_ROOT = Path(__file__).resolve().parents[2]
 SHARED_DATA = PROJECT_ROOT.parent / "shared" / "data"
+
+# A test run started with SIGINT ignored (a background job of a shell without job control)
+# would hand that to every command it starts, and the tests that interrupt a command with
+# SIGINT, as Ctrl-C in a terminal does, would see it ignored: kiseki rightly keeps a SIGINT
+# its parent ignores. The run takes SIGINT back as a terminal has it, so its children do too.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture(scope="session")

@@ -442,7 +442,8 @@ def test_localize_on_dev_zero_and_on_an_endless_fifo_is_one_line_and_exit_1(tmp_
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT])
 def test_a_long_read_ends_promptly_on_a_signal(tmp_path, project_data, signum):
     """A gzip log of 960 MiB of zeros (below the 1 GiB limit, about 6 s to decompress): the
-    signal, sent once the read is under way, ends kiseki within a second."""
+    signal, sent once the read is under way, ends kiseki promptly: 0.2-0.5 s measured on 2 cores,
+    3 s allowed for a loaded machine; read whole in one call, as before, it took 9-37 s."""
     log = _zeros_gz(tmp_path / "long.log.gz", 15)
     proc = _kiseki(
         "localize",
@@ -468,7 +469,7 @@ def test_a_long_read_ends_promptly_on_a_signal(tmp_path, project_data, signum):
     name = signal.Signals(signum).name
     print(f"{name}: exit {proc.returncode} {took:.2f} s after it, {peak / 1024:.0f} MB peak before")
     assert proc.returncode == 128 + signum, err
-    assert took < 1.0
+    assert took < 3.0
     assert err.strip().splitlines()[-1].startswith("kiseki: interrupted before any output")
 
 
