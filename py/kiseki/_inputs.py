@@ -46,6 +46,7 @@ __all__ = [
     "describe_bytes",
     "read_input",
     "read_input_text",
+    "special_kind",
 ]
 
 MIB = 1 << 20
@@ -67,6 +68,12 @@ _KINDS = (
     (stat.S_ISFIFO, "a FIFO (named pipe)"),
     (stat.S_ISSOCK, "a socket"),
 )
+
+
+def special_kind(mode: int) -> str:
+    """What a file that is neither a regular file nor a folder is, from its ``st_mode``: ``a
+    character device``, ``a FIFO (named pipe)``, ... (``a special file`` when none of those)."""
+    return next((name for test, name in _KINDS if test(mode)), "a special file")
 
 
 def describe_bytes(count: int) -> str:
@@ -95,7 +102,7 @@ def check_input(
         return None
     mode = info.st_mode
     if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
-        kind = next((name for test, name in _KINDS if test(mode)), "a special file")
+        kind = special_kind(mode)
         target = ""
         if os.path.islink(path):
             target = f" (a link to {os.path.realpath(path)})"

@@ -22,6 +22,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
+from kiseki.core import SEED_RULE
 from kiseki.errors import KisekiError
 
 __all__ = [
@@ -139,7 +140,7 @@ class Seed(Count):
         super().__init__(name, 0, 2**64 - 1)
 
     def rule(self) -> str:
-        return "an integer in [0, 2**64)"
+        return SEED_RULE.removeprefix("must be ")
 
 
 class Quantity(_Bounded):

@@ -28,7 +28,7 @@ from kiseki._input_refs import (
     input_files,
     input_folder,
 )
-from kiseki._inputs import _KINDS
+from kiseki._inputs import special_kind
 
 __all__ = [
     "FIGURE_SUFFIXES",
@@ -257,7 +257,7 @@ def _refuse_not_regular(label: str, out: Path) -> None:
         mode = None
     link = os.path.islink(out)
     if mode is not None and not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
-        kind = next((name for test, name in _KINDS if test(mode)), "a special file")
+        kind = special_kind(mode)
         via = f" (through a symlink to {os.readlink(out)})" if link else ""
         raise ValueError(f"{label} {out}: {kind}{via}, {replacing}")
     if link:

@@ -1,18 +1,41 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""What the route page's browser tests share: a free port, the JSON API called as a script
-would (no Origin), `kiseki serve` started as a subprocess, the route picked by taps, and the
-pose the page shows."""
+"""What the route page's browser tests share: Debian's chromium and Playwright, a free port,
+the JSON API called as a script would (no Origin), `kiseki serve` started as a subprocess, the
+route picked by taps, and the pose the page shows."""
 
 from __future__ import annotations
 
 import json
+import os
+import shutil
 import socket
 import subprocess
 import time
 import urllib.error
 import urllib.request
 from pathlib import Path
+
+import pytest
+
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+IN_CI = os.environ.get("CI", "").lower() == "true"
+
+
+def playwright_or_skip():
+    """Playwright's ``(sync_playwright, expect)`` for a browser test module: outside CI a
+    missing Debian chromium or playwright skips the module with a message; under CI their
+    absence is an error."""
+    if not Path(CHROMIUM).exists() and not IN_CI:
+        pytest.skip(
+            "Debian's chromium is not installed (apt-get install chromium; CI runs these tests)",
+            allow_module_level=True,
+        )
+    if not IN_CI:
+        pytest.importorskip("playwright.sync_api")
+    from playwright.sync_api import expect, sync_playwright
+
+    return sync_playwright, expect
 
 
 def free_port() -> int:

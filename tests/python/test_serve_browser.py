@@ -8,8 +8,6 @@ the requests of other sites: test_serve_browser_safety.py.)"""
 
 from __future__ import annotations
 
-import os
-import shutil
 import subprocess
 import sys
 import time
@@ -17,21 +15,10 @@ from pathlib import Path
 
 import pytest
 
-from serve_pages import api, free_port, shown_pose
+from serve_pages import CHROMIUM, api, free_port, playwright_or_skip, shown_pose
 from serve_pages import pick_route as pick
 
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-IN_CI = os.environ.get("CI", "").lower() == "true"
-if not Path(CHROMIUM).exists() and not IN_CI:
-    pytest.skip(
-        "Debian's chromium is not installed (apt-get install chromium; CI runs these tests)",
-        allow_module_level=True,
-    )
-if IN_CI:
-    from playwright.sync_api import expect, sync_playwright
-else:
-    sync_playwright = pytest.importorskip("playwright.sync_api").sync_playwright
-    from playwright.sync_api import expect
+sync_playwright, expect = playwright_or_skip()
 
 ROUTE = {"start": "P0", "via": ["T1", "T2"], "goal": "G", "home": "P0"}
 P0 = (0.0, 0.0)  # where factory_turn's route starts

@@ -18,7 +18,6 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -29,20 +28,18 @@ from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 import pytest
 import yaml
 
-from serve_pages import api, free_port, pick_route, shown_pose, start_server, stop_server
+from serve_pages import (
+    CHROMIUM,
+    api,
+    free_port,
+    pick_route,
+    playwright_or_skip,
+    shown_pose,
+    start_server,
+    stop_server,
+)
 
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-IN_CI = os.environ.get("CI", "").lower() == "true"
-if not os.path.exists(CHROMIUM) and not IN_CI:
-    pytest.skip(
-        "Debian's chromium is not installed (apt-get install chromium; CI runs these tests)",
-        allow_module_level=True,
-    )
-if IN_CI:
-    from playwright.sync_api import expect, sync_playwright
-else:
-    sync_playwright = pytest.importorskip("playwright.sync_api").sync_playwright
-    from playwright.sync_api import expect
+sync_playwright, expect = playwright_or_skip()
 
 ROUTE = {"start": "P0", "via": ["P1"], "goal": "P2", "home": "P0"}
 P0 = (0.0, 0.0)
