@@ -2,34 +2,46 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 #
-# The whole test suite: set-up, ruff, C++ GoogleTest suites with ctest (warnings as errors),
-# the same suites under AddressSanitizer + UndefinedBehaviorSanitizer, the libFuzzer targets of
-# the C++ readers, then pytest (with the atheris targets of the Python readers).
+# The whole test suite: set-up, ruff, the C++ GoogleTest suites built and run by colcon (Release,
+# warnings as errors), the same suites under AddressSanitizer + UndefinedBehaviorSanitizer, the
+# libFuzzer targets of the C++ readers, then pytest on two workers (with the atheris targets of
+# the Python readers). Every stage prints how long it took.
 # Fails when any step fails. Extra arguments go to pytest.
 set -euo pipefail
+SECONDS=0
+stage_name="set-up"
+stage_start=0
+# Closes the previous stage with its wall time and opens the next one.
+stage() {
+  printf '   (%s: %d s; %d s in all)\n' "$stage_name" $((SECONDS - stage_start)) "$SECONDS"
+  [ $# -eq 0 ] && return 0
+  stage_name="$1"
+  stage_start=$SECONDS
+  echo "== $1"
+}
+trap stage EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 cd "$KISEKI_ROOT"
 export CMAKE_BUILD_PARALLEL_LEVEL="${CMAKE_BUILD_PARALLEL_LEVEL:-2}"
 
-echo "== ruff"
+stage "ruff"
 ruff check py tests benchmarks examples scripts
 ruff format --check py tests benchmarks examples scripts
 
-echo "== C++ tests (Release, -Werror)"
-cmake -S . -B build/cpp -G Ninja -DCMAKE_BUILD_TYPE=Release -DKISEKI_WARNINGS_AS_ERRORS=ON >/dev/null
-cmake --build build/cpp
-ctest --test-dir build/cpp --output-on-failure --timeout 300
+stage "C++ tests (Release, -Werror), built, installed and run by colcon"
+bash scripts/colcon_test.sh build/colcon
 
-echo "== C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer"
+stage "C++ tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DKISEKI_SANITIZE=ON >/dev/null
 cmake --build build/asan
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-  ctest --test-dir build/asan --output-on-failure --timeout 600
+  ctest --test-dir build/asan --output-on-failure --timeout 600 -j "$CMAKE_BUILD_PARALLEL_LEVEL"
 
-echo "== C++ readers under libFuzzer + ASan + UBSan (fixed runs and seed)"
+stage "C++ readers under libFuzzer + ASan + UBSan (fixed runs and seed)"
 cmake -S tests/fuzz/cpp -B build/fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ >/dev/null
 cmake --build build/fuzz
 tests/fuzz/cpp/run.sh build/fuzz "${KISEKI_FUZZ_CPP_RUNS:-20000}"
 
-echo "== pytest"
-python -m pytest --durations=15 "$@"  # the slowest tests, in every run
+stage "pytest"
+# two workers, each taking the next test when free; the slowest tests listed in every run
+python -m pytest -n "${KISEKI_TEST_WORKERS:-2}" --dist worksteal --durations=15 "$@"
