@@ -24,6 +24,7 @@ from kiseki.localization import LocalizeConfig
 from kiseki.mapping import MapBuildConfig
 from kiseki.speed import SpeedLimiterConfig
 from kiseki.teach import PlaybackConfig
+from kiseki.terrain.mapper import MapperConfig
 
 
 def run(*args, cwd: Path | None = None, columns: int = 200) -> subprocess.CompletedProcess:
@@ -228,3 +229,6 @@ def test_the_options_defaults_are_the_config_types():
     assert option_default(("demo",), "particles") == PlaybackConfig.particles
     assert option_default(("speed", "limits"), "v_max") == SpeedLimiterConfig.v_max
     assert option_default(("speed", "limits"), "half_angle") == pytest.approx(90.0)
+    assert option_default(("terrain", "run"), "removal") == MapperConfig.removal
+    # the command's documented default search, held by the config (the experiments set theirs)
+    assert option_default(("terrain", "run"), "search") == MapperConfig.search == "coarse-to-fine"

@@ -70,7 +70,8 @@ def terrain_run(
         default_of(MapperConfig, "removal"), help="Plane removal: hough (the paper's), pcl, none."
     ),
     search: str = typer.Option(
-        "coarse-to-fine", help="exhaustive (the paper's 56,916 candidates) or coarse-to-fine."
+        default_of(MapperConfig, "search"),
+        help="exhaustive (the paper's 56,916 candidates) or coarse-to-fine.",
     ),
 ) -> None:
     """Moves a robot through WORLD stopping every --step metres; at each stop a tilting-laser
