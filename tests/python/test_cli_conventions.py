@@ -196,12 +196,12 @@ def test_exit_codes_and_no_traceback(grid_file: Path, args, code):
 
 
 def test_an_internal_error_exits_3_with_its_traceback(grid_file, monkeypatch, capsys):
-    import kiseki.cli.map  # the module of `kiseki map`, which imports grid_summary at its top
+    import kiseki.cli.map_info  # the module of `kiseki map info`: grid_summary imported at its top
 
     def broken(grid):
         raise KeyError("a bug")
 
-    monkeypatch.setattr(kiseki.cli.map, "grid_summary", broken)
+    monkeypatch.setattr(kiseki.cli.map_info, "grid_summary", broken)
     monkeypatch.setattr(sys, "argv", ["kiseki", "map", "info", str(grid_file)])
     with pytest.raises(SystemExit) as exit_info:
         main()

@@ -19,6 +19,7 @@ from typer.core import TyperGroup
 
 from kiseki.cli import ALIASES, COMMANDS, app
 from kiseki.cli._help import reflow
+from kiseki.cli._lazy import LazyGroup
 from kiseki.global_localization import GlobalConfig
 from kiseki.localization import LocalizeConfig
 from kiseki.mapping import MapBuildConfig
@@ -68,16 +69,20 @@ def test_help_lists_every_command_with_its_line_and_no_alias():
 
 
 def test_each_table_line_is_its_commands_own_first_paragraph():
-    root, ctx = root_and_context()
-    for name, entry in COMMANDS.items():
-        command = root.get_command(ctx, name)
-        assert command is not None and command.name == name
-        assert command.help.split("\n\n")[0] == entry.help, name
-        assert isinstance(command, TyperGroup) == entry.group, name
+    root, _ = root_and_context()
+    lazy = [group for _, group in every_command(root) if isinstance(group, LazyGroup)]
+    assert {g.table is COMMANDS for g in lazy} == {True, False}  # the root and `kiseki map`
+    for group in lazy:
+        ctx = typer.Context(group)
+        for name, entry in group.table.items():
+            command = group.get_command(ctx, name)
+            assert command is not None and command.name == name
+            assert command.help.split("\n\n")[0] == entry.help, name
+            assert isinstance(command, TyperGroup) == entry.group, name
 
 
 def loaded_modules(*args: str) -> set[str]:
-    """The kiseki.cli and kiseki_experiments modules a fresh interpreter loads to run
+    """The kiseki.cli, kiseki_experiments and matplotlib modules a fresh interpreter loads to run
     ``kiseki ARGS``."""
     code = (
         "import runpy, sys\n"
@@ -86,7 +91,7 @@ def loaded_modules(*args: str) -> set[str]:
         "    runpy.run_module('kiseki.cli', run_name='__main__')\n"
         "except SystemExit:\n"
         "    pass\n"
-        "names = [m for m in sys.modules if m.startswith(('kiseki.cli', 'kiseki_exp'))]\n"
+        "names = [m for m in sys.modules if m.startswith(('kiseki.cli', 'kiseki_exp', 'matpl'))]\n"
         "print('MODULES', *names, file=sys.stderr)\n"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
@@ -103,6 +108,11 @@ def test_help_imports_no_command_module_and_a_command_only_its_own():
     assert "kiseki.cli.localize" in localize_loads
     assert not (localize_loads & modules) - {"kiseki.cli.localize"}
     assert not any(m.startswith("kiseki_experiments") for m in localize_loads)
+    # within a group too: `kiseki map info` loads neither from-log's log readers nor matplotlib
+    info_loads = loaded_modules("map", "info", "--help")
+    assert {"kiseki.cli.map", "kiseki.cli.map_info"} <= info_loads
+    assert not {"kiseki.cli.map_from_log", "kiseki.cli.map_render"} & info_loads
+    assert not any(m.startswith("matplotlib") for m in info_loads)
 
 
 def test_an_unknown_command_is_a_usage_error():

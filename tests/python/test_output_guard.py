@@ -333,7 +333,7 @@ def test_serve_writes_its_route_history_in_the_taught_folder_and_nothing_else_th
 def test_derived_outputs_are_declared(tmp_path):
     """localize's OUTPUT-STEM.config.yaml and, with --global, OUTPUT.json; a map's image."""
     from kiseki.cli.localize import localize_command
-    from kiseki.cli.map import map_convert
+    from kiseki.cli.map_convert import map_convert
 
     (tmp_path / "t.json").write_text("{}")
     localize = _spec(localize_command)
@@ -461,7 +461,7 @@ def test_an_output_that_is_a_device_a_fifo_or_a_symlink_is_refused(tmp_path):
     import stat
 
     from kiseki import OccupancyGrid, save_map
-    from kiseki.cli.map import map_render
+    from kiseki.cli.map_render import map_render
 
     save_map(OccupancyGrid(4, 4, 0.1), tmp_path / "m.yaml")
     os.mkfifo(tmp_path / "fifo.png")

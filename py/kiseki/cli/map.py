@@ -1,172 +1,51 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""``kiseki map``: occupancy-grid maps: build, render, inspect."""
+"""``kiseki map``: occupancy-grid maps: build, render, inspect. A group that loads each of its
+commands' modules only when that command runs (``kiseki map info`` does not load matplotlib or
+the log readers that ``kiseki map from-log`` needs)."""
 
 from __future__ import annotations
 
-import time
-from pathlib import Path
-
-import numpy as np
 import typer
-from rich.console import Console
 
-from kiseki._guard import Derived, guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import CELL_LIMITS, REACH_LIMIT, Metres, refuse_given
-from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
-from kiseki._table import show_fields
-from kiseki.cli._defaults import default_of
-from kiseki.datasets import open_scans, read_carmen_log
-from kiseki.datasets.rosbag import is_ros_bag
-from kiseki.grid import grid_summary
-from kiseki.map_io import load_map, save_map
-from kiseki.mapping import MapBuildConfig, endpoint_agreement, map_of_log
-from kiseki.plots import render_map
-from kiseki.teach.environment_map import build_teaching_map
-from kiseki.trajectory_csv import read_trajectory_csv
+from kiseki._guard import Derived
+from kiseki.cli._lazy import Entry, LazyGroup
 
-__all__ = ["app"]
+__all__ = ["COMMANDS", "MAP_IMAGE", "app"]
 
-app = typer.Typer(no_args_is_help=True, help="Occupancy-grid maps: build, render, inspect.")
-console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
 # the image a map YAML names, written beside it (kiseki._guard)
-_MAP_IMAGE = Derived("--output's image", lambda a: a["output"].with_suffix(".pgm"))
+MAP_IMAGE = Derived("--output's image", lambda a: a["output"].with_suffix(".pgm"))
 
-
-@app.command("from-log")
-@guarded(inputs=("log",), outputs=("output", _MAP_IMAGE, "render"))
-@interruptible()
-def map_from_log(
-    ctx: typer.Context,
-    log: Path = typer.Argument(
-        ...,
-        help="CARMEN log (.log, .log.gz), kiseki run (.mcap), ROS 1 bag (.bag) or ROS 2 bag "
-        "(folder, .db3 or .mcap).",
+# its commands in listing order, each with its module and its line (its first paragraph)
+COMMANDS = {
+    "from-log": Entry(
+        "kiseki.cli.map_from_log",
+        "Build an occupancy grid from a log's poses and scans and save it as a ROS map.",
+        group=False,
     ),
-    output: Path = typer.Option(..., "-o", "--output", help="Map YAML to write (image beside)."),
-    resolution: float = typer.Option(
-        default_of(MapBuildConfig, "resolution"),
-        parser=Metres("--resolution", *CELL_LIMITS),
-        help="Cell size in metres.",
+    "render": Entry(
+        "kiseki.cli.map_render",
+        "Draw a map (and a trajectory over it) to a PNG.",
+        group=False,
     ),
-    usable_range: float = typer.Option(
-        default_of(MapBuildConfig, "usable_range"),
-        parser=Metres("--usable-range", 0, REACH_LIMIT, lo_open=True),
-        help="Free space is marked at most this far (m); --rules log-odds only.",
+    "convert": Entry(
+        "kiseki.cli.map_convert",
+        "Save a map (e.g. the CMU Wean .dat.gz) as a ROS map YAML + PGM (trinary).",
+        group=False,
     ),
-    render: Path | None = typer.Option(None, help="Also draw the map and trajectory to this PNG."),
-    rules: str = typer.Option(
-        "log-odds",
-        help="log-odds (occupancy probabilities), teaching (the thesis' merge rules: the map "
-        "the space observation model expects; use --resolution 0.1) or evidence (a teaching map "
-        "whose cells turn free only when their free observations outweigh their hits).",
+    "info": Entry(
+        "kiseki.cli.map_info",
+        "Print a map's size, resolution, origin and cell counts: a table on a terminal, "
+        "tab-separated field/value lines when piped, or JSON with --json.",
+        group=False,
     ),
-    scan_topic: str = typer.Option("/scan", help="ROS bags: the sensor_msgs/LaserScan topic."),
-    odom_topic: str = typer.Option(
-        "/odom", help="ROS bags: the nav_msgs/Odometry topic (if absent: odom -> base on /tf)."
-    ),
-    reference_topic: str | None = typer.Option(
-        None, help="ROS bags: a nav_msgs/Odometry topic of reference poses, e.g. /ground_truth."
-    ),
-) -> None:
-    """Build an occupancy grid from a log's poses and scans and save it as a ROS map.
-
-    Example: kiseki map from-log run.mcap -o map.yaml --render map.png"""
-    if rules not in ("log-odds", "teaching", "evidence"):
-        raise ValueError(f"--rules must be log-odds, teaching or evidence, got {rules!r}")
-    if rules != "log-odds":  # teaching maps merge 8 m local maps: they have no usable range
-        refuse_given(ctx, ["usable_range"], f"to --rules {rules} (only to log-odds)")
-    check_suffix("--output", output, (".yaml", ".yml"))
-    check_suffix("--render", render, FIGURE_SUFFIXES)
-    config = MapBuildConfig(resolution=resolution, usable_range=usable_range)
-    start = time.perf_counter()
-    scans = open_scans(log, scan_topic, odom_topic, reference_topic)
-    if not scans.has_reference_poses:
-        hint = ""
-        if reference_topic is None and is_ros_bag(log):
-            hint = " (a bag's reference poses come from --reference-topic, e.g. /ground_truth)"
-        raise ValueError(f"{log}: the log has no reference poses to build a map from{hint}")
-    if rules in ("teaching", "evidence"):
-        grid = build_teaching_map(
-            scans.poses,
-            scans.ranges,
-            scans.angles,
-            scans.max_range,
-            resolution,
-            rule="thesis" if rules == "teaching" else "evidence",
-            progress=True,
-        )
-    else:
-        grid = map_of_log(scans, config, True)
-    seconds = time.perf_counter() - start
-    saved = load_map(save_map(grid, output))
-    share = endpoint_agreement(saved, scans.poses, scans.ranges, scans.angles, scans.max_range)
-    if render is not None:
-        render_map(saved, render, trajectory=scans.poses, title=f"{log.name}")
-    console.print(
-        f"{output}: {grid.width} x {grid.height} cells at {grid.resolution} m from "
-        f"{len(scans)} scans ({scans.invalid_ranges} invalid range readings skipped) in "
-        f"{seconds:.2f} s; {100 * share:.1f} % of scan endpoints on or next to occupied cells"
-    )
+}
 
 
-def _read_trajectory(path: Path) -> np.ndarray:
-    """x, y[, theta] rows from a CSV with a header naming x and y, or poses of a CARMEN log."""
-    if path.name.endswith((".log", ".log.gz")):
-        return read_carmen_log(path).scans.poses
-    return read_trajectory_csv(path)
+class _MapGroup(LazyGroup):
+    table = COMMANDS
 
 
-@app.command("render")
-@guarded(inputs=("map_file", "trajectory"), outputs=("output",))
-@interruptible()
-def map_render(
-    map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat map."),
-    output: Path = typer.Option(..., "-o", "--output", help="PNG to write."),
-    trajectory: Path | None = typer.Option(
-        None, help="Trajectory to overlay: CSV with x,y columns, or a CARMEN log."
-    ),
-) -> None:
-    """Draw a map (and a trajectory over it) to a PNG.
-
-    Example: kiseki map render data/maps/factory_corridor.yaml -o corridor.png"""
-    check_suffix("--output", output, FIGURE_SUFFIXES)
-    grid = load_map(map_file)
-    path = _read_trajectory(trajectory) if trajectory is not None else None
-    render_map(grid, output, trajectory=path, title=map_file.name)
-    console.print(f"{output}: {grid.width} x {grid.height} map drawn")
-
-
-@app.command("convert")
-@guarded(inputs=("map_file",), outputs=("output", _MAP_IMAGE))
-@interruptible()
-def map_convert(
-    map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat(.gz) map."),
-    output: Path = typer.Option(..., "-o", "--output", help="ROS map YAML to write (PGM beside)."),
-) -> None:
-    """Save a map (e.g. the CMU Wean .dat.gz) as a ROS map YAML + PGM (trinary).
-
-    Example: kiseki map convert data/maps/factory_corridor.yaml -o corridor.yaml"""
-    check_suffix("--output", output, (".yaml", ".yml"))
-    grid = load_map(map_file)
-    save_map(grid, output)
-    summary = grid_summary(grid)
-    console.print(
-        f"{output}: {grid.width} x {grid.height} cells at {grid.resolution} m; "
-        f"{summary['free']} free, {summary['occupied']} occupied, {summary['unknown']} unknown"
-    )
-
-
-@app.command("info")
-@guarded(inputs=("map_file",))
-def map_info(
-    map_file: Path = typer.Argument(..., metavar="MAP", help="ROS map YAML or CMU .dat map."),
-    as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
-) -> None:
-    """Print a map's size, resolution, origin and cell counts: a table on a terminal,
-    tab-separated field/value lines when piped, or JSON with --json.
-
-    Example: kiseki map info data/maps/factory_corridor.yaml --json"""
-    summary = grid_summary(load_map(map_file))
-    show_fields(str(map_file), summary, as_json=as_json, console=console)
+app = typer.Typer(
+    cls=_MapGroup, no_args_is_help=True, help="Occupancy-grid maps: build, render, inspect."
+)
