@@ -343,6 +343,8 @@ def scan_preparer(model, scans: LaserScans) -> Callable[[int], _core.SensorModel
 class LocalizeConfig:
     """Localization along a log: the method, its sensor model and the engine's settings.
 
+    * ``method`` likelihood-field: nav2 AMCL's model and the baseline MCL (Probabilistic Robotics);
+      what ``kiseki localize`` runs by default (it reads this default).
     * ``beams`` 90: nav2's max_beams rule (every k-th beam); 90 is half of a 180-beam scan.
     * ``sigma_hit`` 0.2 m (nav2); ``z_hit`` 0.95 / ``z_rand`` 0.05 (Probabilistic Robotics'
       likelihood field); the beam model adds ``z_short``, ``z_max``, ``lambda_short`` (nav2's).
@@ -350,7 +352,7 @@ class LocalizeConfig:
     * ``alphas`` None: :func:`motion_alphas` (the noise the odometry has).
     """
 
-    method: str = "space-observation"
+    method: str = "likelihood-field"
     seed: int = 0
     odometry_noise: float = 0.0  # SD as a fraction of each odometry increment's component
     particles: int = 500

@@ -220,7 +220,7 @@ def test_a_map_that_is_not_the_logs_building_warns(inputs):
 def test_the_off_map_check_skips_only_what_it_cannot_measure(capsys):
     """No estimate, or no endpoint below max_range: no share, no warning. Any other error of
     endpoint_agreement (here ranges one column short) is raised: it was swallowed with them."""
-    from kiseki.cli import _warn_if_off_the_map
+    from kiseki.cli.localize import _warn_if_off_the_map
 
     grid, poses = room(), np.array([[0.0, -1.0, 0.0], [0.5, -1.0, 0.0]])
 
@@ -308,7 +308,7 @@ def test_a_playback_to_a_waypoint_without_truth_reports_its_stop():
     raised KeyError: 'truth' (a traceback after the work)."""
     from types import SimpleNamespace
 
-    from kiseki.cli import _stop_summary
+    from kiseki.cli.playback import _stop_summary
 
     result = SimpleNamespace(
         steps=120, stop_true=(7.43, 0.04, 0.0), stop_estimate=(7.38, 0.0, 0.0), reached=True,

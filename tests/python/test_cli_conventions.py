@@ -57,8 +57,10 @@ def run_on_terminal(*args: str) -> str:
 def commands(group=None, path=()) -> list[tuple[tuple[str, ...], object]]:
     """Every leaf command of the app, as (its words, its click command)."""
     group = typer.main.get_command(app) if group is None else group
+    ctx = typer.Context(group)  # the root loads its groups on request: asked through click's API
     found = []
-    for name, sub in sorted(group.commands.items()):
+    for name in sorted(group.list_commands(ctx)):
+        sub = group.get_command(ctx, name)
         if hasattr(sub, "commands"):
             found += commands(sub, (*path, name))
         else:
@@ -127,13 +129,13 @@ def test_report_json_counts_the_claims_written(tmp_path: Path):
     names = sorted(all_experiments())
     write_result(tmp_path / "results", names[0], [True, False, True])
     write_result(tmp_path / "results", names[-1], [False, False])
-    done = run("report", "--json", cwd=tmp_path)
+    done = run("experiment", "report", "--json", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     doc = json.loads(done.stdout)
     assert (doc["claims"], doc["hold"]) == (5, 2)
     assert doc["missing"] == names[1:-1] and doc["output"] == "REPRODUCTION.md"
     assert "5 claims, 2 hold." in (tmp_path / "REPRODUCTION.md").read_text()
-    done = run("report", "-o", "R2.md", cwd=tmp_path)
+    done = run("experiment", "report", "-o", "R2.md", cwd=tmp_path)
     fields = dict(line.split("\t") for line in done.stdout.splitlines()[1:])
     assert (fields["claims"], fields["hold"]) == ("5", "2")
     assert fields["missing"] == ", ".join(names[1:-1])
@@ -194,12 +196,12 @@ def test_exit_codes_and_no_traceback(grid_file: Path, args, code):
 
 
 def test_an_internal_error_exits_3_with_its_traceback(grid_file, monkeypatch, capsys):
-    import kiseki.grid
+    import kiseki.cli.map_info  # the module of `kiseki map info`: grid_summary imported at its top
 
     def broken(grid):
         raise KeyError("a bug")
 
-    monkeypatch.setattr(kiseki.grid, "grid_summary", broken)
+    monkeypatch.setattr(kiseki.cli.map_info, "grid_summary", broken)
     monkeypatch.setattr(sys, "argv", ["kiseki", "map", "info", str(grid_file)])
     with pytest.raises(SystemExit) as exit_info:
         main()

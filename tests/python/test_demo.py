@@ -16,7 +16,7 @@ import yaml
 from rich.console import Console
 
 from kiseki import load_map
-from kiseki.demo import run_demo
+from kiseki.cli.demo import run_demo
 from kiseki_experiments.mapping.corridor_scans import CorridorLaser, simulate_scans
 
 

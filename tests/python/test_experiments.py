@@ -168,7 +168,7 @@ def test_results_folder_latest_link_and_reproduction_report(tmp_path):
         "holds",
         "note",
     ]
-    done = cli("report", cwd=tmp_path)
+    done = cli("experiment", "report", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     text = (tmp_path / "REPRODUCTION.md").read_text()
     assert "1 claims, 1 hold." in text
@@ -255,7 +255,7 @@ def test_report_refuses_a_missing_folder_and_broken_results_in_one_line(
         write.write_bytes(claims) if isinstance(claims, bytes) else write.write_text(claims)
         latest.joinpath("manifest.json").write_text(manifest)
     where = "nonexistent" if claims is None else str(results)
-    done = cli("report", "--results", where, "-o", "R.md", cwd=tmp_path)
+    done = cli("experiment", "report", "--results", where, "-o", "R.md", cwd=tmp_path)
     assert done.returncode == 1, done.stdout + done.stderr
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], done.stderr
@@ -273,7 +273,7 @@ def test_report_refuses_a_latest_link_outside_the_results_in_one_line(tmp_path):
     latest = tmp_path / "results" / "exp1-corridor" / "latest"
     latest.parent.mkdir(parents=True)
     latest.symlink_to(elsewhere)
-    done = cli("report", "--results", "results", "-o", "R.md", cwd=tmp_path)
+    done = cli("experiment", "report", "--results", "results", "-o", "R.md", cwd=tmp_path)
     assert done.returncode == 1, done.stdout + done.stderr
     assert done.stderr.splitlines() == [
         f"kiseki: error: {Path('results', 'exp1-corridor', 'latest')}: the link points outside "

@@ -110,7 +110,9 @@ def test_space_observation_tracks_the_logs_far_better_than_odometry(shared_data,
     scans = read_carmen_log(shared_data / "carmen" / f"{log}-corrected.log.gz").scans
     grid = build_teaching_map(scans.poses, scans.ranges, scans.angles, scans.max_range)
     odometry = localize(scans, grid, LocalizeConfig("odometry", odometry_noise=0.1)).estimates
-    tracked = localize(scans, grid, LocalizeConfig(odometry_noise=0.1)).estimates
+    tracked = localize(
+        scans, grid, LocalizeConfig("space-observation", odometry_noise=0.1)
+    ).estimates
     odo, so = ape(odometry, scans.poses).rmse, ape(tracked, scans.poses).rmse
     assert so < 0.6 and so < odo / 8, (so, odo)
 

@@ -45,8 +45,10 @@ WALK_BUDGET_S = 10.0  # every value into every numeric option of every command
 def leaves(group=None, path=()):
     """Every command of the app: (its words, its click command)."""
     group = typer.main.get_command(app) if group is None else group
+    ctx = typer.Context(group)  # the root loads its groups on request: asked through click's API
     found = []
-    for name, sub in sorted(group.commands.items()):
+    for name in sorted(group.list_commands(ctx)):
+        sub = group.get_command(ctx, name)
         found += leaves(sub, (*path, name)) if hasattr(sub, "commands") else [((*path, name), sub)]
     return found
 

@@ -59,7 +59,9 @@ def _commands(group=None, path=()):
     from kiseki.cli import app
 
     group = typer.main.get_command(app) if group is None else group
-    for name, sub in sorted(group.commands.items()):
+    ctx = typer.Context(group)  # the root loads its groups on request: asked through click's API
+    for name in sorted(group.list_commands(ctx)):
+        sub = group.get_command(ctx, name)
         if hasattr(sub, "commands"):
             yield from _commands(sub, (*path, name))
         else:
@@ -182,7 +184,7 @@ def test_an_existing_folder_as_the_output_file_is_refused_before_the_work(inputs
     """It failed after the work, naming a temporary file: [Errno 21] Is a directory:
     '.outdir.zb7lp2zf' -> 'outdir'. As every file output of every command (speed limits' here,
     in this process)."""
-    from kiseki.cli_speed import speed_limits
+    from kiseki.cli.speed import speed_limits
 
     (inputs / "outdir").mkdir()
     (inputs / "outdir" / "keep.txt").write_text("mine")
@@ -236,7 +238,7 @@ def test_an_aalto_prefix_stands_for_its_files(tmp_path):
     with pytest.raises(ValueError, match=r"would overwrite the input DATA's run file .*1-mag\.csv"):
         check_outputs({"--output": runs / "1-mag.csv"}, {"DATA": runs / "1"})
     check_outputs({"--output": runs / "2-mag.csv"}, {"DATA": runs / "1"})  # another run: fine
-    from kiseki.cli_magnetic import fit
+    from kiseki.cli.magnetic_fit import fit
 
     with pytest.raises(ValueError, match="would overwrite the folder holding the input DATA"):
         _spec(fit).check({"data": [runs / "1"], "output": runs})
@@ -245,7 +247,8 @@ def test_an_aalto_prefix_stands_for_its_files(tmp_path):
 def test_files_an_input_names_are_inputs(tmp_path, project_root):
     """A scene's octomap, a waypoint file's maps and their images."""
     from kiseki import OccupancyGrid, save_map
-    from kiseki.cli import playback_command, sim_show
+    from kiseki.cli.playback import playback_command
+    from kiseki.cli.sim import sim_show
 
     (tmp_path / "world.bt").write_bytes(b"octree")
     (tmp_path / "scene.yaml").write_text("name: s\noctomap: world.bt\n")
@@ -266,7 +269,7 @@ def test_files_an_input_names_are_inputs(tmp_path, project_root):
 
 
 def test_an_input_in_an_output_folder_is_refused_only_where_the_command_writes(tmp_path):
-    from kiseki.cli_terrain import terrain_run
+    from kiseki.cli.terrain import terrain_run
 
     out = tmp_path / "OUT"
     out.mkdir()
@@ -286,7 +289,7 @@ def test_an_input_in_an_output_folder_is_refused_only_where_the_command_writes(t
 
 
 def test_an_output_folder_inside_an_input_folder_is_refused(tmp_path):
-    from kiseki.cli_magnetic import navigate
+    from kiseki.cli.magnetic import navigate
 
     (tmp_path / "taught").mkdir()
     spec = _spec(navigate)
@@ -298,7 +301,7 @@ def test_an_output_folder_inside_an_input_folder_is_refused(tmp_path):
 
 
 def test_a_hard_link_to_a_file_of_an_input_folder_is_that_file(tmp_path):
-    from kiseki.cli import localize_command
+    from kiseki.cli.localize import localize_command
 
     (tmp_path / "bag").mkdir()
     (tmp_path / "bag" / "metadata.yaml").write_text("rosbag2_bagfile_information: {}\n")
@@ -311,7 +314,7 @@ def test_a_hard_link_to_a_file_of_an_input_folder_is_that_file(tmp_path):
 
 
 def test_serve_writes_its_route_history_in_the_taught_folder_and_nothing_else_there(tmp_path):
-    from kiseki.cli import serve_command
+    from kiseki.cli.serve import serve_command
 
     taught = tmp_path / "taught"
     taught.mkdir()
@@ -329,7 +332,8 @@ def test_serve_writes_its_route_history_in_the_taught_folder_and_nothing_else_th
 
 def test_derived_outputs_are_declared(tmp_path):
     """localize's OUTPUT-STEM.config.yaml and, with --global, OUTPUT.json; a map's image."""
-    from kiseki.cli import localize_command, map_convert
+    from kiseki.cli.localize import localize_command
+    from kiseki.cli.map_convert import map_convert
 
     (tmp_path / "t.json").write_text("{}")
     localize = _spec(localize_command)
@@ -387,8 +391,8 @@ def test_a_link_to_an_input_in_a_folder_written_whole_is_refused(tmp_path, proje
 def test_links_in_an_output_folder_are_refused_where_the_command_writes(tmp_path):
     """A symlink, a symlinked folder holding the input; with patterns, only the entries the
     command writes."""
-    from kiseki.cli import teach_command
-    from kiseki.cli_terrain import terrain_run
+    from kiseki.cli.teach import teach_command
+    from kiseki.cli.terrain import terrain_run
 
     scene = tmp_path / "scene.yaml"
     scene.write_text("name: s\n")
@@ -423,7 +427,8 @@ def test_an_input_yaml_larger_than_1_mib_still_protects_the_files_it_names(tmp_p
     readers accept (up to kiseki._inputs.YAML_LIMIT) is looked into."""
     from kiseki import OccupancyGrid, save_map
     from kiseki._inputs import YAML_LIMIT
-    from kiseki.cli import playback_command, sim_run
+    from kiseki.cli.playback import playback_command
+    from kiseki.cli.sim import sim_run
 
     assert 2 * len(PADDING) < YAML_LIMIT  # the file is one the readers accept
     (tmp_path / "big").mkdir()
@@ -456,7 +461,7 @@ def test_an_output_that_is_a_device_a_fifo_or_a_symlink_is_refused(tmp_path):
     import stat
 
     from kiseki import OccupancyGrid, save_map
-    from kiseki.cli import map_render
+    from kiseki.cli.map_render import map_render
 
     save_map(OccupancyGrid(4, 4, 0.1), tmp_path / "m.yaml")
     os.mkfifo(tmp_path / "fifo.png")

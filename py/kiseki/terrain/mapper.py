@@ -34,12 +34,14 @@ __all__ = ["MapperConfig", "SdemMapper", "Sweep"]
 @dataclass(frozen=True)
 class MapperConfig:
     """removal: plane removal before matching (``hough`` the paper's, ``pcl``, ``none``);
-    search: ``exhaustive`` (the paper's) or ``coarse-to-fine``; cost: eq. 4 as ``mean`` or
-    ``sum``; the search box (m) and step; voxel: the global map's resolution (m); seed: PCL's
-    RANSAC (the only random part)."""
+    search: ``exhaustive`` (the paper's) or ``coarse-to-fine`` (the default, what ``kiseki
+    terrain run`` runs: 42 ms a pair of sweeps against the exhaustive search's second, and the
+    exhaustive minimum on 12 of 12 simulated pairs, README; the experiments set theirs); cost:
+    eq. 4 as ``mean`` or ``sum``; the search box (m) and step; voxel: the global map's
+    resolution (m); seed: PCL's RANSAC (the only random part)."""
 
     removal: Literal["hough", "pcl", "none"] = "hough"
-    search: Literal["exhaustive", "coarse-to-fine"] = "exhaustive"
+    search: Literal["exhaustive", "coarse-to-fine"] = "coarse-to-fine"
     cost: Literal["mean", "sum"] = "mean"
     x: tuple[float, float] = (0.0, 0.70)
     y: tuple[float, float] = (-0.50, 0.50)

@@ -17,11 +17,17 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+import typer
 import yaml
 from rich.console import Console
 
 from kiseki._atomic import atomic_write
+from kiseki._guard import guarded
+from kiseki._interrupt import interruptible
+from kiseki._options import PARTICLE_LIMIT, Count, Seed
 from kiseki._table import show
+from kiseki.cli._defaults import default_of
+from kiseki.cli.teach import merge_rule
 from kiseki.core import derive_seed
 from kiseki.map_io import load_map
 from kiseki.plots import render_map
@@ -30,7 +36,7 @@ from kiseki.sim.scene import load_scene
 from kiseki.teach import PlaybackConfig, playback, teach
 from kiseki.teach.local_maps import METHODS
 
-__all__ = ["DemoConfig", "run_demo"]
+__all__ = ["DemoConfig", "app", "run_demo"]
 
 # Thesis Table 4.5 (5 runs each): stop error mean (m), estimate error mean (m), stops within 0.1 m
 THESIS = {
@@ -43,10 +49,45 @@ THESIS = {
 
 @dataclass(frozen=True)
 class DemoConfig:
+    """What the demo runs with (written to OUT/config.yaml); the command's defaults."""
+
     scene: str = "data/worlds/factory_turn.yaml"
     seed: int = 0
-    particles: int = 1000
+    particles: int = default_of(PlaybackConfig, "particles")  # the filter's own default
     merge: str = "thesis"  # the environment maps' merge rule (kiseki.teach.environment_map)
+
+
+app = typer.Typer()
+console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
+
+
+@app.command("demo")
+@guarded(inputs=("scene",), output_folders=("out",))
+@interruptible()
+def demo(
+    out: Path = typer.Option(Path("results/demo"), help="Folder for the run, maps and figures."),
+    scene: Path = typer.Option(
+        Path(DemoConfig.scene), "--scene", help="Scene with a taught route."
+    ),
+    seed: int = typer.Option(
+        DemoConfig.seed, parser=Seed(), help="Seed of every noise source of the run."
+    ),
+    particles: int = typer.Option(
+        DemoConfig.particles,
+        parser=Count("--particles", 1, PARTICLE_LIMIT),
+        help="Particles of the localization filter.",
+    ),
+    merge: str = typer.Option(
+        DemoConfig.merge,
+        help="Merge rule of the taught maps: thesis or evidence (see kiseki teach).",
+    ),
+) -> None:
+    """The main job: teach the factory route with a turn, measure the taught maps against the
+    scene's truth, play the route back with each method, and print the thesis' Table 4.5-style
+    comparison.
+
+    Example: kiseki demo --out results/demo --seed 0"""
+    run_demo(scene, out, seed, console, particles, merge_rule(merge))
 
 
 def _write_text(path: Path, text: str) -> None:
@@ -58,8 +99,8 @@ def run_demo(
     out: Path,
     seed: int,
     console: Console,
-    particles: int = 1000,
-    merge: str = "thesis",
+    particles: int = DemoConfig.particles,
+    merge: str = DemoConfig.merge,
 ) -> dict:
     config = DemoConfig(scene=str(scene_file), seed=seed, particles=particles, merge=merge)
     PlaybackConfig(particles=particles)  # a bad --particles is refused before the teaching

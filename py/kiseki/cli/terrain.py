@@ -8,15 +8,25 @@ from pathlib import Path
 
 import numpy as np
 import typer
+import yaml
 from rich.console import Console
+from tqdm import tqdm
 
+from kiseki import _core
+from kiseki._atomic import atomic_write
 from kiseki._guard import Folder, guarded
 from kiseki._interrupt import interruptible
 from kiseki._options import Count, Metres, Seed, refuse_given
+from kiseki.cli._defaults import default_of
+from kiseki.sim.terrain_moves import terrain_stops
+from kiseki.terrain.cloud_picture import planes_summary, render_cloud_planes, write_planes_csv
+from kiseki.terrain.cloud_planes import CLOUD_METHODS, cloud_planes, read_cloud
+from kiseki.terrain.mapper import MapperConfig, SdemMapper
+from kiseki.terrain.render import render_run
 
-__all__ = ["terrain_app"]
+__all__ = ["app"]
 
-terrain_app = typer.Typer(
+app = typer.Typer(
     no_args_is_help=True,
     help="3-D localization and mapping in rubble: sphere elevation maps, plane removal, "
     "correlation search, OctoMap global maps.",
@@ -37,7 +47,7 @@ def _destination(out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
 
 
-@terrain_app.command("run")
+@app.command("run")
 @guarded(inputs=("world",), output_folders=(_RUN_FILES,))
 @interruptible()
 def terrain_run(
@@ -56,9 +66,12 @@ def terrain_run(
     step: float = typer.Option(
         0.35, parser=Metres("--step", 0.02, 0.6), help="Metres between stops."
     ),
-    removal: str = typer.Option("hough", help="Plane removal: hough (the paper's), pcl, none."),
+    removal: str = typer.Option(
+        default_of(MapperConfig, "removal"), help="Plane removal: hough (the paper's), pcl, none."
+    ),
     search: str = typer.Option(
-        "coarse-to-fine", help="exhaustive (the paper's 56,916 candidates) or coarse-to-fine."
+        default_of(MapperConfig, "search"),
+        help="exhaustive (the paper's 56,916 candidates) or coarse-to-fine.",
     ),
 ) -> None:
     """Moves a robot through WORLD stopping every --step metres; at each stop a tilting-laser
@@ -69,14 +82,6 @@ def terrain_run(
     OUT/global_map.bt (octovis opens it), OUT/trajectory.png and OUT/config.yaml.
 
     Example: kiseki terrain run data/worlds/rubble_a.yaml --moves 10 -o rubble-run"""
-    import yaml
-    from tqdm import tqdm
-
-    from kiseki import _core
-    from kiseki._atomic import atomic_write
-    from kiseki.sim.terrain_moves import terrain_stops
-    from kiseki.terrain.mapper import MapperConfig, SdemMapper
-
     if not world.exists():
         raise ValueError(f"WORLD {world}: no such file")
     config = MapperConfig(removal=removal, search=search, seed=seed)  # checks both names
@@ -97,7 +102,6 @@ def terrain_run(
     doc = {"world": str(world), "moves": moves, "seed": seed, "step": step, **config.to_dict()}
     doc["hough"], doc["pcl"] = vars(config.hough), vars(config.pcl)
     atomic_write(output / "config.yaml", lambda tmp: Path(tmp).write_text(yaml.safe_dump(doc)))
-    from kiseki.terrain.render import render_run
 
     render_run(table, mapper.global_map, output / "trajectory.png", title=world.name)
     err = np.linalg.norm(table[:, 4:7] - table[:, 1:4], axis=1)
@@ -111,7 +115,7 @@ def terrain_run(
     )
 
 
-@terrain_app.command("planes")
+@app.command("planes")
 @guarded(inputs=("cloud",), outputs=("output", "csv"))
 @interruptible()
 def terrain_planes(
@@ -144,9 +148,6 @@ def terrain_planes(
     on the sensor: PCD's VIEWPOINT, (0, 0, 0) for text files.
 
     Example: kiseki terrain planes scan.dat.bz2 -o planes.png --csv planes.csv"""
-    from kiseki.terrain.cloud_picture import planes_summary, render_cloud_planes, write_planes_csv
-    from kiseki.terrain.cloud_planes import CLOUD_METHODS, cloud_planes, read_cloud
-
     if method not in CLOUD_METHODS:
         raise ValueError(f"--method must be one of {CLOUD_METHODS}, got {method!r}")
     if output.suffix.lower() != ".png":

@@ -9,16 +9,23 @@ from pathlib import Path
 
 import numpy as np
 import typer
+import yaml
 from rich.console import Console
 
+from kiseki._atomic import atomic_write
 from kiseki._guard import Derived, guarded
 from kiseki._interrupt import interruptible
 from kiseki._options import REACH_LIMIT, Degrees, Metres, Quantity, refuse_given
 from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki.datasets import open_scans
+from kiseki.map_io import load_map
+from kiseki.speed import SpeedLimiterConfig
+from kiseki.speed.along_log import limits_along_log
+from kiseki.speed.render import render_limits
 
-__all__ = ["speed_app"]
+__all__ = ["app"]
 
-speed_app = typer.Typer(
+app = typer.Typer(
     no_args_is_help=True, help="Speed limits that consider occluded regions and passage width."
 )
 console = Console(soft_wrap=True)
@@ -27,7 +34,7 @@ METHODS = ("occlusion", "occlusion-width", "width")
 _CONFIG = Derived("the config", lambda a: a["output"].with_suffix(".config.yaml"))
 
 
-@speed_app.command("limits")
+@app.command("limits")
 @guarded(inputs=("log", "map_file"), outputs=("output", _CONFIG, "plot"))
 @interruptible()
 def speed_limits(
@@ -48,13 +55,13 @@ def speed_limits(
         help="Sensor range of eq. 1's region (m); the paper's 4 m.",
     ),
     half_angle: float = typer.Option(
-        90.0,
+        math.degrees(SpeedLimiterConfig.half_angle),
         parser=Degrees("--half-angle", 0, 180, lo_open=True),
         help="theta: +-degrees around the motion (paper 90); not with --method width.",
     ),
     # 10 m/s is faster than any robot that drives among people, which the limit is for
     v_max: float = typer.Option(
-        0.5,
+        SpeedLimiterConfig.v_max,
         parser=Quantity("--v-max", 0, 10, "m/s", lo_open=True),
         help="The robot's maximum speed (m/s).",
     ),
@@ -73,12 +80,6 @@ def speed_limits(
 
     Example: kiseki speed limits intel.log.gz --map intel.yaml -o limits.csv --plot limits.png
     """
-    from kiseki._atomic import atomic_write
-    from kiseki.datasets import open_scans
-    from kiseki.map_io import load_map
-    from kiseki.speed import SpeedLimiterConfig
-    from kiseki.speed.along_log import limits_along_log
-
     if method not in METHODS:
         raise ValueError(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
     if method == "width":  # eq. 2 measures the passage ahead: no region of +-theta
@@ -103,7 +104,6 @@ def speed_limits(
     rows = np.column_stack(list(columns.values()))
     text = ",".join(columns) + "\n" + "\n".join(",".join(f"{v:.6g}" for v in r) for r in rows)
     atomic_write(output, lambda tmp: Path(tmp).write_text(text + "\n", encoding="utf-8"))
-    import yaml
 
     doc = {"log": str(log), "map": str(map_file), "method": method, "reach": reach}
     doc |= {"heading": heading, **vars(config)}
@@ -114,7 +114,5 @@ def speed_limits(
         f"{np.median(v):.2f}); below half of v_max at {np.mean(v < v_max / 2):.0%} of the scans"
     )
     if plot is not None:
-        from kiseki.speed.render import render_limits
-
         render_limits(grid, limits, plot, v_max, title=f"{log.name}: {method}")
         console.print(f"{plot}: the path coloured by the limit")

@@ -1,0 +1,288 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""``kiseki localize``: localization along a recorded log (position tracking, or global)."""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+import typer
+import yaml
+from rich.console import Console
+
+from kiseki._atomic import atomic_write
+from kiseki._guard import Derived, guarded
+from kiseki._interrupt import interruptible
+from kiseki._options import (
+    BEAM_LIMIT,
+    PARTICLE_LIMIT,
+    THREAD_LIMIT,
+    Count,
+    Fraction,
+    Seed,
+    refuse_given,
+)
+from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki._table import show_fields
+from kiseki.cli._defaults import default_of
+from kiseki.datasets import open_scans
+from kiseki.global_localization import (
+    GlobalConfig,
+    describe,
+    global_localize,
+    render_global,
+    write_report,
+)
+from kiseki.localization import LocalizeConfig, localize
+from kiseki.map_io import load_map
+from kiseki.mapping import endpoint_agreement
+from kiseki.metrics import ape
+
+__all__ = ["app"]
+
+app = typer.Typer()
+console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
+# files the command writes that no option names (kiseki._guard)
+_CONFIG_BESIDE = Derived(
+    "its config", lambda a: a["output"].with_name(a["output"].stem + ".config.yaml")
+)
+_GLOBAL_REPORT = Derived(
+    "its report", lambda a: a["output"].with_suffix(".json") if a["global_start"] is True else None
+)
+
+
+@app.command("localize")
+@guarded(
+    inputs=("log", "map_file"),
+    outputs=("output", _CONFIG_BESIDE, _GLOBAL_REPORT, "plot"),
+)
+@interruptible()
+def localize_command(
+    ctx: typer.Context,
+    log: Path = typer.Argument(
+        ...,
+        help="CARMEN log (.log, .log.gz), kiseki run (.mcap), CMU Wean robotdata log, ROS 1 bag "
+        "(.bag) or ROS 2 bag (folder, .db3 or .mcap).",
+    ),
+    map_file: Path = typer.Option(
+        ..., "--map", help="ROS map YAML of the log's building, or a CMU .dat(.gz) map."
+    ),
+    # LocalizeConfig's method, GlobalConfig's too (the same: a test holds them equal)
+    method: str = typer.Option(
+        default_of(LocalizeConfig, "method"),
+        help="beam, likelihood-field, space-observation or odometry.",
+    ),
+    seed: int = typer.Option(
+        default_of(LocalizeConfig, "seed"),
+        parser=Seed(),
+        help="Seed of the filter and of the odometry noise.",
+    ),
+    # the defaults are the configs' (LocalizeConfig; GlobalConfig with --global), shown here
+    # an SD up to the step itself: beyond it the odometry says nothing of the motion
+    odometry_noise: float | None = typer.Option(
+        None,
+        parser=Fraction("--odometry-noise", 0, 1),
+        help="Odometry noise SD, fraction of each step (default "
+        f"{LocalizeConfig.odometry_noise:g}); not with --global.",
+    ),
+    particles: int | None = typer.Option(
+        None,
+        parser=Count("--particles", 1, PARTICLE_LIMIT),
+        help=f"Particles (default {LocalizeConfig.particles:,}; {GlobalConfig.particles:,} at the "
+        "start with --global); with --kld the maximum.",
+    ),
+    kld: bool = typer.Option(False, "--kld", help="Adapt the particle count by KLD sampling."),
+    beams: int | None = typer.Option(
+        None,
+        parser=Count("--beams", 0, BEAM_LIMIT, "0 = every beam"),
+        help=f"Beams used per scan, nav2's max_beams (default {LocalizeConfig.beams}; "
+        f"{GlobalConfig.beams} with --global); not with space-observation.",
+    ),
+    recovery: str | None = typer.Option(
+        None,
+        help="none, augmented (Augmented MCL) or resetting (expansion, then sensor resetting); "
+        f"with --global from the cloud's convergence on (default {LocalizeConfig.recovery}).",
+    ),
+    threads: int | None = typer.Option(
+        None,
+        parser=Count("--threads", 0, THREAD_LIMIT, "0 = every core"),
+        help=f"Threads of the filter (0 = every core; default {LocalizeConfig.threads}).",
+    ),
+    global_start: bool = typer.Option(
+        False,
+        "--global",
+        help="Global localization: start uniformly over the map's free cells (no initial pose).",
+    ),
+    tracking_particles: int | None = typer.Option(
+        None,
+        parser=Count("--tracking-particles", 1, PARTICLE_LIMIT),
+        help="With --global: particles kept once the cloud has converged (default "
+        f"{GlobalConfig.tracking_particles:,}).",
+    ),
+    plot: Path | None = typer.Option(
+        None, help="With --global: draw the map, the estimates and where they converged (PNG)."
+    ),
+    output: Path = typer.Option(
+        ..., "-o", "--output", help="CSV t,x,y,theta,reliability to write."
+    ),
+    scan_topic: str = typer.Option("/scan", help="ROS bags: the sensor_msgs/LaserScan topic."),
+    odom_topic: str = typer.Option(
+        "/odom", help="ROS bags: the nav_msgs/Odometry topic (if absent: odom -> base on /tf)."
+    ),
+    reference_topic: str | None = typer.Option(
+        None, help="ROS bags: a nav_msgs/Odometry topic of reference poses, e.g. /ground_truth."
+    ),
+    as_json: bool = typer.Option(
+        False, "--json", help="Print the errors (and the convergence report) as one JSON object."
+    ),
+) -> None:
+    """Localize along a log: position tracking from its first reference pose, or with --global
+    from a uniform start. Prints the absolute pose error against the log's reference poses when
+    it has them; with --global also the convergence report (written to OUTPUT.json too); with
+    --json the same numbers as one JSON object. The settings it ran with are written beside the
+    output as OUTPUT-STEM.config.yaml.
+
+    Example: kiseki localize run.mcap --map data/maps/factory_corridor.yaml -o track.csv --json"""
+    _refuse_unused_by_localize(ctx, method, global_start)
+
+    check_suffix("--plot", plot, FIGURE_SUFFIXES)
+    if not global_start:
+        for name, value in (("--tracking-particles", tracking_particles), ("--plot", plot)):
+            if value is not None:
+                raise ValueError(f"{name} applies only with --global")
+    if global_start and output.suffix.lower() == ".json":
+        raise ValueError(f"{output}: the report goes to OUTPUT.json: give a .csv output")
+    scans = open_scans(
+        log, scan_topic=scan_topic, odom_topic=odom_topic, reference_topic=reference_topic
+    )
+    grid = load_map(map_file)
+    reliability = np.full(len(scans), np.nan)
+    shared = dict(method=method, seed=seed, particles=particles, kld=kld, beams=beams)
+    shared.update(recovery=recovery, threads=threads)
+    if global_start:
+        gconfig = GlobalConfig(**_given(**shared, tracking_particles=tracking_particles))
+        saved_config = {"command": "localize --global", **asdict(gconfig)}
+        result = global_localize(scans, grid, gconfig, progress=True)
+        trajectory, reliability = result.estimates, result.reliability
+    else:
+        config = LocalizeConfig(**_given(**shared, odometry_noise=odometry_noise))
+        if not scans.has_reference_poses:
+            raise ValueError(f"{log}: the log has no reference poses to start from: use --global")
+        saved_config = {"command": "localize", **config.to_dict()}
+        tracked = localize(scans, grid, config, progress=True)
+        trajectory, reliability = tracked.estimates, tracked.reliability
+    saved_config.update(log=str(log), map=str(map_file))
+    _write_trajectory(output, scans.times, trajectory, reliability)
+    if not global_start:
+        _warn_if_off_the_map(grid, trajectory, scans, map_file)
+    elif result.report.converged and result.report.fit is not None:  # from convergence on
+        _warn_if_off_the_map(grid, trajectory, scans, map_file, result.report.fit.within_1_cell)
+    config_path = output.with_name(output.stem + ".config.yaml")
+    _write_yaml(config_path, saved_config)
+    summary: dict = {"output": str(output), "poses": len(scans), "method": method}
+    summary["invalid_ranges"] = scans.invalid_ranges  # skipped (kiseki.scans' rule)
+    lines = [f"{output}: {len(scans)} poses; the log has no reference poses"]
+    if scans.has_reference_poses:
+        position = ape(trajectory, scans.poses)
+        heading = ape(trajectory, scans.poses, "rotation_deg")
+        summary.update(position_rmse_m=position.rmse, position_max_m=position.max)
+        summary.update(heading_rmse_deg=heading.rmse)
+        lines = [
+            f"{output}: {len(scans)} poses; {method}: position RMSE {position.rmse:.3f} m "
+            f"(max {position.max:.3f} m), heading RMSE {heading.rmse:.2f} deg"
+        ]
+    lines[0] += f"; {scans.invalid_ranges} invalid range readings skipped"
+    if global_start:
+        report_path = write_report(result, output.with_suffix(".json"))
+        lines.append(describe(result.report) + f" (report: {report_path})")
+        summary.update(report_file=str(report_path), convergence=result.report.to_dict())
+    _print_report(lines, summary, as_json)
+    if global_start and plot is not None:
+        render_global(grid, result, plot, title=f"{log.name}: global {method}")
+
+
+def _given(**settings) -> dict:
+    """The settings the command line gave (not None): the others keep their config's default,
+    so that each default lives in one place (LocalizeConfig, GlobalConfig)."""
+    return {name: value for name, value in settings.items() if value is not None}
+
+
+def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bool) -> None:
+    """Options the chosen method or start does not use are errors, not silently ignored."""
+    if method == "odometry":  # the odometry alone: no filter, no sensor model, no start
+        refuse_given(
+            ctx,
+            ["particles", "kld", "beams", "recovery", "threads", "global_start"],
+            "to --method odometry (the odometry alone: no particle filter)",
+        )
+    elif method == "space-observation":  # a local map of the whole scan: no beam selection
+        refuse_given(ctx, ["beams"], "to --method space-observation (it weighs the whole scan)")
+    if global_start:
+        refuse_given(ctx, ["odometry_noise"], "with --global (it is for logs with reference poses)")
+
+
+def _print_report(lines: list[str], summary: dict, as_json: bool) -> None:
+    """A command's report: its sentences for people (never wrapped when piped, so each stays
+    one line for grep), or the same numbers as one JSON object with --json."""
+    if as_json:
+        show_fields("", summary, as_json=True)
+    elif sys.stdout.isatty():
+        for line in lines:
+            console.print(line)
+    else:
+        for line in lines:
+            typer.echo(line)
+
+
+OFF_MAP_SHARE = 0.5  # below this share of endpoints near a wall the map is not the log's
+
+
+def _warn_if_off_the_map(
+    grid, trajectory: np.ndarray, scans, map_file: Path, share: float | None = None
+) -> None:
+    """One warning line when most scan endpoints, at the estimated poses, miss the map's walls
+    (a map of another building, a 1x1 map): the poses alone look fine in such a case.
+    ``share``: the share already measured (global localization's, from convergence on)."""
+    if share is None:
+        finite = np.isfinite(trajectory).all(axis=1)
+        # endpoint_agreement's endpoints: finite readings in (0, max_range), float32 as the core
+        # reads them, compared in double as it does; with none (no estimate, or every reading
+        # at max_range) the share is undefined and there is nothing to warn about
+        ranges = np.asarray(scans.ranges, dtype=np.float32)[finite].astype(np.float64)
+        if not (np.isfinite(ranges) & (ranges > 0.0) & (ranges < scans.max_range)).any():
+            return
+        share = endpoint_agreement(
+            grid, trajectory[finite], scans.ranges[finite], scans.angles, scans.max_range
+        )
+    if share < OFF_MAP_SHARE:
+        typer.echo(
+            f"kiseki: warning: only {100 * share:.1f} % of the scan endpoints fall on or next to "
+            f"an occupied cell of {map_file} at the estimated poses: the map is probably not "
+            "the log's building, or the localization is lost",
+            err=True,
+        )
+
+
+def _write_trajectory(
+    output: Path, times: np.ndarray, trajectory: np.ndarray, reliability: np.ndarray
+) -> None:
+    rows = np.column_stack([times, trajectory, reliability])
+    text = "t,x,y,theta,reliability\n" + "\n".join(
+        ",".join(f"{v:.6f}" for v in row) for row in rows
+    )
+    atomic_write(output, lambda tmp: Path(tmp).write_text(text + "\n", encoding="utf-8"))
+
+
+def _write_yaml(path: Path, doc: dict) -> None:
+    def plain(value):
+        if isinstance(value, tuple | list):
+            return [plain(v) for v in value]
+        if isinstance(value, np.generic):
+            return value.item()
+        return value
+
+    text = yaml.safe_dump({k: plain(v) for k, v in doc.items()}, sort_keys=False)
+    atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))

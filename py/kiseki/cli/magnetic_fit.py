@@ -1,0 +1,232 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""``kiseki magnetic fit``: a magnetic field map by Gaussian-process regression (thesis ch. 6)
+from measurements; the ``kiseki magnetic`` group (kiseki.cli.magnetic) runs it."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import typer
+from rich.console import Console
+
+from kiseki._guard import guarded
+from kiseki._interrupt import interruptible
+from kiseki._options import CELL_LIMITS, Count, Metres, Seed, refuse_given
+from kiseki.datasets.magnetic import concatenate_samples, read_magnetic_data
+from kiseki.gp import SquaredExponential, fit_hyperparameters
+from kiseki.gp.kernel import subsample
+from kiseki.magnetic.binning import bin_readings
+from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData, fit_component_gps
+from kiseki.magnetic.map_folder import check_map_destination
+
+__all__ = ["KERNEL_LIMITS", "fit"]
+
+console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
+EXACT_LIMIT = 10_000  # beyond this many measurements the default is the reduced-rank GP
+METHODS = ("exact", "hilbert")
+
+
+# --kernel's numbers (kiseki.gp.SquaredExponential): the signal and noise SDs in the data's units
+# (uT or G), the length scale in metres. 1e-6..1e6 spans a picotesla to a tesla (in uT) and a
+# micrometre to 1,000 km, and keeps what the GP computes with, their squares (1e-12..1e12) and
+# d^2 / l^2, far from a double's overflow (1e200 squared is inf) and underflow (1e-200 squared
+# is 0: a noise-free kernel whose matrix cannot be factorised)
+KERNEL_LIMITS = (1e-6, 1e6)  # as the message writes them: [1e-6, 1e6]
+_KERNEL_PARTS = (("sigma_f", "the data's units"), ("l", "m"), ("sigma_n", "the data's units"))
+
+
+def _parse_kernel(text: str):
+    """The kernel --kernel SIGMA_F,L,SIGMA_N gives; a ValueError naming --kernel and the number
+    outside :data:`KERNEL_LIMITS`."""
+    parts = text.split(",")
+    try:
+        values = [float(v) for v in parts]
+    except ValueError:
+        values = []
+    if len(values) != 3:
+        raise ValueError(f"--kernel must be three numbers sigma_f,l,sigma_n, got {text.strip()}")
+    lo, hi = KERNEL_LIMITS
+    for (name, unit), part, value in zip(_KERNEL_PARTS, parts, values, strict=True):
+        if not lo <= value <= hi:  # a NaN never is
+            raise ValueError(
+                f"--kernel: {name} must be a number in [1e-6, 1e6] ({unit}), got {part.strip()}"
+            )
+    return SquaredExponential(*values)
+
+
+def _check_fit_options(ctx: typer.Context, kernel, max_points, method, units) -> None:
+    """The fit's words and what its numbers do not apply to (the numbers have their ranges)."""
+    if kernel is not None:  # the given hyperparameters: no search, so nothing per component
+        refuse_given(ctx, ["per_component"], "with --kernel (its hyperparameters are given)")
+        if max_points is None:  # no search and no subsample: nothing random
+            refuse_given(ctx, ["seed"], "with --kernel and without --max-points (nothing random)")
+    if method is not None and method not in METHODS:
+        raise ValueError(f"--method must be exact or hilbert, got {method!r}")
+    if units is not None and units not in ("uT", "G"):
+        raise ValueError(f"--units must be uT or G, got {units!r}")
+
+
+def _read_data(data: list[Path], units: str | None, dimension: int | None):
+    """(positions, field, height, units) of DATA, positions in the map's dimension (a 2-D map
+    of 3-D data: x, y, and the height is the median z)."""
+    samples = concatenate_samples([read_magnetic_data(d) for d in data])
+    if units is not None and samples.units not in ("unknown", units):
+        raise ValueError(f"--units {units}: the data state their units as {samples.units}")
+    x, height = np.asarray(samples.positions), None
+    dimension = dimension or samples.dimension
+    if dimension == 3 and samples.dimension == 2:
+        raise ValueError(f"--dimension 3: {samples.source} has 2-D positions (no z)")
+    if dimension == 2 and samples.dimension == 3:
+        height, x = float(np.median(x[:, 2])), x[:, :2]
+    return x, np.asarray(samples.field), height, units or samples.units
+
+
+def _fit_gps(x, y, kernel, per_component: bool, method: str, seed: int):
+    """(GPs, kernels, seconds for the hyperparameters, seconds for the fit)."""
+    columns = [slice(k, k + 1) for k in range(3)] if per_component else [slice(0, 3)]
+    start = time.perf_counter()
+    if kernel is not None:
+        kernels = [kernel] * len(columns)
+    else:  # maximise the log marginal likelihood (eqs. 6.11-6.15)
+        kernels = [fit_hyperparameters(x, y[:, c], seed=seed).kernel for c in columns]
+    hyper = time.perf_counter() - start
+    start = time.perf_counter()
+    gps = fit_component_gps(x, y, kernels, method)
+    return gps, kernels, hyper, time.perf_counter() - start
+
+
+def _hilbert_settings(gp) -> dict | None:
+    """The reduced-rank GP's box, so that predictions rebuild the same GP."""
+    if not hasattr(gp, "lower"):
+        return None
+    return {"domain": [np.asarray(gp.lower).tolist(), np.asarray(gp.upper).tolist()]}
+
+
+@guarded(inputs=("data",), output_folders=("output",))  # replaced whole
+@interruptible()
+def fit(
+    ctx: typer.Context,
+    data: list[Path] = typer.Argument(
+        ...,
+        help="Measurements: Aalto run prefixes DIR/N (DIR/N-loc.csv, -mag.csv, -time.csv), CSV "
+        "files with columns x,y[,z],mx,my,mz, or .mat hand-held walks.",
+    ),
+    output: Path = typer.Option(..., "-o", "--output", help="Map folder to write."),
+    dimension: int | None = typer.Option(
+        None,
+        parser=Count("--dimension", 2, 3),
+        help="2 (grid over x, y) or 3 (voxels); default: the data's.",
+    ),
+    resolution: float = typer.Option(
+        0.1, parser=Metres("--resolution", *CELL_LIMITS), help="Cell (voxel) size in metres."
+    ),
+    # a kilometre around the data at most; the cells of the whole box then have their limit
+    margin: float = typer.Option(
+        0.5,
+        parser=Metres("--margin", 0, 1000),
+        help="Metres added around the data's bounding box.",
+    ),
+    per_component: bool = typer.Option(
+        False, "--per-component", help="Own hyperparameters for each of mx, my, mz."
+    ),
+    kernel: str | None = typer.Option(
+        None,
+        help="sigma_f,l,sigma_n, each in [1e-6, 1e6] (SDs in the data's units, l in m; default: "
+        "maximise the log marginal likelihood).",
+    ),
+    # a GP needs a few points; 10^8 readings of (x, y, z, mx, my, mz) are 4.8 GB of doubles
+    max_points: int | None = typer.Option(
+        None,
+        parser=Count("--max-points", 4, 100_000_000),
+        help="Fit on a seeded random subsample of this many measurements.",
+    ),
+    seed: int = typer.Option(
+        0, parser=Seed(), help="Seed of the subsample and the optimizer's restarts."
+    ),
+    method: str | None = typer.Option(
+        None, help=f"exact or hilbert (default: exact up to {EXACT_LIMIT:,} measurements)."
+    ),
+    units: str | None = typer.Option(None, help="uT or G: the units of CSV data."),
+    bin_size: float | None = typer.Option(
+        None,
+        "--bin",
+        parser=Metres("--bin", *CELL_LIMITS),
+        help="Average the readings per cell of this size (m) first, one reading per place (the "
+        "thesis stores its 3-D survey per 0.2 m voxel); recommended for dense 50 Hz tracks.",
+    ),
+) -> None:
+    """Fit a GP to magnetic measurements and write the map of its mean and variance (the
+    data's bounding box plus --margin), with the measurements for exact predictions.
+
+    Example: kiseki magnetic fit aalto/invensense/1 aalto/invensense/2 -o hall-map
+    """
+    _check_fit_options(ctx, kernel, max_points, method, units)
+    fixed = _parse_kernel(kernel) if kernel is not None else None
+    check_map_destination(output)
+    x, y, height, units = _read_data(data, units, dimension)
+    n_read = len(x)
+    if bin_size is not None:
+        x, y, _ = bin_readings(x, y, bin_size)
+    if max_points is not None and len(x) > max_points:  # after --bin: of the cells' readings
+        keep = subsample(len(x), max_points, seed)
+        x, y = x[keep], y[keep]
+    method = method or ("exact" if len(x) <= EXACT_LIMIT else "hilbert")
+    gps, kernels, t_hyper, t_fit = _fit_gps(x, y, fixed, per_component, method, seed)
+    lml = [float(g.log_marginal_likelihood()) for g in gps if hasattr(g, "log_marginal_likelihood")]
+    start = time.perf_counter()
+    lower, upper = x.min(axis=0) - margin, x.max(axis=0) + margin
+    training = TrainingData(x, y, method, "constant", _hilbert_settings(gps[0]))
+    provenance = {
+        "data": {
+            "sources": [str(d) for d in data],
+            "points": n_read,
+            "bin": bin_size,
+            "used_points": len(x),
+        },
+        "fit": {
+            "method": method,
+            "per_component": per_component,
+            "hyperparameters": "given"
+            if fixed is not None
+            else "maximised log marginal likelihood",
+            "log_marginal_likelihood": lml or None,
+            "seed": seed,
+            "seconds": {"hyperparameters": round(t_hyper, 3), "fit": round(t_fit, 3)},
+        },
+    }
+    fmap = MagneticFieldMap.from_gp(
+        gps,
+        lower,
+        upper,
+        resolution,
+        height,
+        units=units,
+        provenance=provenance,
+        training=training,
+        progress=True,
+    )
+    t_map = time.perf_counter() - start
+    fmap.save(output)
+    _report_fit(fmap, output, kernels, lml, len(x), n_read, (t_hyper, t_fit, t_map))
+
+
+def _report_fit(fmap, output: Path, kernels, lml: list, used: int, read: int, seconds) -> None:
+    names = ("mx, my, mz",) if len(kernels) == 1 else ("mx", "my", "mz")
+    u = "" if fmap.units == "unknown" else f" {fmap.units}"
+    for c, k in zip(names, kernels, strict=True):
+        console.print(
+            f"{c}: sigma_f {k.sigma_f:.4g}{u}, length scale {k.length_scale:.4g} m, "
+            f"sigma_n {k.sigma_n:.4g}{u}"
+        )
+    if lml:
+        console.print(f"log marginal likelihood {sum(lml):.6g} (eq. 6.11)")
+    t_hyper, t_fit, t_map = seconds
+    console.print(
+        f"{output}: {fmap.dimension}-D map, {' x '.join(map(str, fmap.cells))} cells of "
+        f"{fmap.resolution:g} m from {used:,} of {read:,} measurements "
+        f"({fmap.training.method} GP); hyperparameters {t_hyper:.2f} s, fit {t_fit:.2f} s, "
+        f"map {t_map:.2f} s"
+    )

@@ -1,0 +1,51 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""``kiseki map``: occupancy-grid maps: build, render, inspect. A group that loads each of its
+commands' modules only when that command runs (``kiseki map info`` does not load matplotlib or
+the log readers that ``kiseki map from-log`` needs)."""
+
+from __future__ import annotations
+
+import typer
+
+from kiseki._guard import Derived
+from kiseki.cli._lazy import Entry, LazyGroup
+
+__all__ = ["COMMANDS", "MAP_IMAGE", "app"]
+
+# the image a map YAML names, written beside it (kiseki._guard)
+MAP_IMAGE = Derived("--output's image", lambda a: a["output"].with_suffix(".pgm"))
+
+# its commands in listing order, each with its module and its line (its first paragraph)
+COMMANDS = {
+    "from-log": Entry(
+        "kiseki.cli.map_from_log",
+        "Build an occupancy grid from a log's poses and scans and save it as a ROS map.",
+        group=False,
+    ),
+    "render": Entry(
+        "kiseki.cli.map_render",
+        "Draw a map (and a trajectory over it) to a PNG.",
+        group=False,
+    ),
+    "convert": Entry(
+        "kiseki.cli.map_convert",
+        "Save a map (e.g. the CMU Wean .dat.gz) as a ROS map YAML + PGM (trinary).",
+        group=False,
+    ),
+    "info": Entry(
+        "kiseki.cli.map_info",
+        "Print a map's size, resolution, origin and cell counts: a table on a terminal, "
+        "tab-separated field/value lines when piped, or JSON with --json.",
+        group=False,
+    ),
+}
+
+
+class _MapGroup(LazyGroup):
+    table = COMMANDS
+
+
+app = typer.Typer(
+    cls=_MapGroup, no_args_is_help=True, help="Occupancy-grid maps: build, render, inspect."
+)
