@@ -20,9 +20,9 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from kiseki._guard import Derived, Rewrites, guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import (
+from kiseki._support.guard import Derived, Rewrites, guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import (
     BEAM_LIMIT,
     CELL_LIMITS,
     PARTICLE_LIMIT,
@@ -39,13 +39,12 @@ from kiseki._options import (
     Seed,
     refuse_given,
 )
-from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
+from kiseki._support.outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
 from kiseki.cli_magnetic import magnetic_app
 from kiseki.cli_speed import speed_app
 from kiseki.cli_terrain import terrain_app
 from kiseki.errors import KisekiError
-from kiseki.global_localization import GlobalConfig
-from kiseki.localization import LocalizeConfig
+from kiseki.filters import GlobalConfig, LocalizeConfig
 
 app = typer.Typer(
     no_args_is_help=True,
@@ -99,7 +98,7 @@ def _merge_rule(value: str) -> str:
     return value
 
 
-# files the commands read or write that no option names (kiseki._guard)
+# files the commands read or write that no option names (kiseki._support.guard)
 _MAP_IMAGE = Derived("--output's image", lambda a: a["output"].with_suffix(".pgm"))
 _TAUGHT_WAYPOINTS = Derived(
     "--taught's waypoint file", lambda a: a["taught"] / "waypoints.yaml" if a["taught"] else None
@@ -153,7 +152,7 @@ def map_from_log(
 
     Example: kiseki map from-log run.mcap -o map.yaml --render map.png"""
     from kiseki.datasets import open_scans
-    from kiseki.map_io import load_map, save_map
+    from kiseki.io.ros_map import load_map, save_map
     from kiseki.mapping import MapBuildConfig, endpoint_agreement, map_of_log
     from kiseki.plots import render_map
     from kiseki.teach.environment_map import build_teaching_map
@@ -205,7 +204,7 @@ def _read_trajectory(path: Path) -> np.ndarray:
         from kiseki.datasets import read_carmen_log
 
         return read_carmen_log(path).scans.poses
-    from kiseki.trajectory_csv import read_trajectory_csv
+    from kiseki.io.trajectory_csv import read_trajectory_csv
 
     return read_trajectory_csv(path)
 
@@ -223,7 +222,7 @@ def map_render(
     """Draw a map (and a trajectory over it) to a PNG.
 
     Example: kiseki map render data/maps/factory_corridor.yaml -o corridor.png"""
-    from kiseki.map_io import load_map
+    from kiseki.io.ros_map import load_map
     from kiseki.plots import render_map
 
     check_suffix("--output", output, FIGURE_SUFFIXES)
@@ -244,7 +243,7 @@ def map_convert(
 
     Example: kiseki map convert data/maps/factory_corridor.yaml -o corridor.yaml"""
     from kiseki.grid import grid_summary
-    from kiseki.map_io import load_map, save_map
+    from kiseki.io.ros_map import load_map, save_map
 
     check_suffix("--output", output, (".yaml", ".yml"))
     grid = load_map(map_file)
@@ -266,9 +265,9 @@ def map_info(
     tab-separated field/value lines when piped, or JSON with --json.
 
     Example: kiseki map info data/maps/factory_corridor.yaml --json"""
-    from kiseki._table import show_fields
+    from kiseki._support.table import show_fields
     from kiseki.grid import grid_summary
-    from kiseki.map_io import load_map
+    from kiseki.io.ros_map import load_map
 
     summary = grid_summary(load_map(map_file))
     show_fields(str(map_file), summary, as_json=as_json, console=console)
@@ -452,7 +451,7 @@ def sim_render(
     """Animate a recorded run over its scene (GIF).
 
     Example: kiseki sim render run.mcap -o run.gif"""
-    from kiseki.sim.mcap_log import read_run
+    from kiseki.io.runlog import read_run
     from kiseki.sim.render import render_run
     from kiseki.sim.scene import load_scene
     from kiseki.teach.scene_identity import resolve_scene_file
@@ -509,7 +508,7 @@ def sim_show(
             )
     render_scene(scene, output)
     if octree is not None:
-        from kiseki._atomic import atomic_write
+        from kiseki._support.atomic import atomic_write
 
         tree = _core.OctreeWorld.from_boxes(scene.world, resolution)
         atomic_write(octree, tree.write_binary)
@@ -625,8 +624,8 @@ def teach_command(
     logged as it goes.
 
     Example: kiseki teach data/worlds/factory_corridor.yaml -o taught"""
+    from kiseki.apps.teach.teaching import recover, teach
     from kiseki.sim.scene import load_scene
-    from kiseki.teach.teaching import recover, teach
 
     if merge is not None:
         _merge_rule(merge)
@@ -651,7 +650,7 @@ def teach_command(
             f"{log}: a teaching log exists; --resume rebuilds from it, --overwrite replaces it"
         )
     elif keyboard:
-        from kiseki.teach.keyboard import KeyScript, TerminalKeys, teach_keyboard
+        from kiseki.apps.teach.keyboard import KeyScript, TerminalKeys, teach_keyboard
 
         source = KeyScript(keys) if keys is not None else TerminalKeys(sys.stdin.fileno(), 0.1)
         try:
@@ -726,12 +725,12 @@ def playback_command(
 
     Example: kiseki playback data/worlds/factory_corridor.yaml --taught taught --route P0,P1,P2"""
 
-    from kiseki.map_io import load_map
+    from kiseki.apps.teach import PlaybackConfig, playback
+    from kiseki.apps.teach.teaching import load_route
+    from kiseki.io.ros_map import load_map
     from kiseki.sim.scene import load_scene
-    from kiseki.teach import PlaybackConfig, playback
     from kiseki.teach.local_maps import METHODS
     from kiseki.teach.scene_identity import check_scene, taught_scene_of
-    from kiseki.teach.teaching import load_route
 
     if (taught is None) == (waypoints is None):
         raise ValueError("give either --taught FOLDER or --waypoints FILE (with --map MAP.yaml)")
@@ -976,7 +975,7 @@ def localize_command(
 
     Example: kiseki localize run.mcap --map data/maps/factory_corridor.yaml -o track.csv --json"""
     from kiseki.datasets import open_scans
-    from kiseki.map_io import load_map
+    from kiseki.io.ros_map import load_map
     from kiseki.metrics import ape
 
     _refuse_unused_by_localize(ctx, method, global_start)
@@ -996,14 +995,14 @@ def localize_command(
     shared = dict(method=method, seed=seed, particles=particles, kld=kld, beams=beams)
     shared.update(recovery=recovery, threads=threads)
     if global_start:
-        from kiseki.global_localization import global_localize
+        from kiseki.filters import global_localize
 
         gconfig = GlobalConfig(**_given(**shared, tracking_particles=tracking_particles))
         saved_config = {"command": "localize --global", **asdict(gconfig)}
         result = global_localize(scans, grid, gconfig, progress=True)
         trajectory, reliability = result.estimates, result.reliability
     else:
-        from kiseki.localization import localize
+        from kiseki.filters import localize
 
         config = LocalizeConfig(**_given(**shared, odometry_noise=odometry_noise))
         if not scans.has_reference_poses:
@@ -1033,14 +1032,14 @@ def localize_command(
         ]
     lines[0] += f"; {scans.invalid_ranges} invalid range readings skipped"
     if global_start:
-        from kiseki.global_localization import describe, write_report
+        from kiseki.filters import describe, write_report
 
         report_path = write_report(result, output.with_suffix(".json"))
         lines.append(describe(result.report) + f" (report: {report_path})")
         summary.update(report_file=str(report_path), convergence=result.report.to_dict())
     _print_report(lines, summary, as_json)
     if global_start and plot is not None:
-        from kiseki.global_localization import render_global
+        from kiseki.filters import render_global
 
         render_global(grid, result, plot, title=f"{log.name}: global {method}")
 
@@ -1069,7 +1068,7 @@ def _print_report(lines: list[str], summary: dict, as_json: bool) -> None:
     """A command's report: its sentences for people (never wrapped when piped, so each stays
     one line for grep), or the same numbers as one JSON object with --json."""
     if as_json:
-        from kiseki._table import show_fields
+        from kiseki._support.table import show_fields
 
         show_fields("", summary, as_json=True)
     elif sys.stdout.isatty():
@@ -1114,7 +1113,7 @@ def _warn_if_off_the_map(
 def _write_trajectory(
     output: Path, times: np.ndarray, trajectory: np.ndarray, reliability: np.ndarray
 ) -> None:
-    from kiseki._atomic import atomic_write
+    from kiseki._support.atomic import atomic_write
 
     rows = np.column_stack([times, trajectory, reliability])
     text = "t,x,y,theta,reliability\n" + "\n".join(
@@ -1126,7 +1125,7 @@ def _write_trajectory(
 def _write_yaml(path: Path, doc: dict) -> None:
     import yaml
 
-    from kiseki._atomic import atomic_write
+    from kiseki._support.atomic import atomic_write
 
     def plain(value):
         if isinstance(value, tuple | list):
@@ -1152,7 +1151,7 @@ def report(
     tab-separated field/value lines when piped, or JSON with --json.
 
     Example: kiseki report --results results -o REPRODUCTION.md"""
-    from kiseki._table import show_fields
+    from kiseki._support.table import show_fields
     from kiseki_experiments.harness.report import write_reproduction  # here: start-up time
 
     total, held, missing = write_reproduction(results, output)

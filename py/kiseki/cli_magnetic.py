@@ -12,10 +12,10 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from kiseki._guard import Folder, guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import CELL_LIMITS, Count, Fraction, Metres, Seed, refuse_given
-from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki._support.guard import Folder, guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import CELL_LIMITS, Count, Fraction, Metres, Seed, refuse_given
+from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 
 __all__ = ["magnetic_app"]
 
@@ -24,7 +24,7 @@ magnetic_app = typer.Typer(
     help="Magnetic field maps (fit, predict, render), walks, teaching and navigation.",
 )
 console = Console(soft_wrap=True)
-# what kiseki magnetic navigate writes in its -o folder (kiseki._guard)
+# what kiseki magnetic navigate writes in its -o folder (kiseki._support.guard)
 _NAVIGATION = Folder("output", ("run.mcap", "navigation.csv", "navigation.png"))
 EXACT_LIMIT = 10_000  # beyond this many measurements the default is the reduced-rank GP
 METHODS = ("exact", "hilbert")
@@ -266,7 +266,7 @@ def predict(
     --interpolate, the grid is interpolated (the GP prior outside the map).
 
     Example: kiseki magnetic predict hall-map --at points.csv -o field.csv"""
-    from kiseki._atomic import atomic_write
+    from kiseki._support.atomic import atomic_write
     from kiseki.magnetic.field_map import MagneticFieldMap
     from kiseki.magnetic.points_csv import read_points
 
@@ -353,7 +353,7 @@ def walk(
     2 m from every map node) are reported and not localized.
 
     Example: kiseki magnetic walk eight.mat -o eight-walk --seed 0"""
-    from kiseki._atomic import atomic_write
+    from kiseki._support.atomic import atomic_write
     from kiseki.datasets.kok import read_kok_walk
     from kiseki.magnetic.travel_distance_walk import WalkOdometry, localize_walk
 
@@ -397,7 +397,7 @@ def teach(
     OUT (a linear-map folder; left/ and right/; the teaching runs in runs/).
 
     Example: kiseki magnetic teach data/worlds/magnetic_path.yaml -o taught"""
-    from kiseki.magnetic.navigate_outputs import teach_folder
+    from kiseki.apps.magnetic.navigate_outputs import teach_folder
 
     maps = teach_folder(scene, output, seed, offset)
     console.print(f"{output}: {len(maps.center)} nodes over {maps.center.s[-1]:.1f} m")
@@ -420,7 +420,7 @@ def navigate(
     OUT/navigation.csv and OUT/navigation.png (path, cross-track error, priority history).
 
     Example: kiseki magnetic navigate data/worlds/magnetic_path.yaml --map taught -o nav"""
-    from kiseki.magnetic.navigate_outputs import navigate_folder
+    from kiseki.apps.magnetic.navigate_outputs import navigate_folder
 
     r = navigate_folder(scene, map_folder, navigator, output, seed)
     off = np.abs(r.cross_track)

@@ -10,9 +10,9 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from kiseki._guard import Folder, guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import Count, Metres, Seed, refuse_given
+from kiseki._support.guard import Folder, guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import Count, Metres, Seed, refuse_given
 
 __all__ = ["terrain_app"]
 
@@ -23,7 +23,7 @@ terrain_app = typer.Typer(
 )
 console = Console(soft_wrap=True)
 TRAJECTORY_COLUMNS = ("move", "x_true", "y_true", "z_true", "x_est", "y_est", "z_est")
-# what kiseki terrain run writes in its -o folder (kiseki._guard)
+# what kiseki terrain run writes in its -o folder (kiseki._support.guard)
 _RUN_FILES = Folder(
     "output", ("sdem_*.pcd", "trajectory.csv", "global_map.bt", "trajectory.png", "config.yaml")
 )
@@ -73,7 +73,7 @@ def terrain_run(
     from tqdm import tqdm
 
     from kiseki import _core
-    from kiseki._atomic import atomic_write
+    from kiseki._support.atomic import atomic_write
     from kiseki.sim.terrain_moves import terrain_stops
     from kiseki.terrain.mapper import MapperConfig, SdemMapper
 

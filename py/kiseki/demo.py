@@ -20,14 +20,14 @@ import numpy as np
 import yaml
 from rich.console import Console
 
-from kiseki._atomic import atomic_write
-from kiseki._table import show
+from kiseki._support.atomic import atomic_write
+from kiseki._support.table import show
+from kiseki.apps.teach import PlaybackConfig, playback, teach
 from kiseki.core import derive_seed
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
 from kiseki.plots import render_map
 from kiseki.sim.render import render_scene
 from kiseki.sim.scene import load_scene
-from kiseki.teach import PlaybackConfig, playback, teach
 from kiseki.teach.local_maps import METHODS
 
 __all__ = ["DemoConfig", "run_demo"]

@@ -27,9 +27,10 @@ from pathlib import Path
 from types import MappingProxyType
 
 import numpy as np
+from tqdm import tqdm
 
 from kiseki.errors import MapFormatError
-from kiseki.gp import SquaredExponential
+from kiseki.gp import ExactGP, HilbertGP, SquaredExponential
 from kiseki.magnetic.map_folder import COMPONENTS, read_map_folder, write_map_folder
 
 __all__ = [
@@ -389,8 +390,6 @@ def _predict_all(gps: list, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 
 
 def _evaluate(gps, origin, resolution, shape, height, progress):
-    from tqdm import tqdm
-
     total = int(np.prod(shape))
     mean = np.empty((total, 3))
     var = np.empty((total, 3))
@@ -412,7 +411,6 @@ def _evaluate(gps, origin, resolution, shape, height, progress):
 def fit_component_gps(x, y, kernels, method: str, *, mean: str = "constant", domain=None) -> list:
     """GPs of the field's three columns: one GP of all three with one kernel, or one GP per
     column with three; exact or reduced-rank ("hilbert", on `domain` or its default box)."""
-    from kiseki.gp import ExactGP, HilbertGP
 
     kernels = [kernels] if isinstance(kernels, SquaredExponential) else list(kernels)
     columns = [slice(0, 3)] if len(kernels) == 1 else [slice(k, k + 1) for k in range(3)]

@@ -118,8 +118,8 @@ def build_server(
     simulated AGV there (playback's configuration with `method`, `particles` and `seed`), to
     be served at `host`:`port` (on loopback it answers only to that address's names); the
     finished routes are read from and written to the JSON file `history` (None: in memory)."""
+    from kiseki.apps.teach.playback import PlaybackConfig
     from kiseki.sim.scene import load_scene
-    from kiseki.teach.playback import PlaybackConfig
 
     taught = TaughtRun(folder, method)
     scene_file = scene_of(folder, scene)

@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from kiseki._schema import parse
+from kiseki._support.schema import parse
 from kiseki.core import Random, check_seed, normalize_angle
 from kiseki.sim._values import finite_array as _finite_array
 from kiseki.sim._values import finite_scalar as _finite_scalar
