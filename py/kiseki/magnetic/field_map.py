@@ -15,6 +15,9 @@ resolution``; voxel index i on an axis is key ``origin / resolution + 32768 + i`
 On disk a map is a folder (kind and dimension declared in ``magnetic_map.yaml``):
 :func:`save_map_folder` and :func:`load_map_folder` (and the map's ``save`` and ``load``) write
 and read it through :mod:`kiseki.magnetic.map_folder`, which holds the layout.
+
+Why one file over 400 lines: the map, its building from a GP, its evaluation on the
+grid and its folder round trip are one type's life; the folder files are in map_folder.py.
 """
 
 from __future__ import annotations

@@ -29,6 +29,9 @@ moments. Frames:
 
 All randomness comes from :class:`kiseki.core.Random`; give each sensor its own stream with
 ``kiseki.derive_seed(seed, k)``.
+
+Why one file over 400 lines: the world's field and the magnetometer that reads it
+share the units, frames and noise model; the dipoles and the lattice already live apart.
 """
 
 from __future__ import annotations

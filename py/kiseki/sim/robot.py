@@ -44,6 +44,9 @@ closed-form prediction is y mean -0.21 m / SD 0.22 m at 13 m and -0.08 m / 0.11 
 
 Every random number comes from :class:`kiseki.core.Random`; pass ``derive_seed(seed, k)`` to
 give each robot's odometry its own stream.
+
+Why one file over 400 lines: the two platforms share the odometry error model, the
+command limits and the stepping rules; they are one concept (a simulated robot's motion).
 """
 
 from __future__ import annotations

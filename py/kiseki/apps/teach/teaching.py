@@ -6,6 +6,9 @@ waypoint (id, name, odometry pose) is recorded where the operator marks one. The
 to MCAP as it goes (odometry, depth images, waypoint marks), so that `recover` rebuilds the map
 and the waypoints from the log after a crash, losing at most the last unwritten chunk (well
 under a second at 10 Hz).
+
+Why one file over 400 lines: a teaching run, its recovery from the log and the files it
+writes are one run's life; the maps and waypoints it builds are kiseki.teach's.
 """
 
 from __future__ import annotations
