@@ -7,16 +7,14 @@ declaration on the command (:data:`SPEC_ATTRIBUTE`, a :class:`GuardSpec`, so tha
 check that every path parameter of every command is declared) and, before the command's body
 runs, refuses in one line whatever would let an output destroy an input: the rules are
 :func:`kiseki._support.outputs.check_outputs`'s. Labels are the ones the user typed: an option's
-long
-name (``--output``), an argument's metavar (``MAP``).
+long name (``--output``), an argument's metavar (``MAP``).
 
 Checks that need the work's own results (the scene a recorded run names, read from the run)
 stay in the command, through :func:`~kiseki._support.outputs.check_outputs` itself.
 
 What the guard lets through is written whole or not at all (:mod:`kiseki._support.atomic`: a
-temporary
-file in the same folder, renamed), save the MCAP logs that runs stream as they go (``sim run``,
-``teach``'s ``teach.mcap``, ``playback --log``, ``magnetic navigate``'s ``run.mcap``): those
+temporary file in the same folder, renamed), save the MCAP logs that runs stream as they go (``sim
+run``, ``teach``'s ``teach.mcap``, ``playback --log``, ``magnetic navigate``'s ``run.mcap``): those
 are closed properly when interrupted, so that what was recorded stays readable (``teach
 --resume`` rebuilds from it), and an existing one is replaced only with ``--overwrite`` (or
 is the command's own, in its output folder)."""

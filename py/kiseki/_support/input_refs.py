@@ -1,9 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """What an input stands for, for the output guard (:mod:`kiseki._support.outputs`): the input
-itself,
-the files it names (a ROS map YAML's image, a scene's octree, a waypoint file's maps and their
-images), the files of an Aalto run prefix, and the folder it is or belongs to (a ROS 2 bag).
+itself, the files it names (a ROS map YAML's image, a scene's octree, a waypoint file's maps and
+their images), the files of an Aalto run prefix, and the folder it is or belongs to (a ROS 2 bag).
 YAML inputs are looked into as kiseki's readers read them, without building the document."""
 
 from __future__ import annotations

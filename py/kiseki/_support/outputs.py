@@ -5,8 +5,7 @@ files written beside them) are compared with its input files (and the files they
 as a ROS map YAML's image), paths resolved through symlinks and relative parts, and every
 output folder is checked to exist and be writable. kiseki writes a file by renaming a new one
 onto its path (:mod:`kiseki._support.atomic`), so an output must be a regular file or nothing yet:
-one
-that is a device, a FIFO or a socket (``-o /dev/null``) is refused, and so is an output that is
+one that is a device, a FIFO or a socket (``-o /dev/null``) is refused, and so is an output that is
 a symlink, whatever it points to (the rename would replace the link, not the file it points
 to): give that file instead. :func:`check_outputs` holds the rules; :mod:`kiseki._support.guard`
 applies them to every command from its declared parameters."""
@@ -326,8 +325,7 @@ def check_outputs(
       (:func:`~kiseki._support.input_refs.input_files`: a map YAML's image, a scene's octomap, a
       waypoint file's maps, an Aalto prefix's ``N-*.csv``), nor inside an input folder
       (:func:`~kiseki._support.input_refs.input_folder`: a ROS 2 bag, a taught run, a map folder),
-      nor
-      a link to a file in it (the folder listed as :func:`_folder_files` says);
+      nor a link to a file in it (the folder listed as :func:`_folder_files` says);
     * an output folder is not an input folder nor inside one;
     * an input (or a file it refers to) inside an output folder is refused when the command
       writes it there (matches a pattern; an input folder: when the command writes anything

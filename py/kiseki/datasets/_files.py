@@ -14,7 +14,6 @@ __all__ = ["GZIP_MAGIC", "read_maybe_gzipped"]
 def read_maybe_gzipped(path: Path, error: type[Exception], what: str, limit: int) -> str:
     """The file's text (latin-1), gunzipped when it starts with the gzip magic bytes, read
     within ``limit`` bytes (decompressed; :func:`kiseki._support.inputs.read_input`, which states
-    the
-    limit for ``what``); a truncated or corrupt stream, a special file or a text past the limit
+    the limit for ``what``); a truncated or corrupt stream, a special file or a text past the limit
     raises ``error`` naming the file."""
     return read_input(path, what, limit, error, unzip="gzip").decode("latin-1")

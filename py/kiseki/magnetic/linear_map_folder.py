@@ -11,8 +11,7 @@
   (n, 2, NaN: no obstacle), ``position`` (n, 2, NaN: unknown) and int64 ``count``.
 
 Both files are written by :func:`kiseki._support.atomic.atomic_write_all` (the arrays before the
-YAML).
-A folder of the GP magnetic field maps (:mod:`kiseki.magnetic.map_folder`,
+YAML). A folder of the GP magnetic field maps (:mod:`kiseki.magnetic.map_folder`,
 ``magnetic_map.yaml``) is refused here, and that module refuses this kind.
 """
 

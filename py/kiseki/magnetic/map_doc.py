@@ -149,6 +149,5 @@ class MagneticMapDoc(FileModel):
 def read_map_doc(doc: Any, path: str | os.PathLike) -> MagneticMapDoc:
     """`doc` (the parsed ``magnetic_map.yaml`` at `path`) checked against
     :class:`MagneticMapDoc`: a :class:`~kiseki._support.schema.SchemaError` naming the file, the
-    field
-    and the value."""
+    field and the value."""
     return parse(MagneticMapDoc, doc, path)

@@ -119,8 +119,7 @@ class _Params:
         Missing keys keep their documented defaults. Unknown keys, non-numeric values, NaN or
         infinite values and values out of range (sizes and limits must be > 0) raise
         :class:`kiseki._support.schema.SchemaError` (a ValueError) naming ``source`` (e.g. the
-        config
-        file), the key (after the path ``at`` of the section in its file) and the value.
+        config file), the key (after the path ``at`` of the section in its file) and the value.
         """
         return parse(_document(cls), d, source, at=at).root
 

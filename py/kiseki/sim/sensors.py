@@ -44,8 +44,8 @@ MAX_RANGE = 1000.0
 """Metres a range sensor's ray is cast."""
 
 # The parameter classes are pydantic dataclasses (kiseki._support.schema's strict number types):
-# checked
-# on construction, on dataclasses.replace and as a section of a scene file (kiseki.sim.setup).
+# checked on construction, on dataclasses.replace and as a section of a scene file
+# (kiseki.sim.setup).
 _params = pydantic_dataclass(frozen=True, config=ConfigDict(extra="forbid"))
 Range = Annotated[float, Field(strict=True, gt=0, le=MAX_RANGE, allow_inf_nan=False)]
 Probability = Annotated[float, Field(strict=True, ge=0, lt=1, allow_inf_nan=False)]

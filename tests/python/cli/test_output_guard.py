@@ -348,8 +348,7 @@ def test_derived_outputs_are_declared(tmp_path):
 
 def test_the_octree_of_sim_show_is_written_atomically(tmp_path, project_root):
     """sim show's --octree went straight to its file; now through kiseki._support.atomic (recorded
-    as
-    written whole), as terrain run's .bt and PCD files."""
+    as written whole), as terrain run's .bt and PCD files."""
     from typer.testing import CliRunner
 
     from kiseki._support.atomic import written_files

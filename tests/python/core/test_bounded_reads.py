@@ -1,9 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """Every reader of a user's file reads within bounds (``kiseki._support.inputs``): a device, a FIFO
-or a
-socket is refused from ``os.stat`` alone (a FIFO is never opened: opening one blocks), a file or
-what it decompresses to is refused past its format's stated limit, and a long read ends within
+or a socket is refused from ``os.stat`` alone (a FIFO is never opened: opening one blocks), a file
+or what it decompresses to is refused past its format's stated limit, and a long read ends within
 a fraction of a second of SIGINT or SIGTERM. The readers run in child processes with an address
 space limit (RLIMIT_AS) and a timeout, so that a regression fails here instead of exhausting the
 machine; each case reports its time and peak memory (``-s`` prints them)."""
@@ -306,19 +305,19 @@ def test_limits_are_counted_while_reading_and_stated(tmp_path):
             "id": "run mcap chunk bomb",
             "call": "kiseki.io.runlog:read_run",
             "args": [str(_mcap_of_zeros(tmp_path / "bomb.mcap"))],
-            "set": {"kiseki.io.runlog:MAX_CHUNK_BYTES": low},
+            "set": {"kiseki.io.runlog.reader:MAX_CHUNK_BYTES": low},
         },
         {
             "id": "run mcap lz4 chunk bomb",
             "call": "kiseki.io.runlog:read_run",
             "args": [str(_mcap_of_zeros(tmp_path / "lz4.mcap", compression="LZ4"))],
-            "set": {"kiseki.io.runlog:MAX_CHUNK_BYTES": low},
+            "set": {"kiseki.io.runlog.reader:MAX_CHUNK_BYTES": low},
         },
         {
             "id": "run mcap past total",
             "call": "kiseki.io.runlog:read_run",
             "args": [str(tmp_path / "bomb.mcap")],
-            "set": {"kiseki.io.runlog:MAX_RUN_BYTES": low},
+            "set": {"kiseki.io.runlog.reader:MAX_RUN_BYTES": low},
         },
         {
             "id": "ros2 mcap chunk bomb",

@@ -8,8 +8,7 @@ magnetic map descriptions, route history, experiment configs) declares its range
 The walk reads each model's pydantic core schema (where Field, Annotated and constrained types
 have been merged, so the convention is pydantic's own: ``ge``/``gt`` and ``le``/``lt`` on the
 number, ``allow_inf_nan=False`` on a float, i.e. kiseki._support.schema's number types), recursing
-into
-nested models, dataclasses, lists, tuples, dicts, unions and validator wrappers. A number is
+into nested models, dataclasses, lists, tuples, dicts, unions and validator wrappers. A number is
 bounded when:
 
 - an int has a lower and an upper bound inside int32, or is kiseki._support.schema.Seed (its

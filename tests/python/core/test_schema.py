@@ -1,8 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """kiseki._support.schema: the messages of the one validation layer name the file, the whole field
-path
-and the value; numbers are strict and finite; seeds are integers in [0, 2**64)."""
+path and the value; numbers are strict and finite; seeds are integers in [0, 2**64)."""
 
 from __future__ import annotations
 

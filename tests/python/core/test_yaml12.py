@@ -1,8 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """kiseki._support.yaml types plain scalars as YAML 1.2's core schema does (YAML 1.2.2, sec. 10.3.2
-and
-its example 10.9), not as PyYAML's YAML 1.1 resolver does: checked scalar by scalar against the
+and its example 10.9), not as PyYAML's YAML 1.1 resolver does: checked scalar by scalar against the
 spec's table, and against PyYAML on the scalars where both specs agree."""
 
 from __future__ import annotations

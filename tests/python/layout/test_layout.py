@@ -141,9 +141,8 @@ def private_imports(source: str, module: str, is_package: bool = False) -> list[
     The private modules of the package ``kiseki`` itself (``kiseki._core``,
     ``kiseki._support.atomic``,
     ``kiseki._support.schema``, ...) are for every module of the project: kiseki's and the
-    experiments'
-    beside it, shipped in the same wheel (they write files atomically and read configs as the
-    CLI does)."""
+    experiments' beside it, shipped in the same wheel (they write files atomically and read configs
+    as the CLI does)."""
     found = []
     for line, target in imported_names(source, module, is_package):
         parts = target.split(".")
