@@ -9,9 +9,9 @@ of 120 x 160 is written and read back, median of 3 repeats:
   channels, ``jsonschema`` schemas), ranges as JSON numbers, depth images as base64 text in
   JSON, written here with the plain ``mcap`` writer (zstd chunks of 128 KiB, flushed after each
   message as kiseki's writer does);
-* after: :class:`kiseki.sim.mcap_log.RunWriter` as it is now.
+* after: :class:`kiseki.io.runlog.RunWriter` as it is now.
 
-Both files are read with :func:`kiseki.sim.mcap_log.read_run` (which reads either), then
+Both files are read with :func:`kiseki.io.runlog.read_run` (which reads either), then
 ``laser_scans`` and ``depth_images``. Figures: microseconds per scan (write: the scan and pose
 messages; read: the file plus ``laser_scans``), microseconds per depth image, file sizes.
 
@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 from mcap.writer import CompressionType, Writer
 
-from kiseki.sim.mcap_log import RunWriter, read_run
+from kiseki.io.runlog import RunWriter, read_run
 
 SCANS, BEAMS, IMAGES, HEIGHT, WIDTH = 2000, 1081, 100, 120, 160
 MAX_RANGE = 30.0

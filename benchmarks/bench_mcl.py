@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from kiseki.datasets import read_carmen_log
-from kiseki.localization import LocalizeConfig, MclConfig, MonteCarloLocalizer, scan_model
+from kiseki.filters import LocalizeConfig, MclConfig, MonteCarloLocalizer, scan_model
 from kiseki.mapping import MapBuildConfig, map_of_log
 
 LOG = (

@@ -39,8 +39,8 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki.datasets import read_carmen_log
+from kiseki.filters import LOCALIZATION_METHODS, LocalizeConfig, motion_alphas, noisy_odometry
 from kiseki.grid import FREE, OCCUPIED
-from kiseki.localization import LOCALIZATION_METHODS, LocalizeConfig, motion_alphas, noisy_odometry
 from kiseki.mapping import MapBuildConfig, map_of_log
 from kiseki.metrics import ape
 
@@ -54,11 +54,11 @@ LOGS = ("intel", "aces", "csail", "freiburg-079")
 
 # --- the settings both filters share ---------------------------------------------------------
 # Odometry: the corrected logs' odometry is their reference path, so both filters get the same
-# noisy odometry made from it (kiseki.localization.noisy_odometry: each increment component with
+# noisy odometry made from it (kiseki.filters.noisy_odometry: each increment component with
 # SD = F x |component|).
 ODOMETRY_NOISE = 0.1  # F
 # Motion noise: nav2's defaults are alpha1..alpha5 = 0.2 each, far more than the odometry above
-# has. Both filters get the alphas that describe it (kiseki.localization.motion_alphas: alpha1 =
+# has. Both filters get the alphas that describe it (kiseki.filters.motion_alphas: alpha1 =
 # alpha3 = F^2 = 0.01, alpha2 = alpha4 = F^2 / 10 = 0.001), in the same convention (Probabilistic
 # Robotics Table 5.6; nav2's "differential" model: alpha1 rotation from rotation, alpha2
 # rotation from translation, alpha3 translation from translation, alpha4 translation from
@@ -187,7 +187,7 @@ def kiseki_api():
     names = {f.name for f in dataclasses.fields(LocalizeConfig)}
     if not {"beams", "threads", "update_min_d", "resample_threshold", "combination"} <= names:
         return None
-    from kiseki.localization import localize
+    from kiseki.filters import localize
 
     return localize
 

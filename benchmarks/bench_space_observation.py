@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from kiseki import Pose2
+from kiseki.filters import MclConfig, MonteCarloLocalizer
 from kiseki.grid import beam_angles
-from kiseki.localization import MclConfig, MonteCarloLocalizer
 from kiseki.models import LocalMapBuilder, SpaceObservationModel, likelihood_reference
 from kiseki.sim.scene import load_scene
 

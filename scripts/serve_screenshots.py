@@ -137,8 +137,8 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         taught = args.taught
         if taught is None:
+            from kiseki.apps.teach import teach
             from kiseki.sim.scene import load_scene
-            from kiseki.teach import teach
 
             taught = Path(tmp) / "teach"
             teach(load_scene(ROOT / "data" / "worlds" / "factory_turn.yaml"), taught, seed=3)

@@ -27,10 +27,10 @@ from pathlib import Path
 
 import yaml
 
+from kiseki.apps.teach import PlaybackConfig, playback, teach
 from kiseki.core import derive_seed
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
 from kiseki.sim.scene import load_scene
-from kiseki.teach import PlaybackConfig, playback, teach
 from kiseki.teach.local_maps import METHODS
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -2,16 +2,23 @@
 # Copyright (c) 2026 the kiseki authors
 """kiseki: mobile-robot localization and navigation toolkit (C++17 core, Python front).
 
-The public API lives in the submodules (``kiseki.core``, ``kiseki.grid``, ``kiseki.map_io``,
-``kiseki.mapping``, ``kiseki.datasets``); the most used names are re-exported here.
+The public API lives in the areas (``kiseki.core``, ``kiseki.grid``, ``kiseki.mapping``,
+``kiseki.io``, ``kiseki.filters``, ``kiseki.datasets``, ...; docs/DESIGN.md maps them); the
+most used names are re-exported here. The modules that moved in the house layout
+(``kiseki.localization``, ``kiseki.global_localization``, ``kiseki.map_io``,
+``kiseki.map_schema``, ``kiseki.trajectory_csv``, ``kiseki.sim.mcap_log``) still import, with a
+DeprecationWarning naming their new home, for one release (``kiseki._support.moved``).
 """
 
 from __future__ import annotations
 
+from kiseki._support import moved
 from kiseki.core import Pose2, Pose3, Random, derive_seed, library_versions, normalize_angle
 from kiseki.errors import KisekiError, LogFormatError, MapFormatError
 from kiseki.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
-from kiseki.map_io import load_map, save_map
+from kiseki.io.ros_map import load_map, save_map
+
+moved.install()
 
 __version__ = library_versions()["kiseki"]
 

@@ -11,6 +11,7 @@ platform. ``derive_seed(seed, k)`` gives stream ``k`` of a seed (per trial, robo
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -37,8 +38,8 @@ take any such integer)."""
 def check_seed(seed, name: str = "seed") -> int:
     """A seed as kiseki takes it: an integer in [0, 2**64) (numpy integers too); anything else
     a ValueError ``"NAME must be an integer in [0, 2**64), got X"``. The one seed check: the
-    file models' ``Seed`` (:mod:`kiseki._schema`) words its problem with :data:`SEED_RULE`."""
-    import numbers
+    file models' ``Seed`` (:mod:`kiseki._support.schema`) words its problem with
+    :data:`SEED_RULE`."""
 
     if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or not 0 <= seed < 2**64:
         raise ValueError(f"{name} {SEED_RULE}, got {seed!r}")

@@ -18,7 +18,7 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from kiseki._atomic import atomic_write
+from kiseki._support.atomic import atomic_write
 from kiseki.grid import OccupancyGrid
 
 __all__ = [

@@ -5,7 +5,7 @@ localization pipelines take, with the one rule every reader applies to what it r
 
 :class:`LaserScans` is made by the readers of recorded data (``kiseki.datasets``: CARMEN logs,
 the CMU Wean Hall logs, ROS bags) and by simulated runs
-(``kiseki.sim.mcap_log.SimRun.laser_scans``), so a simulated run replays through the interface
+(``kiseki.io.runlog.SimRun.laser_scans``), so a simulated run replays through the interface
 of a real log. Readers and the simulator import it from here, not from one another.
 
 Each reader's docstring says what its logs put in the fields (which pose is the laser's, whether

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Fuzz the key-script reader kiseki.teach.keyboard.KeyScript (``kiseki teach --keys``) and
+"""Fuzz the key-script reader kiseki.apps.teach.keyboard.KeyScript (``kiseki teach --keys``) and
 the keys it hands out; see fuzz_common.py."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from pathlib import Path
 
 from fuzz_common import main
 
-from kiseki.teach.keyboard import KeyScript, Teleop
+from kiseki.apps.teach.keyboard import KeyScript, Teleop
 
 
 def seeds(_folder: Path):

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Fuzz the ROS map reader kiseki.map_io.load_map: the YAML file (``--target yaml``, the
+"""Fuzz the ROS map reader kiseki.io.ros_map.load_map: the YAML file (``--target yaml``, the
 default, with a small valid image beside it) or the image it names (``--target image``, decoded
 by the C++ core's OpenCV reader, with a fixed YAML); see fuzz_common.py."""
 
@@ -13,7 +13,7 @@ import numpy as np
 from fuzz_common import PROJECT_DATA, main, pick_target
 from PIL import Image
 
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
 
 CORRIDOR = PROJECT_DATA / "maps" / "factory_corridor"
 

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Fuzz the MCAP run reader kiseki.sim.mcap_log.read_run and the decoders of its topics
+"""Fuzz the MCAP run reader kiseki.io.runlog.read_run and the decoders of its topics
 (laser scans, poses, grid, depth images, velocities); see fuzz_common.py.
 
 An input that starts with the MCAP magic is the file itself (the seeds: the sample run as
@@ -24,7 +24,7 @@ from mcap.writer import CompressionType, Writer
 
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
-from kiseki.sim.mcap_log import TWIST_SCHEMA, TWIST_SCHEMA_NAME, RunWriter, read_run
+from kiseki.io.runlog import TWIST_SCHEMA, TWIST_SCHEMA_NAME, RunWriter, read_run
 
 MAGIC = b"\x89MCAP0\r\n"
 DECODERS = {

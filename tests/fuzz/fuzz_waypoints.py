@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Fuzz the waypoint-file reader kiseki.teach.teaching.load_route (the file ``kiseki teach``
+"""Fuzz the waypoint-file reader kiseki.apps.teach.teaching.load_route (the file ``kiseki teach``
 writes and ``kiseki playback`` reads), with a taught map beside it; see fuzz_common.py."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from pathlib import Path
 import yaml
 from fuzz_common import PROJECT_DATA, main
 
-from kiseki.teach.teaching import load_route
+from kiseki.apps.teach.teaching import load_route
 
 CORRIDOR = PROJECT_DATA / "maps" / "factory_corridor"
 

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """Fuzz the CMU Wean Hall readers: the BeeSoft ``.dat`` map (``--target map``, the default,
-through kiseki.map_io.load_map) and the robotdata logs (``--target log``,
+through kiseki.io.ros_map.load_map) and the robotdata logs (``--target log``,
 kiseki.datasets.read_wean_log); see fuzz_common.py."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from pathlib import Path
 from fuzz_common import head_lines, main, pick_target, shared_data
 
 from kiseki.datasets.wean_log import read_wean_log
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
 
 TINY_MAP = (
     b"robot_specifications->global_mapsize_x 40\nrobot_specifications->global_mapsize_y 30\n"

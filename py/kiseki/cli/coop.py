@@ -11,10 +11,10 @@ from pathlib import Path
 import typer
 from rich.console import Console
 
-from kiseki._guard import guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import Count, Degrees, Metres, Seed
-from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki._support.guard import guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import Count, Degrees, Metres, Seed
+from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki.coop import START, plan, simulate
 from kiseki.coop.planner import plan_moves
 from kiseki.coop.render import render_run

@@ -21,19 +21,19 @@ import typer
 import yaml
 from rich.console import Console
 
-from kiseki._atomic import atomic_write
-from kiseki._guard import guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import PARTICLE_LIMIT, Count, Seed
-from kiseki._table import show
+from kiseki._support.atomic import atomic_write
+from kiseki._support.guard import guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import PARTICLE_LIMIT, Count, Seed
+from kiseki._support.table import show
+from kiseki.apps.teach import PlaybackConfig, playback, teach
 from kiseki.cli._defaults import default_of
 from kiseki.cli.teach import merge_rule
 from kiseki.core import derive_seed
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
 from kiseki.plots import render_map
 from kiseki.sim.render import render_scene
 from kiseki.sim.scene import load_scene
-from kiseki.teach import PlaybackConfig, playback, teach
 from kiseki.teach.local_maps import METHODS
 
 __all__ = ["DemoConfig", "app", "run_demo"]

@@ -14,10 +14,10 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from kiseki._guard import guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import RUN_LIMIT, WORKER_LIMIT, Count, Seed
-from kiseki._table import show_fields
+from kiseki._support.guard import guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import RUN_LIMIT, WORKER_LIMIT, Count, Seed
+from kiseki._support.table import show_fields
 from kiseki.errors import KisekiError
 from kiseki_experiments.harness.registry import all_experiments
 from kiseki_experiments.harness.report import write_reproduction

@@ -13,10 +13,10 @@ import typer
 import yaml
 from rich.console import Console
 
-from kiseki._atomic import atomic_write
-from kiseki._guard import Derived, guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import (
+from kiseki._support.atomic import atomic_write
+from kiseki._support.guard import Derived, guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import (
     BEAM_LIMIT,
     PARTICLE_LIMIT,
     THREAD_LIMIT,
@@ -25,19 +25,20 @@ from kiseki._options import (
     Seed,
     refuse_given,
 )
-from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
-from kiseki._table import show_fields
+from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki._support.table import show_fields
 from kiseki.cli._defaults import default_of
 from kiseki.datasets import open_scans
-from kiseki.global_localization import (
+from kiseki.filters import (
     GlobalConfig,
+    LocalizeConfig,
     describe,
     global_localize,
+    localize,
     render_global,
     write_report,
 )
-from kiseki.localization import LocalizeConfig, localize
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
 from kiseki.mapping import endpoint_agreement
 from kiseki.metrics import ape
 
@@ -45,7 +46,7 @@ __all__ = ["app"]
 
 app = typer.Typer()
 console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
-# files the command writes that no option names (kiseki._guard)
+# files the command writes that no option names (kiseki._support.guard)
 _CONFIG_BESIDE = Derived(
     "its config", lambda a: a["output"].with_name(a["output"].stem + ".config.yaml")
 )

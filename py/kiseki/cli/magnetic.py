@@ -12,15 +12,15 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from kiseki._atomic import atomic_write
-from kiseki._guard import Folder, guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import Count, Fraction, Metres, Seed, refuse_given
-from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki._support.atomic import atomic_write
+from kiseki._support.guard import Folder, guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import Count, Fraction, Metres, Seed, refuse_given
+from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki.apps.magnetic.navigate_outputs import navigate_folder, teach_folder
 from kiseki.cli.magnetic_fit import fit
 from kiseki.datasets.kok import read_kok_walk
 from kiseki.magnetic.field_map import MagneticFieldMap
-from kiseki.magnetic.navigate_outputs import navigate_folder, teach_folder
 from kiseki.magnetic.points_csv import read_points
 from kiseki.magnetic.render import picture_size, render_field_map
 from kiseki.magnetic.travel_distance_walk import WalkOdometry, localize_walk
@@ -33,7 +33,7 @@ app = typer.Typer(
 )
 app.command("fit")(fit)  # first in the listing: the map the other commands read
 console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
-# what kiseki magnetic navigate writes in its -o folder (kiseki._guard)
+# what kiseki magnetic navigate writes in its -o folder (kiseki._support.guard)
 _NAVIGATION = Folder("output", ("run.mcap", "navigation.csv", "navigation.png"))
 
 

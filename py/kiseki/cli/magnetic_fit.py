@@ -12,9 +12,9 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from kiseki._guard import guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import CELL_LIMITS, Count, Metres, Seed, refuse_given
+from kiseki._support.guard import guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import CELL_LIMITS, Count, Metres, Seed, refuse_given
 from kiseki.datasets.magnetic import concatenate_samples, read_magnetic_data
 from kiseki.gp import SquaredExponential, fit_hyperparameters
 from kiseki.gp.kernel import subsample

@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import typer
 
-from kiseki._guard import Derived
+from kiseki._support.guard import Derived
 from kiseki.cli._lazy import Entry, LazyGroup
 
 __all__ = ["COMMANDS", "MAP_IMAGE", "app"]
 
-# the image a map YAML names, written beside it (kiseki._guard)
+# the image a map YAML names, written beside it (kiseki._support.guard)
 MAP_IMAGE = Derived("--output's image", lambda a: a["output"].with_suffix(".pgm"))
 
 # its commands in listing order, each with its module and its line (its first paragraph)

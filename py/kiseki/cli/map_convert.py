@@ -9,12 +9,12 @@ from pathlib import Path
 import typer
 from rich.console import Console
 
-from kiseki._guard import guarded
-from kiseki._interrupt import interruptible
-from kiseki._outputs import check_suffix
+from kiseki._support.guard import guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.outputs import check_suffix
 from kiseki.cli.map import MAP_IMAGE
 from kiseki.grid import grid_summary
-from kiseki.map_io import load_map, save_map
+from kiseki.io.ros_map import load_map, save_map
 
 __all__ = ["app"]
 

@@ -10,15 +10,15 @@ from pathlib import Path
 import typer
 from rich.console import Console
 
-from kiseki._guard import guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import CELL_LIMITS, REACH_LIMIT, Metres, refuse_given
-from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki._support.guard import guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import CELL_LIMITS, REACH_LIMIT, Metres, refuse_given
+from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki.cli._defaults import default_of
 from kiseki.cli.map import MAP_IMAGE
 from kiseki.datasets import open_scans
 from kiseki.datasets.rosbag import is_ros_bag
-from kiseki.map_io import load_map, save_map
+from kiseki.io.ros_map import load_map, save_map
 from kiseki.mapping import MapBuildConfig, endpoint_agreement, map_of_log
 from kiseki.plots import render_map
 from kiseki.teach.environment_map import build_teaching_map

@@ -9,10 +9,10 @@ from pathlib import Path
 import typer
 from rich.console import Console
 
-from kiseki._guard import guarded
-from kiseki._table import show_fields
+from kiseki._support.guard import guarded
+from kiseki._support.table import show_fields
 from kiseki.grid import grid_summary
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
 
 __all__ = ["app"]
 

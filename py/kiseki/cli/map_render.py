@@ -10,13 +10,13 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from kiseki._guard import guarded
-from kiseki._interrupt import interruptible
-from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki._support.guard import guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki.datasets import read_carmen_log
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
+from kiseki.io.trajectory_csv import read_trajectory_csv
 from kiseki.plots import render_map
-from kiseki.trajectory_csv import read_trajectory_csv
 
 __all__ = ["app"]
 

@@ -12,23 +12,23 @@ import numpy as np
 import typer
 from rich.console import Console
 
-from kiseki._guard import Derived, guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import Seed
+from kiseki._support.guard import Derived, guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import Seed
+from kiseki.apps.teach import PlaybackConfig, playback
+from kiseki.apps.teach.teaching import load_route
 from kiseki.cli._defaults import default_of
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
 from kiseki.sim.scene import load_scene
 from kiseki.speed import SpeedLimiter, SpeedLimiterConfig
-from kiseki.teach import PlaybackConfig, playback
 from kiseki.teach.local_maps import METHODS
 from kiseki.teach.scene_identity import check_scene, taught_scene_of
-from kiseki.teach.teaching import load_route
 
 __all__ = ["app"]
 
 app = typer.Typer()
 console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
-# the waypoint file of the taught folder, which no option names (kiseki._guard)
+# the waypoint file of the taught folder, which no option names (kiseki._support.guard)
 _TAUGHT_WAYPOINTS = Derived(
     "--taught's waypoint file", lambda a: a["taught"] / "waypoints.yaml" if a["taught"] else None
 )

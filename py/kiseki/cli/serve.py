@@ -11,11 +11,11 @@ import typer
 import uvicorn
 from rich.console import Console
 
-from kiseki._guard import Rewrites, guarded
-from kiseki._options import PARTICLE_LIMIT, Count, Fraction, Seconds, Seed
+from kiseki._support.guard import Rewrites, guarded
+from kiseki._support.options import PARTICLE_LIMIT, Count, Fraction, Seconds, Seed
+from kiseki.apps.teach import PlaybackConfig
 from kiseki.cli._defaults import default_of
 from kiseki.serve import HISTORY_FILE, LOOPBACK, build_server, listening_sockets
-from kiseki.teach import PlaybackConfig
 
 __all__ = ["app"]
 

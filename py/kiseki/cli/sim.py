@@ -11,13 +11,20 @@ import typer
 from rich.console import Console
 
 from kiseki import _core
-from kiseki._atomic import atomic_write
-from kiseki._guard import guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import CELL_LIMITS, SIM_SECONDS_LIMIT, Metres, Seconds, Seed, refuse_given
-from kiseki._outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
+from kiseki._support.atomic import atomic_write
+from kiseki._support.guard import guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import (
+    CELL_LIMITS,
+    SIM_SECONDS_LIMIT,
+    Metres,
+    Seconds,
+    Seed,
+    refuse_given,
+)
+from kiseki._support.outputs import FIGURE_SUFFIXES, check_outputs, check_suffix
 from kiseki.cli._defaults import default_of
-from kiseki.sim.mcap_log import read_run
+from kiseki.io.runlog import read_run
 from kiseki.sim.render import render_run, render_scene
 from kiseki.sim.run import SimConfig, read_commands, simulate
 from kiseki.sim.scene import load_scene

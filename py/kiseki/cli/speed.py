@@ -12,13 +12,13 @@ import typer
 import yaml
 from rich.console import Console
 
-from kiseki._atomic import atomic_write
-from kiseki._guard import Derived, guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import REACH_LIMIT, Degrees, Metres, Quantity, refuse_given
-from kiseki._outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki._support.atomic import atomic_write
+from kiseki._support.guard import Derived, guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import REACH_LIMIT, Degrees, Metres, Quantity, refuse_given
+from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki.datasets import open_scans
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
 from kiseki.speed import SpeedLimiterConfig
 from kiseki.speed.along_log import limits_along_log
 from kiseki.speed.render import render_limits
@@ -30,7 +30,7 @@ app = typer.Typer(
 )
 console = Console(soft_wrap=True)
 METHODS = ("occlusion", "occlusion-width", "width")
-# the settings written beside the CSV (kiseki._guard)
+# the settings written beside the CSV (kiseki._support.guard)
 _CONFIG = Derived("the config", lambda a: a["output"].with_suffix(".config.yaml"))
 
 

@@ -10,12 +10,12 @@ from pathlib import Path
 import typer
 from rich.console import Console
 
-from kiseki._guard import guarded
-from kiseki._options import Seed, refuse_given
+from kiseki._support.guard import guarded
+from kiseki._support.options import Seed, refuse_given
+from kiseki.apps.teach.keyboard import KeyScript, TerminalKeys, teach_keyboard
+from kiseki.apps.teach.teaching import recover, teach
 from kiseki.sim.scene import load_scene
 from kiseki.teach.environment_map import MERGE_RULES
-from kiseki.teach.keyboard import KeyScript, TerminalKeys, teach_keyboard
-from kiseki.teach.teaching import recover, teach
 
 __all__ = ["app", "merge_rule"]
 

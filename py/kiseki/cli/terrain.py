@@ -13,10 +13,10 @@ from rich.console import Console
 from tqdm import tqdm
 
 from kiseki import _core
-from kiseki._atomic import atomic_write
-from kiseki._guard import Folder, guarded
-from kiseki._interrupt import interruptible
-from kiseki._options import Count, Metres, Seed, refuse_given
+from kiseki._support.atomic import atomic_write
+from kiseki._support.guard import Folder, guarded
+from kiseki._support.interrupt import interruptible
+from kiseki._support.options import Count, Metres, Seed, refuse_given
 from kiseki.cli._defaults import default_of
 from kiseki.sim.terrain_moves import terrain_stops
 from kiseki.terrain.cloud_picture import planes_summary, render_cloud_planes, write_planes_csv
@@ -33,7 +33,7 @@ app = typer.Typer(
 )
 console = Console(soft_wrap=True)
 TRAJECTORY_COLUMNS = ("move", "x_true", "y_true", "z_true", "x_est", "y_est", "z_est")
-# what kiseki terrain run writes in its -o folder (kiseki._guard)
+# what kiseki terrain run writes in its -o folder (kiseki._support.guard)
 _RUN_FILES = Folder(
     "output", ("sdem_*.pcd", "trajectory.csv", "global_map.bt", "trajectory.png", "config.yaml")
 )

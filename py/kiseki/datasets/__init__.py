@@ -10,7 +10,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from kiseki._inputs import check_input
+from kiseki._support.inputs import check_input
 from kiseki.datasets.carmen import CarmenLog, OdometryRecords, read_carmen_log
 from kiseki.datasets.kok import read_kok_walk
 from kiseki.datasets.magnetic import (
@@ -24,8 +24,8 @@ from kiseki.datasets.rosbag import BAG_KINDS, is_ros_bag, read_bag_scans, write_
 from kiseki.datasets.wean import WeanMap, read_wean_map
 from kiseki.datasets.wean_log import WeanLog, is_wean_log, read_wean_log
 from kiseki.errors import LogFormatError
+from kiseki.io.runlog import read_run
 from kiseki.scans import LaserScans
-from kiseki.sim.mcap_log import read_run
 
 __all__ = [
     "open_scans",

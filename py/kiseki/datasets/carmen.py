@@ -59,7 +59,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kiseki._inputs import GIB
+from kiseki._support.inputs import GIB
 from kiseki.datasets._files import read_maybe_gzipped
 from kiseki.errors import LogFormatError
 from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps, largest_reading

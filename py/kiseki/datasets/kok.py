@@ -47,7 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kiseki._inputs import MIB, check_input, decompressed_size, describe_bytes
+from kiseki._support.inputs import MIB, check_input, decompressed_size, describe_bytes
 from kiseki.datasets.magnetic_samples import MagneticSamples
 from kiseki.errors import LogFormatError
 

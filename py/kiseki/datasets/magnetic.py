@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kiseki._inputs import CSV_LIMIT, check_input, read_input
+from kiseki._support.inputs import CSV_LIMIT, check_input, read_input
 from kiseki.datasets.kok import read_kok_walk
 from kiseki.datasets.magnetic_samples import UNITS, MagneticSamples, concatenate_samples
 from kiseki.errors import LogFormatError
@@ -130,7 +130,7 @@ def read_magnetic_data(spec: str | os.PathLike) -> MagneticSamples:
 
 def _numbered_lines(path: Path) -> list[tuple[int, str]]:
     """The file's non-blank lines with their 1-based line numbers (a file of at most
-    :data:`kiseki._inputs.CSV_LIMIT` bytes)."""
+    :data:`kiseki._support.inputs.CSV_LIMIT` bytes)."""
     check_input(path, error=LogFormatError)
     if path.is_dir():
         raise LogFormatError(f"{path}: a directory, not a file")

@@ -38,6 +38,10 @@ Writing (:func:`write_bag`) converts a :class:`LaserScans` (e.g. a CARMEN log) i
 ``rosbags``' own writers: LaserScan messages, the odometry of ``base_link`` in ``odom``, the mount
 on ``/tf_static`` and, when the scans have reference poses, ``base_link`` in ``map`` on the
 reference topic. Each message is stamped (and logged) at its scan's time.
+
+Why one file over 400 lines: ROS 1 and ROS 2 bags share the message layout, the
+checks of a scan and the writer's inverse of the reader; split, each half would import the
+other's private rules.
 """
 
 from __future__ import annotations
@@ -56,8 +60,8 @@ from typing import Any
 import numpy as np
 import yaml
 
-from kiseki._chunk_limits import check_mcap_chunks, check_ros1_chunks
-from kiseki._inputs import (
+from kiseki._support.chunk_limits import check_mcap_chunks, check_ros1_chunks
+from kiseki._support.inputs import (
     GIB,
     MIB,
     YAML_LIMIT,
@@ -66,7 +70,7 @@ from kiseki._inputs import (
     describe_bytes,
     read_input_text,
 )
-from kiseki._yaml import safe_load_12
+from kiseki._support.yaml import safe_load_12
 from kiseki.errors import LogFormatError
 from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps
 
@@ -137,6 +141,8 @@ def is_ros_bag(path: str | os.PathLike) -> bool:
 def _is_ros2_mcap(path: Path) -> bool:
     """A ROS 2 MCAP: its channels' message encoding is ``cdr``; without channels (an empty bag),
     its header profile is ``ros2``."""
+    # here, not at the top: the MCAP and rosbags libraries load only for a bag, so that
+    # `import kiseki.datasets` stays fast
     from mcap.exceptions import McapError
     from mcap.reader import make_reader
     from mcap.records import Channel, Header
@@ -332,6 +338,7 @@ def _check_chunks(path: Path) -> None:
 @contextmanager
 def _open_bag(path: Path) -> Iterator[Any]:
     """An open ``rosbags`` AnyReader; its errors become LogFormatError naming the bag."""
+    # here: rosbags loads only for a bag (see _is_ros2_mcap)
     from rosbags.highlevel import AnyReader, AnyReaderError
     from rosbags.typesys import Stores, get_typestore
 
@@ -572,6 +579,7 @@ def write_bag(
     with its inverse. The bag is written beside ``path`` under a temporary name and renamed when
     complete; an existing ``path`` is refused. Scan times that step back or repeat (some CARMEN
     logs) are written as they are, but the reader orders scans and poses by stamp."""
+    # here: rosbags loads only for a bag (see _is_ros2_mcap)
     from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
     path = Path(path)
@@ -709,7 +717,7 @@ def _yaw_quaternion(theta: float) -> tuple[float, float, float, float]:
 def _write_ros1(
     path: Path, store: Any, msgtypes: dict[str, str], records: Iterator[tuple[str, int, Any]]
 ) -> None:
-    from rosbags.rosbag1 import Writer
+    from rosbags.rosbag1 import Writer  # here: rosbags loads only for a bag
 
     with Writer(path) as writer:
         connections = {
@@ -729,7 +737,7 @@ def _write_ros2(
     records: Iterator[tuple[str, int, Any]],
     storage: str,
 ) -> None:
-    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.rosbag2 import StoragePlugin, Writer  # here: rosbags only for a bag
 
     plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
     with Writer(path, version=Writer.VERSION_LATEST, storage_plugin=plugin) as writer:

@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kiseki._inputs import MIB
+from kiseki._support.inputs import MIB
 from kiseki.datasets._files import read_maybe_gzipped
 from kiseki.errors import MapFormatError
 

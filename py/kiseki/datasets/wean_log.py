@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kiseki._inputs import GIB, check_input
+from kiseki._support.inputs import GIB, check_input
 from kiseki.datasets._files import GZIP_MAGIC, read_maybe_gzipped
 from kiseki.datasets.carmen import flaser_angles
 from kiseki.errors import LogFormatError

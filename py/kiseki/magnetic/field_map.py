@@ -15,6 +15,9 @@ resolution``; voxel index i on an axis is key ``origin / resolution + 32768 + i`
 On disk a map is a folder (kind and dimension declared in ``magnetic_map.yaml``):
 :func:`save_map_folder` and :func:`load_map_folder` (and the map's ``save`` and ``load``) write
 and read it through :mod:`kiseki.magnetic.map_folder`, which holds the layout.
+
+Why one file over 400 lines: the map, its building from a GP, its evaluation on the
+grid and its folder round trip are one type's life; the folder files are in map_folder.py.
 """
 
 from __future__ import annotations
@@ -27,9 +30,10 @@ from pathlib import Path
 from types import MappingProxyType
 
 import numpy as np
+from tqdm import tqdm
 
 from kiseki.errors import MapFormatError
-from kiseki.gp import SquaredExponential
+from kiseki.gp import ExactGP, HilbertGP, SquaredExponential
 from kiseki.magnetic.map_folder import COMPONENTS, read_map_folder, write_map_folder
 
 __all__ = [
@@ -389,8 +393,6 @@ def _predict_all(gps: list, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]
 
 
 def _evaluate(gps, origin, resolution, shape, height, progress):
-    from tqdm import tqdm
-
     total = int(np.prod(shape))
     mean = np.empty((total, 3))
     var = np.empty((total, 3))
@@ -412,7 +414,6 @@ def _evaluate(gps, origin, resolution, shape, height, progress):
 def fit_component_gps(x, y, kernels, method: str, *, mean: str = "constant", domain=None) -> list:
     """GPs of the field's three columns: one GP of all three with one kernel, or one GP per
     column with three; exact or reduced-rank ("hilbert", on `domain` or its default box)."""
-    from kiseki.gp import ExactGP, HilbertGP
 
     kernels = [kernels] if isinstance(kernels, SquaredExponential) else list(kernels)
     columns = [slice(0, 3)] if len(kernels) == 1 else [slice(k, k + 1) for k in range(3)]

@@ -2,7 +2,7 @@
 # Copyright (c) 2026 the kiseki authors
 """MCL with a LIDAR and the magnetic heading correction of the magnetic-navigation thesis
 (``002_74cea16d239c028f.txt``, ch. 5, sec. 5.2), on kiseki's engine
-(:class:`kiseki.localization.MonteCarloLocalizer` with the C++ beam model).
+(:class:`kiseki.filters.MonteCarloLocalizer` with the C++ beam model).
 
 Per laser scan (sec. 5.2, steps 1-6):
 
@@ -47,8 +47,8 @@ import numpy as np
 
 from kiseki import _core
 from kiseki.core import Pose2, check_seed, derive_seed
+from kiseki.filters import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
 from kiseki.grid import OccupancyGrid
-from kiseki.localization import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
 from kiseki.magnetic.linear_map import LinearMagneticMap
 from kiseki.magnetic.travel_distance import R_THETA_GATE, R_Z_GATE, azimuth_heading
 

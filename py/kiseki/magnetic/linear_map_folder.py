@@ -10,8 +10,8 @@
 * ``nodes.npz``: the float64 arrays ``s``, ``field`` (n, 3), ``m_theta``, ``heading``, ``g``
   (n, 2, NaN: no obstacle), ``position`` (n, 2, NaN: unknown) and int64 ``count``.
 
-Both files are written by :func:`kiseki._atomic.atomic_write_all` (the arrays before the YAML).
-A folder of the GP magnetic field maps (:mod:`kiseki.magnetic.map_folder`,
+Both files are written by :func:`kiseki._support.atomic.atomic_write_all` (the arrays before the
+YAML). A folder of the GP magnetic field maps (:mod:`kiseki.magnetic.map_folder`,
 ``magnetic_map.yaml``) is refused here, and that module refuses this kind.
 """
 
@@ -24,9 +24,11 @@ import numpy as np
 import yaml
 from pydantic import Field
 
-from kiseki._atomic import atomic_write_all
-from kiseki._inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
-from kiseki._schema import FileModel, FiniteFloat, PositiveFloat, PositiveInt, parse
+from kiseki import __version__
+from kiseki._support.atomic import atomic_write_all
+from kiseki._support.inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
+from kiseki._support.schema import FileModel, FiniteFloat, PositiveFloat, PositiveInt, parse
+from kiseki._support.yaml import read_yaml_file, safe_load_12
 from kiseki.errors import KisekiError, MapFormatError
 from kiseki.magnetic.linear_map import LinearMagneticMap
 
@@ -78,7 +80,6 @@ class LinearMapDoc(FileModel):
 
 
 def _is_kind(folder: Path, name: str, kind: str) -> bool:
-    from kiseki._yaml import safe_load_12
 
     try:
         doc = safe_load_12(read_input_text(folder / name, "YAML files", YAML_LIMIT))
@@ -97,7 +98,6 @@ def save_linear_map(lmap: LinearMagneticMap, folder) -> Path:
     """Writes ``lmap`` to ``folder`` (created if absent; its parent must exist). A folder
     holding another linear map is overwritten; a GP map folder or any other non-empty folder
     is refused."""
-    from kiseki import __version__
 
     if not isinstance(lmap, LinearMagneticMap):
         raise ValueError(f"expected a LinearMagneticMap, got {type(lmap).__name__}")
@@ -173,7 +173,6 @@ def load_linear_map(folder, path_id: str | None = None) -> LinearMagneticMap:
     path raises :class:`OtherPathError` naming both identities. A GP magnetic map folder, a
     malformed YAML or arrays that disagree with it raise MapFormatError (SchemaError for the
     YAML's fields) naming the file; an absent folder FileNotFoundError."""
-    from kiseki._yaml import read_yaml_file
 
     folder = Path(folder)
     if not folder.exists():

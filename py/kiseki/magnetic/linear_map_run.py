@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kiseki.errors import LogFormatError
+from kiseki.io.runlog import read_run
 from kiseki.magnetic.linear_map import (
     NODE_SPACING,
     WINDOW_ANGLE,
@@ -80,7 +81,6 @@ def teaching_samples(
 ) -> TeachingSamples:
     """The samples of the MCAP run ``run_file`` (see the module text). LogFormatError names the
     file and the missing or malformed topic."""
-    from kiseki.sim.mcap_log import read_run  # the MCAP reader, not the simulator
 
     run = read_run(run_file)
     t_mag, readings = _rows(run, mag_topic, ("x", "y", "z"))

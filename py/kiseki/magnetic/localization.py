@@ -2,7 +2,7 @@
 # Copyright (c) 2026 the kiseki authors
 """Monte Carlo localization on a 2-D magnetic field map (thesis chapter 6.7, eqs. 6.17-6.18).
 
-The particle filter is kiseki's engine (:class:`kiseki.localization.MonteCarloLocalizer`); the
+The particle filter is kiseki's engine (:class:`kiseki.filters.MonteCarloLocalizer`); the
 measurement model is :class:`MagneticMapModel` (C++: ``kiseki/models/magnetic_map_model.hpp``):
 each magnetometer's 3-axis reading is Gaussian about the map's mean at the sensor's position,
 with the map's variance plus the sensor's noise, and the sensors are independent (eq. 6.18).
@@ -17,10 +17,11 @@ from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
+from tqdm import tqdm
 
 from kiseki import _core
 from kiseki.core import check_seed
-from kiseki.localization import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
+from kiseki.filters import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
 
 __all__ = [
     "FRAMES",
@@ -97,7 +98,7 @@ class MagneticMapModel:
 class MagneticMclConfig:
     """The filter's settings. particles 1000 and resample_threshold 0.5 (ESS < n/2) are the
     thesis'; alphas the engine's odometry noise for a real wheeled robot
-    (``kiseki.localization.REAL_ODOMETRY_ALPHAS``); noise_sd None: the map's kernel sigma_n;
+    (``kiseki.filters.REAL_ODOMETRY_ALPHAS``); noise_sd None: the map's kernel sigma_n;
     update_min_d: travel between updates (0: every reading)."""
 
     particles: int = 1000
@@ -186,8 +187,6 @@ def localize_on_magnetic_map(
     resamplings = 0
     steps = range(len(odo))
     if progress:
-        from tqdm import tqdm
-
         steps = tqdm(steps, desc="magnetic MCL", unit="step")
     for t in steps:
         report = localizer.step(odo[t], lambda t=t: model.set_readings(z[t]))

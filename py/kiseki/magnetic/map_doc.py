@@ -29,7 +29,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
-from kiseki._schema import FileModel, FiniteFloat, PositiveFloat, parse
+from kiseki._support.schema import FileModel, FiniteFloat, PositiveFloat, parse
 
 __all__ = ["MAX_MAP_CELLS", "MAX_TRAINING_POINTS", "MagneticMapDoc", "read_map_doc"]
 
@@ -148,6 +148,6 @@ class MagneticMapDoc(FileModel):
 
 def read_map_doc(doc: Any, path: str | os.PathLike) -> MagneticMapDoc:
     """`doc` (the parsed ``magnetic_map.yaml`` at `path`) checked against
-    :class:`MagneticMapDoc`: a :class:`~kiseki._schema.SchemaError` naming the file, the field
-    and the value."""
+    :class:`MagneticMapDoc`: a :class:`~kiseki._support.schema.SchemaError` naming the file, the
+    field and the value."""
     return parse(MagneticMapDoc, doc, path)

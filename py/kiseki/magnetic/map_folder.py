@@ -42,11 +42,13 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from kiseki._atomic import record_written
-from kiseki._inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
-from kiseki._yaml import safe_load_12
+from kiseki import __version__, _core
+from kiseki._support.atomic import record_written
+from kiseki._support.inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
+from kiseki._support.yaml import read_yaml_file, safe_load_12
 from kiseki.errors import MapFormatError
 from kiseki.gp import SquaredExponential
+from kiseki.io.ros_map import write_image
 from kiseki.magnetic.map_doc import Kernel, MagneticMapDoc, read_map_doc
 
 __all__ = [
@@ -127,7 +129,6 @@ def _kernel_doc(kernel) -> dict:
 
 
 def _document(fmap, files: dict) -> dict:
-    from kiseki import __version__
 
     d = fmap.dimension
     doc = {
@@ -165,7 +166,6 @@ def _document(fmap, files: dict) -> dict:
 
 
 def _write_layers_2d(fmap, tmp: Path) -> dict:
-    from kiseki.map_io import write_image
 
     arrays = {"origin": fmap.origin, "resolution": np.float64(fmap.resolution)}
     images = {}
@@ -287,7 +287,6 @@ def _check_grid(path: Path, arrays: dict, origin: np.ndarray, resolution: float)
 
 
 def _read_2d(folder: Path, doc: MagneticMapDoc, meta: Path, origin, resolution, shape) -> tuple:
-    from kiseki import _core
 
     files = doc.files
     layers = files.get("layers")
@@ -356,7 +355,6 @@ def read_map_folder(folder) -> MapFolderContents:
     :func:`kiseki.magnetic.field_map.load_map_folder`). Raises FileNotFoundError when the
     folder is absent, MapFormatError naming the file for another kind of folder, a missing
     layer, shapes that disagree, NaN or a malformed description."""
-    from kiseki._yaml import read_yaml_file
 
     folder = Path(folder)
     if not folder.exists():

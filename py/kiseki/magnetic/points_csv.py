@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from kiseki._csv import CsvNumber
-from kiseki._inputs import CSV_LIMIT, read_input_text
-from kiseki._schema import FileModel, parse
+from kiseki._support.csv import CsvNumber
+from kiseki._support.inputs import CSV_LIMIT, read_input_text
+from kiseki._support.schema import FileModel, parse
 
 __all__ = ["MAX_POINTS", "Point2", "Point3", "read_points"]
 

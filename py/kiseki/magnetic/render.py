@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kiseki._atomic import atomic_write
+from kiseki._support.atomic import atomic_write
 from kiseki.magnetic.field_map import COMPONENTS, MagneticFieldMap
 from kiseki.plots import new_figure
 

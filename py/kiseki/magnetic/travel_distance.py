@@ -48,6 +48,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from kiseki import _core
 from kiseki.magnetic.linear_map import LinearMagneticMap
 
 __all__ = [
@@ -180,7 +181,6 @@ class TravelDistanceLocalizer:
         config: TravelDistanceConfig | None = None,
         start: float = 0.0,
     ) -> None:
-        from kiseki import _core
 
         self.config = TravelDistanceConfig() if config is None else config
         if not isinstance(self.config, TravelDistanceConfig):

@@ -28,7 +28,7 @@ positions from the visual-inertial odometry, the field turned to the world frame
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -222,6 +222,5 @@ def localize_walk(
 
 
 def _with_seed(config: TravelDistanceConfig, seed: int) -> TravelDistanceConfig:
-    from dataclasses import replace
 
     return replace(config, seed=seed)

@@ -11,6 +11,7 @@ import os
 from dataclasses import replace
 from pathlib import Path
 
+from kiseki.apps.teach.playback import PlaybackConfig
 from kiseki.serve.app import STATIC, create_app
 from kiseki.serve.guard import loopback_hosts
 from kiseki.serve.history import RouteHistory
@@ -18,6 +19,8 @@ from kiseki.serve.listen import listening_sockets
 from kiseki.serve.robot import Robot, RobotState, SimulatedAgv
 from kiseki.serve.routes import RouteRequest, RouteRunner
 from kiseki.serve.taught import TaughtRun, taught_scene
+from kiseki.sim.scene import load_scene
+from kiseki.teach.scene_identity import resolve_scene_file, scene_digest, taught_scene_of
 
 __all__ = [
     "HISTORY_FILE",
@@ -53,8 +56,6 @@ def scene_of(folder: str | os.PathLike, scene: str | os.PathLike | None) -> Path
     same SHA-1; for a run recorded without one, the same file or text), or the recorded one when
     `scene` is None, found from any working directory (relative to the taught folder, or for an
     older run to the working directory it was taught in: ``resolve_scene_file``)."""
-    from kiseki.teach.scene_identity import resolve_scene_file, scene_digest
-
     folder = Path(folder)
     identity = _taught_identity(folder)
     recorded = identity.file if identity is not None and identity.file else taught_scene(folder)
@@ -94,8 +95,6 @@ def scene_of(folder: str | os.PathLike, scene: str | os.PathLike | None) -> Path
 def _taught_identity(folder: Path):
     """The taught scene (file, SHA-1) as the run's waypoint file (or its log) records it, or
     None."""
-    from kiseki.teach.scene_identity import taught_scene_of
-
     waypoints = folder / "waypoints.yaml"
     return taught_scene_of(waypoints) if waypoints.is_file() else None
 
@@ -118,9 +117,6 @@ def build_server(
     simulated AGV there (playback's configuration with `method`, `particles` and `seed`), to
     be served at `host`:`port` (on loopback it answers only to that address's names); the
     finished routes are read from and written to the JSON file `history` (None: in memory)."""
-    from kiseki.sim.scene import load_scene
-    from kiseki.teach.playback import PlaybackConfig
-
     taught = TaughtRun(folder, method)
     scene_file = scene_of(folder, scene)
     finished = RouteHistory(history)  # a file that is not a route history stops here

@@ -9,7 +9,8 @@ serve --history FILE``; by default ``route_history.json`` in the taught folder):
 
 Read at start, checked by its model (a file that is not a route history is an error naming the
 file and the field, never dropped or overwritten), and rewritten whole and atomically after
-every route (:mod:`kiseki._atomic`: the file is the old history or the new one, never half)."""
+every route (:mod:`kiseki._support.atomic`: the file is the old history or the new one, never
+half)."""
 
 from __future__ import annotations
 
@@ -20,8 +21,8 @@ from typing import Annotated, Literal
 
 from pydantic import Field
 
-from kiseki._atomic import atomic_write
-from kiseki._schema import FileModel, NonNegativeFloat, PositiveInt, parse
+from kiseki._support.atomic import atomic_write
+from kiseki._support.schema import FileModel, NonNegativeFloat, PositiveInt, parse
 from kiseki.teach.waypoint_schema import MAX_NAME_LENGTH, MAX_WAYPOINTS
 
 __all__ = ["KIND", "RouteHistory"]

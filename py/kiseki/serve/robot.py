@@ -2,7 +2,7 @@
 # Copyright (c) 2026 the kiseki authors
 """The robot the server drives, behind an interface: :class:`Robot` starts a route of taught
 waypoints, steps (or polls) one control period and stops; :class:`SimulatedAgv` implements it
-with playback (:class:`kiseki.teach.playback.PlaybackRun`) in the scene the route was taught
+with playback (:class:`kiseki.apps.teach.playback.PlaybackRun`) in the scene the route was taught
 in. A real robot's adapter would implement the same four members, with ``pose`` None (no
 ground truth) and ``step`` waiting for the robot's next state."""
 
@@ -13,9 +13,9 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from kiseki.apps.teach.playback import PlaybackConfig, PlaybackRun
 from kiseki.grid import OccupancyGrid
 from kiseki.sim.scene import Scene
-from kiseki.teach.playback import PlaybackConfig, PlaybackRun
 
 __all__ = ["Robot", "RobotState", "SimulatedAgv"]
 

@@ -22,10 +22,10 @@ import threading
 import time
 from dataclasses import dataclass, field
 
+from kiseki.apps.teach.playback import check_route
 from kiseki.serve.history import RouteHistory
 from kiseki.serve.robot import Robot, RobotState
 from kiseki.serve.taught import TaughtRun
-from kiseki.teach.playback import check_route
 
 __all__ = ["Broadcaster", "RouteBusyError", "RouteRefusedError", "RouteRequest", "RouteRunner"]
 

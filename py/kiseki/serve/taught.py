@@ -17,11 +17,12 @@ import numpy as np
 import yaml
 
 from kiseki import _core
-from kiseki._atomic import atomic_write
+from kiseki._support.atomic import atomic_write
+from kiseki.apps.teach.teaching import load_route
 from kiseki.grid import OccupancyGrid
-from kiseki.map_io import load_map, write_image
+from kiseki.io.ros_map import load_map, write_image
+from kiseki.io.runlog import read_run
 from kiseki.teach.local_maps import METHODS
-from kiseki.teach.teaching import load_route
 from kiseki.teach.waypoint_schema import MAX_NAME_LENGTH, read_waypoint_file
 
 __all__ = ["NAME_RULE", "TaughtRun", "WaypointError", "taught_scene"]
@@ -45,8 +46,6 @@ class WaypointError(ValueError):
 def taught_scene(folder: str | os.PathLike) -> str | None:
     """The scene file the run in `folder` was taught in, as its teaching log records it (None
     when the log is missing or records none)."""
-    from kiseki.sim.mcap_log import read_run
-
     doc = read_waypoint_file(Path(folder) / "waypoints.yaml")
     log = Path(folder) / (doc.log or "teach.mcap")
     if not log.is_file():

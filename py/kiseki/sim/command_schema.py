@@ -22,9 +22,9 @@ from typing import Annotated
 import numpy as np
 from pydantic import Field
 
-from kiseki._csv import CsvNumber, data_rows
-from kiseki._inputs import CSV_LIMIT, check_input, read_input_text
-from kiseki._schema import FileModel, parse
+from kiseki._support.csv import CsvNumber, data_rows
+from kiseki._support.inputs import CSV_LIMIT, check_input, read_input_text
+from kiseki._support.schema import FileModel, parse
 
 __all__ = [
     "HEADERS",

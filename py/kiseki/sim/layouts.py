@@ -57,8 +57,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from kiseki._inputs import YAML_LIMIT, read_input_text
-from kiseki._yaml import safe_load_12
+from kiseki._support.inputs import YAML_LIMIT, read_input_text
+from kiseki._support.yaml import safe_load_12
 from kiseki.core import Random, derive_seed
 from kiseki.sim.collisions import FootprintChecker, body_grid
 from kiseki.sim.scene import Scene, load_scene

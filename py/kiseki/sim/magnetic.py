@@ -29,6 +29,9 @@ moments. Frames:
 
 All randomness comes from :class:`kiseki.core.Random`; give each sensor its own stream with
 ``kiseki.derive_seed(seed, k)``.
+
+Why one file over 400 lines: the world's field and the magnetometer that reads it
+share the units, frames and noise model; the dipoles and the lattice already live apart.
 """
 
 from __future__ import annotations
@@ -39,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from kiseki._schema import parse
+from kiseki._support.schema import parse
 from kiseki.core import Random, check_seed, normalize_angle
 from kiseki.sim._values import finite_array as _finite_array
 from kiseki.sim._values import finite_scalar as _finite_scalar

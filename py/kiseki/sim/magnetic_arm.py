@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from kiseki._schema import SchemaError, parse
+from kiseki._support.schema import SchemaError, parse
 from kiseki.core import derive_seed
 from kiseki.sim._values import finite_array as _finite_array
 from kiseki.sim._values import finite_scalar as _finite_scalar

@@ -40,7 +40,7 @@ from pydantic import (
     model_validator,
 )
 
-from kiseki._schema import FileModel, FiniteFloat, NonNegativeFloat, PositiveFloat, Seed
+from kiseki._support.schema import FileModel, FiniteFloat, NonNegativeFloat, PositiveFloat, Seed
 from kiseki.sim.magnetic_lattice import MAX_LATTICE_DIPOLES
 
 __all__ = [
@@ -118,7 +118,7 @@ def _earth_form(value: Any) -> str:
     return "function-angles" if isinstance(value, dict) else "function-vector"
 
 
-# The tags start with "function-" so that kiseki._schema leaves them out of the key path.
+# The tags start with "function-" so that kiseki._support.schema leaves them out of the key path.
 EarthField = Annotated[
     Union[  # noqa: UP007 (tagged members)
         Annotated[Vector, Tag("function-vector")],

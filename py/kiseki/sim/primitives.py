@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from kiseki._schema import parse
+from kiseki._support.schema import parse
 from kiseki.core import Random, rotation_zyx
 from kiseki.sim.primitives_schema import (
     Beam,

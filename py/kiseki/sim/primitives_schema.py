@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """The models of a scene file's ``objects:`` entries (one per primitive type: wall, partition,
-box, workbench, shelf, slope, rubble, beam, pillar), checked by :mod:`kiseki._schema`.
+box, workbench, shelf, slope, rubble, beam, pillar), checked by :mod:`kiseki._support.schema`.
 
 Lengths in metres, angles in degrees. Every entry has a ``type``, may carry an ``id`` (a label)
 and ``only_in: teach | playback``. :attr:`box_count` says how many boxes an entry expands to
@@ -14,7 +14,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import Field, PlainValidator, RootModel, model_validator
 
-from kiseki._schema import FileModel, FiniteFloat, NonNegativeFloat, PositiveFloat, Seed
+from kiseki._support.schema import FileModel, FiniteFloat, NonNegativeFloat, PositiveFloat, Seed
 
 __all__ = [
     "MAX_RUBBLE_PIECES",

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from kiseki.sim.mcap_log import RunWriter
+from kiseki.io.runlog import RunWriter
 from kiseki.sim.pedestrians import DiscStamp
 from kiseki.sim.pose6 import resting_pose
 from kiseki.sim.scene import Scene

@@ -12,7 +12,7 @@ import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.colors import ListedColormap
 
-from kiseki._atomic import atomic_write
+from kiseki._support.atomic import atomic_write
 from kiseki.plots import new_figure
 from kiseki.sim.scene import Scene
 
@@ -160,7 +160,7 @@ def _scan_points(message: dict) -> np.ndarray:
 def render_run(
     scene: Scene, run, path: str | os.PathLike, scan_topic: str = "/scan", frames: int = 40
 ) -> Path:
-    """An animation of a recorded run (kiseki.sim.mcap_log.SimRun): every robot's ground truth
+    """An animation of a recorded run (kiseki.io.runlog.SimRun): every robot's ground truth
     and odometry, and the laser scan, over the scene. GIF via Pillow."""
     topics = run.topics()
     prefixes = sorted(t[: -len("/ground_truth")] for t in topics if t.endswith("/ground_truth"))

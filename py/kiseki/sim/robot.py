@@ -44,6 +44,9 @@ closed-form prediction is y mean -0.21 m / SD 0.22 m at 13 m and -0.08 m / 0.11 
 
 Every random number comes from :class:`kiseki.core.Random`; pass ``derive_seed(seed, k)`` to
 give each robot's odometry its own stream.
+
+Why one file over 400 lines: the two platforms share the odometry error model, the
+command limits and the stepping rules; they are one concept (a simulated robot's motion).
 """
 
 from __future__ import annotations
@@ -58,7 +61,7 @@ from typing import Annotated, Any, TypeVar
 from pydantic import ConfigDict, Field, RootModel
 from pydantic.dataclasses import dataclass as pydantic_dataclass
 
-from kiseki._schema import (
+from kiseki._support.schema import (
     FiniteFloat,
     NonNegativeFloat,
     PositiveFloat,
@@ -87,7 +90,7 @@ PoseLike = Pose2 | Sequence[float]
 # --------------------------------------------------------------------------------------------
 
 # The parameter classes are pydantic dataclasses: still frozen dataclasses (dataclasses.fields,
-# replace and asdict work), checked on construction by pydantic with kiseki._schema's strict
+# replace and asdict work), checked on construction by pydantic with kiseki._support.schema's strict
 # number types (an int is a float, a float is not an int, a bool is not a number, NaN and
 # infinities are errors). A relative error e gives a physical value nominal * (1 + e), so it
 # must lie in (-1, 1) for the value to stay positive.
@@ -115,8 +118,8 @@ class _Params:
 
         Missing keys keep their documented defaults. Unknown keys, non-numeric values, NaN or
         infinite values and values out of range (sizes and limits must be > 0) raise
-        :class:`kiseki._schema.SchemaError` (a ValueError) naming ``source`` (e.g. the config
-        file), the key (after the path ``at`` of the section in its file) and the value.
+        :class:`kiseki._support.schema.SchemaError` (a ValueError) naming ``source`` (e.g. the
+        config file), the key (after the path ``at`` of the section in its file) and the value.
         """
         return parse(_document(cls), d, source, at=at).root
 

@@ -21,9 +21,9 @@ from tqdm import tqdm
 
 from kiseki.control import PurePursuit
 from kiseki.core import check_seed
+from kiseki.io.runlog import TWIST_SCHEMA, TWIST_SCHEMA_NAME, RunWriter, read_run
 from kiseki.sim.collisions import COLLISION_SCHEMA, Collision, CollisionCheck
 from kiseki.sim.command_schema import MAX_COMMAND_SECONDS, read_command_rows
-from kiseki.sim.mcap_log import TWIST_SCHEMA, TWIST_SCHEMA_NAME, RunWriter, read_run
 from kiseki.sim.pedestrians import PEDESTRIANS_SCHEMA
 from kiseki.sim.recorder import Recorder, planar_pose
 from kiseki.sim.scene import Scene

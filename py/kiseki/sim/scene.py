@@ -39,9 +39,9 @@ import numpy as np
 import yaml
 
 from kiseki import _core
-from kiseki._inputs import MIB, YAML_LIMIT, check_input, read_input_text
-from kiseki._schema import SchemaError, parse
-from kiseki._yaml import safe_load_12
+from kiseki._support.inputs import MIB, YAML_LIMIT, check_input, read_input_text
+from kiseki._support.schema import SchemaError, parse
+from kiseki._support.yaml import safe_load_12
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
 from kiseki.sim.magnetic_schema import MagneticSection
@@ -124,7 +124,7 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
     """Reads a scene file. ``variant`` selects objects marked ``only_in`` (a bicycle park that
     changes between teaching and playback), and magnetic sources so marked (``Scene.variant``:
     build the field with ``MagneticWorld.from_dict(scene.magnetic, variant=scene.variant)``).
-    A :class:`~kiseki._schema.SchemaError` (a ValueError) names the file, the field and the
+    A :class:`~kiseki._support.schema.SchemaError` (a ValueError) names the file, the field and the
     value of what does not match."""
     path = Path(path)
     if variant not in VARIANTS:

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """The model of a scene file's top level (see :mod:`kiseki.sim.scene` for what each key means),
-checked by :mod:`kiseki._schema`: name, description, source, bounds, floor, octomap, objects
+checked by :mod:`kiseki._support.schema`: name, description, source, bounds, floor, octomap, objects
 (:mod:`kiseki.sim.primitives_schema`), grid_resolution, measurement_grid, robots (their name
 and the sections kiseki.sim.setup and kiseki.sim.robot read), turns, poses, pedestrians and
 point_robots, and ``route`` (:class:`Route`, ``route: {}`` is none). ``robot``, ``sensors`` and
@@ -24,7 +24,7 @@ from typing import Annotated, Any
 from pydantic import BeforeValidator, Field, field_validator, model_validator
 from pydantic_core import PydanticCustomError, ValidationError
 
-from kiseki._schema import FileModel, FiniteFloat, NonNegativeFloat, PositiveFloat
+from kiseki._support.schema import FileModel, FiniteFloat, NonNegativeFloat, PositiveFloat
 from kiseki.mapping import check_map_size
 from kiseki.sim.magnetic_survey import MeasurementGrid
 from kiseki.sim.primitives_schema import Object

@@ -16,7 +16,7 @@ import numpy as np
 from pydantic import ConfigDict, Field, model_validator
 from pydantic.dataclasses import dataclass as pydantic_dataclass
 
-from kiseki._schema import NonNegativeFloat, PositiveFloat
+from kiseki._support.schema import NonNegativeFloat, PositiveFloat
 from kiseki.core import Random, check_seed
 from kiseki.grid import OccupancyGrid, beam_angles
 from kiseki.sim.pose6 import pose_matrix
@@ -43,8 +43,9 @@ MAX_IMAGE_SIDE = 4096
 MAX_RANGE = 1000.0
 """Metres a range sensor's ray is cast."""
 
-# The parameter classes are pydantic dataclasses (kiseki._schema's strict number types): checked
-# on construction, on dataclasses.replace and as a section of a scene file (kiseki.sim.setup).
+# The parameter classes are pydantic dataclasses (kiseki._support.schema's strict number types):
+# checked on construction, on dataclasses.replace and as a section of a scene file
+# (kiseki.sim.setup).
 _params = pydantic_dataclass(frozen=True, config=ConfigDict(extra="forbid"))
 Range = Annotated[float, Field(strict=True, gt=0, le=MAX_RANGE, allow_inf_nan=False)]
 Probability = Annotated[float, Field(strict=True, ge=0, lt=1, allow_inf_nan=False)]

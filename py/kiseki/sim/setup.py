@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from kiseki._schema import SchemaError, location_text, parse
+from kiseki._support.schema import SchemaError, location_text, parse
 from kiseki.core import check_seed, derive_seed
 from kiseki.sim import robot as robots
 from kiseki.sim.collisions import check_free_start

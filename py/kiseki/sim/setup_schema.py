@@ -2,7 +2,7 @@
 # Copyright (c) 2026 the kiseki authors
 """The models of a scene file's robots and sensors: the ``robot`` mapping and each entry of the
 ``sensors`` list (or, with several robots, the same keys of each entry of ``robots``). Checked
-by kiseki.sim.setup with kiseki._schema.parse before the robots and sensors are built, so an
+by kiseki.sim.setup with kiseki._support.schema.parse before the robots and sensors are built, so an
 error names the file, the path (``robots[1].sensors[0].rate_hz``) and the value.
 
 A robot: ``type`` (diff_drive, the default, or omni), ``start`` [x, y, yaw_deg], ``params`` and
@@ -39,7 +39,7 @@ from pydantic import (
 )
 from pydantic_core import PydanticCustomError
 
-from kiseki._schema import FileModel, FiniteFloat
+from kiseki._support.schema import FileModel, FiniteFloat
 from kiseki.sim.robot import (
     DiffDriveParams,
     OdometryErrorParams,

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from kiseki import _core
-from kiseki._inputs import check_input
+from kiseki._support.inputs import check_input
 from kiseki.core import check_seed
 from kiseki.sim.pose6 import Pose6, resting_pose
 from kiseki.sim.scene import MAX_OCTOMAP_BYTES, load_scene

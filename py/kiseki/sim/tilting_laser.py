@@ -48,7 +48,7 @@ import numpy as np
 from pydantic import ConfigDict, Field, model_validator
 from pydantic.dataclasses import dataclass as pydantic_dataclass
 
-from kiseki._schema import FiniteFloat, NonNegativeFloat, PositiveFloat
+from kiseki._support.schema import FiniteFloat, NonNegativeFloat, PositiveFloat
 from kiseki.core import Random, check_seed, derive_seed
 from kiseki.sim.gyro import Gyro
 from kiseki.sim.pose6 import attitude

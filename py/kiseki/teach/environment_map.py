@@ -12,7 +12,7 @@
   so the space observation model reads either map alike.
 
 `build_teaching_map` builds M from scans at known poses (recorded logs); teaching builds it
-from depth images placed by odometry (`kiseki.teach.teaching`).
+from depth images placed by odometry (`kiseki.apps.teach.teaching`).
 """
 
 from __future__ import annotations

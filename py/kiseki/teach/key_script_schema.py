@@ -22,8 +22,8 @@ from typing import Annotated, Any
 
 from pydantic import BeforeValidator, Field, field_validator
 
-from kiseki._inputs import MIB, check_input, read_input_text
-from kiseki._schema import FileModel, parse
+from kiseki._support.inputs import MIB, check_input, read_input_text
+from kiseki._support.schema import FileModel, parse
 
 __all__ = [
     "KEYS",

@@ -10,11 +10,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, Protocol
 
 import numpy as np
 
 from kiseki import _core
-from kiseki.sim.sensors import DepthCamera
 
 __all__ = ["BANDS", "METHODS", "LocalMapMaker"]
 
@@ -26,6 +26,19 @@ METHODS = {
     "proposal2": ("band", False),
     "both": ("band", True),
 }
+
+
+class DepthCamera(Protocol):
+    """What a local map needs of a depth camera (the simulator's ``DepthCamera`` or a real
+    one): its image size (``params.width``, ``params.height``), its optical frame in the robot
+    frame and the projection arguments of the C++ builder. The method takes the camera, it
+    does not import the simulator."""
+
+    params: Any
+
+    def optical_pose(self, robot_pose: Any) -> np.ndarray: ...
+
+    def camera_args(self) -> tuple: ...
 
 
 @dataclass

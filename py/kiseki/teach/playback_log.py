@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from kiseki.control import SpeedLimit
-from kiseki.sim.mcap_log import TWIST_SCHEMA, TWIST_SCHEMA_NAME, RunWriter
+from kiseki.io.runlog import TWIST_SCHEMA, TWIST_SCHEMA_NAME, RunWriter
 
 __all__ = ["SPEED_LIMIT_SCHEMA", "PlaybackLog"]
 

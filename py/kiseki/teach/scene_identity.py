@@ -20,7 +20,9 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from kiseki._inputs import YAML_LIMIT, read_input
+from kiseki._support.inputs import YAML_LIMIT, read_input
+from kiseki.io.runlog import read_run
+from kiseki.teach.waypoint_schema import read_waypoint_file
 
 __all__ = [
     "TaughtScene",
@@ -80,10 +82,10 @@ class TaughtScene:
 
 
 def taught_scene_of(waypoints: str | os.PathLike) -> TaughtScene | None:
-    """The taught scene recorded in a waypoint file (one :func:`kiseki.teach.teaching.load_route`
+    """The taught scene recorded in a waypoint file (one
+    :func:`kiseki.apps.teach.teaching.load_route`
     accepted), else in the metadata of the teaching log it names (waypoint files written before
     the scene was recorded in them); None when neither records it (a hand-made file)."""
-    from kiseki.teach.waypoint_schema import read_waypoint_file
 
     doc = read_waypoint_file(waypoints)
     folder = str(Path(waypoints).parent)
@@ -91,7 +93,6 @@ def taught_scene_of(waypoints: str | os.PathLike) -> TaughtScene | None:
         return TaughtScene(doc.scene_file or "", doc.scene_sha1, folder)
     if not doc.log or not (log := Path(waypoints).parent / doc.log).is_file():
         return None
-    from kiseki.sim.mcap_log import read_run
 
     try:
         meta = read_run(log).metadata

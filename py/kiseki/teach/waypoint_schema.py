@@ -25,9 +25,9 @@ from typing import Annotated, Any
 
 from pydantic import AfterValidator, Field, field_validator, model_validator
 
-from kiseki._inputs import check_input
-from kiseki._schema import INT32_MAX, FileModel, FiniteFloat, SchemaError, parse
-from kiseki._yaml import read_yaml_file
+from kiseki._support.inputs import check_input
+from kiseki._support.schema import INT32_MAX, FileModel, FiniteFloat, SchemaError, parse
+from kiseki._support.yaml import read_yaml_file
 
 __all__ = [
     "MAX_BANDS",
@@ -151,7 +151,7 @@ def _with_names(err: SchemaError, doc: dict, path: Path) -> SchemaError:
 
 def read_waypoint_file(path: str | os.PathLike) -> WaypointFile:
     """The checked waypoint file at `path`: FileNotFoundError when there is none, ValueError
-    (a :class:`~kiseki._schema.SchemaError` for a field) naming the file otherwise."""
+    (a :class:`~kiseki._support.schema.SchemaError` for a field) naming the file otherwise."""
     path = Path(path)
     check_input(path)
     if not path.is_file():

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kiseki._atomic import atomic_write
+from kiseki._support.atomic import atomic_write
 from kiseki.terrain.cloud_planes import Cloud, CloudPlanes
 
 __all__ = ["PLANES_COLUMNS", "planes_summary", "render_cloud_planes", "write_planes_csv"]
@@ -56,10 +56,11 @@ def planes_summary(cloud: Cloud, result: CloudPlanes) -> list[str]:
 def render_cloud_planes(
     cloud: Cloud, result: CloudPlanes, path: str | os.PathLike, seed: int = 0
 ) -> None:
+    # here, not at the top: matplotlib takes a second to load, and only drawing needs it
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # after the backend is chosen, as above
 
     pts, label = cloud.points, result.label
     if len(pts) > DRAWN:

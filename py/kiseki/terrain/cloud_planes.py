@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from kiseki import _core
-from kiseki._inputs import GIB, MIB, check_input, describe_bytes, read_input
+from kiseki._support.inputs import GIB, MIB, check_input, describe_bytes, read_input
 from kiseki.core import check_seed
 from kiseki.terrain.plane_removal import HoughParams, PclParams, remove_planes
 from kiseki.terrain.sdem import sdem_from_points, sphere_grid
@@ -121,7 +121,7 @@ def _is_pcd(path: Path) -> bool:
 
 
 class _CloudError(ValueError):
-    """A text cloud's read refused by :func:`kiseki._inputs.read_input`."""
+    """A text cloud's read refused by :func:`kiseki._support.inputs.read_input`."""
 
 
 def _check_pcd_size(path: Path) -> None:
@@ -236,7 +236,7 @@ def _pcl(points: np.ndarray, params: PclParams, seed: int, max_points: int) -> C
     if subset is None:
         label = sub_label
     else:
-        from scipy.spatial import cKDTree
+        from scipy.spatial import cKDTree  # here: scipy is slow to load, and rarely needed
 
         _, nearest = cKDTree(fit).query(points, k=1)
         label = sub_label[nearest]

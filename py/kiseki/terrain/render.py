@@ -9,17 +9,18 @@ import os
 
 import numpy as np
 
-from kiseki._atomic import atomic_write
+from kiseki._support.atomic import atomic_write
 
 __all__ = ["render_run"]
 
 
 def render_run(table: np.ndarray, global_map, path: str | os.PathLike, title: str = "") -> None:
     """table: rows (move, x_true, y_true, z_true, x_est, y_est, z_est)."""
+    # here, not at the top: matplotlib takes a second to load, and only drawing needs it
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # after the backend is chosen, as above
 
     centres = global_map.occupied_centres()
     fig, ax = plt.subplots(figsize=(7, 6), dpi=120)

@@ -22,7 +22,7 @@ from typing import Annotated, Any
 import yaml
 from pydantic import Field, create_model
 
-from kiseki._schema import (
+from kiseki._support.schema import (
     FileModel,
     FiniteFloat,
     NonNegativeFloat,
@@ -31,7 +31,7 @@ from kiseki._schema import (
     Seed,
     parse,
 )
-from kiseki._yaml import safe_load_12
+from kiseki._support.yaml import safe_load_12
 
 __all__ = [
     "LIST_LIMIT",
@@ -65,7 +65,7 @@ __all__ = [
 ]
 
 PARTICLE_LIMIT = 10_000_000
-"""The most particles an experiment's filter may take (as ``kiseki.localization.MclConfig``)."""
+"""The most particles an experiment's filter may take (as ``kiseki.filters.MclConfig``)."""
 RUN_LIMIT = 100_000
 """The most runs (repetitions of a setting) an experiment's config may ask for."""
 LIST_LIMIT = 10_000

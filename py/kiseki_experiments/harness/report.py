@@ -18,9 +18,9 @@ from typing import Any
 import pandas as pd
 from rich.console import Console
 
-from kiseki._atomic import atomic_write, atomic_write_all, reworded
-from kiseki._inputs import CSV_LIMIT, YAML_LIMIT, check_input, read_input_text
-from kiseki._table import show
+from kiseki._support.atomic import atomic_write, atomic_write_all, reworded
+from kiseki._support.inputs import CSV_LIMIT, YAML_LIMIT, check_input, read_input_text
+from kiseki._support.table import show
 from kiseki_experiments.harness.base import CLAIM_COLUMNS, Analysis, Claim, Experiment
 from kiseki_experiments.harness.registry import all_experiments
 

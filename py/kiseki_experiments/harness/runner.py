@@ -23,9 +23,9 @@ import yaml
 from pydantic import Field, RootModel
 from tqdm import tqdm
 
-from kiseki._atomic import atomic_write, check_writable_folder
-from kiseki._schema import FileModel, SchemaError, Seed, parse
-from kiseki._yaml import read_yaml_file
+from kiseki._support.atomic import atomic_write, check_writable_folder
+from kiseki._support.schema import FileModel, SchemaError, Seed, parse
+from kiseki._support.yaml import read_yaml_file
 from kiseki.core import check_seed, derive_seed
 from kiseki.errors import KisekiError
 from kiseki_experiments.harness.config import (

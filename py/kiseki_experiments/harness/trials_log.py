@@ -13,7 +13,7 @@ from typing import Any
 
 import pandas as pd
 
-from kiseki._atomic import reworded
+from kiseki._support.atomic import reworded
 
 __all__ = ["TrialLog"]
 

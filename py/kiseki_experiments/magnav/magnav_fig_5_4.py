@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from kiseki._inputs import YAML_LIMIT, read_input_text
+from kiseki._support.inputs import YAML_LIMIT, read_input_text
 from kiseki.magnetic.lidar_mcl import LidarMclConfig
 from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import Count, NonNegativeReal, Particles, PositiveReal, Seed

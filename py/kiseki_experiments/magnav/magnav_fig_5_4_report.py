@@ -149,7 +149,7 @@ def figures(ok: pd.DataFrame, out: Path) -> list[Path]:
 
 NOTES = """
 Scene: data/worlds/magnetic_lidar_path.yaml (its header states the geometry, the pipes and the
-odometry; tests/python/test_sim_magnetic_lidar_path.py measures them). The laser is 180 deg /
+odometry; tests/python/sim/test_sim_magnetic_lidar_path.py measures them). The laser is 180 deg /
 30 m as in sec. 5.3; the odometry is magnetic_path.yaml's outdoor robot, the same for every
 method. The magnetic map is the taught route's linear map (0.1 m nodes) looked up by position
 (kiseki.magnetic.lidar_mcl: the thesis' 2-D grid holds values only along the taught path, sec.

@@ -10,7 +10,7 @@ day later, with the geometric conditions changed").
 Each trial (one seed): one teaching run (the route driven on the true pose; the linear map from
 its odometry, magnetometer and laser, :func:`kiseki.magnetic.linear_map_from_run`), then one
 playback per method with the same playback seed (the same odometry errors and sensor noise),
-by :func:`kiseki.magnetic.navigate_run.navigate` with its defaults: the odometry navigator on
+by :func:`kiseki.apps.magnetic.navigate_run.navigate` with its defaults: the odometry navigator on
 the odometry's travel distance, the others on the travel-distance filter with the azimuth
 heading reset (sec. 4.4). The navigators' gates are the thesis' (r_z >= 0.998,
 |g_n - g_t| <= 1.0 m) and the scene is the issue's: neither is tuned here.
@@ -29,8 +29,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from kiseki._inputs import YAML_LIMIT, read_input_text
-from kiseki._yaml import safe_load_12
+from kiseki._support.inputs import YAML_LIMIT, read_input_text
+from kiseki._support.yaml import safe_load_12
 from kiseki.core import derive_seed
 from kiseki.magnetic.navigators import NAVIGATORS, RZ_MIN
 from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
@@ -94,9 +94,9 @@ def closed_form_validity(counts, noise_sd: float, gate: float = 1.0 - RZ_MIN) ->
 
 
 def _teach(scene_path: Path, waypoints: np.ndarray, seed: int, folder: Path):
+    from kiseki.apps.magnetic.navigate_run import TaughtMaps
     from kiseki.magnetic.linear_map import path_identity
     from kiseki.magnetic.linear_map_run import linear_map_from_run
-    from kiseki.magnetic.navigate_run import TaughtMaps
     from kiseki.sim.run import SimConfig, simulate
     from kiseki.sim.scene import load_scene
 
@@ -114,7 +114,7 @@ def _validity(config, maps, result) -> dict:
     cols = {n: p[:, list(result.navigators).index(n)] > 0 for n in result.navigators}
     lmap = maps.center
     mz = lmap.field[:, 2]
-    from kiseki.magnetic.navigate_run import cross_track
+    from kiseki.apps.magnetic.navigate_run import cross_track
 
     _, node_along = cross_track(maps.waypoints, lmap.position)  # the nodes' true places
     order = np.argsort(node_along, kind="stable")
@@ -157,7 +157,7 @@ def _noise_sd(config: NavigatorsConfig) -> float:
 
 
 def trial(config: NavigatorsConfig, index: int, seed: int) -> TrialOutput:
-    from kiseki.magnetic.navigate_run import navigate
+    from kiseki.apps.magnetic.navigate_run import navigate
 
     record: dict = {}
     with tempfile.TemporaryDirectory(prefix="magnav-nav-") as tmp:

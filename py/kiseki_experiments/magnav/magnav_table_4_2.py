@@ -39,10 +39,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from kiseki.apps.magnetic.navigate_run import cross_track
 from kiseki.core import derive_seed
 from kiseki.magnetic.linear_map import build_linear_map, path_identity
 from kiseki.magnetic.linear_map_run import teaching_samples
-from kiseki.magnetic.navigate_run import cross_track
 from kiseki.magnetic.travel_distance import TravelDistanceConfig, TravelDistanceLocalizer
 from kiseki.sim.magnetic import MagneticWorld
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput

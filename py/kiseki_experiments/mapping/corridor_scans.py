@@ -16,7 +16,7 @@ import pandas as pd
 
 from kiseki.core import Random
 from kiseki.grid import beam_angles
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
 from kiseki.mapping import build_map, endpoint_agreement
 from kiseki.plots import new_figure
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput

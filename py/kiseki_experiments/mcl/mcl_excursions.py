@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kiseki.localization import (
+from kiseki.filters import (
     RECOVERY_MODES,
     LocalizeConfig,
     MclConfig,

@@ -34,7 +34,7 @@ import numpy as np
 import pandas as pd
 
 from kiseki.core import Pose2, derive_seed
-from kiseki.localization import RECOVERY_MODES, LocalizeConfig, localize
+from kiseki.filters import RECOVERY_MODES, LocalizeConfig, localize
 from kiseki.plots import new_figure
 from kiseki.scans import LaserScans
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
@@ -198,7 +198,7 @@ def trial_sim(config: KidnapConfig, index: int, seed: int) -> TrialOutput:
     import copy
     import tempfile
 
-    from kiseki.sim.mcap_log import read_run
+    from kiseki.io.runlog import read_run
     from kiseki.sim.run import SimConfig, simulate
     from kiseki.sim.scene import load_scene
 

@@ -3,7 +3,7 @@
 """mcl-kld: KLD sampling from global localization to tracking, against fixed particle counts.
 
 Global localization along a CARMEN log (odometry rebuilt from the corrected poses with noise
-F = 0.1, the likelihood field on the 0.05 m log-odds map, kiseki.global_localization's settings:
+F = 0.1, the likelihood field on the 0.05 m log-odds map, kiseki.filters's settings:
 a uniform start, AMCL's update gate, the tempered likelihood until the cloud converges), three
 ways: KLD sampling (Fox 2003, nav2's pf_err 0.05 and pf_z 0.99) between ``min_particles`` and
 ``max_particles``; a fixed ``max_particles`` all along; and the fixed rule kiseki used before
@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kiseki.localization import noisy_odometry
+from kiseki.filters import noisy_odometry
 from kiseki.metrics import ape
 from kiseki.plots import new_figure
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
@@ -52,7 +52,7 @@ def preflight(config: KldConfig) -> None:
 
 def trial(config: KldConfig, index: int, seed: int) -> TrialOutput:
     from kiseki.datasets import read_carmen_log
-    from kiseki.global_localization import GlobalConfig, global_localize
+    from kiseki.filters import GlobalConfig, global_localize
     from kiseki.mapping import MapBuildConfig, map_of_log
 
     name = config.logs[index % len(config.logs)]

@@ -29,7 +29,7 @@ import numpy as np
 
 from kiseki.control import FuzzyPotentialMethod
 from kiseki.grid import OccupancyGrid
-from kiseki.sim.mcap_log import read_run
+from kiseki.io.runlog import read_run
 from kiseki.sim.run import SimConfig, simulate
 from kiseki.sim.scene import Scene, load_scene
 from kiseki.speed import (

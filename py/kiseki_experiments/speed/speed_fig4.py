@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kiseki._yaml import safe_load_12
+from kiseki._support.yaml import safe_load_12
 from kiseki.plots import draw_map, new_figure
 from kiseki.sim.scene import load_scene
 from kiseki.sim.sensors import LASER_PRESETS, Laser2D, Mount

@@ -43,7 +43,7 @@ from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOu
 from kiseki_experiments.harness.config import Boxes, Particles, Runs
 from kiseki_experiments.teach import teach_playback as tp
 
-REFUSED = "crosses occupied space"  # kiseki.teach.playback.check_route's refusal
+REFUSED = "crosses occupied space"  # kiseki.apps.teach.playback.check_route's refusal
 GENERAL = 0.8  # a claim generalises when it holds in at least this share of layouts
 SHADES = ListedColormap(["white", "#a0a0a0", "black"])
 # the layout parameters in the report's per-layout table (all of them are in trials.parquet)

@@ -12,7 +12,7 @@ and measure
   is the reference);
 - the space observation model's tracking error along the log on that map (position and
   heading RMSE against the corrected poses, odometry noise 0.1, the filter's motion noise
-  matched to it: `kiseki.localization`).
+  matched to it: `kiseki.filters`).
 Trial i is log i, both rules (the maps are deterministic; the trial's seed drives the odometry
 noise and the filter, the same for both rules).
 """
@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from kiseki.datasets import read_carmen_log
-from kiseki.localization import LocalizeConfig, localize
+from kiseki.filters import LocalizeConfig, localize
 from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
 from kiseki.metrics import ape
 from kiseki.plots import new_figure

@@ -30,15 +30,15 @@ import pandas as pd
 import yaml
 from matplotlib.patches import Circle
 
-from kiseki._inputs import YAML_LIMIT, read_input_text
-from kiseki._yaml import safe_load_12
+from kiseki._support.inputs import YAML_LIMIT, read_input_text
+from kiseki._support.yaml import safe_load_12
+from kiseki.apps.teach import PlaybackConfig, playback, teach
 from kiseki.core import Random, derive_seed
-from kiseki.map_io import load_map
+from kiseki.io.ros_map import load_map
 from kiseki.models import SpaceObservationModel
 from kiseki.plots import new_figure
 from kiseki.sim.scene import load_scene
 from kiseki.sim.setup import build_robot, build_sensors
-from kiseki.teach import PlaybackConfig, playback, teach
 from kiseki.teach.environment_map import MERGE_RULES
 from kiseki.teach.local_maps import METHODS, LocalMapMaker
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput

@@ -1,0 +1,371 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Playback (thesis sec. 3.5): the robot follows the taught waypoints on the particle filter's
+estimate and stops when the estimate is within 0.1 m of the goal; it then decelerates at its
+acceleration limit (the filter still running) and its stop pose is where it comes to rest. The
+filter (kiseki's Monte Carlo engine, :mod:`kiseki.filters`) predicts from odometry and
+weighs particles with the space observation model on the chosen method's local map.
+
+A speed limiter (any :class:`~kiseki.control.SpeedLimitSource`; playback never imports the
+limiter's area) caps the follower's speed at every control step: the scene's first laser scans
+the world at the true pose, and the limiter gets that scan with the laser pose the robot knows,
+the one of its estimate in the taught map. With ``log`` the run is written to MCAP as it goes
+(:mod:`kiseki.teach.playback_log`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import math
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from kiseki import _core
+from kiseki.control import PurePursuit, SpeedLimit, SpeedLimitSource
+from kiseki.core import derive_seed
+from kiseki.filters import MclConfig, MonteCarloLocalizer
+from kiseki.grid import OccupancyGrid
+from kiseki.sim.scene import Scene
+from kiseki.sim.setup import SensorSetup, build_robot, build_sensors
+from kiseki.teach.local_maps import METHODS, LocalMapMaker
+from kiseki.teach.playback_log import PlaybackLog
+from kiseki.teach.scene_identity import TaughtScene, check_scene
+
+__all__ = ["PlaybackConfig", "PlaybackResult", "PlaybackRun", "check_route", "playback"]
+
+
+def check_route(environment: OccupancyGrid, waypoints: list[dict]) -> None:
+    """Raises ValueError when a straight leg between consecutive waypoints crosses occupied
+    cells of the taught map (the robot follows the legs, so such a route is unreachable)."""
+    for a, b in zip(waypoints, waypoints[1:], strict=False):
+        length = math.hypot(b["x"] - a["x"], b["y"] - a["y"])
+        if length == 0:
+            continue
+        heading = math.atan2(b["y"] - a["y"], b["x"] - a["x"])
+        rng, hit, cell = environment.cast_ray(a["x"], a["y"], heading, max_range=length)
+        if hit and rng < length - environment.resolution:
+            x, y = environment.cell_to_world(np.array([cell], dtype=float))[0]
+            raise ValueError(
+                f"the route leg {a['name']} -> {b['name']} crosses occupied space "
+                f"at ({x:.2f}, {y:.2f}) m of the taught map"
+            )
+
+
+@dataclass(frozen=True)
+class PlaybackConfig:
+    method: str = "proposal2"
+    particles: int = 1000
+    seed: int = 0
+    dt: float = 0.1  # s, 10 Hz as in the thesis
+    speed: float = 0.5  # m/s
+    goal_tolerance: float = 0.1  # m, the thesis' stop rule
+    initial_sd: tuple[float, float, float] = (0.05, 0.05, math.radians(1.0))
+    # Odometry motion model noise (Probabilistic Robotics Table 5.6), the same for every method,
+    # set so that its 1-sigma spread covers the simulated AGV's odometry error (sim.robot's
+    # OdometryErrorParams) at 10 Hz and 0.5 m/s (0.05 m, up to about 0.05 rad per step):
+    #   alpha1 (rot -> rot): track width +0.5 % over a 90 deg turn of about 30 steps needs
+    #     0.005^2 * 30 = 7.5e-4, turning slip 5e-5 rad/rad adds 5e-5 / 0.05 = 1e-3 -> 0.002;
+    #   alpha2 (trans -> rot, rad^2/m^2): the 0.1 % wheel-radius difference over the 0.5 m track
+    #     turns 0.002 rad/m, over a 10 m leg of 200 steps (0.002 * 10)^2 / 200 / 0.05^2 = 8e-4;
+    #     wheel slip 4e-6 m/m per wheel adds 2 * 4e-6 / 0.5^2 / 0.05 = 6.4e-4 -> 0.002;
+    #   alpha3 (trans -> trans): mean wheel radius -0.1 % over 200 steps 0.001^2 * 200 = 2e-4,
+    #     slip 2e-6 / 0.05 = 4e-5 -> 5e-4;
+    #   alpha4 (rot -> trans, m^2/rad^2): no modelled source; a floor of 5e-4.
+    # (Each sum rounded up to 1, 2 or 5 times a power of ten.)
+    alphas: tuple[float, float, float, float] = (0.002, 0.002, 0.0005, 0.0005)
+    max_duration: float = 300.0
+
+    def __post_init__(self) -> None:
+        if self.method not in METHODS:
+            raise ValueError(f"method must be one of {', '.join(METHODS)}, got {self.method!r}")
+        if not (isinstance(self.particles, int) and 1 <= self.particles <= 10_000_000):
+            raise ValueError(
+                f"particles must be an integer in 1..10,000,000, got {self.particles!r}"
+            )
+        if not self.dt > 0 or not self.goal_tolerance > 0:
+            raise ValueError("dt > 0 and goal_tolerance > 0 are needed")
+
+
+@dataclass
+class PlaybackResult:
+    reached: bool
+    steps: int
+    stop_true: tuple[float, float, float]
+    stop_estimate: tuple[float, float, float]
+    stop_odometry: tuple[float, float, float]
+    passes: dict = field(default_factory=dict)  # waypoint -> true / estimate / odometry poses
+    truth: np.ndarray | None = None
+    estimates: np.ndarray | None = None
+    times: np.ndarray | None = None  # s, of each step (truth[k] and estimates[k] at times[k])
+    speed_limits: np.ndarray | None = None  # m/s the limiter allowed at each step, if any
+    scene_identity: dict = field(default_factory=dict)  # scene_sha1, taught_scene_sha1, variant
+
+    @property
+    def duration(self) -> float:
+        """Seconds from the start to the last step (the stop at rest)."""
+        return float(self.times[-1]) if self.times is not None and len(self.times) else 0.0
+
+
+def _pose(p) -> tuple[float, float, float]:
+    return (float(p.x), float(p.y), float(p.theta))
+
+
+def playback(
+    scene: Scene,
+    environment: OccupancyGrid,
+    waypoints: list[dict],
+    config: PlaybackConfig | None = None,
+    speed_limiter: SpeedLimitSource | None = None,
+    log: str | os.PathLike | None = None,
+    taught_scene: TaughtScene | None = None,
+    variant: str | None = None,
+) -> PlaybackResult:
+    """Runs the route through `waypoints` (taught marks, map frame) in the scene; the follower's
+    speed is capped by `speed_limiter` when given (the scene needs a laser), and the run is
+    written to the MCAP file `log` (which must not exist) when given. A loop over
+    :class:`PlaybackRun`'s steps, for at most ``config.max_duration``.
+
+    `taught_scene` (a :class:`TeachResult`'s ``scene``) is the scene the route was taught in: a
+    scene file whose bytes differ is refused (ValueError) unless `variant` labels the change;
+    the scene's and the taught scene's SHA-1s and the label go into the log's metadata and the
+    result's ``scene_identity``."""
+    config = config or PlaybackConfig()
+    identity = check_scene(taught_scene, scene.path, variant)
+    run = PlaybackRun(scene, environment, waypoints, config, speed_limiter)
+    meta = {
+        **identity,
+        "scene_file": str(scene.path),
+        "route": ",".join(str(w["name"]) for w in waypoints),
+        "method": config.method,
+        "seed": str(config.seed),
+        "dt": str(config.dt),
+        "speed_limiter": type(speed_limiter).__name__ if speed_limiter is not None else "none",
+    }
+    with PlaybackLog(log, meta) if log is not None else contextlib.nullcontext() as writer:
+        run.writer = writer
+        for _ in range(int(config.max_duration / config.dt)):
+            if not run.step():
+                break
+    result = run.result()
+    result.scene_identity = identity
+    return result
+
+
+class PlaybackRun:
+    """One playback in steps of one control period, for a driver that cannot wait for the whole
+    route (a server streaming the run, a stop button). Created with :func:`playback`'s
+    arguments: the simulated robot is placed where the start was taught (its ``truth``) and the
+    filter starts around the start's taught pose. :meth:`step` runs one period; :meth:`stop`
+    brings the robot to rest at its acceleration limit; :meth:`follow` starts the next route
+    from where the robot rests with the same robot, sensors and filter (a route that starts
+    where the previous one ended). ``writer`` (a :class:`PlaybackLog`) logs the steps when set.
+    """
+
+    def __init__(
+        self,
+        scene: Scene,
+        environment: OccupancyGrid,
+        waypoints: list[dict],
+        config: PlaybackConfig | None = None,
+        speed_limiter: SpeedLimitSource | None = None,
+        writer: PlaybackLog | None = None,
+    ) -> None:
+        self.config = config = config or PlaybackConfig()
+        _check_waypoints(environment, waypoints)
+        band, occlusion = METHODS[config.method]
+        if "truth" in waypoints[0]:  # in simulation the robot starts where the start was taught
+            x, y, th = waypoints[0]["truth"]
+            scene = copy.copy(scene)
+            scene.robot_specs = [dict(scene.robot_specs[0])]
+            scene.robot_specs[0]["robot"] = {
+                **scene.robot_specs[0]["robot"],
+                "start": [x, y, math.degrees(th)],
+            }
+        self.scene, self.environment, self.writer = scene, environment, writer
+        self.setup = build_robot(scene, derive_seed(config.seed, 1))
+        sensors = build_sensors(scene, self.setup, config.seed, config.dt)
+        self.cameras = [s.device for s in sensors if s.kind == "depth_camera"]
+        self.limiter = None
+        if speed_limiter is not None:
+            self.limiter = _ScanLimiter(scene, sensors, speed_limiter, config.dt)
+        self.maker = LocalMapMaker(self.cameras, band)
+        self.model = _core.SpaceObservationModel(environment, occlusion_aware=occlusion)
+        self.localizer = MonteCarloLocalizer(
+            MclConfig(particles=config.particles, alphas=tuple(config.alphas)),
+            derive_seed(config.seed, 2),
+        )
+        start = waypoints[0]
+        self.localizer.initialize((start["x"], start["y"], start["theta"]), config.initial_sd)
+        self._begin(waypoints)
+
+    def _begin(self, waypoints: list[dict]) -> None:
+        self.waypoints = list(waypoints)
+        self.controller = PurePursuit(
+            [[w["x"], w["y"]] for w in waypoints],
+            self.config.speed,
+            0.6,
+            self.config.goal_tolerance,
+            self.setup.robot.params.max_accel,
+        )
+        self.passes: dict = {}
+        self._truths: list[tuple[float, float, float]] = []
+        self._estimates: list[tuple[float, float, float]] = []
+        self.command: tuple[float, float] = (0.0, 0.0)  # (v m/s, w rad/s) of the last step
+        self.stopping = False  # stop() was called
+        self.done = False  # the robot rests at the end of the route, or after stop()
+
+    def follow(self, waypoints: list[dict]) -> None:
+        """Starts the next route with the same robot and filter, from where the robot rests
+        (the filter is not reset: the start waypoint should be where the robot is)."""
+        if not self.done:
+            raise ValueError("the robot is still on its route: stop it or let it finish first")
+        _check_waypoints(self.environment, waypoints)
+        self._begin(waypoints)
+
+    @property
+    def steps(self) -> int:
+        """Steps recorded on this route."""
+        return len(self._truths)
+
+    @property
+    def truth(self) -> tuple[float, float, float]:
+        """The true pose of the last recorded step (simulation)."""
+        return self._truths[-1] if self._truths else _pose(self.setup.robot.pose)
+
+    @property
+    def estimate(self) -> tuple[float, float, float]:
+        """The filter's estimate of the last recorded step."""
+        return tuple(float(v) for v in self.localizer.estimate)
+
+    @property
+    def velocity(self) -> tuple[float, float]:
+        """The robot's (v m/s, w rad/s) now (after its acceleration limit)."""
+        v, w = self.setup.robot.velocity
+        return float(v), float(w)
+
+    @property
+    def reached(self) -> bool:
+        """The estimate came within the goal tolerance of the goal (the follower's stop rule)."""
+        return bool(self.controller.done)
+
+    def particles(self, count: int | None = None) -> np.ndarray:
+        """The filter's particles (n, 3), or `count` of them, evenly spaced in its array."""
+        poses = np.asarray(self.localizer.engine.poses, dtype=float)
+        if count is None or count >= len(poses):
+            return poses
+        return poses[np.linspace(0, len(poses) - 1, max(count, 1)).astype(int)]
+
+    def stop(self) -> None:
+        """Commands zero speed from the next step on: the robot brakes at its acceleration
+        limit (the filter still running) and the run is done once it rests."""
+        self.stopping = True
+
+    def step(self) -> bool:
+        """One control period: the filter's update at the current pose (recorded), then the
+        follower's command for dt, unless the route is over (reached or stopped) and the robot
+        at rest. Returns False when the robot rests at the end (that step recorded, no command),
+        and from then on."""
+        if self.done:
+            return False
+        config, setup, writer = self.config, self.setup, self.writer
+        t = len(self._truths) * config.dt
+        truth = _pose(setup.robot.pose)
+        self._observed = truth
+        self.localizer.step(_pose(setup.odometry.pose), self._observe)
+        estimate = self.estimate
+        self._truths.append(truth)
+        self._estimates.append(estimate)
+        odometry = _pose(setup.odometry.pose)
+        _record_passes(self.passes, self.waypoints, self.controller, truth, estimate, odometry)
+        cap = None  # m/s, the limiter's cap of the follower's speed
+        if self.limiter is not None:
+            cap = self.limiter.update(t, truth, estimate, writer)
+        if writer is not None:
+            writer.step(t, truth, estimate, odometry)
+        if (self.controller.done or self.stopping) and not any(setup.robot.velocity):
+            self.done, self.command = True, (0.0, 0.0)
+            return False  # the stop pose is where the robot comes to rest, not where it was told
+        if self.stopping:
+            v, w = 0.0, 0.0
+        else:
+            v, _, w = self.controller.command(estimate, max_speed=cap)
+        self.command = (float(v), float(w))
+        if writer is not None:
+            writer.command(t, v, w)
+        setup.odometry.update(setup.robot.step(v, w, config.dt))
+        return True
+
+    def _observe(self):
+        images = [c.render(self.scene.world, self._observed) for c in self.cameras]
+        self.model.set_local_map(self.maker.make(images))
+        return self.model
+
+    def result(self) -> PlaybackResult:
+        """The route so far as a :class:`PlaybackResult`."""
+        return PlaybackResult(
+            self.reached,
+            len(self._truths),
+            self._truths[-1],
+            self._estimates[-1],
+            _pose(self.setup.odometry.pose),
+            self.passes,
+            np.array(self._truths),
+            np.array(self._estimates),
+            np.arange(len(self._truths)) * self.config.dt,
+            None if self.limiter is None else np.array(self.limiter.limits),
+        )
+
+
+def _check_waypoints(environment: OccupancyGrid, waypoints: list[dict]) -> None:
+    if len(waypoints) < 2:
+        raise ValueError("a route needs a start and a goal waypoint")
+    check_route(environment, waypoints)
+
+
+class _ScanLimiter:
+    """Feeds a speed limiter: the scene's first laser scans the world at the true pose (the
+    sensor sees the world); the limiter gets the laser pose of the estimate (the robot knows
+    only its estimate, in the taught map's frame) and, as the direction of motion of this
+    differential drive, the estimate's heading."""
+
+    def __init__(
+        self, scene: Scene, sensors: list[SensorSetup], source: SpeedLimitSource, dt: float
+    ) -> None:
+        if not isinstance(source, SpeedLimitSource):
+            raise TypeError(f"a speed limiter needs an update() method, got {type(source)}")
+        laser = next((s for s in sensors if s.kind == "laser"), None)
+        if laser is None:
+            raise ValueError(f"scene {scene.name} ({scene.path}) has no laser for a speed limiter")
+        self.laser, self.source, self.dt = laser, source, dt
+        self.angles, self.max_range = laser.device.params.angles, laser.device.params.max_range
+        self.grid = scene.ground_truth(laser.mount.z - 0.02, laser.mount.z + 0.02)
+        self.limits: list[float] = []  # m/s, one per update
+
+    def update(self, t: float, truth, estimate, writer: PlaybackLog | None) -> float:
+        """The step's speed cap (m/s); logs the scan and the limit when `writer` is given."""
+        true_sensor, ranges = self.laser.device.scan(self.grid, truth)
+        sensor = self.laser.mount.planar(estimate)
+        limit = self.source.update(
+            sensor, self.angles, ranges, self.max_range, self.dt, heading=float(estimate[2])
+        )
+        if not isinstance(limit, SpeedLimit):
+            raise TypeError(f"the speed limiter returned {type(limit)}, not a SpeedLimit")
+        self.limits.append(limit.metres_per_second)
+        if writer is not None:
+            writer.scan(t, true_sensor, self.angles, ranges, self.max_range)
+            writer.speed_limit(t, limit)
+        return limit.metres_per_second
+
+
+def _record_passes(passes, waypoints, controller, truth, estimate, odom) -> None:
+    """Poses when the estimate passes each via-point and at the goal (the latest wins)."""
+    for i, w in enumerate(waypoints[1:], start=1):
+        if w["name"] in passes and i < len(waypoints) - 1:
+            continue
+        if controller.progress >= controller.cum[i] - 0.05 or (
+            i == len(waypoints) - 1 and controller.done
+        ):
+            passes[w["name"]] = {"true": truth, "estimate": estimate, "odometry": odom}

@@ -1,0 +1,72 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The Monte Carlo engine as Python drives it: its config and the filter (`engine`), tracking
+along a log with the scan sensor models (`tracking`), and localization from a uniform start
+(`global_localization`, with its convergence report in `convergence`). The engine itself,
+its motion models, resampling, KLD sampling and recovery are C++ (``kiseki._core``).
+
+``from kiseki.filters import MclConfig, localize, global_localize`` is the one import path."""
+
+from __future__ import annotations
+
+from kiseki.filters.convergence import (
+    ConvergenceReport,
+    ScanFit,
+    convergence_report,
+    describe,
+    scan_fit,
+    spread_radius,
+)
+from kiseki.filters.engine import (
+    REAL_ODOMETRY_ALPHAS,
+    RECOVERY_MODES,
+    RESAMPLING_METHODS,
+    MclConfig,
+    MonteCarloLocalizer,
+)
+from kiseki.filters.global_localization import (
+    GlobalConfig,
+    GlobalResult,
+    global_localize,
+    render_global,
+    write_report,
+)
+from kiseki.filters.tracking import (
+    LOCALIZATION_METHODS,
+    LocalizationResult,
+    LocalizeConfig,
+    ScanSpaceObservation,
+    localize,
+    motion_alphas,
+    noisy_odometry,
+    scan_model,
+    scan_preparer,
+)
+
+__all__ = [
+    "LOCALIZATION_METHODS",
+    "REAL_ODOMETRY_ALPHAS",
+    "RECOVERY_MODES",
+    "RESAMPLING_METHODS",
+    "ConvergenceReport",
+    "GlobalConfig",
+    "GlobalResult",
+    "LocalizationResult",
+    "LocalizeConfig",
+    "MclConfig",
+    "MonteCarloLocalizer",
+    "ScanFit",
+    "ScanSpaceObservation",
+    "convergence_report",
+    "describe",
+    "global_localize",
+    "localize",
+    "motion_alphas",
+    "noisy_odometry",
+    "render_global",
+    "scan_fit",
+    "scan_preparer",
+    "scan_model",
+    "spread_radius",
+    "write_report",
+]

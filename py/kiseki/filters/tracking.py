@@ -1,0 +1,327 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Tracking a robot along a log with the engine (:func:`localize`), and the sensor models it
+weighs with.
+
+* Sensor models: :func:`scan_model` makes nav2's ``beam`` or ``likelihood-field`` model, or the
+  teaching-and-playback thesis' ``space-observation`` model fed with local maps made from each
+  scan. A model written in Python plugs in through
+  :meth:`~kiseki.filters.engine.MonteCarloLocalizer.step_log_likelihoods` (one log-likelihood
+  per particle).
+* Invalid readings (NaN, zero, negative; the log readers store them as NaN, see
+  :mod:`kiseki.scans`) are skipped; readings of +inf or at or beyond the scan's max range are
+  "no return": the likelihood field skips them (as nav2), the beam model scores them with its
+  z_max term.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+from tqdm import tqdm
+
+from kiseki import _core
+from kiseki.core import Pose2, Random, check_seed, derive_seed
+from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
+from kiseki.grid import OccupancyGrid
+from kiseki.mapping import scan_local_map
+from kiseki.scans import LaserScans, check_odometry_jumps
+
+__all__ = [
+    "LOCALIZATION_METHODS",
+    "LocalizationResult",
+    "LocalizeConfig",
+    "ScanSpaceObservation",
+    "localize",
+    "motion_alphas",
+    "noisy_odometry",
+    "scan_model",
+    "scan_preparer",
+]
+
+LOCALIZATION_METHODS = ("odometry", "space-observation", "likelihood-field", "beam")
+
+
+def _check(condition: bool, message: str) -> None:
+    """A config's check: ValueError with `message` unless `condition` holds."""
+    if not condition:
+        raise ValueError(message)
+
+
+class ScanSpaceObservation:
+    """The space observation model fed with a local map made from each 2-D scan."""
+
+    def __init__(self, grid: OccupancyGrid) -> None:
+        self.model = _core.SpaceObservationModel(grid)
+
+    def set_scan(self, angles: np.ndarray, ranges: np.ndarray, max_range: float) -> None:
+
+        self.model.set_local_map(scan_local_map(angles, ranges, max_range))
+
+
+def scan_preparer(model, scans: LaserScans) -> Callable[[int], _core.SensorModel]:
+    """``prepare(k)`` for :meth:`MonteCarloLocalizer.step`: gives scan k to a model of
+    :func:`scan_model` and returns what the engine weighs with."""
+    engine_model = model.model if isinstance(model, ScanSpaceObservation) else model
+
+    def prepare(k: int) -> _core.SensorModel:
+        model.set_scan(scans.angles, scans.ranges[k], scans.max_range)
+        return engine_model
+
+    return prepare
+
+
+@dataclass(frozen=True)
+class LocalizeConfig:
+    """Localization along a log: the method, its sensor model and the engine's settings.
+
+    * ``method`` likelihood-field: nav2 AMCL's model and the baseline MCL (Probabilistic Robotics);
+      what ``kiseki localize`` runs by default (it reads this default).
+    * ``beams`` 90: nav2's max_beams rule (every k-th beam); 90 is half of a 180-beam scan.
+    * ``sigma_hit`` 0.2 m (nav2); ``z_hit`` 0.95 / ``z_rand`` 0.05 (Probabilistic Robotics'
+      likelihood field); the beam model adds ``z_short``, ``z_max``, ``lambda_short`` (nav2's).
+    * ``combination`` product (beams independent) or nav2 (1 + sum pz^3).
+    * ``alphas`` None: :func:`motion_alphas` (the noise the odometry has).
+    """
+
+    method: str = "likelihood-field"
+    seed: int = 0
+    odometry_noise: float = 0.0  # SD as a fraction of each odometry increment's component
+    particles: int = 500
+    initial_sd: tuple[float, float, float] = (0.1, 0.1, math.radians(3.0))
+    alphas: tuple[float, ...] | None = None
+    beams: int = 90
+    sigma_hit: float = 0.2
+    z_hit: float = 0.95
+    z_rand: float = 0.05
+    z_short: float = 0.05
+    z_max: float = 0.05
+    lambda_short: float = 0.1
+    combination: str = "product"
+    kld: bool = False
+    min_particles: int = 100
+    resampling: str = "systematic"
+    resample_threshold: float = 0.5
+    recovery: str = "none"
+    update_min_d: float = 0.0
+    update_min_a: float = 0.0
+    threads: int = 0
+    global_start: bool = False  # start uniformly over the map (no initial pose)
+    resetting_injects: bool = False  # resetting adds Augmented MCL's injection (MclConfig)
+    likelihood_power: float = 1.0
+
+    def __post_init__(self) -> None:
+        _check(
+            self.method in LOCALIZATION_METHODS,
+            f"method must be one of {', '.join(LOCALIZATION_METHODS)}, got {self.method!r}",
+        )
+        check_seed(self.seed)
+        _check(
+            self.odometry_noise >= 0 and math.isfinite(self.odometry_noise),
+            f"odometry noise must be >= 0, got {self.odometry_noise}",
+        )
+        _check(
+            len(self.initial_sd) == 3 and all(s >= 0 and math.isfinite(s) for s in self.initial_sd),
+            f"initial_sd must be three finite numbers >= 0, got {self.initial_sd}",
+        )
+        _check(
+            isinstance(self.beams, int) and self.beams >= 0,
+            f"beams must be an integer >= 0 (0 = every beam), got {self.beams!r}",
+        )
+        _check(
+            self.combination in ("product", "nav2"),
+            f"combination must be product or nav2, got {self.combination!r}",
+        )
+        for name in ("sigma_hit", "lambda_short"):
+            value = getattr(self, name)
+            _check(value > 0 and math.isfinite(value), f"{name} must be > 0, got {value}")
+        for name in ("z_hit", "z_rand", "z_short", "z_max"):
+            value = getattr(self, name)
+            _check(value >= 0 and math.isfinite(value), f"{name} must be >= 0, got {value}")
+        _check(self.z_hit + self.z_rand > 0, "z_hit and z_rand must not both be 0")
+        if self.alphas is not None:
+            _check(
+                len(self.alphas) in (4, 5)
+                and all(a >= 0 and math.isfinite(a) for a in self.alphas),
+                f"alphas must be 4 (or 5) finite numbers >= 0, got {self.alphas}",
+            )
+        self.mcl(REAL_ODOMETRY_ALPHAS)  # the engine's checks, as ValueError
+
+    def mcl(self, alphas: tuple[float, ...]) -> MclConfig:
+        return MclConfig(
+            particles=self.particles,
+            kld=self.kld,
+            min_particles=self.min_particles,
+            alphas=tuple(alphas),
+            resampling=self.resampling,
+            resample_threshold=self.resample_threshold,
+            likelihood_power=self.likelihood_power,
+            recovery=self.recovery,
+            resetting_injects=self.resetting_injects,
+            update_min_d=self.update_min_d,
+            update_min_a=self.update_min_a,
+            threads=self.threads,
+        )
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def scan_model(method: str, grid: OccupancyGrid, config: LocalizeConfig | None = None):
+    """The sensor model of a method over a map; give it each scan with ``set_scan``."""
+    config = config or LocalizeConfig(method=method)
+    combination = getattr(_core.BeamCombination, config.combination)
+    if method == "likelihood-field":
+        return _core.LikelihoodFieldModel(
+            grid,
+            sigma_hit=config.sigma_hit,
+            z_hit=config.z_hit,
+            z_rand=config.z_rand,
+            max_beams=config.beams,
+            combination=combination,
+        )
+    if method == "beam":
+        return _core.BeamModel(
+            grid,
+            z_hit=config.z_hit,
+            z_short=config.z_short,
+            z_max=config.z_max,
+            z_rand=config.z_rand,
+            sigma_hit=config.sigma_hit,
+            lambda_short=config.lambda_short,
+            max_beams=config.beams,
+            combination=combination,
+        )
+    if method == "space-observation":
+        return ScanSpaceObservation(grid)
+    raise ValueError(
+        f"no sensor model for method {method!r}: use likelihood-field, beam or space-observation"
+    )
+
+
+def motion_alphas(config: LocalizeConfig, scans: LaserScans) -> tuple[float, ...]:
+    """The filter's motion noise: `config.alphas` if given, else the noise the odometry has.
+
+    That is the log's own odometry error plus the noise `noisy_odometry` adds. The log's own:
+    none when its odometry equals its reference poses (the CARMEN "corrected" logs), else
+    unknown, and then `REAL_ODOMETRY_ALPHAS`. The added noise has SD F |component| on each
+    increment, so in the motion model's terms a rotation SD of F |rotation| and a translation
+    SD of F |translation|: alpha1 = alpha3 = F^2; the cross terms (translation turning the
+    heading, rotation moving the robot) get a tenth of that. A filter told of more noise than
+    the odometry has spreads its particles further than one scan can pull them back, which the
+    weakly peaked space observation model does not survive on long corridors."""
+    if config.alphas is not None:
+        return tuple(config.alphas)
+    exact = scans.odometry.shape == scans.poses.shape and np.allclose(
+        scans.odometry, scans.poses, atol=1e-6
+    )
+    base = (0.0, 0.0, 0.0, 0.0) if exact else REAL_ODOMETRY_ALPHAS
+    f2 = config.odometry_noise**2
+    added = (f2, 0.1 * f2, f2, 0.1 * f2)
+    return tuple(max(b + a, 1e-6) for b, a in zip(base, added, strict=True))
+
+
+def noisy_odometry(poses: np.ndarray, fraction: float, seed: int) -> np.ndarray:
+    """Odometry rebuilt from the increments of `poses` (in each previous pose's frame), each
+    component perturbed by zero-mean Gaussian noise with SD = fraction x |component|."""
+    poses = np.asarray(poses, dtype=float)
+    rng = Random(seed)
+    out = np.empty_like(poses)
+    out[0] = poses[0]
+    current = Pose2(*poses[0])
+    for k in range(1, len(poses)):
+        step = Pose2(*poses[k - 1]).between(Pose2(*poses[k])).to_array()
+        if fraction > 0:
+            step = step + fraction * np.abs(step) * rng.normal(0.0, 1.0, 3)
+        current = current * Pose2(*step)
+        out[k] = current.to_array()
+    return out
+
+
+@dataclass(frozen=True)
+class LocalizationResult:
+    estimates: np.ndarray  # (n, 3) estimated sensor pose after each scan
+    reliability: np.ndarray  # (n,) the engine's reliability estimate after each scan
+    particle_counts: np.ndarray  # (n,)
+    updated: np.ndarray  # (n,) bool: a measurement update was made at this scan
+    update_seconds: (
+        np.ndarray
+    )  # (updates,) wall time of each update (motion + weighing + resampling)
+    resets: np.ndarray  # (n,) str: none, expansion or sensor
+    config: LocalizeConfig = field(repr=False)
+
+
+def _check_scans(scans: LaserScans, grid: OccupancyGrid) -> None:
+    if len(scans) == 0:
+        raise ValueError("the log has no scans")
+    if scans.ranges.ndim != 2 or scans.ranges.shape[1] != scans.angles.shape[0]:
+        raise ValueError(
+            f"scans: {scans.ranges.shape[1] if scans.ranges.ndim == 2 else '?'} ranges per scan "
+            f"but {scans.angles.shape[0]} beam angles"
+        )
+    if not np.isfinite(scans.odometry).all():
+        raise ValueError("scans: the odometry has NaN or infinite poses")
+    if not np.any(grid.cells == 0):
+        raise ValueError("the map has no free cell (empty or all unknown): nothing to localize in")
+
+
+def localize(
+    scans: LaserScans, grid: OccupancyGrid, config: LocalizeConfig, progress: bool = False
+) -> LocalizationResult:
+    """Localization along a log: tracking from its first reference pose, or from a uniform start
+    over the map's free cells with ``config.global_start``. Estimates are sensor poses."""
+    _check_scans(scans, grid)
+    odom = noisy_odometry(scans.odometry, config.odometry_noise, derive_seed(config.seed, 1))
+    noise = f" with noise {config.odometry_noise:g}" if config.odometry_noise else ""
+    check_odometry_jumps(f"the odometry{noise}", scans.times, odom)
+    n = len(scans)
+    if config.method == "odometry":
+        return LocalizationResult(
+            odom,
+            np.full(n, np.nan),
+            np.zeros(n, dtype=np.int64),
+            np.zeros(n, dtype=bool),
+            np.zeros(0),
+            np.full(n, "none"),
+            config,
+        )
+    if not config.global_start and not np.isfinite(scans.poses[0]).all():
+        raise ValueError("the log has no reference pose to start from: use a global start")
+    localizer = MonteCarloLocalizer(
+        config.mcl(motion_alphas(config, scans)), derive_seed(config.seed, 2), grid
+    )
+    if config.global_start:
+        localizer.initialize_global()
+    else:
+        localizer.initialize(scans.poses[0], config.initial_sd)
+    prepare = scan_preparer(scan_model(config.method, grid, config), scans)
+    estimates = np.empty((n, 3))
+    reliability = np.empty(n)
+    counts = np.empty(n, dtype=np.int64)
+    updated = np.zeros(n, dtype=bool)
+    resets = np.full(n, "none", dtype=object)
+    seconds: list[float] = []
+
+    for k in tqdm(range(n), desc=config.method, unit="scan", disable=not progress):
+        start = time.perf_counter()
+        report = localizer.step(odom[k], lambda k=k: prepare(k))
+        if report is not None:
+            seconds.append(time.perf_counter() - start)
+            updated[k] = True
+            resets[k] = report.reset
+        estimates[k] = localizer.estimate
+        reliability[k] = localizer.reliability
+        counts[k] = localizer.size
+    return LocalizationResult(
+        estimates,
+        reliability,
+        counts,
+        updated,
+        np.asarray(seconds),
+        resets.astype(str),
+        config,
+    )

@@ -1,0 +1,275 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Map files: the ROS map_server format (YAML + PGM/PNG image) and the CMU Wean Hall .dat map.
+
+Loading follows nav2's map_server rules for every field the format defines (``image``,
+``resolution``, ``origin``, ``negate``, ``occupied_thresh``, ``free_thresh``, ``mode`` trinary /
+scale / raw). Saving follows nav2's map_saver, except that ``free_thresh`` defaults to 0.196
+(the ROS 1 map_saver value) so that the 205-grey of unknown cells loads back as unknown; nav2's
+0.25 would turn it into free space. Files are written to a temporary name and renamed, so an
+interrupted save never leaves a half-written map behind.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import struct
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from kiseki import _core
+from kiseki._support.atomic import atomic_write_all
+from kiseki._support.inputs import GIB, YAML_LIMIT, check_input, read_input_text
+from kiseki._support.schema import SchemaError, parse
+from kiseki._support.yaml import safe_load_12
+from kiseki.core import Pose2
+from kiseki.errors import MapFormatError
+from kiseki.grid import OCCUPIED, UNKNOWN, OccupancyGrid
+from kiseki.io.map_schema import MODES, RosMapYaml
+from kiseki.mapping import MAX_MAP_CELLS
+
+__all__ = [
+    "MAX_IMAGE_BYTES",
+    "MapMetadata",
+    "load_map",
+    "map_files",
+    "read_map_metadata",
+    "save_map",
+    "write_image",
+]
+
+
+MAX_IMAGE_BYTES = 1 * GIB
+"""A map image file holds at most this: MAX_MAP_CELLS pixels of 16-bit RGBA (8 bytes each), or
+of a text PGM (at most 6 bytes each), fit; its header's pixel count is checked before decoding."""
+
+
+@dataclass(frozen=True)
+class MapMetadata:
+    """The fields of a ROS map YAML file."""
+
+    image: Path
+    resolution: float
+    origin: tuple[float, float, float]
+    mode: str = "trinary"
+    negate: bool = False
+    occupied_thresh: float = 0.65
+    free_thresh: float = 0.196
+
+
+def _parse_yaml(path: Path) -> RosMapYaml:
+    try:
+        text = read_input_text(path, "ROS map YAML files", YAML_LIMIT, MapFormatError)
+    except UnicodeDecodeError as err:
+        raise MapFormatError(
+            f"{path}: not a map YAML file (not UTF-8 text: byte {err.start} is "
+            f"0x{err.object[err.start]:02x})"
+        ) from err
+    try:
+        doc = safe_load_12(text)  # resolution: 5e-2 is a number, as nav2 reads it
+    except yaml.YAMLError as err:
+        raise MapFormatError(f"{path}: invalid YAML ({err})") from err
+    if not isinstance(doc, dict):
+        raise MapFormatError(f"{path}: expected a YAML mapping with image, resolution and origin")
+    try:
+        return parse(RosMapYaml, doc, path)
+    except SchemaError as err:
+        raise MapFormatError(str(err)) from None
+
+
+def read_map_metadata(path: str | os.PathLike) -> MapMetadata:
+    """Reads and checks a ROS map YAML file (:class:`kiseki.io.map_schema.RosMapYaml`; the image
+    path is resolved next to it). MapFormatError names the file, the key and the value."""
+    path = Path(path)
+    check_input(path, error=MapFormatError)
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: map YAML file not found")
+    doc = _parse_yaml(path)
+    image = Path(doc.image)
+    return MapMetadata(
+        image=image if image.is_absolute() else path.parent / image,
+        resolution=doc.resolution,
+        origin=doc.origin,
+        mode=doc.mode,
+        negate=doc.negate,
+        occupied_thresh=doc.occupied_thresh,
+        free_thresh=doc.free_thresh,
+    )
+
+
+_PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def _check_cells(path: Path, image: Path, width: int, height: int) -> None:
+    if width * height > MAX_MAP_CELLS:
+        raise MapFormatError(
+            f"{image} (the image of {path}) is {width} x {height} pixels: more than the "
+            f"limit of {MAX_MAP_CELLS:.0e} map cells"
+        )
+
+
+def _check_binary_pgm(path: Path, image: Path) -> None:
+    """A binary PGM (P5) cut short is refused here, naming both files: OpenCV would print its
+    own 'can't read data' line on stderr before failing. A PGM or PNG whose header states more
+    than MAX_MAP_CELLS pixels is refused before it is decoded."""
+    with open(image, "rb") as f:
+        head = f.read(512)
+        if head.startswith(_PNG) and head[12:16] == b"IHDR":
+            _check_cells(path, image, *struct.unpack(">II", head[16:24]))
+        if not head.startswith((b"P5", b"P2")):
+            return  # other formats: the decoder's error
+        fields: list[bytes] = []
+        at = 2
+        while len(fields) < 3 and at < len(head):
+            if head[at : at + 1] == b"#":  # a comment runs to the end of its line
+                end = head.find(b"\n", at)
+                at = len(head) if end < 0 else end + 1
+            elif head[at : at + 1].isspace():
+                at += 1
+            else:
+                end = at
+                while end < len(head) and not head[end : end + 1].isspace():
+                    end += 1
+                fields.append(head[at:end])
+                at = end
+        if len(fields) < 3 or not all(x.isdigit() for x in fields):
+            return  # a malformed header: the decoder's error
+        width, height, maxval = (int(x) for x in fields)
+        _check_cells(path, image, width, height)
+        if head.startswith(b"P2"):
+            return  # a text PGM: its numbers are not counted here
+        need = width * height * (1 if maxval < 256 else 2)
+        have = os.fstat(f.fileno()).st_size - (at + 1)  # one whitespace byte after maxval
+    if have < need:
+        raise MapFormatError(
+            f"{path}: cannot decode image {image}: a truncated PGM ({max(have, 0)} of the {need} "
+            f"pixel bytes of {width} x {height})"
+        )
+
+
+def _load_ros_map(path: Path) -> OccupancyGrid:
+    meta = read_map_metadata(path)
+    try:
+        check_input(meta.image, "map images", MAX_IMAGE_BYTES, MapFormatError)
+    except MapFormatError as err:
+        raise MapFormatError(f"{path}: image {err}") from None
+    if not meta.image.is_file():
+        raise FileNotFoundError(f"{path}: image file {meta.image} not found")
+    _check_binary_pgm(path, meta.image)
+    try:
+        image = _core.read_image(str(meta.image))
+    except RuntimeError as err:
+        raise MapFormatError(f"{path}: {err}") from err
+    return _core.occupancy_from_image(
+        image,
+        meta.resolution,
+        Pose2(*meta.origin),
+        mode=meta.mode,
+        negate=meta.negate,
+        occupied_thresh=meta.occupied_thresh,
+        free_thresh=meta.free_thresh,
+    )
+
+
+def load_map(path: str | os.PathLike) -> OccupancyGrid:
+    """Loads a map: a ROS map YAML (``.yaml``/``.yml``) or a CMU Wean ``.dat``/``.dat.gz``."""
+    path = Path(path)
+    name = path.name.lower()
+    if name.endswith((".dat", ".dat.gz")):
+        # here, not at the top: `import kiseki` loads this module, and the dataset readers'
+        # package (the ROS bag and MCAP libraries) would make it slow
+        from kiseki.datasets.wean import read_wean_map
+
+        wean = read_wean_map(path)
+        return OccupancyGrid(wean.to_cells(), wean.resolution)
+    if not name.endswith((".yaml", ".yml")):
+        raise MapFormatError(f"{path}: unknown map format (expected .yaml, .yml, .dat or .dat.gz)")
+    return _load_ros_map(path)
+
+
+def write_image(path: str | os.PathLike, image: np.ndarray) -> None:
+    """Writes an image file (OpenCV's encoders; the format by the extension). Raises OSError
+    naming `path` when the file cannot be written whole, with the system's reason (a full disk:
+    ENOSPC): the C++ writer checks every step, since cv::imwrite reports success for a PGM that
+    a full disk has cut short, which an atomic rename would then put over a good map."""
+    try:
+        _core.write_image(str(path), image)
+    except RuntimeError as err:
+        text = str(err)
+        text = text.removeprefix(f"{path}: ")
+        for code in (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.ENOENT):
+            if text.endswith(os.strerror(code)):
+                raise OSError(code, os.strerror(code), str(path)) from err
+        raise OSError(errno.EIO, text, str(path)) from err
+
+
+def save_map(
+    grid: OccupancyGrid,
+    path: str | os.PathLike,
+    mode: str = "trinary",
+    image_format: str | None = None,
+    occupied_thresh: float = 0.65,
+    free_thresh: float = 0.196,
+) -> Path:
+    """Saves a grid as ROS map YAML + image (``<stem>.pgm``, or ``.png`` in scale mode, which
+    needs an alpha channel). Returns the YAML path. Both files are written before either
+    replaces a previous map, so a failed save leaves the previous map whole."""
+    path = Path(path)
+    atomic_write_all(map_files(grid, path, mode, image_format, occupied_thresh, free_thresh))
+    return path
+
+
+def map_files(
+    grid: OccupancyGrid,
+    path: str | os.PathLike,
+    mode: str = "trinary",
+    image_format: str | None = None,
+    occupied_thresh: float = 0.65,
+    free_thresh: float = 0.196,
+) -> list[tuple[Path, Callable[[str], object]]]:
+    """The checked files of :func:`save_map`, image first, each with its writer, for
+    `kiseki._support.atomic.atomic_write_all` (to save them together with other files)."""
+    path = Path(path)
+    if path.suffix.lower() not in (".yaml", ".yml"):
+        raise ValueError(f"{path}: a ROS map must be saved to a .yaml file")
+    if not path.parent.is_dir():
+        raise FileNotFoundError(f"{path}: directory {path.parent} does not exist")
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+    image_format = (image_format or ("png" if mode == "scale" else "pgm")).lower()
+    if image_format not in ("pgm", "png"):
+        raise ValueError(f"image_format must be 'pgm' or 'png', got {image_format!r}")
+    if mode == "scale" and image_format == "pgm":
+        raise ValueError("scale mode stores unknown cells in an alpha channel: use PNG")
+    cells = grid.cells
+    bad = (cells < UNKNOWN) | (cells > OCCUPIED)
+    if bad.any():
+        y, x = np.argwhere(bad)[0]
+        raise ValueError(
+            f"{path}: the grid has {int(bad.sum())} cells outside -1..100 (cell x={x}, y={y} "
+            f"holds {int(cells[y, x])}): nothing written"
+        )
+    image = _core.image_from_occupancy(
+        grid, mode=mode, occupied_thresh=occupied_thresh, free_thresh=free_thresh
+    )
+    image_path = path.with_suffix(f".{image_format}")
+    origin = grid.origin
+    doc = {
+        "image": image_path.name,
+        "mode": mode,
+        "resolution": float(grid.resolution),
+        "origin": [float(origin.x), float(origin.y), float(origin.theta)],
+        "negate": 0,
+        "occupied_thresh": float(occupied_thresh),
+        "free_thresh": float(free_thresh),
+    }
+    text = yaml.safe_dump(doc, sort_keys=False, default_flow_style=None)
+    return [
+        (image_path, lambda tmp: write_image(tmp, image)),
+        (path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8")),
+    ]

@@ -1,0 +1,6 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""What several test folders share: reading pictures back (`pixels`), the route page's server
+and browser (`serve_pages`), the speed papers' reference figures (`speed_reference`) and the
+small room and its run log that the command-line tests feed the commands (`room_log`).
+Importable as ``_helpers`` because pyproject's pytest section puts tests/python on the path."""

@@ -1,0 +1,343 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Keyboard teaching: key decoding and limits, key scripts, the real CLI driven through a
+pseudo-terminal (keys pressed while it runs, terminal mode restored, also on Ctrl-C), refusal
+without a terminal, and a killed keyboard run rebuilt with --resume."""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+import re
+import select
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+import yaml
+
+from kiseki import load_map
+from kiseki.apps.teach.keyboard import KeyScript, Teleop, decode_keys, teach_keyboard
+from kiseki.apps.teach.teaching import recover
+from kiseki.io.runlog import read_run
+from kiseki.sim.scene import load_scene
+
+termios = pytest.importorskip("termios")
+
+
+def test_keys_are_decoded_and_commands_stay_within_the_limits():
+    keys, rest = decode_keys(b"wW\x1b[Aa\x1b[D \x1bOBmxq\x1b[")
+    assert keys == ["w", "w", "up", "a", "left", "space", "down", "m", "q"] and rest == b"\x1b["
+    keys, rest = decode_keys(rest + b"C\x1b")
+    assert keys == ["right"] and rest == b"\x1b"
+    teleop = Teleop(max_speed=1.0, max_yaw_rate=0.5)
+    for _ in range(15):
+        teleop.press("w")
+    assert teleop.v == 1.0
+    for _ in range(8):
+        teleop.press("right")
+    assert teleop.w == -0.5
+    assert teleop.press("down") is None and teleop.v == 0.9
+    assert teleop.press("m") == "mark" and teleop.press("q") == "quit"
+    teleop.press("space")
+    assert (teleop.v, teleop.w) == (0.0, 0.0)
+    teleop.press("s")
+    assert teleop.v == -0.1  # reverse
+    with pytest.raises(ValueError, match="unknown key 'x'"):
+        teleop.press("x")
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("0 w\n1 m\n", ": a key script must end with q (finish)"),
+        ("0 w\n-1 q\n", ":2: time: must be greater than or equal to 0, got '-1'"),
+        ("zero w\n1 q\n", ":1: time: must be a number of seconds (a line is TIME KEY"),
+        ("0 w\n1 jump\n2 q\n", ":2: keys[0]: must be one of w, a, s, d, up, "),
+        ("0 w\n1 jump\n2 q\n", "m, q, got 'jump'"),
+        ("2 w\n1 q\n", ":2: time: must not decrease (the line before is at 2 s), got 1"),
+        ("1\n2 q\n", ":1: keys: a line is TIME KEY [KEY ...]: no key after the time, got []"),
+        ("0 w\n\n# c\n nan q\n", ":4: time: must be a finite number of seconds, got 'nan'"),
+        ("0 w\n3600.5 q\n", ":2: time: must be less than or equal to 3600, got '3600.5'"),
+    ],
+)
+def test_bad_key_scripts(tmp_path, text, message):
+    path = tmp_path / "keys.txt"
+    path.write_text(text)
+    with pytest.raises(ValueError) as err:
+        KeyScript(path)
+    assert str(err.value).startswith(str(path)) and message in str(err.value)
+    with pytest.raises(FileNotFoundError, match="key script not found"):
+        KeyScript(tmp_path / "none.txt")
+
+
+def test_a_key_script_teaches_like_the_operator(tmp_path, project_root):
+    scene = load_scene(project_root / "data" / "worlds" / "factory_turn.yaml")
+    keys = tmp_path / "keys.txt"
+    # 0.5 m/s ahead for 5 s, mark; stop and turn left at 0.5 rad/s for 2 s; 0.3 m/s for 2 s
+    keys.write_text(
+        "# time keys\n0.0 w w w w w\n5.0 m space\n5.0 a a a a a\n7.0 space w w w\n9.0 m q\n"
+    )
+    status = io.StringIO()
+    with KeyScript(keys) as source:
+        result = teach_keyboard(scene, tmp_path / "t", source, seed=3, stream=status)
+    assert [m["name"] for m in result.marks] == ["P0", "P1"]
+    assert result.steps == 91  # t = 0.0 ... 9.0 s
+    p0, p1 = result.marks
+    # 50 steps: 0.05, 0.10, ... 0.5 m/s (0.5 m/s^2 ramp), then 0.5 m/s; no turn yet
+    assert p0["truth"][0] == pytest.approx(0.275 + 2.0, abs=1e-6) and abs(p0["truth"][1]) < 1e-9
+    # the turn at 1 rad/s^2: 0.1 ... 0.5 rad/s, 0.5 rad/s until 7.0 s (0.9 rad in 20 steps),
+    # then 0.4 ... 0 rad/s (0.1 rad)
+    assert p1["truth"][2] == pytest.approx(1.0, abs=1e-6)
+    assert p1["truth"][1] > p0["truth"][1] + 0.2  # it drove off to the left
+    lines = status.getvalue().splitlines()
+    assert "m mark a waypoint" in lines[1] and lines[-1].startswith("step 90 | odom ")
+    assert lines[-1].endswith("| v +0.3 w +0.0 | waypoints 2 (P1)")
+    again = recover(scene, result.log, tmp_path / "r")
+    assert again.marks == result.marks and again.steps == result.steps
+    for band, path in again.maps.items():
+        np.testing.assert_array_equal(load_map(path).cells, load_map(result.maps[band]).cells)
+
+
+def test_the_readme_key_script_runs(tmp_path, project_root):
+    readme = (project_root / "README.md").read_text(encoding="utf-8")
+    section = readme[readme.index("### Teaching from the keyboard") :]
+    script = re.search(r"```text\n(.*?)```", section, re.S).group(1)
+    (tmp_path / "keys.txt").write_text(script)
+    scene = load_scene(project_root / "data" / "worlds" / "factory_turn.yaml")
+    with KeyScript(tmp_path / "keys.txt") as keys:
+        result = teach_keyboard(scene, tmp_path / "t", keys, stream=io.StringIO())
+    assert [m["name"] for m in result.marks] == ["P0", "P1"] and result.steps == 91
+    assert result.marks[1]["truth"][2] > 0.5  # it turned left in place at 0.2 rad/s for 4 s
+
+
+# --------------------------------------------------------------------------------------------
+# The real CLI in a pseudo-terminal
+# --------------------------------------------------------------------------------------------
+
+
+class _Terminal:
+    """Runs the CLI with a pseudo-terminal as its controlling terminal, stdin and stdout."""
+
+    def __init__(self, args: list[str]) -> None:
+        import fcntl
+
+        self.master, self.slave = os.openpty()
+        self.before = termios.tcgetattr(self.slave)
+        self.output = b""
+
+        def controlling_terminal() -> None:  # runs in the child after setsid()
+            fcntl.ioctl(0, termios.TIOCSCTTY, 0)
+
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "kiseki.cli", *args],
+            stdin=self.slave,
+            stdout=self.slave,
+            stderr=self.slave,
+            start_new_session=True,
+            preexec_fn=controlling_terminal,
+        )
+
+    def read(self, seconds: float) -> None:
+        end = time.monotonic() + seconds
+        while (left := end - time.monotonic()) > 0:
+            ready, _, _ = select.select([self.master], [], [], left)
+            if ready:
+                try:
+                    self.output += os.read(self.master, 65536)
+                except OSError:  # the child closed the terminal
+                    return
+
+    def step(self) -> int:
+        steps = re.findall(rb"step +(\d+) \|", self.output)
+        return int(steps[-1]) if steps else -1
+
+    def wait_for_step(self, step: int, timeout: float = 120.0) -> int:
+        """Waits until the status line shows step `step` or later; returns the step shown."""
+        end = time.monotonic() + timeout
+        while self.step() < step:
+            assert time.monotonic() < end, f"no step {step} shown: {self.output[-300:]!r}"
+            assert self.proc.poll() is None, f"the CLI ended: {self.output[-500:]!r}"
+            self.read(0.05)
+        return self.step()
+
+    def press(self, keys: bytes) -> None:
+        os.write(self.master, keys)
+
+    def finish(self, timeout: float = 120.0) -> int:
+        end = time.monotonic() + timeout
+        while self.proc.poll() is None and time.monotonic() < end:
+            self.read(0.1)
+        self.read(0.2)
+        code = self.proc.wait(timeout=5)
+        return code
+
+    def close(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait()
+        os.close(self.master)
+        os.close(self.slave)
+
+
+def _flags(attrs) -> tuple[bool, bool]:
+    return bool(attrs[3] & termios.ICANON), bool(attrs[3] & termios.ECHO)
+
+
+def test_keyboard_teaching_in_a_terminal(tmp_path, project_root):
+    scene = project_root / "data" / "worlds" / "factory_turn.yaml"
+    out = tmp_path / "t"
+    term = _Terminal(["teach", str(scene), "--keyboard", "-o", str(out), "--seed", "2"])
+    try:
+        now = term.wait_for_step(0)
+        assert b"m mark a waypoint" in term.output  # the key help
+        assert _flags(termios.tcgetattr(term.slave)) == (False, False)  # cbreak, no echo
+        # each wait counts from the step shown when the keys went out, so a slow machine
+        # only makes the moves longer
+        term.press(b"wwww\x1b[A")  # 0.5 m/s ahead (Up arrow for the last step)
+        now = term.wait_for_step(now + 50)
+        term.press(b" ")  # stop
+        now = term.wait_for_step(now + 15)
+        term.press(b"m")
+        now = term.wait_for_step(now + 5)
+        term.press(b"aaaaa")  # turn left in place at 0.5 rad/s
+        now = term.wait_for_step(now + 12)
+        term.press(b" www")  # stop turning, 0.3 m/s ahead
+        now = term.wait_for_step(now + 25)
+        term.press(b"m")
+        term.wait_for_step(now + 2)
+        term.press(b"q")
+        assert term.finish() == 0, term.output[-500:]
+        after = termios.tcgetattr(term.slave)
+    finally:
+        term.close()
+    assert after == term.before and _flags(after) == (True, True)  # the terminal is restored
+    text = re.sub(r"\x1b\[[0-9;]*[A-Za-z]", "", term.output.decode(errors="replace"))
+    text = " ".join(text.split())  # rich wraps the summary at the terminal's width
+    assert "waypoints 2 (P1)" in text and re.search(r"\d+ steps, waypoints P0, P1", text)
+    assert (out / "map_band.yaml").is_file() and (out / "map_plane.yaml").is_file()
+    doc = yaml.safe_load((out / "waypoints.yaml").read_text())
+    p0, p1 = doc["waypoints"]
+    assert (p0["name"], p1["name"]) == ("P0", "P1")
+    run = read_run(out / "teach.mcap")
+    odom = {round(t, 6): m for t, m in run.messages("/odom")}
+    times, poses = run.poses("/ground_truth")
+    truth = {round(float(t), 6): p for t, p in zip(times, poses, strict=True)}
+    marked = [(round(t, 6), m) for t, m in run.messages("/waypoints")]
+    assert [m for _, m in marked] == doc["waypoints"]
+    for t, mark in marked:
+        # a mark is the logged odometry and true pose of the step it was pressed at
+        assert (mark["x"], mark["y"], mark["theta"]) == (
+            odom[t]["x"],
+            odom[t]["y"],
+            odom[t]["theta"],
+        )
+        np.testing.assert_allclose(mark["truth"], truth[t], atol=1e-9)  # via a quaternion
+        # odometry drift: the start heading is off by -0.2 deg + N(0, 0.7 deg) (3 sd: 2.3 deg),
+        # so under 0.05 m of lateral error per metre driven, plus 0.05 m for slip and the turn
+        driven = math.hypot(*mark["truth"][:2])
+        assert math.hypot(mark["x"] - mark["truth"][0], mark["y"] - mark["truth"][1]) < (
+            0.05 * driven + 0.05
+        )
+        assert abs(mark["theta"] - mark["truth"][2]) < math.radians(3.0)
+    # ahead along +x: at least 48 steps at 0.5 m/s after the 1 s ramp (over 2 m)
+    assert p0["truth"][0] > 2.0 and abs(p0["truth"][1]) < 0.01 and abs(p0["truth"][2]) < 0.01
+    # a left turn of at least 10 steps: 0.15 rad up the ramp, 0.25 rad at 0.5 rad/s, 0.1 rad
+    # braking; then at least 23 steps at up to 0.3 m/s (over 0.5 m) to the left of +x
+    assert p1["truth"][2] > 0.45
+    assert p1["truth"][1] - p0["truth"][1] > 0.15 and p1["truth"][0] > p0["truth"][0]
+
+
+@pytest.mark.parametrize("stop", ["ctrl-c", "sigterm"])
+def test_an_interrupt_restores_the_terminal_and_keeps_the_log(tmp_path, project_root, stop):
+    scene = project_root / "data" / "worlds" / "factory_turn.yaml"
+    out = tmp_path / "t"
+    term = _Terminal(["teach", str(scene), "--keyboard", "-o", str(out)])
+    try:
+        now = term.wait_for_step(0)
+        term.press(b"ww")
+        now = term.wait_for_step(now + 10)
+        term.press(b"m")
+        term.wait_for_step(now + 15)
+        if stop == "ctrl-c":
+            term.press(b"\x03")  # SIGINT from the terminal (cbreak mode keeps ISIG)
+        else:
+            term.proc.send_signal(signal.SIGTERM)
+        assert term.finish() == (130 if stop == "ctrl-c" else 143)
+        after = termios.tcgetattr(term.slave)
+    finally:
+        term.close()
+    assert after == term.before
+    assert b"interrupted" in term.output and b"--resume" in term.output
+    assert not (out / "waypoints.yaml").exists()
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "teach", str(scene), "-o", str(out), "--resume"],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    # the log was closed on the way out: every step shown is in it
+    steps = int(re.search(r"(\d+) steps", done.stdout.replace("\n", " ")).group(1))
+    assert steps >= term.step() + 1
+    assert [
+        w["name"] for w in yaml.safe_load((out / "waypoints.yaml").read_text())["waypoints"]
+    ] == ["P0"]
+
+
+def test_keyboard_needs_a_terminal_or_a_key_script(tmp_path, project_root):
+    scene = project_root / "data" / "worlds" / "factory_turn.yaml"
+    cli = [sys.executable, "-m", "kiseki.cli", "teach", str(scene), "-o", str(tmp_path / "t")]
+    done = subprocess.run(
+        [*cli, "--keyboard"], stdin=subprocess.DEVNULL, capture_output=True, text=True
+    )
+    assert done.returncode == 1
+    assert done.stderr.strip() == (
+        "kiseki: error: --keyboard needs a terminal on stdin (or --keys FILE of timed keys)"
+    )
+    assert not (tmp_path / "t").exists()
+    keys = tmp_path / "keys.txt"
+    keys.write_text("0 w\n1 q\n")
+    done = subprocess.run([*cli, "--keys", str(keys)], capture_output=True, text=True)
+    assert done.returncode == 1 and "--keys FILE goes with --keyboard" in done.stderr
+    keys.write_text("0 w\n1 fly\n2 q\n")
+    done = subprocess.run([*cli, "--keyboard", "--keys", str(keys)], capture_output=True, text=True)
+    assert done.returncode == 1 and "keys.txt:2: keys[0]: must be one of w, a," in done.stderr
+    assert done.stderr.strip().endswith("got 'fly'")
+    (tmp_path / "t").mkdir()
+    (tmp_path / "t" / "teach.mcap").write_bytes(b"")  # an earlier run's log is not replaced
+    keys.write_text("0 w\n1 q\n")
+    done = subprocess.run([*cli, "--keyboard", "--keys", str(keys)], capture_output=True, text=True)
+    assert done.returncode == 1 and "a teaching log exists; --resume" in done.stderr
+    assert (tmp_path / "t" / "teach.mcap").read_bytes() == b""
+
+
+def test_a_killed_keyboard_run_is_recovered(tmp_path, project_root):
+    scene = project_root / "data" / "worlds" / "factory_turn.yaml"
+    keys = tmp_path / "keys.txt"
+    keys.write_text("0 w w w\n2.0 m\n3.0 a\n600 q\n")  # the kill comes long before q
+    cli = [sys.executable, "-m", "kiseki.cli", "teach", str(scene), "-o", str(tmp_path / "t")]
+    status = tmp_path / "status.txt"
+    with status.open("w") as stream:
+        proc = subprocess.Popen([*cli, "--keyboard", "--keys", str(keys)], stdout=stream)
+        deadline = time.monotonic() + 120
+        shown: list[int] = []
+        while time.monotonic() < deadline and (not shown or max(shown) < 60):
+            time.sleep(0.05)
+            shown = [int(n) for n in re.findall(r"step +(\d+) \|", status.read_text())]
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+    shown = [int(n) for n in re.findall(r"step +(\d+) \|", status.read_text())]
+    assert shown and max(shown) >= 60, "the keyboard run showed no progress before the kill"
+    done = subprocess.run([*cli, "--resume"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    steps = int(re.search(r"(\d+) steps", done.stdout.replace("\n", " ")).group(1))
+    # the status counts a step once it is logged: at most the last second (10 steps) is lost
+    assert max(shown) + 1 - 10 <= steps < 6000
+    doc = yaml.safe_load((tmp_path / "t" / "waypoints.yaml").read_text())
+    assert [w["name"] for w in doc["waypoints"]] == ["P0"]
+    assert doc["waypoints"][0]["truth"][0] > 0.3  # marked after 2 s at up to 0.3 m/s
+    assert (tmp_path / "t" / "map_band.yaml").is_file()
