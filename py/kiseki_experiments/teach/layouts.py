@@ -84,12 +84,13 @@ def _configs(config: LayoutsConfig, scene: Path, method: str | None = None) -> d
     }
 
 
-def _run(cfg, index: int, seed: int, prefix: str, refusals: bool = True) -> dict:
-    """One call of exp2-turn's / exp3-boxes' trial, its record keys prefixed. When playback
-    refuses the route (a leg crosses occupied cells of the taught map), the record says so
-    (with `refusals`; else the ValueError propagates)."""
+def _run(cfg, index: int, seed: int, prefix: str, refusals: bool = True, taught=None) -> dict:
+    """One call of exp2-turn's / exp3-boxes' trial (with the run's teaching `taught`, when
+    given), its record keys prefixed. When playback refuses the route (a leg crosses occupied
+    cells of the taught map), the record says so (with `refusals`; else the ValueError
+    propagates)."""
     try:
-        record = tp.trial(cfg, index, seed).record
+        record = tp.trial(cfg, index, seed, taught=taught).record
     except ValueError as err:
         if not refusals or REFUSED not in str(err):
             raise
@@ -97,24 +98,28 @@ def _run(cfg, index: int, seed: int, prefix: str, refusals: bool = True) -> dict
     return {f"{prefix}{k}": v for k, v in record.items()}
 
 
-def _exp2(config: LayoutsConfig, scene: Path, index: int, seed: int, prefix: str) -> dict:
+def _exp2(
+    config: LayoutsConfig, scene: Path, index: int, seed: int, prefix: str, taught=None
+) -> dict:
     """exp2-turn's trial with every method; when playback refuses the route, once per method
     (the same teaching seed gives the same taught maps and results), so that one method's
     refusal does not hide the others' stops."""
     try:
-        return _run(_configs(config, scene)["exp2"], index, seed, prefix, refusals=False)
+        return _run(_configs(config, scene)["exp2"], index, seed, prefix, False, taught)
     except ValueError as err:
         if REFUSED not in str(err):
             raise
     record = {}
     for m in config.methods:
-        record |= _run(_configs(config, scene, m)["exp2"], index, seed, prefix)
+        record |= _run(_configs(config, scene, m)["exp2"], index, seed, prefix, taught=taught)
     return record
 
 
 def trial(config: LayoutsConfig, index: int, seed: int) -> TrialOutput:
     """Layout `seed`: per run, exp2-turn's trial (all methods, see :func:`_exp2`) and
-    exp3-boxes' trial, both with the run's seed (so the same teaching)."""
+    exp3-boxes' trial, both with the run's seed, so the same teaching: it is run once per run
+    (exp2-turn's and exp3-boxes' teaching differ in nothing: scene, merge rule and seed) and
+    both trials play back on it."""
     layout = generate_layout(seed)
     record = {f"layout_{k}": v for k, v in layout.params.items()}
     timings = {}
@@ -122,11 +127,15 @@ def trial(config: LayoutsConfig, index: int, seed: int) -> TrialOutput:
         scene = write_layout(layout, Path(tmp) / f"layout_{index}.yaml")
         for r in range(config.runs_per_layout):
             run_seed = derive_seed(seed, 10 + r)
+            configs = _configs(config, scene)
             start = time.perf_counter()
-            record |= _exp2(config, scene, index, run_seed, f"exp2_r{r}_")
+            taught = tp.teach_route(configs["exp2"], run_seed, Path(tmp) / f"teach_r{r}")
+            timings[f"teach_r{r}_seconds"] = time.perf_counter() - start
+            start = time.perf_counter()
+            record |= _exp2(config, scene, index, run_seed, f"exp2_r{r}_", taught)
             timings[f"exp2_r{r}_seconds"] = time.perf_counter() - start
             start = time.perf_counter()
-            record |= _run(_configs(config, scene)["exp3"], index, run_seed, f"exp3_r{r}_")
+            record |= _run(configs["exp3"], index, run_seed, f"exp3_r{r}_", taught=taught)
             timings[f"exp3_r{r}_seconds"] = time.perf_counter() - start
     return TrialOutput(record, timings)
 

@@ -182,18 +182,23 @@ def _boxes_beside_final_leg(scene_file: Path) -> dict:
     return {"final_leg_boxes_left": left, "final_leg_boxes_right": right}
 
 
-def trial(config: Exp1Config, index: int, seed: int) -> TrialOutput:
+def teach_route(config: Exp1Config, seed: int, folder: Path):
+    """The trial's teaching run (the same for every config with this scene, merge and seed)."""
+    return teach(
+        load_scene(Path(config.scene)), folder, seed=derive_seed(seed, 1), merge=config.merge
+    )
+
+
+def trial(config: Exp1Config, index: int, seed: int, taught=None) -> TrialOutput:
+    """Teaching (or `taught`, :func:`teach_route`'s result for this config and seed, when
+    given), then playback with each method."""
     del index
     scene_file = Path(config.scene)
     methods = config.methods
     record = {}
     with tempfile.TemporaryDirectory() as tmp:
-        taught = teach(
-            load_scene(scene_file),
-            Path(tmp) / "teach",
-            seed=derive_seed(seed, 1),
-            merge=config.merge,
-        )
+        if taught is None:
+            taught = teach_route(config, seed, Path(tmp) / "teach")
         for band, t in taught.truth.items():
             record[f"taught_{band}_erased_share"] = t["erased_share"]
             record[f"taught_{band}_false_occupied_share"] = t["false_occupied_share"]

@@ -87,6 +87,8 @@ def small_run(shared_data, tmp_path_factory):
         "sweep_raw=false",
         "mcl_seeds=2",
         "particles=300",
+        # the pictures' grid only: every table is the same at 0.2 m as at 0.1 m (22 -> 16 s)
+        "grid_resolution=0.2",
     ]
     out = tmp_path_factory.mktemp("gp-aalto") / "run"
     run = run_experiment("gp-aalto", seed=0, overrides=overrides, out=out, progress=False)

@@ -95,6 +95,10 @@ def test_route_aisle_widths_and_what_lies_behind_as_stated(scenes):
 
 
 def test_the_experiment_runs_on_two_layouts_and_writes_the_table(tmp_path):
+    """Above 20 s (about 45 s on an idle core): two layouts is the fewest a share of layouts
+    is taken over, and each layout's run is one teaching and three playbacks (exp2-turn's,
+    exp3-boxes' with its boxes and without them), whose cost is the depth cameras' rendering
+    (in the C++ core), not the particle count (100) or the methods (proposal 2 alone)."""
     from kiseki_experiments.harness.runner import run_experiment
 
     result = run_experiment(
@@ -120,7 +124,7 @@ def test_a_refused_route_fails_only_that_method(monkeypatch, tmp_path):
     per method, so the refusal is recorded for that method and the others still stop."""
     from kiseki_experiments.teach import layouts as exp
 
-    def fake_trial(cfg, index, seed):
+    def fake_trial(cfg, index, seed, taught=None):
         if "conventional" in cfg.methods:
             raise ValueError(f"the route leg T2 -> G {exp.REFUSED} at (7.05, -3.15) m")
         return exp.TrialOutput({f"{m}_stop_error": 0.05 for m in cfg.methods})
@@ -130,6 +134,6 @@ def test_a_refused_route_fails_only_that_method(monkeypatch, tmp_path):
     record = exp._exp2(config, tmp_path / "layout.yaml", 0, 1, "exp2_r0_")
     assert exp.REFUSED in record["exp2_r0_conventional_refused"]
     assert record["exp2_r0_proposal2_stop_error"] == 0.05
-    monkeypatch.setattr(exp.tp, "trial", lambda *a: (_ for _ in ()).throw(ValueError("other")))
+    monkeypatch.setattr(exp.tp, "trial", lambda *a, **k: (_ for _ in ()).throw(ValueError("other")))
     with pytest.raises(ValueError, match="other"):
         exp._exp2(config, tmp_path / "layout.yaml", 0, 1, "exp2_r0_")
