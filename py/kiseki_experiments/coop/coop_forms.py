@@ -22,8 +22,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kiseki.coop import GOAL, START, paper_angle, plan, simulate
+from kiseki.coop import GOAL, START, paper_angle, paper_error, plan, simulate, simulate_3d
+from kiseki.coop.planner import plan_moves, predicted_goal_rms
 from kiseki.plots import new_figure
+from kiseki.sim.robot import BodyMotion, OmniOdometry
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki_experiments.harness.config import Count, NonNegativeReal, PositiveReal, Runs, Spacing
 
@@ -66,8 +68,6 @@ def preflight(config: CoopFormsConfig) -> None:
 
 
 def _errors(form: int, moves: int, goal, runs: int, sigma: float, seed: int) -> dict:
-    from kiseki.coop.planner import predicted_goal_rms
-
     run = simulate(plan(form, moves, None, START, goal), runs, sigma, seed)
     last = run.plan.steps[-1]
     d = run.estimates[:, -1, last.robot] - last.target
@@ -87,8 +87,6 @@ def _errors(form: int, moves: int, goal, runs: int, sigma: float, seed: int) -> 
 
 def _dead_reckoning(config: CoopFormsConfig, seed: int) -> dict:
     """The scout's straight drive from (0, -1) to the goal on odometry alone."""
-    from kiseki.sim.robot import BodyMotion, OmniOdometry
-
     distance = float(np.hypot(*(GOAL - START[2])))
     steps = int(math.ceil(distance / config.step))
     step = distance / steps
@@ -114,8 +112,6 @@ def trial(config: CoopFormsConfig, index: int, seed: int) -> TrialOutput:
     if kind == "dead-reckoning":
         return TrialOutput({"kind": kind, "form": 0, "moves": 0, **_dead_reckoning(config, seed)})
     if kind == "3d":
-        from kiseki.coop import simulate_3d
-
         a, wl = config.ground_amplitude, config.ground_wavelength
 
         def ground(x, y):
@@ -136,8 +132,6 @@ def trial(config: CoopFormsConfig, index: int, seed: int) -> TrialOutput:
             }
         )
     if kind == "planner":
-        from kiseki.coop.planner import plan_moves, predicted_goal_rms
-
         chosen = plan_moves(START, GOAL, sigma)
         run = simulate(chosen, config.runs, sigma, seed)
         return TrialOutput(
@@ -172,8 +166,6 @@ def analytic_optimum(distance: float = 10.0, d: float = 1.0, dtheta: float = 1e-
     d, with theta1 = theta2 = theta and equal errors dtheta1 = dtheta2 (the along-track worst
     case); the along-track errors add up over the n steps, and n d tan(theta) = distance.
     Returns (n, theta in deg, the error) minimising that error over n = 1..200."""
-    from kiseki.coop import paper_error
-
     best = None
     for n in range(1, 201):
         theta = math.atan(distance / (n * d))

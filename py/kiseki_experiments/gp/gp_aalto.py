@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from kiseki_experiments.gp import gp_aalto_tasks as work
+from kiseki_experiments.gp.gp_aalto_report import analyze
 from kiseki_experiments.harness.base import Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
     Count,
@@ -173,12 +174,6 @@ def trial(config: GpAaltoConfig, index: int, seed: int) -> TrialOutput:
     return TrialOutput({"task": task, "payload": json.dumps(payload)}, timings)
 
 
-def _analyze(config, trials, timings, figures):
-    from kiseki_experiments.gp.gp_aalto_report import analyze
-
-    return analyze(config, trials, timings, figures)
-
-
 EXPERIMENT = Experiment(
     name="gp-aalto",
     paper="002_74cea16d239c028f.txt",
@@ -187,7 +182,7 @@ EXPERIMENT = Experiment(
     "detection, magnetic-map MCL, 3-D walks",
     config_type=GpAaltoConfig,
     trial=trial,
-    analyze=_analyze,
+    analyze=analyze,
     default_runs=5,
     preflight=preflight,
     trial_count=lambda config: len(tasks(config)),

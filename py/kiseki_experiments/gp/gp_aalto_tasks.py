@@ -11,8 +11,12 @@ import time
 from pathlib import Path
 
 import numpy as np
+import scipy.io
 
+from kiseki.datasets.kok import SENSOR_TO_BODY, quaternion_to_matrix, read_kok_walk
 from kiseki.gp import ExactGP
+from kiseki.magnetic.field_map import MagneticFieldMap
+from kiseki.magnetic.localization import MagneticMclConfig, localize_on_magnetic_map
 from kiseki_experiments.gp import gp_aalto_steps as st
 
 __all__ = ["change_task", "map_task", "mcl_task", "walks_task"]
@@ -216,9 +220,6 @@ def noisy_odometry(truth: np.ndarray, rng, scale_sd: float, heading_walk: float)
 def mcl_task(config, folder: Path, sensor: str, seed: int, timings: dict) -> dict:
     """Magnetic-map MCL (eqs. 6.17-6.18) along the test run, one update per mcl_step of
     travel, against odometry alone, for mcl_seeds odometry-noise seeds."""
-    from kiseki.magnetic.field_map import MagneticFieldMap
-    from kiseki.magnetic.localization import MagneticMclConfig, localize_on_magnetic_map
-
     runs = st.load_runs(folder, sensor, st.all_runs(config))
     sm = st.static_map(config, folder, sensor)
     test = runs[config.test_run]
@@ -290,10 +291,6 @@ def mcl_task(config, folder: Path, sensor: str, seed: int, timings: dict) -> dic
 
 def _walk_rotations(path: Path) -> np.ndarray:
     """(n, 3, 3) sensor-to-world rotations of a Kok-Solin walk (its reader's convention)."""
-    import scipy.io
-
-    from kiseki.datasets.kok import SENSOR_TO_BODY, quaternion_to_matrix
-
     q = np.asarray(scipy.io.loadmat(path)["quat"], dtype=float)
     return quaternion_to_matrix(q / np.linalg.norm(q, axis=1, keepdims=True)) @ SENSOR_TO_BODY
 
@@ -312,8 +309,6 @@ def sensor_offset(field: np.ndarray, rotations: np.ndarray) -> np.ndarray:
 def walks_task(config, folder: Path, timings: dict) -> dict:
     """3-D maps of each walk's first part, predicting the rest (raw, and less a sensor-frame
     offset fitted on the first part)."""
-    from kiseki.datasets.kok import read_kok_walk
-
     out = []
     for name in config.walks:
         path = folder / "kok_1d" / f"{name}.mat"

@@ -129,6 +129,7 @@ def _serial(jobs, name, values) -> Iterator[dict[str, Any]]:
 def _dask_client(workers: int | None, scheduler: str | None):
     """A Dask client: on a user's scheduler, or on a local cluster of `workers` processes."""
     try:
+        # here, not at the top: dask.distributed takes ~0.3 s to load; only parallel runs use it
         from dask.distributed import Client, LocalCluster
     except ImportError as err:
         raise KisekiError(
@@ -158,6 +159,7 @@ def _dask_client(workers: int | None, scheduler: str | None):
 
 
 def _on_dask(client, jobs, name, values) -> Iterator[dict[str, Any]]:
+    # here, not at the top: only a parallel run loads dask.distributed (see _dask_client)
     from dask.distributed import as_completed
 
     futures = [client.submit(run_trial, name, values, i, s, pure=False) for i, s in jobs]

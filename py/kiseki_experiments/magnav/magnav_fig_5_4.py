@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import math
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -118,8 +119,6 @@ def _measures(r, lo: float, hi: float) -> dict:
 
 
 def trial(config: LidarMclFigureConfig, index: int, seed: int) -> TrialOutput:
-    import time
-
     lo, hi = blind_stretch(config.scene)
     taught = _taught(config.scene, config.map_seed)
     record: dict = {"blind_lo": lo, "blind_hi": hi}

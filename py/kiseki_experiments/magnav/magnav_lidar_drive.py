@@ -28,6 +28,8 @@ from kiseki.control import PurePursuit
 from kiseki.core import derive_seed
 from kiseki.magnetic.lidar_mcl import LidarMclConfig, MagneticLidarMcl, PathHeadingMap
 from kiseki.magnetic.linear_map import LinearMagneticMap, build_linear_map, path_identity
+from kiseki.sim.scene import load_scene
+from kiseki.sim.setup import build_robot, build_sensors
 
 __all__ = ["DRIVE_METHODS", "LOOKAHEAD", "DriveResult", "drive", "load", "teach_heading_map"]
 
@@ -42,9 +44,6 @@ DT = 0.1  # s: 10 Hz, the thesis' laser and magnetometer rate (sec. 3.3.2)
 
 def load(scene_path: str | os.PathLike, seed: int):
     """(scene, robot setup, laser, magnetometer, grid at the laser's height) for ``seed``."""
-    from kiseki.sim.scene import load_scene
-    from kiseki.sim.setup import build_robot, build_sensors
-
     scene = load_scene(scene_path)
     setup = build_robot(scene, seed)
     sensors = build_sensors(scene, setup, seed, DT)

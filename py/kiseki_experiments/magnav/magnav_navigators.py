@@ -31,13 +31,20 @@ import yaml
 
 from kiseki._support.inputs import YAML_LIMIT, read_input_text
 from kiseki._support.yaml import safe_load_12
+from kiseki.apps.magnetic.navigate_run import TaughtMaps, cross_track, navigate
 from kiseki.core import derive_seed
+from kiseki.magnetic.linear_map import path_identity
+from kiseki.magnetic.linear_map_run import linear_map_from_run
 from kiseki.magnetic.navigators import NAVIGATORS, RZ_MIN
+from kiseki.sim.magnetic import DEFAULT_NOISE_SD
+from kiseki.sim.run import SimConfig, simulate
+from kiseki.sim.scene import load_scene
 from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import PositiveReal, Real
 from kiseki_experiments.harness.paths import WORLDS
 from kiseki_experiments.harness.records import pack
 from kiseki_experiments.magnav.magnav_navigators_report import analyze_navigators
+from kiseki_experiments.magnav.magnav_table_4_2 import cut_route
 
 __all__ = ["EXPERIMENT", "METHODS", "NavigatorsConfig", "closed_form_validity"]
 
@@ -62,8 +69,6 @@ class NavigatorsConfig:
 
 def _cut_scene(config: NavigatorsConfig, folder: Path) -> tuple[Path, np.ndarray]:
     """The scene with its route cut to ``length`` m, written to ``folder``."""
-    from kiseki_experiments.magnav.magnav_table_4_2 import cut_route
-
     doc = safe_load_12(read_input_text(config.scene, "scene files", YAML_LIMIT))
     points = np.asarray(doc["route"]["waypoints"], dtype=np.float64)
     waypoints = cut_route(points, config.length)
@@ -94,12 +99,6 @@ def closed_form_validity(counts, noise_sd: float, gate: float = 1.0 - RZ_MIN) ->
 
 
 def _teach(scene_path: Path, waypoints: np.ndarray, seed: int, folder: Path):
-    from kiseki.apps.magnetic.navigate_run import TaughtMaps
-    from kiseki.magnetic.linear_map import path_identity
-    from kiseki.magnetic.linear_map_run import linear_map_from_run
-    from kiseki.sim.run import SimConfig, simulate
-    from kiseki.sim.scene import load_scene
-
     run = folder / "teach.mcap"
     scene = load_scene(scene_path, "teach")
     simulate(scene, run, SimConfig(seed=seed), overwrite=True, progress=False)
@@ -114,8 +113,6 @@ def _validity(config, maps, result) -> dict:
     cols = {n: p[:, list(result.navigators).index(n)] > 0 for n in result.navigators}
     lmap = maps.center
     mz = lmap.field[:, 2]
-    from kiseki.apps.magnetic.navigate_run import cross_track
-
     _, node_along = cross_track(maps.waypoints, lmap.position)  # the nodes' true places
     order = np.argsort(node_along, kind="stable")
     k = np.searchsorted(node_along[order], result.along_track).clip(0, len(lmap) - 1)
@@ -148,17 +145,12 @@ def _validity(config, maps, result) -> dict:
 
 
 def _noise_sd(config: NavigatorsConfig) -> float:
-    from kiseki.sim.magnetic import DEFAULT_NOISE_SD
-    from kiseki.sim.scene import load_scene
-
     scene = load_scene(config.scene, "playback")
     mag = [s for s in scene.sensors if s.get("type") == "magnetometer"]
     return float(mag[0].get("noise_sd", DEFAULT_NOISE_SD)) if mag else DEFAULT_NOISE_SD
 
 
 def trial(config: NavigatorsConfig, index: int, seed: int) -> TrialOutput:
-    from kiseki.apps.magnetic.navigate_run import navigate
-
     record: dict = {}
     with tempfile.TemporaryDirectory(prefix="magnav-nav-") as tmp:
         folder = Path(tmp)

@@ -45,6 +45,8 @@ from kiseki.magnetic.linear_map import build_linear_map, path_identity
 from kiseki.magnetic.linear_map_run import teaching_samples
 from kiseki.magnetic.travel_distance import TravelDistanceConfig, TravelDistanceLocalizer
 from kiseki.sim.magnetic import MagneticWorld
+from kiseki.sim.run import SimConfig, simulate
+from kiseki.sim.scene import load_scene
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki_experiments.harness.config import NonNegativeReal, Particles, PositiveReal, Real, Share
 from kiseki_experiments.harness.paths import WORLDS
@@ -93,8 +95,6 @@ def _field(scene) -> MagneticWorld:
 
 def _scene(config: Table42Config, variant: str):
     """The scene's variant with the route cut to ``length`` and the magnetometer alone."""
-    from kiseki.sim.scene import load_scene
-
     scene = load_scene(config.scene, variant)
     waypoints = cut_route(np.asarray(scene.route["waypoints"], dtype=np.float64), config.length)
     route = {**scene.route, "waypoints": waypoints.tolist()}
@@ -163,8 +163,6 @@ def changed_stretches(
 
 def _drive(scene, seed: int, folder: Path, name: str, waypoints: np.ndarray):
     """(true distance along the route, odometry distance, readings) of one run."""
-    from kiseki.sim.run import SimConfig, simulate
-
     run = folder / f"{name}.mcap"
     simulate(scene, run, SimConfig(seed=seed), overwrite=True, progress=False)
     samples = teaching_samples(run, scan_topic=None)

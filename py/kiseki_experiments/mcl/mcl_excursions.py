@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from kiseki.datasets import read_carmen_log
 from kiseki.filters import (
     RECOVERY_MODES,
     LocalizeConfig,
@@ -31,8 +32,10 @@ from kiseki.filters import (
     scan_model,
     scan_preparer,
 )
+from kiseki.mapping import MapBuildConfig, map_of_log
 from kiseki.metrics import ape
 from kiseki.plots import new_figure
+from kiseki.teach.environment_map import build_teaching_map
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
     NonNegativeReal,
@@ -111,10 +114,6 @@ def model_sees(scans, grid, lc: LocalizeConfig, estimates: np.ndarray, index: np
 
 
 def trial(config: ExcursionsConfig, index: int, seed: int) -> TrialOutput:
-    from kiseki.datasets import read_carmen_log
-    from kiseki.mapping import MapBuildConfig, map_of_log
-    from kiseki.teach.environment_map import build_teaching_map
-
     name = config.logs[index % len(config.logs)]
     path = shared_data("carmen", config.data_dir) / f"{name}.log.gz"
     scans = read_carmen_log(path).scans.first(config.max_scans)

@@ -26,7 +26,9 @@ recovery time is from the jump to the first of those updates.
 
 from __future__ import annotations
 
+import copy
 import math
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,9 +36,14 @@ import numpy as np
 import pandas as pd
 
 from kiseki.core import Pose2, derive_seed
+from kiseki.datasets import read_carmen_log
 from kiseki.filters import RECOVERY_MODES, LocalizeConfig, localize
+from kiseki.io.runlog import read_run
+from kiseki.mapping import MapBuildConfig, map_of_log
 from kiseki.plots import new_figure
 from kiseki.scans import LaserScans
+from kiseki.sim.run import SimConfig, simulate
+from kiseki.sim.scene import load_scene
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
     Count,
@@ -195,13 +202,6 @@ def _laser_mount(spec: dict) -> Pose2:
 
 def trial_sim(config: KidnapConfig, index: int, seed: int) -> TrialOutput:
     """One simulated run of the scene (laser only), spliced and tracked."""
-    import copy
-    import tempfile
-
-    from kiseki.io.runlog import read_run
-    from kiseki.sim.run import SimConfig, simulate
-    from kiseki.sim.scene import load_scene
-
     scene = load_scene(PROJECT / config.scene)
     spec = dict(scene.robot_specs[0])
     spec["sensors"] = [s for s in spec.get("sensors", []) if s.get("type") == "laser"]
@@ -220,9 +220,6 @@ def trial_sim(config: KidnapConfig, index: int, seed: int) -> TrialOutput:
 
 
 def trial_carmen(config: KidnapConfig, index: int, seed: int) -> TrialOutput:
-    from kiseki.datasets import read_carmen_log
-    from kiseki.mapping import MapBuildConfig, map_of_log
-
     name = config.logs[index % len(config.logs)]
     path = shared_data("carmen", config.data_dir) / f"{name}.log.gz"
     scans = read_carmen_log(path).scans

@@ -21,7 +21,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kiseki.filters import noisy_odometry
+from kiseki.datasets import read_carmen_log
+from kiseki.filters import GlobalConfig, global_localize, noisy_odometry
+from kiseki.mapping import MapBuildConfig, map_of_log
 from kiseki.metrics import ape
 from kiseki.plots import new_figure
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
@@ -51,10 +53,6 @@ def preflight(config: KldConfig) -> None:
 
 
 def trial(config: KldConfig, index: int, seed: int) -> TrialOutput:
-    from kiseki.datasets import read_carmen_log
-    from kiseki.filters import GlobalConfig, global_localize
-    from kiseki.mapping import MapBuildConfig, map_of_log
-
     name = config.logs[index % len(config.logs)]
     path = shared_data("carmen", config.data_dir) / f"{name}.log.gz"
     scans = read_carmen_log(path).scans.first(config.max_scans)

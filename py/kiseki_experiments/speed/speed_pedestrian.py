@@ -40,7 +40,13 @@ from kiseki.sim.pedestrians import Pedestrian
 from kiseki.sim.scene import load_scene
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki_experiments.harness.config import NonNegativeReal, PositiveReal, Real, Seconds, Speed
-from kiseki_experiments.speed.speed_common import WORLDS, drive, prior_map, with_pedestrians
+from kiseki_experiments.speed.speed_common import (
+    METHODS,
+    WORLDS,
+    drive,
+    prior_map,
+    with_pedestrians,
+)
 
 __all__ = ["EXPERIMENT", "PedestrianConfig"]
 
@@ -64,8 +70,6 @@ class PedestrianConfig:
 
 
 def preflight(config: PedestrianConfig) -> None:
-    from kiseki_experiments.speed.speed_common import METHODS
-
     unknown = sorted(set(config.methods) - set(METHODS))
     if unknown:
         raise ValueError(f"speed-pedestrian: unknown methods {unknown} (known: {METHODS})")

@@ -26,7 +26,13 @@ from kiseki.grid import OccupancyGrid
 from kiseki.models import LocalMapBuilder, SpaceObservationModel
 from kiseki.plots import new_figure
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
-from kiseki_experiments.harness.config import Count, NonNegativeReal, PositiveReal, Real
+from kiseki_experiments.harness.config import (
+    ConfigError,
+    Count,
+    NonNegativeReal,
+    PositiveReal,
+    Real,
+)
 
 
 @dataclass(frozen=True)
@@ -44,8 +50,6 @@ class Fig314Config:
     def __post_init__(self) -> None:
         """Refuses settings that make the check meaningless (beams=0 drew every likelihood at
         1.0 and a claim 'held'), naming the key."""
-        from kiseki_experiments.harness.config import ConfigError
-
         finite = np.isfinite
         checks = (
             ("beams", self.beams >= 2, ">= 2"),

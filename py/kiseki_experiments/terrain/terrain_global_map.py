@@ -17,6 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
+from kiseki.sim.terrain_moves import terrain_stops
+from kiseki.terrain.mapper import MapperConfig, SdemMapper
+from kiseki.terrain.render import render_run
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki_experiments.harness.config import Count, Resolution
 from kiseki_experiments.harness.paths import WORLDS
@@ -39,8 +42,6 @@ class GlobalMapConfig:
 
 
 def preflight(config: GlobalMapConfig) -> None:
-    from kiseki.terrain.mapper import MapperConfig
-
     MapperConfig(removal=config.removal, search=config.search, cost=config.cost)
     if not Path(config.scene).is_file():
         raise FileNotFoundError(f"terrain-global-map: scene {config.scene} not found")
@@ -49,9 +50,6 @@ def preflight(config: GlobalMapConfig) -> None:
 
 
 def _run(config: GlobalMapConfig, seed: int):
-    from kiseki.sim.terrain_moves import terrain_stops
-    from kiseki.terrain.mapper import MapperConfig, SdemMapper
-
     stops = terrain_stops(config.scene, config.moves, seed, config.step)
     mapper_config = MapperConfig(
         removal=config.removal, search=config.search, cost=config.cost, voxel=config.voxel,
@@ -84,8 +82,6 @@ def trial(config: GlobalMapConfig, index: int, seed: int) -> TrialOutput:
 
 
 def analyze(config: GlobalMapConfig, trials, timings, figures: Path) -> Analysis:
-    from kiseki.terrain.render import render_run
-
     ok = trials[trials["error"].isna()]
     if ok.empty:
         return Analysis(notes="every trial failed: nothing to analyse")
