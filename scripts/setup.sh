@@ -5,7 +5,8 @@
 # Idempotent set-up, sourced by scripts/demo.sh and scripts/test.sh:
 #   1. Debian packages (apt-get, through sudo when not root), only when one is missing;
 #   2. .venv/ at the project root with the build tools and Python dependencies;
-#   3. kiseki installed editable into .venv, rebuilt only when C++/CMake sources changed.
+#   3. kiseki installed editable into .venv, again only when C++/CMake sources changed or a
+#      Python module was added, moved or removed.
 # A second run does no download and no compilation when nothing changed.
 set -euo pipefail
 
@@ -69,7 +70,11 @@ PY
     rm -f "$KISEKI_VENV/.kiseki-build"
   fi
   local build_stamp="$KISEKI_VENV/.kiseki-build" build_hash
-  build_hash="$(tree_hash cpp bindings cmake CMakeLists.txt pyproject.toml)"
+  # the editable install maps each Python module by name, so a module added, moved or removed
+  # needs it again as much as a changed C++ source does
+  build_hash="$(tree_hash cpp bindings cmake CMakeLists.txt pyproject.toml)-$(
+    cd "$KISEKI_ROOT" && find py -name '*.py' -not -path '*/__pycache__/*' | sort | sha1sum |
+      cut -d' ' -f1)"
   if [ "$(cat "$build_stamp" 2>/dev/null)" != "$build_hash" ]; then
     log "building and installing kiseki (incremental C++ build in build/editable)"
     (cd "$KISEKI_ROOT" && CMAKE_BUILD_PARALLEL_LEVEL="${CMAKE_BUILD_PARALLEL_LEVEL:-2}" \
