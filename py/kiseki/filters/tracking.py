@@ -86,12 +86,14 @@ class LocalizeConfig:
       likelihood field); the beam model adds ``z_short``, ``z_max``, ``lambda_short`` (nav2's).
     * ``combination`` product (beams independent) or nav2 (1 + sum pz^3).
     * ``alphas`` None: :func:`motion_alphas` (the noise the odometry has).
+    * the engine's settings (particles, KLD, resampling, recovery, update thresholds,
+      threads) default to :class:`MclConfig`'s, which holds each of them once.
     """
 
     method: str = "likelihood-field"
     seed: int = 0
     odometry_noise: float = 0.0  # SD as a fraction of each odometry increment's component
-    particles: int = 500
+    particles: int = MclConfig.particles
     initial_sd: tuple[float, float, float] = (0.1, 0.1, math.radians(3.0))
     alphas: tuple[float, ...] | None = None
     beams: int = 90
@@ -102,17 +104,17 @@ class LocalizeConfig:
     z_max: float = 0.05
     lambda_short: float = 0.1
     combination: str = "product"
-    kld: bool = False
-    min_particles: int = 100
-    resampling: str = "systematic"
-    resample_threshold: float = 0.5
-    recovery: str = "none"
-    update_min_d: float = 0.0
-    update_min_a: float = 0.0
-    threads: int = 0
+    kld: bool = MclConfig.kld
+    min_particles: int = MclConfig.min_particles
+    resampling: str = MclConfig.resampling
+    resample_threshold: float = MclConfig.resample_threshold
+    recovery: str = MclConfig.recovery
+    update_min_d: float = MclConfig.update_min_d
+    update_min_a: float = MclConfig.update_min_a
+    threads: int = MclConfig.threads
     global_start: bool = False  # start uniformly over the map (no initial pose)
-    resetting_injects: bool = False  # resetting adds Augmented MCL's injection (MclConfig)
-    likelihood_power: float = 1.0
+    resetting_injects: bool = MclConfig.resetting_injects  # Augmented MCL's injection
+    likelihood_power: float = MclConfig.likelihood_power
 
     def __post_init__(self) -> None:
         _check(
