@@ -70,12 +70,14 @@ def test_trials_to_decide_scale_the_half_width_as_one_over_sqrt_n():
     # the variance: 80 trials
     assert trials_to_decide(AT_LEAST, Estimate(0.55, 0.45, 0.65, 20)) == 80
     assert trials_to_decide(AT_LEAST, Estimate(0.5, 0.4, 0.6, 20)) is None  # on the threshold
-    # brute force: a share of 0.6 decides >= 0.5 within 10 % of the predicted count (Wilson's
-    # arm shrinks a little faster than 1/sqrt(n) at small n), not at a third of it
+    # brute force for a share, whose Wilson interval is searched: 12 of 20 (0.6) decides >= 0.5
+    # at the count given, not one below; all of 10 decides >= 0.95 at 73 (n / (n + 1.96^2))
     need = trials_to_decide(AT_LEAST, estimate(Evidence.share("k", 12, 20), 0))
-    for m, verdict in ((math.ceil(1.1 * need), "holds"), (need // 3, "inconclusive")):
-        share = Evidence.share("k", math.ceil(0.6 * m), m)
+    for m, verdict in ((need, "holds"), (need - 1, "inconclusive")):
+        share = Evidence.share("k", round(0.6 * m), m)
         assert decide(AT_LEAST, estimate(share, 0)) == verdict, (m, need)
+    target = Criterion("0.95", ">=", 0.95, "the issue's target", bounds=(0.0, 1.0))
+    assert trials_to_decide(target, estimate(Evidence.share("k", 10, 10), 0)) == 73
 
 
 def _experiment(claims=()) -> base.Experiment:
