@@ -54,7 +54,7 @@ def main() -> None:
     ratio = per_call(lambda p, a, r, m: occlusion_ratio(prior, p, a, r, m, math.pi / 2), calls)
     limiter = SpeedLimiter(prior)
     full = per_call(lambda p, a, r, m: limiter.update(p, a, r, m, 0.1), calls)
-    distance = DistanceSpeedLimiter()
+    distance = DistanceSpeedLimiter(prior)
     polygon = PolygonSpeedLimiter()
     dist_t = per_call(lambda p, a, r, m: distance.update(p, a, r, m, 0.1), calls)
     poly_t = per_call(lambda p, a, r, m: polygon.update(p, a, r, m, 0.1), calls)

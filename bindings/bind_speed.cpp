@@ -69,19 +69,19 @@ void bind_speed(py::module_& m) {
       "uint8 [y, x], 0 outside the region, 1 occluded free cell, 2 seen.");
   m.def(
       "passage_width",
-      [](const py::handle& angles, const py::handle& ranges, double max_range, double heading, double window_ahead) {
+      [](const py::handle& angles, const py::handle& ranges, double max_range, double heading, double half_band) {
         const ScanArrays s(angles, ranges, max_range);
-        const PassageWidth w = passage_width(s.scan, heading, window_ahead);
+        const PassageWidth w = passage_width(s.scan, heading, half_band);
         return py::make_tuple(w.width, w.left, w.right);
       },
-      "angles"_a, "ranges"_a, "max_range"_a, "heading"_a = 0.0, "window_ahead"_a = 1.0,
-      "(w, left, right): the passage across the heading (sensor frame, rad).");
+      "angles"_a, "ranges"_a, "max_range"_a, "heading"_a = 0.0, "half_band"_a = 0.05,
+      "(w, left, right): eq. 2's w, measured on the line across the heading (sensor frame, rad).");
   m.def("width_factor", &width_factor, "w"_a, "w1"_a, "w2"_a, "a"_a, "f(w) of eq. 3 (the sigmoid, typo corrected).");
   m.def(
       "speed_reference",
       [](const OccupancyGrid& grid, const py::handle& pose, const py::handle& angles, const py::handle& ranges,
          double max_range, py::object heading, double v_max, double half_angle, int free_threshold, double w1,
-         double w2, double a, double window_ahead, bool use_occlusion, bool use_width) {
+         double w2, double a, double half_band, bool use_occlusion, bool use_width) {
         const Pose2 sensor = pose_of(pose);
         const ScanArrays s(angles, ranges, max_range);
         if (free_threshold < 0 || free_threshold > 100) throw std::invalid_argument("free_threshold must be in 0..100");
@@ -89,7 +89,7 @@ void bind_speed(py::module_& m) {
         p.v_max = v_max;
         p.occlusion.half_angle = half_angle;
         p.occlusion.free_threshold = static_cast<std::int8_t>(free_threshold);
-        p.w1 = w1, p.w2 = w2, p.a = a, p.window_ahead = window_ahead;
+        p.w1 = w1, p.w2 = w2, p.a = a, p.half_band = half_band;
         p.use_occlusion = use_occlusion, p.use_width = use_width;
         const double h = heading.is_none() ? sensor.theta : heading.cast<double>();
         SpeedReference r;
@@ -110,7 +110,7 @@ void bind_speed(py::module_& m) {
       },
       "grid"_a, "pose"_a, "angles"_a, "ranges"_a, "max_range"_a, "heading"_a = py::none(), "v_max"_a = 0.5,
       "half_angle"_a = M_PI / 2, "free_threshold"_a = 25, "w1"_a = 0.70, "w2"_a = 2.0, "a"_a = 4.9,
-      "window_ahead"_a = 1.0, "use_occlusion"_a = true, "use_width"_a = true,
+      "half_band"_a = 0.05, "use_occlusion"_a = true, "use_width"_a = true,
       "Eq. 4's speed reference and its factors, as a dict.");
 }
 

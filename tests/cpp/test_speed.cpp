@@ -2,6 +2,7 @@
 // Copyright (c) 2026 the kiseki authors
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <opencv2/core.hpp>
@@ -125,26 +126,59 @@ TEST(OcclusionRatio, BadInputIsRefused) {
   EXPECT_THROW(occlusion_ratio(map, Pose2(), s.view(), 0.0, {}), std::invalid_argument);
 }
 
-TEST(PassageWidth, CorridorWallsGiveTheClearWidth) {
-  // walls at y = +0.8 and y = -0.7 of a sensor looking along +x
+/// The paper's laser (683 beams over +-120 deg, 4 m) at the origin looking along +x in a
+/// corridor along x with walls at y = +left and y = -right and, when ahead > 0, an end wall
+/// across it at x = ahead: exact ranges (ray against the three lines).
+Scan corridor(double left, double right, double ahead) {
   Scan s;
   for (int i = 0; i < 683; ++i) s.angles.push_back(-2 * kPi / 3 + i * (4 * kPi / 3) / 682);
   for (double a : s.angles) {
-    const double sn = std::sin(a);
+    const double sn = std::sin(a), cs = std::cos(a);
     double r = s.max_range;
-    if (sn > 1e-9) r = std::min(r, 0.8 / sn);
-    if (sn < -1e-9) r = std::min(r, -0.7 / sn);
+    if (sn > 1e-9) r = std::min(r, left / sn);
+    if (sn < -1e-9) r = std::min(r, -right / sn);
+    if (ahead > 0 && cs > 1e-9) r = std::min(r, ahead / cs);
     s.ranges.push_back(static_cast<float>(r));
   }
-  const PassageWidth w = passage_width(s.view(), 0.0, 1.0);
+  return s;
+}
+
+TEST(PassageWidth, CorridorWallsGiveTheClearWidth) {
+  // walls at y = +0.8 and y = -0.7 of a sensor looking along +x: eq. 2's w = 1.5 m
+  const Scan s = corridor(0.8, 0.7, 0.0);
+  const PassageWidth w = passage_width(s.view(), 0.0, 0.05);
   EXPECT_NEAR(w.left, 0.8, 1e-5);
   EXPECT_NEAR(w.right, 0.7, 1e-5);
   EXPECT_NEAR(w.width, 1.5, 1e-5);
-  // heading across the corridor (+y): the left wall lies 0.8 m ahead, inside the window, and
-  // closes the passage (its points straight ahead are at |y'| ~ 0 on both sides)
-  EXPECT_LT(passage_width(s.view(), kPi / 2, 1.0).width, 0.01);
-  // ... but not with a window that ends before it: nothing bounds the passage then
-  EXPECT_DOUBLE_EQ(passage_width(s.view(), kPi / 2, 0.5).width, 2 * s.max_range);
+  // heading across the corridor (+y): the line across that heading is the corridor's axis,
+  // which no wall crosses within the range: both sides are open
+  EXPECT_DOUBLE_EQ(passage_width(s.view(), kPi / 2, 0.05).width, 2 * s.max_range);
+}
+
+TEST(PassageWidth, AWallAheadIsNotASideOfThePassage) {
+  // w is measured across the heading (eq. 2, Fig. 3a): a straight corridor of width W gives
+  // w = W whatever wall closes it ahead, wherever the robot stands across it, with the default
+  // parameters of eq. 4. The first case is the 2.3 m corridor of the paper's situation 1 with a
+  // wall 0.9 m ahead (w = 2.3 m; counting the wall's points straight ahead as sides gave 0.006 m
+  // and f(w) = 0.0018).
+  SpeedReferenceParams params;  // the paper's sec. 4 values
+  params.use_occlusion = false;
+  const OccupancyGrid map = free_field();
+  for (double width : {2.3, 1.5, 0.9}) {
+    for (double offset : {0.0, 0.2, -0.3}) {
+      for (double ahead : {0.9, 0.3, 1.5, 3.0}) {
+        const double left = width / 2 - offset, right = width / 2 + offset;
+        const Scan s = corridor(left, right, ahead);
+        const SpeedReference r = speed_reference(map, Pose2(), s.view(), 0.0, params);
+        EXPECT_NEAR(r.passage.width, width, 1e-5) << "W " << width << ", offset " << offset << ", wall " << ahead;
+        EXPECT_NEAR(r.passage.left, left, 1e-5);
+        EXPECT_NEAR(r.passage.right, right, 1e-5);
+        const double f = 1.0 / (1.0 + std::exp(-4.9 * (width - 1.3)));  // eq. 3
+        EXPECT_NEAR(r.v_ref, 0.5 * f, 1e-5);                             // eq. 2
+      }
+    }
+  }
+  EXPECT_THROW(passage_width(corridor(1.0, 1.0, 0.0).view(), 0.0, 0.0), std::invalid_argument);
 }
 
 TEST(WidthFactor, SigmoidAtTheParametersOfThePaper) {

@@ -9,12 +9,11 @@
 
 namespace kiseki {
 
-PassageWidth passage_width(const PlanarScan& scan, double heading_in_sensor, double window_ahead) {
+PassageWidth passage_width(const PlanarScan& scan, double heading_in_sensor, double half_band) {
   check_scan(scan);
   if (!std::isfinite(heading_in_sensor)) throw std::invalid_argument("the heading must be finite");
-  if (!(std::isfinite(window_ahead) && window_ahead > 0)) {
-    throw std::invalid_argument("window_ahead must be a positive number of metres, got " +
-                                std::to_string(window_ahead));
+  if (!(std::isfinite(half_band) && half_band > 0)) {
+    throw std::invalid_argument("half_band must be a positive number of metres, got " + std::to_string(half_band));
   }
   const double c = std::cos(heading_in_sensor), s = std::sin(heading_in_sensor);
   PassageWidth out{0.0, scan.max_range, scan.max_range};
@@ -23,14 +22,17 @@ PassageWidth passage_width(const PlanarScan& scan, double heading_in_sensor, dou
     if (!(r < scan.max_range)) continue;  // no return (or NaN): nothing bounds the passage there
     const double px = r * std::cos(scan.angles[i]), py = r * std::sin(scan.angles[i]);
     const double along = px * c + py * s, across = -px * s + py * c;  // the heading's frame
-    if (along < 0 || along > window_ahead) continue;
+    // Eq. 2's w is measured perpendicular to the heading (Fig. 3a): only obstacles on the line
+    // across the heading through the sensor bound it; one ahead of or behind that line (a wall
+    // the robot drives towards) is not a side of the passage.
+    if (std::abs(along) > half_band) continue;
     if (across >= 0) {
       out.left = std::min(out.left, across);
     } else {
       out.right = std::min(out.right, -across);
     }
   }
-  out.width = out.left + out.right;
+  out.width = out.left + out.right;  // w of eq. 2: left wall to right wall, across the heading
   return out;
 }
 

@@ -16,8 +16,8 @@ void check_params(const SpeedReferenceParams& p) {
   }
   if (p.occlusion.free_threshold < 0) throw std::invalid_argument("free_threshold must be in 0..100");
   width_factor(p.w2, p.w1, p.w2, p.a);  // checks w1, w2 and a
-  if (!(std::isfinite(p.window_ahead) && p.window_ahead > 0)) {
-    throw std::invalid_argument("window_ahead must be positive");
+  if (!(std::isfinite(p.half_band) && p.half_band > 0)) {
+    throw std::invalid_argument("half_band must be positive");
   }
 }
 
@@ -32,7 +32,7 @@ SpeedReference speed_reference(const OccupancyGrid& map, const Pose2& sensor_pos
     factor *= out.occlusion.ratio;  // eq. 1
   }
   if (params.use_width) {
-    out.passage = passage_width(scan, normalize_angle(heading - sensor_pose.theta), params.window_ahead);
+    out.passage = passage_width(scan, normalize_angle(heading - sensor_pose.theta), params.half_band);
     out.width_factor = width_factor(out.passage.width, params.w1, params.w2, params.a);
     factor *= out.width_factor;  // eq. 2
   }

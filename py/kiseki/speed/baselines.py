@@ -8,17 +8,28 @@ the same runs. Both implement ``kiseki.control.SpeedLimitSource`` and pass their
 update, up and down alike (the robot can neither speed up nor brake faster than a_max), starting
 from ``initial`` (0 m/s by default: the robot starts at rest).
 
-``DistanceSpeedLimiter``: distance-only slowdown, in the spirit of J. Miura, Y. Negishi and
-Y. Shirai, "Adaptive robot speed control by considering map and motion uncertainty" (J. RSJ
-24(1) 47-55, 2006; paper 004's ref. [4]): the robot may go as fast as it can still stop, braking
-at a_brake, before the nearest obstacle ahead. With d the distance from the robot's centre to
-the nearest scan point within +-``half_angle`` of the heading,
+``DistanceSpeedLimiter``: distance-only slowdown after paper 004's ref. [4] (J. Miura,
+Y. Negishi and Y. Shirai, "Adaptive robot speed control by considering map and motion
+uncertainty", J. RSJ 24(1) 47-55, 2006), which paper 004 describes only as setting the speed
+from the distance to the unobserved region the robot moves towards, and then faults for looking
+at the distance alone and not at how large the hidden region is. The rule kept here: with
+d_hidden the distance from the robot's body to the nearest occluded region,
 
-    v = min(v_max, sqrt(2 a_brake max(0, d - d_stop))),  d_stop = half_length + stop_margin
+    v = v_max * min(1, d_hidden / d_stop),  d_stop = v_max * t_react + v_max^2 / (2 a_max)
 
-a_brake = a_max (0.5 m/s^2), half_length 0.35 m (the 0.70 m robot), stop_margin 0.1 m: the
-robot stops 0.1 m before its front would touch. No point ahead: v_max. (Miura et al. plan on a
-map with uncertainty; only their distance-to-stop rule is kept here.)
+d_stop is the distance the robot needs to stop from v_max: one scan period t_react = 0.1 s
+(paper 004's LRF cycle, after which the next limit applies) at v_max, then braking at a_max.
+The ramp is linear, not the kinematic sqrt(2 a_max d): a robot at this v stops within
+d^2 / d_stop <= d, so it still stops before the region, and a ramp is what "a speed set from
+the distance" says; the kinematic reading allows more speed at every d < d_stop. The occluded
+region is exactly method 1's (eq. 1; ``kiseki.speed.occlusion_labels``): the prior map's free
+cells within +-theta of the direction of motion and within the sensor's reach that the current
+scan does not see. d_hidden = the distance from the body centre to the nearest such cell's
+centre minus ``half_length`` (the body taken as a disc of 0.35 m, the 0.70 m robot), at least
+0; no occluded cell: v_max. Paper 004's sentence on [4] also names obstacles the sensor
+detects; those are left out on purpose: the navigator that drives every method (the Fuzzy
+Potential Method) already slows for what it sees, so this baseline and method 1 differ only in
+how they turn the occluded region into a speed (its distance here, its size in eq. 1).
 
 ``PolygonSpeedLimiter``: nav2's collision monitor (nav2_collision_monitor; parameters as in
 docs.nav2.org "Using Collision Monitor" and the package README): polygons with ``action_type``
@@ -34,9 +45,10 @@ slowdown box, v_max otherwise. Differences from nav2: nav2 scales the commanded 
 omnidirectional). Points on a box's edge count as inside.
 
 Geometry shared by both: the laser sits ``sensor_offset`` metres ahead of the body centre along
-its own x axis (the speed worlds mount it at 0.2 m; default 0), facing the body's front; scan
-returns at or beyond ``max_range`` and NaN are ignored; the heading (map frame) defaults to the
-sensor's.
+its own x axis (the speed worlds mount it at 0.2 m; default 0), facing the body's front; the
+heading (map frame) defaults to the sensor's. The polygon ignores scan returns at or beyond
+``max_range`` and NaN ones; for the distance limiter they are what eq. 1 makes of them (a
+no-return reading sees up to the range, a NaN one sees nothing).
 """
 
 from __future__ import annotations
@@ -46,7 +58,9 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from kiseki import _core
 from kiseki.control.speed_limit import SpeedLimit
+from kiseki.grid import OccupancyGrid
 
 __all__ = [
     "AccelerationLimit",
@@ -109,42 +123,73 @@ def points_in_motion_frame(sensor_pose, angles, ranges, max_range, heading, sens
 
 @dataclass(frozen=True)
 class DistanceLimiterConfig:
-    """``DistanceSpeedLimiter``'s parameters (m, m/s, m/s^2, rad)."""
+    """``DistanceSpeedLimiter``'s parameters (m, m/s, m/s^2, s, rad); ``half_angle`` and
+    ``free_threshold`` are method 1's (``SpeedLimiterConfig``), so both see one region."""
 
     v_max: float = 0.5
     a_max: float = 0.5
-    half_angle: float = math.radians(30.0)
-    half_length: float = 0.35
-    stop_margin: float = 0.1
+    reaction_time: float = 0.1  # s, one scan period of paper 004's LRF
+    half_angle: float = math.pi / 2  # rad, theta of eq. 1
+    half_length: float = 0.35  # m, the body's half size (the 0.70 m robot)
+    free_threshold: int = 25  # map cells 0..25 are free, as for method 1
     sensor_offset: float = 0.0
     initial_speed: float = 0.0
 
     def __post_init__(self) -> None:
-        _check_config(self, non_negative=("stop_margin", "sensor_offset", "initial_speed"))
+        _check_config(
+            self,
+            non_negative=("reaction_time", "half_length", "free_threshold", "sensor_offset",
+                          "initial_speed"),
+        )  # fmt: skip
         if self.half_angle > math.pi:
             raise ValueError(
                 f"DistanceLimiterConfig.half_angle must be <= pi, got {self.half_angle}"
             )
+        if not (isinstance(self.free_threshold, int) and self.free_threshold <= 100):
+            raise ValueError("DistanceLimiterConfig.free_threshold must be an integer in 0..100")
+
+    @property
+    def stop_distance(self) -> float:
+        """d_stop = v_max t_react + v_max^2 / (2 a_max) (m): 0.30 m at the defaults."""
+        return self.v_max * self.reaction_time + self.v_max**2 / (2 * self.a_max)
 
 
 class DistanceSpeedLimiter:
-    """The speed from which the robot still stops before the nearest obstacle ahead."""
+    """v = v_max min(1, d_hidden / d_stop): the distance to the nearest occluded region alone
+    (module docstring). ``grid``: the prior map, as for ``SpeedLimiter``."""
 
-    def __init__(self, config: DistanceLimiterConfig | None = None) -> None:
+    def __init__(self, grid: OccupancyGrid, config: DistanceLimiterConfig | None = None) -> None:
+        if not isinstance(grid, OccupancyGrid):
+            raise TypeError(
+                "DistanceSpeedLimiter(grid, config) needs the prior map (a kiseki OccupancyGrid) "
+                f"first, got {type(grid).__name__}"
+            )
+        self.grid = grid
         self.config = config if config is not None else DistanceLimiterConfig()
         self.rate = AccelerationLimit(self.config.a_max, self.config.initial_speed)
+
+    def hidden_distance(self, sensor_pose, angles, ranges, max_range, heading=None) -> float:
+        """d_hidden (m): from the body to the nearest occluded cell's centre, inf if none."""
+        c = self.config
+        x, y, theta = (float(v) for v in np.asarray(sensor_pose, dtype=float).reshape(3))
+        _, _, _, labels = _core.occlusion_ratio(
+            self.grid, (x, y, theta), angles, ranges, float(max_range), c.half_angle, heading,
+            free_threshold=c.free_threshold, with_labels=True,
+        )  # fmt: skip
+        rows, cols = np.nonzero(labels == 1)  # 1: a free cell of eq. 1's region not seen
+        if rows.size == 0:
+            return math.inf
+        centres = self.grid.cell_to_world(np.column_stack([cols, rows]))
+        cx = x - c.sensor_offset * math.cos(theta)  # the body centre
+        cy = y - c.sensor_offset * math.sin(theta)
+        nearest = float(np.hypot(centres[:, 0] - cx, centres[:, 1] - cy).min())
+        return max(0.0, nearest - c.half_length)
 
     def target(self, sensor_pose, angles, ranges, max_range, heading=None) -> float:
         """The limit (m/s) before the acceleration limit."""
         c = self.config
-        px, py = points_in_motion_frame(
-            sensor_pose, angles, ranges, max_range, heading, c.sensor_offset
-        )
-        ahead = np.abs(np.arctan2(py, px)) <= c.half_angle
-        if not ahead.any():
-            return c.v_max
-        d = float(np.hypot(px[ahead], py[ahead]).min())
-        return min(c.v_max, math.sqrt(2 * c.a_max * max(0.0, d - c.half_length - c.stop_margin)))
+        d = self.hidden_distance(sensor_pose, angles, ranges, max_range, heading)
+        return c.v_max * min(1.0, d / c.stop_distance)
 
     def update(self, sensor_pose, angles, ranges, max_range, dt, heading=None) -> SpeedLimit:
         value = self.rate.step(self.target(sensor_pose, angles, ranges, max_range, heading), dt)

@@ -8,8 +8,10 @@ for autonomous mobile robots considering occluded regions based on map and senso
   over the map's free cells within the sensor's reach (walls of the map hide some of them: a
   known corner or crossing shrinks the ratio, and so does an obstacle the map does not know).
 - Eqs. 2-3, the width term: v_max * f(w), f(w) = 1 / (1 + exp(-a (w - b))), b = w2 - w1, w the
-  width of the passage across the direction of motion. The paper prints ``1 - exp``, a typo: that
-  function has a pole at w = b and is negative below it; its Fig. 3b draws the sigmoid.
+  distance between the obstacles detected, perpendicular to the direction of motion (Fig. 3a):
+  measured on the line across the heading through the sensor, so a wall the robot drives
+  towards is not a side of the passage. The paper prints ``1 - exp``, a typo: that function has
+  a pole at w = b and is negative below it; its Fig. 3b draws the sigmoid.
 - Eq. 4, both: v_max * ratio * f(w).
 
 The counting is in C++ (``kiseki._core``; one limit of a 683-beam scan on a 0.05 m grid with a
@@ -19,9 +21,10 @@ offers the limit as ``kiseki.control.SpeedLimitSource`` to the code that drives 
 
 Defaults are the paper's sec. 4: v_max 0.5 m/s, a_max 0.5 m/s^2, theta 90 deg, w1 0.70 m (the
 robot's width), w2 2.0 m, a 4.9 /m. Two choices are kiseki's, the paper being silent:
-``window_ahead`` (1.0 m: obstacles up to 1 m ahead of the sensor bound the passage; the robot's
-length plus its 0.25 m stopping distance at v_max, rounded up) and ``free_threshold`` (map cells
-0..25 are free, nav2 map_server's free_thresh 0.25).
+``half_band`` (0.05 m: the scan's points within 0.05 m of the line across the heading, ahead or
+behind, bound the passage; one cell of the paper's 0.05 m grid either side, which holds four or
+more beams of the paper's 683-beam scan at every range up to 4 m) and ``free_threshold`` (map
+cells 0..25 are free, nav2 map_server's free_thresh 0.25).
 """
 
 from __future__ import annotations
@@ -118,12 +121,13 @@ def passage_width(
     ranges: np.ndarray,
     max_range: float,
     heading: float = 0.0,
-    window_ahead: float = 1.0,
+    half_band: float = 0.05,
 ) -> float:
-    """The passage's width w (m) across ``heading`` (rad, sensor frame): the nearest hit point
-    on the left plus the nearest on the right, among those 0..``window_ahead`` metres ahead; a
-    side without one counts ``max_range``."""
-    width, _, _ = _core.passage_width(angles, ranges, float(max_range), heading, window_ahead)
+    """Eq. 2's passage width w (m) across ``heading`` (rad, sensor frame): the nearest hit point
+    on the left plus the nearest on the right, among those within ``half_band`` metres of the
+    line across the heading through the sensor (an obstacle ahead of it is not a side); a side
+    without one counts ``max_range``."""
+    width, _, _ = _core.passage_width(angles, ranges, float(max_range), heading, half_band)
     return float(width)
 
 
@@ -149,13 +153,13 @@ class SpeedLimiterConfig:
     w1: float = 0.70  # m, the robot's width
     w2: float = 2.0  # m, a passage that needs no slowing down
     a: float = 4.9  # 1/m, the sigmoid's slope
-    window_ahead: float = 1.0  # m (kiseki's choice, see the module docstring)
+    half_band: float = 0.05  # m, where w is measured (kiseki's choice, module docstring)
     free_threshold: int = 25  # map cells 0..25 are free (nav2 map_server's free_thresh)
     use_occlusion: bool = True
     use_width: bool = True
 
     def __post_init__(self) -> None:
-        for name in ("v_max", "a_max", "w1", "w2", "a", "window_ahead"):
+        for name in ("v_max", "a_max", "w1", "w2", "a", "half_band"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int | float):
                 raise ValueError(f"SpeedLimiterConfig.{name} must be a number, got {value!r}")
@@ -222,7 +226,7 @@ class SpeedLimiter:
             w1=c.w1,
             w2=c.w2,
             a=c.a,
-            window_ahead=c.window_ahead,
+            half_band=c.half_band,
             use_occlusion=c.use_occlusion,
             use_width=c.use_width,
         )

@@ -13,8 +13,9 @@ toward the goal and the limiter named by ``method`` caps the speed
 and seed: only the limiter differs.
 
 Methods: ``none`` (v_max), ``occlusion`` (the paper's method 1, eq. 1), ``occlusion-width``
-(methods 1 + 2, eq. 4), ``width`` (method 2 alone), ``distance`` (distance-only slowdown) and
-``polygon`` (nav2 collision-monitor style boxes); the last two are kiseki.speed's baselines.
+(methods 1 + 2, eq. 4), ``width`` (method 2 alone), ``distance`` (distance-only slowdown: from
+the distance to the nearest occluded region, after the paper's ref. [4]) and ``polygon`` (nav2
+collision-monitor style boxes); the last two are kiseki.speed's baselines.
 """
 
 from __future__ import annotations
@@ -108,7 +109,7 @@ def make_limiter(method: str, prior: OccupancyGrid, sensor_offset: float):
         )
         return RecordingLimiter(SpeedLimiter(prior, config))
     if method == "distance":
-        return DistanceSpeedLimiter(DistanceLimiterConfig(sensor_offset=sensor_offset))
+        return DistanceSpeedLimiter(prior, DistanceLimiterConfig(sensor_offset=sensor_offset))
     if method == "polygon":
         return PolygonSpeedLimiter(PolygonLimiterConfig(sensor_offset=sensor_offset))
     raise ValueError(f"unknown speed method {method!r} (known: {', '.join(METHODS)})")

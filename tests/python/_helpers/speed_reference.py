@@ -30,13 +30,14 @@ def reference_ratio(grid, pose, angles, ranges, max_range, half_angle, heading):
     return 1.0 if free == 0 else int((region & seen).sum()) / free
 
 
-def reference_width(angles, ranges, max_range, heading, window=1.0):
-    """The passage width by its definition: hit points 0..window ahead of the heading bound the
-    passage left and right; a side without one counts max_range."""
+def reference_width(angles, ranges, max_range, heading, half_band=0.05):
+    """The passage width by its definition (eq. 2, across the heading): hit points within
+    half_band of the line across the heading through the sensor bound the passage left and
+    right; a side without one counts max_range."""
     hit = np.isfinite(ranges) & (ranges < max_range)
     a, r = angles[hit] - heading, ranges[hit].astype(float)
     along, across = r * np.cos(a), r * np.sin(a)
-    ahead = (along >= 0) & (along <= window)
+    ahead = np.abs(along) <= half_band
     left = across[ahead & (across >= 0)]
     right = -across[ahead & (across < 0)]
     return (left.min() if left.size else max_range) + (right.min() if right.size else max_range)

@@ -121,6 +121,37 @@ def test_passage_width_of_a_corridor():
     assert passage_width(ANGLES, ranges, MAX_RANGE) == pytest.approx(1.5, abs=1e-6)  # float32
 
 
+def _corridor(left, right, ahead):
+    """Exact ranges of a sensor looking along +x between walls y = +left and y = -right, with
+    an end wall x = ahead across the corridor (none when ahead is inf)."""
+    s, c = np.sin(ANGLES), np.cos(ANGLES)
+    with np.errstate(divide="ignore"):
+        r = np.minimum.reduce(
+            [
+                np.where(s > 1e-9, left / s, np.inf),
+                np.where(s < -1e-9, -right / s, np.inf),
+                np.where(c > 1e-9, ahead / c, np.inf),
+            ]
+        )
+    return np.minimum(MAX_RANGE, r)
+
+
+@pytest.mark.parametrize("width", [2.3, 1.5])
+@pytest.mark.parametrize("offset", [0.0, 0.25])
+@pytest.mark.parametrize("ahead", [0.9, 0.4, 2.0, math.inf])
+def test_passage_width_is_measured_across_the_heading(width, offset, ahead):
+    # eq. 2 (Fig. 3a): w = W in a straight corridor of width W whatever wall lies ahead; the
+    # 2.3 m corridor with a wall 0.9 m ahead gives 2.3 m (a wall straight ahead counted as a
+    # side gave 0.006 m, f(w) = 0.0018); the limiter's v_ref carries f(W)
+    ranges = _corridor(width / 2 + offset, width / 2 - offset, ahead)
+    assert passage_width(ANGLES, ranges, MAX_RANGE) == pytest.approx(width, abs=1e-5)
+    ref = SpeedLimiter(_field(), SpeedLimiterConfig(use_occlusion=False)).reference(
+        (0.0, 0.0, 0.0), ANGLES, ranges, MAX_RANGE
+    )
+    assert ref["width"] == pytest.approx(width, abs=1e-5)
+    assert ref["v_ref"] == pytest.approx(0.5 / (1 + math.exp(-4.9 * (width - 1.3))), abs=1e-5)
+
+
 def test_limiter_combines_the_terms_and_limits_acceleration():
     grid = _field()
     grid.cells[round((2.0 + 5.0) / 0.05), :] = OCCUPIED

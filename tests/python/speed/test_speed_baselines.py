@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The baseline speed limiters: hand-computed limits for walls at known distances, the rate
-limit, and the polygon's point counts against a brute-force point-in-polygon test."""
+"""The baseline speed limiters: the distance-only limit against its closed form for occluded
+regions at known distances, the rate limit, and the polygon's hand-computed limits and point
+counts against a brute-force point-in-polygon test."""
 
 from __future__ import annotations
 
@@ -11,6 +12,8 @@ import numpy as np
 import pytest
 
 from kiseki.control import SpeedLimitSource
+from kiseki.core import Pose2
+from kiseki.grid import FREE, OccupancyGrid
 from kiseki.speed import (
     AccelerationLimit,
     DistanceLimiterConfig,
@@ -40,45 +43,102 @@ def wall_left(d, angles=ANGLES):
     return np.minimum(r, MAX_RANGE)
 
 
+def free_map() -> OccupancyGrid:
+    """A free 10 m x 10 m prior map, 0.05 m cells, cell edges at multiples of 0.05 m."""
+    return OccupancyGrid(200, 200, 0.05, Pose2(-5.0, -5.0, 0.0), FREE)
+
+
+FACING_Y = (0.0, 0.0, math.pi / 2)  # the sensor at the origin looking along +y of the map
+D_STOP = 0.5 * 0.1 + 0.5**2 / (2 * 0.5)  # v_max t_react + v_max^2 / (2 a_max) = 0.30 m
+
+
+def nearest_hidden_behind(face):
+    """Distance from the sensor to the nearest cell centre an unknown wall across the heading,
+    its face ``face`` metres ahead (just past a cell edge), hides: the cell holding the face
+    has its centre beyond the beams' ends (not seen), the one before it is passed more than
+    half a cell before them (seen); the centres nearest the axis sit 0.025 m off it."""
+    centre = math.floor(face / 0.05) * 0.05 + 0.025
+    return math.hypot(0.025, centre)
+
+
 def test_both_are_speed_limit_sources():
-    assert isinstance(DistanceSpeedLimiter(), SpeedLimitSource)
+    assert isinstance(DistanceSpeedLimiter(free_map()), SpeedLimitSource)
     assert isinstance(PolygonSpeedLimiter(), SpeedLimitSource)
 
 
-@pytest.mark.parametrize(
-    ("d", "expected"),
-    [
-        (0.30, 0.0),  # inside the stop distance 0.35 + 0.1
-        (0.449, 0.0),
-        (0.55, math.sqrt(2 * 0.5 * 0.10)),  # 0.316 m/s
-        (0.60, math.sqrt(2 * 0.5 * 0.15)),  # 0.387 m/s
-        (0.70, 0.5),  # sqrt(0.25) = 0.5 exactly: the cap
-        (2.00, 0.5),
-    ],
-)
-def test_distance_limit_for_a_wall_ahead(d, expected):
-    limiter = DistanceSpeedLimiter()
-    assert limiter.target(ORIGIN, ANGLES, wall_ahead(d), MAX_RANGE) == pytest.approx(expected)
+def test_distance_limit_without_an_occluded_region_is_v_max():
+    # a free field seen to the sensor's reach: nothing within 4 m - 0.35 m is occluded; an empty
+    # map has no free cell at all
+    limiter = DistanceSpeedLimiter(free_map())
+    open_scan = np.full(ANGLES.shape, MAX_RANGE)
+    assert limiter.hidden_distance(FACING_Y, ANGLES, open_scan, MAX_RANGE) > 3.5
+    assert limiter.target(FACING_Y, ANGLES, open_scan, MAX_RANGE) == 0.5
+    unknown = OccupancyGrid(200, 200, 0.05, Pose2(-5.0, -5.0, 0.0), -1)
+    limiter = DistanceSpeedLimiter(unknown)
+    assert limiter.hidden_distance(FACING_Y, ANGLES, open_scan, MAX_RANGE) == math.inf
+    assert limiter.target(FACING_Y, ANGLES, open_scan, MAX_RANGE) == 0.5
+    assert DistanceLimiterConfig().stop_distance == pytest.approx(D_STOP)
 
 
-def test_distance_limit_measures_from_the_body_centre_and_looks_along_the_heading():
-    # laser 0.2 m ahead of the centre: a wall 0.4 m ahead of it is 0.6 m from the centre
-    offset = DistanceSpeedLimiter(DistanceLimiterConfig(sensor_offset=0.2))
-    got = offset.target((1.0, 2.0, 0.3), ANGLES, wall_ahead(0.4), MAX_RANGE, heading=0.3)
-    assert got == pytest.approx(math.sqrt(0.15))
-    # a wall 0.6 m to the left: moving left (heading +90 deg) it is 0.6 m ahead; moving
-    # forwards the nearest point within +-30 deg is at 0.6 / sin(30 deg) = 1.2 m -> v_max
-    limiter = DistanceSpeedLimiter()
-    ranges = wall_left(0.6)
-    nearest = 0.6 / math.sin(ANGLES[np.argmin(np.abs(ANGLES - math.pi / 2))])  # no beam at 90
-    assert limiter.target(ORIGIN, ANGLES, ranges, MAX_RANGE, heading=math.pi / 2) == (
-        pytest.approx(math.sqrt(2 * 0.5 * (nearest - 0.45)), abs=1e-12)
+def test_distance_limit_at_half_the_stop_distance_is_half_v_max():
+    # an unknown wall (not on the map) 0.455 m ahead hides the map's free space behind it;
+    # with the body's half size set so that the region is d_stop / 2 from the body: v_max / 2
+    hidden = nearest_hidden_behind(0.455)
+    config = DistanceLimiterConfig(half_length=hidden - D_STOP / 2)
+    limiter = DistanceSpeedLimiter(free_map(), config)
+    ranges = wall_ahead(0.455)
+    assert limiter.hidden_distance(FACING_Y, ANGLES, ranges, MAX_RANGE) == pytest.approx(
+        D_STOP / 2, abs=1e-9
     )
-    assert limiter.target(ORIGIN, ANGLES, ranges, MAX_RANGE, heading=0.0) == 0.5
-    # the sensor turned by 90 deg in the map: the same scan, heading +90 deg in the map = 0
-    # relative to the sensor
-    turned = limiter.target((0, 0, math.pi / 2), ANGLES, ranges, MAX_RANGE, heading=math.pi / 2)
-    assert turned == 0.5
+    assert limiter.target(FACING_Y, ANGLES, ranges, MAX_RANGE) == pytest.approx(0.25, abs=1e-9)
+
+
+@pytest.mark.parametrize("face", [0.305, 0.355, 0.405, 0.505, 0.605, 0.655, 0.905, 2.005])
+def test_distance_limit_follows_the_ramp_to_v_max(face):
+    # v = v_max min(1, d_hidden / d_stop), d_hidden = nearest hidden centre - 0.35 m (>= 0)
+    limiter = DistanceSpeedLimiter(free_map())
+    d = max(0.0, nearest_hidden_behind(face) - 0.35)
+    got = limiter.target(FACING_Y, ANGLES, wall_ahead(face), MAX_RANGE)
+    assert got == pytest.approx(0.5 * min(1.0, d / D_STOP), abs=1e-9)
+
+
+def test_distance_limit_slows_for_a_region_hidden_to_the_side():
+    # an unknown pillar 0.45 m away at 60 deg to the left of the heading (outside +-30 deg)
+    # hides the free cells behind it: a cell is unseen when its centre lies less than half a
+    # cell before the beam's end, so the nearest lies 0.45 - 0.025 to 0.45 + 0.035 (half a
+    # cell's diagonal) m from the sensor, 0.075-0.135 m from the body, well under d_stop. A
+    # limiter that reads only the scan's points within +-30 deg of the heading sees nothing
+    # ahead and allows v_max.
+    bearing, distance = math.radians(60), 0.45
+    ranges = np.full(ANGLES.shape, MAX_RANGE)
+    ranges[np.abs(ANGLES - bearing) <= math.radians(6)] = distance
+    limiter = DistanceSpeedLimiter(free_map())
+    d = limiter.hidden_distance(FACING_Y, ANGLES, ranges, MAX_RANGE)
+    assert 0.45 - 0.025 - 0.35 <= d <= 0.45 + 0.0354 - 0.35
+    assert limiter.target(FACING_Y, ANGLES, ranges, MAX_RANGE) == pytest.approx(
+        0.5 * d / D_STOP, abs=1e-9
+    )
+    assert limiter.target(FACING_Y, ANGLES, ranges, MAX_RANGE) < 0.5 / 2
+
+
+def test_distance_limit_measures_from_the_body_centre_in_the_direction_of_motion():
+    # laser 0.2 m ahead of the centre: the wall's hidden cells are 0.2 m farther from the body
+    face = 0.305
+    on_axis = math.floor(face / 0.05) * 0.05 + 0.025
+    offset = DistanceSpeedLimiter(free_map(), DistanceLimiterConfig(sensor_offset=0.2))
+    d = offset.hidden_distance(FACING_Y, ANGLES, wall_ahead(face), MAX_RANGE)
+    assert d == pytest.approx(math.hypot(0.025, on_axis + 0.2) - 0.35, abs=1e-9)
+    # moving backwards (heading -y): eq. 1's region is the half disc behind the sensor, which
+    # the +-120 deg laser sees only in two 30 deg wedges: the hidden cells beside the sensor
+    # then lie within 0.35 m of the body centre -> stop
+    limiter = DistanceSpeedLimiter(free_map())
+    back = limiter.target(FACING_Y, ANGLES, wall_ahead(2.0), MAX_RANGE, heading=-math.pi / 2)
+    assert back == 0.0
+
+
+def test_distance_limiter_needs_the_map():
+    with pytest.raises(TypeError, match="prior map"):
+        DistanceSpeedLimiter(DistanceLimiterConfig())
 
 
 def test_acceleration_limit_moves_by_at_most_a_max_dt_both_ways():
@@ -91,16 +151,16 @@ def test_acceleration_limit_moves_by_at_most_a_max_dt_both_ways():
         rate.step(0.1, -0.1)
 
 
-def test_limiter_output_is_rate_limited_towards_the_hand_computed_limit():
-    limiter = DistanceSpeedLimiter()
-    near, far = wall_ahead(0.6), wall_ahead(3.0)
-    out = [limiter.update(ORIGIN, ANGLES, near, MAX_RANGE, 0.1).speed_limit for _ in range(9)]
-    expected = [min(0.05 * (k + 1), math.sqrt(0.15)) for k in range(9)]
-    assert out == pytest.approx(expected)
-    up = [limiter.update(ORIGIN, ANGLES, far, MAX_RANGE, 0.1).speed_limit for _ in range(4)]
-    assert up == pytest.approx([min(0.5, math.sqrt(0.15) + 0.05 * (k + 1)) for k in range(4)])
-    down = limiter.update(ORIGIN, ANGLES, wall_ahead(0.4), MAX_RANGE, 0.1)
-    assert down.speed_limit == pytest.approx(0.5 - 0.05)  # brakes at a_max, not instantly
+def test_limiter_output_is_rate_limited_towards_the_closed_form_limit():
+    limiter = DistanceSpeedLimiter(free_map())
+    near, far = wall_ahead(0.505), wall_ahead(3.0)
+    v_near = 0.5 * (nearest_hidden_behind(0.505) - 0.35) / D_STOP
+    out = [limiter.update(FACING_Y, ANGLES, near, MAX_RANGE, 0.1).speed_limit for _ in range(9)]
+    assert out == pytest.approx([min(0.05 * (k + 1), v_near) for k in range(9)])
+    up = [limiter.update(FACING_Y, ANGLES, far, MAX_RANGE, 0.1).speed_limit for _ in range(4)]
+    assert up == pytest.approx([min(0.5, v_near + 0.05 * (k + 1)) for k in range(4)])
+    down = limiter.update(FACING_Y, ANGLES, wall_ahead(0.305), MAX_RANGE, 0.1)
+    assert down.speed_limit == pytest.approx(up[-1] - 0.05)  # brakes at a_max, not at once
     assert down.percentage is False and down.max_speed == 0.5
 
 
@@ -169,6 +229,7 @@ def test_polygon_counts_match_a_brute_force_point_in_polygon(seed):
     [
         (DistanceLimiterConfig, "a_max", 0.0),
         (DistanceLimiterConfig, "half_angle", math.nan),
+        (DistanceLimiterConfig, "reaction_time", -0.1),
         (PolygonLimiterConfig, "slowdown_ratio", 1.5),
         (PolygonLimiterConfig, "min_points", 0),
         (PolygonLimiterConfig, "stop_ahead", -0.1),

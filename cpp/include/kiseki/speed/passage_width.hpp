@@ -6,10 +6,15 @@
 
 namespace kiseki {
 
-/// The width of the passage across the direction of motion (the paper's Fig. 3a): in a frame
-/// whose x axis is the heading, the scan's hit points with 0 <= x <= window_ahead bound the
-/// passage on the left (y > 0) and on the right (y < 0); w = the nearest left |y| + the nearest
-/// right |y|. A side without such a point is open: its distance counts as max_range.
+/// The width w of the passage, eq. 2 of Yorozu, Moriguchi and Takahashi: "the distance between
+/// the obstacles detected, perpendicular to the robot's direction of motion" (Fig. 3a). In a
+/// frame whose x axis is the heading and whose origin is the sensor, the line across the heading
+/// (x = 0) is where w is measured: the scan's hit points with |x| <= half_band (a strip that
+/// holds a beam or more of a discrete scan) bound the passage on the left (y > 0) and on the
+/// right (y < 0); w = the nearest left |y| + the nearest right |y|. An obstacle ahead of the
+/// strip (a wall the robot drives towards) is not a side of the passage and leaves w alone. A
+/// side without such a point (an open side, or one outside the scan's field of view) counts
+/// max_range.
 struct PassageWidth {
   double width = 0.0;  ///< w (m)
   double left = 0.0;   ///< distance to the nearest obstacle on the left (m)
@@ -17,7 +22,8 @@ struct PassageWidth {
 };
 
 /// heading_in_sensor: the direction of motion relative to the sensor's x axis (rad).
-PassageWidth passage_width(const PlanarScan& scan, double heading_in_sensor, double window_ahead);
+/// half_band: half the strip's width along the heading (m), > 0.
+PassageWidth passage_width(const PlanarScan& scan, double heading_in_sensor, double half_band);
 
 /// Eq. 3 with the paper's typo corrected (it prints 1 / (1 - exp(...)), which has a pole at
 /// w = b and is negative below it): the sigmoid f(w) = 1 / (1 + exp(-a (w - b))), b = w2 - w1,

@@ -14,7 +14,7 @@ struct SpeedReferenceParams {
   double w1 = 0.70;                        ///< m, the robot's width
   double w2 = 2.0;                         ///< m, a passage that needs no slowing down
   double a = 4.9;                          ///< 1/m, the sigmoid's slope
-  double window_ahead = 1.0;               ///< m, how far ahead obstacles bound the passage
+  double half_band = 0.05;                 ///< m, the strip across the heading where w is measured
   bool use_occlusion = true;               ///< method 1 (eq. 1)
   bool use_width = true;                   ///< method 2 (eq. 2)
 };
