@@ -37,7 +37,7 @@ class GlobalMapConfig:
     step: Resolution = 0.35
     removal: str = "hough"
     search: str = "exhaustive"
-    cost: str = "mean"
+    cost: str = "sum"  # eq. 4 as printed; "mean": kiseki's variant
     voxel: Resolution = 0.05
 
 
