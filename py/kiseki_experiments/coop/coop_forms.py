@@ -29,10 +29,12 @@ import pandas as pd
 from kiseki.coop import GOAL, START, paper_angle, plan, simulate, simulate_3d
 from kiseki.coop.planner import plan_moves, predicted_goal_rms
 from kiseki.coop.positioning import FORM1_READINGS
+from kiseki.core import derive_seed
 from kiseki.plots import new_figure
 from kiseki.sim.robot import BodyMotion, OmniOdometry
-from kiseki_experiments.coop.coop_optimum import analytic_optimum, argmin_interval, range_verdict
-from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki_experiments.coop.coop_claims import N_PAPER, claims
+from kiseki_experiments.coop.coop_optimum import analytic_optimum
+from kiseki_experiments.harness.base import Analysis, Claim, Evidence, Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
     Count,
     NonNegativeReal,
@@ -54,9 +56,15 @@ class CoopFormsConfig:
     form2_moves: list[Count] = field(default_factory=lambda: list(range(1, 31)))
     form1_readings: list[str] = field(default_factory=lambda: list(FORM1_READINGS))
     # Figs. 7-8: the representative angle swept at a fixed number of moves per form (form 1,
-    # form 2): the middles of the paper's best ranges (10-20 and 5-10 moves)
-    angles_deg: list[Real] = field(default_factory=lambda: [float(a) for a in range(20, 85, 5)])
+    # form 2): the middles of the paper's best ranges (10-20 and 5-10 moves); from 30 deg, as
+    # below it form 2's second move (from the start's width to the formation's) has lines of
+    # sight that nearly meet head on (0.01 deg at 25 deg, 7 moves) and cannot be triangulated
+    angles_deg: list[Real] = field(default_factory=lambda: [float(a) for a in range(30, 85, 5)])
     angle_moves: list[Count] = field(default_factory=lambda: [15, 7])
+    # each sweep setting is simulated this many times (runs each, seeds derived from the
+    # trial's): the claims' intervals are over these repeats of the whole sweep
+    repeats: Count = 10
+    anchors: bool = True  # dead reckoning, CPS-II, the planner, 3-D (the controls drop them)
     dead_reckoning_runs: Runs = 1000
     step: Spacing = 0.05  # m, dead reckoning's odometry step
     # the 3-D case: uneven ground z = A sin(2 pi x / L) cos(2 pi y / L), markers 0.5 m above it
@@ -72,6 +80,8 @@ def _settings(config: CoopFormsConfig) -> list[tuple]:
     m1, m2 = config.angle_moves
     rows += [("angle", 1, m1, a, r) for r in r1 for a in config.angles_deg]
     rows += [("angle", 2, m2, a, "") for a in config.angles_deg]
+    if not config.anchors:
+        return rows
     anchors = [("dead-reckoning", 0, 0, None, ""), ("cps2", 1, 0, None, r1[0]),
                ("cps2", 2, 0, None, ""), ("planner", 0, 0, None, "")]  # fmt: skip
     return rows + anchors + [("3d", 1, 5, None, r1[0]), ("3d", 2, 7, None, "")]
@@ -96,10 +106,18 @@ def preflight(config: CoopFormsConfig) -> None:
                  FORM1_READINGS[0])  # fmt: skip
 
 
-def _errors(form, moves, angle, reading, goal, runs: int, sigma: float, seed: int) -> dict:
+def _errors(
+    form, moves, angle, reading, goal, runs: int, sigma: float, seed: int, repeats: int = 1
+) -> dict:
+    """One setting's errors at the goal: the first repeat's runs in full, and per repeat (each
+    ``runs`` runs on a seed derived from ``seed``) the mean error and the along-track RMS."""
     the_plan = plan(form, moves, None if angle is None else math.radians(angle), START, goal,
                     reading or FORM1_READINGS[0])  # fmt: skip
     run = simulate(the_plan, runs, sigma, seed)
+    again = [simulate(the_plan, runs, sigma, derive_seed(seed, r)) for r in range(1, repeats)]
+    ends = [run, *again]
+    last = the_plan.steps[-1]
+    offsets = [r.estimates[:, -1, last.robot] - last.target for r in ends]
     last = run.plan.steps[-1]
     d = run.estimates[:, -1, last.robot] - last.target
     e = np.hypot(d[:, 0], d[:, 1])
@@ -117,6 +135,8 @@ def _errors(form, moves, angle, reading, goal, runs: int, sigma: float, seed: in
         "min_sight_angle_deg": float(np.degrees(the_plan.sight_angles().min())),
         "errors_m": [round(float(v), 7) for v in e],
         "along_m": [round(float(v), 7) for v in d[:, 1]],
+        "repeat_mean_m": [float(np.hypot(o[:, 0], o[:, 1]).mean()) for o in offsets],
+        "repeat_along_rms_m": [float(np.sqrt(np.mean(o[:, 1] ** 2))) for o in offsets],
     }
 
 
@@ -143,7 +163,7 @@ def trial(config: CoopFormsConfig, index: int, seed: int) -> TrialOutput:
     kind, form, moves, angle, reading = settings[index]
     sigma = math.radians(config.angle_sigma_deg)
     if kind in ("sweep", "angle"):
-        row = _errors(form, moves, angle, reading, GOAL, config.runs, sigma, seed)
+        row = _errors(form, moves, angle, reading, GOAL, config.runs, sigma, seed, config.repeats)
         return TrialOutput({"kind": kind, **row})
     if kind == "dead-reckoning":
         return TrialOutput({"kind": kind, "form": 0, "moves": 0, **_dead_reckoning(config, seed)})
@@ -202,11 +222,6 @@ def _best(rows: pd.DataFrame) -> pd.Series:
 
 COLUMNS = ["form", "reading", "moves", "angle_deg", "mean_error_m", "sd_error_m", "along_rms_m",
            "cross_rms_m", "predicted_rms_m", "min_sight_angle_deg"]  # fmt: skip
-PAPER_BEST = {1: ((10, 20), (50, 60)), 2: ((5, 10), (50, 60))}  # sec. 4: moves, angle (deg)
-ANGLE_SLACK = 2.5  # deg: half the angle sweep's 5 deg step either side of the paper's range
-FACTOR = 2.0
-"""The analytic optimum's tolerance: within a factor of 2 of n = tan(theta_e), the agreement
-the paper itself draws in sec. 4 (form 2's best 5-10 moves, form 1's 10-20 agree with n = 10)."""
 
 
 def _groups(ok: pd.DataFrame, kind: str, key: str) -> dict[str, pd.DataFrame]:
@@ -219,40 +234,44 @@ def _groups(ok: pd.DataFrame, kind: str, key: str) -> dict[str, pd.DataFrame]:
     return out
 
 
-def _interval_claim(label, form, rows, key, paper_range, slack, figure) -> Claim:
-    best, lo, hi = argmin_interval(rows[key], list(rows["errors_m"]))
-    word = range_verdict(lo, hi, paper_range[0] - slack, paper_range[1] + slack)
-    what = "moves" if key == "moves" else "deg of representative angle"
-    return Claim(
-        claim=f"{label}: the error at the goal is smallest at about {paper_range[0]}-"
-        f"{paper_range[1]} {what}",
-        paper_value=f"{paper_range[0]}-{paper_range[1]} (Fig. {figure})",
-        measured_value=f"{best:g} (95 % CI {lo:g}-{hi:g}; "
-        f"{1000 * rows['mean_error_m'].min():.1f} mm): {word}",
-        unit=what,
-        holds=word == "holds",
-        note="argmin of the mean error over the sweep; bootstrap over each setting's runs; "
-        "holds when the interval lies within the paper's range, fails when outside it",
-    )
+def _per_repeat_argmin(rows: pd.DataFrame, key: str, column: str, x=None) -> np.ndarray:
+    """Per repeat of the sweep in ``rows``: the ``key`` value (or ``x``) at the smallest
+    ``column`` (a list per setting, one value per repeat)."""
+    values = np.array([list(v) for v in rows[column]])  # (settings, repeats)
+    xs = np.asarray(rows[key] if x is None else x, dtype=float)
+    return xs[np.argmin(values, axis=0)]
 
 
-def _optimum_claim(label: str, form: int, rows: pd.DataFrame, n_paper: float) -> Claim:
-    """The simulation's along-track optimum (measurements per run: form 1's scouts, (moves +
-    1) / 2, are the sec. 3.1 measurements; form 2's every move) against n = tan(theta_e)."""
-    count = (rows["moves"] + 1) // 2 if form == 1 else rows["moves"]
-    best, lo, hi = argmin_interval(count, list(rows["along_m"]), kind="rms")
-    word = range_verdict(lo, hi, n_paper / FACTOR, n_paper * FACTOR)
-    return Claim(
-        claim=f"{label}: the along-track error at the goal is smallest at n = tan(theta_e) "
-        "measurements (sec. 3.1, eq. 5)",
-        paper_value=f"n = {n_paper:.0f}",
-        measured_value=f"n = {best:g} (95 % CI {lo:g}-{hi:g}): {word}",
-        unit="measurements",
-        holds=word == "holds",
-        note="the simulation's argmin of the along-track RMS error over the moves sweep "
-        f"(form 1: its scout moves); holds within a factor of {FACTOR:g} of n (the agreement "
-        "the paper draws in sec. 4), fails outside it",
-    )
+def _per_repeat_min(rows: pd.DataFrame) -> np.ndarray:
+    return np.array([list(v) for v in rows["repeat_mean_m"]]).min(axis=0)
+
+
+def _subject(label: str) -> str:
+    return label if label.startswith("form 1") else ""
+
+
+def _evidence(forms: dict, angles: dict) -> list[Evidence]:
+    """The declared claims' evidence (kiseki_experiments.coop.coop_claims), one value per
+    repeat of the sweep."""
+    out = []
+    for label, rows in forms.items():
+        f = int(rows["form"].iloc[0])
+        best = _per_repeat_argmin(rows, "moves", "repeat_mean_m")
+        out.append(Evidence.of(f"moves_{f}", best, "median", subject=_subject(label),
+                               shown=f"{1000 * rows['mean_error_m'].min():.1f} mm"))  # fmt: skip
+        count = (rows["moves"] + 1) // 2 if f == 1 else rows["moves"]
+        n = _per_repeat_argmin(rows, "moves", "repeat_along_rms_m", x=count)
+        out.append(Evidence.of("n_tan", n, "median", subject=label))
+    for label, rows in angles.items():
+        f = int(rows["form"].iloc[0])
+        best = _per_repeat_argmin(rows, "angle_deg", "repeat_mean_m")
+        out.append(Evidence.of(f"angle_{f}", best, "median", subject=_subject(label)))
+    if "form 2" in forms:
+        two = _per_repeat_min(forms["form 2"])
+        for label in (k for k in forms if k.startswith("form 1")):
+            ratio = _per_repeat_min(forms[label]) / two
+            out.append(Evidence.of("lower_min", ratio, "median", subject=label))
+    return out
 
 
 def analyze(config: CoopFormsConfig, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path):
@@ -263,60 +282,20 @@ def analyze(config: CoopFormsConfig, trials: pd.DataFrame, timings: pd.DataFrame
     table = sweep[COLUMNS].reset_index(drop=True) if forms else pd.DataFrame(columns=COLUMNS)
     claims: list[Claim] = []
     figure_paths: list[Path] = []
-    for label, rows in forms.items():
-        f = int(rows["form"].iloc[0])
-        claims.append(_interval_claim(label, f, rows, "moves", PAPER_BEST[f][0], 0, 4 + f))
-    for label, rows in angles.items():
-        f = int(rows["form"].iloc[0])
-        claims.append(
-            _interval_claim(label, f, rows, "angle_deg", PAPER_BEST[f][1], ANGLE_SLACK, 6 + f)
-        )
-    ones = [k for k in forms if k.startswith("form 1")]
-    if ones and "form 2" in forms:
-        b2 = _best(forms["form 2"])
-        for k in ones:
-            b1 = _best(forms[k])
-            claims.append(
-                Claim(
-                    claim=f"{k} reaches a lower minimum error than form 2",
-                    paper_value="form 1 < form 2",
-                    measured_value=f"{1000 * b1['mean_error_m']:.1f} mm vs "
-                    f"{1000 * b2['mean_error_m']:.1f} mm",
-                    unit="mean error at the goal",
-                    holds=bool(b1["mean_error_m"] < b2["mean_error_m"]),
-                )
-            )
 
     def spread(rows: pd.DataFrame) -> float:
         band = rows[(rows["angle_deg"] >= 30) & (rows["angle_deg"] <= 75)]
         return float(band["mean_error_m"].max() / band["mean_error_m"].min())
 
-    if "form 2" in angles:
-        s2 = spread(angles["form 2"])
-        for k in (k for k in angles if k.startswith("form 1")):
-            s1 = spread(angles[k])
-            claims.append(
-                Claim(
-                    claim=f"form 2 varies less with the representative angle (30-75 deg) than {k}",
-                    paper_value="form 2 flatter (Figs. 7-8)",
-                    measured_value=f"max/min error over the angle sweep: {k} {s1:.2f}, form 2 "
-                    f"{s2:.2f}",
-                    unit="ratio",
-                    holds=bool(s2 < s1),
-                )
-            )
     distance = float(GOAL[1] - START[:2, 1].mean())
     n_opt, theta_opt, _ = analytic_optimum(distance)
-    n_paper = math.tan(math.atan(distance / 1.0))  # tan(theta_e), half-width 1 m
-    for label, rows in forms.items():
-        claims.append(_optimum_claim(label, int(rows["form"].iloc[0]), rows, n_paper))
     extra = {
         "paper_algebra": pd.DataFrame(
             [
                 {
                     "n": n_opt,
                     "theta_deg": theta_opt,
-                    "n_tan_theta_e": n_paper,
+                    "n_tan_theta_e": N_PAPER,
                     "source": "eq. 4 summed over n steps, brute force over n (the paper's algebra)",
                 }
             ]
@@ -324,6 +303,10 @@ def analyze(config: CoopFormsConfig, trials: pd.DataFrame, timings: pd.DataFrame
     }
     if angles:
         extra["angle_sweep"] = pd.concat(angles.values())[COLUMNS].reset_index(drop=True)
+        # Figs. 7-8's flatness: a table row (no control can make the comparison fail for sure)
+        extra["angle_spread"] = pd.DataFrame(
+            [{"sweep": k, "max_over_min_30_75_deg": spread(r)} for k, r in angles.items()]
+        )
     dead = ok[ok["kind"] == "dead-reckoning"]
     anchors = ok[ok["kind"] == "cps2"]
     if len(dead) and len(forms):
@@ -431,8 +414,13 @@ def analyze(config: CoopFormsConfig, trials: pd.DataFrame, timings: pd.DataFrame
         "fail); the claims on n = tan(theta_e) compare the simulation's optimum with it."
     )
     return Analysis(
-        tables={"sweep": table, **extra}, figures=figure_paths, claims=claims, notes=notes
-    )
+        tables={"sweep": table, **extra}, figures=figure_paths, claims=claims, notes=notes,
+        evidence=_evidence(forms, angles),
+    )  # fmt: skip
+
+
+def setting_count(config: CoopFormsConfig) -> int:
+    return len(_settings(config))
 
 
 EXPERIMENT = Experiment(
@@ -445,5 +433,6 @@ EXPERIMENT = Experiment(
     analyze=analyze,
     default_runs=len(_settings(CoopFormsConfig())),
     preflight=preflight,
-    trial_count=lambda config: len(_settings(config)),
+    trial_count=setting_count,
+    claims=claims(CoopFormsConfig, setting_count),
 )

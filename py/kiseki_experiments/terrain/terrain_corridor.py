@@ -16,9 +16,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from kiseki_experiments.harness.base import Analysis, Claim, Experiment
+from kiseki_experiments.harness.base import Analysis, Evidence, Experiment
 from kiseki_experiments.harness.config import Real
 from kiseki_experiments.harness.paths import WORLDS
+from kiseki_experiments.terrain.terrain_claims import CLAIMS_CORRIDOR, LARGE
 from kiseki_experiments.terrain.terrain_envs import (
     COST_NAMES,
     EnvAConfig,
@@ -28,11 +29,9 @@ from kiseki_experiments.terrain.terrain_envs import (
     trial,
 )
 from kiseki_experiments.terrain.terrain_figures import draw_match
-from kiseki_experiments.terrain.terrain_stats import share_interval, verdict
+from kiseki_experiments.terrain.terrain_stats import share_interval
 
 __all__ = ["CORRIDOR", "CorridorConfig"]
-
-LARGE = 0.05  # m: an along-track error above A's 5 cm tolerance is "large"
 
 
 @dataclass(frozen=True)
@@ -42,33 +41,6 @@ class CorridorConfig(EnvAConfig):
     attitude_deg: list[Real] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     removals: list[str] = field(default_factory=lambda: ["none", "hough", "pcl"])
     exact_gyro_rows: bool = True
-
-
-def _share_claim(by: pd.DataFrame, removal: str, cost: str, n: int) -> Claim:
-    """Most seeds' |along-track error| above (no removal) or within (a removal) LARGE."""
-    row = by.loc[removal]
-    large = removal == "none"
-    share, lo, hi = row["large_share"], row["large_low"], row["large_high"]
-    if not large:
-        share, lo, hi = 1 - share, 1 - hi, 1 - lo
-    word = verdict(lo, hi, 0.5)
-    what = (
-        "without plane removal the error along the travel direction is large"
-        if large
-        else f"{removal} plane removal keeps the error along the travel direction small"
-    )
-    return Claim(
-        claim=f"{what} in a narrow flat-walled corridor ({cost})",
-        paper_value="large along-track error without plane removal (no figure given)"
-        if large
-        else "plane removal is the paper's remedy",
-        measured_value=f"|along-track| {'above' if large else 'within'} {100 * LARGE:.0f} cm in "
-        f"{100 * share:.0f} % of {n} seeds (95 % CI {100 * lo:.0f}-{100 * hi:.0f} %), mean "
-        f"{row['along_mean_cm']:.1f} cm (truth 35 cm along): {word}",
-        unit="share of seeds",
-        holds=word == "holds",
-        note="Wilson 95 % interval of the share against 50 %",
-    )
 
 
 def analyze(config: CorridorConfig, trials, timings, figures: Path) -> Analysis:
@@ -98,11 +70,18 @@ def analyze(config: CorridorConfig, trials, timings, figures: Path) -> Analysis:
                 }
             )
     table = pd.DataFrame(rows)
-    claims = []
-    for cost in dict.fromkeys((config.cost, *config.variant_costs)):
-        name = COST_NAMES.get(cost, cost)
-        by = table[(table["gyro"] == "with error") & (table["cost"] == name)].set_index("removal")
-        claims += [_share_claim(by, m, name, len(ok)) for m in ("none", "hough") if m in by.index]
+    evidence = []
+    if "none" in config.removals:
+        for tag, exact, cost in arms(config):
+            if not exact:
+                along = ok[f"{tag}none_along"].abs().to_numpy()
+                evidence.append(
+                    Evidence.share(
+                        "none_large", int((along > LARGE).sum()), len(along),
+                        subject=COST_NAMES.get(cost, cost),
+                        shown=f"mean |along| {100 * along.mean():.1f} cm",
+                    )
+                )  # fmt: skip
     by = table[(table["gyro"] == "with error") & (table["cost"] == COST_NAMES[config.cost])]
     by = by.set_index("removal")
     seed0 = int(ok.sort_values("trial")["seed"].iloc[0])
@@ -134,7 +113,7 @@ def analyze(config: CorridorConfig, trials, timings, figures: Path) -> Analysis:
             "mm) and flat surfaces exactly flat (a real laser's systematic range errors on large "
             "flat surfaces, incidence angle and mixed pixels, are not simulated)."
         )
-    return Analysis({"along_track": table}, [path], claims, notes)
+    return Analysis({"along_track": table}, [path], notes=notes, evidence=evidence)
 
 
 CORRIDOR = Experiment(
@@ -147,4 +126,5 @@ CORRIDOR = Experiment(
     analyze=analyze,
     default_runs=10,
     preflight=preflight,
+    claims=CLAIMS_CORRIDOR,
 )

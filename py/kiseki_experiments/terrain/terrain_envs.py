@@ -24,9 +24,16 @@ import pandas as pd
 
 from kiseki.sim.pose6 import PAPER_MOVES, Pose6
 from kiseki.terrain import attitude_matrix
-from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki_experiments.harness.base import Analysis, Evidence, Experiment, TrialOutput
 from kiseki_experiments.harness.config import Real, Resolution, Seconds
 from kiseki_experiments.harness.paths import WORLDS
+from kiseki_experiments.terrain.terrain_claims import (
+    CLAIMS_A,
+    CLAIMS_B,
+    PAPER_A_CM,
+    PAPER_B_CM,
+    TOLERANCE,
+)
 from kiseki_experiments.terrain.terrain_common import (
     check_common,
     local_maps,
@@ -34,24 +41,11 @@ from kiseki_experiments.terrain.terrain_common import (
     object_cells,
 )
 from kiseki_experiments.terrain.terrain_figures import draw_match
-from kiseki_experiments.terrain.terrain_stats import (
-    median_difference_interval,
-    median_interval,
-    share_interval,
-    verdict,
-)
+from kiseki_experiments.terrain.terrain_stats import median_interval, share_interval
 
 __all__ = ["ENV_A", "ENV_B", "EnvAConfig", "EnvBConfig", "search_move"]
 
 PAPER = "003_fd335d240f62896b.txt"
-TRUTH_CM = (35.0, 30.0, 5.0)  # sec. 7.3: the true motion in both environments
-PAPER_A_CM = (32.0, 26.0, 6.0)  # the paper's estimate in environment A (a success)
-PAPER_B_CM = (44.0, -26.0, 20.0)  # and in environment B (a failure)
-TOLERANCE = float(np.linalg.norm(np.subtract(PAPER_A_CM, TRUTH_CM))) / 100 + 1e-9
-"""m: "found" means no further from the truth than the paper's own success in A (5.10 cm).
-The search's 2 cm grid makes the errors discrete (... 4.69, 5.10, 5.48 ... cm against the
-paper's odd-centimetre truth), so a round 5 cm would call the paper's own A a failure."""
-MAJORITY = 0.5  # a share claim holds when its Wilson interval lies above one half
 COST_NAMES = {"sum": "eq. 4 (sum)", "mean": "kiseki (mean cost)"}
 
 
@@ -72,7 +66,8 @@ class EnvAConfig:
     step: Resolution = 0.02
     exact_gyro_rows: bool = True
     label_objects: bool = False
-    contrast: bool = False  # also environment A's move (paper's removal), same seed
+    contrast: bool = False  # also contrast_env's move (the paper's removal), same seed
+    contrast_env: str = "A"  # the environment B is contrasted with (B: the control)
 
 
 @dataclass(frozen=True)
@@ -90,6 +85,8 @@ def _move(config: EnvAConfig) -> Pose6:
 
 
 def preflight(config: EnvAConfig) -> None:
+    if config.contrast_env not in ("A", "B"):
+        raise ValueError(f"terrain-env: contrast_env must be A or B, got {config.contrast_env!r}")
     for cost in (config.cost, *config.variant_costs):
         check_common("terrain-env", config.removals, config.search, cost, config.step)
     _move(config)
@@ -193,8 +190,8 @@ def trial(config: EnvAConfig, index: int, seed: int) -> TrialOutput:
             record[f"{tag}{m.method}_rise_along"], record[f"{tag}{m.method}_rise_across"] = rise
             if labels is not None and not tag:
                 record.update(_object_shares(maps, labels, m))
-    if config.contrast:  # environment A's move, the same seed, the paper's removal
-        a = EnvAConfig()
+    if config.contrast:  # the other environment's move, the same seed, the paper's removal
+        a = EnvAConfig() if config.contrast_env == "A" else EnvBConfig()
         maps = local_maps(a.scene, _move(a), seed, config.move_seconds)
         for cost in dict.fromkeys((config.cost, *config.variant_costs)):
             m = match(maps, config.removals[0], config.search, cost, config.step, seed)
@@ -249,27 +246,25 @@ def per_seed(config: EnvAConfig, ok: pd.DataFrame) -> pd.DataFrame:
     return table.sort_values("trial").reset_index(drop=True)
 
 
-def _share_claim(env: str, row, n: int, found: bool, paper_value: str) -> Claim:
-    """Whether most seeds find (``found``) or miss the move, decided by the Wilson interval of
-    the share within TOLERANCE against one half."""
-    share, lo, hi = row.within_tolerance, row.within_low, row.within_high
-    if not found:
-        share, lo, hi = 1 - share, 1 - hi, 1 - lo
-    word = verdict(lo, hi, MAJORITY)
-    what = "finds the move" if found else "misses the move"
-    return Claim(
-        claim=f"environment {env}: the paper's method ({row.removal}, {row.cost}) {what} "
-        f"(error {'within' if found else 'above'} {100 * TOLERANCE:.1f} cm) in most seeds",
-        paper_value=paper_value,
-        measured_value=f"{100 * share:.0f} % of {n} seeds (95 % CI {100 * lo:.0f}-"
-        f"{100 * hi:.0f} %); median {row.error_median_cm:.1f} cm (95 % CI "
-        f"{row.median_low_cm:.1f}-{row.median_high_cm:.1f}): {word}",
-        unit="share of seeds",
-        holds=word == "holds",
-        note="holds when the Wilson 95 % interval of the share lies above 50 %, fails when it "
-        f"lies below, else inconclusive; {100 * TOLERANCE:.1f} cm is the paper's own error in "
-        "environment A (its success)",
-    )
+def _costs(config: EnvAConfig) -> list[tuple[str, str]]:
+    """(record prefix, cost) of the arms with the gyro's error: the paper's cost, the variants."""
+    return [(tag, cost) for tag, exact, cost in arms(config) if not exact]
+
+
+def _found(config: EnvAConfig, ok: pd.DataFrame, key: str, method: str) -> list[Evidence]:
+    """Per cost, the seeds whose estimate with ``method`` lies within TOLERANCE."""
+    out = []
+    for tag, cost in _costs(config):
+        if f"{tag}{method}_error" in ok:
+            err = ok[f"{tag}{method}_error"].to_numpy()
+            out.append(
+                Evidence.share(
+                    key, int((err <= TOLERANCE).sum()), len(err),
+                    subject=COST_NAMES.get(cost, cost),
+                    shown=f"median {100 * np.median(err):.1f} cm",
+                )
+            )  # fmt: skip
+    return out
 
 
 def _analyze(env: str, paper_xyz, config, trials, timings, figures: Path) -> Analysis:
@@ -288,19 +283,14 @@ def _analyze(env: str, paper_xyz, config, trials, timings, figures: Path) -> Ana
               for r in summary.itertuples()),
         ]
     )  # fmt: skip
-    paper_err = float(np.linalg.norm(np.asarray(paper_xyz) - truth))
-    paper_value = (
-        f"({paper_xyz[0]}, {paper_xyz[1]}, {paper_xyz[2]}) cm, {paper_err:.1f} cm from the truth"
-    )
-    first = summary[(summary["gyro"] == "with error") & (summary["removal"] == config.removals[0])]
-    claims = [_share_claim(env, r, len(ok), env == "A", paper_value) for r in first.itertuples()]
+    evidence = _found(config, ok, "found", config.removals[0]) if env == "A" else []
     seed0 = int(ok.sort_values("trial")["seed"].iloc[0])
     path = figures / f"terrain_env_{env.lower()}.png"
     maps, _, found = search_move(config, seed0, False)
     draw_match(path, maps, found, config.step, f"environment {env}, first trial")
     return Analysis(
         {"summary": summary, "per_seed": per_seed(config, ok), "paper_vs_kiseki": paper},
-        [path], claims, _notes(config, ok),
+        [path], notes=_notes(config, ok), evidence=evidence,
     )  # fmt: skip
 
 
@@ -327,70 +317,28 @@ def analyze_a(config, trials, timings, figures):
     return _analyze("A", PAPER_A_CM, config, trials, timings, figures)
 
 
-def _contrast_claim(config: EnvBConfig, ok: pd.DataFrame, cost: str) -> Claim:
-    """The paper's contrast (A found, B not) as the paired difference of the median errors."""
-    m = config.removals[0]
-    b = ok[f"{'' if cost == config.cost else f'{cost}cost_'}{m}_error"].to_numpy()
-    a = ok[f"contrast_a_{cost}_error"].to_numpy()
-    lo, hi = median_difference_interval(b, a)
-    diff = float(np.median(b) - np.median(a))
-    word = verdict(lo, hi, TOLERANCE)
-    paper_diff = np.linalg.norm(np.subtract(PAPER_B_CM, TRUTH_CM)) - 100 * TOLERANCE
-    return Claim(
-        claim=f"environment B is harder than A for the paper's method ({m}, "
-        f"{COST_NAMES.get(cost, cost)}): B's median error exceeds A's by more than "
-        f"{100 * TOLERANCE:.1f} cm",
-        paper_value=f"B {np.linalg.norm(np.subtract(PAPER_B_CM, TRUTH_CM)):.1f} cm vs A "
-        f"{100 * TOLERANCE:.1f} cm: {paper_diff:.1f} cm more",
-        measured_value=f"median B - median A {100 * diff:+.1f} cm (95 % CI {100 * lo:+.1f} to "
-        f"{100 * hi:+.1f}; B {100 * np.median(b):.1f}, A {100 * np.median(a):.1f} cm over "
-        f"{len(a)} paired seeds): {word}",
-        unit="cm",
-        holds=word == "holds",
-        note="paired bootstrap over seeds (each seed gives both environments' sweeps); holds "
-        "when the interval lies above A's tolerance, fails when below it, else inconclusive",
-    )
-
-
 def analyze_b(config, trials, timings, figures):
     analysis = _analyze("B", PAPER_B_CM, config, trials, timings, figures)
-    if not analysis.claims:
-        return analysis
     ok = trials[trials["error"].isna()]
-    for cost in dict.fromkeys((config.cost, *config.variant_costs)):
-        if f"contrast_a_{cost}_error" in ok:
-            analysis.claims.append(_contrast_claim(config, ok, cost))
+    if ok.empty:
+        return analysis
+    m = config.removals[0]
+    for tag, cost in _costs(config):
+        if f"contrast_a_{cost}_error" in ok and f"{tag}{m}_error" in ok:
+            b, a = (100 * ok[k].to_numpy() for k in (f"{tag}{m}_error", f"contrast_a_{cost}_error"))
+            analysis.evidence.append(
+                Evidence.of(
+                    "harder", b - a, statistic="median", subject=COST_NAMES.get(cost, cost),
+                    shown=f"median B {np.median(b):.1f} cm, {config.contrast_env} "
+                    f"{np.median(a):.1f} cm",
+                )
+            )  # fmt: skip
+    if "pcl" in config.removals:
+        analysis.evidence += _found(config, ok, "pcl_fixes", "pcl")
     summary = analysis.tables["summary"]
     by = summary[(summary["gyro"] == "with error") & (summary["cost"] == COST_NAMES["sum"])]
     by = by.set_index("removal")
     if {"hough", "pcl"} <= set(by.index) and "objects_removed" in by:
-        analysis.claims.append(
-            Claim(
-                claim="the Hough step removes objects on the floor (the paper's reason for B)",
-                paper_value="objects on the floor removed",
-                measured_value=f"Hough removes {100 * by.loc['hough', 'objects_removed']:.0f} % "
-                f"of the object cells, PCL {100 * by.loc['pcl', 'objects_removed']:.0f} %",
-                unit="%",
-                holds=bool(by.loc["hough", "objects_removed"] > by.loc["pcl", "objects_removed"]),
-                note="holds when Hough removes a larger share of the object cells than PCL",
-            )
-        )
-        pcl = by.loc["pcl"]
-        word = verdict(pcl.within_low, pcl.within_high, MAJORITY)
-        analysis.claims.append(
-            Claim(
-                claim="the 3-D plane removal (PCL) fixes environment B: the move is found "
-                f"(within {100 * TOLERANCE:.1f} cm) in most seeds",
-                paper_value="not tried",
-                measured_value=f"{100 * pcl.within_tolerance:.0f} % of seeds (95 % CI "
-                f"{100 * pcl.within_low:.0f}-{100 * pcl.within_high:.0f} %), median "
-                f"{pcl.error_median_cm:.1f} cm vs Hough {by.loc['hough', 'error_median_cm']:.1f}"
-                f" cm: {word}",
-                unit="share of seeds",
-                holds=word == "holds",
-                note="Wilson 95 % interval of the share against 50 %",
-            )
-        )
         analysis.notes += _b_notes(by)
     return analysis
 
@@ -426,6 +374,7 @@ ENV_A = Experiment(
     analyze=analyze_a,
     default_runs=10,
     preflight=preflight,
+    claims=CLAIMS_A,
 )
 
 ENV_B = Experiment(
@@ -439,4 +388,5 @@ ENV_B = Experiment(
     analyze=analyze_b,
     default_runs=10,
     preflight=preflight,
+    claims=CLAIMS_B,
 )

@@ -1,10 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The intervals the rubble experiments decide their claims with: a percentile bootstrap of the
-median error over seeds (B. Efron, Ann. Statist. 7, 1979), the same for the difference of two
-medians over paired seeds (one seed gives both environments' trials), the Wilson interval of a
-share (kiseki.metrics.wilson_interval), and the three-way verdict of an interval against a
-criterion."""
+"""The intervals of the rubble experiments' tables (the claims' own come from the harness,
+kiseki_experiments.harness.verdict): a percentile bootstrap of the median error over seeds
+(B. Efron, Ann. Statist. 7, 1979) and the Wilson interval of a share
+(kiseki.metrics.wilson_interval)."""
 
 from __future__ import annotations
 
@@ -12,13 +11,7 @@ import numpy as np
 
 from kiseki.metrics import wilson_interval
 
-__all__ = [
-    "RESAMPLES",
-    "median_difference_interval",
-    "median_interval",
-    "share_interval",
-    "verdict",
-]
+__all__ = ["RESAMPLES", "median_interval", "share_interval"]
 
 RESAMPLES = 4000
 """Bootstrap resamples: the 2.5 and 97.5 % quantiles move by well under a cell (2 cm) between
@@ -40,34 +33,9 @@ def median_interval(values, resamples: int = RESAMPLES, seed: int = 0) -> tuple[
     return float(np.quantile(medians, 0.025)), float(np.quantile(medians, 0.975))
 
 
-def median_difference_interval(
-    b, a, resamples: int = RESAMPLES, seed: int = 0
-) -> tuple[float, float]:
-    """The 95 % bootstrap interval of median(b) - median(a), ``a[i]`` and ``b[i]`` from the same
-    seed (resampled together)."""
-    vb, va = _values(b), _values(a)
-    if len(va) != len(vb):
-        raise ValueError("interval: paired values must have the same length")
-    pick = np.random.default_rng(seed).integers(0, len(va), (resamples, len(va)))
-    diff = np.median(vb[pick], axis=1) - np.median(va[pick], axis=1)
-    return float(np.quantile(diff, 0.025)), float(np.quantile(diff, 0.975))
-
-
 def share_interval(flags) -> tuple[float, float, float]:
     """(share, Wilson 95 % low, high) of the true values in ``flags``."""
     f = np.asarray(flags, dtype=bool)
     k, n = int(f.sum()), int(f.size)
     lo, hi = wilson_interval(k, n)
     return (k / n if n else float("nan")), lo, hi
-
-
-def verdict(low: float, high: float, threshold: float, above: bool = True) -> str:
-    """``holds`` when the whole interval lies on the claimed side of ``threshold`` (above it for
-    ``above``, below otherwise), ``fails`` when it lies wholly on the other side, else
-    ``inconclusive``."""
-    if not (np.isfinite(low) and np.isfinite(high)):
-        return "inconclusive"
-    over, under = low > threshold, high < threshold
-    if above:
-        return "holds" if over else "fails" if under else "inconclusive"
-    return "holds" if under else "fails" if over else "inconclusive"

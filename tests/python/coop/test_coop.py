@@ -434,17 +434,14 @@ def test_form1_readings_meet_at_their_closed_form_sight_angles(deg) -> None:
         plan(1, 15, theta, reading="diagonal")
 
 
-def test_argmin_interval_against_known_sweeps() -> None:
-    from kiseki_experiments.coop.coop_optimum import argmin_interval, range_verdict
+def test_per_repeat_argmin_against_brute_force() -> None:
+    import pandas as pd
 
-    rng = np.random.default_rng(7)
-    xs = [1, 2, 3, 4, 5]
-    # a clear minimum at x = 3 (errors 1 mm apart, 0.01 mm of noise): the interval is 3-3
-    runs = [c + 1e-5 * rng.standard_normal(200) for c in (0.005, 0.004, 0.003, 0.004, 0.005)]
-    assert argmin_interval(xs, runs) == (3.0, 3.0, 3.0)
-    # five settings of one distribution: the argmin wanders over the sweep
-    flat = [0.004 + 1e-3 * rng.standard_normal(50) for _ in xs]
-    _, lo, hi = argmin_interval(xs, flat)
-    assert lo <= 2 and hi >= 4
-    assert [range_verdict(3, 3, 2, 4), range_verdict(1, 5, 2, 4), range_verdict(5, 6, 2, 4)] == [
-        "holds", "inconclusive", "fails"]  # fmt: skip
+    from kiseki_experiments.coop.coop_forms import _per_repeat_argmin, _per_repeat_min
+
+    rng = np.random.default_rng(3)
+    values = rng.uniform(0.01, 0.1, (6, 5))  # 6 settings, 5 repeats
+    rows = pd.DataFrame({"moves": [1, 3, 5, 7, 9, 11], "repeat_mean_m": list(values)})
+    want = [rows["moves"][int(np.argmin(values[:, r]))] for r in range(5)]
+    assert _per_repeat_argmin(rows, "moves", "repeat_mean_m").tolist() == want
+    assert _per_repeat_min(rows).tolist() == values.min(axis=0).tolist()

@@ -163,7 +163,25 @@ def test_global_map_reports_the_drift_of_a_multi_move_run(tmp_path):
     assert row["travelled_m"] == pytest.approx(3 * 0.35, abs=0.05)
     assert row["drift_share"] == pytest.approx(row["final_error_m"] / row["travelled_m"])
     assert row["final_error_m"] < 0.35  # far better than no motion estimate at all
-    claims = pd.read_csv(run.run_dir / "claims.csv")
-    assert bool(claims["holds"].iloc[0]) == (row["drift_share"] < 0.10)
+    claims = pd.read_csv(run.run_dir / "claims.csv").set_index("claim")
+    drift = claims.filter(like="10 % of the distance", axis=0).iloc[0]
+    assert float(drift["measured_value"].split()[0]) == pytest.approx(row["drift_share"], 1e-3)
+    assert drift["verdict"] == "inconclusive"  # one seed: no interval, no verdict
     tree = _core.OctreeWorld.read_binary(str(run.run_dir / "figures" / "terrain_global_map.bt"))
     assert tree.occupied_leaves > 1000
+
+
+def test_global_map_control_places_every_stop_at_the_start(tmp_path):
+    """motion=zero (the drift claim's control): the final error is the straight distance from
+    the first stop to the last, recomputed here from the simulated stops."""
+    from kiseki.sim.terrain_moves import terrain_stops
+
+    run = run_experiment(
+        "terrain-global-map", runs=1, seed=4, overrides=["moves=2", "motion=zero"],
+        out=tmp_path / "zero", progress=False,
+    )  # fmt: skip
+    row = pd.read_parquet(run.run_dir / "trials.parquet").iloc[0]
+    stops = terrain_stops(WORLDS / "rubble_a.yaml", 2, int(row["seed"]), 0.35)
+    true = np.array([s.sensor[:3, 3] for s in stops])
+    assert row["final_error_m"] == pytest.approx(np.linalg.norm(true[-1] - true[0]), abs=1e-9)
+    assert row["drift_share"] > 0.9  # the route bends a little: far above the 10 % criterion
