@@ -4,7 +4,8 @@
 checked by :mod:`kiseki._support.schema`: name, description, source, bounds, floor, octomap, objects
 (:mod:`kiseki.sim.primitives_schema`), grid_resolution, measurement_grid, robots (their name
 and the sections kiseki.sim.setup and kiseki.sim.robot read), turns, poses, pedestrians and
-point_robots, and ``route`` (:class:`Route`, ``route: {}`` is none). ``robot``, ``sensors`` and
+point_robots, ``calibrated`` (:class:`Calibration`: the parameters fitted to a paper's number),
+and ``route`` (:class:`Route`, ``route: {}`` is none). ``robot``, ``sensors`` and
 each robot's ``type``, ``start``, ``params``, ``odometry_errors`` are checked by the models of
 kiseki.sim.setup_schema (:func:`~kiseki.sim.setup_schema.check_robots`, with the rules that
 depend on the rest of the scene), ``magnetic`` by kiseki.sim.magnetic_schema (in
@@ -31,6 +32,7 @@ from kiseki.sim.primitives_schema import Object
 from kiseki.sim.setup_schema import RobotSections, check_robots
 
 __all__ = [
+    "Calibration",
     "MAX_POSES",
     "MAX_PEDESTRIANS",
     "MAX_ROBOTS",
@@ -245,6 +247,18 @@ def extent_problem(
     return None
 
 
+class Calibration(FileModel):
+    """A scene parameter fitted to a paper's number: ``parameter`` is its dotted key path in
+    the scene file (``robots.0.odometry_errors.wheel_radius``), ``fitted_to`` the number it was
+    fitted to (in ``unit``), ``source`` where the number is printed (paper, table or figure).
+    No claim may then compare a result with that number (the experiments' calibration test)."""
+
+    parameter: Name
+    fitted_to: FiniteFloat
+    unit: str = Field(strict=True)
+    source: Name
+
+
 class SceneDoc(FileModel):
     """A scene file's top level."""
 
@@ -266,6 +280,7 @@ class SceneDoc(FileModel):
     poses: Poses | None = None
     pedestrians: Annotated[list[PedestrianDoc], Field(max_length=MAX_PEDESTRIANS)] | None = None
     point_robots: bool = Field(False, strict=True)
+    calibrated: list[Calibration] = []
 
     @field_validator("objects")
     @classmethod
