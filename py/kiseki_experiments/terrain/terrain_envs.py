@@ -333,8 +333,6 @@ def analyze_b(config, trials, timings, figures):
                     f"{np.median(a):.1f} cm",
                 )
             )  # fmt: skip
-    if "pcl" in config.removals:
-        analysis.evidence += _found(config, ok, "pcl_fixes", "pcl")
     summary = analysis.tables["summary"]
     by = summary[(summary["gyro"] == "with error") & (summary["cost"] == COST_NAMES["sum"])]
     by = by.set_index("removal")
