@@ -17,6 +17,7 @@ from kiseki._support.options import Count, Degrees, Metres, Seed
 from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki.coop import START, plan, simulate
 from kiseki.coop.planner import plan_moves
+from kiseki.coop.positioning import FORM1_READINGS
 from kiseki.coop.render import render_run
 
 __all__ = ["app"]
@@ -48,6 +49,9 @@ def coop_simulate(
         parser=Degrees("--angle", 5, 85),
         help="Representative angle (deg); default: the start's width kept, as the paper.",
     ),
+    reading: str | None = typer.Option(
+        None, help="Form 1's reading: pair-scout (the default) or crossing."
+    ),
     runs: int = typer.Option(100, parser=Count("--runs", 1, 1_000_000), help="Noisy runs."),
     sigma: float = typer.Option(
         0.1,
@@ -72,15 +76,20 @@ def coop_simulate(
     if planner and (form, moves, angle) != (None, None, None):
         raise ValueError("--planner chooses the moves itself: drop --form, --moves and --angle")
     form = 1 if form is None else form
+    if reading is not None and (planner or form != 1):
+        raise ValueError("--reading does not apply to --form 2 or --planner (form 1's readings)")
+    reading = FORM1_READINGS[0] if reading is None else reading
     moves = 15 if moves is None else moves
     if planner:
         the_plan = plan_moves(START, goal, math.radians(sigma))
         what = f"planner, {the_plan.moves} moves"
     else:
-        the_plan = plan(form, moves, None if angle is None else math.radians(angle), START, goal)
+        the_plan = plan(
+            form, moves, None if angle is None else math.radians(angle), START, goal, reading
+        )
         what = (
-            f"form {form}, {moves} moves, representative angle "
-            f"{math.degrees(the_plan.angle):.1f} deg"
+            f"form {form}{f' ({reading})' if form == 1 else ''}, {moves} moves, "
+            f"representative angle {math.degrees(the_plan.angle):.1f} deg"
         )
     run = simulate(the_plan, runs, math.radians(sigma), seed)
     e = run.goal_errors

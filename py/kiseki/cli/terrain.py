@@ -73,6 +73,10 @@ def terrain_run(
         default_of(MapperConfig, "search"),
         help="exhaustive (the paper's 56,916 candidates) or coarse-to-fine.",
     ),
+    cost: str = typer.Option(
+        default_of(MapperConfig, "cost"),
+        help="Eq. 4 as printed (sum) or kiseki's variant (mean: over the summed weights).",
+    ),
 ) -> None:
     """Moves a robot through WORLD stopping every --step metres; at each stop a tilting-laser
     sweep becomes an S-DEM, the motion since the last stop is found by the correlation search,
@@ -84,7 +88,7 @@ def terrain_run(
     Example: kiseki terrain run data/worlds/rubble_a.yaml --moves 10 -o rubble-run"""
     if not world.exists():
         raise ValueError(f"WORLD {world}: no such file")
-    config = MapperConfig(removal=removal, search=search, seed=seed)  # checks both names
+    config = MapperConfig(removal=removal, search=search, cost=cost, seed=seed)  # checks the names
     _destination(output)
     stops = terrain_stops(world, moves, seed, step)
     mapper = SdemMapper(config, start=stops[0].sensor[:3, 3])

@@ -27,7 +27,15 @@ a representative angle. kiseki's reading, with both forms starting from the pape
   and it form the next pair (the centre of the pair moving by w to one side and back the next
   time); the pair robot left behind is the next scout. The first apex is over the start's
   baseline (w = 1 m); the others are spaced evenly to reach the goal, with w = h / tan(theta).
-  An odd number of moves (A, B, ..., A): the last is the scout's, to the goal.
+  An odd number of moves (A, B, ..., A): the last is the scout's, to the goal. The joiner is
+  seen by the scout along the new pair's line and by the robot left behind from 3 w to the
+  side: the two lines of sight meet at atan(tan(theta) / 3), 25 deg at theta = 55 deg.
+* **Form 1, crossing** (``reading="crossing"``, a second reading of the same drawing-less
+  text): as pair and scout, but the pair robot *farther* from the joiner's place crosses over
+  to it, so the robot left behind stands under the new pair's centre (w to the side of the
+  joiner's place, h behind): every triangulation then has its lines of sight meet at the
+  representative angle theta, and the next scout goes straight up the centre line. This is the
+  reading in which, as the paper says of each form, one angle represents every measurement.
 * **Form 2, leapfrog** (1 move per unit). The robots stand on a zigzag of points on two rails
   x = +-w, one unit s apart along y; at each move the rearmost robot jumps over the other two to
   the next point ahead. Each measured triangle is isosceles: the standing robot on the mover's
@@ -55,6 +63,8 @@ START = np.array([[-1.0, 0.0], [1.0, 0.0], [0.0, -1.0]])
 GOAL = np.array([0.0, 10.0])
 ANGLE_SIGMA = math.radians(0.1)
 FORMS = (1, 2)
+FORM1_READINGS = ("pair-scout", "crossing")
+"""kiseki's readings of form 1 (see the module): the first is the one run by default."""
 
 
 @dataclass(frozen=True)
@@ -73,6 +83,18 @@ class Plan:
     angle: float  # rad, the representative angle (NaN for the planner's)
     start: np.ndarray = field(repr=False)
     steps: list[Move] = field(repr=False)
+    reading: str = ""  # form 1's reading (FORM1_READINGS); "" for form 2 and the planner
+
+    def sight_angles(self) -> np.ndarray:
+        """(moves,) the angle (rad, 0..pi/2) at which the two standing robots' lines of sight
+        meet at each move's target: small angles make weak triangles."""
+        at = self.nominal_positions()
+        out = []
+        for k, m in enumerate(self.steps):
+            u, v = (m.target - at[k][i] for i in m.standing)
+            c = abs(float(u @ v)) / (float(np.hypot(*u)) * float(np.hypot(*v)))
+            out.append(math.acos(min(1.0, c)))
+        return np.array(out)
 
     def nominal_positions(self) -> np.ndarray:
         """(moves + 1, 3, 2): every robot's planned position before the first move and after
@@ -133,19 +155,33 @@ def _check(form: int, moves: int, angle: float) -> None:
         )
 
 
-def plan(form: int, moves: int, angle: float | None = None, start=START, goal=GOAL) -> Plan:
+def plan(
+    form: int,
+    moves: int,
+    angle: float | None = None,
+    start=START,
+    goal=GOAL,
+    reading: str = FORM1_READINGS[0],
+) -> Plan:
     """The planned moves of a form (see the module) from ``start`` (3 x 2, the paper's by
     default) to ``goal`` in ``moves`` moves at the representative ``angle`` (rad; None: the
-    formation keeps the start's width and the angle follows from ``moves``, ``paper_angle``)."""
+    formation keeps the start's width and the angle follows from ``moves``, ``paper_angle``);
+    ``reading``: form 1's reading (FORM1_READINGS; form 2 has one)."""
     start, goal = _check_places(start, goal)
+    if reading not in FORM1_READINGS:
+        raise ValueError(f"reading must be one of {', '.join(FORM1_READINGS)}, got {reading!r}")
     if angle is None:
         angle = paper_angle(form, moves, start, goal)
     _check(form, moves, angle)
-    steps = _form1(moves, angle, start, goal) if form == 1 else _form2(moves, angle, start, goal)
-    return Plan(form, moves, angle, start, steps)
+    if form == 2:
+        return Plan(form, moves, angle, start, _form2(moves, angle, start, goal))
+    crossing = reading == "crossing"
+    return Plan(form, moves, angle, start, _form1(moves, angle, start, goal, crossing), reading)
 
 
-def _form1(moves: int, angle: float, start: np.ndarray, goal: np.ndarray) -> list[Move]:
+def _form1(
+    moves: int, angle: float, start: np.ndarray, goal: np.ndarray, crossing: bool
+) -> list[Move]:
     pair = [int(i) for i in np.argsort(start[:, 1])[1:]]  # the two ahead; the third scouts
     scout = int(np.argmin(start[:, 1]))
     pos = start.copy()
@@ -176,7 +212,8 @@ def _form1(moves: int, angle: float, start: np.ndarray, goal: np.ndarray) -> lis
         else:  # off it: the pair's centre goes back to the line
             side = -math.copysign(1.0, target[0] - goal[0])
         joiner_at = np.array([target[0] + 2 * width * side, level])
-        joiner = min(pair, key=lambda i: float(np.hypot(*(pos[i] - joiner_at))))
+        near = min(pair, key=lambda i: float(np.hypot(*(pos[i] - joiner_at))))
+        joiner = (pair[0] if near == pair[1] else pair[1]) if crossing else near
         left = pair[0] if joiner == pair[1] else pair[1]
         steps.append(Move(joiner, joiner_at, (scout, left)))
         pos[joiner] = joiner_at

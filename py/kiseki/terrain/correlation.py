@@ -9,9 +9,11 @@ current S-DEM is
 minimised over a grid of candidates: the paper's x 0..70 cm, y -50..50 cm, z -30..30 cm in
 2 cm steps (56,916 candidates). The attitude change comes from the gyro and is not searched.
 
-Eq. 4 as printed is a sum, so a candidate that shares fewer cells costs less; ``cost="mean"``
-(kiseki's default) divides by the sum of the weights, ``cost="sum"`` is the printed form. A
-candidate sharing fewer than ``min_overlap`` cells is not scored (+inf). The C++ core does the
+``cost="sum"`` (the default) is eq. 4 as printed. ``cost="mean"`` is kiseki's named variant: it
+divides the sum by the sum of the weights cos(phi). Why a variant: a sum rewards a candidate for
+sharing fewer cells (fewer terms, a smaller sum), so in a corridor, where the candidates further
+along share fewer cells, the printed sum's minimum slides along it (terrain-corridor reports both).
+A candidate sharing fewer than ``min_overlap`` cells is not scored (+inf). The C++ core does the
 work on every core (``kiseki/terrain/correlation_search.hpp``).
 """
 
@@ -78,14 +80,14 @@ def correlation_search(
     rotation: Any = None,
     grid: SearchGrid | None = None,
     method: Literal["exhaustive", "coarse-to-fine"] = "exhaustive",
-    cost: Literal["mean", "sum"] = "mean",
+    cost: Literal["sum", "mean"] = "sum",
     min_overlap: int = 50,
     threads: int = 0,
 ) -> SearchResult:
     """The motion (x, y, z) from the previous S-DEM to the current one (previous sensor frame).
     rotation: the current sensor's attitude in the previous sensor's frame (R_prev^T R_cur,
-    from the gyro); None: unchanged. Raises ValueError for an empty map, a bad grid, a NaN
-    attitude or an unknown method."""
+    from the gyro); None: unchanged. cost: eq. 4 as printed (``sum``) or kiseki's ``mean``.
+    Raises ValueError for an empty map, a bad grid, a NaN attitude or an unknown method."""
     for name, m in (("previous", previous), ("current", current)):
         if not isinstance(m, SphereElevationMap):
             raise TypeError(f"correlation search: {name} must be a SphereElevationMap")

@@ -33,16 +33,17 @@ __all__ = ["MapperConfig", "SdemMapper", "Sweep"]
 
 @dataclass(frozen=True)
 class MapperConfig:
-    """removal: plane removal before matching (``hough`` the paper's, ``pcl``, ``none``);
-    search: ``exhaustive`` (the paper's) or ``coarse-to-fine`` (the default, what ``kiseki
-    terrain run`` runs: 42 ms a pair of sweeps against the exhaustive search's second, and the
-    exhaustive minimum on 12 of 12 simulated pairs, README; the experiments set theirs); cost:
-    eq. 4 as ``mean`` or ``sum``; the search box (m) and step; voxel: the global map's
-    resolution (m); seed: PCL's RANSAC (the only random part)."""
+    """removal: plane removal before matching (``hough`` the paper's, ``pcl``, ``none``); search:
+    ``exhaustive`` (the paper's) or ``coarse-to-fine`` (the default, what ``kiseki terrain run``
+    runs: 42 ms a pair of sweeps against the exhaustive search's second, and the exhaustive minimum
+    on 12 of 12 simulated pairs, README; the experiments set theirs); cost: ``sum`` (eq. 4 as
+    printed, the default) or ``mean`` (kiseki's named variant: the sum over the summed weights, so
+    that sharing fewer cells is not rewarded; kiseki.terrain.correlation); the search box (m) and
+    step; voxel: the global map's resolution (m); seed: PCL's RANSAC (the only random part)."""
 
     removal: Literal["hough", "pcl", "none"] = "hough"
     search: Literal["exhaustive", "coarse-to-fine"] = "coarse-to-fine"
-    cost: Literal["mean", "sum"] = "mean"
+    cost: Literal["sum", "mean"] = "sum"
     x: tuple[float, float] = (0.0, 0.70)
     y: tuple[float, float] = (-0.50, 0.50)
     z: tuple[float, float] = (-0.30, 0.30)
@@ -57,6 +58,8 @@ class MapperConfig:
             raise ValueError(f"removal must be hough, pcl or none, got {self.removal!r}")
         if self.search not in ("exhaustive", "coarse-to-fine"):
             raise ValueError(f"search must be exhaustive or coarse-to-fine, got {self.search!r}")
+        if self.cost not in ("sum", "mean"):
+            raise ValueError(f"cost must be sum (eq. 4) or mean, got {self.cost!r}")
         if not (isinstance(self.voxel, (int, float)) and 0.005 <= self.voxel <= 10):
             raise ValueError(f"voxel must be in 0.005..10 m, got {self.voxel!r}")
         check_seed(self.seed)

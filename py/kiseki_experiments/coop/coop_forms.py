@@ -5,9 +5,13 @@
 Three robots start at (-1, 0), (1, 0) and (0, -1) and advance to the goal (0, 10) by taking
 turns (kiseki.coop.positioning, which defines the two movement forms); every measured angle has
 Gaussian noise of SD 0.1 deg; 100 runs per setting; the error is the distance between the goal
-and the estimate of the robot that moved there. As in the paper, the formation keeps the
-start's width, so the number of moves sets the representative angle (Figs. 5-6 and 7-8 are two
-views of one sweep). Trial i is one setting (form, moves); the last trials are the anchors:
+and the estimate of the robot that moved there. Figs. 5-6 (versus moves): as in the paper's
+simulation, the formation keeps the start's width, so the number of moves sets the
+representative angle. Figs. 7-8 (versus the representative angle) have a sweep of their own:
+the angle varied at a fixed number of moves per form (``angle_moves``), the formation's width
+following from it. Form 1 is run in each of kiseki's readings (``form1_readings``,
+kiseki.coop.positioning: pair and scout, and crossing). Trial i is one setting; the last
+trials are the anchors:
 dead reckoning over the same distance with the simulator's omnidirectional odometry model, and
 kiseki's scheme over the 21.5 m that Kurazume and Hirose's CPS-II reported (0.12 % error),
 the move planner, and the 3-D case on uneven ground for the best setting of each form.
@@ -22,12 +26,23 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from kiseki.coop import GOAL, START, paper_angle, paper_error, plan, simulate, simulate_3d
+from kiseki.coop import GOAL, START, paper_angle, plan, simulate, simulate_3d
 from kiseki.coop.planner import plan_moves, predicted_goal_rms
+from kiseki.coop.positioning import FORM1_READINGS
+from kiseki.core import derive_seed
 from kiseki.plots import new_figure
 from kiseki.sim.robot import BodyMotion, OmniOdometry
-from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
-from kiseki_experiments.harness.config import Count, NonNegativeReal, PositiveReal, Runs, Spacing
+from kiseki_experiments.coop.coop_claims import N_PAPER, claims
+from kiseki_experiments.coop.coop_optimum import analytic_optimum
+from kiseki_experiments.harness.base import Analysis, Claim, Evidence, Experiment, TrialOutput
+from kiseki_experiments.harness.config import (
+    Count,
+    NonNegativeReal,
+    PositiveReal,
+    Real,
+    Runs,
+    Spacing,
+)
 
 CPS2_DISTANCE = 21.5  # m, Kurazume and Hirose's CPS-II experiment
 CPS2_ERROR = 0.0012  # 0.12 % of the distance
@@ -39,6 +54,17 @@ class CoopFormsConfig:
     angle_sigma_deg: NonNegativeReal = 0.1  # the paper's
     form1_moves: list[Count] = field(default_factory=lambda: list(range(1, 40, 2)))
     form2_moves: list[Count] = field(default_factory=lambda: list(range(1, 31)))
+    form1_readings: list[str] = field(default_factory=lambda: list(FORM1_READINGS))
+    # Figs. 7-8: the representative angle swept at a fixed number of moves per form (form 1,
+    # form 2): the middles of the paper's best ranges (10-20 and 5-10 moves); from 30 deg, as
+    # below it form 2's second move (from the start's width to the formation's) has lines of
+    # sight that nearly meet head on (0.01 deg at 25 deg, 7 moves) and cannot be triangulated
+    angles_deg: list[Real] = field(default_factory=lambda: [float(a) for a in range(30, 85, 5)])
+    angle_moves: list[Count] = field(default_factory=lambda: [15, 7])
+    # each sweep setting is simulated this many times (runs each, seeds derived from the
+    # trial's): the claims' intervals are over these repeats of the whole sweep
+    repeats: Count = 10
+    anchors: bool = True  # dead reckoning, CPS-II, the planner, 3-D (the controls drop them)
     dead_reckoning_runs: Runs = 1000
     step: Spacing = 0.05  # m, dead reckoning's odometry step
     # the 3-D case: uneven ground z = A sin(2 pi x / L) cos(2 pi y / L), markers 0.5 m above it
@@ -47,11 +73,18 @@ class CoopFormsConfig:
 
 
 def _settings(config: CoopFormsConfig) -> list[tuple]:
-    rows = [("sweep", 1, n) for n in config.form1_moves] + [
-        ("sweep", 2, n) for n in config.form2_moves
-    ]
-    anchors = [("dead-reckoning", 0, 0), ("cps2", 1, 0), ("cps2", 2, 0), ("planner", 0, 0)]
-    return rows + anchors + [("3d", 1, 5), ("3d", 2, 7)]
+    """(kind, form, moves, angle in deg or None, form 1's reading or "") of every trial."""
+    r1 = config.form1_readings
+    rows = [("sweep", 1, n, None, r) for r in r1 for n in config.form1_moves]
+    rows += [("sweep", 2, n, None, "") for n in config.form2_moves]
+    m1, m2 = config.angle_moves
+    rows += [("angle", 1, m1, a, r) for r in r1 for a in config.angles_deg]
+    rows += [("angle", 2, m2, a, "") for a in config.angles_deg]
+    if not config.anchors:
+        return rows
+    anchors = [("dead-reckoning", 0, 0, None, ""), ("cps2", 1, 0, None, r1[0]),
+               ("cps2", 2, 0, None, ""), ("planner", 0, 0, None, "")]  # fmt: skip
+    return rows + anchors + [("3d", 1, 5, None, r1[0]), ("3d", 2, 7, None, "")]
 
 
 def preflight(config: CoopFormsConfig) -> None:
@@ -59,21 +92,38 @@ def preflight(config: CoopFormsConfig) -> None:
         raise ValueError("coop-forms: runs and dead_reckoning_runs must be >= 2")
     if not 0 < config.angle_sigma_deg < 10:
         raise ValueError("coop-forms: angle_sigma_deg must lie in (0, 10)")
-    for n in config.form1_moves:
+    bad = [r for r in config.form1_readings if r not in FORM1_READINGS]
+    if not config.form1_readings or bad:
+        raise ValueError(f"coop-forms: form1_readings must be some of {', '.join(FORM1_READINGS)}")
+    if len(config.angle_moves) != 2:
+        raise ValueError("coop-forms: angle_moves takes 2 counts (form 1, form 2)")
+    for n in (*config.form1_moves, config.angle_moves[0]):
         if n < 1 or n % 2 == 0:
             raise ValueError(f"coop-forms: form 1 takes odd move counts, got {n}")
-    for form, moves in ((1, config.form1_moves), (2, config.form2_moves)):
-        for n in moves:
-            plan(form, n)  # raises for a count whose angle is out of range
+    for kind, form, moves, angle, reading in _settings(config):
+        if kind in ("sweep", "angle"):  # raises for a count or angle out of range
+            plan(form, moves, None if angle is None else math.radians(angle), reading=reading or
+                 FORM1_READINGS[0])  # fmt: skip
 
 
-def _errors(form: int, moves: int, goal, runs: int, sigma: float, seed: int) -> dict:
-    run = simulate(plan(form, moves, None, START, goal), runs, sigma, seed)
+def _errors(
+    form, moves, angle, reading, goal, runs: int, sigma: float, seed: int, repeats: int = 1
+) -> dict:
+    """One setting's errors at the goal: the first repeat's runs in full, and per repeat (each
+    ``runs`` runs on a seed derived from ``seed``) the mean error and the along-track RMS."""
+    the_plan = plan(form, moves, None if angle is None else math.radians(angle), START, goal,
+                    reading or FORM1_READINGS[0])  # fmt: skip
+    run = simulate(the_plan, runs, sigma, seed)
+    again = [simulate(the_plan, runs, sigma, derive_seed(seed, r)) for r in range(1, repeats)]
+    ends = [run, *again]
+    last = the_plan.steps[-1]
+    offsets = [r.estimates[:, -1, last.robot] - last.target for r in ends]
     last = run.plan.steps[-1]
     d = run.estimates[:, -1, last.robot] - last.target
     e = np.hypot(d[:, 0], d[:, 1])
     return {
         "form": form,
+        "reading": reading,
         "moves": moves,
         "angle_deg": math.degrees(run.plan.angle),
         "mean_error_m": float(e.mean()),
@@ -82,6 +132,11 @@ def _errors(form: int, moves: int, goal, runs: int, sigma: float, seed: int) -> 
         "along_rms_m": float(np.sqrt(np.mean(d[:, 1] ** 2))),
         "cross_rms_m": float(np.sqrt(np.mean(d[:, 0] ** 2))),
         "predicted_rms_m": predicted_goal_rms(run.plan, sigma),
+        "min_sight_angle_deg": float(np.degrees(the_plan.sight_angles().min())),
+        "errors_m": [round(float(v), 7) for v in e],
+        "along_m": [round(float(v), 7) for v in d[:, 1]],
+        "repeat_mean_m": [float(np.hypot(o[:, 0], o[:, 1]).mean()) for o in offsets],
+        "repeat_along_rms_m": [float(np.sqrt(np.mean(o[:, 1] ** 2))) for o in offsets],
     }
 
 
@@ -105,10 +160,11 @@ def trial(config: CoopFormsConfig, index: int, seed: int) -> TrialOutput:
     settings = _settings(config)
     if index >= len(settings):
         raise ValueError(f"coop-forms: {len(settings)} trials (settings), index {index}")
-    kind, form, moves = settings[index]
+    kind, form, moves, angle, reading = settings[index]
     sigma = math.radians(config.angle_sigma_deg)
-    if kind == "sweep":
-        return TrialOutput({"kind": kind, **_errors(form, moves, GOAL, config.runs, sigma, seed)})
+    if kind in ("sweep", "angle"):
+        row = _errors(form, moves, angle, reading, GOAL, config.runs, sigma, seed, config.repeats)
+        return TrialOutput({"kind": kind, **row})
     if kind == "dead-reckoning":
         return TrialOutput({"kind": kind, "form": 0, "moves": 0, **_dead_reckoning(config, seed)})
     if kind == "3d":
@@ -117,7 +173,7 @@ def trial(config: CoopFormsConfig, index: int, seed: int) -> TrialOutput:
         def ground(x, y):
             return a * np.sin(2 * np.pi * x / wl) * np.cos(2 * np.pi * y / wl)
 
-        the_plan = plan(form, moves)
+        the_plan = plan(form, moves, reading=reading or FORM1_READINGS[0])
         off = simulate_3d(the_plan, ground, config.runs, sigma, seed=seed).goal_offsets
         flat = simulate(the_plan, config.runs, sigma, seed).goal_errors
         return TrialOutput(
@@ -154,109 +210,105 @@ def trial(config: CoopFormsConfig, index: int, seed: int) -> TrialOutput:
             continue
         if not math.radians(5) <= paper_angle(form, n, START, goal) <= math.radians(85):
             continue
-        row = _errors(form, n, goal, config.runs, sigma, seed)
+        row = _errors(form, n, None, reading, goal, config.runs, sigma, seed)
         if best is None or row["mean_error_m"] < best["mean_error_m"]:
             best = row
     return TrialOutput({"kind": kind, **best, "distance_m": CPS2_DISTANCE})
-
-
-def analytic_optimum(distance: float = 10.0, d: float = 1.0, dtheta: float = 1e-3):
-    """The paper's sec. 3.1, from its eq. 4 (kiseki.coop.paper_error): each of n measurements
-    places the moving robot on the centre line, d tan(theta) ahead of a baseline of half-width
-    d, with theta1 = theta2 = theta and equal errors dtheta1 = dtheta2 (the along-track worst
-    case); the along-track errors add up over the n steps, and n d tan(theta) = distance.
-    Returns (n, theta in deg, the error) minimising that error over n = 1..200."""
-    best = None
-    for n in range(1, 201):
-        theta = math.atan(distance / (n * d))
-        error = n * abs(paper_error(d, theta, theta, dtheta, dtheta)[1])
-        if best is None or error < best[2]:
-            best = (n, math.degrees(theta), error)
-    return best
 
 
 def _best(rows: pd.DataFrame) -> pd.Series:
     return rows.loc[rows["mean_error_m"].idxmin()]
 
 
+COLUMNS = ["form", "reading", "moves", "angle_deg", "mean_error_m", "sd_error_m", "along_rms_m",
+           "cross_rms_m", "predicted_rms_m", "min_sight_angle_deg"]  # fmt: skip
+
+
+def _groups(ok: pd.DataFrame, kind: str, key: str) -> dict[str, pd.DataFrame]:
+    """The rows of one sweep by form and form 1's reading, sorted by ``key``."""
+    rows = ok[ok["kind"] == kind]
+    out = {}
+    for (form, reading), g in rows.groupby(["form", "reading"], sort=True):
+        label = f"form 1 ({reading})" if int(form) == 1 else "form 2"
+        out[label] = g.sort_values(key)
+    return out
+
+
+def _per_repeat_argmin(rows: pd.DataFrame, key: str, column: str, x=None) -> np.ndarray:
+    """Per repeat of the sweep in ``rows``: the ``key`` value (or ``x``) at the smallest
+    ``column`` (a list per setting, one value per repeat)."""
+    values = np.array([list(v) for v in rows[column]])  # (settings, repeats)
+    xs = np.asarray(rows[key] if x is None else x, dtype=float)
+    return xs[np.argmin(values, axis=0)]
+
+
+def _per_repeat_min(rows: pd.DataFrame) -> np.ndarray:
+    return np.array([list(v) for v in rows["repeat_mean_m"]]).min(axis=0)
+
+
+def _subject(label: str) -> str:
+    return label if label.startswith("form 1") else ""
+
+
+def _evidence(forms: dict, angles: dict) -> list[Evidence]:
+    """The declared claims' evidence (kiseki_experiments.coop.coop_claims), one value per
+    repeat of the sweep."""
+    out = []
+    for label, rows in forms.items():
+        f = int(rows["form"].iloc[0])
+        best = _per_repeat_argmin(rows, "moves", "repeat_mean_m")
+        out.append(Evidence.of(f"moves_{f}", best, "median", subject=_subject(label),
+                               shown=f"{1000 * rows['mean_error_m'].min():.1f} mm"))  # fmt: skip
+        count = (rows["moves"] + 1) // 2 if f == 1 else rows["moves"]
+        n = _per_repeat_argmin(rows, "moves", "repeat_along_rms_m", x=count)
+        out.append(Evidence.of("n_tan", n, "median", subject=label))
+    for label, rows in angles.items():
+        f = int(rows["form"].iloc[0])
+        best = _per_repeat_argmin(rows, "angle_deg", "repeat_mean_m")
+        out.append(Evidence.of(f"angle_{f}", best, "median", subject=_subject(label)))
+    if "form 2" in forms:
+        two = _per_repeat_min(forms["form 2"])
+        for label in (k for k in forms if k.startswith("form 1")):
+            ratio = _per_repeat_min(forms[label]) / two
+            out.append(Evidence.of("lower_min", ratio, "median", subject=label))
+    return out
+
+
 def analyze(config: CoopFormsConfig, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path):
     ok = trials[trials["error"].isna()]
-    sweep = ok[ok["kind"] == "sweep"].sort_values(["form", "moves"])
-    table = sweep[
-        [
-            "form",
-            "moves",
-            "angle_deg",
-            "mean_error_m",
-            "sd_error_m",
-            "along_rms_m",
-            "cross_rms_m",
-            "predicted_rms_m",
-        ]
-    ].reset_index(drop=True)
+    forms = _groups(ok, "sweep", "moves")
+    angles = _groups(ok, "angle", "angle_deg")
+    sweep = pd.concat(forms.values()) if forms else ok.iloc[:0]
+    table = sweep[COLUMNS].reset_index(drop=True) if forms else pd.DataFrame(columns=COLUMNS)
     claims: list[Claim] = []
     figure_paths: list[Path] = []
-    forms = {f: sweep[sweep["form"] == f] for f in (1, 2) if (sweep["form"] == f).any()}
-    paper = {1: ((10, 20), (50, 60)), 2: ((5, 10), (50, 60))}
-    for f, rows in forms.items():
-        b = _best(rows)
-        (lo, hi), (alo, ahi) = paper[f]
-        claims.append(
-            Claim(
-                claim=f"form {f}: the error at the goal is smallest at about {lo}-{hi} moves and "
-                f"a representative angle of {alo}-{ahi} deg",
-                paper_value=f"{lo}-{hi} moves, {alo}-{ahi} deg (Figs. {4 + f}, {6 + f})",
-                measured_value=f"{int(b['moves'])} moves, {b['angle_deg']:.0f} deg, "
-                f"{1000 * b['mean_error_m']:.1f} mm",
-                unit="moves, deg",
-                holds=bool(lo <= b["moves"] <= hi and alo - 2.5 <= b["angle_deg"] <= ahi + 2.5),
-            )
-        )
-    if len(forms) == 2:
-        b1, b2 = _best(forms[1]), _best(forms[2])
-        claims.append(
-            Claim(
-                claim="form 1 reaches the lower minimum error",
-                paper_value="form 1 < form 2",
-                measured_value=f"{1000 * b1['mean_error_m']:.1f} mm vs "
-                f"{1000 * b2['mean_error_m']:.1f} mm",
-                unit="mean error at the goal",
-                holds=bool(b1["mean_error_m"] < b2["mean_error_m"]),
-            )
-        )
 
-        def spread(rows: pd.DataFrame) -> float:
-            band = rows[(rows["angle_deg"] >= 30) & (rows["angle_deg"] <= 75)]
-            return float(band["mean_error_m"].max() / band["mean_error_m"].min())
+    def spread(rows: pd.DataFrame) -> float:
+        band = rows[(rows["angle_deg"] >= 30) & (rows["angle_deg"] <= 75)]
+        return float(band["mean_error_m"].max() / band["mean_error_m"].min())
 
-        s1, s2 = spread(forms[1]), spread(forms[2])
-        claims.append(
-            Claim(
-                claim="form 2 varies less with the representative angle (30-75 deg)",
-                paper_value="form 2 flatter",
-                measured_value=f"max/min error: form 1 {s1:.2f}, form 2 {s2:.2f}",
-                unit="ratio",
-                holds=bool(s2 < s1),
-            )
+    distance = float(GOAL[1] - START[:2, 1].mean())
+    n_opt, theta_opt, _ = analytic_optimum(distance)
+    extra = {
+        "paper_algebra": pd.DataFrame(
+            [
+                {
+                    "n": n_opt,
+                    "theta_deg": theta_opt,
+                    "n_tan_theta_e": N_PAPER,
+                    "source": "eq. 4 summed over n steps, brute force over n (the paper's algebra)",
+                }
+            ]
+        )  # fmt: skip
+    }
+    if angles:
+        extra["angle_sweep"] = pd.concat(angles.values())[COLUMNS].reset_index(drop=True)
+        # Figs. 7-8's flatness: a table row (no control can make the comparison fail for sure)
+        extra["angle_spread"] = pd.DataFrame(
+            [{"sweep": k, "max_over_min_30_75_deg": spread(r)} for k, r in angles.items()]
         )
-    n_opt, theta_opt, _ = analytic_optimum(float(GOAL[1] - START[:2, 1].mean()))
-    theta_e = math.degrees(math.atan((GOAL[1] - START[:2, 1].mean()) / 1.0))
-    claims.append(
-        Claim(
-            claim="along-track error (eq. 4, theta1 = theta2, equal errors) is smallest at "
-            "n = tan(theta_e) measurements and theta = pi/4",
-            paper_value=f"n = tan(theta_e) = {math.tan(math.radians(theta_e)):.0f}, 45 deg "
-            "(eqs. 5-6)",
-            measured_value=f"n = {n_opt}, {theta_opt:.1f} deg (brute force over n)",
-            unit="measurements, deg",
-            holds=bool(n_opt == round(math.tan(math.radians(theta_e))) and abs(theta_opt - 45) < 1),
-            note="the paper's own error model, summed over the steps; theta_e is the goal's "
-            "bearing from the start robots' baseline (half-width 1 m)",
-        )
-    )
     dead = ok[ok["kind"] == "dead-reckoning"]
     anchors = ok[ok["kind"] == "cps2"]
-    extra = {}
     if len(dead) and len(forms):
         best_any = min(_best(r)["mean_error_m"] for r in forms.values())
         d = dead.iloc[0]
@@ -330,17 +382,21 @@ def analyze(config: CoopFormsConfig, trials: pd.DataFrame, timings: pd.DataFrame
                 "paper's",
             )
         )
-    if forms:
+    if forms or angles:
         fig = new_figure(figsize=(10, 7), dpi=120)
         axes = fig.subplots(2, 2)
-        for col, (f, rows) in enumerate(forms.items()):
-            for row, x, label in ((0, "moves", "number of moves"), (1, "angle_deg", "angle")):
-                ax = axes[row, col]
+        for row, (groups, x, label) in enumerate(
+            ((forms, "moves", "number of moves"), (angles, "angle_deg", "angle (deg)"))
+        ):
+            for name, rows in groups.items():
+                f = int(rows["form"].iloc[0])
+                ax = axes[row, f - 1]
                 ax.errorbar(rows[x], 1000 * rows["mean_error_m"], 1000 * rows["sd_error_m"],
-                            fmt="o-", ms=3, capsize=2)  # fmt: skip
-                ax.set_xlabel(label + (" (deg)" if row else ""))
+                            fmt="o-", ms=3, capsize=2, label=name)  # fmt: skip
+                ax.set_xlabel(label)
                 ax.set_ylabel("error at the goal (mm)")
                 ax.set_title(f"form {f}: Fig. {4 + f + 2 * row}", fontsize=9)
+                ax.legend(fontsize=7)
         fig.tight_layout()
         path = figures / "coop_forms.png"
         fig.savefig(path)
@@ -348,12 +404,23 @@ def analyze(config: CoopFormsConfig, trials: pd.DataFrame, timings: pd.DataFrame
     notes = (
         f"{config.runs} runs per setting, angle noise {config.angle_sigma_deg} deg; mean and SD "
         "of the distance between the goal and the estimate of the robot that moved there. The "
-        "movement forms are kiseki's reading (kiseki.coop.positioning): the paper's drawings "
-        "are not in its text."
+        "movement forms are kiseki's readings (kiseki.coop.positioning): the paper's drawings "
+        "are not in its text. Form 1 (pair and scout) sees its joiner along lines of sight "
+        "meeting at atan(tan(theta) / 3) (25 deg at 55 deg); form 1 (crossing) moves the other "
+        "pair robot so that they meet at theta (min_sight_angle_deg in the tables). Figs. 5-6 "
+        "keep the start's width (the angle follows from the moves); Figs. 7-8 sweep the angle "
+        f"at {config.angle_moves[0]} (form 1) and {config.angle_moves[1]} (form 2) moves. "
+        "paper_algebra is the paper's sec. 3.1 minimised as printed (a table row: it cannot "
+        "fail); the claims on n = tan(theta_e) compare the simulation's optimum with it."
     )
     return Analysis(
-        tables={"sweep": table, **extra}, figures=figure_paths, claims=claims, notes=notes
-    )
+        tables={"sweep": table, **extra}, figures=figure_paths, claims=claims, notes=notes,
+        evidence=_evidence(forms, angles),
+    )  # fmt: skip
+
+
+def setting_count(config: CoopFormsConfig) -> int:
+    return len(_settings(config))
 
 
 EXPERIMENT = Experiment(
@@ -366,5 +433,6 @@ EXPERIMENT = Experiment(
     analyze=analyze,
     default_runs=len(_settings(CoopFormsConfig())),
     preflight=preflight,
-    trial_count=lambda config: len(_settings(config)),
+    trial_count=setting_count,
+    claims=claims(CoopFormsConfig, setting_count),
 )

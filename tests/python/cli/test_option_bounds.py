@@ -341,6 +341,8 @@ WORLD = "data/worlds/factory_corridor.yaml"
          "--slices does not apply to flat: a 2-D map (slices are 3-D maps')"),
         (["magnetic", "predict", "flat", "--at", "p.csv", "-o", "f.csv", "--interpolate"],
          "--interpolate does not apply to flat: it keeps no data to re-evaluate"),
+        (["coop", "simulate", "--form", "2", "--reading", "crossing"],
+         "--reading does not apply to --form 2 or --planner (form 1's readings)"),
         (["terrain", "planes", "c.xyz", "-o", "p.png", "--origin", "0,0,0"],
          "--origin does not apply to --method pcl (hough's S-DEM is centred on it)"),
         (["terrain", "planes", "c.xyz", "-o", "p.png", "--method", "hough", "--max-points",

@@ -169,6 +169,25 @@ def test_eq4_cost_matches_a_brute_force_reference(cost):
         assert got == pytest.approx(want, rel=2e-3, abs=1e-9)
 
 
+def test_the_default_cost_is_eq4_as_printed_a_sum():
+    """correlation_search and the mapper without a cost score eq. 4 as the paper prints it
+    (the sum over the shared cells), not kiseki's mean: the cost surface against numpy."""
+    from kiseki.terrain.mapper import MapperConfig
+
+    pts = rubble_points(9, 3000)
+    prev = sdem_from_points(pts)
+    prev_points, _ = prev.to_points()
+    current = sdem_from_points(pts - [0.2, 0.1, 0.0])
+    grid = search_grid((0.1, 0.3), (0.0, 0.2), (-0.04, 0.04), 0.1)
+    found = correlation_search(prev, current, None, grid)
+    eye = np.eye(3)
+    for (i, j, k), got in np.ndenumerate(found.costs):
+        t = np.array([0.1 + 0.1 * i, 0.1 * j, -0.04 + 0.1 * k])
+        want, _ = brute_force_eq4(prev_points, current, eye, t, "sum")
+        assert got == pytest.approx(want, rel=2e-3, abs=1e-9)
+    assert MapperConfig().cost == "sum"
+
+
 @pytest.mark.parametrize("true_t", [(0.30, 0.20, 0.04), (0.56, -0.34, -0.12)])
 def test_both_searches_find_a_known_offset_exactly(true_t):
     pts = rubble_points(7)
