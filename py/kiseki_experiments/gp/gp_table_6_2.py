@@ -30,6 +30,7 @@ from kiseki.gp import ExactGP, SquaredExponential, fit_hyperparameters
 from kiseki.plots import new_figure, save_figure
 from kiseki.sim.scene import load_scene
 from kiseki_experiments.gp.gp_common import HALL, SENSOR_NOISE, magnetic_world
+from kiseki_experiments.gp.gp_floor_mapping_report import CALIBRATED
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki_experiments.harness.config import Count, NonNegativeReal, Real, Restarts
 from kiseki_experiments.harness.records import pack, unpack
@@ -182,7 +183,12 @@ def analyze(config: Table62Config, trials, timings, figures: Path) -> Analysis:
     if len(ok):
         figs.append(_plot_slice(config, ok.iloc[0], figures))
     return Analysis(
-        {"table_6_2": table, "hyperparameters": hyper, "components_and_thesis_kernel": components},
+        {
+            "table_6_2": table,
+            "hyperparameters": hyper,
+            "components_and_thesis_kernel": components,
+            "calibrated": calibrated(table, hyper),
+        },
         figs,
         claims,
         _notes(config, hyper),
@@ -193,19 +199,40 @@ def _thesis(spacing: float, column: int) -> float:
     return THESIS_TABLE.get(round(float(spacing), 1), (np.nan,) * 3)[column]
 
 
+def calibrated(table: pd.DataFrame, hyper: pd.DataFrame) -> pd.DataFrame:
+    """The numbers magnetic_hall.yaml was built to give (its ``calibrated`` marks): the grid of
+    2816 points, whose subsamples are Table 6.2's training counts by arithmetic, and the
+    sources' spatial scale, aimed at Table 6.1's length scale. Shown, not claimed."""
+    rows = [
+        {
+            "quantity": f"training points at {s:g} m",
+            "thesis": float(THESIS_TABLE[round(s, 1)][0]),
+            "kiseki": float(n),
+            "note": "16 x 16 x 11 grid points (fitted to 2816); subsamples by arithmetic",
+        }
+        for s, n in zip(table["spacing_m"], table["train"], strict=True)
+        if round(s, 1) in THESIS_TABLE
+    ]
+    at04 = hyper[hyper.spacing_m.round(1) == 0.4]
+    if len(at04):
+        rows.append(
+            {
+                "quantity": "length scale, the magnitude's GP on the 0.4 m set (Table 6.1)",
+                "thesis": THESIS_KERNEL[1],
+                "kiseki": float(at04["length_scale"].iloc[0]),
+                "note": "mx, my, mz with one kernel on the same points: l = "
+                f"{float(at04['length_scale_xyz'].iloc[0]):.3f} m; the sources were aimed at "
+                "the thesis' value",
+            }
+        )
+    out = pd.DataFrame(rows)
+    out["status"] = CALIBRATED
+    return out
+
+
 def _claims(config, table: pd.DataFrame, hyper: pd.DataFrame, seeds: int) -> list[Claim]:
     by = table.set_index("spacing_m")
-    counts = ", ".join(str(int(v)) for v in table["train"])
-    thesis_counts = ", ".join(str(THESIS_TABLE[s][0]) for s in THESIS_TABLE)
     claims = [
-        Claim(
-            "training points of the 0.4 / 0.6 / 0.8 / 1.0 m subsamples (Table 6.2)",
-            thesis_counts,
-            counts,
-            "points",
-            counts == thesis_counts,
-            "16 x 16 x 11 grid points; the 1.0 m and 0.8 m sets both hold 4 x 4 x 3 points",
-        ),
         Claim(
             "the mean error grows with the spacing (Table 6.2)",
             " < ".join(f"{THESIS_TABLE[s][1]:.5f}" for s in THESIS_TABLE),
@@ -237,21 +264,6 @@ def _claims(config, table: pd.DataFrame, hyper: pd.DataFrame, seeds: int) -> lis
                 "ratio of error SDs",
                 bool(near <= 1 + m and far >= 1 + m),
                 f"holds when the first ratio is <= {1 + m:.2f} and the second >= {1 + m:.2f}",
-            )
-        )
-    at04 = hyper[hyper.spacing_m.round(1) == 0.4]
-    if len(at04):
-        l04, lxyz = float(at04["length_scale"].iloc[0]), float(at04["length_scale_xyz"].iloc[0])
-        claims.append(
-            Claim(
-                "length scale of the field (Table 6.1; kiseki: the magnitude's GP on the 0.4 m "
-                "set)",
-                f"{THESIS_KERNEL[1]:.5f}",
-                f"{l04:.3f}",
-                "m",
-                bool(abs(l04 / THESIS_KERNEL[1] - 1) <= 0.5),
-                f"holds within +-50 %; mx, my, mz with one kernel on the same points: l = "
-                f"{lxyz:.3f} m",
             )
         )
     return claims

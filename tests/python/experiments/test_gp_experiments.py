@@ -106,8 +106,15 @@ def test_table_6_2_protocol(tmp_path):
     held_out = ~grid.mask(2)
     expected = np.abs(prediction - truth)[held_out].mean()
     assert table.loc[0.4, "mean_err_vs_truth_G"] == pytest.approx(expected, rel=1e-4)
+    # the grid was fitted to the thesis' 2816 points and the sources to its length scale (the
+    # scene's marks): the counts and the length scale are rows, not claims
+    marks = {m["fitted_to"] for m in load_scene(HALL).calibrated}
+    calibrated = pd.read_csv(run.run_dir / "tables" / "calibrated.csv")
+    assert calibrated["kiseki"].iloc[:4].tolist() == [384, 144, 48, 48]
+    assert (calibrated["status"] == CALIBRATED).all() and 0.47496 in set(calibrated["thesis"])
     claims = pd.read_csv(run.run_dir / "claims.csv")
-    assert claims.loc[0, "holds"]  # the training counts
+    assert not claims["claim"].str.contains("training points|length scale").any()
+    assert not any(f"{m:g}" in str(v) for m in marks for v in claims["paper_value"])
     assert (run.run_dir / "figures" / "gp_table_6_2_slice.png").stat().st_size > 20_000
 
 
