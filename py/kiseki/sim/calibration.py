@@ -13,30 +13,18 @@ so in a top-level ``calibrated`` list, one entry per fitted parameter::
          source: "002, Table 4.2 (mean error without localization)"}
 
 ``parameter`` is the dotted key path of the value in the scene file (list items by their index:
-``robots.0.route.speed``); :func:`check_marks` checks that each path names a value.
+``robots.0.route.speed``); the entries' types are :class:`kiseki.sim.scene_schema.Calibration`'s,
+and :func:`check_marks` checks that each path names a value.
 """
 
 from __future__ import annotations
 
-from typing import Annotated, Any
+from typing import Any
 
-from pydantic import Field
+from kiseki._support.schema import SchemaError
+from kiseki.sim.scene_schema import Calibration
 
-from kiseki._support.schema import FileModel, FiniteFloat, SchemaError
-
-__all__ = ["CalibrationMark", "check_marks", "value_at"]
-
-Text = Annotated[str, Field(strict=True, min_length=1)]
-
-
-class CalibrationMark(FileModel):
-    """One fitted parameter: where it is, the paper's number it was fitted to, that number's
-    unit and where the paper prints it."""
-
-    parameter: Text  # dotted key path in the scene file
-    fitted_to: FiniteFloat
-    unit: Text
-    source: Text
+__all__ = ["check_marks", "value_at"]
 
 
 def value_at(doc: Any, parameter: str) -> Any:
@@ -53,7 +41,7 @@ def value_at(doc: Any, parameter: str) -> Any:
     return here
 
 
-def check_marks(doc: dict, marks: list[CalibrationMark], source: str) -> list[dict]:
+def check_marks(doc: dict, marks: list[Calibration], source: str) -> list[dict]:
     """The marks as plain mappings, after checking that each names a value of ``doc``."""
     for k, mark in enumerate(marks):
         try:

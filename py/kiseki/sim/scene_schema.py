@@ -3,12 +3,14 @@
 """The model of a scene file's top level (see :mod:`kiseki.sim.scene` for what each key means),
 checked by :mod:`kiseki._support.schema`: name, description, source, bounds, floor, octomap, objects
 (:mod:`kiseki.sim.primitives_schema`), grid_resolution, measurement_grid, robots (their name
-and the sections kiseki.sim.setup and kiseki.sim.robot read), turns, poses, pedestrians,
-point_robots, calibrated (:mod:`kiseki.sim.calibration`), and ``route`` (:class:`Route`,
-``route: {}`` is none). ``robot``, ``sensors`` and each robot's ``type``, ``start``,
-``params``, ``odometry_errors`` are checked by the models of kiseki.sim.setup_schema
-(:func:`~kiseki.sim.setup_schema.check_robots`, with the rules that depend on the rest of the
-scene), ``magnetic`` by kiseki.sim.magnetic_schema (in kiseki.sim.scene.load_scene).
+and the sections kiseki.sim.setup and kiseki.sim.robot read), turns, poses, pedestrians and
+point_robots, ``calibrated`` (:class:`Calibration`: the parameters fitted to a paper's number;
+each path is checked by :mod:`kiseki.sim.calibration`),
+and ``route`` (:class:`Route`, ``route: {}`` is none). ``robot``, ``sensors`` and
+each robot's ``type``, ``start``, ``params``, ``odometry_errors`` are checked by the models of
+kiseki.sim.setup_schema (:func:`~kiseki.sim.setup_schema.check_robots`, with the rules that
+depend on the rest of the scene), ``magnetic`` by kiseki.sim.magnetic_schema (in
+kiseki.sim.scene.load_scene).
 
 Limits on what sizes a run: the boxes the objects expand to (every box is ray cast by every
 sensor: 200,000 boxes take about 12 s to build), the ground truth's cells
@@ -26,12 +28,12 @@ from pydantic_core import PydanticCustomError, ValidationError
 
 from kiseki._support.schema import FileModel, FiniteFloat, NonNegativeFloat, PositiveFloat
 from kiseki.mapping import check_map_size
-from kiseki.sim.calibration import CalibrationMark
 from kiseki.sim.magnetic_survey import MeasurementGrid
 from kiseki.sim.primitives_schema import Object
 from kiseki.sim.setup_schema import RobotSections, check_robots
 
 __all__ = [
+    "Calibration",
     "MAX_POSES",
     "MAX_PEDESTRIANS",
     "MAX_ROBOTS",
@@ -246,6 +248,18 @@ def extent_problem(
     return None
 
 
+class Calibration(FileModel):
+    """A scene parameter fitted to a paper's number: ``parameter`` is its dotted key path in
+    the scene file (``robots.0.odometry_errors.wheel_radius``), ``fitted_to`` the number it was
+    fitted to (in ``unit``), ``source`` where the number is printed (paper, table or figure).
+    No claim may then compare a result with that number (the experiments' calibration test)."""
+
+    parameter: Name
+    fitted_to: FiniteFloat
+    unit: str = Field(strict=True)
+    source: Name
+
+
 class SceneDoc(FileModel):
     """A scene file's top level."""
 
@@ -267,7 +281,7 @@ class SceneDoc(FileModel):
     poses: Poses | None = None
     pedestrians: Annotated[list[PedestrianDoc], Field(max_length=MAX_PEDESTRIANS)] | None = None
     point_robots: bool = Field(False, strict=True)
-    calibrated: list[CalibrationMark] = []  # parameters fitted to a paper's number
+    calibrated: list[Calibration] = []
 
     @field_validator("objects")
     @classmethod

@@ -74,3 +74,6 @@ class Experiment:
     # The claims the experiment tests, each with its criterion and control (declared here,
     # before any run); the analysis gives their Evidence.
     claims: tuple[ClaimSpec, ...] = ()
+    # Scene files (names in data/worlds) the experiment uses beyond those its default config
+    # names: the calibration test reads their calibration marks against the claims.
+    scenes: tuple[str, ...] = ()

@@ -27,6 +27,7 @@ __all__ = [
     "BOOTSTRAP_RESAMPLES",
     "MIN_TRIALS",
     "UNMIGRATED",
+    "VERDICT_COLUMNS",
     "ClaimSpec",
     "Control",
     "Criterion",
@@ -36,6 +37,7 @@ __all__ = [
     "decide",
     "estimate",
     "judge",
+    "legacy",
     "trials_to_decide",
 ]
 

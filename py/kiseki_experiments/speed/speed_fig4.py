@@ -3,7 +3,8 @@
 """speed-fig4: paper 004's Fig. 4: the occluded region's corner seen from 1.5 m at phi = 0..60
 deg in 5 deg steps (data/worlds/speed_corner.yaml's ``poses``), the robot heading +y; method 1's
 limit v_max * ratio (eq. 1, theta = 90 deg) at each pose, and the hidden region at phi = 20 and
-60 deg (Figs. 4c, 4d). One trial per pose; the scan carries the laser's noise (seeded).
+60 deg (Figs. 4c, 4d). One trial per (pose, repeat): ``repeats`` sweeps, each with the laser's
+noise of its trials' seeds, so each claim has one value per sweep and an interval over sweeps.
 
 The paper's point: at the same distance from the corner, the limit follows the geometry (how
 much of the free space ahead is hidden), not the distance. The figure's own values are not in
@@ -24,8 +25,9 @@ from kiseki.plots import draw_map, new_figure
 from kiseki.sim.scene import load_scene
 from kiseki.sim.sensors import LASER_PRESETS, Laser2D, Mount
 from kiseki.speed import occlusion_labels
-from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
-from kiseki_experiments.harness.config import PositiveReal, Speed
+from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
+from kiseki_experiments.harness.config import Count, PositiveReal, Speed
+from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion, Evidence
 from kiseki_experiments.speed.speed_common import WORLDS, laser_mount, prior_map
 
 __all__ = ["EXPERIMENT", "Fig4Config"]
@@ -36,6 +38,14 @@ class Fig4Config:
     scene: str = str(WORLDS / "speed_corner.yaml")
     v_max: Speed = 0.5  # m/s, the paper's
     half_angle_deg: PositiveReal = 90.0  # theta, the paper's
+    repeats: Count = 5  # sweeps over the poses, each with its own laser noise
+    # "occlusion": method 1 (eq. 1); "distance": the distance-only rule of the paper's ref. [4]
+    # as the issue reads it, v_max min(1, d_hidden / d_stop), the claims' control
+    limit: str = "occlusion"
+    a_max: PositiveReal = 0.5  # m/s^2, the robot's (kiseki.sim.robot), for d_stop
+
+
+LIMITS = ("occlusion", "distance")
 
 
 def _sweep(config: Fig4Config) -> tuple[list, tuple[float, float]]:
@@ -48,6 +58,8 @@ def _sweep(config: Fig4Config) -> tuple[list, tuple[float, float]]:
 
 def preflight(config: Fig4Config) -> None:
     _sweep(config)
+    if config.limit not in LIMITS:
+        raise ValueError(f"speed-fig4: limit must be one of {', '.join(LIMITS)}")
     if not 0 < config.half_angle_deg <= 180 or not config.v_max > 0:
         raise ValueError("speed-fig4: need 0 < half_angle_deg <= 180 and v_max > 0")
 
@@ -74,11 +86,28 @@ def _view(config: Fig4Config, index: int, seed: int):
     return phi, pose, ratio, labels, prior, math.dist(corner, pose[:2])
 
 
+def _hidden_distance(prior, labels: np.ndarray, pose) -> float:
+    """m from the robot to the nearest hidden free cell within reach (label 1); inf if none."""
+    rows, cols = np.nonzero(labels == 1)
+    if rows.size == 0:
+        return math.inf
+    res, ox, oy = prior.resolution, prior.origin.x, prior.origin.y
+    x, y = ox + (cols + 0.5) * res, oy + (rows + 0.5) * res
+    return float(np.min(np.hypot(x - pose[0], y - pose[1])))
+
+
 def trial(config: Fig4Config, index: int, seed: int) -> TrialOutput:
-    phi, pose, ratio, labels, _, distance = _view(config, index, seed)
+    poses = len(_sweep(config)[0])
+    phi, pose, ratio, labels, prior, distance = _view(config, index % poses, seed)
+    d_hidden = _hidden_distance(prior, labels, pose)
+    if config.limit == "distance":  # v_max min(1, d_hidden / d_stop), d_stop = v^2 / (2 a)
+        d_stop = config.v_max**2 / (2 * config.a_max)
+        ratio = min(1.0, d_hidden / d_stop)
     return TrialOutput(
         {
+            "repeat": index // poses,
             "phi_deg": round(phi, 6),
+            "hidden_distance_m": d_hidden,
             "x": pose[0],
             "y": pose[1],
             "corner_distance_m": distance,
@@ -94,32 +123,31 @@ def analyze(config: Fig4Config, trials: pd.DataFrame, timings, figures: Path) ->
     ok = trials[trials["error"].isna()].sort_values("phi_deg")
     if ok.empty:
         return Analysis(notes="every trial failed: nothing to analyse")
-    table = ok[["phi_deg", "corner_distance_m", "ratio", "v_ref", "seen_cells", "region_cells"]]
-    spread = float(ok["v_ref"].max() - ok["v_ref"].min())
-    claims = [
-        Claim(
-            claim="at one distance from the corner, the limit follows the geometry (Fig. 4b)",
-            paper_value="differs with phi at 1.5 m",
-            measured_value=f"{ok['v_ref'].min():.3f}-{ok['v_ref'].max():.3f} m/s over phi "
-            f"{ok['phi_deg'].min():.0f}-{ok['phi_deg'].max():.0f} deg, distance "
-            f"{ok['corner_distance_m'].min():.3f}-{ok['corner_distance_m'].max():.3f} m",
-            unit="m/s",
-            holds=bool(spread >= 0.1 * config.v_max),
-            note="holds when the limit spans at least 10 % of v_max across phi",
+    columns = ["phi_deg", "corner_distance_m", "hidden_distance_m", "ratio", "v_ref"]
+    table = ok.groupby("phi_deg", as_index=False)[columns[1:] + ["seen_cells", "region_cells"]]
+    table = table.mean()
+    per_sweep = ok.groupby("repeat")
+    spread = (per_sweep["v_ref"].max() - per_sweep["v_ref"].min()) / config.v_max
+    at = ok.assign(phi=ok["phi_deg"].round()).pivot_table("v_ref", "repeat", "phi")
+    evidence = [
+        Evidence.of(
+            "spread",
+            spread,
+            shown=f"{table['v_ref'].min():.3f}-{table['v_ref'].max():.3f} m/s over phi "
+            f"{table['phi_deg'].min():.0f}-{table['phi_deg'].max():.0f} deg at "
+            f"{table['corner_distance_m'].mean():.3f} m ({config.limit})",
         )
     ]
-    at = {round(p): r for p, r in zip(ok["phi_deg"], ok["v_ref"], strict=True)}
-    if 20 in at and 60 in at:
-        claims.append(
-            Claim(
-                claim="the hidden region differs between phi = 20 and 60 deg (Figs. 4c, 4d)",
-                paper_value="the view differs",
-                measured_value=f"{at[20]:.3f} vs {at[60]:.3f} m/s",
-                unit="m/s",
-                holds=bool(abs(at[20] - at[60]) >= 0.05 * config.v_max),
+    if 20 in at.columns and 60 in at.columns:
+        evidence.append(
+            Evidence.of(
+                "views",
+                (at[20] - at[60]).abs() / config.v_max,
+                shown=f"{at[20].mean():.3f} vs {at[60].mean():.3f} m/s",
                 note="from further back (60 deg) the corner hides more of the side corridor",
             )
         )
+    ok = table
     fig = new_figure(figsize=(12, 4.2), dpi=120)
     axes = fig.subplots(1, 3)
     axes[0].plot(ok["phi_deg"], ok["v_ref"], "o-")
@@ -140,7 +168,47 @@ def analyze(config: Fig4Config, trials: pd.DataFrame, timings, figures: Path) ->
         "(data/worlds/speed_corner.yaml). The map is the scene's ground truth at the laser's "
         "height; the scan has the laser's noise."
     )
-    return Analysis({"sweep": table.reset_index(drop=True)}, [path], claims, notes)
+    return Analysis({"sweep": table}, [path], notes=notes, evidence=evidence)
+
+
+CONTROL = Control(
+    name="the distance-only rule (ref. [4]) in place of method 1",
+    overrides=("limit=distance",),
+    runs=5 * 13,  # 5 sweeps of the 13 poses
+    why="at one distance from the corner the hidden region is as near at every phi: the "
+    "distance rule gives v_max at each pose (d_hidden > d_stop = 0.25 m)",
+)
+CLAIMS = (
+    ClaimSpec(
+        key="spread",
+        claim="at one distance from the corner, the limit follows the geometry (Fig. 4b)",
+        unit="(max - min) of the limit over phi / v_max",
+        criterion=Criterion(
+            paper_value="differs with phi at 1.5 m",
+            compare=">=",
+            threshold=0.1,
+            why="a tenth of v_max (0.05 m/s) is 5x the speed command's resolution and well "
+            "above the laser noise's effect on the ratio",
+            bounds=(0.0, 1.0),
+        ),
+        control=CONTROL,
+        measure="one sweep's spread of the limit over the 13 poses",
+    ),
+    ClaimSpec(
+        key="views",
+        claim="the hidden region differs between phi = 20 and 60 deg (Figs. 4c, 4d)",
+        unit="|limit(20 deg) - limit(60 deg)| / v_max",
+        criterion=Criterion(
+            paper_value="the view differs",
+            compare=">=",
+            threshold=0.05,
+            why="half the spread's threshold: two poses, not the whole sweep",
+            bounds=(0.0, 1.0),
+        ),
+        control=CONTROL,
+        measure="one sweep's difference between the two poses",
+    ),
+)
 
 
 def _phis(config: Fig4Config) -> list[float]:
@@ -170,7 +238,8 @@ EXPERIMENT = Experiment(
     config_type=Fig4Config,
     trial=trial,
     analyze=analyze,
-    default_runs=13,
+    default_runs=13 * 5,
     preflight=preflight,
-    trial_count=lambda config: len(_sweep(config)[0]),
+    trial_count=lambda config: len(_sweep(config)[0]) * config.repeats,
+    claims=CLAIMS,
 )

@@ -12,8 +12,9 @@ Potential Method toward the goal, kiseki_experiments.speed.speed_common) in the 
 - Situation 3 (Fig. 7): a 1.5 m corridor opening into a hall (speed_corridor.yaml), method 1
   against methods 1 + 2.
 
-One trial per (situation, method); the laser noise of a trial comes from its seed. The paper
-prints no numbers for these figures: the claims are its statements, measured.
+One trial per (situation, method, repeat): ``repeats`` drives of each, the laser noise of a
+trial from its seed, so each claim has one value per repeat and an interval over repeats. The
+paper prints no numbers for these figures: the claims are its statements, measured.
 """
 
 from __future__ import annotations
@@ -28,9 +29,11 @@ import pandas as pd
 from kiseki.plots import draw_map, new_figure
 from kiseki.sim.scene import load_scene
 from kiseki.speed import SpeedLimiter, SpeedLimiterConfig
-from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
-from kiseki_experiments.harness.config import Index, Seconds
+from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
+from kiseki_experiments.harness.config import Count, Index, Seconds
+from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion, Evidence
 from kiseki_experiments.speed.speed_common import (
+    METHODS,
     WORLDS,
     RecordingLimiter,
     drive,
@@ -58,6 +61,12 @@ class SituationsConfig:
     worlds: str = str(WORLDS)
     max_duration: Seconds = 120.0  # s, a run that has not arrived by then fails
     runs: list[Index] = field(default_factory=lambda: list(range(len(RUNS))))
+    repeats: Count = 5  # drives of each run, each with its own laser noise
+    # what runs in each arm (the controls swap them): the arm without speed control, method 1's
+    # arms and situation 3's methods 1 + 2 arm
+    baseline: str = "none"
+    method_1: str = "occlusion"
+    method_12: str = "occlusion-width"
 
 
 class OfflineMapLimiter:
@@ -79,24 +88,37 @@ def preflight(config: SituationsConfig) -> None:
     for index in config.runs:
         if not 0 <= index < len(RUNS):
             raise ValueError(f"speed-situations: runs must lie in 0..{len(RUNS) - 1}")
+    known = set(METHODS) | {"offline-map"}
+    for arm in ("baseline", "method_1", "method_12"):
+        if getattr(config, arm) not in known:
+            raise ValueError(f"speed-situations: {arm} must be one of {', '.join(sorted(known))}")
     for name in {r[1] for r in RUNS}:
         if not (Path(config.worlds) / name).is_file():
             raise FileNotFoundError(f"speed-situations: {Path(config.worlds) / name} not found")
 
 
+def _runs_as(config: SituationsConfig, method: str) -> str:
+    """The method that runs in an arm named ``method`` (as RUNS names it)."""
+    arms = {"none": config.baseline, "occlusion": config.method_1}
+    return {**arms, "occlusion-width": config.method_12}.get(method, method)
+
+
 def trial(config: SituationsConfig, index: int, seed: int) -> TrialOutput:
-    situation, name, variant, goal, method = RUNS[config.runs[index]]
+    situation, name, variant, goal, method = RUNS[config.runs[index % len(config.runs)]]
+    runs = _runs_as(config, method)
     scene_file = Path(config.worlds) / name
     prior = prior_map(scene_file)
     scene = load_scene(scene_file, variant)
-    limiter = OfflineMapLimiter(prior) if method == "offline-map" else None
+    limiter = OfflineMapLimiter(prior) if runs == "offline-map" else None
     d = drive(
-        scene, goal, "occlusion" if limiter else method, seed, prior, config.max_duration, limiter
+        scene, goal, "occlusion" if limiter else runs, seed, prior, config.max_duration, limiter
     )
     return TrialOutput(
         {
             "situation": situation,
             "method": method,
+            "runs": runs,
+            "repeat": index // len(config.runs),
             "reached": d.reached,
             "duration_s": d.duration,
             "collision": "" if d.collision is None else d.collision["hit"],
@@ -129,87 +151,163 @@ def _argmin_y(row, y0: float, y1: float) -> float:
     return float(y[inside][np.argmin(v[inside])])
 
 
+def _evidence(runs: dict, repeats: list[int]) -> list[Evidence]:
+    """Each claim's values, one per repeat that has the runs it compares."""
+    near, far = CROSSING
+    box = (2.0, 4.9)  # from where the box is in reach until the robot passes it
+    width = (1.5, CORRIDOR_END - 1.0)
+    values: dict[str, list[float]] = {k: [] for k in ("full", "slows", "speeds", "box", "width")}
+    for r in repeats:
+        if (1, "none", r) in runs:
+            values["full"].append(_between(runs[(1, "none", r)], 1.0, 9.0).min() / V_MAX)
+        if (1, "occlusion", r) in runs:
+            m1 = runs[(1, "occlusion", r)]
+            before = _between(m1, 0.5, near).min()
+            values["slows"].append(before / V_MAX)
+            values["speeds"].append(_between(m1, near + 0.35, far).mean() - before)
+        if (2, "occlusion", r) in runs and (2, "offline-map", r) in runs:
+            scan = _between(runs[(2, "occlusion", r)], *box, "ratio").min()
+            mapped = _between(runs[(2, "offline-map", r)], *box, "ratio").min()
+            values["box"].append(mapped - scan)
+        if (3, "occlusion", r) in runs and (3, "occlusion-width", r) in runs:
+            a = _between(runs[(3, "occlusion", r)], *width).mean()
+            b = _between(runs[(3, "occlusion-width", r)], *width).mean()
+            values["width"].append(b / a)
+    f15 = 1 / (1 + math.exp(-4.9 * (1.5 - 1.3)))
+    shown = {
+        "full": "min speed y 1-9 m / v_max",
+        "slows": f"min speed before the crossing's near face (y = {near} m) / v_max",
+        "speeds": "mean speed inside minus the min before (m/s)",
+        "box": "eq. 1 ratio's min, y 2.0-4.9 m: map only minus scan",
+        "width": f"mean speed y 1.5-5 m, methods 1 + 2 over method 1 (f(1.5 m) = {f15:.3f})",
+    }
+    return [Evidence.of(k, v, shown=shown[k]) for k, v in values.items() if v]
+
+
+V_MAX = 0.5  # m/s, the paper's robot (kiseki.sim.robot)
+
+
 def analyze(config: SituationsConfig, trials: pd.DataFrame, timings, figures: Path) -> Analysis:
     ok = trials[trials["error"].isna()]
-    runs = {(int(r["situation"]), r["method"]): r for _, r in ok.iterrows()}
-    table = ok[["situation", "method", "reached", "duration_s", "collision"]].copy()
+    runs = {(int(r["situation"]), r["method"], int(r["repeat"])): r for _, r in ok.iterrows()}
+    table = ok[["situation", "method", "runs", "repeat", "reached", "duration_s", "collision"]]
+    table = table.copy()
     table["min_speed_en_route"] = [_en_route(r).min() for _, r in ok.iterrows()]
     table["mean_speed"] = [float(np.mean(r["speed"])) for _, r in ok.iterrows()]
-    claims: list[Claim] = []
-    v_max = 0.5
-    near, far = CROSSING
-    if (1, "none") in runs and (1, "occlusion") in runs:
-        plain, m1 = runs[(1, "none")], runs[(1, "occlusion")]
-        before = _between(m1, 0.5, near)
-        inside = _between(m1, near + 0.35, far)
-        claims += [
-            Claim(
-                claim="situation 1 without speed control crosses at full speed (Fig. 5a)",
-                paper_value="v_max through the crossing",
-                measured_value=f"min {_between(plain, 1.0, 9.0).min():.3f} m/s, y 1-9 m",
-                unit="m/s",
-                holds=bool(_between(plain, 1.0, 9.0).min() >= 0.98 * v_max),
-            ),
-            Claim(
-                claim="situation 1 with method 1 slows before the crossing (Fig. 5b)",
-                paper_value="slows before entering",
-                measured_value=f"min {before.min():.3f} m/s at y = "
-                f"{_argmin_y(m1, 0.5, near):.2f} m",
-                unit="m/s",
-                holds=bool(before.min() <= 0.8 * v_max),
-                note=f"the crossing's near face is at y = {near} m",
-            ),
-            Claim(
-                claim="... and speeds up inside it (Fig. 5c)",
-                paper_value="accelerates once inside",
-                measured_value=f"{inside.mean():.3f} m/s inside vs {before.min():.3f} m/s min "
-                "before",
-                unit="m/s",
-                holds=bool(inside.mean() >= before.min() + 0.1),
-            ),
-        ]
-    if all((2, m) in runs for m in ("occlusion", "offline-map")):
-        m1, offline = runs[(2, "occlusion")], runs[(2, "offline-map")]
-        s1 = runs.get((1, "occlusion"))
-        box = (2.0, 4.9)  # from where the box is in reach until the robot passes it
-        with_box = float(_between(m1, *box, "ratio").min())
-        offline_min = float(_between(offline, *box, "ratio").min())
-        claims.append(
-            Claim(
-                claim="situation 2: method 1 slows for the occlusion of an object the map "
-                "lacks; a limit from the map alone does not (Fig. 6)",
-                paper_value="slows for the unknown box",
-                measured_value=f"ratio min {with_box:.3f} (scan) vs {offline_min:.3f} (map only)"
-                + (
-                    f"; {float(_between(s1, *box, 'ratio').min()):.3f} without the box"
-                    if s1 is not None
-                    else ""
-                ),
-                unit="eq. 1 ratio, y 2.0-4.9 m",
-                holds=bool(with_box <= offline_min - 0.05),
-            )
-        )
-    if (3, "occlusion") in runs and (3, "occlusion-width") in runs:
-        m1, m12 = runs[(3, "occlusion")], runs[(3, "occlusion-width")]
-        a = _between(m1, 1.5, CORRIDOR_END - 1.0).mean()
-        b = _between(m12, 1.5, CORRIDOR_END - 1.0).mean()
-        f15 = 1 / (1 + math.exp(-4.9 * (1.5 - 1.3)))
-        claims.append(
-            Claim(
-                claim="situation 3: the width term lowers the speed in the 1.5 m corridor (Fig. 7)",
-                paper_value="lower speed with method 2",
-                measured_value=f"{b:.3f} vs {a:.3f} m/s (ratio {b / a:.3f}; f(1.5 m) = {f15:.3f})",
-                unit="mean speed, y 1.5-5 m",
-                holds=bool(b <= 0.9 * a),
-            )
-        )
-    figure_paths = [_plot(runs, s, figures) for s in (1, 2, 3) if any(k[0] == s for k in runs)]
+    evidence = _evidence(runs, sorted({k[2] for k in runs}))
+    first = {k[:2]: r for k, r in runs.items() if k[2] == 0}  # the figures: the first repeat
+    figure_paths = [_plot(first, s, figures) for s in (1, 2, 3) if any(k[0] == s for k in first)]
     notes = (
         "Closed loop: the FPM chooses the direction, the limiter caps the speed, the omni robot "
         "keeps facing +y; the prior map is the scene's ground truth at the laser's height "
-        "(teach variant, outside the building unknown). Speeds are the simulated robot's."
+        "(teach variant, outside the building unknown). Speeds are the simulated robot's; the "
+        "figures show the first repeat."
     )
-    return Analysis({"runs": table.reset_index(drop=True)}, figure_paths, claims, notes)
+    return Analysis(
+        {"runs": table.reset_index(drop=True)}, figure_paths, notes=notes, evidence=evidence
+    )
+
+
+def _control(name: str, runs: str, overrides: tuple[str, ...], why: str) -> Control:
+    """A control that drives only the runs its claims compare (``runs``), 5 repeats each."""
+    count = len(runs.split(","))
+    return Control(name, (f"runs={runs}", "repeats=5", *overrides), 5 * count, why)
+
+
+NO_LIMIT_IN_METHOD_1 = _control(
+    "method 1's arm without speed control",
+    "1",
+    ("method_1=none",),
+    "without a limit the robot keeps v_max before and inside the crossing",
+)
+CLAIMS = (
+    ClaimSpec(
+        key="full",
+        claim="situation 1 without speed control crosses at full speed (Fig. 5a)",
+        unit="min speed, y 1-9 m / v_max",
+        criterion=Criterion(
+            paper_value="v_max through the crossing",
+            compare=">=",
+            threshold=0.98,
+            why="2 % of v_max (1 cm/s) for the FPM's steering and the speed command's rounding",
+            bounds=(0.0, 1.0),
+        ),
+        control=_control(
+            "method 1 in the arm without speed control",
+            "0",
+            ("baseline=occlusion",),
+            "method 1 slows before the crossing",
+        ),
+        measure="one drive's min speed",
+    ),
+    ClaimSpec(
+        key="slows",
+        claim="situation 1 with method 1 slows before the crossing (Fig. 5b)",
+        unit="min speed before the crossing / v_max",
+        criterion=Criterion(
+            paper_value="slows before entering",
+            compare="<=",
+            threshold=0.8,
+            why="a fifth of v_max: a slowdown, not the 2 % the FPM's steering costs",
+            bounds=(0.0, 1.0),
+        ),
+        control=NO_LIMIT_IN_METHOD_1,
+        measure="one drive's min speed before the near face",
+    ),
+    ClaimSpec(
+        key="speeds",
+        claim="... and speeds up inside it (Fig. 5c)",
+        unit="m/s",
+        criterion=Criterion(
+            paper_value="accelerates once inside",
+            compare=">=",
+            threshold=0.1,
+            why="a fifth of v_max (0.1 m/s) above the min before the crossing",
+            bounds=(-V_MAX, V_MAX),
+        ),
+        control=NO_LIMIT_IN_METHOD_1,
+        measure="one drive's mean speed inside minus its min before",
+    ),
+    ClaimSpec(
+        key="box",
+        claim="situation 2: method 1 slows for the occlusion of an object the map lacks; a "
+        "limit from the map alone does not (Fig. 6)",
+        unit="eq. 1 ratio (map only minus scan), y 2.0-4.9 m",
+        criterion=Criterion(
+            paper_value="slows for the unknown box",
+            compare=">=",
+            threshold=0.05,
+            why="5 % of v_max: above the ratio's change from the laser's noise",
+            bounds=(-1.0, 1.0),
+        ),
+        control=_control(
+            "the map-only limit in method 1's arm",
+            "3,4",
+            ("method_1=offline-map",),
+            "both arms see only the map: the box hides nothing from either",
+        ),
+        measure="one repeat's difference between the two arms",
+    ),
+    ClaimSpec(
+        key="width",
+        claim="situation 3: the width term lowers the speed in the 1.5 m corridor (Fig. 7)",
+        unit="mean speed y 1.5-5 m, methods 1 + 2 / method 1",
+        criterion=Criterion(
+            paper_value="lower speed with method 2",
+            compare="<=",
+            threshold=0.9,
+            why="a tenth lower; f(1.5 m) = 0.727 of eq. 4 would give 0.73",
+            bounds=(0.0, math.inf),
+        ),
+        control=_control(
+            "method 1 in the methods 1 + 2 arm (no width term)",
+            "5,6",
+            ("method_12=occlusion",),
+            "the same method in both arms: a ratio of ~1",
+        ),
+        measure="one repeat's ratio of the two arms' mean speeds",
+    ),
+)
 
 
 def _plot(runs: dict, situation: int, figures: Path) -> Path:
@@ -219,7 +317,7 @@ def _plot(runs: dict, situation: int, figures: Path) -> Path:
     fig = new_figure(figsize=(10, 4.5), dpi=120)
     ax_map, ax_speed = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.6]})
     draw_map(ax_map, grid)
-    for (s, method), row in sorted(runs.items()):
+    for (s, method), row in sorted(runs.items(), key=lambda item: item[0]):
         if s != situation:
             continue
         ax_map.plot(row["x"], row["y"], lw=1, label=method)
@@ -246,7 +344,9 @@ EXPERIMENT = Experiment(
     config_type=SituationsConfig,
     trial=trial,
     analyze=analyze,
-    default_runs=len(RUNS),
+    default_runs=5 * len(RUNS),
     preflight=preflight,
-    trial_count=lambda config: len(config.runs),
+    trial_count=lambda config: len(config.runs) * config.repeats,
+    claims=CLAIMS,
+    scenes=tuple(sorted({r[1] for r in RUNS})),
 )

@@ -23,6 +23,7 @@ from kiseki_experiments.harness import base, registry
 from kiseki_experiments.harness.config import ConfigError, apply_overrides
 from kiseki_experiments.harness.report import write_reproduction
 from kiseki_experiments.harness.runner import run_experiment
+from kiseki_experiments.harness.verdict import VERDICT_COLUMNS
 from kiseki_experiments.mapping.corridor_scans import CorridorScansConfig
 
 
@@ -48,6 +49,10 @@ def test_serial_and_two_worker_local_cluster_give_identical_records(tmp_path):
         tmp_path / "dask" / "trials.parquet"
     ).read_bytes()
     assert list(a["seed"]) == [derive_seed(11, i) for i in range(6)]
+    # the verdicts too: the bootstrap's generator comes from the run's seed, not the executor
+    assert (tmp_path / "serial" / "claims.csv").read_bytes() == (
+        tmp_path / "dask" / "claims.csv"
+    ).read_bytes()
     assert a["lateral_offset"].nunique() == 6  # the seeds reach the trials
     workers = pd.read_parquet(tmp_path / "dask" / "timings.parquet")["worker"].nunique()
     assert workers == 2  # both workers of the LocalCluster took trials
@@ -63,8 +68,11 @@ def test_carmen_maps_serial_equals_local_cluster(shared_data, tmp_path):
     assert serial.returncode == 0 and parallel.returncode == 0, serial.stderr + parallel.stderr
     pd.testing.assert_frame_equal(frame(tmp_path / "s"), frame(tmp_path / "p"))
     claims = pd.read_csv(tmp_path / "s" / "claims.csv")
-    intel = claims[claims["claim"].str.startswith("intel")].iloc[0]
-    assert intel["holds"] and float(intel["measured_value"]) >= 0.9
+    intel = claims[claims["claim"].str.endswith("[intel-corrected]")].iloc[0]
+    assert intel["verdict"] == "holds" and intel["ci_low"] >= 0.9
+    assert (tmp_path / "s" / "claims.csv").read_bytes() == (
+        tmp_path / "p" / "claims.csv"
+    ).read_bytes()
 
 
 def test_resume_after_kill_equals_an_uninterrupted_run(tmp_path):
@@ -151,7 +159,7 @@ def test_failing_trials_are_recorded_and_the_sweep_continues(tmp_path, monkeypat
 
 
 def test_results_folder_latest_link_and_reproduction_report(tmp_path):
-    done = cli("experiment", "run", "corridor-scans", "--runs", "3", cwd=tmp_path)
+    done = cli("experiment", "run", "corridor-scans", "--runs", "5", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     latest = tmp_path / "results" / "corridor-scans" / "latest"
     assert latest.is_symlink()
@@ -166,41 +174,42 @@ def test_results_folder_latest_link_and_reproduction_report(tmp_path):
     ):
         assert (latest / name).is_file(), name
     saved = yaml.safe_load((latest / "config.yaml").read_text())
-    assert saved["runs"] == 3 and saved["config"]["range_noise_sd"] == 0.01
+    assert saved["runs"] == 5 and saved["config"]["range_noise_sd"] == 0.01
     claims = pd.read_csv(latest / "claims.csv")
-    assert list(claims.columns) == [
-        "claim",
-        "paper_value",
-        "measured_value",
-        "unit",
-        "holds",
-        "note",
-    ]
+    assert list(claims.columns) == VERDICT_COLUMNS
+    # every rebuilt cell of 5 seeds lies by a wall: the interval [1, 1] is inside >= 0.99
+    assert claims["verdict"].tolist() == ["holds"] and claims["ci_low"].iloc[0] >= 0.99
     done = cli("experiment", "report", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     text = (tmp_path / "REPRODUCTION.md").read_text()
-    assert "1 claims, 1 hold." in text
+    assert "1 claims: 1 hold, 0 fail, 0 inconclusive, 0 not yet migrated" in text
+    assert "decided: 100 %" in text
     missing = text.split("Missing experiments (")[1].split("\n")[0]
     assert "carmen-maps" in missing and "corridor-scans" not in missing
-    assert "every rebuilt occupied cell" in text
+    assert "rebuilt occupied cells lie within 1.5 cells of a true obstacle" in text
 
 
 def test_reproduction_report_with_carmen_maps(shared_data, tmp_path):
     assert cli("experiment", "run", "carmen-maps", cwd=tmp_path).returncode == 0
-    total, held, missing = write_reproduction(tmp_path / "results", tmp_path / "R.md")
+    totals, missing = write_reproduction(tmp_path / "results", tmp_path / "R.md")
     claims = pd.read_csv(tmp_path / "results" / "carmen-maps" / "latest" / "claims.csv")
-    # each claim holds exactly when its measured share reaches the 0.90 threshold (intel 0.964
-    # and csail 0.953 do, aces 0.896 and freiburg 0.886 do not, as measured)
-    measured = claims.set_index("claim")["measured_value"].astype(float)
-    holding = sorted(c.split(":")[0] for c in measured.index[measured >= 0.90])
+    # each log's share of endpoints against 0.90 (intel 0.964 and csail 0.953 hold, aces 0.896
+    # and freiburg 0.886 fail, as measured): the verdict is the side of 0.90 its Wilson
+    # interval lies on, and the interval holds the measured share
+    measured = claims["measured_value"].astype(float)
+    assert ((claims["ci_low"] <= measured) & (measured <= claims["ci_high"])).all()
+    expected = ["holds" if lo >= 0.90 else "fails" for lo in claims["ci_low"]]
+    assert claims["verdict"].tolist() == expected
+    holding = sorted(c.split("[")[1].rstrip("]") for c in claims["claim"][measured >= 0.90])
     assert holding == ["csail-corrected", "intel-corrected"]
-    assert claims["holds"].tolist() == (measured >= 0.90).tolist()
-    assert (total, held) == (4, 2) and "corridor-scans" in missing
-    assert "carmen-maps" not in missing
+    assert (totals["claims"], totals["holds"], totals["fails"]) == (4, 2, 2)
+    assert "corridor-scans" in missing and "carmen-maps" not in missing
     text = (tmp_path / "R.md").read_text()
-    assert "4 claims, 2 hold." in text
-    for row in claims.itertuples():  # every claim is a table row with its value and verdict
-        assert f"| {row.claim} | >= 0.90 | {row.measured_value:g} | share | {row.holds} |" in text
+    assert "4 claims: 2 hold, 2 fail, 0 inconclusive, 0 not yet migrated" in text
+    for row in claims.itertuples():  # every claim is a table row with its interval and verdict
+        interval = f"{row.measured_value:g} [{row.ci_low:.4g}, {row.ci_high:.4g}]"
+        assert f"| {row.claim} | {row.paper_value} | {interval} | {row.unit} |" in text
+        assert f"| {row.verdict} | {row.trials} |" in text
 
 
 def test_overrides_are_typed():
@@ -246,7 +255,7 @@ def test_bad_input_is_one_line_and_non_zero(tmp_path, args, needle):
     ("claims", "manifest", "needle"),
     [
         (None, None, "nonexistent: results folder not found"),
-        ("claim,value\nx,1\n", "{}", "corridor-scans/latest/claims.csv: no column holds"),
+        ("claim,value\nx,1\n", "{}", "corridor-scans/latest/claims.csv: no column paper_value"),
         (b"\xff\xfe\x00garbage\x81", "{}", "corridor-scans/latest/claims.csv: not a claims"),
         ("claim,holds\nx,True\n", "[1,", "corridor-scans/latest/manifest.json: not a JSON"),
         ("claim,holds\nx,True\n", "{}", "corridor-scans/latest/manifest.json: a manifest needs"),
