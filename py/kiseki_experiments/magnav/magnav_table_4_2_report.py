@@ -218,7 +218,9 @@ plots it); here {plate}. The largest change on a component is {change["b"]:.4f} 
 The plates lie from the path's centre line to 1.5 m right of it, magnetised in their plane along
 y (north): the edge under the path raises mz by about 0.12 G along the whole stretch (plates
 centred on the path would change only By there, by symmetry). With plate_moment=0,0,0 the
-time-varying run reads the very same mz as the static one (same seed) and its claims fail.
+time-varying run reads the very same mz as the static one (same seed), and the claims that the
+change raises the error and the ESS fail (their control); with localize=false the filter's
+estimate is replaced by odometry's travel distance, and the claims on the errors fail (theirs).
 
 Filter: {config.particles} particles, a = {config.gain:g}, window l = {config.window:g} m (the
 thesis names l without a value: Rahok's 6 m window), motion spread {config.odometry_noise:g} m
