@@ -375,6 +375,7 @@ def _old_claims(claims: pd.DataFrame) -> pd.DataFrame:
                 "trials_to_decide": math.nan,
                 "verdict": UNMIGRATED,
                 "note": f"point verdict without an interval: {'holds' if holds else 'fails'}",
+                "holds": holds,
             }
         )
     return pd.DataFrame(rows, columns=VERDICT_COLUMNS)

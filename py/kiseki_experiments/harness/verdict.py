@@ -160,6 +160,7 @@ class Estimate:
     low: float
     high: float
     n: int
+    share: bool = False  # a Wilson interval of k of n (not a bootstrap)
 
 
 def _generator(seed: int, evidence: Evidence) -> np.random.Generator:
@@ -174,9 +175,9 @@ def estimate(evidence: Evidence, seed: int) -> Estimate:
     if evidence.trials is not None:
         k, n = int(evidence.successes or 0), int(evidence.trials)
         low, high = wilson_interval(k, n)
-        return Estimate(k / n if n else math.nan, low, high, n)
+        return Estimate(k / n if n else math.nan, low, high, n, share=True)
     x = np.asarray(evidence.values, dtype=float)
-    x = x[np.isfinite(x)]
+    x = x[~np.isnan(x)]  # an infinite value (never back, never converged) stays and counts
     stat = np.median if evidence.statistic == "median" else np.mean
     if x.size == 0:
         return Estimate(math.nan, math.nan, math.nan, 0)
@@ -185,7 +186,9 @@ def estimate(evidence: Evidence, seed: int) -> Estimate:
         return Estimate(value, math.nan, math.nan, int(x.size))
     picks = _generator(seed, evidence).integers(0, x.size, (BOOTSTRAP_RESAMPLES, x.size))
     resampled = stat(x[picks], axis=1)
-    low, high = np.quantile(resampled, [0.025, 0.975])
+    # the empirical quantiles themselves (no interpolation between resamples: an infinite
+    # value, never back or never converged, gives an infinite end, not inf - inf)
+    low, high = np.quantile(resampled, [0.025, 0.975], method="inverted_cdf")
     return Estimate(value, float(low), float(high), int(x.size))
 
 
@@ -205,18 +208,43 @@ def decide(criterion: Criterion, est: Estimate) -> Outcome:
 def trials_to_decide(criterion: Criterion, est: Estimate) -> int | None:
     """Trials that would decide an undecided claim, from the interval's half-width h at n
     trials scaling as 1/sqrt(n): n * (h / d)^2, d the distance from the value to the nearest
-    edge of the criterion's band (the interval must shrink inside it, or away from it). None
+    edge of the criterion's band and h the interval's arm on that side (the interval must shrink
+    inside the band, or away from it); for a share, the Wilson interval at the same share,
+    searched. An estimate: the value itself moves with more trials. None
     when the value sits on an edge (d = 0: no number of trials decides it)."""
     if est.n == 0 or math.isnan(est.value):
         return None
+    if est.share:
+        return _share_trials(criterion, est)
     if math.isnan(est.low):  # too few trials for an interval
         return MIN_TRIALS
     a, b = criterion.band()
-    d = min(abs(est.value - a), abs(est.value - b))
-    half = (est.high - est.low) / 2
-    if d == 0 or not math.isfinite(d):
+    edge = a if abs(est.value - a) <= abs(est.value - b) else b
+    d = abs(est.value - edge)
+    # the interval's arm on the edge's side (a Wilson interval is not symmetric)
+    half = est.value - est.low if edge <= est.value else est.high - est.value
+    if d == 0 or not math.isfinite(d) or not math.isfinite(half):
         return None
     return max(est.n + 1, math.ceil(est.n * (half / d) ** 2))
+
+
+def _share_trials(criterion: Criterion, est: Estimate, most: int = 10**7) -> int | None:
+    """For a share, the fewest trials whose Wilson interval at the same share is decided
+    (found by doubling, then bisection): a share at 0 or 1 narrows as 1/n, not 1/sqrt(n)."""
+
+    def decided(m: int) -> bool:
+        low, high = wilson_interval(round(est.value * m), m)
+        return decide(criterion, Estimate(est.value, low, high, m)) != "inconclusive"
+
+    low, high = est.n, max(est.n + 1, 2 * est.n)
+    while not decided(high):
+        low, high = high, 2 * high
+        if high > most:
+            return None  # on the threshold: no number of trials decides it
+    while high - low > 1:
+        mid = (low + high) // 2
+        low, high = (low, mid) if decided(mid) else (mid, high)
+    return high
 
 
 @dataclass(frozen=True)
@@ -235,6 +263,9 @@ class Verdict:
     trials_to_decide: float  # NaN when decided (or when no number of trials decides it)
     control: str
     note: str
+    # Kept while experiments migrate (their tests read it): verdict == "holds" for a declared
+    # claim, the point verdict for an old Claim. No report counts it; the verdict decides.
+    holds: bool = False
 
 
 VERDICT_COLUMNS = [f for f in Verdict.__dataclass_fields__]
@@ -267,6 +298,7 @@ def judge(specs: tuple[ClaimSpec, ...], evidence: list[Evidence], seed: int) -> 
                 trials_to_decide=math.nan if more is None else float(more),
                 control=spec.control.name if spec.control else "",
                 note=e.note,
+                holds=outcome == "holds",
             )
         )
     return out
@@ -288,4 +320,5 @@ def legacy(claim) -> Verdict:
         control="",
         note=f"point verdict without an interval: {'holds' if claim.holds else 'fails'}"
         + (f"; {claim.note}" if claim.note else ""),
+        holds=bool(claim.holds),
     )

@@ -361,7 +361,9 @@ SIM = Experiment(
     config_type=KidnapConfig,
     trial=trial_sim,
     analyze=analyze,
-    default_runs=50,
+    # resetting recovered 50 of 50 (the README's run): Wilson's lower end is then 0.929, below
+    # 0.95; from 73 of 73 on it is above (n / (n + 1.96^2) >= 0.95): 80 decide it
+    default_runs=80,
     preflight=preflight_sim,
     claims=_claims(),
 )
@@ -374,7 +376,7 @@ CARMEN = Experiment(
     config_type=KidnapConfig,
     trial=trial_carmen,
     analyze=analyze,
-    default_runs=2 * len(CARMEN_LOGS),
+    default_runs=20 * len(CARMEN_LOGS),  # as the simulated runs: 80 decide a share >= 0.95
     preflight=preflight_carmen,
     # the controls on the Intel log alone (about 1 s a trial; Freiburg's 4,791 scans take 4 s)
     claims=_claims(("logs=intel-corrected",)),

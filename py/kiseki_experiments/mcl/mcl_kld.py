@@ -26,9 +26,10 @@ from kiseki.filters import GlobalConfig, global_localize, noisy_odometry
 from kiseki.mapping import MapBuildConfig, map_of_log
 from kiseki.metrics import ape
 from kiseki.plots import new_figure
-from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import NonNegativeReal, Particles, Scans
 from kiseki_experiments.harness.paths import shared_data
+from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion, Evidence
 
 WAYS = ("kld", "fixed", "cut")
 
@@ -103,25 +104,29 @@ def analyze(config: KldConfig, trials: pd.DataFrame, timings: pd.DataFrame, figu
                 }
             )
     table = pd.DataFrame(rows)
-    claims = []
-    for log, t in table.groupby("log", sort=False):
-        t = t.set_index("way")
+    evidence = []
+    for log, group in ok.groupby("log", sort=False):
+        t = table[table["log"] == log].set_index("way")
         kld, fixed = t.loc["kld"], t.loc["fixed"]
-        claims.append(
-            Claim(
-                claim=f"{log}: KLD sampling tracks as well as the fixed count with fewer particles",
-                paper_value="(Fox 2003: same accuracy, far fewer samples)",
-                measured_value=(
-                    f"RMSE {kld.rmse_after_convergence_m:.3f} vs "
-                    f"{fixed.rmse_after_convergence_m:.3f} m, mean particles "
-                    f"{kld.mean_particles:.0f} vs {fixed.mean_particles:.0f}"
-                ),
-                unit="m; particles",
-                holds=bool(
-                    kld.converged == fixed.converged
-                    and kld.rmse_after_convergence_m <= 1.5 * fixed.rmse_after_convergence_m + 0.01
-                    and kld.mean_particles < 0.5 * fixed.mean_particles
-                ),
+        evidence.append(
+            Evidence.of(
+                "particles",
+                group["kld_mean_particles"] / group["fixed_mean_particles"],
+                subject=log,
+                shown=f"mean particles {kld.mean_particles:.0f} vs {fixed.mean_particles:.0f}",
+            )
+        )
+        # a seed whose KLD cloud never converged while the fixed one did: infinitely worse
+        lost = (group["kld_converged_scan"] < 0) & (group["fixed_converged_scan"] >= 0)
+        diff = (group["kld_rmse_m"] - group["fixed_rmse_m"]).where(~lost, np.inf)
+        evidence.append(
+            Evidence.of(
+                "accuracy",
+                diff,
+                subject=log,
+                shown=f"RMSE {kld.rmse_after_convergence_m:.3f} vs "
+                f"{fixed.rmse_after_convergence_m:.3f} m; converged {kld.converged} vs "
+                f"{fixed.converged} of {len(group)}",
             )
         )
     fig = new_figure(figsize=(8, 3.5), dpi=120)
@@ -142,7 +147,49 @@ def analyze(config: KldConfig, trials: pd.DataFrame, timings: pd.DataFrame, figu
         f"{config.max_particles} until the cloud converged, then {config.min_particles}. RMSE "
         "from the scan at which the cloud converged on; time of the filter on one thread."
     )
-    return Analysis(tables={"kld": table}, figures=[path], claims=claims, notes=notes)
+    return Analysis(tables={"kld": table}, figures=[path], notes=notes, evidence=evidence)
+
+
+SMALL = ("logs=aces-corrected", "max_scans=250", "max_particles=2000")  # a control's size
+CLAIMS = (
+    ClaimSpec(
+        key="particles",
+        claim="KLD sampling tracks with far fewer particles than the fixed count",
+        unit="mean particles, KLD / fixed",
+        criterion=Criterion(
+            paper_value="(Fox 2003: far fewer samples)",
+            compare="<=",
+            threshold=0.5,
+            why="'far fewer': at most half the fixed count over the run",
+            bounds=(0.0, 1.0),
+        ),
+        control=Control(
+            name="KLD's floor at the fixed count",
+            overrides=(*SMALL, "min_particles=2000"),
+            runs=5,
+            why="with min_particles = max_particles KLD keeps the fixed count: a ratio of 1",
+        ),
+        measure="a seed's mean particle count under KLD over the fixed one's",
+    ),
+    ClaimSpec(
+        key="accuracy",
+        claim="KLD sampling tracks as well as the fixed count",
+        unit="m (RMSE after convergence, KLD minus fixed)",
+        criterion=Criterion(
+            paper_value="(Fox 2003: same accuracy)",
+            compare="<=",
+            threshold=0.05,
+            why="5 cm, one cell of the 0.05 m map: below it the two track alike",
+        ),
+        control=Control(
+            name="KLD with a floor of 5 particles",
+            overrides=(*SMALL, "min_particles=5", "odometry_noise=0.3"),
+            runs=5,
+            why="a converged cloud of 5 particles under noisy odometry loses the track",
+        ),
+        measure="a seed's RMSE after convergence, KLD minus fixed (inf if only KLD was lost)",
+    ),
+)
 
 
 EXPERIMENT = Experiment(
@@ -153,6 +200,7 @@ EXPERIMENT = Experiment(
     config_type=KldConfig,
     trial=trial,
     analyze=analyze,
-    default_runs=4,
+    default_runs=10,  # 5 seeds per log: the fewest an interval is computed from
     preflight=preflight,
+    claims=CLAIMS,
 )

@@ -13,6 +13,7 @@ the text, so the claims are the paper's qualitative statements, measured.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -48,8 +49,15 @@ class Fig4Config:
 LIMITS = ("occlusion", "distance")
 
 
+@functools.lru_cache(maxsize=4)
+def _scene(path: str):
+    """The scene, its prior map and its laser's mount: one load per process, not per pose."""
+    scene = load_scene(path)
+    return scene, prior_map(path), laser_mount(scene)
+
+
 def _sweep(config: Fig4Config) -> tuple[list, tuple[float, float]]:
-    scene = load_scene(config.scene)
+    scene = _scene(config.scene)[0]
     if not scene.poses:
         raise ValueError(f"{config.scene}: speed-fig4 needs a scene with 'poses'")
     corner = safe_load_12(Path(config.scene).read_text(encoding="utf-8"))["poses"]["corner"]
@@ -67,9 +75,7 @@ def preflight(config: Fig4Config) -> None:
 def _view(config: Fig4Config, index: int, seed: int):
     """(phi, robot pose, ratio, labels) of pose `index` with the laser's noise of `seed`."""
     poses, corner = _sweep(config)
-    scene = load_scene(config.scene)
-    prior = prior_map(config.scene)
-    mount = laser_mount(scene)
+    _, prior, mount = _scene(config.scene)
     laser = Laser2D(LASER_PRESETS["speed_lrf"], Mount(*mount), seed)
     pose = poses[index]
     sensor, ranges = laser.scan(prior, pose)  # the world is the map here: no unknown objects

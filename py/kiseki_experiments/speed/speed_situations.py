@@ -283,7 +283,8 @@ CLAIMS = (
         control=_control(
             "the map-only limit in method 1's arm",
             "3,4",
-            ("method_1=offline-map",),
+            # 18 s of each drive: past y = 4.9 m, where the claim's window ends
+            ("method_1=offline-map", "max_duration=18"),
             "both arms see only the map: the box hides nothing from either",
         ),
         measure="one repeat's difference between the two arms",
@@ -302,7 +303,7 @@ CLAIMS = (
         control=_control(
             "method 1 in the methods 1 + 2 arm (no width term)",
             "5,6",
-            ("method_12=occlusion",),
+            ("method_12=occlusion", "max_duration=18"),  # past y = 5 m, the window's end
             "the same method in both arms: a ratio of ~1",
         ),
         measure="one repeat's ratio of the two arms' mean speeds",

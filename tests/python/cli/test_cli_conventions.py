@@ -113,11 +113,15 @@ def test_map_info_json_and_plain_lines_hold_the_grids_own_counts(grid_file: Path
     assert "┃" in run_on_terminal("map", "info", str(grid_file))
 
 
-def write_result(results: Path, name: str, holds: list[bool]) -> None:
+def write_result(results: Path, name: str, verdicts: list[str]) -> None:
     latest = results / name / "latest"
     latest.mkdir(parents=True)
-    rows = [f"claim {i},1,{i},m,{h},note" for i, h in enumerate(holds)]
-    head = "claim,paper_value,measured_value,unit,holds,note\n"
+    head = "claim,paper_value,measured_value,ci_low,ci_high,unit,criterion,verdict,trials,"
+    head += "trials_to_decide,control,note,holds\n"
+    rows = [
+        f"claim {i},1,{i},0,2,m,>= 1 (why),{v},5,,c,note,{v == 'holds'}"
+        for i, v in enumerate(verdicts)
+    ]
     (latest / "claims.csv").write_text(head + "\n".join(rows) + "\n")
     manifest = {"trials": 3, "trials_failed": 0, "git": {"commit": "abc"}}
     (latest / "manifest.json").write_text(json.dumps(manifest))
@@ -127,14 +131,17 @@ def test_report_json_counts_the_claims_written(tmp_path: Path):
     from kiseki_experiments.harness.registry import all_experiments
 
     names = sorted(all_experiments())
-    write_result(tmp_path / "results", names[0], [True, False, True])
-    write_result(tmp_path / "results", names[-1], [False, False])
+    write_result(tmp_path / "results", names[0], ["holds", "fails", "holds"])
+    write_result(tmp_path / "results", names[-1], ["inconclusive", "fails"])
     done = run("experiment", "report", "--json", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     doc = json.loads(done.stdout)
-    assert (doc["claims"], doc["hold"]) == (5, 2)
+    assert (doc["claims"], doc["hold"], doc["fail"], doc["inconclusive"]) == (5, 2, 2, 1)
+    assert doc["decided_share"] == 0.8
     assert doc["missing"] == names[1:-1] and doc["output"] == "REPRODUCTION.md"
-    assert "5 claims, 2 hold." in (tmp_path / "REPRODUCTION.md").read_text()
+    text = (tmp_path / "REPRODUCTION.md").read_text()
+    assert "5 claims: 2 hold, 2 fail, 1 inconclusive, 0 not yet migrated" in text
+    assert "decided: 80 %" in text
     done = run("experiment", "report", "-o", "R2.md", cwd=tmp_path)
     fields = dict(line.split("\t") for line in done.stdout.splitlines()[1:])
     assert (fields["claims"], fields["hold"]) == ("5", "2")
@@ -217,8 +224,8 @@ def test_experiment_run_prints_its_claims_as_plain_lines_when_piped(tmp_path: Pa
     done = run("experiment", "run", "speed-fig4", "--seed", "0", "--out", "r", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     lines = [line.split("\t") for line in done.stdout.splitlines() if "\t" in line]
-    assert lines[0] == ["claim", "paper_value", "measured_value", "unit", "holds"]
+    assert lines[0] == ["claim", "paper", "kiseki [95 % CI]", "unit", "verdict"]
     claims = pd.read_csv(tmp_path / "r" / "claims.csv", keep_default_na=False)
     assert [row[0] for row in lines[1:]] == list(claims["claim"])
-    assert [row[4] == "yes" for row in lines[1:]] == [bool(h) for h in claims["holds"]]
+    assert [row[4] for row in lines[1:]] == list(claims["verdict"])
     assert "│" not in done.stdout and "━" not in done.stdout

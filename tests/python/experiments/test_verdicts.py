@@ -1,0 +1,112 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Verdicts with uncertainty: the intervals against their closed forms, the three verdicts, the
+trials that would decide an undecided claim, and how the reports count and show them."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from kiseki.metrics import wilson_interval
+from kiseki_experiments.harness import base
+from kiseki_experiments.harness.report import _undecided, claims_frame, tally
+from kiseki_experiments.harness.verdict import (
+    UNMIGRATED,
+    ClaimSpec,
+    Control,
+    Criterion,
+    Estimate,
+    Evidence,
+    decide,
+    estimate,
+    trials_to_decide,
+)
+
+AT_LEAST = Criterion("0.5", ">=", 0.5, "a test's threshold", bounds=(0.0, 1.0))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_bootstrap_interval_of_a_mean_matches_the_normal_one(seed):
+    # 400 draws of N(2, 1): the 95 % interval of the mean is 2 +- 1.96 / 20 = +-0.098
+    x = np.random.default_rng(100 + seed).normal(2.0, 1.0, 400)
+    est = estimate(Evidence.of("k", x), seed)
+    half = 1.96 * x.std(ddof=1) / math.sqrt(x.size)
+    assert est.value == pytest.approx(x.mean())
+    assert est.low == pytest.approx(x.mean() - half, abs=0.15 * half)
+    assert est.high == pytest.approx(x.mean() + half, abs=0.15 * half)
+    assert estimate(Evidence.of("k", x), seed) == est  # one seed, one result
+
+
+def test_a_share_takes_wilsons_interval_and_few_values_none():
+    est = estimate(Evidence.share("k", 9, 10), 0)
+    assert (est.low, est.high) == wilson_interval(9, 10) and est.value == 0.9
+    few = estimate(Evidence.of("k", [1.0, 2.0, 3.0, 4.0]), 0)  # below MIN_TRIALS
+    assert math.isnan(few.low) and decide(AT_LEAST, few) == "inconclusive"
+
+
+@pytest.mark.parametrize(
+    ("low", "high", "at_least", "in_band"),
+    [
+        (0.6, 0.9, "holds", "inconclusive"),
+        (0.1, 0.4, "fails", "fails"),
+        (0.4, 0.6, "inconclusive", "inconclusive"),
+        (0.5, 0.7, "holds", "holds"),
+        (0.85, 0.95, "holds", "fails"),
+    ],
+)
+def test_the_verdict_is_where_the_interval_lies(low, high, at_least, in_band):
+    est = Estimate((low + high) / 2, low, high, 20)
+    assert decide(AT_LEAST, est) == at_least
+    within = Criterion("0.65", "within", 0.65, "a test's band", 0.15, (0.0, 1.0))  # 0.5-0.8
+    assert decide(within, est) == in_band
+
+
+def test_trials_to_decide_scale_the_half_width_as_one_over_sqrt_n():
+    # value 0.55, interval +-0.1 at 20 trials: the interval must shrink to 0.05, a quarter of
+    # the variance: 80 trials
+    assert trials_to_decide(AT_LEAST, Estimate(0.55, 0.45, 0.65, 20)) == 80
+    assert trials_to_decide(AT_LEAST, Estimate(0.5, 0.4, 0.6, 20)) is None  # on the threshold
+    # brute force for a share, whose Wilson interval is searched: 12 of 20 (0.6) decides >= 0.5
+    # at the count given, not one below; all of 10 decides >= 0.95 at 73 (n / (n + 1.96^2))
+    need = trials_to_decide(AT_LEAST, estimate(Evidence.share("k", 12, 20), 0))
+    for m, verdict in ((need, "holds"), (need - 1, "inconclusive")):
+        share = Evidence.share("k", round(0.6 * m), m)
+        assert decide(AT_LEAST, estimate(share, 0)) == verdict, (m, need)
+    target = Criterion("0.95", ">=", 0.95, "the issue's target", bounds=(0.0, 1.0))
+    assert trials_to_decide(target, estimate(Evidence.share("k", 10, 10), 0)) == 73
+
+
+def _experiment(claims=()) -> base.Experiment:
+    return base.Experiment(
+        "t", "p", "a", "d", dict, lambda *a: None, lambda *a: None, claims=claims
+    )
+
+
+def test_reports_count_unmigrated_claims_as_undecided_and_price_the_undecided():
+    spec = ClaimSpec("k", "a share", "share", AT_LEAST, Control("c", ("x=1",), 5))
+    analysis = base.Analysis(
+        claims=[base.Claim("old", "1", "1", "m", True)],
+        evidence=[Evidence.share("k", 11, 20)],  # 0.55, Wilson 0.34-0.74: inconclusive
+    )
+    claims = claims_frame(_experiment((spec,)), analysis, 0)
+    assert claims["verdict"].tolist() == ["inconclusive", UNMIGRATED]
+    counts = tally(claims)
+    assert (counts["decided"], counts["inconclusive"], counts["not_migrated"]) == (0, 1, 1)
+    need = int(claims["trials_to_decide"].iloc[0])
+    assert need == trials_to_decide(AT_LEAST, estimate(Evidence.share("k", 11, 20), 0))
+    # 20 trials of the run, 2 s each: the claim's `need` trials take 2 * need s
+    lines = _undecided(claims, 20, pd.DataFrame({"trial_seconds": [1.0, 3.0]}))
+    row = next(line for line in lines if line.startswith("| a share |"))
+    wall = 2 * need
+    shown = f"{wall / 3600:.2f} h" if wall > 3600 else f"{wall:.0f} s"
+    assert row == f"| a share | 20 | {need} | {need} | {shown} |"
+
+
+def test_evidence_for_an_undeclared_claim_is_refused():
+    analysis = base.Analysis(evidence=[Evidence.share("other", 1, 2)])
+    with pytest.raises(ValueError, match="which no claim declares"):
+        claims_frame(_experiment(), analysis, 0)
