@@ -20,7 +20,8 @@ others stand. ``poses`` {corner, distance, phi_deg [start, stop, step], heading_
 test poses around a corner (``Scene.poses``, a list of (x, y, theta)). ``pedestrians``: walking
 discs (see kiseki.sim.pedestrians; ``Scene.pedestrians``). ``point_robots: true``: the paper
 treats its robots as points, so the robots' bodies do not collide with each other (they still
-do with obstacles and pedestrians).
+do with obstacles and pedestrians). ``calibrated``: the parameters fitted to a paper's number,
+each with that number (kiseki.sim.calibration; ``Scene.calibrated``).
 
 The file is checked by the models of kiseki.sim.scene_schema (limits on the boxes, cells,
 points, robots, pedestrians, moves and poses a scene makes are stated there); errors name the
@@ -44,6 +45,7 @@ from kiseki._support.schema import SchemaError, parse
 from kiseki._support.yaml import safe_load_12
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
+from kiseki.sim.calibration import check_marks
 from kiseki.sim.magnetic_schema import MagneticSection
 from kiseki.sim.magnetic_survey import MeasurementGrid
 from kiseki.sim.pedestrians import Pedestrian
@@ -84,6 +86,8 @@ class Scene:
     pedestrians: list[Pedestrian] = field(default_factory=list)
     # the paper treats its robots as points: contacts between them are logged, not stopped at
     point_robots: bool = False
+    # the parameters fitted to a paper's number: [{parameter, fitted_to, unit, source}]
+    calibrated: list[dict] = field(default_factory=list)
     _bands: dict = field(default_factory=dict, repr=False, compare=False)  # ground_truth's
 
     def ground_truth(
@@ -189,6 +193,7 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
         poses=_poses(doc.poses),
         pedestrians=[Pedestrian(**p.model_dump()) for p in doc.pedestrians or []],
         point_robots=doc.point_robots,
+        calibrated=check_marks(raw, doc.calibrated, str(path)),
     )
 
 

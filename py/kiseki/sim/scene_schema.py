@@ -4,7 +4,8 @@
 checked by :mod:`kiseki._support.schema`: name, description, source, bounds, floor, octomap, objects
 (:mod:`kiseki.sim.primitives_schema`), grid_resolution, measurement_grid, robots (their name
 and the sections kiseki.sim.setup and kiseki.sim.robot read), turns, poses, pedestrians and
-point_robots, ``calibrated`` (:class:`Calibration`: the parameters fitted to a paper's number),
+point_robots, ``calibrated`` (:class:`Calibration`: the parameters fitted to a paper's number;
+each path is checked by :mod:`kiseki.sim.calibration`),
 and ``route`` (:class:`Route`, ``route: {}`` is none). ``robot``, ``sensors`` and
 each robot's ``type``, ``start``, ``params``, ``odometry_errors`` are checked by the models of
 kiseki.sim.setup_schema (:func:`~kiseki.sim.setup_schema.check_robots`, with the rules that

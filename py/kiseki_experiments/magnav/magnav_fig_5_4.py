@@ -12,6 +12,7 @@ same robot, odometry errors and sensor noise for each). See
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import time
@@ -28,6 +29,7 @@ from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import Count, NonNegativeReal, Particles, PositiveReal, Seed
 from kiseki_experiments.harness.paths import WORLDS
 from kiseki_experiments.harness.records import load_average, pack
+from kiseki_experiments.magnav.magnav_fig_5_4_claims import CLAIMS, evidence
 from kiseki_experiments.magnav.magnav_fig_5_4_report import NOTES, claims, figures
 from kiseki_experiments.magnav.magnav_lidar_drive import DRIVE_METHODS, drive, teach_heading_map
 
@@ -44,6 +46,9 @@ class LidarMclFigureConfig:
     reach: PositiveReal = 0.3  # m, the farthest map node used (lidar_mcl's module text)
     map_seed: Seed = 0  # the mapping run's noise (one map for every trial)
     distance: NonNegativeReal = 0.0  # m of travel after which a run stops (0: the whole route)
+    # false: the proposed arm runs without the magnetic heading reset (LIDAR MCL alone, the
+    # same seed): the control of the claims about the reset
+    heading_reset: bool = True
 
 
 def blind_stretch(scene: str) -> tuple[float, float]:
@@ -125,7 +130,9 @@ def trial(config: LidarMclFigureConfig, index: int, seed: int) -> TrialOutput:
     timings: dict = {"load": load_average()}
     for method in DRIVE_METHODS:
         start = time.perf_counter()
-        r = drive(config.scene, method, taught, _mcl(config), seed, config.distance or None)
+        runs = "laser" if method == "magnetic" and not config.heading_reset else method
+        r = drive(config.scene, runs, taught, _mcl(config), seed, config.distance or None)
+        r = dataclasses.replace(r, method=method)
         timings[f"{method}_s"] = time.perf_counter() - start
         timings[f"{method}_sim_s"] = float(r.times[-1])
         record.update(_measures(r, lo, hi))
@@ -151,7 +158,11 @@ def analyze(config: LidarMclFigureConfig, trials: pd.DataFrame, timings, out: Pa
     ]
     per_run = per_run.merge(timings[["trial", *(f"{m}_s" for m in DRIVE_METHODS)]], on="trial")
     return Analysis(
-        {"summary": summary, "runs": per_run}, figures(ok, out), claims(ok, summary), NOTES
+        {"summary": summary, "runs": per_run},
+        figures(ok, out),
+        claims(ok, summary),
+        NOTES,
+        evidence=evidence(ok),
     )
 
 
@@ -163,6 +174,7 @@ EXPERIMENT = Experiment(
     config_type=LidarMclFigureConfig,
     trial=trial,
     analyze=analyze,
-    default_runs=4,
+    default_runs=5,  # the fewest a claim's interval is computed from
     preflight=preflight,
+    claims=CLAIMS,
 )

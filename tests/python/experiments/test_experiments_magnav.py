@@ -14,18 +14,21 @@ import pandas as pd
 import pytest
 
 from kiseki.core import Random
+from kiseki.sim.scene import load_scene
 from kiseki_experiments.harness.runner import run_experiment
 from kiseki_experiments.magnav.magnav_navigators import closed_form_validity
 from kiseki_experiments.magnav.magnav_navigators_report import required_noise
-from kiseki_experiments.magnav.magnav_table_4_2 import (
-    THESIS_TABLE,
-    Table42Config,
-    changed_stretches,
-)
+from kiseki_experiments.magnav.magnav_table_4_2 import Table42Config, changed_stretches
+from kiseki_experiments.magnav.magnav_table_4_2_report import CALIBRATED, CLAIMS, THESIS_TABLE
 
 
 def _claims(run_dir) -> pd.DataFrame:
     return pd.read_csv(run_dir / "claims.csv").set_index("claim")
+
+
+def _held(row) -> bool:
+    """An old point claim's verdict (not yet migrated: no interval), from its note."""
+    return str(row["note"]).startswith("point verdict without an interval: holds")
 
 
 @pytest.fixture(scope="module")
@@ -38,13 +41,13 @@ def table(tmp_path_factory):
     return run.run_dir
 
 
-def test_the_road_plate_is_inside_the_thesis_region_a():
+def test_the_road_plates_change_mz_over_the_thesis_region_a():
     change: dict = {}
     (a, b), *rest = changed_stretches(Table42Config(), change)
     assert not rest
-    assert 10.0 <= a < 14.5 and 17.5 < b <= 25.0  # the plate at 14.5-17.5 m, region A 10-25 m
-    # the scene's plate changes By alone on the path (y = 0): its mz change is 0 by symmetry
-    assert change["b"] > 0.09 and change["mz"] < 1e-9
+    # region A of Fig. 4.7: "about 10 to 25 m" of travel; the plates lie at 10-25 m
+    assert 8.5 <= a <= 10.5 and 24.5 <= b <= 26.5  # |B| changes 1.3 m beyond the ends
+    assert 0.11 < change["mz"] < 0.14  # the closed form of the plates' edge: 0.124 G (scene)
 
 
 def test_table_4_2_filter_beats_odometry_and_claims_follow_the_table(table):
@@ -56,43 +59,56 @@ def test_table_4_2_filter_beats_odometry_and_claims_follow_the_table(table):
     assert static["final_err_m"] < none["final_err_m"]
     # the odometry over-counts by 0.57 % (scene header): 0.17 m at 30 m, half of it on average
     assert none["final_err_m"] == pytest.approx(0.0057 * 30.0, rel=0.25)
-    # with the scene's plate the filter reads the same mz in both runs (same seed)
-    assert rows.loc["time-varying field", "mean_err_m"] == pytest.approx(static["mean_err_m"])
+    # the scene's tyres were fitted to the thesis' 0.678 m: a table row, no claim
+    assert list(rows["thesis_value_is"]) == [CALIBRATED, "compared", "compared"]
+    marks = {m["fitted_to"] for m in load_scene(Table42Config().scene).calibrated}
+    assert marks == {0.678}
+    assert all(c.criterion.paper_number not in marks for c in CLAIMS)
     claims = _claims(table)
-    for case, label in (("none", "without localization"), ("static", "static field")):
+    assert list(claims.index) == [c.claim for c in CLAIMS]
+    assert not any("0.678" in str(v) for v in claims["paper_value"])
+    trials = pd.read_parquet(table / "trials.parquet")
+    for case, label in (("static", "static field"), ("dynamic", "time-varying field")):
         row = claims.loc[f"mean travel-distance error, {label} (Table 4.2)"]
-        got = rows.loc[label, "mean_err_m"]
-        assert float(row["measured_value"]) == pytest.approx(got, abs=5e-4)
-        want = THESIS_TABLE[case][0]
-        assert bool(row["holds"]) == (abs(got - want) <= 0.3 * want)
-    # ... so the time-varying claim is refused, whatever its number
-    dynamic = claims.loc["mean travel-distance error, time-varying field (Table 4.2)"]
-    assert not bool(dynamic["holds"]) and "not a time-varying case" in dynamic["note"]
+        assert row["measured_value"].startswith(f"{trials[f'mean_{case}'].mean():.4g} ")
+        assert row["trials"] == 2 and row["verdict"] == "inconclusive"  # too few for an interval
+    # the plates change mz: the time-varying run reads other values than the static one
+    order = claims.loc["the time-varying field's error exceeds the static field's (Table 4.2)"]
+    assert float(order["measured_value"]) == pytest.approx(
+        (trials["mean_dynamic"] - trials["mean_static"]).mean(), rel=1e-3
+    )
+    assert (trials["mean_dynamic"] != trials["mean_static"]).all()
+    ess = pd.read_csv(table / "tables" / "fig_4_7_ess.csv").set_index("field")
+    dyn = ess.loc["time-varying field", "ess_over_n_region_a"]
+    sta = ess.loc["static field", "ess_over_n_region_a"]
+    claim = claims.loc[
+        "ESS stays high where the field changed: all weights drop together (Fig. 4.7 A)"
+    ]
+    assert f"({dyn:.3f} vs {sta:.3f})" in claim["measured_value"]
     report = (table / "report.md").read_text(encoding="utf-8")
-    assert "thesis_mean_err_m" in report and "0.678" in report and "0.133" in report
+    assert "thesis_mean_err_m" in report and CALIBRATED in report and "0.133" in report
     assert (table / "figures" / "magnav_fig_4_7_ess.png").stat().st_size > 20_000
 
 
-def test_ess_stays_high_where_a_plate_changes_mz(tmp_path):
-    """The road plate magnetised along the path changes mz by about 0.12 G at 13-19 m: every
-    particle's window mismatches there, so the weights stay even (ESS/n up, Fig. 4.7 A)."""
+def test_without_the_plates_the_time_varying_claims_fail(tmp_path):
+    """The declared control of the claims about the change: plates of no moment leave the
+    field as taught, the time-varying run reads the static run's mz (same seed), and the claims
+    that the change raises the error and the ESS fail (on the old scene's plate, which changed
+    mz on the path by 0, they could not hold)."""
+    control = next(c.control for c in CLAIMS if c.key == "order")
     run = run_experiment(
         "magnav-table-4-2",
-        runs=1,
-        overrides=["length=30.0", "plate_moment=2.0625,0.0,0.0"],
+        runs=control.runs,
+        overrides=list(control.overrides),
         out=tmp_path / "p",
         progress=False,
     )
-    ess = pd.read_csv(run.run_dir / "tables" / "fig_4_7_ess.csv").set_index("field")
-    dyn = ess.loc["time-varying field", "ess_over_n_changed_stretch"]
-    sta = ess.loc["static field", "ess_over_n_changed_stretch"]
-    assert dyn > sta
-    claim = _claims(run.run_dir).loc[
-        "ESS stays high where the field changed: all weights drop together (Fig. 4.7 A)"
-    ]
-    assert bool(claim["holds"]) and f"{dyn:.3f}" in claim["measured_value"]
-    rows = pd.read_csv(run.run_dir / "tables" / "table_4_2.csv").set_index("case")
-    assert rows.loc["time-varying field", "mean_err_m"] != rows.loc["static field", "mean_err_m"]
+    trials = pd.read_parquet(run.run_dir / "trials.parquet")
+    assert (trials["mean_dynamic"] - trials["mean_static"]).abs().max() < 1e-12
+    claims = _claims(run.run_dir)
+    for spec in CLAIMS:
+        if spec.control == control:
+            assert claims.loc[spec.claim, "verdict"] == "fails", spec.claim
 
 
 def test_closed_form_validity_matches_sampled_noise():
@@ -128,11 +144,11 @@ def test_navigators_short_path(tmp_path):
     claims = _claims(run.run_dir)
     done = claims.loc["the multi-navigator system completes the route (Fig. 4.9)"]
     assert done["measured_value"].startswith(f"{int(table.loc['multi', 'completed_runs'])} of 1")
-    assert bool(done["holds"]) == bool(table.loc["multi", "completed_runs"] == 1)
+    assert _held(done) == bool(table.loc["multi", "completed_runs"] == 1)
     quiet = claims.loc[
         "outside the disturbances the magnetic navigators are valid most of the time (Fig. 4.13: "
         "r_z above the threshold over much of the path; sec. 4.6)"
     ]
-    assert not bool(quiet["holds"]) and math.isfinite(float(quiet["measured_value"].split()[0]))
+    assert not _held(quiet) and math.isfinite(float(quiet["measured_value"].split()[0]))
     report = (run.run_dir / "report.md").read_text(encoding="utf-8")
     assert "left the path after about 60 m" in report and "noise_sd_for_90pct_valid_G" in report

@@ -21,6 +21,8 @@ from kiseki_experiments.gp.gp_common import (
     survey_3d,
     voxel_average,
 )
+from kiseki_experiments.gp.gp_floor_mapping_report import CALIBRATED
+from kiseki_experiments.gp.gp_table_6_2_claims import CLAIMS as TABLE_6_2_CLAIMS
 from kiseki_experiments.harness.records import unpack
 from kiseki_experiments.harness.runner import run_experiment
 
@@ -105,8 +107,20 @@ def test_table_6_2_protocol(tmp_path):
     held_out = ~grid.mask(2)
     expected = np.abs(prediction - truth)[held_out].mean()
     assert table.loc[0.4, "mean_err_vs_truth_G"] == pytest.approx(expected, rel=1e-4)
+    # the grid was fitted to the thesis' 2816 points and the sources to its length scale (the
+    # scene's marks): the counts and the length scale are rows, not claims
+    marks = {m["fitted_to"] for m in load_scene(HALL).calibrated}
+    calibrated = pd.read_csv(run.run_dir / "tables" / "calibrated.csv")
+    assert calibrated["kiseki"].iloc[:4].tolist() == [384, 144, 48, 48]
+    assert (calibrated["status"] == CALIBRATED).all() and 0.47496 in set(calibrated["thesis"])
     claims = pd.read_csv(run.run_dir / "claims.csv")
-    assert claims.loc[0, "holds"]  # the training counts
+    assert list(claims["claim"]) == [c.claim for c in TABLE_6_2_CLAIMS]
+    assert (claims["verdict"] == "inconclusive").all()  # one noise seed gives no interval
+    rise = claims.set_index("claim").loc[TABLE_6_2_CLAIMS[0].claim, "measured_value"]
+    assert float(rise.split()[0]) == pytest.approx(
+        table.loc[1.0, "mean_err_G"] - table.loc[0.4, "mean_err_G"], rel=1e-3
+    )
+    assert not any(f"{m:g}" in str(v) for m in marks for v in claims["paper_value"])
     assert (run.run_dir / "figures" / "gp_table_6_2_slice.png").stat().st_size > 20_000
 
 
@@ -151,6 +165,32 @@ def test_floor_mapping_small(tmp_path):
     assert np.sqrt(np.mean((got - truth) ** 2)) < 0.02  # cells of 0.5 m around readings
     for name in ("gp_floor_2d_map.png", "gp_floor_3d_map.png", "gp_floor_2d_truth.png"):
         assert (run.run_dir / "figures" / name).stat().st_size > 20_000
+    # the surveys' sizes were fitted to the thesis' (the scene's marks): rows, not claims
+    marks = {m["fitted_to"] for m in load_scene(FLOOR).calibrated}
+    calibrated = pd.read_csv(run.run_dir / "tables" / "calibrated.csv")
+    assert set(calibrated["thesis"]) <= marks and (calibrated["status"] == CALIBRATED).all()
+    claims = pd.read_csv(run.run_dir / "claims.csv")
+    counts = [f"{m:g}" for m in marks if m > 1000]  # 6432 readings, 6556 voxels
+    assert len(counts) == 2
+    assert not any(c in str(v) for c in counts for v in claims["paper_value"])
+    assert not claims["claim"].str.contains("survey:").any()
+    # the time beside the thesis' is on all points: the subsample fit's evaluations at the
+    # costs measured on all points (one with the gradient, one Cholesky factorisation)
+    timings = pd.read_parquet(run.run_dir / "timings.parquet").merge(
+        trials.reset_index()[["trial", "map"]], on="trial"
+    )
+    for kind, t in timings.set_index("map").iterrows():
+        c = cost.loc[kind]
+        assert c["hyper_points"] < c["training_points"]  # the fit ran on a subsample
+        by_hand = (
+            t["hyper_gradients"] * t["evaluation_all_s"]
+            + (t["hyper_evaluations"] - t["hyper_gradients"]) * t["fit_s"]
+        )
+        assert c["hyperparameters_all_s_extrapolated"] == pytest.approx(by_hand)
+        assert c["gp_all_s_extrapolated"] == pytest.approx(by_hand + t["fit_s"] + t["predict_s"])
+        assert t["hyper_evaluations"] >= t["hyper_gradients"] > 0
+    times = claims[claims["claim"].str.contains("GP regression time")]
+    assert len(times) == 2 and times["claim"].str.contains("on all").all()
 
 
 def test_mcl_beats_odometry_on_both_routes(tmp_path):
