@@ -46,6 +46,7 @@ from kiseki_experiments.teach import teach_playback as tp
 REFUSED = "crosses occupied space"  # kiseki.apps.teach.playback.check_route's refusal
 GENERAL = 0.8  # a claim generalises when it holds in at least this share of layouts
 SHADES = ListedColormap(["white", "#a0a0a0", "black"])
+LOW_BAND_M, HIGH_BAND_M = (0.05, 0.6), (0.6, 2.0)  # the layout pictures' two height bands
 # the layout parameters in the report's per-layout table (all of them are in trials.parquet)
 LAYOUT_COLUMNS = [
     "seed",
@@ -303,7 +304,7 @@ def _layout_picture(seed: int) -> tuple[np.ndarray, list[float], np.ndarray, dic
     layout = generate_layout(seed)
     with tempfile.TemporaryDirectory() as tmp:
         scene = load_scene(write_layout(layout, Path(tmp) / "layout.yaml"))
-    low, high = scene.ground_truth(0.05, 0.6), scene.ground_truth(0.6, 2.0)
+    low, high = scene.ground_truth(*LOW_BAND_M), scene.ground_truth(*HIGH_BAND_M)
     shade = np.where(low.cells == 100, 2, np.where(high.cells == 100, 1, 0))
     o, r = low.origin, low.resolution
     extent = [o.x, o.x + low.width * r, o.y, o.y + low.height * r]
@@ -390,13 +391,15 @@ def _verdict(low: float, high: float) -> str:
     """Whether a claim's share of layouts is above GENERAL (its 95 % interval above it),
     below it, or undecided by this many layouts."""
     if low >= GENERAL:
-        return "general: holds in >= 80 % of layouts (95 % interval)"
+        return f"general: holds in >= {GENERAL:.0%} of layouts (95 % interval)"
     if high < GENERAL:
-        return "layout-specific: holds in < 80 % of layouts (95 % interval)"
-    return "undecided by this many layouts (the 95 % interval spans 80 %)"
+        return f"layout-specific: holds in < {GENERAL:.0%} of layouts (95 % interval)"
+    return f"undecided by this many layouts (the 95 % interval spans {GENERAL:.0%})"
 
 
 def _notes(config: LayoutsConfig, ok: int, total: int) -> str:
+    n = config.runs_per_layout
+    separable = wilson_interval(n, n)[0] > wilson_interval(0, n)[1]
     return (
         f"{ok} of {total} layouts ran (kiseki.sim.layouts states every range and its reason). "
         f"Each layout: {config.runs_per_layout} run(s) of exp2-turn's trial (teaching, then "
@@ -404,16 +407,16 @@ def _notes(config: LayoutsConfig, ok: int, total: int) -> str:
         f"trial ({config.boxes} unknown boxes, proposal 2, and the control without them), "
         f"{config.particles} particles, merge rule {config.merge!r}; a layout's claims are "
         "exp2-turn's and exp3-boxes' own analyses applied to its runs. The thesis' claims are "
-        "means and counts over 5 runs; with fewer runs per layout a claim is judged on fewer "
-        "stops, so a layout's verdict is noisier than the thesis' (a count claim such as 4/5 "
-        "within 0.1 m needs every run within when there are 2; exp2-turn's conventional 0/5 "
-        "count claim, at least 0/5 within, holds everywhere by construction). A claim "
-        "generalises when it "
+        f"means and counts over {tp.THESIS_RUNS} runs; exp2-turn's comparisons are decided on "
+        "95 % intervals of a layout's runs, so with fewer runs per layout a layout's verdict is "
+        f"less often decided (with {n} run(s) per layout, {n}/{n} against 0/{n} within "
+        f"{tp.STOP_TOLERANCE_M:g} m {'does' if separable else 'does not'} separate the two "
+        "shares' Wilson intervals). A claim generalises when it "
         f"holds in >= {GENERAL:.0%} of layouts; the note of each claim says whether the 95 % "
         "Wilson interval lies above that (general), below it (layout-specific) or across it. "
         "Table `by_behind` splits the shares by what lies behind the final leg's boundary "
         "lines; figures `fails_*.png` draw the layouts where a claim fails (ground truth "
-        "0.05-2.0 m, route P0 -> T1 -> T2 -> G)."
+        f"{LOW_BAND_M[0]:g}-{HIGH_BAND_M[1]:g} m, route P0 -> T1 -> T2 -> G)."
     )
 
 
