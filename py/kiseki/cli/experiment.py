@@ -114,11 +114,22 @@ def report(
     output: Path = typer.Option(Path("REPRODUCTION.md"), "-o", "--output", help="File to write."),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as one JSON object."),
 ) -> None:
-    """Gather the latest result of every experiment into REPRODUCTION.md and print a summary
-    (claims, how many hold, the experiments without a result): a table on a terminal,
+    """Gather the latest result of every experiment into REPRODUCTION.md (each claim: the
+    paper's value, kiseki's with its 95 % interval, the verdict) and print a summary (claims by
+    verdict, the share decided, the experiments without a result): a table on a terminal,
     tab-separated field/value lines when piped, or JSON with --json.
 
     Example: kiseki experiment report --results results -o REPRODUCTION.md"""
-    total, held, missing = write_reproduction(results, output)
-    summary = {"output": str(output), "claims": total, "hold": held, "missing": missing}
+    totals, missing = write_reproduction(results, output)
+    decided = totals["decided"] / totals["claims"] if totals["claims"] else 0.0
+    summary = {
+        "output": str(output),
+        "claims": totals["claims"],
+        "hold": totals["holds"],
+        "fail": totals["fails"],
+        "inconclusive": totals["inconclusive"],
+        "not_migrated": totals["not_migrated"],
+        "decided_share": round(decided, 4),
+        "missing": missing,
+    }
     show_fields(str(output), summary, as_json=as_json, console=console)

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """What an experiment is: a typed config (defaults from the paper), a trial function (one
-seeded trial -> a record) and an analysis (records -> tables, figures, claims)."""
+seeded trial -> a record), the claims it tests, declared before the run (criterion and control,
+:mod:`.verdict`), and an analysis (records -> tables, figures, the evidence of each claim)."""
 
 from __future__ import annotations
 
@@ -12,14 +13,16 @@ from typing import Any
 
 import pandas as pd
 
-__all__ = ["Analysis", "Claim", "Experiment", "TrialOutput"]
+from kiseki_experiments.harness.verdict import ClaimSpec, Evidence
 
-CLAIM_COLUMNS = ["claim", "paper_value", "measured_value", "unit", "holds", "note"]
+__all__ = ["Analysis", "Claim", "ClaimSpec", "Evidence", "Experiment", "TrialOutput"]
 
 
 @dataclass(frozen=True)
 class Claim:
-    """One claim of a paper, the paper's value beside kiseki's, and whether it holds."""
+    """The old form of a claim: a point value and whether it holds, with no interval. Still
+    accepted so that experiments not yet migrated to :class:`ClaimSpec` run; reported as
+    "no interval (not yet migrated)" and never counted as decided."""
 
     claim: str
     paper_value: str
@@ -45,8 +48,9 @@ class Analysis:
 
     tables: dict[str, pd.DataFrame] = field(default_factory=dict)
     figures: list[Path] = field(default_factory=list)
-    claims: list[Claim] = field(default_factory=list)
+    claims: list[Claim] = field(default_factory=list)  # the old form (not yet migrated)
     notes: str = ""
+    evidence: list[Evidence] = field(default_factory=list)  # of the declared claims
 
 
 @dataclass(frozen=True)
@@ -67,3 +71,6 @@ class Experiment:
     # For an experiment whose trials are the settings of its config (one trial per setting):
     # the number of trials a config has; the default --runs, and the most it accepts.
     trial_count: Callable[[Any], int] | None = None
+    # The claims the experiment tests, each with its criterion and control (declared here,
+    # before any run); the analysis gives their Evidence.
+    claims: tuple[ClaimSpec, ...] = ()

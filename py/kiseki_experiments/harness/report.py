@@ -11,7 +11,6 @@ import math
 import os
 import shutil
 import tempfile
-from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -21,11 +20,14 @@ from rich.console import Console
 from kiseki._support.atomic import atomic_write, atomic_write_all, reworded
 from kiseki._support.inputs import CSV_LIMIT, YAML_LIMIT, check_input, read_input_text
 from kiseki._support.table import show
-from kiseki_experiments.harness.base import CLAIM_COLUMNS, Analysis, Claim, Experiment
+from kiseki_experiments.harness.base import Analysis, Experiment
 from kiseki_experiments.harness.registry import all_experiments
+from kiseki_experiments.harness.verdict import UNMIGRATED, VERDICT_COLUMNS, judge, legacy
 
 __all__ = [
+    "claims_frame",
     "print_claims",
+    "tally",
     "markdown_table",
     "write_failed_outputs",
     "write_outputs",
@@ -50,13 +52,92 @@ def markdown_table(frame: pd.DataFrame) -> str:
     return "\n".join([head, rule, *rows])
 
 
-def _claims_frame(claims: Iterable[Claim]) -> pd.DataFrame:
-    rows = [[getattr(c, k) for k in CLAIM_COLUMNS] for c in claims]
-    return pd.DataFrame(rows, columns=CLAIM_COLUMNS)
+def claims_frame(experiment: Experiment, analysis: Analysis, seed: int) -> pd.DataFrame:
+    """Every claim's verdict row (:class:`~.verdict.Verdict`): the declared claims judged on
+    their evidence with the run's seed, then the old point claims, shown as not migrated."""
+    rows = judge(experiment.claims, analysis.evidence, seed) + [legacy(c) for c in analysis.claims]
+    return pd.DataFrame(
+        [[getattr(r, k) for k in VERDICT_COLUMNS] for r in rows], columns=VERDICT_COLUMNS
+    )
 
 
-def _report(experiment: Experiment, analysis: Analysis, manifest: dict, claims: pd.DataFrame):
-    held = int(claims["holds"].sum())
+def tally(claims: pd.DataFrame) -> dict[str, int]:
+    """Claims by verdict; ``decided`` = holds + fails (an unmigrated claim is never decided)."""
+    verdicts = claims["verdict"].astype(str)
+    out = {k: int(verdicts.eq(k).sum()) for k in ("holds", "fails", "inconclusive")}
+    out["not_migrated"] = int(verdicts.eq(UNMIGRATED).sum())
+    out["claims"] = len(claims)
+    out["decided"] = out["holds"] + out["fails"]
+    return out
+
+
+def tally_text(t: dict[str, int]) -> str:
+    share = f"{100 * t['decided'] / t['claims']:.0f} %" if t["claims"] else "none"
+    return (
+        f"{t['claims']} claims: {t['holds']} hold, {t['fails']} fail, {t['inconclusive']} "
+        f"inconclusive, {t['not_migrated']} not yet migrated (no interval); decided: {share}"
+    )
+
+
+def _shown(claims: pd.DataFrame) -> pd.DataFrame:
+    """The claims as the reports show them: kiseki's value with its 95 % interval."""
+
+    def kiseki(row) -> str:
+        lo, hi = float(row.ci_low), float(row.ci_high)
+        ci = "" if math.isnan(lo) or math.isnan(hi) else f" [{lo:.4g}, {hi:.4g}]"
+        return f"{row.measured_value}{ci}"
+
+    frame = pd.DataFrame(
+        {
+            "claim": claims["claim"],
+            "paper": claims["paper_value"],
+            "kiseki [95 % CI]": [kiseki(r) for r in claims.itertuples(False)],
+            "unit": claims["unit"],
+            "criterion": claims["criterion"],
+            "verdict": claims["verdict"],
+            "trials": claims["trials"],
+            "control": claims["control"],
+            "note": claims["note"],
+        }
+    )
+    return frame
+
+
+def _mean_trial_seconds(timings: pd.DataFrame | None) -> float:
+    if timings is None or "trial_seconds" not in timings:
+        return math.nan
+    return float(pd.to_numeric(timings["trial_seconds"], errors="coerce").mean())
+
+
+def _undecided(claims: pd.DataFrame, runs: int, timings: pd.DataFrame | None) -> list[str]:
+    """For each inconclusive claim: the trials that would decide it (its interval's half-width
+    scaling as 1/sqrt(n)) and their wall time at the run's mean trial time (one core)."""
+    rows = claims[claims["verdict"].astype(str).eq("inconclusive")]
+    if rows.empty:
+        return []
+    per_trial = _mean_trial_seconds(timings)
+    lines = [
+        "",
+        "### Undecided claims",
+        "",
+        "| claim | trials now | trials that would decide it | run trials | wall time (1 core) |",
+        "|---|---|---|---|---|",
+    ]
+    for row in rows.itertuples(False):
+        need, n = float(row.trials_to_decide), int(row.trials)
+        if math.isnan(need) or n == 0:
+            lines.append(f"| {_cell(row.claim)} | {n} | none (on the threshold) | | |")
+            continue
+        run_trials = math.ceil(need * runs / n)  # a claim may take k of the run's trials
+        wall = run_trials * per_trial
+        when = (
+            "" if math.isnan(wall) else f"{wall / 3600:.2f} h" if wall > 3600 else f"{wall:.0f} s"
+        )
+        lines.append(f"| {_cell(row.claim)} | {n} | {int(need)} | {run_trials} | {when} |")
+    return lines
+
+
+def _report(experiment, analysis, manifest, claims: pd.DataFrame, timings=None) -> str:
     lines = [
         f"# {experiment.name}: {experiment.description}",
         "",
@@ -66,9 +147,14 @@ def _report(experiment: Experiment, analysis: Analysis, manifest: dict, claims: 
         f"{manifest['execution']}, commit {manifest['git']['commit'] or 'unknown'}"
         f"{' (with local changes)' if manifest['git']['dirty'] else ''}.",
         "",
-        f"## Claims: {len(claims)} claims, {held} hold",
+        f"## Claims: {tally_text(tally(claims))}",
         "",
-        markdown_table(claims),
+        "Each claim's criterion was declared before the run; the interval is 95 % (percentile "
+        "bootstrap over trials, Wilson for a share); inconclusive: the interval straddles the "
+        "criterion.",
+        "",
+        markdown_table(_shown(claims)),
+        *_undecided(claims, int(manifest["trials"]), timings),
     ]
     for name, table in analysis.tables.items():
         lines += ["", f"## {name}", "", markdown_table(table)]
@@ -82,11 +168,10 @@ def _report(experiment: Experiment, analysis: Analysis, manifest: dict, claims: 
 
 def print_claims(title: str, claims: pd.DataFrame) -> None:
     """The claims as a table on a terminal, tab-separated lines when piped."""
-    rows = [
-        (row.claim, row.paper_value, row.measured_value, row.unit, "yes" if row.holds else "no")
-        for row in claims.itertuples(False)
-    ]
-    show(title, CLAIM_COLUMNS[:5], rows, as_json=False, data=None)
+    shown = _shown(claims)
+    columns = ["claim", "paper", "kiseki [95 % CI]", "unit", "verdict"]
+    rows = [tuple(str(v) for v in r) for r in shown[columns].itertuples(False)]
+    show(title, columns, rows, as_json=False, data=None)
 
 
 def _frames(trials, timings, run_dir: Path) -> list:
@@ -171,13 +256,13 @@ def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) 
             if not _drawing_error(err, drawn):
                 raise  # the analysis's own (a missing input file): as it is
             raise _results_error(err, experiment, run_dir) from err
-        claims = _claims_frame(analysis.claims)
+        claims = claims_frame(experiment, analysis, int(manifest["seed"]))
         texts = {
             run_dir / "tables" / f"{n}.csv": t.to_csv(index=False)
             for n, t in analysis.tables.items()
         }
         texts[run_dir / "claims.csv"] = claims.to_csv(index=False)
-        texts[run_dir / "report.md"] = _report(experiment, analysis, manifest, claims)
+        texts[run_dir / "report.md"] = _report(experiment, analysis, manifest, claims, timings)
         texts[run_dir / "manifest.json"] = json.dumps(manifest, indent=2)
         try:
             atomic_write_all(_frames(trials, timings, run_dir) + _texts(texts))
@@ -197,13 +282,15 @@ def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) 
     return claims
 
 
-def write_reproduction(results_root: Path, out: Path) -> tuple[int, int, list[str]]:
-    """Gathers the latest run of every registered experiment into one markdown file.
-    Returns (claims, claims that hold, missing experiment names)."""
+def write_reproduction(results_root: Path, out: Path) -> tuple[dict[str, int], list[str]]:
+    """Gathers the latest run of every registered experiment into one markdown file: each
+    claim with the paper's value, kiseki's with its interval and the verdict, the undecided
+    claims with the trials that would decide them, and the share of claims decided. Returns
+    (the tally of verdicts, :func:`tally`; the missing experiment names)."""
     if not results_root.is_dir():
         raise FileNotFoundError(f"{results_root}: results folder not found")
     by_paper: dict[str, list[str]] = {}
-    total = held = 0
+    frames: list[pd.DataFrame] = []
     missing: list[str] = []
     for name, experiment in sorted(all_experiments().items()):
         section = by_paper.setdefault(experiment.paper, [])
@@ -218,37 +305,48 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[int, int, list[st
         if not run_dir.is_relative_to(results_root.resolve()):  # a link moved or made by hand
             raise ValueError(f"{latest}: the link points outside --results ({run_dir})")
         claims, manifest = _read_result(latest)
-        total += len(claims)
-        held += int(claims["holds"].astype(str).str.lower().eq("true").sum())
+        frames.append(claims)
+        timings_path = latest / "timings.parquet"
+        timings = pd.read_parquet(timings_path) if timings_path.is_file() else None
         section += [
             f"Result: `{run_dir.relative_to(results_root.resolve())}`, "
             f"{manifest['trials']} trials, {manifest['trials_failed']} failed, "
-            f"commit {manifest['git']['commit'] or 'unknown'}.",
+            f"commit {manifest['git']['commit'] or 'unknown'}; {tally_text(tally(claims))}.",
             "",
-            markdown_table(claims),
+            markdown_table(_shown(claims)),
+            *_undecided(claims, int(manifest["trials"]), timings),
         ]
-    lines = ["# Reproduction report", "", f"{total} claims, {held} hold."]
+    empty = pd.DataFrame({"verdict": pd.Series([], dtype=str)})
+    totals = tally(pd.concat(frames, ignore_index=True) if frames else empty)
+    lines = ["# Reproduction report", "", f"{tally_text(totals)}."]
     if missing:
         lines.append(f"Missing experiments ({len(missing)}): {', '.join(missing)}.")
     for paper, section in by_paper.items():
         lines += ["", f"## {paper}", *section]
     _text(out, "\n".join(lines) + "\n")
-    return total, held, missing
+    return totals, missing
 
 
 def _read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
     """A run's claims.csv and manifest.json, refused in one line naming the file when unreadable
-    or without the columns and fields the report needs."""
+    or without the columns and fields the report needs. A claims table of the old form (a
+    column ``holds``, no interval) is read as not yet migrated."""
     claims_path, manifest_path = latest / "claims.csv", latest / "manifest.json"
     check_input(claims_path, "claims tables", CSV_LIMIT)
     try:
         claims = pd.read_csv(claims_path, keep_default_na=False)
     except (ValueError, UnicodeDecodeError) as err:
         raise ValueError(f"{claims_path}: not a claims table ({err})") from None
-    if "holds" not in claims.columns:
+    if "verdict" not in claims.columns and {"claim", "holds"} <= set(claims.columns):
+        claims = _old_claims(claims)
+    lacking = [c for c in VERDICT_COLUMNS if c not in claims.columns]
+    if lacking:
         raise ValueError(
-            f"{claims_path}: no column holds (a claims table has {', '.join(CLAIM_COLUMNS)})"
+            f"{claims_path}: no column {lacking[0]} (a claims table has "
+            f"{', '.join(VERDICT_COLUMNS)})"
         )
+    for column in ("ci_low", "ci_high", "trials_to_decide"):
+        claims[column] = pd.to_numeric(claims[column], errors="coerce")
     try:
         manifest = json.loads(read_input_text(manifest_path, "JSON manifests", YAML_LIMIT))
     except (ValueError, UnicodeDecodeError) as err:
@@ -257,3 +355,26 @@ def _read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
     if not isinstance(manifest, dict) or any(k not in manifest for k in needed):
         raise ValueError(f"{manifest_path}: a manifest needs the fields {', '.join(needed)}")
     return claims, manifest
+
+
+def _old_claims(claims: pd.DataFrame) -> pd.DataFrame:
+    """A claims table written before verdicts had intervals: every row not yet migrated."""
+    rows = []
+    for row in claims.to_dict("records"):
+        holds = str(row.get("holds", "")).lower() == "true"
+        rows.append(
+            {
+                **{c: "" for c in VERDICT_COLUMNS},
+                "claim": row.get("claim", ""),
+                "paper_value": row.get("paper_value", ""),
+                "measured_value": row.get("measured_value", ""),
+                "unit": row.get("unit", ""),
+                "ci_low": math.nan,
+                "ci_high": math.nan,
+                "trials": 0,
+                "trials_to_decide": math.nan,
+                "verdict": UNMIGRATED,
+                "note": f"point verdict without an interval: {'holds' if holds else 'fails'}",
+            }
+        )
+    return pd.DataFrame(rows, columns=VERDICT_COLUMNS)

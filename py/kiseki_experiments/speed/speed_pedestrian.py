@@ -38,8 +38,9 @@ from kiseki.metrics import wilson_interval
 from kiseki.plots import new_figure
 from kiseki.sim.pedestrians import Pedestrian
 from kiseki.sim.scene import load_scene
-from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import NonNegativeReal, PositiveReal, Real, Seconds, Speed
+from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion, Evidence
 from kiseki_experiments.speed.speed_common import (
     METHODS,
     WORLDS,
@@ -67,10 +68,13 @@ class PedestrianConfig:
     # m from the robot's corridor axis, out of the laser's sight
     start_distance: NonNegativeReal = 4.0
     max_duration: Seconds = 90.0  # s
+    # what runs in method 1's arm ("occlusion"): the paper's method 1; a control replaces it
+    # by a baseline to show the claims below can fail
+    method_1: str = "occlusion"
 
 
 def preflight(config: PedestrianConfig) -> None:
-    unknown = sorted(set(config.methods) - set(METHODS))
+    unknown = sorted((set(config.methods) | {config.method_1}) - set(METHODS))
     if unknown:
         raise ValueError(f"speed-pedestrian: unknown methods {unknown} (known: {METHODS})")
     if not (config.walking_speed > 0 and config.radius > 0 and config.start_distance > 1):
@@ -120,11 +124,12 @@ def trial(config: PedestrianConfig, index: int, seed: int) -> TrialOutput:
     record: dict = {}
     for k, method in enumerate(config.methods):
         rng = Random(seed)  # the same side, lane and phase for every method
-        person = _encounter(config, method, rng)
+        runs = config.method_1 if method == "occlusion" else method
+        person = _encounter(config, runs, rng)
         d = drive(
             with_pedestrians(scene, [person]),
             tuple(config.goal),
-            method,
+            runs,
             seed + k,
             prior,
             config.max_duration,
@@ -149,7 +154,8 @@ def analyze(config: PedestrianConfig, trials: pd.DataFrame, timings, figures: Pa
         safe = int(outcomes.isin(["clear", "stopped"]).sum())
         lo, hi = wilson_interval(safe, n)
         hits = ok.loc[outcomes == "collision", f"{method}_contact_speed"]
-        _, _, route = _reference(config.scene, tuple(config.goal), method, config.max_duration)
+        runs = config.method_1 if method == "occlusion" else method
+        _, _, route = _reference(config.scene, tuple(config.goal), runs, config.max_duration)
         rows.append(
             {
                 "method": method,
@@ -165,34 +171,20 @@ def analyze(config: PedestrianConfig, trials: pd.DataFrame, timings, figures: Pa
             }
         )
     table = pd.DataFrame(rows)
+    safe = {
+        m: ok[f"{m}_outcome"].isin(["clear", "stopped"]).to_numpy(float) for m in config.methods
+    }
     by = table.set_index("method")
-    claims = []
-    if {"none", "occlusion"} <= set(by.index):
-        a, b = by.loc["occlusion"], by.loc["none"]
-        claims.append(
-            Claim(
-                claim="slowing for occluded regions lets the robot avoid a pedestrian stepping "
-                "out of them (beyond the paper)",
-                paper_value="(implied, not measured)",
-                measured_value=f"{100 * a.safe_share:.0f} % safe vs {100 * b.safe_share:.0f} % "
-                f"without a limit; route {a.route_time_s:.1f} vs {b.route_time_s:.1f} s",
-                unit="share of encounters",
-                holds=bool(a.safe_ci_low > b.safe_ci_high),
-                note="holds when the 95 % Wilson intervals do not overlap",
-            )
-        )
-    for baseline in ("distance", "polygon"):
-        if {baseline, "occlusion"} <= set(by.index):
+    evidence = []
+    for baseline, key in (("none", "avoids"), ("distance", "distance"), ("polygon", "polygon")):
+        if {baseline, "occlusion"} <= set(safe):
             a, b = by.loc["occlusion"], by.loc[baseline]
-            claims.append(
-                Claim(
-                    claim=f"method 1 against the {baseline} baseline (beyond the paper)",
-                    paper_value="(distance alone slows too early or too late)",
-                    measured_value=f"{100 * a.safe_share:.0f} % vs {100 * b.safe_share:.0f} % "
-                    f"safe; route {a.route_time_s:.1f} vs {b.route_time_s:.1f} s",
-                    unit="share of encounters",
-                    holds=bool(a.safe_share >= b.safe_share),
-                    note="holds when method 1 is at least as safe",
+            evidence.append(
+                Evidence.of(
+                    key,
+                    safe["occlusion"] - safe[baseline],  # paired: the same encounter
+                    shown=f"{100 * a.safe_share:.0f} % vs {100 * b.safe_share:.0f} % safe; "
+                    f"route {a.route_time_s:.1f} vs {b.route_time_s:.1f} s",
                 )
             )
     fig = new_figure(figsize=(8, 4), dpi=120)
@@ -219,7 +211,61 @@ def analyze(config: PedestrianConfig, trials: pd.DataFrame, timings, figures: Pa
         "(pedestrians here do not avoid robots). Route times come from each method's run "
         "without a pedestrian."
     )
-    return Analysis({"safety": table}, [path], claims, notes)
+    return Analysis({"safety": table}, [path], notes=notes, evidence=evidence)
+
+
+def _superiority(baseline: str, margin: float, why: str) -> Criterion:
+    return Criterion(
+        paper_value="(implied, not measured)"
+        if baseline == "none"
+        else "(distance alone slows too early or too late)",
+        compare=">=",
+        threshold=margin,
+        why=why,
+        bounds=(-1.0, 1.0),  # a difference of two shares
+    )
+
+
+def _as_baseline(baseline: str) -> Control:
+    """Method 1's arm replaced by the baseline: the paired difference is then 0 but for the
+    laser's noise, below the margin."""
+    return Control(
+        name=f"method 1 replaced by {'no limit' if baseline == 'none' else baseline}",
+        # only the two arms the claim compares (the control's trials are the test's time)
+        overrides=(f"method_1={baseline}", f"methods=occlusion,{baseline}"),
+        runs=5,
+        why="the same encounters met by the same method: a difference of ~0",
+    )
+
+
+MARGIN = 0.1
+WHY = (
+    "a tenth of the encounters (10 percentage points) is the smallest gain in safety worth a "
+    "slower route; the paired difference is per encounter"
+)
+CLAIMS = (
+    ClaimSpec(
+        key="avoids",
+        claim="slowing for occluded regions lets the robot avoid a pedestrian stepping out of "
+        "them (beyond the paper): method 1's safe share minus no limit's",
+        unit="difference of shares of encounters",
+        criterion=_superiority("none", MARGIN, WHY),
+        control=_as_baseline("none"),
+        measure="1 if method 1 did not hit the pedestrian, minus the same for no limit",
+    ),
+    *(
+        ClaimSpec(
+            key=baseline,
+            claim=f"method 1 is safer than the {baseline} baseline (beyond the paper): "
+            "method 1's safe share minus the baseline's",
+            unit="difference of shares of encounters",
+            criterion=_superiority(baseline, MARGIN, WHY),
+            control=_as_baseline(baseline),
+            measure=f"1 if method 1 did not hit the pedestrian, minus the same for {baseline}",
+        )
+        for baseline in ("distance", "polygon")
+    ),
+)
 
 
 EXPERIMENT = Experiment(
@@ -232,4 +278,5 @@ EXPERIMENT = Experiment(
     analyze=analyze,
     default_runs=200,
     preflight=preflight,
+    claims=CLAIMS,
 )

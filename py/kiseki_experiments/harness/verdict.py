@@ -1,0 +1,289 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Verdicts that can fail and say how sure they are.
+
+A claim is declared before any trial runs (:class:`ClaimSpec`): its text, its :class:`Criterion`
+(the paper's value, the comparison, the threshold and tolerance, why that tolerance, and the
+bounds of the measured quantity) and its :class:`Control` (a config override under which the
+criterion must fail). The analysis then hands the harness the per-trial evidence of each claim
+(:class:`Evidence`: one value per trial, or k successes of n); the harness gives the measured
+value, a 95 % interval (percentile bootstrap of the mean or median, B. Efron and R. Tibshirani,
+*An Introduction to the Bootstrap*, 1993, ch. 13, with a generator seeded from the run's seed;
+the Wilson score interval for a share) and the verdict: ``holds`` when the whole interval meets
+the criterion, ``fails`` when none of it does, ``inconclusive`` when it straddles it."""
+
+from __future__ import annotations
+
+import math
+import zlib
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from kiseki.metrics import wilson_interval
+
+__all__ = [
+    "BOOTSTRAP_RESAMPLES",
+    "MIN_TRIALS",
+    "UNMIGRATED",
+    "ClaimSpec",
+    "Control",
+    "Criterion",
+    "Estimate",
+    "Evidence",
+    "Verdict",
+    "decide",
+    "estimate",
+    "judge",
+    "trials_to_decide",
+]
+
+BOOTSTRAP_RESAMPLES = 4000
+"""Resamples of a percentile bootstrap: the 2.5 % and 97.5 % quantiles of 4000 resampled means
+move by well under a tenth of the interval's width between generators."""
+MIN_TRIALS = 5
+"""Fewest per-trial values a bootstrap interval is computed from: below it the resamples take
+too few distinct values and the interval is far too narrow (no verdict, ``inconclusive``)."""
+UNMIGRATED = "no interval (not yet migrated)"
+"""The verdict shown for a claim still built as the old point ``Claim``: never decided."""
+
+Compare = Literal["<=", ">=", "within"]
+Outcome = Literal["holds", "fails", "inconclusive"]
+
+
+@dataclass(frozen=True)
+class Criterion:
+    """What the measured quantity must satisfy, fixed before the run.
+
+    ``compare`` is ``"<="`` or ``">="`` against ``threshold``, or ``"within"``: inside
+    ``threshold +- tolerance``. ``why`` says where the threshold and tolerance come from (the
+    paper, a sensor's resolution, a share of v_max). ``bounds`` is the quantity's own range (a
+    share [0, 1], an error [0, inf), a difference of shares [-1, 1]): a criterion that its bounds
+    already satisfy cannot fail and is refused by :meth:`problems`. ``paper_number`` is the
+    paper's printed number when there is one (checked against the scenes' calibration marks)."""
+
+    paper_value: str
+    compare: Compare
+    threshold: float
+    why: str
+    tolerance: float = 0.0
+    bounds: tuple[float, float] = (-math.inf, math.inf)
+    paper_number: float | None = None
+
+    def band(self) -> tuple[float, float]:
+        """The values that meet the criterion, as a closed interval."""
+        if self.compare == "<=":
+            return (-math.inf, self.threshold)
+        if self.compare == ">=":
+            return (self.threshold, math.inf)
+        return (self.threshold - self.tolerance, self.threshold + self.tolerance)
+
+    def text(self) -> str:
+        if self.compare == "within":
+            return f"within {self.threshold:g} +- {self.tolerance:g}"
+        return f"{self.compare} {self.threshold:g}"
+
+    def problems(self) -> list[str]:
+        """Why this criterion cannot decide anything (empty when it can): met by every value
+        in the quantity's bounds, or by none of them."""
+        low, high = self.bounds
+        a, b = self.band()
+        out = []
+        if self.compare not in ("<=", ">=", "within"):
+            out.append(f"unknown comparison {self.compare!r}")
+        if not self.why.strip():
+            out.append("no reason given for the threshold (why)")
+        if self.compare == "within" and not self.tolerance > 0:
+            out.append("'within' needs a tolerance > 0")
+        if a <= low and b >= high:
+            out.append(f"{self.text()} holds for every value in the bounds [{low:g}, {high:g}]")
+        if b < low or a > high:
+            out.append(f"{self.text()} holds for no value in the bounds [{low:g}, {high:g}]")
+        return out
+
+
+@dataclass(frozen=True)
+class Control:
+    """A named config override (``--set`` items) under which the claim's criterion must fail,
+    and the trials (``runs``) it needs to fail decidedly; ``why`` says why it must fail."""
+
+    name: str
+    overrides: tuple[str, ...]
+    runs: int
+    why: str = ""
+
+
+@dataclass(frozen=True)
+class ClaimSpec:
+    """A claim as declared before the run: ``key`` joins it to its :class:`Evidence`;
+    ``measure`` says what one trial contributes (the statistic over trials is the Evidence's)."""
+
+    key: str
+    claim: str
+    unit: str
+    criterion: Criterion
+    control: Control | None
+    measure: str = ""
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """The per-trial evidence of a declared claim: ``values`` (one per trial; a difference
+    between two arms is one value per trial of arm a - arm b on the same seed) summarised by
+    ``statistic``, or ``successes`` of ``trials`` for a share. ``subject`` names what the claim
+    is about when it is made once per log or setting; ``shown`` adds context to the value."""
+
+    key: str
+    values: tuple[float, ...] = ()
+    statistic: Literal["mean", "median"] = "mean"
+    successes: int | None = None
+    trials: int | None = None
+    subject: str = ""
+    shown: str = ""
+    note: str = ""
+
+    @classmethod
+    def of(cls, key: str, values, statistic: Literal["mean", "median"] = "mean", **kw):
+        return cls(key, tuple(float(v) for v in values), statistic, **kw)
+
+    @classmethod
+    def share(cls, key: str, successes: int, trials: int, **kw):
+        return cls(key, successes=int(successes), trials=int(trials), **kw)
+
+
+@dataclass(frozen=True)
+class Estimate:
+    value: float
+    low: float
+    high: float
+    n: int
+
+
+def _generator(seed: int, evidence: Evidence) -> np.random.Generator:
+    """One generator per (run seed, claim, subject): a claim's interval does not depend on
+    which other claims were judged before it."""
+    tag = zlib.crc32(f"{evidence.key}\0{evidence.subject}".encode())
+    return np.random.default_rng([int(seed) % 2**63, tag])
+
+
+def estimate(evidence: Evidence, seed: int) -> Estimate:
+    """The measured value and its 95 % interval (NaN ends when there is too little evidence)."""
+    if evidence.trials is not None:
+        k, n = int(evidence.successes or 0), int(evidence.trials)
+        low, high = wilson_interval(k, n)
+        return Estimate(k / n if n else math.nan, low, high, n)
+    x = np.asarray(evidence.values, dtype=float)
+    x = x[np.isfinite(x)]
+    stat = np.median if evidence.statistic == "median" else np.mean
+    if x.size == 0:
+        return Estimate(math.nan, math.nan, math.nan, 0)
+    value = float(stat(x))
+    if x.size < MIN_TRIALS:
+        return Estimate(value, math.nan, math.nan, int(x.size))
+    picks = _generator(seed, evidence).integers(0, x.size, (BOOTSTRAP_RESAMPLES, x.size))
+    resampled = stat(x[picks], axis=1)
+    low, high = np.quantile(resampled, [0.025, 0.975])
+    return Estimate(value, float(low), float(high), int(x.size))
+
+
+def decide(criterion: Criterion, est: Estimate) -> Outcome:
+    """holds: the interval lies inside the criterion's band; fails: it lies outside;
+    inconclusive: it straddles an edge (or there is no interval)."""
+    if math.isnan(est.low) or math.isnan(est.high):
+        return "inconclusive"
+    a, b = criterion.band()
+    if a <= est.low and est.high <= b:
+        return "holds"
+    if est.high < a or est.low > b:
+        return "fails"
+    return "inconclusive"
+
+
+def trials_to_decide(criterion: Criterion, est: Estimate) -> int | None:
+    """Trials that would decide an undecided claim, from the interval's half-width h at n
+    trials scaling as 1/sqrt(n): n * (h / d)^2, d the distance from the value to the nearest
+    edge of the criterion's band (the interval must shrink inside it, or away from it). None
+    when the value sits on an edge (d = 0: no number of trials decides it)."""
+    if est.n == 0 or math.isnan(est.value):
+        return None
+    if math.isnan(est.low):  # too few trials for an interval
+        return MIN_TRIALS
+    a, b = criterion.band()
+    d = min(abs(est.value - a), abs(est.value - b))
+    half = (est.high - est.low) / 2
+    if d == 0 or not math.isfinite(d):
+        return None
+    return max(est.n + 1, math.ceil(est.n * (half / d) ** 2))
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """A claim's row in claims.csv and the reports."""
+
+    claim: str
+    paper_value: str
+    measured_value: float | str
+    ci_low: float
+    ci_high: float
+    unit: str
+    criterion: str
+    verdict: str
+    trials: int
+    trials_to_decide: float  # NaN when decided (or when no number of trials decides it)
+    control: str
+    note: str
+
+
+VERDICT_COLUMNS = [f for f in Verdict.__dataclass_fields__]
+
+
+def judge(specs: tuple[ClaimSpec, ...], evidence: list[Evidence], seed: int) -> list[Verdict]:
+    """The verdict of every piece of evidence, in the order given, against its declared claim;
+    evidence for a key no claim declares is a ValueError (a claim is declared before the run)."""
+    by_key = {s.key: s for s in specs}
+    out = []
+    for e in evidence:
+        if e.key not in by_key:
+            raise ValueError(f"evidence for {e.key!r}, which no claim declares")
+        spec = by_key[e.key]
+        est = estimate(e, seed)
+        outcome = decide(spec.criterion, est)
+        more = trials_to_decide(spec.criterion, est) if outcome == "inconclusive" else None
+        shown = f"{est.value:.4g}" + (f" ({e.shown})" if e.shown else "")
+        out.append(
+            Verdict(
+                claim=spec.claim + (f" [{e.subject}]" if e.subject else ""),
+                paper_value=spec.criterion.paper_value,
+                measured_value=shown,
+                ci_low=est.low,
+                ci_high=est.high,
+                unit=spec.unit,
+                criterion=spec.criterion.text() + f" ({spec.criterion.why})",
+                verdict=outcome,
+                trials=est.n,
+                trials_to_decide=math.nan if more is None else float(more),
+                control=spec.control.name if spec.control else "",
+                note=e.note,
+            )
+        )
+    return out
+
+
+def legacy(claim) -> Verdict:
+    """An old point ``Claim`` (no interval): shown, never counted as decided."""
+    return Verdict(
+        claim=claim.claim,
+        paper_value=claim.paper_value,
+        measured_value=claim.measured_value,
+        ci_low=math.nan,
+        ci_high=math.nan,
+        unit=claim.unit,
+        criterion="",
+        verdict=UNMIGRATED,
+        trials=0,
+        trials_to_decide=math.nan,
+        control="",
+        note=f"point verdict without an interval: {'holds' if claim.holds else 'fails'}"
+        + (f"; {claim.note}" if claim.note else ""),
+    )
