@@ -29,7 +29,6 @@ import numpy as np
 import pandas as pd
 import yaml
 from matplotlib.patches import Circle
-from scipy import stats
 
 from kiseki._support.inputs import YAML_LIMIT, read_input_text
 from kiseki._support.yaml import safe_load_12
@@ -46,6 +45,7 @@ from kiseki.teach.local_maps import METHODS, LocalMapMaker
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki_experiments.harness.config import Boxes, Particles
 from kiseki_experiments.harness.paths import WORLDS
+from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion, Evidence
 
 
 @dataclass(frozen=True)
@@ -235,49 +235,53 @@ def trial(config: Exp1Config, index: int, seed: int, taught=None) -> TrialOutput
         goal = taught.marks[-1]
         before = taught.marks[-2] if len(taught.marks) > 1 else goal
         record["final_leg_m"] = math.hypot(goal["x"] - before["x"], goal["y"] - before["y"])
-        played = stand_ins(config)
+        played, runs = stand_ins(config), {}
         for method in methods:
             actual = played.get(method, method)  # a negative control plays another method
-            band, _ = METHODS[actual]
-            result = playback(
-                scene,
-                maps[band],
-                taught.marks,
-                PlaybackConfig(
-                    method=actual, particles=config.particles, seed=derive_seed(seed, 2)
-                ),
-                taught_scene=taught.scene,
-                variant="exp3-boxes" if config.boxes else None,  # the copy with the boxes
-            )
-            # which scene file it played in: its SHA-1 and the variant label of a changed copy
-            record["scene_sha1"] = result.scene_identity["scene_sha1"]
-            record["scene_variant"] = result.scene_identity.get("variant", "")
-            for k, v in _errors(result, goal).items():
-                record[f"{method}_{k}"] = v
-            for k, v in _goal_profile(scene, maps[band], goal, actual).items():
-                record[f"{method}_{k}"] = v
-            if config.boxes:  # the control: the same run without the boxes
-                control = playback(
-                    load_scene(scene_file, "playback"),
-                    maps[band],
-                    taught.marks,
-                    PlaybackConfig(
-                        method=actual, particles=config.particles, seed=derive_seed(seed, 2)
-                    ),
-                    taught_scene=taught.scene,
-                )
-                for k, v in _errors(control, goal).items():
-                    if k.startswith("stop_"):
-                        record[f"{method}_nobox_{k}"] = v
-            for name, poses in result.passes.items():
-                mark = next(m for m in taught.marks if m["name"] == name)
-                t, e, o = poses["true"], poses["estimate"], poses["odometry"]
-                # localization error: the estimate's offset from the waypoint minus the truth's
-                record[f"{method}_{name}_loc_dx"] = (e[0] - mark["x"]) - (t[0] - mark["truth"][0])
-                record[f"{method}_{name}_loc_dy"] = (e[1] - mark["y"]) - (t[1] - mark["truth"][1])
-                record[f"{method}_{name}_odo_dx"] = o[0] - t[0]
-                record[f"{method}_{name}_odo_dy"] = o[1] - t[1]
+            if actual not in runs:  # a method played twice on one seed is the same run
+                runs[actual] = _play(config, scene, maps, taught, actual, seed)
+            identity, out = runs[actual]
+            record.update(identity)
+            record.update({f"{method}_{k}": v for k, v in out.items()})
     return TrialOutput(record)
+
+
+def _play(config, scene, maps, taught, method: str, seed: int) -> tuple[dict, dict]:
+    """One playback of `method` on the trial's taught maps (and, with boxes, the same run
+    without them): which scene it played in, and its record (keys without the method)."""
+    goal = taught.marks[-1]
+    band, _ = METHODS[method]
+    play = PlaybackConfig(method=method, particles=config.particles, seed=derive_seed(seed, 2))
+    result = playback(
+        scene,
+        maps[band],
+        taught.marks,
+        play,
+        taught_scene=taught.scene,
+        variant="exp3-boxes" if config.boxes else None,  # the copy with the boxes
+    )
+    # which scene file it played in: its SHA-1 and the variant label of a changed copy
+    identity = {
+        "scene_sha1": result.scene_identity["scene_sha1"],
+        "scene_variant": result.scene_identity.get("variant", ""),
+    }
+    out = dict(_errors(result, goal))
+    out.update(_goal_profile(scene, maps[band], goal, method))
+    if config.boxes:  # the control: the same run without the boxes
+        plain = load_scene(Path(config.scene), "playback")
+        control = playback(plain, maps[band], taught.marks, play, taught_scene=taught.scene)
+        for k, v in _errors(control, goal).items():
+            if k.startswith("stop_"):
+                out[f"nobox_{k}"] = v
+    for name, poses in result.passes.items():
+        mark = next(m for m in taught.marks if m["name"] == name)
+        t, e, o = poses["true"], poses["estimate"], poses["odometry"]
+        # localization error: the estimate's offset from the waypoint minus the truth's
+        out[f"{name}_loc_dx"] = (e[0] - mark["x"]) - (t[0] - mark["truth"][0])
+        out[f"{name}_loc_dy"] = (e[1] - mark["y"]) - (t[1] - mark["truth"][1])
+        out[f"{name}_odo_dx"] = o[0] - t[0]
+        out[f"{name}_odo_dy"] = o[1] - t[1]
+    return identity, out
 
 
 def _stop_table(config, trials: pd.DataFrame) -> pd.DataFrame:
@@ -532,86 +536,100 @@ THESIS_RUNS = 5
 STOP_TOLERANCE_M = 0.1  # the thesis' stop rule (sec. 2.2)
 
 
-def _share_text(k: int, n: int) -> str:
-    low, high = wilson_interval(k, n)
-    return f"{k}/{n} (95 % CI {low:.2f}-{high:.2f})"
+# Exp. 2's claims: the thesis' findings (Table 4.5, 5 runs per method) as comparisons between
+# methods on the same teaching and seeds, one paired value per run. Their control plays every
+# method as conventional: each difference is then 0, a margin away from each criterion.
+ALL_CONVENTIONAL = Control(
+    name="proposals 1 and 2 played as conventional",
+    overrides=(
+        "plays=proposal1=conventional,proposal2=conventional",
+        "methods=conventional,proposal1,proposal2",
+        "particles=200",  # the control's trials are test time; the differences are 0 at any
+    ),
+    runs=5,
+    why="every method is conventional's run on the same seed: every difference is 0",
+)
+WITHIN_MARGIN = 0.2  # one run in five more within 0.1 m
+WITHIN_WHY = (
+    f"one run in {THESIS_RUNS} (the thesis' runs per method) more within 0.1 m; a difference of "
+    "shares from paired runs"
+)
+FARTHER_MARGIN = 0.01  # m
+FARTHER_WHY = (
+    "the thesis' stop errors have an SD of 0.01 m for every method (Table 4.5): a difference "
+    "of one SD; paired runs"
+)
+WITHIN_PAIRS = (("proposal2", "conventional"), ("proposal1", "conventional"))
+FARTHER_PAIRS = (
+    ("conventional", "proposal2"),
+    ("conventional", "proposal1"),
+    ("proposal1", "proposal2"),
+)
 
 
-def _more_within(by: pd.DataFrame, better: str, worse: str) -> Claim:
-    """The thesis' finding that `better` stops within 0.1 m in more runs than `worse`, decided
-    on the two shares' 95 % Wilson intervals: holds when they do not overlap in the thesis'
-    direction (at the thesis' 5 runs, 5/5 against 0/5 does; its own 4/5 against 0/5 does not)."""
-    kb, nb = int(by.loc[better, "stops_within_0.1m"]), int(by.loc[better, "runs"])
-    kw, nw = int(by.loc[worse, "stops_within_0.1m"]), int(by.loc[worse, "runs"])
-    paper_b, paper_w = THESIS_TABLE_4_5[better][3], THESIS_TABLE_4_5[worse][3]
-    return Claim(
-        f"{better} stops within 0.1 m in more runs than {worse}",
-        f"{paper_b}/{THESIS_RUNS} vs {paper_w}/{THESIS_RUNS}",
-        f"{_share_text(kb, nb)} vs {_share_text(kw, nw)}",
-        "runs",
-        bool(wilson_interval(kb, nb)[0] > wilson_interval(kw, nw)[1]),
-        "criterion: the 95 % Wilson intervals of the two shares do not overlap",
+def _within_claim(better: str, worse: str) -> ClaimSpec:
+    b, w = THESIS_TABLE_4_5[better][3], THESIS_TABLE_4_5[worse][3]
+    return ClaimSpec(
+        key=f"within_{better}_vs_{worse}",
+        claim=f"{better} stops within 0.1 m in more runs than {worse}: {better}'s share "
+        f"minus {worse}'s",
+        unit="difference of shares of runs",
+        criterion=Criterion(
+            paper_value=f"{b}/{THESIS_RUNS} vs {w}/{THESIS_RUNS} ({(b - w) / THESIS_RUNS:+.1f})",
+            compare=">=",
+            threshold=WITHIN_MARGIN,
+            why=WITHIN_WHY,
+            bounds=(-1.0, 1.0),
+            paper_number=(b - w) / THESIS_RUNS,
+        ),
+        control=ALL_CONVENTIONAL,
+        measure=f"1 if {better} stopped within 0.1 m, minus the same for {worse}",
     )
 
 
-def _farther(ok: pd.DataFrame, farther: str, nearer: str) -> Claim:
-    """The thesis' finding that `farther` stops farther from the goal than `nearer` (mean stop
-    error), decided on the per-trial differences (same teaching and seeds for both methods):
-    holds when the 95 % t interval of their mean lies above 0."""
-    d = (ok[f"{farther}_stop_error"] - ok[f"{nearer}_stop_error"]).to_numpy()
-    low, high = _mean_interval(d)
-    paper = THESIS_TABLE_4_5[farther][0] - THESIS_TABLE_4_5[nearer][0]
-    return Claim(
-        f"{farther} stops farther from the goal than {nearer} (mean stop error difference)",
-        f"{THESIS_TABLE_4_5[farther][0]:.2f} - {THESIS_TABLE_4_5[nearer][0]:.2f} = {paper:+.2f}",
-        f"{d.mean():+.3f} (95 % CI {low:+.3f} to {high:+.3f}, {len(d)} paired runs)",
-        "m",
-        bool(low > 0.0),
-        "criterion: the 95 % t interval of the mean per-run difference lies above 0",
+def _farther_claim(farther: str, nearer: str) -> ClaimSpec:
+    f, n = THESIS_TABLE_4_5[farther][0], THESIS_TABLE_4_5[nearer][0]
+    return ClaimSpec(
+        key=f"farther_{farther}_than_{nearer}",
+        claim=f"{farther} stops farther from the goal than {nearer}: mean stop error difference",
+        unit="m",
+        criterion=Criterion(
+            paper_value=f"{f:.2f} - {n:.2f} = {f - n:+.2f}",
+            compare=">=",
+            threshold=FARTHER_MARGIN,
+            why=FARTHER_WHY,
+            paper_number=round(f - n, 2),
+        ),
+        control=ALL_CONVENTIONAL,
+        measure=f"{farther}'s stop error minus {nearer}'s",
     )
 
 
-def _mean_interval(values: np.ndarray) -> tuple[float, float]:
-    """The 95 % Student-t interval of a mean (NaN ends below 2 values)."""
-    n = len(values)
-    if n < 2:
-        return (math.nan, math.nan)
-    half = stats.t.ppf(0.975, n - 1) * values.std(ddof=1) / math.sqrt(n)
-    return (float(values.mean() - half), float(values.mean() + half))
+EXP2_CLAIMS = (
+    *(_within_claim(b, w) for b, w in WITHIN_PAIRS),
+    *(_farther_claim(f, n) for f, n in FARTHER_PAIRS),
+)
+
+
+def _exp2_evidence(ok: pd.DataFrame, methods) -> list[Evidence]:
+    evidence = []
+    for better, worse in WITHIN_PAIRS:
+        if better in methods and worse in methods:
+            a = (ok[f"{better}_stop_error"] <= STOP_TOLERANCE_M).astype(float)
+            b = (ok[f"{worse}_stop_error"] <= STOP_TOLERANCE_M).astype(float)
+            shown = f"{int(a.sum())}/{len(a)} vs {int(b.sum())}/{len(b)}"
+            evidence.append(Evidence.of(f"within_{better}_vs_{worse}", a - b, shown=shown))
+    for farther, nearer in FARTHER_PAIRS:
+        if farther in methods and nearer in methods:
+            a, b = ok[f"{farther}_stop_error"], ok[f"{nearer}_stop_error"]
+            shown = f"{a.mean():.3f} - {b.mean():.3f} m"
+            evidence.append(Evidence.of(f"farther_{farther}_than_{nearer}", a - b, shown=shown))
+    return evidence
 
 
 def analyze_exp2(config, trials, timings, figures) -> Analysis:
     ok = trials[trials["error"].isna()]
     stops = _stop_table(config, ok)
-    by = stops.set_index("method")
-    present = [m for m in THESIS_TABLE_4_5 if m in by.index]
-    claims = []
-    for better, worse in (
-        ("proposal2", "conventional"),
-        ("proposal1", "conventional"),
-        ("proposal2", "proposal1"),
-    ):
-        if better in present and worse in present:
-            claims.append(_more_within(by, better, worse))
-    for farther, nearer in (
-        ("conventional", "proposal2"),
-        ("conventional", "proposal1"),
-        ("proposal1", "proposal2"),
-    ):
-        if farther in present and nearer in present:
-            claims.append(_farther(ok, farther, nearer))
-    if "proposal2" in present:
-        k, n = int(by.loc["proposal2", "stops_within_0.1m"]), int(by.loc["proposal2", "runs"])
-        claims.append(
-            Claim(
-                "proposal2 stops within 0.1 m in most runs",
-                f"5/{THESIS_RUNS}",
-                _share_text(k, n),
-                "runs",
-                bool(wilson_interval(k, n)[0] > 0.5),
-                "criterion: the 95 % Wilson interval of the share lies above 0.5",
-            )
-        )
     thesis = pd.DataFrame(
         [
             {"method": m, "thesis_stop_error_mean_m": v[0], "thesis_stops_within_0.1m": v[3]}
@@ -623,11 +641,11 @@ def analyze_exp2(config, trials, timings, figures) -> Analysis:
     return Analysis(
         tables={"stops": stops, "diagnostics": diag, "taught_maps": _taught_table(config, ok)},
         figures=[_stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
-        claims=claims,
+        evidence=_exp2_evidence(ok, set(config.methods)),
         notes=f"Thesis Tables 4.5/4.6: {THESIS_RUNS} runs per method; 'both' is not in the "
-        "thesis. Each method's own stop error and share within 0.1 m stand in table `stops` "
-        "beside the thesis' (not claims: a method's value alone decides no finding of the "
-        "thesis; the findings are the comparisons above).\n\n" + _diagnosis(diag, ok),
+        "thesis. Each method's own stop error and share within 0.1 m (with its 95 % Wilson "
+        "interval) stand in table `stops` beside the thesis' (table rows, not claims: the "
+        "thesis' findings are the comparisons between methods).\n\n" + _diagnosis(diag, ok),
     )
 
 
@@ -727,6 +745,7 @@ EXP2 = Experiment(
     analyze=analyze_exp2,
     default_runs=5,
     preflight=_preflight,
+    claims=EXP2_CLAIMS,
 )
 EXP3 = Experiment(
     name="exp3-boxes",

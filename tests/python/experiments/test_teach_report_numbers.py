@@ -5,7 +5,9 @@ exp1-corridor, exp2-turn and exp3-boxes applied to three different sets of trial
 the form their trial writes, values drawn at random) give notes whose numbers change with the
 data; a number found in every draw's notes must be one of the constants the code cites (the
 thesis' values, the stop rule, the offsets the likelihood profile is taken at). A fixed figure
-typed into the prose (a share measured once, on another run) is in all of them and fails."""
+typed into the prose (a share measured once, on another run) is in all of them and fails.
+Exp. 2's claims on trials with the thesis' Table 4.5 numbers hold, and fail when the proposals
+are conventional's runs (its negative control)."""
 
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from kiseki_experiments.harness.verdict import judge
 from kiseki_experiments.teach import teach_playback as tp
 
 METHODS = ["conventional", "proposal1", "proposal2", "both"]
@@ -67,6 +70,7 @@ def _cited_constants() -> set[float]:
     out |= {float(v) for v in tp.BOX_SIZE_M} | {float(v) for v in tp.BOX_OFFSET_M}
     out |= {0.1, 0.3}  # the profile offsets the drops are taken at (table `diagnostics`)
     out |= {1.0}  # 1 deg of heading error, turned into metres over the final leg
+    out |= {95.0}  # the confidence level of every interval
     out |= {4.5, 4.6, 4.7, 3.0, 2.0, 8.0}  # the thesis' table numbers; 3 boxes; 8 neighbours
     return out
 
@@ -104,3 +108,41 @@ def test_the_turn_routes_taught_map_shares_are_this_runs(tmp_path):
             f"{band} map {shares[0]:.1f} % erased / {shares[1]:.1f} % falsely occupied with a "
             f"one-cell shift forgiven, {shares[2]:.1f} % / {shares[3]:.1f} % cell by cell"
         ) in notes
+
+
+def _thesis_like(rng: np.random.Generator, conventional_for: tuple[str, ...] = ()) -> pd.DataFrame:
+    """Five runs with the stop errors of the thesis' Table 4.5 (mean, SD 0.01 m, and as many
+    stops within 0.1 m); the methods in `conventional_for` take conventional's errors run by
+    run (what the negative control does)."""
+    trials = _trials(rng)
+    errors = {
+        "conventional": rng.normal(0.13, 0.01, 5).clip(0.105),
+        "proposal1": np.r_[rng.normal(0.085, 0.005, 4), 0.11],  # 4/5 within
+        "proposal2": rng.normal(0.07, 0.01, 5).clip(max=0.095),
+        "both": rng.normal(0.07, 0.01, 5).clip(max=0.095),
+    }
+    for m in METHODS:
+        trials[f"{m}_stop_error"] = errors["conventional" if m in conventional_for else m]
+    return trials
+
+
+@pytest.mark.parametrize("draw", range(3))
+def test_exp2_claims_hold_on_the_thesis_numbers_and_fail_when_the_methods_are_one(tmp_path, draw):
+    config = tp.Exp2Config(methods=METHODS)
+    for spec in tp.EXP2_CLAIMS:
+        assert spec.criterion.problems() == [], spec.key
+    rng = np.random.default_rng(draw)
+    thesis = tp.analyze_exp2(config, _thesis_like(rng), None, tmp_path)
+    verdicts = {v.claim: v.verdict for v in judge(tp.EXP2_CLAIMS, thesis.evidence, draw)}
+    assert len(verdicts) == len(tp.EXP2_CLAIMS) == 5
+    # on the thesis' own five runs none of its findings fails, and its main ones hold:
+    # proposal 2 5/5 within 0.1 m against conventional's 0/5, 0.07 against 0.13 m (proposal 1's
+    # 0.02 m lead over proposal 2 is twice the SD, too close to the 0.01 m margin for 5 runs)
+    assert "fails" not in verdicts.values(), verdicts
+    for spec in tp.EXP2_CLAIMS:
+        if spec.key in ("within_proposal2_vs_conventional", "farther_conventional_than_proposal2"):
+            assert verdicts[spec.claim] == "holds", (spec.key, verdicts)
+    same = _thesis_like(rng, conventional_for=("proposal1", "proposal2"))
+    control = tp.analyze_exp2(config, same, None, tmp_path)
+    verdicts = {v.claim: v.verdict for v in judge(tp.EXP2_CLAIMS, control.evidence, draw)}
+    assert set(verdicts.values()) == {"fails"}, verdicts
