@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 import tempfile
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -41,6 +41,7 @@ from kiseki.teach.environment_map import MERGE_RULES
 from kiseki.teach.local_maps import METHODS
 from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
 from kiseki_experiments.harness.config import Boxes, Particles, Runs
+from kiseki_experiments.harness.verdict import Evidence
 from kiseki_experiments.teach import teach_playback as tp
 
 REFUSED = "crosses occupied space"  # kiseki.apps.teach.playback.check_route's refusal
@@ -74,13 +75,14 @@ class LayoutsConfig:
     particles: Particles = 1000
     boxes: Boxes = 3
     merge: str = "thesis"
+    plays: str = ""  # negative controls: exp2-turn's methods played as others (Exp2Config)
 
 
 def _configs(config: LayoutsConfig, scene: Path, method: str | None = None) -> dict:
     common = {"scene": str(scene), "particles": config.particles, "merge": config.merge}
     methods = list(config.methods) if method is None else [method]
     return {
-        "exp2": tp.Exp2Config(methods=methods, **common),
+        "exp2": tp.Exp2Config(methods=methods, plays=config.plays, **common),
         "exp3": tp.Exp3Config(boxes=config.boxes, **common),
     }
 
@@ -191,7 +193,8 @@ def _layout_claims(config: LayoutsConfig, ok: pd.DataFrame, scratch: Path) -> pd
             key = (int(row["trial"]), name)
             refusals[key] = _refused(frame)
             if any(c.endswith("_stop_error") and np.isfinite(frame[c]).any() for c in frame):
-                found[key] = analyses[name](cfg, frame, pd.DataFrame(), scratch).claims
+                analysis = analyses[name](cfg, frame, pd.DataFrame(), scratch)
+                found[key] = analysis.claims + [_point(e) for e in analysis.evidence]
     templates = {name: claims for (_, name), claims in found.items()}
     rows = []
     for _, row in ok.iterrows():
@@ -215,6 +218,42 @@ def _layout_claims(config: LayoutsConfig, ok: pd.DataFrame, scratch: Path) -> pd
                     }
                 )
     return pd.DataFrame(rows)
+
+
+def _point(evidence: Evidence) -> Claim:
+    """One layout's value of an exp2-turn claim (the mean of its few runs' paired values) and
+    whether that value meets the claim's criterion: a point verdict, for the per-layout
+    table; the claim itself is judged on all layouts' runs (`_pooled`)."""
+    spec = next(s for s in tp.EXP2_CLAIMS if s.key == evidence.key)
+    values = np.asarray(evidence.values, dtype=float)
+    value = float(values[np.isfinite(values)].mean()) if np.isfinite(values).any() else np.nan
+    low, high = spec.criterion.band()
+    return Claim(
+        spec.claim,
+        spec.criterion.paper_value,
+        f"{value:.3f} ({evidence.shown})",
+        spec.unit,
+        bool(low <= value <= high),
+    )
+
+
+def _pooled(config: LayoutsConfig, ok: pd.DataFrame, scratch: Path) -> list[Evidence]:
+    """exp2-turn's evidence over every run of every layout (a run: a random layout and its
+    seeds), one Evidence per exp2-turn claim."""
+    values: dict[str, list[float]] = {}
+    layouts: dict[str, int] = {}
+    cfg = _configs(config, Path("layout.yaml"))["exp2"]
+    for _, row in ok.iterrows():
+        frame = _runs(row, "exp2", config.runs_per_layout)
+        if not any(c.endswith("_stop_error") for c in frame):
+            continue
+        for e in tp.analyze_exp2(cfg, frame, pd.DataFrame(), scratch).evidence:
+            values.setdefault(e.key, []).extend(e.values)
+            layouts[e.key] = layouts.get(e.key, 0) + 1
+    return [
+        Evidence.of(key, v, shown=f"{layouts[key]} layouts x {config.runs_per_layout} run(s)")
+        for key, v in values.items()
+    ]
 
 
 def _shares(per: pd.DataFrame) -> pd.DataFrame:
@@ -360,7 +399,9 @@ def analyze(config: LayoutsConfig, trials, timings, figures: Path) -> Analysis:
             path = figures / f"fails_{name}_{_slug(claim)}.png"
             title = f"{name}: {claim} fails (thesis: {g['paper_value'].iloc[0]})"
             figs.append(_draw_layouts(pictures, sorted(measured), title, path, measured))
-    claims = [
+    with tempfile.TemporaryDirectory() as scratch:
+        evidence = _pooled(config, ok, Path(scratch))
+    claims = [  # exp3-boxes' claims are still point claims (not yet migrated)
         Claim(
             f"{s['experiment']}: {s['claim']} (holds in >= {GENERAL:.0%} of layouts)",
             f"{s['paper_value']} (thesis' factory)",
@@ -371,6 +412,7 @@ def analyze(config: LayoutsConfig, trials, timings, figures: Path) -> Analysis:
             _verdict(s["ci95_low"], s["ci95_high"]),
         )
         for _, s in shares.iterrows()
+        if s["experiment"] == "exp3"
     ]
     return Analysis(
         tables={
@@ -384,7 +426,27 @@ def analyze(config: LayoutsConfig, trials, timings, figures: Path) -> Analysis:
         figures=figs,
         claims=claims,
         notes=_notes(config, len(ok), len(trials)),
+        evidence=evidence,
     )
+
+
+# exp2-turn's claims judged on the runs of all layouts together; their control plays the
+# proposals as conventional (cheap: one layout run each, no boxes, few particles)
+CLAIMS = tuple(
+    replace(
+        spec,
+        claim=f"exp2: {spec.claim} (all layouts' runs)",
+        control=replace(
+            tp.ALL_CONVENTIONAL,
+            overrides=(
+                *tp.ALL_CONVENTIONAL.overrides,
+                "runs_per_layout=1",
+                "boxes=0",
+            ),
+        ),
+    )
+    for spec in tp.EXP2_CLAIMS
+)
 
 
 def _verdict(low: float, high: float) -> str:
@@ -399,19 +461,19 @@ def _verdict(low: float, high: float) -> str:
 
 def _notes(config: LayoutsConfig, ok: int, total: int) -> str:
     n = config.runs_per_layout
-    separable = wilson_interval(n, n)[0] > wilson_interval(0, n)[1]
     return (
         f"{ok} of {total} layouts ran (kiseki.sim.layouts states every range and its reason). "
         f"Each layout: {config.runs_per_layout} run(s) of exp2-turn's trial (teaching, then "
         "conventional, proposal 1, proposal 2 and both on the taught maps) and of exp3-boxes' "
         f"trial ({config.boxes} unknown boxes, proposal 2, and the control without them), "
         f"{config.particles} particles, merge rule {config.merge!r}; a layout's claims are "
-        "exp2-turn's and exp3-boxes' own analyses applied to its runs. The thesis' claims are "
-        f"means and counts over {tp.THESIS_RUNS} runs; exp2-turn's comparisons are decided on "
-        "95 % intervals of a layout's runs, so with fewer runs per layout a layout's verdict is "
-        f"less often decided (with {n} run(s) per layout, {n}/{n} against 0/{n} within "
-        f"{tp.STOP_TOLERANCE_M:g} m {'does' if separable else 'does not'} separate the two "
-        "shares' Wilson intervals). A claim generalises when it "
+        "exp2-turn's and exp3-boxes' own analyses applied to its runs. exp2-turn's claims "
+        "(paired differences between methods) are judged on the runs of all layouts together "
+        "(claims.csv); per layout, table `claims_per_layout` gives the mean of its "
+        f"{n} run(s) and whether that point value meets the criterion (the thesis ran "
+        f"{tp.THESIS_RUNS}; {n} run(s) per layout decide no interval). exp3-boxes' claims are "
+        "still point claims (not yet migrated), counted per layout: such a claim generalises "
+        "when it "
         f"holds in >= {GENERAL:.0%} of layouts; the note of each claim says whether the 95 % "
         "Wilson interval lies above that (general), below it (layout-specific) or across it. "
         "Table `by_behind` splits the shares by what lies behind the final leg's boundary "
@@ -423,6 +485,7 @@ def _notes(config: LayoutsConfig, ok: int, total: int) -> str:
 def _preflight(config: LayoutsConfig) -> None:
     if config.runs_per_layout < 1:
         raise ValueError(f"runs_per_layout must be at least 1, got {config.runs_per_layout}")
+    tp.stand_ins(config)  # a malformed `plays` stops here, named
     unknown = [m for m in config.methods if m not in METHODS]
     if unknown:
         raise ValueError(f"unknown method(s) {unknown} (known: {', '.join(METHODS)})")
@@ -440,4 +503,5 @@ EXPERIMENT = Experiment(
     analyze=analyze,
     default_runs=20,
     preflight=_preflight,
+    claims=CLAIMS,
 )
