@@ -65,6 +65,7 @@ def _numbers(text: str) -> set[float]:
 def _cited_constants() -> set[float]:
     """The numbers the code cites by name (each shown as written, in m, %, runs or deg)."""
     out = {tp.STOP_TOLERANCE_M, float(tp.THESIS_RUNS), abs(tp.THESIS_ODOMETRY_Y_WORST_M)}
+    out |= {abs(v) for v in tp.THESIS_ODOMETRY_P2_M}
     for values in tp.THESIS_TABLE_4_5.values():
         out |= {float(v) for v in values}
     out |= {float(v) for v in tp.BOX_SIZE_M} | {float(v) for v in tp.BOX_OFFSET_M}
