@@ -211,12 +211,18 @@ def stop_error(stop, goal) -> StopError:
 class MapTruth:
     """A taught map measured against the ground truth (`taught_map_truth`)."""
 
+    # forgiving a one-cell shift: the taught cell and its 8 neighbours must all disagree
     erased_share: float  # obstacle cells in reach that the map marks free (with 8 neighbours)
     false_occupied_share: float  # visible free cells the map marks occupied (with 8 neighbours)
     obstacle_cells: int
     erased_cells: int
     visible_free_cells: int
     false_occupied_cells: int
+    # cell by cell: the taught cell under the truth cell alone
+    erased_share_cellwise: float  # obstacle cells in reach that the map marks free
+    false_occupied_share_cellwise: float  # visible free cells the map marks occupied
+    erased_cells_cellwise: int
+    false_occupied_cells_cellwise: int
 
     def as_dict(self) -> dict:
         return {k: getattr(self, k) for k in self.__dataclass_fields__}
@@ -255,7 +261,10 @@ def taught_map_truth(
     - false-occupied share: of the truth's free cells visible from the route, those that the
       taught map marks occupied together with all 8 neighbours.
     The 8 neighbours keep a one-cell shift (odometry, a thin leg beside a beam) from counting:
-    what counts is free space where a wall is, or a wall where open space is.
+    what counts is free space where a wall is, or a wall where open space is. That forgiving
+    measure also hides a wall one or two cells thick drawn into open space, so the same two
+    shares are given cell by cell too (`*_cellwise`: the taught cell under the truth cell
+    alone is free, or occupied).
     """
     poses = np.asarray(sensor_poses, dtype=np.float64)
     if poses.ndim != 2 or poses.shape[1] != 3 or len(poses) == 0 or not np.isfinite(poses).all():
@@ -304,23 +313,38 @@ def taught_map_truth(
     tj = np.floor((ys - taught.origin.y) / taught.resolution).astype(int)[:, None]
     ti, tj = np.broadcast_arrays(ti, tj)
     inside = (ti >= 0) & (ti < taught.width) & (tj >= 0) & (tj < taught.height)
-    free9 = np.zeros(cells.shape, bool)
-    occupied9 = np.zeros(cells.shape, bool)
-    f9, o9 = _all_nine(taught_cells == 0), _all_nine(taught_cells >= 65)
-    free9[inside] = f9[tj[inside], ti[inside]]
-    occupied9[inside] = o9[tj[inside], ti[inside]]
+
+    def under_truth(taught_mask: np.ndarray) -> np.ndarray:
+        out = np.zeros(cells.shape, bool)  # cells outside the taught map: neither
+        out[inside] = taught_mask[tj[inside], ti[inside]]
+        return out
+
+    taught_free, taught_occupied = taught_cells == 0, taught_cells >= 65
     obstacles = occupied & in_reach
     open_cells = free & visible
-    erased = int((obstacles & free9).sum())
-    false_occ = int((open_cells & occupied9).sum())
     n_obst, n_open = int(obstacles.sum()), int(open_cells.sum())
+    counts = [
+        int((obstacles & under_truth(_all_nine(taught_free))).sum()),
+        int((open_cells & under_truth(_all_nine(taught_occupied))).sum()),
+        int((obstacles & under_truth(taught_free)).sum()),
+        int((open_cells & under_truth(taught_occupied)).sum()),
+    ]
+    erased, false_occ, erased_1, false_occ_1 = counts
+
+    def share(k: int, n: int) -> float:
+        return k / n if n else 0.0
+
     return MapTruth(
-        erased / n_obst if n_obst else 0.0,
-        false_occ / n_open if n_open else 0.0,
+        share(erased, n_obst),
+        share(false_occ, n_open),
         n_obst,
         erased,
         n_open,
         false_occ,
+        share(erased_1, n_obst),
+        share(false_occ_1, n_open),
+        erased_1,
+        false_occ_1,
     )
 
 

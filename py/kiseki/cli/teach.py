@@ -116,5 +116,7 @@ def teach_command(
             f"  {band} map against the scene's truth: {100 * t['erased_share']:.1f} % of "
             f"{t['obstacle_cells']} obstacle cells in reach erased, "
             f"{100 * t['false_occupied_share']:.1f} % of {t['visible_free_cells']} visible "
-            "free cells occupied"
+            "free cells occupied (a one-cell shift forgiven); cell by cell "
+            f"{100 * t['erased_share_cellwise']:.1f} % and "
+            f"{100 * t['false_occupied_share_cellwise']:.1f} %"
         )

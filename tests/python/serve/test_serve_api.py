@@ -2,7 +2,8 @@
 # Copyright (c) 2026 the kiseki authors
 """kiseki serve's JSON API and websocket (FastAPI's test client) on a route taught by
 kiseki.teach in the demo's factory: every refusal, a full route start -> via -> goal -> home
-with method both, two pages seeing the same poses, the stop, renames, the token."""
+with method both, two pages seeing the same poses, the stop, renames, the token, and the share
+of routes stopping within 0.1 m of the goal over seeds with the server's defaults."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ import subprocess
 import sys
 import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
@@ -24,6 +26,7 @@ from starlette.testclient import WebSocketDenialResponse
 
 from kiseki import load_map
 from kiseki.apps.teach import teach
+from kiseki.metrics import wilson_interval
 from kiseki.serve import Robot, build_server
 from kiseki.sim.scene import load_scene
 
@@ -323,3 +326,33 @@ def test_command_refuses_bad_input_in_one_line(taught, tmp_path, project_root):
         lines = done.stderr.strip().splitlines()
         assert done.returncode == 1 and len(lines) == 1, (args, done.stderr)
         assert lines[0].startswith("kiseki: error:") and words in lines[0], lines[0]
+
+
+# The route page's stop at the goal over seeds, with every option of the server at its default
+# (method both, 1000 particles; the default seed 0 and the next seven). The criterion: the robot
+# stops within the thesis' 0.1 m (sec. 2.2) in most routes, decided by the 95 % Wilson interval
+# of the share lying above one half. The thesis' proposal 2 stopped within 0.1 m in 5 of 5 runs,
+# whose Wilson interval (0.57-1) lies above one half too; 8 routes are the fewest at which one
+# stop outside 0.1 m can still meet the criterion (7/8: lower bound 0.53; 5/6 and 6/7 cannot),
+# so the test does not ask for a share the thesis' 5 runs cannot show either.
+STOP_SEEDS = range(8)
+MOST = 0.5
+
+
+def _stop_error(taught, seed: int) -> float:
+    server = build_server(taught, speed_up=math.inf, seed=seed)  # the rest: the defaults
+    with TestClient(server.app, base_url=BASE) as client:
+        started = client.post("/api/routes", json={**ROUTE, "home": "G"})  # no way back
+        assert started.status_code == 202, started.text
+        state = _wait(client, lambda s: s["status"] != "running", timeout=900)
+    assert state["status"] == "finished", state["status"]
+    return state["stop_error_m"]
+
+
+def test_most_routes_stop_within_0_1_m_of_the_goal_over_seeds(taught):
+    # two routes at a time: the depth rendering and the filter release the GIL
+    with ThreadPoolExecutor(2) as pool:
+        errors = list(pool.map(lambda s: _stop_error(taught, s), STOP_SEEDS))
+    within = sum(e <= 0.1 for e in errors)
+    low, _ = wilson_interval(within, len(errors))
+    assert low > MOST, f"{within}/{len(errors)} within 0.1 m: {errors}"

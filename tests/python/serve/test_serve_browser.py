@@ -27,10 +27,10 @@ STOP_TOLERANCE_M = 0.1  # thesis 000, section 2.2
 
 def serve_command(taught: Path, port: int) -> list[str]:
     """`kiseki serve` as fast as the simulation steps (about 3x real time here), a short dwell,
-    and a seed whose stop at the goal is within the thesis' 0.1 m (seeds 1-3 are; seed 0 stops
-    0.102 m away)."""
+    and the server's default seed (how often the stop is within the thesis' 0.1 m, over seeds:
+    test_serve_stop_share.py)."""
     return [sys.executable, "-m", "kiseki.cli", "serve", "--taught", str(taught),
-            "--port", str(port), "--speed-up", "4", "--dwell", "2", "--seed", "1"]  # fmt: skip
+            "--port", str(port), "--speed-up", "4", "--dwell", "2"]  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -131,11 +131,19 @@ def test_route_start_via_goal_home_with_stop_report(browser, idle):
     wait_moved(page, start)  # the robot moves on the page
     stop = page.locator("#stop-error")
     expect(stop).not_to_have_attribute("data-m", "", timeout=180_000)  # at the goal
-    assert float(stop.get_attribute("data-m")) < STOP_TOLERANCE_M
+    shown = float(stop.get_attribute("data-m"))
+    # marked against the thesis' tolerance, whichever side of it this stop is
+    assert stop.get_attribute("class") == ("ok" if shown <= STOP_TOLERANCE_M else "bad")
+    assert stop.inner_text() == f"{shown:.3f} m"
     expect(page.locator("body")).to_have_attribute("data-status", "finished", timeout=180_000)
     row = page.locator("#history tr").first
     expect(row).to_contain_text("P0 → T1 → T2 → G ↩ P0")
-    assert float(row.get_attribute("data-stop-error")) < STOP_TOLERANCE_M
+    # the page shows the server's stop error (the distance from the true rest to G's taught
+    # truth): the same number in the live report and in the history row
+    finished = api(idle, "GET", "api/state")[1]["history"][-1]
+    assert shown == pytest.approx(finished["stop_error_m"], abs=1e-4)
+    assert float(row.get_attribute("data-stop-error")) == pytest.approx(shown, abs=1e-4)
+    assert 0.0 < shown < 1.0  # at the goal, not at the start (G is metres from P0)
     home = api(idle, "GET", "api/waypoints")[1]
     latency = page.evaluate("window.kiseki.lastLatency")
     print(f"click to first pose drawn: {latency['click_to_first_pose_ms']:.0f} ms")
