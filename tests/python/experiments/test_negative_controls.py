@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 
 import pandas as pd
 import pytest
@@ -20,12 +21,24 @@ from kiseki_experiments.harness.verdict import Control, Criterion
 
 # the experiments whose inputs are the recorded datasets (skipped without them, as elsewhere)
 RECORDED = ("carmen-maps", "mcl-")
+# Controls that teach a route and play it back several times: 47-146 s each on an idle core,
+# 257 s together, more than the suite's budget for all controls. They run when
+# KISEKI_TEST_HEAVY=1 (as `kiseki experiment run NAME --set ...` would), and are skipped, with
+# this reason shown, otherwise.
+HEAVY = ("exp1-corridor", "exp2-turn", "layouts-exp2-exp3")
+
+
+heavy = pytest.mark.skipif(
+    os.environ.get("KISEKI_TEST_HEAVY") != "1",
+    reason="a teaching-route control (minutes); set KISEKI_TEST_HEAVY=1 to run it",
+)
 
 
 def _cases():
     for name, experiment in sorted(all_experiments().items()):
         for control, specs in control_groups(name).items():
-            yield pytest.param(name, control, specs, id=f"{name}:{control.name}")
+            marks = [heavy] if name in HEAVY else []
+            yield pytest.param(name, control, specs, id=f"{name}:{control.name}", marks=marks)
         del experiment
 
 
