@@ -108,12 +108,15 @@ class Criterion:
 @dataclass(frozen=True)
 class Control:
     """A named config override (``--set`` items) under which the claim's criterion must fail,
-    and the trials (``runs``) it needs to fail decidedly; ``why`` says why it must fail."""
+    and the trials (``runs``) it needs to fail decidedly; ``why`` says why it must fail.
+    ``minutes`` marks a control whose run takes minutes (a teaching route played back several
+    times): the test suite runs it only when asked to (KISEKI_TEST_HEAVY=1)."""
 
     name: str
     overrides: tuple[str, ...]
     runs: int
     why: str = ""
+    minutes: bool = False
 
 
 @dataclass(frozen=True)

@@ -467,6 +467,7 @@ DEAD_RECKONING = Control(
     overrides=("particles=1",),
     runs=5,
     why="without the update the estimate drifts with the odometry: the stops miss P2",
+    minutes=True,  # 5 playbacks of the corridor: 47 s on an idle core
 )
 EXP1_CLAIMS = (
     ClaimSpec(
@@ -558,6 +559,7 @@ ALL_CONVENTIONAL = Control(
     ),
     runs=5,
     why="every method is conventional's run on the same seed: every difference is 0",
+    minutes=True,  # a teaching and 15 playbacks of the turn route: 65 s on an idle core
 )
 WITHIN_MARGIN = 0.2  # one run in five more within 0.1 m
 WITHIN_WHY = (

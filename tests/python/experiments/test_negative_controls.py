@@ -21,23 +21,21 @@ from kiseki_experiments.harness.verdict import Control, Criterion
 
 # the experiments whose inputs are the recorded datasets (skipped without them, as elsewhere)
 RECORDED = ("carmen-maps", "mcl-")
-# Controls that teach a route and play it back several times: 47-146 s each on an idle core,
-# 257 s together, more than the suite's budget for all controls. They run when
-# KISEKI_TEST_HEAVY=1 (as `kiseki experiment run NAME --set ...` would), and are skipped, with
-# this reason shown, otherwise.
-HEAVY = ("exp1-corridor", "exp2-turn", "layouts-exp2-exp3")
 
 
+# A control declared as taking minutes (the teaching routes': 47-146 s each on an idle core,
+# 257 s together, more than the suite's budget for all controls) runs when KISEKI_TEST_HEAVY=1
+# and is skipped, with this reason shown, otherwise.
 heavy = pytest.mark.skipif(
     os.environ.get("KISEKI_TEST_HEAVY") != "1",
-    reason="a teaching-route control (minutes); set KISEKI_TEST_HEAVY=1 to run it",
+    reason="a control that takes minutes; set KISEKI_TEST_HEAVY=1 to run it",
 )
 
 
 def _cases():
     for name, experiment in sorted(all_experiments().items()):
         for control, specs in control_groups(name).items():
-            marks = [heavy] if name in HEAVY else []
+            marks = [heavy] if control.minutes else []
             yield pytest.param(name, control, specs, id=f"{name}:{control.name}", marks=marks)
         del experiment
 
