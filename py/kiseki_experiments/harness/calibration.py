@@ -13,27 +13,14 @@ from pathlib import Path
 from typing import Any
 
 from kiseki._support.yaml import read_yaml_file
+from kiseki.sim.calibration import value_at
 from kiseki_experiments.harness.base import Experiment
 from kiseki_experiments.harness.paths import WORLDS
 
-__all__ = ["RELATIVE", "calibration_conflicts", "calibrations", "resolve", "scenes_of"]
+__all__ = ["RELATIVE", "calibration_conflicts", "calibrations", "scenes_of"]
 
 RELATIVE = 0.005
 """Numbers within 0.5 % of each other count as the same number."""
-
-
-def resolve(doc: Any, dotted: str) -> Any:
-    """The value at a dotted key path (``robots.0.odometry_errors``: a list's item by index);
-    a KeyError naming the first part that is not there."""
-    at = doc
-    for part in dotted.split("."):
-        if isinstance(at, list) and part.isdigit() and int(part) < len(at):
-            at = at[int(part)]
-        elif isinstance(at, dict) and part in at:
-            at = at[part]
-        else:
-            raise KeyError(f"{dotted}: no {part!r} in the scene")
-    return at
 
 
 def calibrations(scene: str | Path) -> list[dict[str, Any]]:
@@ -44,9 +31,11 @@ def calibrations(scene: str | Path) -> list[dict[str, Any]]:
         raise ValueError(f"{scene}: calibrated must be a list of marks")
     for mark in marks:
         try:
-            resolve(doc, str(mark["parameter"]))
-        except KeyError as err:
-            raise ValueError(f"{scene}: calibrated: {err.args[0]}") from None
+            value_at(doc, str(mark["parameter"]))
+        except KeyError as missing:
+            raise ValueError(
+                f"{scene}: calibrated: {mark['parameter']}: no {missing.args[0]!r} in the scene"
+            ) from None
     return marks
 
 
