@@ -90,6 +90,26 @@ TEST(BoxWorld, BvhCastEqualsLinearScanOverAllBoxes) {
   EXPECT_THROW(BoxWorld({bad}), std::invalid_argument);
 }
 
+TEST(BoxWorld, AxisAlignedBoxesAndAxisParallelRaysEqualTheLinearScan) {
+  // walls and furniture are mostly axis-aligned (the cast skips their rotation), and a camera's
+  // centre rays or a laser along a corridor have direction components of exactly +-0
+  std::vector<Box> boxes = random_boxes(5, 200);
+  for (std::size_t i = 0; i < boxes.size(); i += 2) boxes[i].rotation.setIdentity();
+  const BoxWorld world(boxes);
+  Random r(6);
+  for (int i = 0; i < 3000; ++i) {
+    const Eigen::Vector3d o(r.uniform(-6, 6), r.uniform(-6, 6), r.uniform(-1, 3));
+    Eigen::Vector3d d = random_direction(r);
+    if (i % 3 == 0) d[i % 2] = (i % 4 == 0) ? 0.0 : -0.0;
+    if (i % 5 == 0) d[2] = -0.0;
+    d.normalize();
+    if (i % 7 == 0) d = Eigen::Vector3d::Unit(i % 3) * ((i % 2) ? -1.0 : 1.0);
+    double ref = 12.0;
+    for (const Box& b : boxes) ref = std::min(ref, b.intersect(o, d));
+    ASSERT_EQ(world.cast(o, d, 12.0), ref) << i;  // bit for bit
+  }
+}
+
 TEST(BoxWorld, RasterizeBandSeesOnlyWhatIsInTheBand) {
   Box leg, top;
   leg.center = {1.0, 1.0, 0.35};
@@ -162,6 +182,74 @@ TEST(OctreeWorld, VoxelisedBoxesCastWithinAVoxelAndRoundTripThroughBt) {
   std::fclose(g);
   EXPECT_THROW(OctreeWorld::read_binary(path + ".txt"), std::runtime_error);
   EXPECT_THROW(OctreeWorld::read_binary("/nonexistent/x.bt"), std::runtime_error);
+}
+
+TEST(DepthCamera, BoxWorldImageEqualsOneCastPerPixel) {
+  // the box world is rendered per tile against the boxes projected there, each clipped at half
+  // the minimum range; the reference casts every pixel's ray against the whole world, as the
+  // image's definition says. Cameras anywhere among the boxes, inside one, and 0.01-0.4 m from
+  // a box's face (where the clipping must not hide it), with minimum ranges 0.3 m and 0.
+  std::vector<Box> boxes = random_boxes(7, 120);
+  for (std::size_t i = 0; i < boxes.size(); i += 3) boxes[i].rotation.setIdentity();
+  const BoxWorld world(boxes);
+  Random r(8);
+  int hits = 0, frames = 0;
+  for (const double min_range : {0.3, 0.0}) {
+    const auto cam = PinholeCamera::from_fov(61, 37, 1.2, 0.9, min_range, 6.0);
+    for (int k = 0; k < 90; ++k, ++frames) {
+      Eigen::Vector3d origin(r.uniform(-6, 6), r.uniform(-6, 6), r.uniform(-0.5, 2.5));
+      const Box& near = boxes[static_cast<std::size_t>(k) % boxes.size()];
+      if (k % 3 == 1) origin = near.center;  // inside a box
+      if (k % 3 == 2) {  // in front of a face, looking anywhere
+        const double gap = 0.01 + 0.13 * (k % 4);
+        origin = near.center + near.rotation.col(k % 3) * (near.half_size[k % 3] + gap);
+      }
+      const Eigen::Quaterniond q(Eigen::AngleAxisd(r.uniform(-kPi, kPi), random_direction(r)));
+      const cv::Mat depth = render_depth(world, Pose3(origin, q), cam);
+      const Eigen::Matrix3d rot = q.toRotationMatrix();
+      for (int v = 0; v < cam.height; ++v) {
+        for (int u = 0; u < cam.width; ++u) {
+          const Eigen::Vector3d ray((u + 0.5 - cam.cx) / cam.fx, (v + 0.5 - cam.cy) / cam.fy,
+                                    1.0);
+          const double norm = ray.norm();
+          const double z = world.cast(origin, rot * (ray / norm), cam.max_range * norm) / norm;
+          const float expected =
+              (z >= cam.min_range && z < cam.max_range) ? static_cast<float>(z) : 0.f;
+          ASSERT_EQ(depth.at<float>(v, u), expected) << k << " " << u << " " << v;
+          hits += expected > 0.f;
+        }
+      }
+    }
+  }
+  EXPECT_GT(hits, frames * 61 * 37 / 10);  // the scenes are seen, not empty
+  // small boxes just before, across and beyond the minimum range (where a clipping plane too
+  // far out would drop them and show the wall behind), and one beside the camera
+  for (const double min_range : {0.3, 0.0}) {
+    const auto cam = PinholeCamera::from_fov(40, 30, 1.2, 0.9, min_range, 6.0);
+    for (double z = 0.02; z < 0.8; z += 0.04) {
+      Box wall, small, side;
+      wall.center = {0.0, 0.0, 3.0};
+      wall.half_size = {5.0, 5.0, 0.1};
+      small.center = {0.1 * z, -0.05, z};
+      small.half_size = {0.03, 0.03, 0.01};
+      side.center = {0.2 + z, 0.0, 0.0};
+      side.half_size = {0.1, 0.3, 0.3};
+      const BoxWorld few({wall, small, side});
+      const cv::Mat depth = render_depth(few, Pose3(), cam);
+      for (int v = 0; v < cam.height; ++v) {
+        for (int u = 0; u < cam.width; ++u) {
+          const Eigen::Vector3d ray((u + 0.5 - cam.cx) / cam.fx, (v + 0.5 - cam.cy) / cam.fy,
+                                    1.0);
+          const double norm = ray.norm();
+          const double d = few.cast(Eigen::Vector3d::Zero(), ray / norm, cam.max_range * norm);
+          const float expected =
+              (d / norm >= cam.min_range && d / norm < cam.max_range) ? static_cast<float>(d / norm)
+                                                                      : 0.f;
+          ASSERT_EQ(depth.at<float>(v, u), expected) << z << " " << u << " " << v;
+        }
+      }
+    }
+  }
 }
 
 TEST(DepthCamera, FlatWallGivesConstantZDepth) {

@@ -69,6 +69,8 @@ BoxWorld::BoxWorld(std::vector<Box> boxes) : boxes_(std::move(boxes)) {
       throw std::invalid_argument("BoxWorld: box rotation must be orthonormal");
     }
   }
+  axis_aligned_.reserve(boxes_.size());
+  for (const Box& b : boxes_) axis_aligned_.push_back(b.rotation == Eigen::Matrix3d::Identity());
   order_.resize(boxes_.size());
   std::iota(order_.begin(), order_.end(), 0);
   bounds_.setEmpty();
@@ -102,6 +104,27 @@ int BoxWorld::build(int first, int count) {
   return index;
 }
 
+double BoxWorld::intersect(int box, const Eigen::Vector3d& origin,
+                           const Eigen::Vector3d& direction, const Eigen::Vector3d& inv_direction,
+                           double t_max) const {
+  const Box& b = boxes_[box];
+  const Eigen::AlignedBox3d local(-b.half_size, b.half_size);
+  if (axis_aligned_[box]) return ray_aabb(origin - b.center, inv_direction, local, t_max);
+  const Eigen::Vector3d o = b.rotation.transpose() * (origin - b.center);
+  const Eigen::Vector3d d = b.rotation.transpose() * direction;
+  return ray_aabb(o, d.cwiseInverse(), local, t_max);
+}
+
+double BoxWorld::cast_among(const int* candidates, std::size_t count,
+                           const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                           const Eigen::Vector3d& inv_direction, double max_range) const {
+  double best = max_range;
+  for (std::size_t i = 0; i < count; ++i) {
+    best = std::min(best, intersect(candidates[i], origin, direction, inv_direction, best));
+  }
+  return best;
+}
+
 double BoxWorld::cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                       double max_range) const {
   if (!origin.allFinite() || !direction.allFinite() || std::abs(direction.norm() - 1.0) > 1e-6) {
@@ -110,20 +133,34 @@ double BoxWorld::cast(const Eigen::Vector3d& origin, const Eigen::Vector3d& dire
   if (nodes_.empty()) return max_range;
   const Eigen::Vector3d inv_d = direction.cwiseInverse();
   double best = max_range;
-  int stack[128];
+  // (node, entry distance) pairs; the depth of a median-split tree of 2^31 boxes is 31, and
+  // each level pushes at most two
+  std::pair<int, double> stack[128];
   int top = 0;
-  stack[top++] = 0;
+  const double t_root = ray_aabb(origin, inv_d, nodes_[0].box, best);
+  if (t_root < best) stack[top++] = {0, t_root};
   while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (ray_aabb(origin, inv_d, node.box, best) >= best) continue;
+    const auto [index, entry] = stack[--top];
+    if (entry >= best) continue;  // a nearer hit was found after this node was pushed
+    const Node& node = nodes_[index];
     if (node.left < 0) {
       for (int i = node.first; i < node.first + node.count; ++i) {
-        best = std::min(best, boxes_[order_[i]].intersect(origin, direction));
+        // a box entered before best gives Box::intersect's value; one entered beyond it
+        // gives +inf (ray_aabb's t_max), which changes no minimum
+        best = std::min(best, intersect(order_[i], origin, direction, inv_d, best));
       }
-    } else {
-      stack[top++] = node.left;
-      stack[top++] = node.right;
+      continue;
     }
+    const double t_left = ray_aabb(origin, inv_d, nodes_[node.left].box, best);
+    const double t_right = ray_aabb(origin, inv_d, nodes_[node.right].box, best);
+    // the farther child below the nearer one, so the nearer is visited first
+    const bool left_first = t_left <= t_right;
+    const std::pair<int, double> near{left_first ? node.left : node.right,
+                                      left_first ? t_left : t_right};
+    const std::pair<int, double> far{left_first ? node.right : node.left,
+                                     left_first ? t_right : t_left};
+    if (far.second < best) stack[top++] = far;
+    if (near.second < best) stack[top++] = near;
   }
   return best;
 }

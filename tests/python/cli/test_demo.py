@@ -21,11 +21,12 @@ from kiseki_experiments.mapping.corridor_scans import CorridorLaser, simulate_sc
 
 
 def test_demo_teaches_and_plays_back_every_method(tmp_path, project_root):
-    """Above 20 s (80 s with the machine loaded): the demo runs twice, the second time as the
-    check that the same seed gives the same runs, and each run is a teaching and a playback
-    per method on the thesis' route (whose waypoints are checked). Profiled, 71 % of it is the
-    depth cameras' rendering in the C++ core and 14 % the filter (300 particles): no smaller
-    setting of the demo keeps what is checked."""
+    """Above 20 s (about 27 s beside another test; 12 s per run alone): the demo runs twice,
+    the second time as the check that the same seed gives the same runs, and each run is a
+    teaching and a playback per method on the thesis' route (whose waypoints are checked).
+    Profiled, 47 % of a run is the two depth cameras at 30 Hz (their images and the disparity
+    noise) and 13 % the filter (300 particles): no smaller setting of the demo keeps what is
+    checked."""
     scene = project_root / "data" / "worlds" / "factory_turn.yaml"
     summary = run_demo(scene, tmp_path / "a", seed=3, console=Console(quiet=True), particles=300)
     for name in (

@@ -95,11 +95,11 @@ def test_route_aisle_widths_and_what_lies_behind_as_stated(scenes):
 
 
 def test_the_experiment_runs_on_two_layouts_and_writes_the_table(tmp_path):
-    """Above 20 s (about 55 s on an idle core): two layouts is the fewest a share of layouts
-    is taken over, and each layout's run is one teaching and four playbacks (exp2-turn's
-    conventional and proposal 2, the two methods of its main claims; exp3-boxes' with its
-    boxes and without them), whose cost is the depth cameras' rendering (in the C++ core),
-    not the particle count (100)."""
+    """Above 20 s (about 24 s beside another test): two layouts is the fewest a share of
+    layouts is taken over, and each layout's run is one teaching and four playbacks
+    (exp2-turn's conventional and proposal 2, the two methods of its main claims; exp3-boxes'
+    with its boxes and without them), whose cost is the simulated sensors at their rates (the
+    depth cameras at 30 Hz first), not the particle count (100)."""
     from kiseki_experiments.harness.runner import run_experiment
 
     result = run_experiment(

@@ -37,10 +37,10 @@ def test_merge_rules_of_the_thesis():
 
 
 def test_teach_recover_and_playback(tmp_path, project_root):
-    """Near 20 s with two workers: one teaching of the corridor, its recovery from the run log
-    and two playbacks (to the goal and back home), each rendering the depth cameras in the C++
-    core. The four are what is checked (the recovered maps equal the online ones, the stop at
-    the goal, the way home), so none can go."""
+    """About 11 s with two workers: one teaching of the corridor, its recovery from the run
+    log and two playbacks (to the goal and back home), each simulating the depth cameras.
+    The four are what is checked (the recovered maps equal the online ones, the stop at the
+    goal, the way home), so none can go."""
     scene_file = project_root / "data" / "worlds" / "factory_corridor.yaml"
     taught = teach(load_scene(scene_file), tmp_path / "t", seed=5)
     assert [m["name"] for m in taught.marks] == ["P0", "P1", "P2"]
