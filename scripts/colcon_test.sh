@@ -10,16 +10,20 @@
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 ws="${1:?usage: colcon_test.sh WORKSPACE}"
-mkdir -p "$ws/src"
+mkdir -p "$ws"
 ws="$(cd "$ws" && pwd)"
-ln -sfn "$root" "$ws/src/kiseki"
 export COLCON_HOME="$ws/.colcon"
 export CMAKE_BUILD_PARALLEL_LEVEL="${CMAKE_BUILD_PARALLEL_LEVEL:-2}"
+# colcon builds with -jN -lN (N cores) unless MAKEFLAGS sets the jobs; the load limit held the
+# build to one job at a time after the set-up's compile had raised the load average
+export MAKEFLAGS="-j$CMAKE_BUILD_PARALLEL_LEVEL"
 cd "$ws"
 
 fail() { echo "colcon_test: $*" >&2; exit 1; }
 
-colcon build --base-paths src \
+# the package by its own path (not a link in src/), so the compiler sees the same paths as the
+# editable install's build and the compiler cache (scripts/setup.sh) serves the library from it
+colcon build --base-paths "$root" \
   --cmake-args -DCMAKE_BUILD_TYPE=Release -DKISEKI_WARNINGS_AS_ERRORS=ON -GNinja >/dev/null 2>&1 ||
   { cat "$ws"/log/latest_build/kiseki/stdout_stderr.log >&2; fail "colcon build failed"; }
 [ -f install/kiseki/lib/libkiseki_core.a ] || fail "install/kiseki/lib/libkiseki_core.a missing"
@@ -27,7 +31,7 @@ colcon build --base-paths src \
   fail "install/kiseki/include/kiseki/grid/ray_casting.hpp missing"
 
 # ctest runs the suites two at a time (each test is its own process)
-colcon test --base-paths src --ctest-args -j "$CMAKE_BUILD_PARALLEL_LEVEL" --timeout 300 >/dev/null ||
+colcon test --base-paths "$root" --ctest-args -j "$CMAKE_BUILD_PARALLEL_LEVEL" --timeout 300 >/dev/null ||
   fail "colcon test failed"
 summary="$(colcon test-result --test-result-base build --all --verbose)" ||
   { echo "$summary" >&2; fail "C++ tests failed"; }

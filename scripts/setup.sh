@@ -7,7 +7,8 @@
 #   2. .venv/ at the project root with the build tools and Python dependencies;
 #   3. kiseki installed editable into .venv, again only when C++/CMake sources changed or a
 #      Python module was added, moved or removed.
-# A second run does no download and no compilation when nothing changed.
+# A second run does no download and no compilation when nothing changed. C++ builds go through
+# ccache (its cache in build/ccache).
 set -euo pipefail
 
 KISEKI_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -22,6 +23,7 @@ APT_PACKAGES=(
   libgtest-dev googletest
   chromium  # the serve page's browser tests (Playwright drives it; it downloads no browser)
   clang libclang-rt-dev  # libFuzzer targets of the C++ readers (tests/fuzz/cpp)
+  ccache  # the compiler cache every build here goes through (below)
 )
 
 log() { printf '[setup] %s\n' "$*" >&2; }
@@ -85,5 +87,12 @@ PY
 }
 
 install_debian_packages
+# Every C++ build goes through a compiler cache kept in build/ccache: scripts/test.sh's colcon
+# build compiles the library's sources with the same compiler, flags and paths as the editable
+# install and takes them from the cache, and a rebuild compiles only what changed.
+export CCACHE_DIR="${CCACHE_DIR:-$KISEKI_ROOT/build/ccache}"
+export CCACHE_MAXSIZE="${CCACHE_MAXSIZE:-2G}"
+export CMAKE_CXX_COMPILER_LAUNCHER="${CMAKE_CXX_COMPILER_LAUNCHER:-ccache}"
+export CXX="${CXX:-g++}"
 setup_venv
 export PATH="$KISEKI_VENV/bin:$PATH"
