@@ -467,7 +467,7 @@ DEAD_RECKONING = Control(
     overrides=("particles=1",),
     runs=5,
     why="without the update the estimate drifts with the odometry: the stops miss P2",
-    minutes=True,  # 5 playbacks of the corridor: 47 s on an idle core
+    # 5 playbacks of the corridor: 18 s beside another test (47 s before the tiled depth cast)
 )
 EXP1_CLAIMS = (
     ClaimSpec(
@@ -559,7 +559,7 @@ ALL_CONVENTIONAL = Control(
     ),
     runs=5,
     why="every method is conventional's run on the same seed: every difference is 0",
-    minutes=True,  # a teaching and 15 playbacks of the turn route: 65 s on an idle core
+    # a teaching and 15 playbacks of the turn route: 25 s beside another test
 )
 WITHIN_MARGIN = 0.2  # one run in five more within 0.1 m
 WITHIN_WHY = (

@@ -23,9 +23,9 @@ from kiseki_experiments.harness.verdict import Control, Criterion
 RECORDED = ("carmen-maps", "mcl-")
 
 
-# A control declared as taking minutes (the teaching routes': 47-146 s each on an idle core,
-# 257 s together, more than the suite's budget for all controls) runs when KISEKI_TEST_HEAVY=1
-# and is skipped, with this reason shown, otherwise.
+# A control declared as taking minutes (layouts-exp2-exp3's: six layouts taught and played
+# back, 63 s beside another test, more than the suite's budget for one control) runs when
+# KISEKI_TEST_HEAVY=1 and is skipped, with this reason shown, otherwise.
 heavy = pytest.mark.skipif(
     os.environ.get("KISEKI_TEST_HEAVY") != "1",
     reason="a control that takes minutes; set KISEKI_TEST_HEAVY=1 to run it",
