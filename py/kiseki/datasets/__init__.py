@@ -2,8 +2,9 @@
 # Copyright (c) 2026 the kiseki authors
 """Readers for recorded robot data: CARMEN logs, ROS 1 and ROS 2 bags, kiseki's simulated runs
 (MCAP), the CMU Wean Hall map, and magnetic-field samples (CSV, Aalto robot runs, Kok-Solin
-walks). ``open_scans`` gives the laser scans of any supported log through one interface;
-``read_magnetic_data`` the samples of any supported magnetic recording."""
+walks); and unknown obstacles added to a recorded log (``occlude_scans``). ``open_scans`` gives
+the laser scans of any supported log through one interface; ``read_magnetic_data`` the samples
+of any supported magnetic recording."""
 
 from __future__ import annotations
 
@@ -21,6 +22,7 @@ from kiseki.datasets.magnetic import (
     read_magnetic_data,
 )
 from kiseki.datasets.rosbag import BAG_KINDS, is_ros_bag, read_bag_scans, write_bag
+from kiseki.datasets.unknown_obstacles import UnknownObstacles, occlude_scans
 from kiseki.datasets.wean import WeanMap, read_wean_map
 from kiseki.datasets.wean_log import WeanLog, is_wean_log, read_wean_log
 from kiseki.errors import LogFormatError
@@ -34,11 +36,13 @@ __all__ = [
     "LaserScans",
     "MagneticSamples",
     "OdometryRecords",
+    "UnknownObstacles",
     "WeanLog",
     "WeanMap",
     "concatenate_samples",
     "is_ros_bag",
     "is_wean_log",
+    "occlude_scans",
     "read_aalto_run",
     "read_bag_scans",
     "read_carmen_log",

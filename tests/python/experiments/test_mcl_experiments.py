@@ -2,18 +2,29 @@
 # Copyright (c) 2026 the kiseki authors
 """The localization engine's experiments with few trials: the kidnapped robot in simulation
 (resetting recovers, the reliability estimate falls without recovery), the log splice, and
-excursions of the space observation model on a real log."""
+excursions of the space observation model on a real log, and unknown obstacles added to one."""
 
 from __future__ import annotations
 
+import dataclasses
+import re
+
 import numpy as np
 import pandas as pd
+import pytest
 
-from kiseki.core import Pose2
+from kiseki.core import Pose2, derive_seed
+from kiseki.datasets import read_carmen_log
+from kiseki.filters import LocalizeConfig, localize
+from kiseki.grid import OccupancyGrid
+from kiseki.mapping import MapBuildConfig, map_of_log
+from kiseki.metrics import ape
 from kiseki.scans import LaserScans
 from kiseki_experiments.harness.runner import run_experiment
 from kiseki_experiments.mcl.mcl_excursions import excursions
 from kiseki_experiments.mcl.mcl_kidnapping import splice
+from kiseki_experiments.mcl.mcl_unknown_obstacles import UnknownObstaclesConfig, place_obstacles
+from kiseki_experiments.mcl.mcl_unknown_obstacles import preflight as unknown_obstacles_preflight
 
 
 def test_splice_carries_the_robot_and_keeps_the_odometry_smooth() -> None:
@@ -89,3 +100,83 @@ def test_kld_adapts_the_count_from_global_start_to_tracking(shared_data, tmp_pat
     assert table.loc["fixed", "mean_particles"] == 20000
     assert table.loc["kld", "mean_particles"] < 0.2 * table.loc["fixed", "mean_particles"]
     assert table.loc["kld", "converged"] == table.loc["fixed", "converged"] == 1
+
+
+def test_unknown_obstacles_keep_clear_of_the_route_and_on_known_free_cells() -> None:
+    cells = np.full((200, 300), -1, np.int8)  # 30 x 20 m at 0.1 m, unknown
+    cells[40:160, 20:280] = 0  # a free hall of 26 x 12 m
+    cells[95:105, 100:140] = 100  # a wall inside it
+    grid = OccupancyGrid(cells, 0.1, Pose2(0.0, 0.0, 0.0))
+    x = np.linspace(3.0, 27.0, 241)
+    poses = np.column_stack([x, np.full_like(x, 7.0), np.zeros_like(x)])
+    obstacles = place_obstacles(poses, grid, 4.0, seed=11, clearance=0.5, band=3.0)
+    assert len(obstacles) == 10  # 4 per 10 m of a 24 m route
+    centres, reach = obstacles.reach()
+    # brute force: every laser pose at least the clearance from every obstacle's bounding circle
+    gap = np.hypot(*(centres[:, None, :] - poses[None, :, :2]).transpose(2, 0, 1)) - reach[:, None]
+    assert gap.min() >= 0.5
+    for c, r in zip(centres, reach, strict=True):
+        lo, hi = np.floor((c - r) / 0.1).astype(int), np.floor((c + r) / 0.1).astype(int)
+        assert (cells[lo[1] : hi[1] + 1, lo[0] : hi[0] + 1] == 0).all()
+    again = place_obstacles(poses, grid, 4.0, seed=11, clearance=0.5, band=3.0)
+    np.testing.assert_array_equal(again.reach()[0], centres)
+    assert not np.array_equal(
+        place_obstacles(poses, grid, 4.0, seed=12, clearance=0.5, band=3.0).reach()[0], centres
+    )
+
+
+def test_unknown_obstacles_on_a_real_log_cut_more_beams_as_they_grow_denser(
+    shared_data, tmp_path
+) -> None:
+    run = run_experiment(
+        "mcl-unknown-obstacles",
+        runs=1,
+        seed=0,
+        overrides=[
+            "logs=intel-corrected",
+            "max_scans=300",
+            "particles=200",
+            "methods=likelihood-field,odometry",
+            "densities=0,4,16",
+        ],
+        out=tmp_path / "u",
+        progress=False,
+    )
+    assert run.failed == 0
+    table = pd.read_csv(run.run_dir / "tables" / "per_density.csv")
+    lf = table[
+        (table["method"] == "likelihood-field") & (table["recovery"] == "resetting")
+    ].set_index("obstacles_per_10m")
+    assert lf.loc[0.0, "beams_cut"] == 0.0 and lf.loc[0.0, "obstacles"] == 0
+    assert 0 < lf.loc[4.0, "beams_cut"] < lf.loc[16.0, "beams_cut"]
+    # without obstacles the run is the plain tracking of the log (the same seed, the same scans)
+    scans = read_carmen_log(shared_data / "carmen" / "intel-corrected.log.gz").scans.first(300)
+    config = LocalizeConfig(
+        method="likelihood-field",
+        seed=derive_seed(0, 0),
+        particles=200,
+        odometry_noise=0.1,
+        recovery="resetting",
+        threads=1,
+    )
+    plain = localize(scans, map_of_log(scans, MapBuildConfig(0.05)), config)
+    assert lf.loc[0.0, "rmse_mean_m"] == pytest.approx(ape(plain.estimates, scans.poses).rmse)
+    odo = table[table["method"] == "odometry"].set_index("obstacles_per_10m")["rmse_mean_m"]
+    assert odo.nunique() == 1  # the odometry does not see the obstacles
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"densities": [1.0, 2.0]}, "densities must start at 0"),
+        ({"densities": [0.0, 2.0, 2.0]}, "densities must start at 0 (the reference) and rise"),
+        ({"recoveries": ["sometimes"]}, "recoveries must be among"),
+        ({"recoveries": []}, "recoveries must be among"),
+        ({"band": 0.4}, "band must exceed clearance"),
+        ({"methods": ["beam"]}, "include likelihood-field"),
+    ],
+)
+def test_unknown_obstacles_refuses_a_sweep_it_cannot_judge(changes, message) -> None:
+    config = dataclasses.replace(UnknownObstaclesConfig(), **changes)
+    with pytest.raises(ValueError, match=re.escape(message)):
+        unknown_obstacles_preflight(config)
