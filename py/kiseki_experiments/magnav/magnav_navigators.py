@@ -63,8 +63,6 @@ class NavigatorsConfig:
     landmark_free_from: Real = 20.0  # m: the stretch without buildings (scene header)
     landmark_free_to: Real = 95.0
     disturbed: PositiveReal = 0.02  # G: a node whose mz is this far from the median is disturbed
-    thesis_leave_m: PositiveReal = 60.0  # the thesis' odometry navigator left after about 60 m
-    leave_tolerance: PositiveReal = 15.0  # m: "about 60 m" holds within this
 
 
 def _cut_scene(config: NavigatorsConfig, folder: Path) -> tuple[Path, np.ndarray]:

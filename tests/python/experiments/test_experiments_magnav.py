@@ -61,8 +61,11 @@ def test_table_4_2_filter_beats_odometry_and_claims_follow_the_table(table):
     assert none["final_err_m"] == pytest.approx(0.0057 * 30.0, rel=0.25)
     # the scene's tyres were fitted to the thesis' 0.678 m: a table row, no claim
     assert list(rows["thesis_value_is"]) == [CALIBRATED, "compared", "compared"]
-    marks = {m["fitted_to"] for m in load_scene(Table42Config().scene).calibrated}
-    assert marks == {0.678}
+    calibrated = load_scene(Table42Config().scene).calibrated
+    marks = {m["fitted_to"] for m in calibrated}
+    assert {m["fitted_to"] for m in calibrated if m["parameter"].endswith("radius_error")} == {
+        0.678
+    }
     assert all(c.criterion.paper_number not in marks for c in CLAIMS)
     claims = _claims(table)
     assert list(claims.index) == [c.claim for c in CLAIMS]
