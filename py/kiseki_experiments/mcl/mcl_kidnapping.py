@@ -48,6 +48,7 @@ from kiseki.filters import (
 from kiseki.grid import OccupancyGrid
 from kiseki.io.runlog import read_run
 from kiseki.mapping import MapBuildConfig, map_of_log
+from kiseki.metrics import area_under_roc
 from kiseki.plots import new_figure
 from kiseki.scans import LaserScans
 from kiseki.sim.run import SimConfig, simulate
@@ -242,6 +243,9 @@ def _reliability_record(arm: str, result, errors, headings, seam: int) -> dict:
         out[f"{arm}_{name}low_within_10"] = bool((rel[window] < 0.5).any())
         out[f"{arm}_{name}tracking_high"] = int((rel[tracking] > 0.9).sum())
     out[f"{arm}_agreement_reliability_after"] = float(result.agreement_reliability[window].mean())
+    out[f"{arm}_agreement_reliability"] = [
+        round(float(r), 3) for r in result.agreement_reliability[seam - 20 :]
+    ]
     return out
 
 
@@ -309,6 +313,9 @@ def analyze(config: KidnapConfig, trials: pd.DataFrame, timings: pd.DataFrame, f
             }
         )
     table = pd.DataFrame(rows)
+    tables = {"recovery": table}
+    if "none" in config.recoveries:
+        tables["reliability_auc"] = _auc_table(ok)
     by = table.set_index("recovery")
     evidence = []
     if "resetting" in by.index:
@@ -360,7 +367,7 @@ def analyze(config: KidnapConfig, trials: pd.DataFrame, timings: pd.DataFrame, f
         f"{config.recover_hold} updates. Reliability: the engine's estimate (the recent share "
         "of updates whose scan agrees with the map seen from the particles)."
     )
-    return Analysis(tables={"recovery": table}, figures=[path], notes=notes, evidence=evidence)
+    return Analysis(tables=tables, figures=[path], notes=notes, evidence=evidence)
 
 
 def _reliability_shares(ok: pd.DataFrame, arm: str) -> dict:
@@ -374,6 +381,20 @@ def _reliability_shares(ok: pd.DataFrame, arm: str) -> dict:
         high = ok[f"{arm}_{name}tracking_high"].sum()
         out[f"{name}high_when_tracking"] = float(high / updates) if updates else None
     return out
+
+
+def _auc_table(ok: pd.DataFrame) -> pd.DataFrame:
+    """Per source (simulation or log), the area under the ROC curve of 1 - reliability for
+    "error above 1 m" over the none arm's recorded updates (from 20 before the jump on)."""
+    rows = []
+    for source, group in ok.groupby("source", sort=True):
+        errors = np.concatenate([np.asarray(e) for e in group["none_errors"]])
+        row = {"source": source, "updates": len(errors), "share_lost": float((errors > 1).mean())}
+        for name in ("", "agreement_"):
+            rel = np.concatenate([np.asarray(r) for r in group[f"none_{name}reliability"]])
+            row[f"{name}auc"] = area_under_roc(1.0 - rel, errors > 1.0)
+        rows.append(row)
+    return pd.DataFrame(rows)
 
 
 def _reliability_evidence(ok: pd.DataFrame) -> list[Evidence]:

@@ -14,6 +14,7 @@ import pytest
 
 from kiseki.filters import LEARNED_RELIABILITY, LocalizeConfig, ReliabilityModel
 from kiseki.filters.reliability import fit_logistic
+from kiseki.metrics import area_under_roc
 from kiseki_experiments.mcl.mcl_reliability import FIT_SEEDS, pooled
 
 HELD_OUT_SEEDS = (201, 202, 203, 204)
@@ -69,14 +70,6 @@ def test_a_miscalibrated_estimate_fails_the_same_check(held_out, control) -> Non
     assert calibration_problems(predicted, held_out.localised) != []
 
 
-def area_under_roc(score: np.ndarray, positive: np.ndarray) -> float:
-    """P(score of a positive > score of a negative), ties counted half (Mann-Whitney U)."""
-    pos, neg = np.sort(score[positive]), np.sort(score[~positive])
-    below = np.searchsorted(neg, pos, side="left")
-    ties = np.searchsorted(neg, pos, side="right") - below
-    return float((below + 0.5 * ties).sum() / (len(pos) * len(neg)))
-
-
 def test_the_learned_estimate_tells_lost_from_localised(held_out) -> None:
     """Calibration alone is met by a constant (the share localised); the estimate must also
     rank the updates: area under the ROC curve >= 0.95, where the constant has 0.5."""
@@ -87,14 +80,18 @@ def test_the_learned_estimate_tells_lost_from_localised(held_out) -> None:
     assert area_under_roc(constant, labels) == 0.5
 
 
-def test_the_logistic_fit_matches_scikit_learn() -> None:
-    sklearn = pytest.importorskip("sklearn.linear_model")
+def test_the_logistic_fit_and_the_roc_area_match_scikit_learn() -> None:
+    from sklearn.linear_model import LogisticRegression  # only here: a slow import
+    from sklearn.metrics import roc_auc_score
+
     rng = np.random.default_rng(5)
     x = rng.normal(size=(2000, 2))
     y = rng.uniform(size=2000) < 1 / (1 + np.exp(-(0.5 + x @ [2.0, -1.0])))
     ours = fit_logistic(x, y)
-    theirs = sklearn.LogisticRegression(C=np.inf, tol=1e-10, max_iter=1000).fit(x, y)
+    theirs = LogisticRegression(C=np.inf, tol=1e-10, max_iter=1000).fit(x, y)
     np.testing.assert_allclose(ours, [*theirs.intercept_, *theirs.coef_[0]], atol=1e-4)
+    score = np.round(x[:, 0], 1)  # with ties
+    assert area_under_roc(score, y) == pytest.approx(roc_auc_score(y, score), abs=1e-12)
 
 
 def test_the_default_reliability_is_still_the_engines_and_bad_names_are_refused() -> None:
