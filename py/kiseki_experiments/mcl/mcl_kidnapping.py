@@ -419,6 +419,17 @@ def _reliability_evidence(ok: pd.DataFrame) -> list[Evidence]:
     ]
 
 
+def _issue_target(why: str) -> Criterion:
+    """A share of at least 0.95, the issue's target for recovery and reliability."""
+    return Criterion(
+        paper_value=">= 0.95 (the issue's target)",
+        compare=">=",
+        threshold=0.95,
+        why=f"the issue's target: {why}",
+        bounds=(0.0, 1.0),
+    )
+
+
 def _claims(small: tuple[str, ...] = ()) -> tuple[ClaimSpec, ...]:
     """The claims; ``small`` adds overrides that keep a control's trials small (one log)."""
     return (
@@ -426,13 +437,7 @@ def _claims(small: tuple[str, ...] = ()) -> tuple[ClaimSpec, ...]:
             key="recovers",
             claim="with resetting, kidnapped trials recover (0.5 m, 10 deg, held 10 updates)",
             unit="share of trials",
-            criterion=Criterion(
-                paper_value=">= 0.95 (the issue's target)",
-                compare=">=",
-                threshold=0.95,
-                why="the issue's target: at most 1 kidnapping in 20 left unrecovered",
-                bounds=(0.0, 1.0),
-            ),
+            criterion=_issue_target("at most 1 kidnapping in 20 left unrecovered"),
             control=Control(
                 name="no recovery in the resetting arm",
                 overrides=("resetting_runs=none", "recoveries=resetting", *small),
@@ -465,13 +470,7 @@ def _claims(small: tuple[str, ...] = ()) -> tuple[ClaimSpec, ...]:
             claim="without recovery, the reliability falls below 0.5 within 10 updates of the "
             "jump in trials more than 1 m off",
             unit="share of trials more than 1 m off at each of the 10 updates",
-            criterion=Criterion(
-                paper_value=">= 0.95 (the issue's target)",
-                compare=">=",
-                threshold=0.95,
-                why="the issue's target: a lost robot says so within 10 updates in 19 of 20",
-                bounds=(0.0, 1.0),
-            ),
+            criterion=_issue_target("a lost robot says so within 10 updates in 19 of 20"),
             control=Control(
                 name="the learned estimate without its likelihood drop (agreement alone)",
                 overrides=("drop_weight=0", "recoveries=none", *small),
@@ -484,13 +483,7 @@ def _claims(small: tuple[str, ...] = ()) -> tuple[ClaimSpec, ...]:
             key="high_when_tracking",
             claim="the reliability is above 0.9 while the error is under 0.3 m (and 10 deg)",
             unit="share of updates within 0.3 m and 10 deg (no recovery)",
-            criterion=Criterion(
-                paper_value=">= 0.95 (the issue's target)",
-                compare=">=",
-                threshold=0.95,
-                why="the issue's target: a tracking robot is not called lost in 1 update of 20",
-                bounds=(0.0, 1.0),
-            ),
+            criterion=_issue_target("a tracking robot is not called lost in 1 update of 20"),
             control=Control(
                 name="the learned estimate's odds divided by e^2",
                 overrides=("odds_offset=-2", "recoveries=none", *small),
