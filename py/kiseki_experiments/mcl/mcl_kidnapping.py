@@ -367,7 +367,10 @@ def analyze(config: KidnapConfig, trials: pd.DataFrame, timings: pd.DataFrame, f
         f"{config.recover_hold} updates. Reliability: the engine's estimate (the recent share "
         "of updates whose scan agrees with the map seen from the particles)."
     )
-    return Analysis(tables=tables, figures=[path], notes=notes, evidence=evidence)
+    paths = [path]
+    if "none" in config.recoveries and len(ok):
+        paths.append(_roc_figure(ok, figures / "reliability_roc.png"))
+    return Analysis(tables=tables, figures=paths, notes=notes, evidence=evidence)
 
 
 def _reliability_shares(ok: pd.DataFrame, arm: str) -> dict:
@@ -383,18 +386,49 @@ def _reliability_shares(ok: pd.DataFrame, arm: str) -> dict:
     return out
 
 
+def _lost_and_scores(group: pd.DataFrame):
+    """The none arm's recorded updates (from 20 before the jump on) of some trials: whether
+    each is more than 1 m off, and 1 - reliability of each estimate (learned, engine's)."""
+    errors = np.concatenate([np.asarray(e) for e in group["none_errors"]])
+    scores = {
+        name: 1.0 - np.concatenate([np.asarray(r) for r in group[f"none_{name}reliability"]])
+        for name in ("", "agreement_")
+    }
+    return errors > 1.0, scores
+
+
 def _auc_table(ok: pd.DataFrame) -> pd.DataFrame:
     """Per source (simulation or log), the area under the ROC curve of 1 - reliability for
-    "error above 1 m" over the none arm's recorded updates (from 20 before the jump on)."""
+    "error above 1 m"."""
     rows = []
     for source, group in ok.groupby("source", sort=True):
-        errors = np.concatenate([np.asarray(e) for e in group["none_errors"]])
-        row = {"source": source, "updates": len(errors), "share_lost": float((errors > 1).mean())}
-        for name in ("", "agreement_"):
-            rel = np.concatenate([np.asarray(r) for r in group[f"none_{name}reliability"]])
-            row[f"{name}auc"] = area_under_roc(1.0 - rel, errors > 1.0)
+        lost, scores = _lost_and_scores(group)
+        row = {"source": source, "updates": len(lost), "share_lost": float(lost.mean())}
+        row |= {f"{name}auc": area_under_roc(score, lost) for name, score in scores.items()}
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def _roc_figure(ok: pd.DataFrame, path: Path) -> Path:
+    """ROC curves of both estimates for "error above 1 m", one panel per source."""
+    groups = list(ok.groupby("source", sort=True))
+    fig = new_figure(figsize=(3.2 * len(groups), 3.2), dpi=120)
+    axes = np.atleast_1d(fig.subplots(1, len(groups)))
+    for ax, (source, group) in zip(axes, groups, strict=True):
+        lost, scores = _lost_and_scores(group)
+        for (name, score), colour in zip(scores.items(), ("tab:blue", "tab:grey"), strict=True):
+            order = np.argsort(-score, kind="stable")
+            hit = np.concatenate([[0.0], np.cumsum(lost[order]) / max(lost.sum(), 1)])
+            false = np.concatenate([[0.0], np.cumsum(~lost[order]) / max((~lost).sum(), 1)])
+            label = f"{'engine' if name else 'learned'} {area_under_roc(score, lost):.3f}"
+            ax.plot(false, hit, color=colour, label=label)
+        ax.plot([0, 1], [0, 1], color="k", lw=0.6, ls=":")
+        ax.set_title(source, fontsize=8)
+        ax.set_xlabel("false alarms (share within 1 m)")
+        ax.legend(fontsize=7, loc="lower right")
+    fig.axes[0].set_ylabel("lost updates caught (> 1 m)")
+    fig.savefig(path, bbox_inches="tight")
+    return path
 
 
 def _reliability_evidence(ok: pd.DataFrame) -> list[Evidence]:

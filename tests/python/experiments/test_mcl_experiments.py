@@ -55,6 +55,7 @@ def test_kidnapped_robot_recovers_with_resetting_and_says_when_it_is_lost(tmp_pa
     # at least mean(0.9^1..0.9^10) = 0.586 even if no scan agrees; below 0.65, nearly none did
     assert table.loc["none", "reliability_after"] < 0.65
     assert (run.run_dir / "figures" / "kidnapping.png").stat().st_size > 10_000
+    assert (run.run_dir / "figures" / "reliability_roc.png").stat().st_size > 5_000
 
 
 def test_space_observation_excursions_return_on_a_real_log(shared_data, tmp_path) -> None:
