@@ -22,6 +22,7 @@ __all__ = [
     "StopError",
     "align_trajectory",
     "ape",
+    "area_under_roc",
     "as_se3",
     "rpe",
     "stop_error",
@@ -357,3 +358,18 @@ def wilson_interval(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
     centre = (p + z * z / (2 * n)) / (1 + z * z / n)
     half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
     return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+def area_under_roc(score, positive) -> float:
+    """Area under the ROC curve of ``score`` for the boolean ``positive``: the probability that
+    a positive scores above a negative, ties counted half (the Mann-Whitney U statistic over
+    n_pos n_neg). NaN when either class is empty."""
+    score, positive = np.asarray(score, dtype=float), np.asarray(positive, dtype=bool)
+    if score.shape != positive.shape or not np.isfinite(score).all():
+        raise ValueError("area_under_roc: need finite scores, one per label")
+    pos, neg = np.sort(score[positive]), np.sort(score[~positive])
+    if len(pos) == 0 or len(neg) == 0:
+        return float("nan")
+    below = np.searchsorted(neg, pos, side="left")
+    ties = np.searchsorted(neg, pos, side="right") - below
+    return float((below + 0.5 * ties).sum() / (len(pos) * len(neg)))

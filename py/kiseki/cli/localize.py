@@ -112,6 +112,13 @@ def localize_command(
         parser=Count("--threads", 0, THREAD_LIMIT, "0 = every core"),
         help=f"Threads of the filter (0 = every core; default {LocalizeConfig.threads}).",
     ),
+    reliability_estimate: str | None = typer.Option(
+        None,
+        "--reliability",
+        help="The CSV's reliability: agreement (the engine's recent share of scans that agree "
+        "with the map) or learned (a probability of being within 1 m and 10 deg, fitted on "
+        f"simulated updates); default {LocalizeConfig.reliability}; not with --global.",
+    ),
     global_start: bool = typer.Option(
         False,
         "--global",
@@ -154,6 +161,8 @@ def localize_command(
         for name, value in (("--tracking-particles", tracking_particles), ("--plot", plot)):
             if value is not None:
                 raise ValueError(f"{name} applies only with --global")
+    elif reliability_estimate is not None:
+        raise ValueError("--reliability applies only to tracking (not with --global)")
     if global_start and output.suffix.lower() == ".json":
         raise ValueError(f"{output}: the report goes to OUTPUT.json: give a .csv output")
     scans = open_scans(
@@ -169,7 +178,9 @@ def localize_command(
         result = global_localize(scans, grid, gconfig, progress=True)
         trajectory, reliability = result.estimates, result.reliability
     else:
-        config = LocalizeConfig(**_given(**shared, odometry_noise=odometry_noise))
+        config = LocalizeConfig(
+            **_given(**shared, odometry_noise=odometry_noise, reliability=reliability_estimate)
+        )
         if not scans.has_reference_poses:
             raise ValueError(f"{log}: the log has no reference poses to start from: use --global")
         saved_config = {"command": "localize", **config.to_dict()}

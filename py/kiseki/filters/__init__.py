@@ -31,6 +31,12 @@ from kiseki.filters.global_localization import (
     render_global,
     write_report,
 )
+from kiseki.filters.reliability import (
+    LEARNED_RELIABILITY,
+    RELIABILITY_ESTIMATES,
+    LearnedReliability,
+    ReliabilityModel,
+)
 from kiseki.filters.tracking import (
     LOCALIZATION_METHODS,
     LocalizationResult,
@@ -44,17 +50,21 @@ from kiseki.filters.tracking import (
 )
 
 __all__ = [
+    "LEARNED_RELIABILITY",
     "LOCALIZATION_METHODS",
     "REAL_ODOMETRY_ALPHAS",
     "RECOVERY_MODES",
+    "RELIABILITY_ESTIMATES",
     "RESAMPLING_METHODS",
     "ConvergenceReport",
     "GlobalConfig",
     "GlobalResult",
     "LocalizationResult",
+    "LearnedReliability",
     "LocalizeConfig",
     "MclConfig",
     "MonteCarloLocalizer",
+    "ReliabilityModel",
     "ScanFit",
     "ScanSpaceObservation",
     "convergence_report",

@@ -27,6 +27,12 @@ from tqdm import tqdm
 from kiseki import _core
 from kiseki.core import Pose2, Random, check_seed, derive_seed
 from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
+from kiseki.filters.reliability import (
+    LEARNED_RELIABILITY,
+    RELIABILITY_ESTIMATES,
+    LearnedReliability,
+    ReliabilityModel,
+)
 from kiseki.grid import OccupancyGrid
 from kiseki.mapping import scan_local_map
 from kiseki.scans import LaserScans, check_odometry_jumps
@@ -115,6 +121,9 @@ class LocalizeConfig:
     global_start: bool = False  # start uniformly over the map (no initial pose)
     resetting_injects: bool = MclConfig.resetting_injects  # Augmented MCL's injection
     likelihood_power: float = MclConfig.likelihood_power
+    # the `reliability` of the result: the engine's "agreement" or the "learned" probability
+    # (kiseki.filters.reliability)
+    reliability: str = "agreement"
 
     def __post_init__(self) -> None:
         _check(
@@ -151,6 +160,11 @@ class LocalizeConfig:
                 and all(a >= 0 and math.isfinite(a) for a in self.alphas),
                 f"alphas must be 4 (or 5) finite numbers >= 0, got {self.alphas}",
             )
+        _check(
+            self.reliability in RELIABILITY_ESTIMATES,
+            f"reliability must be one of {', '.join(RELIABILITY_ESTIMATES)}, "
+            f"got {self.reliability!r}",
+        )
         self.mcl(REAL_ODOMETRY_ALPHAS)  # the engine's checks, as ValueError
 
     def mcl(self, alphas: tuple[float, ...]) -> MclConfig:
@@ -254,6 +268,11 @@ class LocalizationResult:
         np.ndarray
     )  # (updates,) wall time of each update (motion + weighing + resampling)
     resets: np.ndarray  # (n,) str: none, expansion or sensor
+    # (n,) the engine's agreement-based estimate, whichever `reliability` holds
+    agreement_reliability: np.ndarray
+    # (n, 2) the learned estimate's features at each update (NaN elsewhere, and when
+    # config.reliability is "agreement")
+    reliability_features: np.ndarray
     config: LocalizeConfig = field(repr=False)
 
 
@@ -272,7 +291,11 @@ def _check_scans(scans: LaserScans, grid: OccupancyGrid) -> None:
 
 
 def localize(
-    scans: LaserScans, grid: OccupancyGrid, config: LocalizeConfig, progress: bool = False
+    scans: LaserScans,
+    grid: OccupancyGrid,
+    config: LocalizeConfig,
+    progress: bool = False,
+    reliability_model: ReliabilityModel = LEARNED_RELIABILITY,
 ) -> LocalizationResult:
     """Localization along a log: tracking from its first reference pose, or from a uniform start
     over the map's free cells with ``config.global_start``. Estimates are sensor poses."""
@@ -289,6 +312,8 @@ def localize(
             np.zeros(n, dtype=bool),
             np.zeros(0),
             np.full(n, "none"),
+            np.full(n, np.nan),
+            np.full((n, 2), np.nan),
             config,
         )
     if not config.global_start and not np.isfinite(scans.poses[0]).all():
@@ -301,8 +326,13 @@ def localize(
     else:
         localizer.initialize(scans.poses[0], config.initial_sd)
     prepare = scan_preparer(scan_model(config.method, grid, config), scans)
+    learned = LearnedReliability(reliability_model) if config.reliability == "learned" else None
     estimates = np.empty((n, 3))
     reliability = np.empty(n)
+    engine_reliability = np.empty(n)
+    features = np.full((n, 2), np.nan)
+    # the learned estimate before the first update: 1 from a known pose, 0 from a uniform start
+    probability = 0.0 if config.global_start else 1.0
     counts = np.empty(n, dtype=np.int64)
     updated = np.zeros(n, dtype=bool)
     resets = np.full(n, "none", dtype=object)
@@ -315,8 +345,13 @@ def localize(
             seconds.append(time.perf_counter() - start)
             updated[k] = True
             resets[k] = report.reset
+            if learned is not None:
+                probability, features[k] = learned.update(
+                    prepare(k), localizer.estimate, report.agreement
+                )
         estimates[k] = localizer.estimate
-        reliability[k] = localizer.reliability
+        engine_reliability[k] = localizer.reliability
+        reliability[k] = engine_reliability[k] if learned is None else probability
         counts[k] = localizer.size
     return LocalizationResult(
         estimates,
@@ -325,5 +360,7 @@ def localize(
         updated,
         np.asarray(seconds),
         resets.astype(str),
+        engine_reliability,
+        features,
         config,
     )

@@ -62,8 +62,11 @@ def test_kidnapped_robot_recovers_with_resetting_and_says_when_it_is_lost(tmp_pa
     # without recovery the filter stays lost, and its reliability estimate falls
     assert table.loc["none", "recovered"] < 1.0
     assert table.loc["none", "reliability_before"] > 0.9
-    assert table.loc["none", "reliability_after"] < 0.5
+    # the mean over the 10 updates from the jump: with r <- r + 0.1 (s - r) from r = 1 it is
+    # at least mean(0.9^1..0.9^10) = 0.586 even if no scan agrees; below 0.65, nearly none did
+    assert table.loc["none", "reliability_after"] < 0.65
     assert (run.run_dir / "figures" / "kidnapping.png").stat().st_size > 10_000
+    assert (run.run_dir / "figures" / "reliability_roc.png").stat().st_size > 5_000
 
 
 def test_space_observation_excursions_return_on_a_real_log(shared_data, tmp_path) -> None:

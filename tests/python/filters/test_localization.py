@@ -208,6 +208,7 @@ def test_localize_command_writes_reliability_and_its_config(shared_data, tmp_pat
         (["--particles", "0"], "particles must be"),
         (["--plot", "x.png"], "--plot applies only with --global"),
         (["--method", "guess"], "method must be one of"),
+        (["--reliability", "guess"], "reliability must be one of agreement, learned"),
     ],
 )
 def test_localize_command_refuses_bad_options_in_one_line(shared_data, tmp_path, args, needle):
