@@ -2,7 +2,8 @@
 # Copyright (c) 2026 the kiseki authors
 """The Monte Carlo engine as Python drives it: its config and the filter (`engine`), tracking
 along a log with the scan sensor models (`tracking`), and localization from a uniform start
-(`global_localization`, with its convergence report in `convergence`). The engine itself,
+(`global_localization`, with its convergence report in `convergence`), and relocalization
+from one scan by branch-and-bound correlative matching (`relocalization`). The engine itself,
 its motion models, resampling, KLD sampling and recovery are C++ (``kiseki._core``).
 
 ``from kiseki.filters import MclConfig, localize, global_localize`` is the one import path."""
@@ -31,6 +32,12 @@ from kiseki.filters.global_localization import (
     render_global,
     write_report,
 )
+from kiseki.filters.relocalization import (
+    Hypothesis,
+    RelocalizeConfig,
+    Relocalizer,
+    relocalize,
+)
 from kiseki.filters.tracking import (
     LOCALIZATION_METHODS,
     LocalizationResult,
@@ -51,10 +58,13 @@ __all__ = [
     "ConvergenceReport",
     "GlobalConfig",
     "GlobalResult",
+    "Hypothesis",
     "LocalizationResult",
     "LocalizeConfig",
     "MclConfig",
     "MonteCarloLocalizer",
+    "RelocalizeConfig",
+    "Relocalizer",
     "ScanFit",
     "ScanSpaceObservation",
     "convergence_report",
@@ -63,6 +73,7 @@ __all__ = [
     "localize",
     "motion_alphas",
     "noisy_odometry",
+    "relocalize",
     "render_global",
     "scan_fit",
     "scan_preparer",
