@@ -13,7 +13,6 @@ is run as a user runs it (kiseki.cli.main, in this process: no Python start per 
 from __future__ import annotations
 
 import math
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -24,6 +23,7 @@ import pytest
 import typer
 import typer.main
 
+from _helpers.cli_main import kiseki
 from _helpers.room_log import room, write_log
 from kiseki import save_map
 from kiseki._support.options import (
@@ -34,7 +34,7 @@ from kiseki._support.options import (
     OptionValueError,
     Quantity,
 )
-from kiseki.cli import app, main
+from kiseki.cli import app
 
 PROBES = ("0", "-0", "-0.0", "-1", str(2**31), str(2**63), "1e308", "-1e308", "nan", "inf",
           "-inf")  # fmt: skip
@@ -81,7 +81,7 @@ def unbounded(command) -> list[str]:
 
 def test_every_numeric_option_of_every_command_declares_its_range():
     commands = leaves()
-    assert len(commands) == 25
+    assert len(commands) == 26
     seen = 0
     for words, command in commands:
         assert unbounded(command) == [], f"kiseki {' '.join(words)}: no declared range"
@@ -191,19 +191,6 @@ def test_the_shared_limits_are_the_libraries_own():
     MclConfig(particles=PARTICLE_LIMIT)  # the engine takes the CLI's largest count
     with pytest.raises(ValueError, match="particles"):
         MclConfig(particles=PARTICLE_LIMIT + 1)
-
-
-def kiseki(monkeypatch, capsys, *args) -> tuple[int, str, str]:
-    """``kiseki ARGS`` as the entry point runs it, in this process: (status, stdout, stderr)."""
-    import signal
-
-    monkeypatch.setattr(signal, "signal", lambda *a: None)  # main's SIGTERM handler
-    monkeypatch.setattr(warnings, "showwarning", warnings.showwarning)  # restored after
-    monkeypatch.setattr(sys, "argv", ["kiseki", *map(str, args)])
-    with pytest.raises(SystemExit) as stop:
-        main()
-    done = capsys.readouterr()
-    return stop.value.code or 0, done.out, done.err
 
 
 @pytest.fixture
