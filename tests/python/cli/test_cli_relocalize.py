@@ -13,17 +13,14 @@ import numpy as np
 import pytest
 
 from _helpers.cli_main import kiseki
-from _helpers.room_log import STEPS, room, write_log
-from kiseki import save_map
+from _helpers.room_log import STEPS, room, write_inputs
 from kiseki.datasets import open_scans
 from kiseki.filters import RelocalizeConfig, relocalize
 
 
 @pytest.fixture
 def inputs(tmp_path: Path, monkeypatch) -> Path:
-    save_map(room(), tmp_path / "room.yaml")
-    write_log(tmp_path / "log.mcap")
-    monkeypatch.chdir(tmp_path)
+    monkeypatch.chdir(write_inputs(tmp_path))
     return tmp_path
 
 

@@ -24,8 +24,7 @@ import typer
 import typer.main
 
 from _helpers.cli_main import kiseki
-from _helpers.room_log import room, write_log
-from kiseki import save_map
+from _helpers.room_log import write_inputs
 from kiseki._support.options import (
     PARTICLE_LIMIT,
     RUN_LIMIT,
@@ -196,9 +195,7 @@ def test_the_shared_limits_are_the_libraries_own():
 @pytest.fixture
 def inputs(tmp_path: Path, monkeypatch) -> Path:
     """A room's map and a 40-scan run in it (the CLI boundary tests' own); the working folder."""
-    save_map(room(), tmp_path / "room.yaml")
-    write_log(tmp_path / "log.mcap")
-    monkeypatch.chdir(tmp_path)
+    monkeypatch.chdir(write_inputs(tmp_path))
     return tmp_path
 
 
