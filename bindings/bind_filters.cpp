@@ -169,18 +169,19 @@ void bind_filters(py::module_& m) {
                                      "Global relocalization from one scan by branch-and-bound correlative matching.")
       .def(py::init([](const OccupancyGrid& map, double max_range, double sigma, double z_hit, double z_rand,
                        int max_beams, double max_distance, const Pose2& sensor, int depth, double angular_step,
-                       int hypotheses, double min_distance, double min_angle, int threads) {
+                       int hypotheses, double min_distance, double min_angle, bool free_only, int threads) {
              CorrelativeMatcherParams p;
              auto& l = p.likelihood;
              l.sigma_hit = sigma, l.z_hit = z_hit, l.z_rand = z_rand, l.max_beams = max_beams;
              l.max_distance = max_distance, l.sensor = sensor;
              p.depth = depth, p.angular_step = angular_step, p.hypotheses = hypotheses;
-             p.min_distance = min_distance, p.min_angle = min_angle, p.threads = threads;
+             p.min_distance = min_distance, p.min_angle = min_angle, p.free_only = free_only, p.threads = threads;
              py::gil_scoped_release release;
              return std::make_unique<CorrelativeScanMatcher>(map, max_range, p);
            }),
            "map"_a, "max_range"_a, "sigma_hit"_a, "z_hit"_a, "z_rand"_a, "max_beams"_a, "max_distance"_a,
-           "sensor"_a, "depth"_a, "angular_step"_a, "hypotheses"_a, "min_distance"_a, "min_angle"_a, "threads"_a)
+           "sensor"_a, "depth"_a, "angular_step"_a, "hypotheses"_a, "min_distance"_a, "min_angle"_a, "free_only"_a,
+           "threads"_a)
       .def("match",
            [](const CorrelativeScanMatcher& cm, const py::handle& a_in, const py::handle& r_in) {
              const auto [a, r] = beams(a_in, r_in);

@@ -537,6 +537,7 @@ std::vector<Scored> exhaustive(const OccupancyGrid& map, const CorrelativeScanMa
   for (int k = 0; k < headings; ++k)
     for (int y = 0; y < map.height(); ++y)
       for (int x = 0; x < map.width(); ++x) {
+        if (p.free_only && !(map.value(x, y) >= 0 && map.value(x, y) < 20)) continue;  // known free only
         poses.push_back(m.lattice_pose(x, y, k, headings));
         all.push_back({0.0, (static_cast<long long>(k) * map.height() + y) * map.width() + x, x, y, k, poses.back()});
       }
@@ -587,6 +588,7 @@ TEST(CorrelativeScanMatcher, EqualsExhaustiveSearchOnRandomSmallMaps) {
     p.likelihood.max_beams = seed % 2 ? 0 : 12;
     p.likelihood.sigma_hit = rng.uniform(0.05, 0.3);
     if (seed == 4) p.likelihood.sensor = Pose2(0.15, -0.05, 0.3);
+    p.free_only = seed % 3 != 1;
     p.threads = 1;
     const CorrelativeScanMatcher one(map, 2.5, p);
     const auto got = one.match(angles.data(), ranges.data(), angles.size());
@@ -648,6 +650,7 @@ TEST(CorrelativeScanMatcher, BadInputIsRefused) {
   p.angular_step = -0.1;
   EXPECT_THROW(CorrelativeScanMatcher(map, 8.0, p), std::invalid_argument);
   EXPECT_THROW(CorrelativeScanMatcher(map, 0.0, {}), std::invalid_argument);
+  EXPECT_THROW(CorrelativeScanMatcher(OccupancyGrid(5, 5, 0.1, Pose2(), kOccupied), 8.0, {}), std::invalid_argument);
   const CorrelativeScanMatcher m(map, 8.0, {});
   const std::vector<double> a = {0.0};
   const std::vector<float> none = {std::numeric_limits<float>::infinity()};

