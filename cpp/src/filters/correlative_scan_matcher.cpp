@@ -263,12 +263,14 @@ std::vector<PoseHypothesis> CorrelativeScanMatcher::match(const double* angles, 
   std::sort(nodes.begin(), nodes.end(), [](const Node& a, const Node& b) {
     return a.bound > b.bound || (a.bound == b.bound && a.index < b.index);
   });
-  // Workers take every t-th node of that order; they share only the (safe) threshold.
+  // Workers take the next node of that order as they come free; they share only the (safe)
+  // threshold, so which worker searches which node does not change the result.
   const std::size_t t = std::min<std::size_t>(static_cast<std::size_t>(resolve_threads(params_.threads)), nodes.size());
   std::vector<Search::Worker> workers(t);
+  std::atomic<std::size_t> next{0};
   parallel_for(t, params_.threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t wi = begin; wi < end; ++wi) {
-      for (std::size_t i = wi; i < nodes.size(); i += t) {
+      for (std::size_t i = next++; i < nodes.size(); i = next++) {
         int x, y, k;
         node_cell(nodes[i].index, x, y, k);
         s.descend(workers[wi], top, x, y, k, nodes[i].bound);
