@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <tuple>
 
@@ -131,8 +132,8 @@ int CorrelativeScanMatcher::headings(const double* angles, const float* ranges, 
   return heading_count(beams, frame_.resolution(), params_.angular_step);
 }
 
-/// One search: the rotated scans' cell offsets, the shared threshold, and per worker the leaves
-/// found and a set of pairwise far poses (the threshold's witnesses).
+/// One search: the rotated scans' cell offsets, the shared threshold and its witnesses (a set of
+/// pairwise far poses found), and per worker the leaves it found.
 struct CorrelativeScanMatcher::Search {
   explicit Search(const CorrelativeScanMatcher& matcher) : m(matcher) {}
   const CorrelativeScanMatcher& m;
@@ -141,9 +142,11 @@ struct CorrelativeScanMatcher::Search {
   std::atomic<double> threshold{-std::numeric_limits<double>::infinity()};
 
   struct Worker {
-    std::vector<Leaf> leaves, far;
+    std::vector<Leaf> leaves;
     std::size_t compacted = 0;
   };
+  std::mutex far_mutex;
+  std::vector<Leaf> far;  // shared by the workers, so the threshold rises as fast as on one
 
   double bound(int level, int x, int y, int k) const {
     const int* ox = dx.data() + static_cast<std::size_t>(k) * beams;
@@ -172,23 +175,24 @@ struct CorrelativeScanMatcher::Search {
     // Keep k found poses pairwise "far" (2 min_distance or 2 min_angle apart), trading a member
     // for a better pose when that keeps them far; their lowest score bounds the k-th result.
     const auto kk = static_cast<std::size_t>(m.params_.hypotheses);
-    std::size_t near = w.far.size(), count = 0;
-    for (std::size_t i = 0; i < w.far.size(); ++i) {
-      if (close(w.far[i].pose, l.pose, 2.0)) near = i, ++count;
+    std::lock_guard<std::mutex> lock(far_mutex);
+    std::size_t near = far.size(), count = 0;
+    for (std::size_t i = 0; i < far.size(); ++i) {
+      if (close(far[i].pose, l.pose, 2.0)) near = i, ++count;
     }
-    if (count == 0 && w.far.size() < kk) {
-      w.far.push_back(l);
+    if (count == 0 && far.size() < kk) {
+      far.push_back(l);
     } else if (count == 0 || count == 1) {
       if (count == 0) {
-        near = static_cast<std::size_t>(std::min_element(w.far.begin(), w.far.end(), [](const Leaf& a, const Leaf& b) {
+        near = static_cast<std::size_t>(std::min_element(far.begin(), far.end(), [](const Leaf& a, const Leaf& b) {
                                           return a.score < b.score;
-                                        }) - w.far.begin());
+                                        }) - far.begin());
       }
-      if (score > w.far[near].score) w.far[near] = l;
+      if (score > far[near].score) far[near] = l;
     }
-    if (w.far.size() == kk) {
-      double lowest = w.far[0].score;
-      for (const auto& f : w.far) lowest = std::min(lowest, f.score);
+    if (far.size() == kk) {
+      double lowest = far[0].score;
+      for (const auto& f : far) lowest = std::min(lowest, f.score);
       raise(lowest);
     }
     if (w.leaves.size() >= 2 * w.compacted + 4096) {
