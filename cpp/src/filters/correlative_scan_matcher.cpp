@@ -151,8 +151,17 @@ struct CorrelativeScanMatcher::Search {
   double bound(int level, int x, int y, int k) const {
     const int* ox = dx.data() + static_cast<std::size_t>(k) * beams;
     const int* oy = dy.data() + static_cast<std::size_t>(k) * beams;
+    // m.value() inlined: one unsigned comparison per axis finds the ends off the stored grid
+    const int pad = (1 << level) - 1;
+    const auto pw = static_cast<unsigned>(m.frame_.width() + pad), ph = static_cast<unsigned>(m.frame_.height() + pad);
+    const float* grid = m.pooled_[static_cast<std::size_t>(level)].data();
+    const float outside = m.outside_;
+    const int gx = x + pad, gy = y + pad;
     double sum = 0.0;
-    for (int b = 0; b < beams; ++b) sum += m.value(level, x + ox[b], y + oy[b]);
+    for (int b = 0; b < beams; ++b) {
+      const auto xx = static_cast<unsigned>(gx + ox[b]), yy = static_cast<unsigned>(gy + oy[b]);
+      sum += (xx < pw && yy < ph) ? grid[static_cast<std::size_t>(yy) * pw + xx] : outside;
+    }
     return sum;
   }
 
