@@ -14,10 +14,11 @@ from rich.console import Console
 from kiseki._support.guard import guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import BEAM_LIMIT, THREAD_LIMIT, Count
+from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki._support.table import show
 from kiseki.cli._defaults import default_of
 from kiseki.datasets import open_scans
-from kiseki.filters import RelocalizeConfig, Relocalizer
+from kiseki.filters import RelocalizeConfig, Relocalizer, render_hypotheses
 from kiseki.io.ros_map import load_map
 
 __all__ = ["app"]
@@ -29,7 +30,7 @@ SCAN_LIMIT = 10_000_000
 
 
 @app.command("relocalize")
-@guarded(inputs=("map_file", "log"))
+@guarded(inputs=("map_file", "log"), outputs=("plot",))
 @interruptible()
 def relocalize_command(
     map_file: Path = typer.Argument(..., help="ROS map YAML, or a CMU .dat(.gz) map."),
@@ -55,6 +56,9 @@ def relocalize_command(
         parser=Count("--threads", 0, THREAD_LIMIT, "0 = every core"),
         help="Threads of the search (the result is the same for any number).",
     ),
+    plot: Path | None = typer.Option(
+        None, help="Draw the map with the hypotheses (and the reference pose, if any) (PNG)."
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print the hypotheses as JSON."),
 ) -> None:
     """Relocalize from one scan: search the whole map for the poses that explain scan N of a
@@ -63,6 +67,7 @@ def relocalize_command(
     poses.
 
     Example: kiseki relocalize map.yaml run.mcap --scan 10 --hypotheses 3"""
+    check_suffix("--plot", plot, FIGURE_SUFFIXES)
     scans = open_scans(log)
     if scan >= len(scans):
         raise ValueError(f"--scan {scan}: {log} has {len(scans)} scans (0..{len(scans) - 1})")
@@ -85,3 +90,5 @@ def relocalize_command(
     columns = list(data[0])
     title = f"{log.name} scan {scan}: {len(found)} hypotheses over {map_file.name}"
     show(title, columns, rows, as_json=as_json, data=data, console=console)
+    if plot is not None:
+        render_hypotheses(grid, found, plot, None if truth is None else tuple(truth), title)

@@ -37,6 +37,7 @@ from kiseki.filters.relocalization import (
     RelocalizeConfig,
     Relocalizer,
     relocalize,
+    render_hypotheses,
 )
 from kiseki.filters.tracking import (
     LOCALIZATION_METHODS,
@@ -75,6 +76,7 @@ __all__ = [
     "noisy_odometry",
     "relocalize",
     "render_global",
+    "render_hypotheses",
     "scan_fit",
     "scan_preparer",
     "scan_model",

@@ -16,7 +16,9 @@ the same for any thread count; the GIL is released during the search.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -24,7 +26,7 @@ from kiseki import _core
 from kiseki.errors import RelocalizationError
 from kiseki.grid import OccupancyGrid
 
-__all__ = ["Hypothesis", "RelocalizeConfig", "Relocalizer", "relocalize"]
+__all__ = ["Hypothesis", "RelocalizeConfig", "Relocalizer", "relocalize", "render_hypotheses"]
 
 
 @dataclass(frozen=True)
@@ -191,6 +193,37 @@ def relocalize(
     """The ``config.hypotheses`` best distinct poses of one scan over the whole map, best first
     (see :class:`Relocalizer`; ``sensor`` is the laser's pose in the robot frame)."""
     return Relocalizer(grid, max_range, config, sensor).match(angles, ranges)
+
+
+def render_hypotheses(
+    grid: OccupancyGrid,
+    hypotheses: list[Hypothesis],
+    path: str | os.PathLike,
+    truth: tuple[float, float, float] | None = None,
+    title: str | None = None,
+) -> Path:
+    """The map with the hypotheses: the best a red dot, the others orange dots numbered by rank,
+    each heading a green line of 1 m; the reference pose (if given) a blue cross."""
+    # here, not at the top: plots loads matplotlib, which `import kiseki.filters` should not
+    from kiseki.plots import draw_map, figure_for_grid, save_figure, world_xy
+
+    fig, ax = figure_for_grid(grid)
+    draw_map(ax, grid)
+    for rank, h in reversed(list(enumerate(hypotheses, start=1))):
+        start = world_xy(
+            grid, np.array([[h.x, h.y], [h.x + math.cos(h.theta), h.y + math.sin(h.theta)]])
+        )
+        ax.plot(start[:, 0], start[:, 1], "-", color="tab:green", linewidth=1.0)
+        colour = "tab:red" if rank == 1 else "tab:orange"
+        ax.plot(start[0, 0], start[0, 1], "o", color=colour, markersize=7 if rank == 1 else 5)
+        if rank > 1:
+            ax.annotate(str(rank), start[0], textcoords="offset points", xytext=(4, 4), fontsize=7)
+    if truth is not None:
+        xy = world_xy(grid, np.array([truth[:2]]))
+        ax.plot(xy[0, 0], xy[0, 1], "x", color="tab:blue", markersize=8, label="reference pose")
+        ax.legend(loc="upper right", fontsize=8)
+    ax.set_title(title or "relocalization hypotheses")
+    return save_figure(fig, path)
 
 
 def _finite(value: object) -> bool:
