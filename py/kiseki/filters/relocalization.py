@@ -153,8 +153,14 @@ class Relocalizer:
         """The ranked hypotheses of one scan: ``angles`` (B,) rad and ``ranges`` (B,) m in the
         laser frame (NaN invalid, +inf or ``>= max_range`` no return, both skipped); an empty
         list when no beam returned."""
-        angles = np.asarray(angles, dtype=np.float64)
-        ranges = np.asarray(ranges, dtype=np.float32)
+        try:
+            angles = np.asarray(angles, dtype=np.float64)
+            with np.errstate(over="ignore"):  # beyond float32: +inf, a no return
+                ranges = np.asarray(ranges, dtype=np.float32)
+        except (TypeError, ValueError):
+            raise RelocalizationError(
+                "relocalize: angles and ranges must be arrays of numbers"
+            ) from None
         if angles.ndim != 1 or angles.shape != ranges.shape:
             raise RelocalizationError(
                 "relocalize: angles and ranges must be 1-D arrays of one length, "

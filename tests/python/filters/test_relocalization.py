@@ -124,6 +124,8 @@ def test_bad_input_is_one_line_naming_the_problem():
         relocalize(grid, angles, ranges, 0.0)
     with pytest.raises(RelocalizationError, match="angles and ranges"):
         relocalize(grid, angles, ranges[:-1], MAX_RANGE)
+    with pytest.raises(RelocalizationError, match="arrays of numbers"):
+        relocalize(grid, angles, ["a"] * len(angles), MAX_RANGE)
     with pytest.raises(RelocalizationError, match="map must be an OccupancyGrid"):
         relocalize(np.zeros((5, 5)), angles, ranges, MAX_RANGE)
     assert relocalize(grid, angles, np.full(len(angles), np.inf, np.float32), MAX_RANGE) == []
