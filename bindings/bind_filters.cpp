@@ -5,6 +5,7 @@
 
 #include <limits>
 
+#include "kiseki/filters/correlative_scan_matcher.hpp"
 #include "kiseki/filters/kld_sampling.hpp"
 #include "kiseki/filters/monte_carlo_localization.hpp"
 #include "kiseki/filters/resampling.hpp"
@@ -163,6 +164,50 @@ void bind_filters(py::module_& m) {
       .def_property_readonly("weights", [](const MonteCarloLocalization& f) { return array_of(f.weights()); })
       .def_property_readonly("size", [](const MonteCarloLocalization& f) { return f.particles().size(); });
   m.attr("MAX_ODOMETRY_JUMP") = kMaxOdometryJump;
+
+  py::class_<CorrelativeScanMatcher>(m, "CorrelativeScanMatcher",
+                                     "Global relocalization from one scan by branch-and-bound correlative matching.")
+      .def(py::init([](const OccupancyGrid& map, double max_range, double sigma, double z_hit, double z_rand,
+                       int max_beams, double max_distance, const Pose2& sensor, int depth, double angular_step,
+                       int hypotheses, double min_distance, double min_angle, bool free_only, int threads) {
+             CorrelativeMatcherParams p;
+             auto& l = p.likelihood;
+             l.sigma_hit = sigma, l.z_hit = z_hit, l.z_rand = z_rand, l.max_beams = max_beams;
+             l.max_distance = max_distance, l.sensor = sensor;
+             p.depth = depth, p.angular_step = angular_step, p.hypotheses = hypotheses;
+             p.min_distance = min_distance, p.min_angle = min_angle, p.free_only = free_only, p.threads = threads;
+             py::gil_scoped_release release;
+             return std::make_unique<CorrelativeScanMatcher>(map, max_range, p);
+           }),
+           "map"_a, "max_range"_a, "sigma_hit"_a, "z_hit"_a, "z_rand"_a, "max_beams"_a, "max_distance"_a,
+           "sensor"_a, "depth"_a, "angular_step"_a, "hypotheses"_a, "min_distance"_a, "min_angle"_a, "free_only"_a,
+           "threads"_a)
+      .def("match",
+           [](const CorrelativeScanMatcher& cm, const py::handle& a_in, const py::handle& r_in) {
+             const auto [a, r] = beams(a_in, r_in);
+             std::vector<PoseHypothesis> found;
+             {
+               py::gil_scoped_release release;
+               found = cm.match(a.data(), r.data(), static_cast<std::size_t>(a.shape(0)));
+             }
+             const auto k = static_cast<py::ssize_t>(found.size());
+             py::array_t<double> poses({k, py::ssize_t{3}}), scores(k);
+             py::array_t<std::int64_t> lattice({k, py::ssize_t{3}});
+             for (py::ssize_t i = 0; i < k; ++i) {
+               const auto& h = found[static_cast<std::size_t>(i)];
+               poses.mutable_at(i, 0) = h.pose.x, poses.mutable_at(i, 1) = h.pose.y, poses.mutable_at(i, 2) = h.pose.theta;
+               scores.mutable_at(i) = h.score;
+               lattice.mutable_at(i, 0) = h.cell_x, lattice.mutable_at(i, 1) = h.cell_y, lattice.mutable_at(i, 2) = h.heading;
+             }
+             return py::make_tuple(poses, scores, lattice);
+           }, "angles"_a, "ranges"_a,
+           "(poses (k, 3), scores (k,), lattice (k, 3): cell x, cell y, heading index), best first; releases the GIL.")
+      .def("headings",
+           [](const CorrelativeScanMatcher& cm, const py::handle& a_in, const py::handle& r_in) {
+             const auto [a, r] = beams(a_in, r_in);
+             return cm.headings(a.data(), r.data(), static_cast<std::size_t>(a.shape(0)));
+           }, "angles"_a, "ranges"_a, "Headings on the search lattice for this scan.")
+      .def("lattice_pose", &CorrelativeScanMatcher::lattice_pose, "cell_x"_a, "cell_y"_a, "heading"_a, "headings"_a);
 
   py::class_<TravelDistanceParams>(m, "TravelDistanceParams")
       .def(py::init<>())

@@ -28,16 +28,6 @@ Pose3 pose3_from_matrix(const Eigen::Matrix4d& m) {
   return {m.block<3, 1>(0, 3), Eigen::Quaterniond(r)};
 }
 
-// A scan's checked beam angles (n,) and ranges (n,).
-std::pair<DoubleArray, FloatArray> beams(const py::handle& a_in, const py::handle& r_in) {
-  auto a = as_doubles(a_in, "angles");
-  auto r = as_floats(r_in, "ranges");
-  require_shape(a, "angles", 1);
-  require_shape(r, "ranges", 1);
-  if (a.shape(0) != r.shape(0)) throw std::invalid_argument("angles and ranges differ in length");
-  return {a, r};
-}
-
 // One value per pose of a checked (n, 3) pose array, computed by fn(poses, n, out) without the GIL.
 template <typename Fn>
 py::array_t<double> per_pose(const py::handle& poses_in, Fn&& fn) {

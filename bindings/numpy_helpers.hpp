@@ -11,6 +11,7 @@
 #include <opencv2/core/mat.hpp>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "kiseki/core/pose.hpp"
@@ -67,6 +68,16 @@ inline DoubleArray as_doubles(const py::handle& obj, const char* name) {
 }
 inline FloatArray as_floats(const py::handle& obj, const char* name) {
   return as_numeric<float>(obj, name);
+}
+
+/// A scan's checked beam angles (n,) and ranges (n,), without a copy when already contiguous.
+inline std::pair<DoubleArray, FloatArray> beams(const py::handle& a_in, const py::handle& r_in) {
+  auto a = as_doubles(a_in, "angles");
+  auto r = as_floats(r_in, "ranges");
+  require_shape(a, "angles", 1);
+  require_shape(r, "ranges", 1);
+  if (a.shape(0) != r.shape(0)) throw std::invalid_argument("angles and ranges differ in length");
+  return {a, r};
 }
 
 inline Pose2 pose_from_row(const double* row) { return {row[0], row[1], row[2]}; }

@@ -8,7 +8,7 @@ Every error derives from :class:`KisekiError`; the format errors also derive fro
 
 from __future__ import annotations
 
-__all__ = ["KisekiError", "MapFormatError", "LogFormatError"]
+__all__ = ["KisekiError", "MapFormatError", "LogFormatError", "RelocalizationError"]
 
 
 class KisekiError(Exception):
@@ -21,3 +21,7 @@ class MapFormatError(KisekiError, ValueError):
 
 class LogFormatError(KisekiError, ValueError):
     """A sensor log (CARMEN, ...) is truncated, corrupt or has no usable records."""
+
+
+class RelocalizationError(KisekiError, ValueError):
+    """A relocalization request whose map, scan or settings cannot be searched."""

@@ -64,8 +64,7 @@ void MonteCarloLocalization::set_free_space(const OccupancyGrid& map) {
   std::vector<std::int32_t> cells;
   for (int y = 0; y < map.height(); ++y) {
     for (int x = 0; x < map.width(); ++x) {
-      const std::int8_t v = map.value(x, y);
-      if (v >= 0 && v < 20) cells.push_back(y * map.width() + x);
+      if (is_free(map.value(x, y))) cells.push_back(y * map.width() + x);
     }
   }
   if (cells.empty()) throw std::invalid_argument("MCL: the map has no free cell to draw poses from");

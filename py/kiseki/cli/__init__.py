@@ -3,10 +3,10 @@
 """The ``kiseki`` command line: one command with subcommands.
 
 Names: the factory AGV's main job has top-level verbs, ``kiseki teach``, ``kiseki playback``,
-``kiseki localize``, ``kiseki serve`` and ``kiseki demo``; everything else is ``kiseki GROUP
-VERB``, the group a noun for what it works on (``kiseki map info``, ``kiseki experiment
-report``, ``kiseki magnetic teach``). An old name runs for one release as a hidden alias that
-prints one warning line (:data:`ALIASES`).
+``kiseki localize``, ``kiseki relocalize``, ``kiseki serve`` and ``kiseki demo``; everything
+else is ``kiseki GROUP VERB``, the group a noun for what it works on (``kiseki map info``,
+``kiseki experiment report``, ``kiseki magnetic teach``). An old name runs for one release as a
+hidden alias that prints one warning line (:data:`ALIASES`).
 
 Exit status: errors in what the user gave (a missing or corrupt file, a bad value) print one
 line ``kiseki: error: ...`` on stderr and exit with status 1; usage errors (an unknown option, a
@@ -71,6 +71,14 @@ COMMANDS = {
         "when it has them; with --global also the convergence report (written to OUTPUT.json "
         "too); with --json the same numbers as one JSON object. The settings it ran with are "
         "written beside the output as OUTPUT-STEM.config.yaml.",
+        group=False,
+    ),
+    "relocalize": Entry(
+        "kiseki.cli.relocalize",
+        "Relocalize from one scan: search the whole map for the poses that explain scan N of a "
+        "log best (branch-and-bound correlative matching, scored with the likelihood field), "
+        "and print the distinct hypotheses ranked by score, with their error when the log has "
+        "reference poses.",
         group=False,
     ),
     "map": Entry("kiseki.cli.map", "Occupancy-grid maps: build, render, inspect."),

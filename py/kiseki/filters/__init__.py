@@ -2,8 +2,10 @@
 # Copyright (c) 2026 the kiseki authors
 """The Monte Carlo engine as Python drives it: its config and the filter (`engine`), tracking
 along a log with the scan sensor models (`tracking`), and localization from a uniform start
-(`global_localization`, with its convergence report in `convergence`). The engine itself,
-its motion models, resampling, KLD sampling and recovery are C++ (``kiseki._core``).
+(`global_localization`, with its convergence report in `convergence`), the reliability
+estimate (`reliability`), and relocalization from one scan by branch-and-bound correlative
+matching (`relocalization`). The engine itself, its motion models, resampling, KLD sampling and
+recovery are C++ (``kiseki._core``).
 
 ``from kiseki.filters import MclConfig, localize, global_localize`` is the one import path."""
 
@@ -37,6 +39,13 @@ from kiseki.filters.reliability import (
     LearnedReliability,
     ReliabilityModel,
 )
+from kiseki.filters.relocalization import (
+    Hypothesis,
+    RelocalizeConfig,
+    Relocalizer,
+    relocalize,
+    render_hypotheses,
+)
 from kiseki.filters.tracking import (
     LOCALIZATION_METHODS,
     LocalizationResult,
@@ -59,12 +68,15 @@ __all__ = [
     "ConvergenceReport",
     "GlobalConfig",
     "GlobalResult",
+    "Hypothesis",
     "LocalizationResult",
     "LearnedReliability",
     "LocalizeConfig",
     "MclConfig",
     "MonteCarloLocalizer",
     "ReliabilityModel",
+    "RelocalizeConfig",
+    "Relocalizer",
     "ScanFit",
     "ScanSpaceObservation",
     "convergence_report",
@@ -73,7 +85,9 @@ __all__ = [
     "localize",
     "motion_alphas",
     "noisy_odometry",
+    "relocalize",
     "render_global",
+    "render_hypotheses",
     "scan_fit",
     "scan_preparer",
     "scan_model",

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from kiseki import OccupancyGrid, Pose2
+from kiseki import OccupancyGrid, Pose2, save_map
 from kiseki.io.runlog import RunWriter
 
 STEPS = 40
@@ -37,3 +37,10 @@ def write_log(path: Path, scan: bool = True, chunk_size: int = 128 * 1024) -> No
             w.write_odometry("/odom", t, pose)
             if scan:
                 w.write_laser_scan("/scan", t, pose, ANGLES, ranges[k], max_range=8.0)
+
+
+def write_inputs(folder: Path) -> Path:
+    """The room's map (room.yaml) and the run through it (log.mcap) in ``folder``."""
+    save_map(room(), folder / "room.yaml")
+    write_log(folder / "log.mcap")
+    return folder

@@ -13,7 +13,6 @@ is run as a user runs it (kiseki.cli.main, in this process: no Python start per 
 from __future__ import annotations
 
 import math
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -24,8 +23,8 @@ import pytest
 import typer
 import typer.main
 
-from _helpers.room_log import room, write_log
-from kiseki import save_map
+from _helpers.cli_main import kiseki
+from _helpers.room_log import write_inputs
 from kiseki._support.options import (
     PARTICLE_LIMIT,
     RUN_LIMIT,
@@ -34,7 +33,7 @@ from kiseki._support.options import (
     OptionValueError,
     Quantity,
 )
-from kiseki.cli import app, main
+from kiseki.cli import app
 
 PROBES = ("0", "-0", "-0.0", "-1", str(2**31), str(2**63), "1e308", "-1e308", "nan", "inf",
           "-inf")  # fmt: skip
@@ -81,7 +80,7 @@ def unbounded(command) -> list[str]:
 
 def test_every_numeric_option_of_every_command_declares_its_range():
     commands = leaves()
-    assert len(commands) == 25
+    assert len(commands) == 26
     seen = 0
     for words, command in commands:
         assert unbounded(command) == [], f"kiseki {' '.join(words)}: no declared range"
@@ -193,25 +192,10 @@ def test_the_shared_limits_are_the_libraries_own():
         MclConfig(particles=PARTICLE_LIMIT + 1)
 
 
-def kiseki(monkeypatch, capsys, *args) -> tuple[int, str, str]:
-    """``kiseki ARGS`` as the entry point runs it, in this process: (status, stdout, stderr)."""
-    import signal
-
-    monkeypatch.setattr(signal, "signal", lambda *a: None)  # main's SIGTERM handler
-    monkeypatch.setattr(warnings, "showwarning", warnings.showwarning)  # restored after
-    monkeypatch.setattr(sys, "argv", ["kiseki", *map(str, args)])
-    with pytest.raises(SystemExit) as stop:
-        main()
-    done = capsys.readouterr()
-    return stop.value.code or 0, done.out, done.err
-
-
 @pytest.fixture
 def inputs(tmp_path: Path, monkeypatch) -> Path:
     """A room's map and a 40-scan run in it (the CLI boundary tests' own); the working folder."""
-    save_map(room(), tmp_path / "room.yaml")
-    write_log(tmp_path / "log.mcap")
-    monkeypatch.chdir(tmp_path)
+    monkeypatch.chdir(write_inputs(tmp_path))
     return tmp_path
 
 

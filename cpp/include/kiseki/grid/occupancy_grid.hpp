@@ -13,6 +13,8 @@ namespace kiseki {
 constexpr std::int8_t kFree = 0;
 constexpr std::int8_t kOccupied = 100;
 constexpr std::int8_t kUnknown = -1;
+/// A known free cell: 0..19 (the free space uniform poses are drawn from).
+constexpr bool is_free(std::int8_t value) { return value >= 0 && value < 20; }
 
 /// Integer cell coordinates: x is the column, y the row (row 0 at the origin, as in ROS).
 struct CellIndex {

@@ -57,6 +57,8 @@ class LikelihoodFieldModel : public SensorModel {
   const LikelihoodFieldParams& params() const { return params_; }
   /// The tabulated per-cell term (log pz or pz^3) for the current max range, for tests.
   const cv::Mat& table() const { return table_; }
+  /// The term of an end outside the map (that of max_distance), for the current max range.
+  float outside() const { return outside_; }
 
  private:
   void tabulate(double max_range);

@@ -1,0 +1,309 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+#include "kiseki/filters/correlative_scan_matcher.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+#include <tuple>
+
+#include "kiseki/core/angle.hpp"
+#include "kiseki/core/parallel.hpp"
+#include "kiseki/models/scan_beams.hpp"
+
+namespace kiseki {
+
+void CorrelativeMatcherParams::validate() const {
+  likelihood.validate();
+  if (depth < 0 || depth > 16) throw std::invalid_argument("correlative matcher: depth must be in 0..16");
+  if (!(angular_step >= 0.0) || !std::isfinite(angular_step)) {
+    throw std::invalid_argument("correlative matcher: angular_step must be finite and >= 0");
+  }
+  if (hypotheses < 1) throw std::invalid_argument("correlative matcher: hypotheses must be >= 1");
+  if (!(min_distance >= 0.0) || !std::isfinite(min_distance) || !(min_angle >= 0.0) || !std::isfinite(min_angle)) {
+    throw std::invalid_argument("correlative matcher: min_distance and min_angle must be finite and >= 0");
+  }
+  if (threads < 0) throw std::invalid_argument("correlative matcher: threads must be >= 0");
+}
+
+CorrelativeScanMatcher::CorrelativeScanMatcher(const OccupancyGrid& map, double max_range,
+                                               const CorrelativeMatcherParams& params)
+    : params_((params.validate(), params)), max_range_(max_range), frame_(map.clone()) {
+  if (!(max_range > 0.0) || !std::isfinite(max_range)) {
+    throw std::invalid_argument("correlative matcher: max_range must be finite and > 0");
+  }
+  // The score table is the likelihood field's own (Probabilistic Robotics, Table 6.3).
+  LikelihoodFieldModel field(map, params_.likelihood);
+  field.set_scan(nullptr, nullptr, 0, max_range);
+  outside_ = field.outside();
+  const int w = map.width(), h = map.height();
+  const cv::Mat& table = field.table();
+  pooled_.assign(static_cast<std::size_t>(params_.depth) + 1, {});
+  pooled_[0].resize(static_cast<std::size_t>(w) * h);
+  for (int y = 0; y < h; ++y) std::copy_n(table.ptr<float>(y), w, pooled_[0].data() + static_cast<std::size_t>(y) * w);
+  free_.assign(pooled_.size(), {});
+  free_[0].resize(pooled_[0].size());
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) free_[0][static_cast<std::size_t>(y) * w + x] = !params_.free_only || is_free(map.value(x, y));
+  if (std::find(free_[0].begin(), free_[0].end(), 1) == free_[0].end()) {
+    throw std::invalid_argument("correlative matcher: the map has no free cell to search");
+  }
+  // P_h(x, y) = max of P_{h-1} over the 2 x 2 blocks of side 2^(h-1) starting at (x, y)
+  // (Hess et al. sec. V.C); stored from x = y = -(2^h - 1), where a window first meets the map.
+  for (int level = 1; level <= params_.depth; ++level) {
+    const int pad = (1 << level) - 1, half = 1 << (level - 1);
+    const int pw = w + pad, ph = h + pad;
+    auto& out = pooled_[static_cast<std::size_t>(level)];
+    out.resize(static_cast<std::size_t>(pw) * ph);
+    auto& any = free_[static_cast<std::size_t>(level)];
+    any.resize(out.size());
+    for (int yy = 0; yy < ph; ++yy) {
+      const int y = yy - pad;
+      for (int xx = 0; xx < pw; ++xx) {
+        const int x = xx - pad;
+        out[static_cast<std::size_t>(yy) * pw + xx] =
+            std::max(std::max(value(level - 1, x, y), value(level - 1, x + half, y)),
+                     std::max(value(level - 1, x, y + half), value(level - 1, x + half, y + half)));
+        any[static_cast<std::size_t>(yy) * pw + xx] = has_free(level - 1, x, y) || has_free(level - 1, x + half, y) ||
+                                                      has_free(level - 1, x, y + half) ||
+                                                      has_free(level - 1, x + half, y + half);
+      }
+    }
+  }
+}
+
+float CorrelativeScanMatcher::value(int level, int x, int y) const {
+  const int pad = (1 << level) - 1;
+  const int xx = x + pad, yy = y + pad, pw = frame_.width() + pad, ph = frame_.height() + pad;
+  if (xx < 0 || yy < 0 || xx >= pw || yy >= ph) return outside_;
+  return pooled_[static_cast<std::size_t>(level)][static_cast<std::size_t>(yy) * pw + xx];
+}
+
+bool CorrelativeScanMatcher::has_free(int level, int x, int y) const {
+  const int pad = (1 << level) - 1;
+  const int xx = x + pad, yy = y + pad, pw = frame_.width() + pad, ph = frame_.height() + pad;
+  if (xx < 0 || yy < 0 || xx >= pw || yy >= ph) return false;
+  return free_[static_cast<std::size_t>(level)][static_cast<std::size_t>(yy) * pw + xx] != 0;
+}
+
+Pose2 CorrelativeScanMatcher::lattice_pose(int cell_x, int cell_y, int heading, int headings) const {
+  if (headings < 1) throw std::invalid_argument("correlative matcher: headings must be >= 1");
+  const double r = frame_.resolution();
+  const Pose2 sensor_in_grid((cell_x + 0.5) * r, (cell_y + 0.5) * r, heading * (2.0 * kPi / headings));
+  return frame_.origin().compose(sensor_in_grid).compose(params_.likelihood.sensor.inverse());
+}
+
+namespace {
+
+ScanBeams used_beams(const double* angles, const float* ranges, std::size_t n, double max_range, int max_beams) {
+  ScanBeams beams;
+  beams.set(angles, ranges, n, max_range, max_beams, /*keep_no_return=*/false);
+  return beams;
+}
+
+int heading_count(const ScanBeams& beams, double resolution, double angular_step) {
+  if (beams.size() == 0) return 0;
+  double step = angular_step;
+  if (step == 0.0) {
+    // Hess et al. eq. (7): the farthest end moves by at most one cell between headings.
+    const double d = *std::max_element(beams.range.begin(), beams.range.end()) / resolution;
+    step = d <= 0.5 ? kPi / 2 : std::acos(1.0 - 1.0 / (2.0 * d * d));
+  }
+  return std::max(1, static_cast<int>(std::ceil(2.0 * kPi / step - 1e-9)));
+}
+
+struct Leaf {
+  double score;
+  std::int64_t index;  // (heading * height + y) * width + x
+  int x, y, k;
+  Pose2 pose;
+};
+
+bool before(const Leaf& a, const Leaf& b) { return a.score > b.score || (a.score == b.score && a.index < b.index); }
+
+}  // namespace
+
+int CorrelativeScanMatcher::headings(const double* angles, const float* ranges, std::size_t n) const {
+  const ScanBeams beams = used_beams(angles, ranges, n, max_range_, params_.likelihood.max_beams);
+  return heading_count(beams, frame_.resolution(), params_.angular_step);
+}
+
+/// One search: the rotated scans' cell offsets, the shared threshold and its witnesses (a set of
+/// pairwise far poses found), and per worker the leaves it found.
+struct CorrelativeScanMatcher::Search {
+  explicit Search(const CorrelativeScanMatcher& matcher) : m(matcher) {}
+  const CorrelativeScanMatcher& m;
+  int headings = 0, beams = 0;
+  std::vector<int> dx, dy;  // [heading * beams + b]
+  std::atomic<double> threshold{-std::numeric_limits<double>::infinity()};
+
+  struct Worker {
+    std::vector<Leaf> leaves;
+    std::size_t compacted = 0;
+  };
+  std::mutex far_mutex;
+  std::vector<Leaf> far;  // shared by the workers, so the threshold rises as fast as on one
+
+  double bound(int level, int x, int y, int k) const {
+    const int* ox = dx.data() + static_cast<std::size_t>(k) * beams;
+    const int* oy = dy.data() + static_cast<std::size_t>(k) * beams;
+    // m.value() inlined: one unsigned comparison per axis finds the ends off the stored grid
+    const int pad = (1 << level) - 1;
+    const auto pw = static_cast<unsigned>(m.frame_.width() + pad), ph = static_cast<unsigned>(m.frame_.height() + pad);
+    const float* grid = m.pooled_[static_cast<std::size_t>(level)].data();
+    const float outside = m.outside_;
+    const int gx = x + pad, gy = y + pad;
+    double sum = 0.0;
+    for (int b = 0; b < beams; ++b) {
+      const auto xx = static_cast<unsigned>(gx + ox[b]), yy = static_cast<unsigned>(gy + oy[b]);
+      sum += (xx < pw && yy < ph) ? grid[static_cast<std::size_t>(yy) * pw + xx] : outside;
+    }
+    return sum;
+  }
+
+  bool close(const Pose2& a, const Pose2& b, double scale) const {
+    return std::hypot(a.x - b.x, a.y - b.y) < scale * m.params_.min_distance &&
+           std::abs(normalize_angle(a.theta - b.theta)) < scale * m.params_.min_angle;
+  }
+
+  void raise(double t) {
+    double cur = threshold.load();
+    while (t > cur && !threshold.compare_exchange_weak(cur, t)) {
+    }
+  }
+
+  void leaf(Worker& w, double score, int x, int y, int k) {
+    if (score < threshold.load()) return;
+    const int width = m.frame_.width(), height = m.frame_.height();
+    Leaf l{score, (static_cast<std::int64_t>(k) * height + y) * width + x, x, y, k, m.lattice_pose(x, y, k, headings)};
+    w.leaves.push_back(l);
+    // Keep k found poses pairwise "far" (2 min_distance or 2 min_angle apart), trading a member
+    // for a better pose when that keeps them far; their lowest score bounds the k-th result.
+    const auto kk = static_cast<std::size_t>(m.params_.hypotheses);
+    std::lock_guard<std::mutex> lock(far_mutex);
+    std::size_t near = far.size(), count = 0;
+    for (std::size_t i = 0; i < far.size(); ++i) {
+      if (close(far[i].pose, l.pose, 2.0)) near = i, ++count;
+    }
+    if (count == 0 && far.size() < kk) {
+      far.push_back(l);
+    } else if (count == 0 || count == 1) {
+      if (count == 0) {
+        near = static_cast<std::size_t>(std::min_element(far.begin(), far.end(), [](const Leaf& a, const Leaf& b) {
+                                          return a.score < b.score;
+                                        }) - far.begin());
+      }
+      if (score > far[near].score) far[near] = l;
+    }
+    if (far.size() == kk) {
+      double lowest = far[0].score;
+      for (const auto& f : far) lowest = std::min(lowest, f.score);
+      raise(lowest);
+    }
+    if (w.leaves.size() >= 2 * w.compacted + 4096) {
+      const double t = threshold.load();
+      w.leaves.erase(std::remove_if(w.leaves.begin(), w.leaves.end(), [t](const Leaf& a) { return a.score < t; }),
+                     w.leaves.end());
+      w.compacted = w.leaves.size();
+    }
+  }
+
+  // Hess et al. Algorithm 3: depth first, children in order of their bounds.
+  void descend(Worker& w, int level, int x, int y, int k, double b) {
+    if (b < threshold.load()) return;
+    if (level == 0) return leaf(w, b, x, y, k);
+    const int half = 1 << (level - 1);
+    std::tuple<double, int, int> kids[4];
+    int n = 0;
+    for (int j = 0; j < 2; ++j) {
+      for (int i = 0; i < 2; ++i) {
+        const int cx = x + i * half, cy = y + j * half;
+        if (cx >= m.frame_.width() || cy >= m.frame_.height() || !m.has_free(level - 1, cx, cy)) continue;
+        kids[n++] = {bound(level - 1, cx, cy, k), cx, cy};
+      }
+    }
+    std::stable_sort(kids, kids + n, [](const auto& a, const auto& b2) { return std::get<0>(a) > std::get<0>(b2); });
+    for (int i = 0; i < n; ++i) descend(w, level - 1, std::get<1>(kids[i]), std::get<2>(kids[i]), k, std::get<0>(kids[i]));
+  }
+};
+
+std::vector<PoseHypothesis> CorrelativeScanMatcher::match(const double* angles, const float* ranges,
+                                                          std::size_t n) const {
+  const ScanBeams beams = used_beams(angles, ranges, n, max_range_, params_.likelihood.max_beams);
+  Search s(*this);
+  s.headings = heading_count(beams, frame_.resolution(), params_.angular_step);
+  s.beams = static_cast<int>(beams.size());
+  if (s.beams == 0) return {};
+  // Each heading is one rotated scan, its ends rounded to cell offsets from the laser's cell
+  // (the laser at a cell centre, as LikelihoodFieldModel reads the end cells).
+  const double inv_res = 1.0 / frame_.resolution();
+  s.dx.resize(static_cast<std::size_t>(s.headings) * s.beams);
+  s.dy.resize(s.dx.size());
+  for (int k = 0; k < s.headings; ++k) {
+    const double th = normalize_angle(k * (2.0 * kPi / s.headings));
+    const double c = std::cos(th), sn = std::sin(th);
+    for (int b = 0; b < s.beams; ++b) {
+      const double bx = beams.range[b] * beams.cos[b] * inv_res, by = beams.range[b] * beams.sin[b] * inv_res;
+      const std::size_t i = static_cast<std::size_t>(k) * s.beams + b;
+      s.dx[i] = static_cast<int>(std::floor(0.5 + (c * bx - sn * by)));
+      s.dy[i] = static_cast<int>(std::floor(0.5 + (sn * bx + c * by)));
+    }
+  }
+  // The coarsest nodes, scored in parallel and visited best bound first.
+  const int top = params_.depth, side = 1 << top, w = frame_.width(), h = frame_.height();
+  const int nx = (w + side - 1) / side, ny = (h + side - 1) / side;
+  struct Node {
+    double bound;
+    std::int64_t index;
+  };
+  std::vector<Node> nodes(static_cast<std::size_t>(nx) * ny * s.headings);
+  const auto node_cell = [&](std::int64_t i, int& x, int& y, int& k) {
+    x = static_cast<int>(i % nx) * side, y = static_cast<int>((i / nx) % ny) * side, k = static_cast<int>(i / (nx * ny));
+  };
+  parallel_for(nodes.size(), params_.threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      int x, y, k;
+      node_cell(static_cast<std::int64_t>(i), x, y, k);
+      // a node without a free cell is not searched (index -1)
+      nodes[i] = has_free(top, x, y) ? Node{s.bound(top, x, y, k), static_cast<std::int64_t>(i)} : Node{0.0, -1};
+    }
+  }, 64);
+  nodes.erase(std::remove_if(nodes.begin(), nodes.end(), [](const Node& n) { return n.index < 0; }), nodes.end());
+  std::sort(nodes.begin(), nodes.end(), [](const Node& a, const Node& b) {
+    return a.bound > b.bound || (a.bound == b.bound && a.index < b.index);
+  });
+  // Workers take the next node of that order as they come free; they share only the (safe)
+  // threshold, so which worker searches which node does not change the result.
+  const std::size_t t = std::min<std::size_t>(static_cast<std::size_t>(resolve_threads(params_.threads)), nodes.size());
+  std::vector<Search::Worker> workers(t);
+  std::atomic<std::size_t> next{0};
+  parallel_for(t, params_.threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t wi = begin; wi < end; ++wi) {
+      for (std::size_t i = next++; i < nodes.size(); i = next++) {
+        int x, y, k;
+        node_cell(nodes[i].index, x, y, k);
+        s.descend(workers[wi], top, x, y, k, nodes[i].bound);
+      }
+    }
+  }, 1);
+  // The greedy selection over the leaves kept, which hold every pose it can take.
+  std::vector<Leaf> all;
+  for (auto& wk : workers) all.insert(all.end(), wk.leaves.begin(), wk.leaves.end());
+  std::sort(all.begin(), all.end(), before);
+  std::vector<PoseHypothesis> out;
+  for (const Leaf& l : all) {
+    if (out.size() == static_cast<std::size_t>(params_.hypotheses)) break;
+    const bool taken = std::any_of(out.begin(), out.end(), [&](const PoseHypothesis& o) { return s.close(o.pose, l.pose, 1.0); });
+    if (!taken) out.push_back({l.pose, l.score, l.x, l.y, l.k});
+  }
+  if (params_.likelihood.combination == BeamCombination::nav2) {
+    for (auto& o : out) o.score = std::log1p(o.score);
+  }
+  return out;
+}
+
+}  // namespace kiseki
