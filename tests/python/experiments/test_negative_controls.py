@@ -4,7 +4,12 @@
 method by its baseline or switches off what the claim is about), at the control's trial count,
 its verdict must be *fails*, not inconclusive. The checking function itself is tested with
 deliberately weakened controls (one that leaves the method unchanged, one too small to decide),
-and every criterion is checked against the bounds of its quantity (no share >= 0)."""
+and every criterion is checked against the bounds of its quantity (no share >= 0).
+
+Why some controls take about 20 s: a control runs its experiment for real, for the trials it
+states, and a verdict needs an interval, so at least 5 trials (verdict.MIN_TRIALS). exp2-turn's
+runs 5 teaching-and-playback trials of the turn; magnav-table-4-2's filter-off control drives the
+whole 118 m route 5 times, because its claims are about the error over the whole route."""
 
 from __future__ import annotations
 
