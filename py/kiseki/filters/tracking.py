@@ -338,16 +338,22 @@ def localize(
     resets = np.full(n, "none", dtype=object)
     seconds: list[float] = []
 
+    weighed_with: list = [None]  # the model holding the scan the last update weighed with
+
+    def prepared(k: int):
+        weighed_with[0] = prepare(k)
+        return weighed_with[0]
+
     for k in tqdm(range(n), desc=config.method, unit="scan", disable=not progress):
         start = time.perf_counter()
-        report = localizer.step(odom[k], lambda k=k: prepare(k))
+        report = localizer.step(odom[k], lambda k=k: prepared(k))
         if report is not None:
             seconds.append(time.perf_counter() - start)
             updated[k] = True
             resets[k] = report.reset
             if learned is not None:
                 probability, features[k] = learned.update(
-                    prepare(k), localizer.estimate, report.agreement
+                    weighed_with[0], localizer.estimate, report.agreement
                 )
         estimates[k] = localizer.estimate
         engine_reliability[k] = localizer.reliability
