@@ -10,6 +10,7 @@
 #include "kiseki/models/likelihood_field.hpp"
 #include "kiseki/models/local_map.hpp"
 #include "kiseki/models/magnetic_map_model.hpp"
+#include "kiseki/models/ray_space_observation.hpp"
 #include "kiseki/models/space_observation.hpp"
 #include "numpy_helpers.hpp"
 
@@ -182,6 +183,29 @@ void bind_models(py::module_& m) {
              const auto [a, r] = beams(a_in, r_in);
              bm.set_scan(a.data(), r.data(), static_cast<std::size_t>(a.shape(0)), max_range);
            }, "angles"_a, "ranges"_a, "max_range"_a);
+
+  py::class_<RaySpaceObservationModel, SensorModel>(m, "RaySpaceObservationModel")
+      .def(py::init([](const OccupancyGrid& map, double sigma, double z_hit, double z_rand,
+                       double z_intrusion, double lambda_short, double max_distance,
+                       int max_beams, const Pose2& sensor, double tolerance) {
+             RaySpaceObservationParams p;
+             p.sigma_hit = sigma, p.z_hit = z_hit, p.z_rand = z_rand, p.z_intrusion = z_intrusion;
+             p.lambda_short = lambda_short, p.max_distance = max_distance;
+             p.max_beams = max_beams, p.sensor = sensor, p.agreement_tolerance = tolerance;
+             return std::make_unique<RaySpaceObservationModel>(map, p);
+           }),
+           "map"_a, "sigma_hit"_a = 0.2, "z_hit"_a = 0.95, "z_rand"_a = 0.05,
+           "z_intrusion"_a = 0.95, "lambda_short"_a = 0.1, "max_distance"_a = 2.0, "max_beams"_a = 0,
+           "sensor"_a = Pose2(), "agreement_tolerance"_a = 0.2)
+      .def("set_scan",
+           [](RaySpaceObservationModel& model, const py::handle& a_in, const py::handle& r_in,
+              double max_range) {
+             const auto [a, r] = beams(a_in, r_in);
+             model.set_scan(a.data(), r.data(), static_cast<std::size_t>(a.shape(0)), max_range);
+           }, "angles"_a, "ranges"_a, "max_range"_a)
+      .def("beam_probability", &RaySpaceObservationModel::beam_probability, "range"_a,
+           "penetration"_a, "end_distance"_a,
+           "pz of one beam from its reading, penetration depth and its end's distance to a wall.");
 
   py::class_<SpaceObservationModel, SensorModel>(m, "SpaceObservationModel")
       .def(py::init([](const OccupancyGrid& map, double sp, double si, double step, bool occ) {

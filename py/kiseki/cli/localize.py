@@ -74,7 +74,8 @@ def localize_command(
     # LocalizeConfig's method, GlobalConfig's too (the same: a test holds them equal)
     method: str = typer.Option(
         default_of(LocalizeConfig, "method"),
-        help="beam, likelihood-field, space-observation or odometry.",
+        help="beam, likelihood-field, space-observation (the thesis'), ray-space-observation "
+        "(kiseki's: the thesis' penetration per ray, and where beams end) or odometry.",
     ),
     seed: int = typer.Option(
         default_of(LocalizeConfig, "seed"),

@@ -62,6 +62,9 @@ __all__ = [
 ]
 
 
+GLOBAL_METHODS = ("likelihood-field", "space-observation", "ray-space-observation")
+
+
 @dataclass(frozen=True)
 class GlobalConfig:
     """Parameters of global localization (units m, rad). Why each default:
@@ -111,9 +114,9 @@ class GlobalConfig:
     threads: int = 0
 
     def __post_init__(self) -> None:
-        if self.method not in ("likelihood-field", "space-observation"):
+        if self.method not in GLOBAL_METHODS:
             raise ValueError(
-                "global localization: method must be likelihood-field or space-observation, "
+                f"global localization: method must be one of {', '.join(GLOBAL_METHODS)}, "
                 f"got {self.method!r}"
             )
         check_seed(self.seed)

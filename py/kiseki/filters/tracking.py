@@ -49,7 +49,13 @@ __all__ = [
     "scan_preparer",
 ]
 
-LOCALIZATION_METHODS = ("odometry", "space-observation", "likelihood-field", "beam")
+LOCALIZATION_METHODS = (
+    "odometry",
+    "space-observation",
+    "ray-space-observation",
+    "likelihood-field",
+    "beam",
+)
 
 
 def _check(condition: bool, message: str) -> None:
@@ -90,6 +96,10 @@ class LocalizeConfig:
     * ``beams`` 90: nav2's max_beams rule (every k-th beam); 90 is half of a 180-beam scan.
     * ``sigma_hit`` 0.2 m (nav2); ``z_hit`` 0.95 / ``z_rand`` 0.05 (Probabilistic Robotics'
       likelihood field); the beam model adds ``z_short``, ``z_max``, ``lambda_short`` (nav2's).
+    * ``ray-space-observation`` (kiseki's, ``kiseki._core.RaySpaceObservationModel``): the
+      likelihood field's terms, the thesis' penetration per ray, and ``z_intrusion`` 0.95 (=
+      z_hit: equal prior odds that a beam's end is a mapped wall or an unmapped object) times
+      the beam model's ``lambda_short`` density for a beam stopped short in free space.
     * ``combination`` product (beams independent) or nav2 (1 + sum pz^3).
     * ``alphas`` None: :func:`motion_alphas` (the noise the odometry has).
     * the engine's settings (particles, KLD, resampling, recovery, update thresholds,
@@ -109,6 +119,7 @@ class LocalizeConfig:
     z_short: float = 0.05
     z_max: float = 0.05
     lambda_short: float = 0.1
+    z_intrusion: float = 0.95
     combination: str = "product"
     kld: bool = MclConfig.kld
     min_particles: int = MclConfig.min_particles
@@ -212,10 +223,21 @@ def scan_model(method: str, grid: OccupancyGrid, config: LocalizeConfig | None =
             max_beams=config.beams,
             combination=combination,
         )
+    if method == "ray-space-observation":
+        return _core.RaySpaceObservationModel(
+            grid,
+            sigma_hit=config.sigma_hit,
+            z_hit=config.z_hit,
+            z_rand=config.z_rand,
+            z_intrusion=config.z_intrusion,
+            lambda_short=config.lambda_short,
+            max_beams=config.beams,
+        )
     if method == "space-observation":
         return ScanSpaceObservation(grid)
     raise ValueError(
-        f"no sensor model for method {method!r}: use likelihood-field, beam or space-observation"
+        f"no sensor model for method {method!r}: use likelihood-field, beam, space-observation "
+        "or ray-space-observation"
     )
 
 
