@@ -12,6 +12,7 @@
 #include "kiseki/core/random.hpp"
 #include "kiseki/grid/ray_casting.hpp"
 #include "kiseki/models/local_map.hpp"
+#include "kiseki/models/ray_space_observation.hpp"
 #include "kiseki/models/space_observation.hpp"
 #include "kiseki/sim/box_world.hpp"
 
@@ -278,4 +279,39 @@ TEST(SpaceObservation, VisibilityReachesEveryCellOfAnOpenWindowAndStopsAtWalls) 
   const OccupancyGrid wall = walled.visibility(Pose2(9.7, 10.0, 0.0));  // cell (97, 100)
   for (int j = 0; j < wall.height(); ++j)
     for (int i = 0; i < wall.width(); ++i) ASSERT_EQ(wall.value(i, j), i == 57 && j == 57 ? 1 : 0);
+}
+
+// A wall one cell thick at x in [5.0, 5.1) across a 10 m x 4 m floor; the robot at (1.05,
+// 2.05) looks along +x with one beam, max range 10 m: the wall is 3.95 m ahead.
+TEST(RaySpaceObservation, OneBeamIsTheMixtureByHand) {
+  OccupancyGrid g(100, 40, 0.1, Pose2(), kFree);
+  for (int y = 0; y < 40; ++y) g.set(50, y, kOccupied);
+  RaySpaceObservationModel model(g);
+  const RaySpaceObservationParams& p = model.params();
+  const double angle = 0.0, max_range = 10.0;
+  const Pose2 robot(1.05, 2.05, 0.0);
+  auto gauss = [&](double h) {
+    return p.z_hit * std::exp(-h * h / (2 * p.sigma_hit * p.sigma_hit)) / (std::sqrt(2 * kPi) * p.sigma_hit);
+  };
+  double out = 0.0;
+  // Stopped 2 m short of the wall (an intrusion): the end is 2.0 m from the wall's cell
+  // centre (capped at max_distance 2.0), and the intrusion term applies.
+  const float short_reading = 2.0f;
+  model.set_scan(&angle, &short_reading, 1, max_range);
+  model.log_likelihoods(&robot, 1, &out);
+  EXPECT_NEAR(out, std::log(gauss(2.0) + p.z_intrusion * p.lambda_short * std::exp(-p.lambda_short * 2.0) +
+                            p.z_rand / max_range), 1e-9);
+  // Through the wall (a penetration): no intrusion term, and scored by the depth past the
+  // wall's face 3.95 m away (0.55 m), which exceeds the end's distance to the wall's centre
+  // (0.5 m: the end's cell centre at 5.55, the wall's at 5.05).
+  const float long_reading = 4.5f;
+  model.set_scan(&angle, &long_reading, 1, max_range);
+  model.log_likelihoods(&robot, 1, &out);
+  EXPECT_NEAR(out, std::log(gauss(0.55) + p.z_rand / max_range), 1e-9);
+  // A no-return is skipped: nothing to weigh.
+  const float none = std::numeric_limits<float>::infinity();
+  model.set_scan(&angle, &none, 1, max_range);
+  model.log_likelihoods(&robot, 1, &out);
+  EXPECT_EQ(out, 0.0);
+  EXPECT_EQ(model.readings(), 0u);
 }

@@ -96,3 +96,27 @@ def test_exp3_boxes_are_in_the_played_back_world(tmp_path, short_corridor):
     row = claims.loc["proposal 2 with unknown boxes: estimate error mean"]
     assert row["measured_value"] == f"{t['proposal2_estimate_error']:.3f}"
     assert _point_verdict(row) == (t["proposal2_estimate_error"] <= 0.08)
+
+
+def test_exp3_with_kisekis_ray_model_stops_by_the_rule_and_its_claim_is_the_paired_difference(
+    tmp_path, short_corridor
+):
+    """ray=true plays the same run (teaching, boxes, seeds) again with kiseki's ray space
+    observation model on the cameras' local map read as a scan: it stops within the thesis'
+    0.1 m too, and the claim's value is the mean of the per-run differences."""
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "experiment", "run", "exp3-boxes", "--runs", "1"]
+        + ["--seed", "0", "--set", f"scene={short_corridor}", "--set", "particles=200"]
+        + ["--set", "ray=true", "--out", "r"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 0, done.stderr
+    t = pd.read_parquet(tmp_path / "r" / "trials.parquet").iloc[0]
+    assert t["proposal2_ray_stop_error"] <= 0.1 and t["proposal2_ray_reached"]
+    claims = pd.read_csv(tmp_path / "r" / "claims.csv", keep_default_na=False)
+    row = claims[claims["claim"].str.startswith("with unknown boxes, kiseki's ray")].iloc[0]
+    difference = t["proposal2_ray_stop_error"] - t["proposal2_stop_error"]
+    assert row["measured_value"].startswith(f"{difference:.4g} ")
+    assert row["verdict"] == "inconclusive"  # one run gives no interval

@@ -39,7 +39,9 @@ def reference_log_likelihood(grid: OccupancyGrid, pose, ranges) -> tuple[float, 
     millimetre decides whether the beam penetrates; both branches are allowed)."""
     res, ox, oy = grid.resolution, grid.origin.x, grid.origin.y
     occupied = np.argwhere(grid.cells >= 65)  # (row, col)
-    centres = np.column_stack([ox + (occupied[:, 1] + 0.5) * res, oy + (occupied[:, 0] + 0.5) * res])
+    centres = np.column_stack(
+        [ox + (occupied[:, 1] + 0.5) * res, oy + (occupied[:, 0] + 0.5) * res]
+    )
     x, y, theta = pose
     low = high = 0.0
     steps = np.arange(0.0, MAX_RANGE + 1e-3, 1e-3)

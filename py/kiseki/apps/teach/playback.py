@@ -77,6 +77,12 @@ class PlaybackConfig:
     # (Each sum rounded up to 1, 2 or 5 times a power of ten.)
     alphas: tuple[float, float, float, float] = (0.002, 0.002, 0.0005, 0.0005)
     max_duration: float = 300.0
+    # The sensor model: the thesis' space observation model on the local map L, or kiseki's
+    # ray space observation model on L read as a scan (``scan_beams`` rays from the robot, to
+    # L's first occupied cell; those reaching L's edge are no-returns), so that both weigh
+    # exactly what the cameras saw.
+    model: str = "space-observation"
+    scan_beams: int = 360
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -87,6 +93,17 @@ class PlaybackConfig:
             )
         if not self.dt > 0 or not self.goal_tolerance > 0:
             raise ValueError("dt > 0 and goal_tolerance > 0 are needed")
+        if self.model not in PLAYBACK_MODELS:
+            raise ValueError(
+                f"model must be one of {', '.join(PLAYBACK_MODELS)}, got {self.model!r}"
+            )
+        if not (isinstance(self.scan_beams, int) and 1 <= self.scan_beams <= 100_000):
+            raise ValueError(
+                f"scan_beams must be an integer in 1..100,000, got {self.scan_beams!r}"
+            )
+
+
+PLAYBACK_MODELS = ("space-observation", "ray-space-observation")
 
 
 @dataclass
@@ -192,7 +209,11 @@ class PlaybackRun:
         if speed_limiter is not None:
             self.limiter = _ScanLimiter(scene, sensors, speed_limiter, config.dt)
         self.maker = LocalMapMaker(self.cameras, band)
-        self.model = _core.SpaceObservationModel(environment, occlusion_aware=occlusion)
+        if config.model == "ray-space-observation":
+            self.model = _core.RaySpaceObservationModel(environment)
+            self._angles = np.linspace(-np.pi, np.pi, config.scan_beams, endpoint=False)
+        else:
+            self.model = _core.SpaceObservationModel(environment, occlusion_aware=occlusion)
         self.localizer = MonteCarloLocalizer(
             MclConfig(particles=config.particles, alphas=tuple(config.alphas)),
             derive_seed(config.seed, 2),
@@ -300,7 +321,13 @@ class PlaybackRun:
 
     def _observe(self):
         images = [c.render(self.scene.world, self._observed) for c in self.cameras]
-        self.model.set_local_map(self.maker.make(images))
+        local = self.maker.make(images)
+        if self.config.model == "ray-space-observation":
+            reach = 0.5 * self.maker.size  # the robot is at L's centre, L's origin at -reach
+            ranges = local.cast_scans(np.zeros((1, 3)), self._angles, max_range=reach)[0]
+            self.model.set_scan(self._angles, ranges.astype(np.float32), reach)
+        else:
+            self.model.set_local_map(local)
         return self.model
 
     def result(self) -> PlaybackResult:
