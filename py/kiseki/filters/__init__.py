@@ -43,6 +43,7 @@ from kiseki.filters.relocalization import (
     Hypothesis,
     RelocalizeConfig,
     Relocalizer,
+    SearchDisc,
     relocalize,
     render_hypotheses,
 )
@@ -79,6 +80,7 @@ __all__ = [
     "Relocalizer",
     "ScanFit",
     "ScanSpaceObservation",
+    "SearchDisc",
     "convergence_report",
     "describe",
     "global_localize",

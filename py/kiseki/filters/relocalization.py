@@ -26,7 +26,14 @@ from kiseki import _core
 from kiseki.errors import RelocalizationError
 from kiseki.grid import OccupancyGrid
 
-__all__ = ["Hypothesis", "RelocalizeConfig", "Relocalizer", "relocalize", "render_hypotheses"]
+__all__ = [
+    "Hypothesis",
+    "RelocalizeConfig",
+    "Relocalizer",
+    "SearchDisc",
+    "relocalize",
+    "render_hypotheses",
+]
 
 
 @dataclass(frozen=True)
@@ -106,6 +113,26 @@ class Hypothesis:
     heading: int  # heading index on the lattice
 
 
+@dataclass(frozen=True)
+class SearchDisc:
+    """A disc (centre ``x``, ``y`` and ``radius`` in m, map frame) that restricts a search:
+    ``inside`` keeps the lattice poses whose robot position is at most ``radius`` from the
+    centre, otherwise those more than ``radius`` from it. The best pose on either side is
+    exact, as the unrestricted search is (nodes with no cell on that side are pruned)."""
+
+    x: float
+    y: float
+    radius: float
+    inside: bool = True
+
+    def __post_init__(self) -> None:
+        if not all(_finite(v) for v in (self.x, self.y, self.radius)) or self.radius < 0:
+            raise RelocalizationError(
+                "relocalize: a search disc needs a finite centre and a radius >= 0, got "
+                f"({self.x!r}, {self.y!r}), {self.radius!r}"
+            )
+
+
 class Relocalizer:
     """The matcher of one map and maximum range: its score table and max-pooled grids are
     built once (here), then each :meth:`match` searches one scan."""
@@ -149,10 +176,13 @@ class Relocalizer:
             threads=config.threads,
         )
 
-    def match(self, angles: np.ndarray, ranges: np.ndarray) -> list[Hypothesis]:
+    def match(
+        self, angles: np.ndarray, ranges: np.ndarray, disc: SearchDisc | None = None
+    ) -> list[Hypothesis]:
         """The ranked hypotheses of one scan: ``angles`` (B,) rad and ``ranges`` (B,) m in the
         laser frame (NaN invalid, +inf or ``>= max_range`` no return, both skipped); an empty
-        list when no beam returned."""
+        list when no beam returned. With ``disc``, only the poses on its side are ranked (an
+        empty list when none is)."""
         try:
             angles = np.asarray(angles, dtype=np.float64)
             with np.errstate(over="ignore"):  # beyond float32: +inf, a no return
@@ -168,7 +198,14 @@ class Relocalizer:
             )
         if not np.isfinite(angles).all():
             raise RelocalizationError("relocalize: beam angles must be finite")
-        poses, scores, lattice = self._matcher.match(angles, ranges)
+        if disc is not None and not isinstance(disc, SearchDisc):
+            raise RelocalizationError(
+                f"relocalize: disc must be a SearchDisc, got {type(disc).__name__}"
+            )
+        region = (
+            None if disc is None else _core.SearchDisc(disc.x, disc.y, disc.radius, disc.inside)
+        )
+        poses, scores, lattice = self._matcher.match(angles, ranges, region)
         return [
             Hypothesis(
                 x=float(p[0]),
