@@ -158,6 +158,9 @@ class Relocalizer:
                 f"relocalize: sensor must be three finite numbers, got {sensor!r}"
             )
         self.config = config
+        self._grid, self._max_range = grid, float(max_range)
+        self._sensor = _core.Pose2(*(float(v) for v in sensor))
+        self._field = None  # the likelihood field of scores(), built on first use
         self._matcher = _core.CorrelativeScanMatcher(
             grid,
             max_range=float(max_range),
@@ -217,6 +220,31 @@ class Relocalizer:
             )
             for p, s, c in zip(poses, scores, lattice, strict=True)
         ]
+
+    def scores(self, angles: np.ndarray, ranges: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """The score of any robot poses (N, 3), on the lattice or off it: the likelihood
+        field's log-likelihood of the scan there with the matcher's beams and parameters (at a
+        lattice pose, its hypothesis' score)."""
+        poses = np.asarray(poses, dtype=np.float64)
+        if poses.ndim != 2 or poses.shape[1] != 3 or not np.isfinite(poses).all():
+            raise RelocalizationError(
+                f"relocalize: poses must be finite (N, 3) x, y, theta, got shape {poses.shape}"
+            )
+        if self._field is None:
+            c = self.config
+            self._field = _core.LikelihoodFieldModel(
+                self._grid,
+                sigma_hit=c.sigma_hit,
+                z_hit=c.z_hit,
+                z_rand=c.z_rand,
+                max_beams=c.beams,
+                max_distance=c.max_distance,
+                sensor=self._sensor,
+            )
+        self._field.set_scan(
+            np.asarray(angles, np.float64), np.asarray(ranges, np.float32), self._max_range
+        )
+        return np.asarray(self._field.log_likelihoods(poses), dtype=np.float64)
 
     def headings(self, angles: np.ndarray, ranges: np.ndarray) -> int:
         """Headings of the search lattice for this scan."""

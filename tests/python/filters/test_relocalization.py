@@ -46,6 +46,11 @@ def test_hypotheses_are_the_brute_force_selection(seed):
     for g in got:
         assert scores[g.heading, g.cell[1], g.cell[0]] == pytest.approx(g.score, abs=1e-6)
     assert got[0].score == pytest.approx(scores.max(), abs=1e-6)
+    # scores() of the hypotheses' poses, the likelihood field read pose by pose, agrees
+    poses = np.array([[g.x, g.y, g.theta] for g in got])
+    np.testing.assert_allclose(
+        matcher.scores(angles, ranges, poses), [g.score for g in got], rtol=0, atol=1e-4
+    )
     two = relocalize(
         grid, angles, ranges, MAX_RANGE, RelocalizeConfig(**{**config.__dict__, "threads": 2})
     )
