@@ -44,6 +44,7 @@ from kiseki.filters.relocalization import (
     RelocalizeConfig,
     Relocalizer,
     SearchDisc,
+    hypothesis_cloud,
     relocalize,
     render_hypotheses,
 )
@@ -84,6 +85,7 @@ __all__ = [
     "convergence_report",
     "describe",
     "global_localize",
+    "hypothesis_cloud",
     "localize",
     "motion_alphas",
     "noisy_odometry",

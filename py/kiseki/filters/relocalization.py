@@ -31,6 +31,7 @@ __all__ = [
     "RelocalizeConfig",
     "Relocalizer",
     "SearchDisc",
+    "hypothesis_cloud",
     "relocalize",
     "render_hypotheses",
 ]
@@ -264,6 +265,33 @@ def relocalize(
     """The ``config.hypotheses`` best distinct poses of one scan over the whole map, best first
     (see :class:`Relocalizer`; ``sensor`` is the laser's pose in the robot frame)."""
     return Relocalizer(grid, max_range, config, sensor).match(angles, ranges)
+
+
+def hypothesis_cloud(
+    hypotheses: list[Hypothesis],
+    count: int,
+    sd_xy: float,
+    sd_theta: float,
+    power: float,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """``count`` poses (count, 3) around ranked hypotheses: hypothesis i gets a share of them
+    proportional to exp(power * (score_i - best score)) (its score as a tempered
+    log-likelihood; the largest remainders round the shares to whole poses), each drawn from a
+    Gaussian of ``sd_xy`` per axis and ``sd_theta`` around it."""
+    if not hypotheses:
+        raise RelocalizationError("relocalize: no hypotheses to draw a cloud around")
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+        raise RelocalizationError(f"relocalize: count must be an integer >= 1, got {count!r}")
+    scores = np.array([h.score for h in hypotheses])
+    share = np.exp(power * (scores - scores.max()))
+    share *= count / share.sum()
+    counts = np.floor(share).astype(np.int64)
+    counts[np.argsort(counts - share, kind="stable")[: count - counts.sum()]] += 1
+    centre = np.repeat([[h.x, h.y, h.theta] for h in hypotheses], counts, axis=0)
+    poses = centre + rng.normal(0.0, 1.0, (count, 3)) * [sd_xy, sd_xy, sd_theta]
+    poses[:, 2] = np.remainder(poses[:, 2] + math.pi, 2 * math.pi) - math.pi
+    return poses
 
 
 def render_hypotheses(
