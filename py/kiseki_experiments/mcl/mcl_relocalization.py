@@ -39,22 +39,20 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Annotated
 
 import numpy as np
-import pandas as pd
 from pydantic import Field
 
 from kiseki.datasets import read_carmen_log
 from kiseki.filters import RelocalizeConfig, Relocalizer, SearchDisc
 from kiseki.mapping import MapBuildConfig, map_of_log
-from kiseki.plots import new_figure
-from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
+from kiseki_experiments.harness.base import Experiment, TrialOutput
 from kiseki_experiments.harness.config import Count, PositiveReal, Resolution, Share, Threads
 from kiseki_experiments.harness.paths import CARMEN_LOGS, shared_data
-from kiseki_experiments.harness.records import pack, unpack
-from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion, Evidence
+from kiseki_experiments.harness.records import pack
+from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion
+from kiseki_experiments.mcl.mcl_relocalization_report import analyze
 
 __all__ = ["EXPERIMENT", "RelocalizationConfig", "ScanOutcome", "draw_scans", "judge_scan"]
 
@@ -193,85 +191,6 @@ def trial(config: RelocalizationConfig, index: int, seed: int) -> TrialOutput:
         "max_s": float(seconds.max()),
     }
     return TrialOutput(record, timings)
-
-
-def analyze(
-    config: RelocalizationConfig, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path
-):
-    ok = trials[trials["error"].isna()].merge(timings, on="trial")
-    rows, evidence = [], []
-    for log, group in ok.groupby("log", sort=False):
-        n, ident = int(group["scans"].sum()), int(group["identifiable"].sum())
-        hits = int(group["best_hit_identifiable"].sum())
-        rows.append(
-            {
-                "log": log,
-                "scans": n,
-                "identifiable_share": ident / n,
-                "identifiable_by_truth_score_share": group["identifiable_by_truth_score"].sum() / n,
-                "best_hit_of_identifiable": f"{hits}/{ident}",
-                "best_hit_share_all": group["best_hit"].sum() / n,
-                "top_hit_share_all": group["top_hit"].sum() / n,
-                "median_s_per_scan": group["median_s"].median(),
-                "p90_s_per_scan": group["p90_s"].max(),
-                "max_s_per_scan": group["max_s"].max(),
-            }
-        )
-        evidence.append(
-            Evidence.share(
-                "best-of-identifiable",
-                hits,
-                ident,
-                subject=log,
-                shown=f"{hits} of {ident} identifiable ({ident} of {n} scans)",
-            )
-        )
-    table = pd.DataFrame(rows)
-    total, top = int(ok["scans"].sum()), int(ok["top_hit"].sum())
-    evidence.append(
-        Evidence.share(
-            "top-5-of-all",
-            top,
-            total,
-            subject="all logs",
-            shown=f"{top} of {total} scans",
-        )
-    )
-    path = _figure(config, ok, figures / "relocalization.png")
-    notes = (
-        f"{config.scans} scans per trial spread over each log; map at {config.resolution} m; "
-        f"a hit is within {config.hit_distance} m and {config.hit_angle_deg} deg of the "
-        f"reference pose; identifiable: no lattice pose more than {config.near_radius} m from "
-        f"it scores within {100 * config.score_tolerance:g} % (of the magnitude) of the best "
-        f"lattice pose within {config.near_radius} m; times are the top-{config.top} search on "
-        f"{config.threads} threads"
-        + (f"; beam angles turned by {config.scan_turn_deg} deg" if config.scan_turn_deg else "")
-    )
-    return Analysis(tables={"per_log": table}, figures=[path], notes=notes, evidence=evidence)
-
-
-def _figure(config: RelocalizationConfig, ok: pd.DataFrame, path: Path) -> Path:
-    """The best hypothesis' position error against the identifiability margin (near - far) /
-    |near| of every scan: scans right of the tolerance line are identifiable."""
-    fig = new_figure(figsize=(7, 4), dpi=120)
-    ax = fig.subplots()
-    for log, group in ok.groupby("log", sort=False):
-        near = np.concatenate([unpack(t) for t in group["near"]])
-        far = np.concatenate([unpack(t) for t in group["far"]])
-        error = np.concatenate([unpack(t) for t in group["error_m"]])
-        margin = np.where(np.isfinite(near), (near - far) / np.maximum(np.abs(near), 1e-9), -1.0)
-        label = str(log).replace("-corrected", "")
-        ax.scatter(np.clip(margin, -0.5, 1.5), np.maximum(error, 1e-3), s=6, label=label)
-    ax.axvline(config.score_tolerance, color="k", linewidth=0.8, linestyle="--")
-    ax.axhline(config.hit_distance, color="tab:red", linewidth=0.8, linestyle=":")
-    ax.set_yscale("log")
-    ax.set_xlabel(
-        "(near - far) / |near|  (clipped to [-0.5, 1.5]; right of the dashed line: identifiable)"
-    )
-    ax.set_ylabel("best hypothesis' position error (m)")
-    ax.legend(fontsize=7)
-    fig.savefig(path, bbox_inches="tight")
-    return path
 
 
 TURNED_SCAN = Control(
