@@ -4,6 +4,7 @@
 #include <pybind11/stl.h>
 
 #include <limits>
+#include <optional>
 
 #include "kiseki/filters/correlative_scan_matcher.hpp"
 #include "kiseki/filters/kld_sampling.hpp"
@@ -165,6 +166,14 @@ void bind_filters(py::module_& m) {
       .def_property_readonly("size", [](const MonteCarloLocalization& f) { return f.particles().size(); });
   m.attr("MAX_ODOMETRY_JUMP") = kMaxOdometryJump;
 
+  py::class_<SearchDisc>(m, "SearchDisc", "A disc that restricts a correlative search to one side of it.")
+      .def(py::init([](double x, double y, double radius, bool inside) { return SearchDisc{x, y, radius, inside}; }),
+           "x"_a, "y"_a, "radius"_a, "inside"_a = true)
+      .def_readonly("x", &SearchDisc::x)
+      .def_readonly("y", &SearchDisc::y)
+      .def_readonly("radius", &SearchDisc::radius)
+      .def_readonly("inside", &SearchDisc::inside);
+
   py::class_<CorrelativeScanMatcher>(m, "CorrelativeScanMatcher",
                                      "Global relocalization from one scan by branch-and-bound correlative matching.")
       .def(py::init([](const OccupancyGrid& map, double max_range, double sigma, double z_hit, double z_rand,
@@ -183,12 +192,13 @@ void bind_filters(py::module_& m) {
            "sensor"_a, "depth"_a, "angular_step"_a, "hypotheses"_a, "min_distance"_a, "min_angle"_a, "free_only"_a,
            "threads"_a)
       .def("match",
-           [](const CorrelativeScanMatcher& cm, const py::handle& a_in, const py::handle& r_in) {
+           [](const CorrelativeScanMatcher& cm, const py::handle& a_in, const py::handle& r_in,
+              std::optional<SearchDisc> disc) {
              const auto [a, r] = beams(a_in, r_in);
              std::vector<PoseHypothesis> found;
              {
                py::gil_scoped_release release;
-               found = cm.match(a.data(), r.data(), static_cast<std::size_t>(a.shape(0)));
+               found = cm.match(a.data(), r.data(), static_cast<std::size_t>(a.shape(0)), disc ? &*disc : nullptr);
              }
              const auto k = static_cast<py::ssize_t>(found.size());
              py::array_t<double> poses({k, py::ssize_t{3}}), scores(k);
@@ -200,8 +210,9 @@ void bind_filters(py::module_& m) {
                lattice.mutable_at(i, 0) = h.cell_x, lattice.mutable_at(i, 1) = h.cell_y, lattice.mutable_at(i, 2) = h.heading;
              }
              return py::make_tuple(poses, scores, lattice);
-           }, "angles"_a, "ranges"_a,
-           "(poses (k, 3), scores (k,), lattice (k, 3): cell x, cell y, heading index), best first; releases the GIL.")
+           }, "angles"_a, "ranges"_a, "disc"_a = py::none(),
+           "(poses (k, 3), scores (k,), lattice (k, 3): cell x, cell y, heading index), best first, over the poses on "
+           "the disc's side when one is given; releases the GIL.")
       .def("headings",
            [](const CorrelativeScanMatcher& cm, const py::handle& a_in, const py::handle& r_in) {
              const auto [a, r] = beams(a_in, r_in);

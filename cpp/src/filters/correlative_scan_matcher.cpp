@@ -139,6 +139,12 @@ struct CorrelativeScanMatcher::Search {
   const CorrelativeScanMatcher& m;
   int headings = 0, beams = 0;
   std::vector<int> dx, dy;  // [heading * beams + b]
+  // A disc restriction: per heading, its centre as the laser's cell coordinates (cell i's centre
+  // at i; the robot's position is the laser's shifted by the heading's rotated sensor offset),
+  // and its radius in cells.
+  const SearchDisc* disc = nullptr;
+  std::vector<double> disc_x, disc_y;
+  double disc_radius = 0.0;
   std::atomic<double> threshold{-std::numeric_limits<double>::infinity()};
 
   struct Worker {
@@ -165,6 +171,27 @@ struct CorrelativeScanMatcher::Search {
     return sum;
   }
 
+  /// Can a cell of the side x side block at (x, y) hold a pose on the disc's side? (Exact up to a
+  /// margin of 1e-6 cell that keeps a node; the leaves are tested exactly.)
+  bool on_side(int level, int x, int y, int k) const {
+    if (disc == nullptr) return true;
+    const int last = (1 << level) - 1;
+    const double px = disc_x[static_cast<std::size_t>(k)], py = disc_y[static_cast<std::size_t>(k)];
+    if (disc->inside) {
+      const double ex = std::max({x - px, 0.0, px - (x + last)}), ey = std::max({y - py, 0.0, py - (y + last)});
+      return std::hypot(ex, ey) <= disc_radius + 1e-6;
+    }
+    const double fx = std::max(std::abs(px - x), std::abs(px - (x + last)));
+    const double fy = std::max(std::abs(py - y), std::abs(py - (y + last)));
+    return std::hypot(fx, fy) > disc_radius - 1e-6;
+  }
+
+  bool kept(const Pose2& p) const {
+    if (disc == nullptr) return true;
+    const bool in = std::hypot(p.x - disc->x, p.y - disc->y) <= disc->radius;
+    return in == disc->inside;
+  }
+
   bool close(const Pose2& a, const Pose2& b, double scale) const {
     return std::hypot(a.x - b.x, a.y - b.y) < scale * m.params_.min_distance &&
            std::abs(normalize_angle(a.theta - b.theta)) < scale * m.params_.min_angle;
@@ -180,6 +207,7 @@ struct CorrelativeScanMatcher::Search {
     if (score < threshold.load()) return;
     const int width = m.frame_.width(), height = m.frame_.height();
     Leaf l{score, (static_cast<std::int64_t>(k) * height + y) * width + x, x, y, k, m.lattice_pose(x, y, k, headings)};
+    if (!kept(l.pose)) return;
     w.leaves.push_back(l);
     // Keep k found poses pairwise "far" (2 min_distance or 2 min_angle apart), trading a member
     // for a better pose when that keeps them far; their lowest score bounds the k-th result.
@@ -222,7 +250,10 @@ struct CorrelativeScanMatcher::Search {
     for (int j = 0; j < 2; ++j) {
       for (int i = 0; i < 2; ++i) {
         const int cx = x + i * half, cy = y + j * half;
-        if (cx >= m.frame_.width() || cy >= m.frame_.height() || !m.has_free(level - 1, cx, cy)) continue;
+        if (cx >= m.frame_.width() || cy >= m.frame_.height() || !m.has_free(level - 1, cx, cy) ||
+            !on_side(level - 1, cx, cy, k)) {
+          continue;
+        }
         kids[n++] = {bound(level - 1, cx, cy, k), cx, cy};
       }
     }
@@ -232,7 +263,7 @@ struct CorrelativeScanMatcher::Search {
 };
 
 std::vector<PoseHypothesis> CorrelativeScanMatcher::match(const double* angles, const float* ranges,
-                                                          std::size_t n) const {
+                                                          std::size_t n, const SearchDisc* disc) const {
   const ScanBeams beams = used_beams(angles, ranges, n, max_range_, params_.likelihood.max_beams);
   Search s(*this);
   s.headings = heading_count(beams, frame_.resolution(), params_.angular_step);
@@ -253,6 +284,24 @@ std::vector<PoseHypothesis> CorrelativeScanMatcher::match(const double* angles, 
       s.dy[i] = static_cast<int>(std::floor(0.5 + (sn * bx + c * by)));
     }
   }
+  if (disc != nullptr) {
+    if (!(disc->radius >= 0.0) || !std::isfinite(disc->radius) || !std::isfinite(disc->x) || !std::isfinite(disc->y)) {
+      throw std::invalid_argument("correlative matcher: a search disc needs a finite centre and radius >= 0");
+    }
+    s.disc = disc;
+    s.disc_radius = disc->radius * inv_res;
+    const Pose2 to_grid = frame_.origin().inverse(), offset = params_.likelihood.sensor.inverse();
+    s.disc_x.resize(static_cast<std::size_t>(s.headings));
+    s.disc_y.resize(s.disc_x.size());
+    for (int k = 0; k < s.headings; ++k) {
+      // robot = laser + R(theta) * offset, so |robot - c| = |laser - (c - R(theta) * offset)|
+      const double th = frame_.origin().theta + k * (2.0 * kPi / s.headings);
+      const Eigen::Vector2d c(disc->x - (std::cos(th) * offset.x - std::sin(th) * offset.y),
+                              disc->y - (std::sin(th) * offset.x + std::cos(th) * offset.y));
+      const Eigen::Vector2d g = to_grid.transform_point(c) * inv_res;
+      s.disc_x[static_cast<std::size_t>(k)] = g.x() - 0.5, s.disc_y[static_cast<std::size_t>(k)] = g.y() - 0.5;
+    }
+  }
   // The coarsest nodes, scored in parallel and visited best bound first.
   const int top = params_.depth, side = 1 << top, w = frame_.width(), h = frame_.height();
   const int nx = (w + side - 1) / side, ny = (h + side - 1) / side;
@@ -269,7 +318,7 @@ std::vector<PoseHypothesis> CorrelativeScanMatcher::match(const double* angles, 
       int x, y, k;
       node_cell(static_cast<std::int64_t>(i), x, y, k);
       // a node without a free cell is not searched (index -1)
-      nodes[i] = has_free(top, x, y) ? Node{s.bound(top, x, y, k), static_cast<std::int64_t>(i)} : Node{0.0, -1};
+      nodes[i] = has_free(top, x, y) && s.on_side(top, x, y, k) ? Node{s.bound(top, x, y, k), static_cast<std::int64_t>(i)} : Node{0.0, -1};
     }
   }, 64);
   nodes.erase(std::remove_if(nodes.begin(), nodes.end(), [](const Node& n) { return n.index < 0; }), nodes.end());

@@ -125,6 +125,12 @@ def localize_command(
         "--global",
         help="Global localization: start uniformly over the map's free cells (no initial pose).",
     ),
+    one_scan: bool = typer.Option(
+        False,
+        "--one-scan",
+        help="With --global: start around the first scan's best poses over the whole map "
+        "(one-scan relocalization) instead of uniformly.",
+    ),
     tracking_particles: int | None = typer.Option(
         None,
         parser=Count("--tracking-particles", 1, PARTICLE_LIMIT),
@@ -162,6 +168,8 @@ def localize_command(
         for name, value in (("--tracking-particles", tracking_particles), ("--plot", plot)):
             if value is not None:
                 raise ValueError(f"{name} applies only with --global")
+        if one_scan:
+            raise ValueError("--one-scan applies only with --global")
     elif reliability_estimate is not None:
         raise ValueError("--reliability applies only to tracking (not with --global)")
     if global_start and output.suffix.lower() == ".json":
@@ -174,7 +182,10 @@ def localize_command(
     shared = dict(method=method, seed=seed, particles=particles, kld=kld, beams=beams)
     shared.update(recovery=recovery, threads=threads)
     if global_start:
-        gconfig = GlobalConfig(**_given(**shared, tracking_particles=tracking_particles))
+        start = "one-scan" if one_scan else None  # else GlobalConfig's default
+        gconfig = GlobalConfig(
+            **_given(**shared, tracking_particles=tracking_particles, start=start)
+        )
         saved_config = {"command": "localize --global", **asdict(gconfig)}
         result = global_localize(scans, grid, gconfig, progress=True)
         trajectory, reliability = result.estimates, result.reliability

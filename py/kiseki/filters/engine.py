@@ -212,6 +212,11 @@ class MonteCarloLocalizer:
         self.engine.initialize_gaussian(Pose2(*np.asarray(pose, dtype=float)), *sd)
         self.estimate = self.engine.estimate().to_array()
 
+    def initialize_particles(self, poses: np.ndarray, weights: np.ndarray | None = None) -> None:
+        """Particles at the given poses (n, 3), with weights (normalised) or equal ones."""
+        self.engine.set_particles(np.asarray(poses, dtype=float), weights)
+        self.estimate = self.engine.estimate().to_array()
+
     def initialize_global(self) -> None:
         """Particles uniform over the free space given at construction."""
         if not self.engine.has_free_space:

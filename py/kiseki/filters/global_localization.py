@@ -3,8 +3,14 @@
 """Global localization along a recorded log: Monte Carlo localization from a uniform start
 (no initial pose), for logs without reference poses such as the CMU Wean Hall robotdata logs.
 
-* Start: ``particles`` poses drawn uniformly over the map's free cells (uniform position inside
-  each cell, uniform heading), from the seed.
+* Start (``start``): ``uniform``, ``particles`` poses drawn uniformly over the map's free cells
+  (uniform position inside each cell, uniform heading), from the seed; or ``one-scan``, the
+  first scan relocalized over the whole map (:class:`kiseki.filters.Relocalizer`, its
+  ``hypotheses`` best distinct poses with the filter's beams and sigma_hit) and the particles
+  drawn around those hypotheses (:func:`kiseki.filters.hypothesis_cloud`): shares by score,
+  tempered by ``likelihood_power`` as the scan likelihood is, a Gaussian of one map cell per
+  axis and one lattice heading step (2 pi / headings of that scan) around each, the lattice's
+  own resolution. The first update then weighs that cloud with the same first scan.
 * Motion: the odometry model of the particle filter (Probabilistic Robotics, Table 5.6),
   applied once per measurement update to the odometry since the previous update (AMCL's way).
 * Measurement: the likelihood-field model (or the space observation model) applied only once
@@ -49,6 +55,7 @@ from kiseki.filters.engine import (
     MclConfig,
     MonteCarloLocalizer,
 )
+from kiseki.filters.relocalization import RelocalizeConfig, Relocalizer, hypothesis_cloud
 from kiseki.filters.tracking import LocalizeConfig, scan_model, scan_preparer
 from kiseki.grid import OccupancyGrid
 from kiseki.scans import LaserScans, check_odometry_jumps
@@ -63,6 +70,8 @@ __all__ = [
 
 
 GLOBAL_METHODS = ("likelihood-field", "space-observation", "ray-space-observation")
+#: how the particles start: uniform over the free space, or around the first scan's hypotheses
+START_MODES = ("uniform", "one-scan")
 
 
 @dataclass(frozen=True)
@@ -93,6 +102,8 @@ class GlobalConfig:
       pi/6 ~ 0.52).
     * ``converged_radius`` 0.5 m: five map cells; a tracking cloud with the noise above is a
       few decimetres wide.
+    * ``start`` uniform (see the module's docstring for ``one-scan``); ``hypotheses`` 5, the
+      first scan's hypotheses of a one-scan start (RelocalizeConfig's default).
     """
 
     method: str = "likelihood-field"
@@ -111,6 +122,8 @@ class GlobalConfig:
     shrink_after: int = 10  # consecutive measurement updates with the spread below shrink_radius
     recovery: str = "none"  # while tracking: none, augmented or resetting
     kld: bool = False  # adapt the count by KLD sampling instead of the fixed cut
+    start: str = "uniform"  # or one-scan
+    hypotheses: int = RelocalizeConfig.hypotheses  # of a one-scan start
     threads: int = 0
 
     def __post_init__(self) -> None:
@@ -120,7 +133,12 @@ class GlobalConfig:
                 f"got {self.method!r}"
             )
         check_seed(self.seed)
-        for name in ("particles", "tracking_particles"):
+        if self.start not in START_MODES:
+            raise ValueError(
+                f"global localization: start must be one of {', '.join(START_MODES)}, "
+                f"got {self.start!r}"
+            )
+        for name in ("particles", "tracking_particles", "hypotheses"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 10**7:
                 raise ValueError(
@@ -185,7 +203,10 @@ def global_localize(
     check_odometry_jumps("global localization", scans.times, scans.odometry)
     start = time.perf_counter()
     localizer = MonteCarloLocalizer(config.mcl(), derive_seed(config.seed, 2), grid)
-    localizer.initialize_global()
+    if config.start == "one-scan":
+        localizer.initialize_particles(one_scan_start(scans, grid, config))
+    else:
+        localizer.initialize_global()
     model = scan_model(
         config.method,
         grid,
@@ -234,6 +255,29 @@ def global_localize(
     )
     report = dataclasses.replace(report, injected=injected)
     return GlobalResult(estimates, spread, counts, report, reliability, config)
+
+
+def one_scan_start(scans: LaserScans, grid: OccupancyGrid, config: GlobalConfig) -> np.ndarray:
+    """The particles of a one-scan start (see the module's docstring): the first scan's
+    hypotheses over the whole map and a cloud of ``config.particles`` poses around them."""
+    relocalizer = Relocalizer(
+        grid,
+        scans.max_range,
+        RelocalizeConfig(
+            beams=config.beams,
+            sigma_hit=config.sigma_hit,
+            hypotheses=config.hypotheses,
+            threads=config.threads,
+        ),
+    )
+    found = relocalizer.match(scans.angles, scans.ranges[0])
+    if not found:
+        raise ValueError("global localization: one-scan start: the first scan has no return")
+    step = 2 * np.pi / relocalizer.headings(scans.angles, scans.ranges[0])
+    rng = np.random.default_rng(derive_seed(config.seed, 3))
+    return hypothesis_cloud(
+        found, config.particles, grid.resolution, step, config.likelihood_power, rng
+    )
 
 
 def write_report(result: GlobalResult, path: str | os.PathLike) -> Path:

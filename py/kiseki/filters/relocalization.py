@@ -26,7 +26,15 @@ from kiseki import _core
 from kiseki.errors import RelocalizationError
 from kiseki.grid import OccupancyGrid
 
-__all__ = ["Hypothesis", "RelocalizeConfig", "Relocalizer", "relocalize", "render_hypotheses"]
+__all__ = [
+    "Hypothesis",
+    "RelocalizeConfig",
+    "Relocalizer",
+    "SearchDisc",
+    "hypothesis_cloud",
+    "relocalize",
+    "render_hypotheses",
+]
 
 
 @dataclass(frozen=True)
@@ -106,6 +114,26 @@ class Hypothesis:
     heading: int  # heading index on the lattice
 
 
+@dataclass(frozen=True)
+class SearchDisc:
+    """A disc (centre ``x``, ``y`` and ``radius`` in m, map frame) that restricts a search:
+    ``inside`` keeps the lattice poses whose robot position is at most ``radius`` from the
+    centre, otherwise those more than ``radius`` from it. The best pose on either side is
+    exact, as the unrestricted search is (nodes with no cell on that side are pruned)."""
+
+    x: float
+    y: float
+    radius: float
+    inside: bool = True
+
+    def __post_init__(self) -> None:
+        if not all(_finite(v) for v in (self.x, self.y, self.radius)) or self.radius < 0:
+            raise RelocalizationError(
+                "relocalize: a search disc needs a finite centre and a radius >= 0, got "
+                f"({self.x!r}, {self.y!r}), {self.radius!r}"
+            )
+
+
 class Relocalizer:
     """The matcher of one map and maximum range: its score table and max-pooled grids are
     built once (here), then each :meth:`match` searches one scan."""
@@ -131,6 +159,9 @@ class Relocalizer:
                 f"relocalize: sensor must be three finite numbers, got {sensor!r}"
             )
         self.config = config
+        self._grid, self._max_range = grid, float(max_range)
+        self._sensor = _core.Pose2(*(float(v) for v in sensor))
+        self._field = None  # the likelihood field of scores(), built on first use
         self._matcher = _core.CorrelativeScanMatcher(
             grid,
             max_range=float(max_range),
@@ -149,10 +180,13 @@ class Relocalizer:
             threads=config.threads,
         )
 
-    def match(self, angles: np.ndarray, ranges: np.ndarray) -> list[Hypothesis]:
+    def match(
+        self, angles: np.ndarray, ranges: np.ndarray, disc: SearchDisc | None = None
+    ) -> list[Hypothesis]:
         """The ranked hypotheses of one scan: ``angles`` (B,) rad and ``ranges`` (B,) m in the
         laser frame (NaN invalid, +inf or ``>= max_range`` no return, both skipped); an empty
-        list when no beam returned."""
+        list when no beam returned. With ``disc``, only the poses on its side are ranked (an
+        empty list when none is)."""
         try:
             angles = np.asarray(angles, dtype=np.float64)
             with np.errstate(over="ignore"):  # beyond float32: +inf, a no return
@@ -168,7 +202,14 @@ class Relocalizer:
             )
         if not np.isfinite(angles).all():
             raise RelocalizationError("relocalize: beam angles must be finite")
-        poses, scores, lattice = self._matcher.match(angles, ranges)
+        if disc is not None and not isinstance(disc, SearchDisc):
+            raise RelocalizationError(
+                f"relocalize: disc must be a SearchDisc, got {type(disc).__name__}"
+            )
+        region = (
+            None if disc is None else _core.SearchDisc(disc.x, disc.y, disc.radius, disc.inside)
+        )
+        poses, scores, lattice = self._matcher.match(angles, ranges, region)
         return [
             Hypothesis(
                 x=float(p[0]),
@@ -180,6 +221,31 @@ class Relocalizer:
             )
             for p, s, c in zip(poses, scores, lattice, strict=True)
         ]
+
+    def scores(self, angles: np.ndarray, ranges: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """The score of any robot poses (N, 3), on the lattice or off it: the likelihood
+        field's log-likelihood of the scan there with the matcher's beams and parameters (at a
+        lattice pose, its hypothesis' score)."""
+        poses = np.asarray(poses, dtype=np.float64)
+        if poses.ndim != 2 or poses.shape[1] != 3 or not np.isfinite(poses).all():
+            raise RelocalizationError(
+                f"relocalize: poses must be finite (N, 3) x, y, theta, got shape {poses.shape}"
+            )
+        if self._field is None:
+            c = self.config
+            self._field = _core.LikelihoodFieldModel(
+                self._grid,
+                sigma_hit=c.sigma_hit,
+                z_hit=c.z_hit,
+                z_rand=c.z_rand,
+                max_beams=c.beams,
+                max_distance=c.max_distance,
+                sensor=self._sensor,
+            )
+        self._field.set_scan(
+            np.asarray(angles, np.float64), np.asarray(ranges, np.float32), self._max_range
+        )
+        return np.asarray(self._field.log_likelihoods(poses), dtype=np.float64)
 
     def headings(self, angles: np.ndarray, ranges: np.ndarray) -> int:
         """Headings of the search lattice for this scan."""
@@ -199,6 +265,33 @@ def relocalize(
     """The ``config.hypotheses`` best distinct poses of one scan over the whole map, best first
     (see :class:`Relocalizer`; ``sensor`` is the laser's pose in the robot frame)."""
     return Relocalizer(grid, max_range, config, sensor).match(angles, ranges)
+
+
+def hypothesis_cloud(
+    hypotheses: list[Hypothesis],
+    count: int,
+    sd_xy: float,
+    sd_theta: float,
+    power: float,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """``count`` poses (count, 3) around ranked hypotheses: hypothesis i gets a share of them
+    proportional to exp(power * (score_i - best score)) (its score as a tempered
+    log-likelihood; the largest remainders round the shares to whole poses), each drawn from a
+    Gaussian of ``sd_xy`` per axis and ``sd_theta`` around it."""
+    if not hypotheses:
+        raise RelocalizationError("relocalize: no hypotheses to draw a cloud around")
+    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
+        raise RelocalizationError(f"relocalize: count must be an integer >= 1, got {count!r}")
+    scores = np.array([h.score for h in hypotheses])
+    share = np.exp(power * (scores - scores.max()))
+    share *= count / share.sum()
+    counts = np.floor(share).astype(np.int64)
+    counts[np.argsort(counts - share, kind="stable")[: count - counts.sum()]] += 1
+    centre = np.repeat([[h.x, h.y, h.theta] for h in hypotheses], counts, axis=0)
+    poses = centre + rng.normal(0.0, 1.0, (count, 3)) * [sd_xy, sd_xy, sd_theta]
+    poses[:, 2] = np.remainder(poses[:, 2] + math.pi, 2 * math.pi) - math.pi
+    return poses
 
 
 def render_hypotheses(

@@ -14,7 +14,13 @@ from kiseki_experiments.gp import gp_aalto, gp_floor_mapping, gp_mcl, gp_table_6
 from kiseki_experiments.harness.base import Experiment
 from kiseki_experiments.magnav import magnav_fig_5_4, magnav_navigators, magnav_table_4_2
 from kiseki_experiments.mapping import carmen_maps, corridor_scans
-from kiseki_experiments.mcl import mcl_excursions, mcl_kidnapping, mcl_kld, mcl_unknown_obstacles
+from kiseki_experiments.mcl import (
+    mcl_excursions,
+    mcl_kidnapping,
+    mcl_kld,
+    mcl_relocalization,
+    mcl_unknown_obstacles,
+)
 from kiseki_experiments.speed import speed_fig4, speed_pedestrian, speed_situations
 from kiseki_experiments.teach import fig_3_14, layouts, merge_rules, teach_playback
 from kiseki_experiments.terrain import terrain_corridor, terrain_envs, terrain_global_map
@@ -40,6 +46,7 @@ def _registry() -> dict[str, Experiment]:
         mcl_kidnapping.SIM,
         mcl_kidnapping.CARMEN,
         mcl_kld.EXPERIMENT,
+        mcl_relocalization.EXPERIMENT,
         mcl_unknown_obstacles.EXPERIMENT,
         merge_rules.EXPERIMENT,
         speed_fig4.EXPERIMENT,

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import gzip
 import hashlib
+import json
 import subprocess
 import sys
 from pathlib import Path
@@ -16,6 +17,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import yaml
 
 from _helpers.room_log import ANGLES, room, write_log
 from kiseki import OccupancyGrid, Pose2, save_map
@@ -100,6 +102,7 @@ def test_a_truncated_run_is_read_with_a_one_line_warning(inputs, project_root, a
     [
         (["--tracking-particles", "500"], "--tracking-particles applies only with --global"),
         (["--plot", "p.png"], "--plot applies only with --global"),
+        (["--one-scan"], "--one-scan applies only with --global"),
     ],
 )
 def test_options_of_global_localization_are_errors_without_it(inputs, args, needle):
@@ -443,3 +446,15 @@ def test_the_command_lines_runs_and_seed_have_the_configs_limits(tmp_path):
             run_experiment("fig-3-14", runs, seed, out=tmp_path / "r", progress=False)
         assert str(err.value) == message
         assert not (tmp_path / "r").exists()
+
+
+def test_global_localization_from_one_scan_is_run_and_saved_as_such(inputs):
+    done = run("localize", "log.mcap", "--map", "room.yaml", "-o", "one.csv", "--global",
+               "--one-scan", "--particles", "300", "--json", cwd=inputs)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    saved = yaml.safe_load((inputs / "one.config.yaml").read_text())
+    assert saved["start"] == "one-scan" and saved["particles"] == 300
+    report = json.loads(done.stdout)["convergence"]
+    # the saved start ran: the cloud converged where the scans fit the map, better than 1 m off
+    assert report["converged"]
+    assert report["fit"]["within_1_cell"] > 2 * report["fit_shifted_1m"]["within_1_cell"]

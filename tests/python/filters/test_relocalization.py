@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Relocalization from one scan against a brute-force numpy reference: every lattice pose of a
-small random map scored with the likelihood field written out (Probabilistic Robotics, Table
-6.3, with nav2's beam rule), then the greedy selection of distinct poses."""
+"""Relocalization from one scan against a brute-force numpy reference (_helpers.
+relocalization_reference): every lattice pose of a small random map scored with the likelihood
+field written out, then the greedy selection of distinct poses, and the best pose on either side
+of a disc."""
 
 from __future__ import annotations
 
@@ -11,77 +12,14 @@ import math
 import numpy as np
 import pytest
 
-from kiseki.core import Pose2
+from _helpers.relocalization_reference import (
+    MAX_RANGE,
+    brute_force,
+    lattice_positions,
+    random_case,
+)
 from kiseki.errors import RelocalizationError
-from kiseki.filters import RelocalizeConfig, Relocalizer, relocalize
-from kiseki.grid import OccupancyGrid
-
-MAX_RANGE = 3.0
-
-
-def random_case(seed: int):
-    rng = np.random.default_rng(seed)
-    h, w = rng.integers(14, 24, size=2)
-    u = rng.random((h, w))
-    cells = np.where(u < 0.12, 100, np.where(u < 0.17, -1, 0)).astype(np.int8)
-    grid = OccupancyGrid(cells, 0.1, Pose2(*rng.uniform(-2, 2, 2), 0.0))
-    n = int(rng.integers(20, 50))
-    angles = np.sort(rng.uniform(-np.pi, np.pi, n))
-    ranges = rng.uniform(0.1, 2.0, n).astype(np.float32)
-    ranges[rng.random(n) < 0.1] = np.inf  # no return: skipped
-    ranges[rng.random(n) < 0.05] = np.nan  # invalid: skipped
-    return grid, angles, ranges
-
-
-def brute_force(grid: OccupancyGrid, angles, ranges, config: RelocalizeConfig, headings: int):
-    cells = np.asarray(grid.cells)
-    h, w = cells.shape
-    res = grid.resolution
-    # distance from every cell centre to the nearest occupied cell centre, capped
-    oy, ox = np.nonzero(cells >= 65)
-    yy, xx = np.mgrid[0:h, 0:w]
-    d = np.sqrt(((xx[..., None] - ox) ** 2 + (yy[..., None] - oy) ** 2).min(axis=-1)) * res
-    s = config.sigma_hit
-
-    def term(dist):
-        g = np.exp(-(dist**2) / (2 * s * s)) / (math.sqrt(2 * math.pi) * s)
-        return np.float32(np.log(config.z_hit * g + config.z_rand / MAX_RANGE))
-
-    table = term(np.minimum(d, config.max_distance)).astype(np.float32)
-    outside = term(np.float64(config.max_distance))
-    # nav2's max_beams rule, then the readings that returned
-    step = max(1, (len(angles) - 1) // (config.beams - 1)) if config.beams > 1 else 1
-    a, r = angles[::step], ranges[::step].astype(np.float64)
-    keep = (r > 0) & (r < MAX_RANGE)
-    a, r = a[keep], r[keep]
-    bx, by = r * np.cos(a) / res, r * np.sin(a) / res
-    scores = np.empty((headings, h, w))
-    for k in range(headings):
-        th = k * 2 * math.pi / headings
-        ex = np.floor(xx[..., None] + 0.5 + (math.cos(th) * bx - math.sin(th) * by)).astype(int)
-        ey = np.floor(yy[..., None] + 0.5 + (math.sin(th) * bx + math.cos(th) * by)).astype(int)
-        inside = (ex >= 0) & (ey >= 0) & (ex < w) & (ey < h)
-        vals = np.where(inside, table[np.clip(ey, 0, h - 1), np.clip(ex, 0, w - 1)], outside)
-        scores[k] = vals.astype(np.float64).sum(axis=-1)
-    if config.free_only:  # the laser on known free cells (0..19) only
-        scores[:, ~((cells >= 0) & (cells < 20))] = -np.inf
-    order = np.lexsort((np.arange(scores.size), -scores.ravel()))
-    taken = []
-    for i in order:
-        k, y, x = np.unravel_index(i, scores.shape)
-        px = grid.origin.x + (x + 0.5) * res  # the origin has no yaw here
-        py = grid.origin.y + (y + 0.5) * res
-        th = math.remainder(k * 2 * math.pi / headings, 2 * math.pi)
-        close = any(
-            math.hypot(px - t[1], py - t[2]) < config.min_distance
-            and abs(math.remainder(th - t[3], 2 * math.pi)) < config.min_angle
-            for t in taken
-        )
-        if not close:
-            taken.append((scores.ravel()[i], px, py, th, (int(x), int(y), int(k))))
-        if len(taken) == config.hypotheses:
-            break
-    return scores, taken
+from kiseki.filters import RelocalizeConfig, Relocalizer, SearchDisc, relocalize
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -108,10 +46,43 @@ def test_hypotheses_are_the_brute_force_selection(seed):
     for g in got:
         assert scores[g.heading, g.cell[1], g.cell[0]] == pytest.approx(g.score, abs=1e-6)
     assert got[0].score == pytest.approx(scores.max(), abs=1e-6)
+    # scores() of the hypotheses' poses, the likelihood field read pose by pose, agrees
+    poses = np.array([[g.x, g.y, g.theta] for g in got])
+    np.testing.assert_allclose(
+        matcher.scores(angles, ranges, poses), [g.score for g in got], rtol=0, atol=1e-4
+    )
     two = relocalize(
         grid, angles, ranges, MAX_RANGE, RelocalizeConfig(**{**config.__dict__, "threads": 2})
     )
     assert two == got
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_best_pose_on_each_side_of_a_disc_is_the_brute_force_maximum(seed):
+    grid, angles, ranges = random_case(10 + seed)
+    sensor = ((0.0, 0.0, 0.0), (0.3, -0.1, 0.4))[seed % 2]
+    config = RelocalizeConfig(
+        beams=15, depth=1 + seed % 3, angular_step=0.3, hypotheses=1, threads=1 + seed % 2
+    )
+    matcher = Relocalizer(grid, MAX_RANGE, config, sensor)
+    headings = matcher.headings(angles, ranges)
+    scores, _ = brute_force(grid, angles, ranges, config, headings)
+    positions = lattice_positions(grid, headings, sensor)
+    rng = np.random.default_rng(seed)
+    h, w = scores.shape[1:]
+    for _ in range(4):
+        centre = grid.origin.x + rng.uniform(0, w * 0.1), grid.origin.y + rng.uniform(0, h * 0.1)
+        radius = float(rng.uniform(0.05, 0.8))
+        distance = np.hypot(positions[..., 0] - centre[0], positions[..., 1] - centre[1])
+        for inside in (True, False):
+            side = distance <= radius if inside else distance > radius
+            want = np.where(side, scores, -np.inf).max()
+            got = matcher.match(angles, ranges, SearchDisc(*centre, radius, inside))
+            if not np.isfinite(want):
+                assert got == []
+                continue
+            assert got[0].score == pytest.approx(want, abs=1e-6)
+            assert side[got[0].heading, got[0].cell[1], got[0].cell[0]]
 
 
 def test_bad_input_is_one_line_naming_the_problem():
@@ -129,3 +100,7 @@ def test_bad_input_is_one_line_naming_the_problem():
     with pytest.raises(RelocalizationError, match="map must be an OccupancyGrid"):
         relocalize(np.zeros((5, 5)), angles, ranges, MAX_RANGE)
     assert relocalize(grid, angles, np.full(len(angles), np.inf, np.float32), MAX_RANGE) == []
+    with pytest.raises(RelocalizationError, match="radius >= 0"):
+        SearchDisc(0.0, 0.0, -1.0)
+    with pytest.raises(RelocalizationError, match="disc must be a SearchDisc"):
+        Relocalizer(grid, MAX_RANGE).match(angles, ranges, (0.0, 0.0, 1.0))

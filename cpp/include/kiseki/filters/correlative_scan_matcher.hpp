@@ -41,6 +41,15 @@ struct PoseHypothesis {
   int cell_x = 0, cell_y = 0, heading = 0;
 };
 
+/// A disc that restricts a search: with `inside`, only lattice poses whose robot position is at
+/// most `radius` m from (x, y) (map frame) are scored; without, only those more than `radius`
+/// m from it. The best pose of each side of a disc is exact, as the unrestricted search is.
+struct SearchDisc {
+  double x = 0.0, y = 0.0;
+  double radius = 0.0;
+  bool inside = true;
+};
+
 /// Global relocalization from one scan by branch-and-bound correlative scan matching over the
 /// whole map (Olson, "Real-time correlative scan matching", ICRA 2009, sec. III-IV: the
 /// multi-resolution search whose coarse cells hold the maximum of the fine ones; Hess, Kohler,
@@ -67,8 +76,11 @@ class CorrelativeScanMatcher {
   CorrelativeScanMatcher(const OccupancyGrid& map, double max_range,
                          const CorrelativeMatcherParams& params = {});
   /// The k best distinct hypotheses for one scan (angles in rad, ranges in m, in the laser
-  /// frame), best first. Empty when no beam returned.
-  std::vector<PoseHypothesis> match(const double* angles, const float* ranges, std::size_t n) const;
+  /// frame), best first. Empty when no beam returned, or when `disc` leaves no pose. With a
+  /// disc, the selection runs over the poses on its side only (a node none of whose cells can
+  /// hold such a pose is pruned).
+  std::vector<PoseHypothesis> match(const double* angles, const float* ranges, std::size_t n,
+                                    const SearchDisc* disc = nullptr) const;
   /// The robot pose of a lattice point: the laser at the cell's centre, heading
   /// heading * 2 pi / headings in the grid frame.
   Pose2 lattice_pose(int cell_x, int cell_y, int heading, int headings) const;
