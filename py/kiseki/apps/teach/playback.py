@@ -323,9 +323,8 @@ class PlaybackRun:
         images = [c.render(self.scene.world, self._observed) for c in self.cameras]
         local = self.maker.make(images)
         if self.config.model == "ray-space-observation":
-            reach = 0.5 * self.maker.size  # the robot is at L's centre, L's origin at -reach
-            ranges = local.cast_scans(np.zeros((1, 3)), self._angles, max_range=reach)[0]
-            self.model.set_scan(self._angles, ranges.astype(np.float32), reach)
+            ranges = _scan_of_local_map(local, self._angles, 0.5 * self.maker.size)
+            self.model.set_scan(self._angles, ranges, 0.5 * self.maker.size)
         else:
             self.model.set_local_map(local)
         return self.model
@@ -344,6 +343,21 @@ class PlaybackRun:
             np.arange(len(self._truths)) * self.config.dt,
             None if self.limiter is None else np.array(self.limiter.limits),
         )
+
+
+def _scan_of_local_map(local, angles: np.ndarray, reach: float) -> np.ndarray:
+    """The local map L (robot at its centre, L's origin at -reach) read as a scan: per angle,
+    the range to the centre of the first occupied cell along the ray (where the beam that
+    marked it ended, on average: a beam's end lies anywhere in its cell, so the cell's near face
+    would read every range short by about half a cell); reach (a no-return) where none."""
+    ranges = local.cast_scans(np.zeros((1, 3)), angles, max_range=reach)[0]
+    hit = ranges < reach
+    res = local.resolution
+    inside = ranges[hit] + 1e-6  # just past the face: in the occupied cell
+    cx = np.floor((inside * np.cos(angles[hit]) + reach) / res)
+    cy = np.floor((inside * np.sin(angles[hit]) + reach) / res)
+    ranges[hit] = np.hypot((cx + 0.5) * res - reach, (cy + 0.5) * res - reach)
+    return ranges.astype(np.float32)
 
 
 def _check_waypoints(environment: OccupancyGrid, waypoints: list[dict]) -> None:
