@@ -40,6 +40,7 @@ __all__ = [
     "Boxes",
     "ConfigError",
     "Count",
+    "Factor",
     "FitPoints",
     "Index",
     "NonNegativeReal",
@@ -118,6 +119,8 @@ PositiveReal = PositiveFloat
 NonNegativeReal = NonNegativeFloat
 # A share or probability.
 Share = Annotated[float, Field(strict=True, ge=0, le=1, allow_inf_nan=False)]
+# A factor applied to a sensor's readings (a calibration): a tenth to ten times.
+Factor = Annotated[float, Field(strict=True, ge=0.1, le=10.0, allow_inf_nan=False)]
 
 # the strict base of an annotated number (its range comes with its annotation)
 _BOUNDED: dict[Any, Any] = {

@@ -83,6 +83,7 @@ class PlaybackConfig:
     # exactly what the cameras saw.
     model: str = "space-observation"
     scan_beams: int = 360
+    scan_range_scale: float = 1.0  # the ray model's readings times this (a range calibration)
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -101,6 +102,8 @@ class PlaybackConfig:
             raise ValueError(
                 f"scan_beams must be an integer in 1..100,000, got {self.scan_beams!r}"
             )
+        if not 0.1 <= self.scan_range_scale <= 10.0:
+            raise ValueError(f"scan_range_scale must lie in [0.1, 10], got {self.scan_range_scale}")
 
 
 PLAYBACK_MODELS = ("space-observation", "ray-space-observation")
@@ -323,8 +326,11 @@ class PlaybackRun:
         images = [c.render(self.scene.world, self._observed) for c in self.cameras]
         local = self.maker.make(images)
         if self.config.model == "ray-space-observation":
-            ranges = _scan_of_local_map(local, self._angles, 0.5 * self.maker.size)
-            self.model.set_scan(self._angles, ranges, 0.5 * self.maker.size)
+            reach = 0.5 * self.maker.size
+            ranges = _scan_of_local_map(local, self._angles, reach)
+            scale = self.config.scan_range_scale
+            ranges[ranges < reach] *= np.float32(scale)
+            self.model.set_scan(self._angles, ranges, reach * max(1.0, scale))
         else:
             self.model.set_local_map(local)
         return self.model
