@@ -16,7 +16,7 @@ import numpy as np
 
 from kiseki import _core
 
-__all__ = ["BANDS", "METHODS", "LocalMapMaker"]
+__all__ = ["BANDS", "METHODS", "LocalMapMaker", "local_map_scan"]
 
 BANDS = {"plane": (0.39, 0.41), "band": (0.4, 1.0)}
 # method -> (local map band, occlusion-aware expected map)
@@ -77,3 +77,20 @@ class LocalMapMaker:
             optical = camera.optical_pose((0.0, 0.0, 0.0))  # in the robot frame
             builder.add_depth_band(depth, optical, *camera.camera_args(), z_min, z_max)
         return builder
+
+
+def local_map_scan(local, angles: np.ndarray, reach: float, scale: float = 1.0) -> np.ndarray:
+    """The local map L (robot at its centre, L's origin at -reach) read as a scan: per angle,
+    the range to the centre of the first occupied cell along the ray (where the beam that
+    marked it ended, on average: a beam's end lies anywhere in its cell, so the cell's near face
+    would read every range short by about half a cell), times ``scale`` (a range calibration);
+    +inf (a no-return) where the ray meets none within reach."""
+    ranges = local.cast_scans(np.zeros((1, 3)), angles, max_range=reach)[0]
+    hit = ranges < reach
+    res = local.resolution
+    inside = ranges[hit] + 1e-6  # just past the face: in the occupied cell
+    cx = np.floor((inside * np.cos(angles[hit]) + reach) / res)
+    cy = np.floor((inside * np.sin(angles[hit]) + reach) / res)
+    ranges[hit] = scale * np.hypot((cx + 0.5) * res - reach, (cy + 0.5) * res - reach)
+    ranges[~hit] = np.inf
+    return ranges.astype(np.float32)

@@ -30,7 +30,7 @@ from kiseki.filters import MclConfig, MonteCarloLocalizer
 from kiseki.grid import OccupancyGrid
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import SensorSetup, build_robot, build_sensors
-from kiseki.teach.local_maps import METHODS, LocalMapMaker
+from kiseki.teach.local_maps import METHODS, LocalMapMaker, local_map_scan
 from kiseki.teach.playback_log import PlaybackLog
 from kiseki.teach.scene_identity import TaughtScene, check_scene
 
@@ -77,10 +77,8 @@ class PlaybackConfig:
     # (Each sum rounded up to 1, 2 or 5 times a power of ten.)
     alphas: tuple[float, float, float, float] = (0.002, 0.002, 0.0005, 0.0005)
     max_duration: float = 300.0
-    # The sensor model: the thesis' space observation model on the local map L, or kiseki's
-    # ray space observation model on L read as a scan (``scan_beams`` rays from the robot, to
-    # L's first occupied cell; those reaching L's edge are no-returns), so that both weigh
-    # exactly what the cameras saw.
+    # The sensor model: the thesis' on the local map L, or kiseki's ray model on L read as a
+    # scan of scan_beams rays (teach.local_maps.local_map_scan): both weigh what the cameras saw.
     model: str = "space-observation"
     scan_beams: int = 360
     scan_range_scale: float = 1.0  # the ray model's readings times this (a range calibration)
@@ -326,10 +324,8 @@ class PlaybackRun:
         images = [c.render(self.scene.world, self._observed) for c in self.cameras]
         local = self.maker.make(images)
         if self.config.model == "ray-space-observation":
-            reach = 0.5 * self.maker.size
-            ranges = _scan_of_local_map(local, self._angles, reach)
-            scale = self.config.scan_range_scale
-            ranges[ranges < reach] *= np.float32(scale)
+            reach, scale = 0.5 * self.maker.size, self.config.scan_range_scale
+            ranges = local_map_scan(local, self._angles, reach, scale)
             self.model.set_scan(self._angles, ranges, reach * max(1.0, scale))
         else:
             self.model.set_local_map(local)
@@ -349,21 +345,6 @@ class PlaybackRun:
             np.arange(len(self._truths)) * self.config.dt,
             None if self.limiter is None else np.array(self.limiter.limits),
         )
-
-
-def _scan_of_local_map(local, angles: np.ndarray, reach: float) -> np.ndarray:
-    """The local map L (robot at its centre, L's origin at -reach) read as a scan: per angle,
-    the range to the centre of the first occupied cell along the ray (where the beam that
-    marked it ended, on average: a beam's end lies anywhere in its cell, so the cell's near face
-    would read every range short by about half a cell); reach (a no-return) where none."""
-    ranges = local.cast_scans(np.zeros((1, 3)), angles, max_range=reach)[0]
-    hit = ranges < reach
-    res = local.resolution
-    inside = ranges[hit] + 1e-6  # just past the face: in the occupied cell
-    cx = np.floor((inside * np.cos(angles[hit]) + reach) / res)
-    cy = np.floor((inside * np.sin(angles[hit]) + reach) / res)
-    ranges[hit] = np.hypot((cx + 0.5) * res - reach, (cy + 0.5) * res - reach)
-    return ranges.astype(np.float32)
 
 
 def _check_waypoints(environment: OccupancyGrid, waypoints: list[dict]) -> None:
