@@ -524,10 +524,11 @@ struct Scored {
   Pose2 pose;
 };
 
-// Every lattice pose scored by the likelihood field itself, then the greedy selection: the
-// best, then the best not within both min_distance and min_angle of one taken.
+// Every lattice pose scored by the likelihood field itself (with a disc, only the poses on its
+// side), then the greedy selection: the best, then the best not within both min_distance and
+// min_angle of one taken.
 std::vector<Scored> exhaustive(const OccupancyGrid& map, const CorrelativeScanMatcher& m, const std::vector<double>& angles,
-                               const std::vector<float>& ranges) {
+                               const std::vector<float>& ranges, const SearchDisc* disc = nullptr) {
   const auto& p = m.params();
   LikelihoodFieldModel field(map, p.likelihood);
   field.set_scan(angles.data(), ranges.data(), angles.size(), m.max_range());
@@ -538,7 +539,9 @@ std::vector<Scored> exhaustive(const OccupancyGrid& map, const CorrelativeScanMa
     for (int y = 0; y < map.height(); ++y)
       for (int x = 0; x < map.width(); ++x) {
         if (p.free_only && !(map.value(x, y) >= 0 && map.value(x, y) < 20)) continue;  // known free only
-        poses.push_back(m.lattice_pose(x, y, k, headings));
+        const Pose2 pose = m.lattice_pose(x, y, k, headings);
+        if (disc && (std::hypot(pose.x - disc->x, pose.y - disc->y) <= disc->radius) != disc->inside) continue;
+        poses.push_back(pose);
         all.push_back({0.0, (static_cast<long long>(k) * map.height() + y) * map.width() + x, x, y, k, poses.back()});
       }
   std::vector<double> ll(poses.size());
@@ -563,6 +566,7 @@ std::vector<Scored> exhaustive(const OccupancyGrid& map, const CorrelativeScanMa
 }  // namespace
 
 TEST(CorrelativeScanMatcher, EqualsExhaustiveSearchOnRandomSmallMaps) {
+  int disc_searches_with_a_result = 0;
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {
     Random rng(seed);
     const int w = 17 + static_cast<int>(rng.below(12)), h = 13 + static_cast<int>(rng.below(12));
@@ -600,6 +604,19 @@ TEST(CorrelativeScanMatcher, EqualsExhaustiveSearchOnRandomSmallMaps) {
       EXPECT_EQ(got[i].heading, want[i].k) << "seed " << seed << " hypothesis " << i;
       EXPECT_NEAR(got[i].score, want[i].score, 1e-9) << "seed " << seed << " hypothesis " << i;
     }
+    // Restricted to one side of a disc (alternately inside and beyond it), still exact.
+    const Eigen::Vector2d centre = map.origin().transform_point({rng.uniform(0.0, 0.1 * w), rng.uniform(0.0, 0.1 * h)});
+    const SearchDisc disc{centre.x(), centre.y(), rng.uniform(0.3, 1.0), seed % 2 == 0};
+    const auto got_disc = one.match(angles.data(), ranges.data(), angles.size(), &disc);
+    const auto want_disc = exhaustive(map, one, angles, ranges, &disc);
+    ASSERT_EQ(got_disc.size(), want_disc.size()) << "seed " << seed << " with a disc";
+    disc_searches_with_a_result += !got_disc.empty();
+    for (std::size_t i = 0; i < got_disc.size(); ++i) {
+      EXPECT_EQ(got_disc[i].cell_x, want_disc[i].x) << "seed " << seed << " disc hypothesis " << i;
+      EXPECT_EQ(got_disc[i].cell_y, want_disc[i].y) << "seed " << seed << " disc hypothesis " << i;
+      EXPECT_EQ(got_disc[i].heading, want_disc[i].k) << "seed " << seed << " disc hypothesis " << i;
+      EXPECT_NEAR(got_disc[i].score, want_disc[i].score, 1e-9) << "seed " << seed << " disc hypothesis " << i;
+    }
     p.threads = 2;
     const auto two = CorrelativeScanMatcher(map, 2.5, p).match(angles.data(), ranges.data(), angles.size());
     ASSERT_EQ(two.size(), got.size());
@@ -610,6 +627,7 @@ TEST(CorrelativeScanMatcher, EqualsExhaustiveSearchOnRandomSmallMaps) {
       EXPECT_EQ(two[i].pose.theta, got[i].pose.theta);
     }
   }
+  EXPECT_EQ(disc_searches_with_a_result, 6);  // no disc left its side empty
 }
 
 TEST(CorrelativeScanMatcher, RecoversAScanSimulatedAtALatticePoseOfAStructuredMap) {
