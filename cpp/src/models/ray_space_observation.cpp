@@ -41,6 +41,11 @@ RaySpaceObservationModel::RaySpaceObservationModel(const OccupancyGrid& map,
 void RaySpaceObservationModel::set_scan(const double* angles, const float* ranges, std::size_t n,
                                         double max_range) {
   beams_.set(angles, ranges, n, max_range, params_.max_beams, /*keep_no_return=*/false);
+  // The intrusion term depends on the reading only: once per beam, not per particle.
+  intrusion_.resize(beams_.size());
+  for (std::size_t b = 0; b < beams_.size(); ++b) {
+    intrusion_[b] = params_.z_intrusion * params_.lambda_short * std::exp(-params_.lambda_short * beams_.range[b]);
+  }
   has_scan_ = true;
 }
 
@@ -75,7 +80,11 @@ void RaySpaceObservationModel::log_likelihoods(const Pose2* poses, std::size_t n
       const bool inside = gx >= 0.0 && gy >= 0.0 && gx < w && gy < h;
       const double d = inside ? dist[static_cast<std::ptrdiff_t>(gy) * w + static_cast<std::ptrdiff_t>(gx)]
                               : params_.max_distance;
-      sum += std::log(beam_probability(r, delta, d));
+      // beam_probability(r, delta, d), with the beam's intrusion term computed once
+      const double h = std::max(d, delta), sigma = params_.sigma_hit;
+      double pz = params_.z_hit * std::exp(-h * h / (2.0 * sigma * sigma)) / (std::sqrt(2.0 * kPi) * sigma);
+      if (delta <= 0.0) pz += intrusion_[b];
+      sum += std::log(pz + params_.z_rand / beams_.max_range);
     }
     out[k] = sum;
   }

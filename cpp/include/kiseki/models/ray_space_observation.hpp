@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <opencv2/core/mat.hpp>
+#include <vector>
 
 #include "kiseki/grid/occupancy_grid.hpp"
 #include "kiseki/grid/range_caster.hpp"
@@ -78,6 +79,7 @@ class RaySpaceObservationModel : public SensorModel {
   OccupancyGrid frame_;
   cv::Mat distance_;  // metres, CV_32F, capped at max_distance
   ScanBeams beams_;
+  std::vector<double> intrusion_;  // per beam: z_intrusion lambda exp(-lambda r), pose-free
   RangeCaster occupied_;
   bool has_scan_ = false;
 };
