@@ -243,13 +243,17 @@ void bind_filters(py::module_& m) {
            }, "distances"_a, "weights"_a = py::none())
       .def("set_weights", [](TravelDistanceFilter& f, const py::handle& w) { f.set_weights(doubles_1d(w, "weights")); }, "weights"_a)
       .def("predict", &TravelDistanceFilter::predict, "distance"_a, "sd"_a, py::call_guard<py::gil_scoped_release>())
+      .def("set_scales", [](TravelDistanceFilter& f, const py::handle& k) { f.set_scales(doubles_1d(k, "scales")); }, "scales"_a)
+      .def("predict_scaled", &TravelDistanceFilter::predict_scaled, "distance"_a, "sd"_a, "scale_sd"_a,
+           py::call_guard<py::gil_scoped_release>())
       .def("update", [](TravelDistanceFilter& f, const py::handle& l) { return f.update(doubles_1d(l, "log_likelihoods")); },
            "log_likelihoods"_a)
       .def("estimate", &TravelDistanceFilter::estimate)
       .def("variance", &TravelDistanceFilter::variance)
       .def_property_readonly("effective_sample_size", &TravelDistanceFilter::effective_sample_size)
       .def_property_readonly("particles", [](const TravelDistanceFilter& f) { return array_of(f.particles()); })
-      .def_property_readonly("weights", [](const TravelDistanceFilter& f) { return array_of(f.weights()); });
+      .def_property_readonly("weights", [](const TravelDistanceFilter& f) { return array_of(f.weights()); })
+      .def_property_readonly("scales", [](const TravelDistanceFilter& f) { return array_of(f.scales()); });
 }
 
 }  // namespace kiseki::bindings

@@ -515,6 +515,45 @@ TEST(TravelDistanceFilter, ConvergesOnTheDistanceAGaussianLikelihoodPoints) {
   EXPECT_THROW(b.predict(1, 0.1), std::logic_error);
 }
 
+TEST(TravelDistanceFilter, EachScaleStaysWithItsDistanceThroughKldResampling) {
+  TravelDistanceParams p;
+  p.particles = 3000;
+  p.kld = true;
+  p.kld_params.min_particles = 100;
+  TravelDistanceFilter f(p, 5);
+  std::vector<double> d(3000), k(3000);
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    d[i] = 0.0;
+    k[i] = 0.5 + static_cast<double>(i) / 2000.0;  // 0.5 .. 2.0, one per particle
+  }
+  f.set_particles(d);
+  f.set_scales(k);
+  f.predict_scaled(4.0, 0.0, 0.0);  // d_i = 4 k_i exactly
+  std::vector<double> log_l(d.size());
+  for (std::size_t i = 0; i < d.size(); ++i) log_l[i] = -0.5 * std::pow((f.particles()[i] - 4.4) / 0.2, 2);
+  f.update(log_l);  // resampled (ESS far below n/2), KLD shrinks the count
+  ASSERT_LT(f.particles().size(), 3000u);
+  for (std::size_t j = 0; j < f.particles().size(); ++j) {
+    EXPECT_DOUBLE_EQ(f.particles()[j], 4.0 * f.scales()[j]) << j;
+    EXPECT_NEAR(f.scales()[j], 1.1, 0.2) << j;
+  }
+  // the scaled motion draws from per-particle streams: one result for any thread count
+  p.kld = false;
+  p.threads = 1;
+  TravelDistanceFilter a(p, 9);
+  p.threads = 2;
+  TravelDistanceFilter b(p, 9);
+  for (TravelDistanceFilter* g : {&a, &b}) {
+    g->set_particles(d);
+    g->set_scales(k);
+    g->predict_scaled(1.0, 0.1, 0.01);
+  }
+  EXPECT_EQ(a.particles(), b.particles());
+  EXPECT_EQ(a.scales(), b.scales());
+  EXPECT_THROW(a.set_scales({1.0}), std::invalid_argument);
+  EXPECT_THROW(a.predict_scaled(1.0, 0.1, -1.0), std::invalid_argument);
+}
+
 namespace {
 
 struct Scored {

@@ -46,6 +46,7 @@ void TravelDistanceFilter::set_particles(const std::vector<double>& d, const std
     if (!std::isfinite(s)) throw std::invalid_argument("travel distance filter: particles must be finite");
   }
   particles_ = d;
+  scales_.assign(d.size(), 1.0);
   if (w.empty()) weights_.assign(d.size(), 1.0 / static_cast<double>(d.size()));
   else set_weights(w);
 }
@@ -60,6 +61,30 @@ void TravelDistanceFilter::set_weights(const std::vector<double>& w) {
   if (!(total > 0.0) || !std::isfinite(total)) throw std::invalid_argument("travel distance filter: the weights sum to 0");
   weights_ = w;
   for (double& v : weights_) v /= total;
+}
+
+void TravelDistanceFilter::set_scales(const std::vector<double>& k) {
+  if (k.size() != particles_.size()) throw std::invalid_argument("travel distance filter: one scale per particle is needed");
+  for (double v : k) {
+    if (!(v > 0.0) || !std::isfinite(v)) throw std::invalid_argument("travel distance filter: scales must be finite and > 0");
+  }
+  scales_ = k;
+}
+
+void TravelDistanceFilter::predict_scaled(double distance, double sd, double scale_sd) {
+  if (particles_.empty()) throw std::logic_error("travel distance filter: not initialised");
+  if (!std::isfinite(distance) || !(sd >= 0.0) || !std::isfinite(sd) || !(scale_sd >= 0.0) || !std::isfinite(scale_sd)) {
+    throw std::invalid_argument("travel distance filter: distance and SDs must be finite, SDs >= 0");
+  }
+  const std::uint64_t seed = rng_.below(~std::uint64_t{0});
+  parallel_for(particles_.size(), params_.threads, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      StreamRandom g(seed, i);
+      const double k = scales_[i] + g.normal(0.0, scale_sd);
+      if (k > 0.0) scales_[i] = k;
+      particles_[i] += scales_[i] * distance + g.normal(0.0, sd);
+    }
+  }, 4096);
 }
 
 void TravelDistanceFilter::predict(double distance, double sd) {
@@ -81,9 +106,20 @@ bool TravelDistanceFilter::update(const std::vector<double>& log_l) {
   const bool changed = apply_log_likelihoods(weights_, log_l, params_.likelihood_power);
   const double n = static_cast<double>(particles_.size());
   if (params_.resample_threshold >= 1.0 || effective_sample_size() < params_.resample_threshold * n) {
-    std::vector<double> out = resample_states(particles_, weights_, params_.particles, params_.resampling,
-                                              params_.kld, params_.kld_params, rng_);
-    particles_.swap(out);
+    // the particles' indices as the states, so that each scale follows its distance (the KLD
+    // bins are those of the distances: the index's particle is binned)
+    std::vector<std::size_t> index(particles_.size());
+    for (std::size_t i = 0; i < index.size(); ++i) index[i] = i;
+    const std::vector<std::size_t> picked = resample_states(index, weights_, params_.particles, params_.resampling,
+                                                            params_.kld, params_.kld_params, rng_,
+                                                            [this](std::size_t i) { return particles_[i]; });
+    std::vector<double> d(picked.size()), k(picked.size());
+    for (std::size_t j = 0; j < picked.size(); ++j) {
+      d[j] = particles_[picked[j]];
+      k[j] = scales_[picked[j]];
+    }
+    particles_.swap(d);
+    scales_.swap(k);
     weights_.assign(particles_.size(), 1.0 / static_cast<double>(particles_.size()));
   }
   return changed;

@@ -53,10 +53,13 @@ class KldBins {
 /// Resampled states: n = params.max_particles indices drawn from the weights by `method`; with
 /// KLD sampling they are taken in random order until the bound for the bins filled so far is met
 /// (Fox 2003, Table 1, with the draws made up front), else all n. State is Pose2 or double.
-template <typename State>
+/// `binned(state)` gives what KLD bins (the state itself by default; a particle's distance
+/// when the states are indices).
+template <typename State, typename Binned = State (*)(const State&)>
 std::vector<State> resample_states(const std::vector<State>& states, const std::vector<double>& weights,
                                    std::size_t n, ResamplingMethod method, bool kld,
-                                   const KldParams& params, Random& rng) {
+                                   const KldParams& params, Random& rng,
+                                   Binned binned = [](const State& s) { return s; }) {
   std::vector<std::size_t> idx = resample_indices(weights, n, method, rng);
   std::vector<State> out;
   out.reserve(n);
@@ -68,7 +71,7 @@ std::vector<State> resample_states(const std::vector<State>& states, const std::
   KldBins bins(params);
   for (std::size_t i : idx) {
     out.push_back(states[i]);
-    bins.add(states[i]);
+    bins.add(binned(states[i]));
     if (bins.enough(out.size())) break;
   }
   return out;
