@@ -1,0 +1,213 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""kiseki's loop filter: travel distance around a closed mapped loop from odometry and the
+magnetic field, for recorded walks where the thesis' filter (:mod:`kiseki.magnetic.
+travel_distance`, kept as printed) carries no information. Not the thesis' method; its
+changes, each for a reason measured on real walks:
+
+* **Two heading-invariant channels** instead of m_z alone: the vertical component and the
+  horizontal magnitude |m_h| (:func:`~kiseki.magnetic.loop_profile.heading_invariant_channels`).
+  The thesis drops m_x and m_y because they turn with the heading (sec. 3.3.2); |m_h| does not,
+  and where the vertical anomaly is weak (1.2 uT SD on a hand-held walk) it doubles what each
+  metre says.
+* **A likelihood instead of w = 1 / (a s + 1)**: each channel c of each reading weighs by
+  N(r_c; mu_c(d), v_c(d)), mu_c and v_c the mean and variance of a 1-D GP of the mapping lap
+  (:class:`~kiseki.magnetic.loop_profile.LoopProfile`; v_c = the field's variance + sigma_n^2,
+  both fitted by marginal likelihood on the lap, so the noise comes from the data). The
+  weights are carried from step to step (Bayes' rule) instead of being set from a window.
+* **Readings count once per length scale**: consecutive readings of a walk see almost the same
+  field and the same lateral offset from the mapping lap, so their errors are not independent.
+  Each channel's log-likelihood is multiplied by tau_c = min(1, |delta d| / l_c), l_c the GP's
+  own length scale: a length scale of travel adds one reading's worth of evidence, standing
+  still adds none.
+* **An odometry scale as a state**: each particle carries k (prior N(1, scale_sd^2), a random
+  walk of ``scale_walk`` per sqrt(m) of travel) and moves by k delta d plus N(0, (noise^2)
+  |delta d|) (:meth:`kiseki._core.TravelDistanceFilter.predict_scaled`).
+* **A closed loop, no laps**: the distance is taken modulo the loop's length L, so a later lap
+  is the same map read again, never a restart from reference positions. The start is either
+  known (``start="known"``: N(start, initial_sd^2)) or unknown (``"global"``: uniform over the
+  loop). The estimate is the weighted circular mean (L / 2 pi times the angle of
+  sum w_i exp(2 pi i d_i / L)).
+* Resampling (the engine's systematic) when ESS < n / 2, the usual rule for a filter whose
+  weights accumulate.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from kiseki import _core
+from kiseki.magnetic.loop_profile import LoopProfile
+
+__all__ = ["LoopTravelConfig", "LoopTravelDistanceLocalizer", "loop_log_likelihood"]
+
+STARTS = ("known", "global")
+
+
+@dataclass(frozen=True)
+class LoopTravelConfig:
+    """The loop filter's settings (module text); every default is stated there."""
+
+    particles: int = 1000  # as the thesis' filter (sec. 4.5.1)
+    odometry_noise: float = 0.1  # m per sqrt(m) of travel, as the thesis' filter in kiseki
+    scale_sd: float = 0.1  # prior SD of the odometry scale: errors of about 10 % (step lengths)
+    scale_walk: float = 0.01  # the scale's random walk per sqrt(m) of travel
+    start: str = "known"
+    initial_sd: float = 0.1  # m, with start="known"
+    resample_threshold: float = 0.5
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if isinstance(self.particles, bool) or not isinstance(self.particles, int):
+            raise ValueError(f"loop filter: particles must be an integer, got {self.particles!r}")
+        if not 1 <= self.particles <= 10_000_000:
+            raise ValueError(
+                f"loop filter: particles must be in 1..10,000,000, got {self.particles}"
+            )
+        for name in ("odometry_noise", "scale_sd", "scale_walk", "initial_sd"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise ValueError(f"loop filter: {name} must be a finite number, got {v!r}")
+            if v < 0:
+                raise ValueError(f"loop filter: {name} must be >= 0, got {v}")
+        if self.scale_sd >= 0.5:
+            raise ValueError(f"loop filter: scale_sd must be < 0.5, got {self.scale_sd}")
+        r = self.resample_threshold
+        if isinstance(r, bool) or not isinstance(r, int | float) or not 0 <= r <= 1:
+            raise ValueError(f"loop filter: resample_threshold must be in [0, 1], got {r!r}")
+        if self.start not in STARTS:
+            raise ValueError(f"loop filter: start must be one of {STARTS}, got {self.start!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int):
+            raise ValueError(f"loop filter: seed must be an integer, got {self.seed!r}")
+        if not 0 <= self.seed < 2**64:
+            raise ValueError(f"loop filter: seed must be in [0, 2**64), got {self.seed}")
+
+
+def loop_log_likelihood(
+    profiles: Sequence[LoopProfile], distances: Any, reading: Any, travelled: float
+) -> np.ndarray:
+    """sum_c tau_c log N(reading_c; mu_c(d), v_c(d)) for each distance d (module text),
+    tau_c = min(1, |travelled| / l_c)."""
+    d = np.asarray(distances, dtype=np.float64)
+    r = np.asarray(reading, dtype=np.float64)
+    if r.shape != (len(profiles),):
+        raise ValueError(f"loop filter: {r.shape} reading for {len(profiles)} channel(s)")
+    total = np.zeros_like(d)
+    for profile, value in zip(profiles, r, strict=True):
+        tau = min(1.0, abs(travelled) / profile.kernel.length_scale)
+        if tau == 0.0:
+            continue
+        mean, var = profile.at(d)
+        total += tau * (-0.5 * (value - mean) ** 2 / var - 0.5 * np.log(2.0 * math.pi * var))
+    return total
+
+
+class LoopTravelDistanceLocalizer:
+    """Travel distance around a loop (module text) on the C++ 1-D engine. ``profiles``: one
+    per channel of the readings, all of one loop; ``start``: the distance at the first
+    reading with ``start="known"``; ``length``: the loop's (needed only without profiles: the
+    filter is then odometry with the scale's prior, a control). Seeded: one config and input,
+    one result."""
+
+    def __init__(
+        self,
+        profiles: Sequence[LoopProfile],
+        config: LoopTravelConfig | None = None,
+        start: float = 0.0,
+        *,
+        length: float | None = None,
+    ) -> None:
+        self.config = LoopTravelConfig() if config is None else config
+        if not isinstance(self.config, LoopTravelConfig):
+            raise ValueError("loop filter: config must be a LoopTravelConfig")
+        profiles = tuple(profiles)
+        if not all(isinstance(p, LoopProfile) for p in profiles):
+            raise ValueError("loop filter: profiles must be LoopProfile")
+        lengths = {p.length for p in profiles} | ({float(length)} if length is not None else set())
+        if len(lengths) != 1:
+            raise ValueError(
+                "loop filter: the profiles and the length disagree on the loop's length"
+                if lengths
+                else "loop filter: no profile: the loop's length must be given"
+            )
+        loop = lengths.pop()
+        if not (math.isfinite(loop) and loop > 0):
+            raise ValueError(f"loop filter: the loop's length must be > 0, got {loop}")
+        if isinstance(start, bool) or not isinstance(start, int | float):
+            raise ValueError(f"loop filter: start must be a number, got {start!r}")
+        if not math.isfinite(start):
+            raise ValueError(f"loop filter: start must be finite, got {start}")
+        self.profiles = profiles
+        self.length = loop
+        c = self.config
+        params = _core.TravelDistanceParams()
+        params.particles = c.particles
+        params.resample_threshold = c.resample_threshold
+        self._filter = _core.TravelDistanceFilter(params, c.seed)
+        rng = np.random.default_rng(c.seed)
+        if c.start == "known":
+            d = float(start) + c.initial_sd * rng.standard_normal(c.particles)
+        else:
+            d = rng.uniform(0.0, self.length, c.particles)
+        self._filter.set_particles(d)
+        k = 1.0 + c.scale_sd * rng.standard_normal(c.particles)
+        self._filter.set_scales(np.maximum(k, 0.05))  # a prior draw below 0.05: 0.05
+        self.estimate = self._circular_mean()
+
+    @property
+    def particles(self) -> np.ndarray:
+        return np.asarray(self._filter.particles)
+
+    @property
+    def weights(self) -> np.ndarray:
+        return np.asarray(self._filter.weights)
+
+    @property
+    def scale(self) -> float:
+        """The weighted mean odometry scale k."""
+        return float(np.dot(self.weights, np.asarray(self._filter.scales)))
+
+    def _circular_mean(self) -> float:
+        angle = (2.0 * math.pi / self.length) * self.particles
+        w = self.weights
+        mean = math.atan2(float(np.dot(w, np.sin(angle))), float(np.dot(w, np.cos(angle))))
+        return (mean % (2.0 * math.pi)) * self.length / (2.0 * math.pi)
+
+    def step(self, distance: float, reading: Any) -> float:
+        """One reading: the odometry's travel since the last one (m) and one value per channel.
+        Returns the estimate in [0, L)."""
+        if isinstance(distance, bool) or not isinstance(distance, int | float):
+            raise ValueError(
+                f"loop filter: the odometry increment must be a number, got {distance!r}"
+            )
+        r = np.asarray(reading, dtype=np.float64)
+        if not (math.isfinite(distance) and np.all(np.isfinite(r))):
+            raise ValueError("loop filter: the increment and the reading must be finite")
+        c = self.config
+        root = math.sqrt(abs(distance))
+        self._filter.predict_scaled(float(distance), c.odometry_noise * root, c.scale_walk * root)
+        log_l = loop_log_likelihood(self.profiles, self.particles, r, distance)
+        self._filter.update(log_l)
+        self.estimate = self._circular_mean()
+        return self.estimate
+
+    def run(self, distances: Any, readings: Any) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`step` over a stream: increments (n,) m and readings (n, channels); the
+        estimates (n,) and the mean scale after each step (n,)."""
+        d = np.asarray(distances, dtype=np.float64)
+        r = np.asarray(readings, dtype=np.float64)
+        if d.ndim != 1 or r.shape != (len(d), len(self.profiles)):
+            raise ValueError(
+                f"loop filter: increments {d.shape} and readings {r.shape} do not match "
+                f"(n,) and (n, {len(self.profiles)})"
+            )
+        est, scale = np.empty(len(d)), np.empty(len(d))
+        for i in range(len(d)):
+            est[i] = self.step(float(d[i]), r[i])
+            scale[i] = self.scale
+        return est, scale
