@@ -21,6 +21,8 @@ from kiseki.apps.magnetic.navigate_outputs import navigate_folder, teach_folder
 from kiseki.cli.magnetic_fit import fit
 from kiseki.datasets.kok import read_kok_walk
 from kiseki.magnetic.field_map import MagneticFieldMap
+from kiseki.magnetic.loop_travel_distance import STARTS, LoopTravelConfig
+from kiseki.magnetic.loop_walk import localize_walk_loop
 from kiseki.magnetic.points_csv import read_points
 from kiseki.magnetic.render import picture_size, render_field_map
 from kiseki.magnetic.travel_distance_walk import WalkOdometry, localize_walk
@@ -121,21 +123,49 @@ def walk(
         parser=Fraction("--scale-error", -1, 1, lo_open=True),
         help="Fixed odometry scale error e (default: drawn from N(0, 0.05^2)).",
     ),
+    filter_name: str = typer.Option(
+        "loop",
+        "--filter",
+        help="loop (kiseki's: the walk as one stream, no lap boundaries) or thesis.",
+    ),
+    start: str = typer.Option(
+        LoopTravelConfig.start,
+        help="With --filter loop: known (the loop's start) or global (anywhere on it).",
+    ),
 ) -> None:
-    """The thesis' travel-distance particle filter (sec. 4.4.1: 1000 particles, w = 1/(a s + 1),
-    a = 50 per G m, l = 6 m of mz, resampling when ESS < 9n/10) on a real walk: the first lap
-    (until the walker comes back within 1.5 m of the start after 10 m) is the linear map, the
-    later laps are localized against it, each from travel distance 0. The filter compares mz,
-    the vertical field (the walk's quaternions turn the readings to the world frame, so the map
-    and the laps compare the same component however the iPad is held). Odometry of the later
-    laps: each horizontal ARKit step
-    |dp| becomes (1 + e) |dp| + N(0, (0.1 |dp|)^2), e drawn once from N(0, 0.05^2) by the seed.
-    Writes OUT/trajectory.csv (t,s_true,s_est,s_odom; s_true from the map node nearest the true
-    position) and prints the RMSE of s_est and s_odom. Laps that leave the map's path (over
-    2 m from every map node) are reported and not localized.
+    """Travel distance along a real walk's loop from odometry and the magnetic field. The first
+    lap (until the walker comes back within 1.5 m of the start after 10 m) is the map.
+
+    --filter loop (default), kiseki's loop filter: everything after the first lap is one
+    stream of odometry and readings (vertical field and horizontal magnitude, which do not
+    turn with the heading), weighed by a Gaussian process of the first lap; the odometry's
+    scale is estimated; no lap boundary is given to it. s_odom is the odometry continued from
+    the same start, around the loop; errors are taken around the loop.
+
+    --filter thesis: the thesis' travel-distance particle filter (sec. 4.4.1: 1000
+    particles, w = 1/(a s + 1), a = 50 per G m, l = 6 m of mz, resampling when ESS < 9n/10):
+    the later laps are localized each from travel distance 0, their starts taken from the
+    walk's positions. It compares mz, the vertical field (the walk's quaternions turn the
+    readings to the world frame). Laps that leave the map's path (over 2 m from every map
+    node) are reported and not localized.
+
+    Odometry after the first lap: each horizontal ARKit step |dp| becomes
+    (1 + e) |dp| + N(0, (0.1 |dp|)^2), e drawn once from N(0, 0.05^2) by the seed. The walk's
+    positions are used to map the first lap and to score, never by --filter loop to localize.
+    Writes OUT/trajectory.csv (t,s_true,s_est,s_odom[,scale]; s_true from the map node nearest
+    the true position) and prints the RMSE of s_est and s_odom.
 
     Example: kiseki magnetic walk eight.mat -o eight-walk --seed 0"""
     target = output / "trajectory.csv"
+    if filter_name not in ("loop", "thesis"):
+        raise ValueError(f"--filter must be loop or thesis, got {filter_name!r}")
+    if start not in STARTS:
+        raise ValueError(f"--start must be {' or '.join(STARTS)}, got {start!r}")
+    if filter_name == "loop":
+        _walk_loop(walk_file, target, seed, scale_error, start)
+        return
+    if start != LoopTravelConfig.start:
+        raise ValueError("--start is for --filter loop (the thesis' laps start at the map's start)")
     result = localize_walk(read_kok_walk(walk_file), seed, WalkOdometry(scale_error=scale_error))
     for lap, t, metres in result.off_path:
         console.print(
@@ -154,6 +184,32 @@ def walk(
         f"{len(result.linear_map)} nodes; odometry scale error {result.scale_error:+.4f}"
     )
     console.print(f"RMSE s_est {result.rmse('s_est'):.3f} m, s_odom {result.rmse('s_odom'):.3f} m")
+
+
+def _walk_loop(walk_file: Path, target: Path, seed: int, scale_error, start: str) -> None:
+    """kiseki's loop filter on a walk (``kiseki magnetic walk --filter loop``)."""
+    odometry = WalkOdometry(scale_error=scale_error)
+    result = localize_walk_loop(
+        read_kok_walk(walk_file), seed, odometry, LoopTravelConfig(start=start)
+    )
+    if result.t.size == 0:
+        raise ValueError(f"{walk_file}: every later sample leaves the map's path: nothing scored")
+    rows = np.column_stack([result.t, result.s_true, result.s_est, result.s_dr, result.scale])
+    text = "t,s_true,s_est,s_odom,scale\n" + "".join(
+        ",".join(f"{v:.6f}" for v in r) + "\n" for r in rows
+    )
+    target.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write(target, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+    kernels = ", ".join(
+        f"{name} l {p.kernel.length_scale:.2f} m, sigma_n {100 * p.kernel.sigma_n:.2f} uT"
+        for name, p in zip(("m_z", "|m_h|"), result.profiles, strict=True)
+    )
+    console.print(
+        f"{target}: {len(rows)} samples after a mapping lap of {result.length:.4f} m "
+        f"({kernels}); odometry scale error {result.scale_error:+.4f}, estimated scale "
+        f"{result.scale[-1]:.4f}"
+    )
+    console.print(f"RMSE s_est {result.rmse('s_est'):.3f} m, s_odom {result.rmse('s_dr'):.3f} m")
 
 
 @app.command("teach")

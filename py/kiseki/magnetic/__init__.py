@@ -2,7 +2,8 @@
 # Copyright (c) 2026 the kiseki authors
 """Magnetic maps and magnetometers: the linear magnetic map along a taught path (thesis
 chapters 3-4), calibration of the sensors (eq. 6.16), field maps from Gaussian-process
-regression, and localization on them (eqs. 6.17-6.18) (thesis chapter 6)."""
+regression, and localization on them (eqs. 6.17-6.18) (thesis chapter 6); kiseki's loop filter
+for travel distance on recorded walks (:mod:`kiseki.magnetic.loop_travel_distance`)."""
 
 from __future__ import annotations
 
@@ -29,6 +30,9 @@ from kiseki.magnetic.localization import (
     MagneticMclConfig,
     localize_on_magnetic_map,
 )
+from kiseki.magnetic.loop_profile import LoopProfile, fit_loop_profile, heading_invariant_channels
+from kiseki.magnetic.loop_travel_distance import LoopTravelConfig, LoopTravelDistanceLocalizer
+from kiseki.magnetic.loop_walk import LoopWalkResult, localize_walk_loop, map_walk_loop
 from kiseki.magnetic.travel_distance import (
     TravelDistanceConfig,
     TravelDistanceLocalizer,
@@ -40,6 +44,10 @@ __all__ = [
     "EllipsoidCalibration",
     "LidarMclConfig",
     "LinearMagneticMap",
+    "LoopProfile",
+    "LoopTravelConfig",
+    "LoopTravelDistanceLocalizer",
+    "LoopWalkResult",
     "MagneticFieldMap",
     "MagneticLidarMcl",
     "MagneticLocalization",
@@ -56,12 +64,16 @@ __all__ = [
     "build_linear_map",
     "calibrated_magnitude",
     "fit_ellipsoid",
+    "fit_loop_profile",
     "fit_sphere",
     "geometric_features",
     "heading_from_map",
+    "heading_invariant_channels",
     "linear_map_from_run",
     "load_linear_map",
     "localize_on_magnetic_map",
+    "localize_walk_loop",
+    "map_walk_loop",
     "path_identity",
     "save_linear_map",
     "teaching_samples",

@@ -37,7 +37,15 @@ from kiseki.datasets.magnetic import MagneticSamples
 from kiseki.magnetic.linear_map import LinearMagneticMap, build_linear_map, path_identity
 from kiseki.magnetic.travel_distance import TravelDistanceConfig, TravelDistanceLocalizer
 
-__all__ = ["WalkOdometry", "WalkResult", "localize_walk", "path_frame_field", "split_laps"]
+__all__ = [
+    "WalkOdometry",
+    "WalkResult",
+    "horizontal_travel",
+    "localize_walk",
+    "path_frame_field",
+    "split_laps",
+    "truth_on_map",
+]
 
 UT_PER_G = 100.0
 MIN_PARTIAL = 1.0
@@ -87,7 +95,8 @@ class WalkResult:
         return float(np.sqrt(np.mean(err**2))) if err.size else math.nan
 
 
-def _travel(xy: np.ndarray) -> np.ndarray:
+def horizontal_travel(xy: np.ndarray) -> np.ndarray:
+    """(n,) cumulative horizontal distance along positions (n, 2), from 0."""
     return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
 
 
@@ -99,7 +108,7 @@ def split_laps(xy: Any, radius: float = 1.5, min_travel: float = 10.0) -> list[t
     if p.ndim != 2 or p.shape[1] != 2 or len(p) < 2:
         raise ValueError(f"walk: positions must be (n, 2) with n >= 2, got {p.shape}")
     near = np.linalg.norm(p - p[0], axis=1) <= radius
-    s = _travel(p)
+    s = horizontal_travel(p)
     dist = np.linalg.norm(p - p[0], axis=1)
     laps, begin = [], 0
     while True:
@@ -137,7 +146,10 @@ def path_frame_field(field_world: Any, xy: Any) -> tuple[np.ndarray, np.ndarray]
     return np.column_stack([fx, fy, -f[:, 2]]), heading
 
 
-def _truth(xy: np.ndarray, m: LinearMagneticMap, expected: np.ndarray, window: float):
+def truth_on_map(xy: np.ndarray, m: LinearMagneticMap, expected: np.ndarray, window: float):
+    """(s of the map node nearest each position among those within ``window`` m of the
+    ``expected`` travel distance, each position's distance to the nearest node) (module text:
+    ``s_true``)."""
     d = np.linalg.norm(xy[:, None, :] - m.position[None, :, :], axis=2)
     offset = d.min(axis=1)
     gated = np.where(np.abs(m.s[None, :] - expected[:, None]) <= window, d, np.inf)
@@ -165,7 +177,7 @@ def localize_walk(
     if len(laps) < 2:
         raise ValueError(f"{walk.source}: one lap only: nothing to localize against its map")
     frame_field, heading = path_frame_field(np.asarray(walk.field) * scale, xy)
-    travel = _travel(xy)
+    travel = horizontal_travel(xy)
     b, e = laps[0]
     lap = slice(b, e + 1)
     m = build_linear_map(
@@ -193,7 +205,9 @@ def localize_walk(
             and np.linalg.norm(xy[e] - xy[0]) <= odometry.radius
         )
         ratio = full / lap_travel[-1] if closed else 1.0  # 1: the partial last lap
-        s_true, offset = _truth(xy[lap], m, lap_travel * ratio + m.s[0], odometry.truth_window)
+        s_true, offset = truth_on_map(
+            xy[lap], m, lap_travel * ratio + m.s[0], odometry.truth_window
+        )
         if offset.max() > odometry.max_offset:
             k = int(np.argmax(offset))
             off_path.append((number, float(walk.times[b + k] - t0), float(offset[k])))

@@ -13,10 +13,9 @@ import numpy as np
 import pytest
 import scipy.io
 
-from kiseki.datasets.kok import SENSOR_TO_BODY
+from _helpers.synthetic_walk import RADIUS, STEP, write_walk
 
-RADIUS = 4.0  # m: a circular loop of 25.1 m
-STEP = 0.1  # m per sample: 1 m/s at 10 Hz
+THESIS = ("--filter", "thesis")
 
 
 def run(*args) -> subprocess.CompletedProcess:
@@ -25,34 +24,6 @@ def run(*args) -> subprocess.CompletedProcess:
         capture_output=True,
         text=True,
     )
-
-
-def loop_field(angle: np.ndarray) -> np.ndarray:
-    """World field (uT, z up) along the loop: -45 uT vertical with 10 uT anomalies."""
-    bumps = sum(10.0 * np.exp(-0.5 * ((angle - c) / 0.08) ** 2) for c in (0.7, 2.0, 3.6, 5.1))
-    return np.column_stack([np.full_like(angle, 15.0), np.zeros_like(angle), -45.0 - bumps])
-
-
-def write_walk(path, laps=3.0, detour=None, **override) -> None:
-    """A walk of ``laps`` laps of a circle at constant speed; ``detour=(lap, metres)`` pushes
-    that lap outwards by up to that many metres."""
-    angle = np.arange(0.0, laps * 2 * np.pi, STEP / RADIUS)
-    r = np.full_like(angle, RADIUS)
-    if detour is not None:
-        lap, metres = detour
-        inside = (angle > (lap - 1) * 2 * np.pi) & (angle < lap * 2 * np.pi)
-        r[inside] += metres * np.sin((angle[inside] % (2 * np.pi)) / 2) ** 2
-    xyz = np.column_stack([r * np.cos(angle) - RADIUS, r * np.sin(angle), np.zeros_like(angle)])
-    world = loop_field(angle % (2 * np.pi))
-    m = world @ SENSOR_TO_BODY  # identity orientation: world = SENSOR_TO_BODY @ m
-    data = {
-        "t": (np.arange(len(angle)) * 0.1)[:, None],
-        "dPos": np.diff(xyz, axis=0),
-        "quat": np.tile([1.0, 0.0, 0.0, 0.0], (len(angle), 1)),
-        "m": m,
-    }
-    data.update(override)
-    scipy.io.savemat(path, data)
 
 
 def read_trajectory(path):
@@ -70,7 +41,7 @@ def printed_rmse(stdout: str) -> tuple[float, float]:
 def test_synthetic_loop_truth_and_rmse(tmp_path):
     write_walk(tmp_path / "loop.mat")
     out = tmp_path / "out"
-    result = run(tmp_path / "loop.mat", "-o", out, "--seed", "1", "--scale-error", "0.06")
+    result = run(tmp_path / "loop.mat", "-o", out, "--seed", "1", "--scale-error", "0.06", *THESIS)
     assert result.returncode == 0, result.stderr
     rows = read_trajectory(out / "trajectory.csv")
     t, s_true, s_est, s_odom = rows.T
@@ -84,14 +55,16 @@ def test_synthetic_loop_truth_and_rmse(tmp_path):
     assert printed_rmse(result.stdout) == pytest.approx((err_est, err_odom), abs=1.5e-3)
     assert err_odom > 0.5  # 6 % of up to 25 m
     assert err_est < 0.5 * err_odom
-    again = run(tmp_path / "loop.mat", "-o", tmp_path / "b", "--seed", "1", "--scale-error", "0.06")
+    again = run(
+        tmp_path / "loop.mat", "-o", tmp_path / "b", "--seed", "1", "--scale-error", "0.06", *THESIS
+    )
     assert (tmp_path / "b" / "trajectory.csv").read_text() == (out / "trajectory.csv").read_text()
     assert again.stdout.splitlines()[-1] == result.stdout.splitlines()[-1]
 
 
 def test_a_lap_off_the_path_is_reported_not_localized(tmp_path):
     write_walk(tmp_path / "detour.mat", detour=(2, 5.0))
-    result = run(tmp_path / "detour.mat", "-o", tmp_path / "out")
+    result = run(tmp_path / "detour.mat", "-o", tmp_path / "out", *THESIS)
     assert result.returncode == 0, result.stderr
     assert "lap 2 leaves the map's path" in result.stdout
     t = read_trajectory(tmp_path / "out" / "trajectory.csv")[:, 0]
@@ -100,7 +73,7 @@ def test_a_lap_off_the_path_is_reported_not_localized(tmp_path):
 
 def test_every_later_lap_off_the_path_is_an_error(tmp_path):
     write_walk(tmp_path / "detour.mat", laps=2.0, detour=(2, 5.0))
-    result = run(tmp_path / "detour.mat", "-o", tmp_path / "out")
+    result = run(tmp_path / "detour.mat", "-o", tmp_path / "out", *THESIS)
     assert result.returncode == 1
     assert "every later lap leaves the map's path" in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1
@@ -145,6 +118,42 @@ def test_bad_options(tmp_path):
     write_walk(short, laps=0.3)
     result = run(short, "-o", tmp_path / "out")
     assert result.returncode == 1 and "never comes back within 1.5 m" in result.stderr
+    for bad, message in (
+        (("--filter", "kalman"), "--filter must be loop or thesis"),
+        (("--start", "nowhere"), "--start must be known or global"),
+        ((*THESIS, "--start", "global"), "--start is for --filter loop"),
+    ):
+        result = run(tmp_path / "loop.mat", "-o", tmp_path / "out", *bad)
+        assert result.returncode == 1 and message in result.stderr, bad
+        assert len(result.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("start", ["known", "global"])
+def test_loop_filter_on_a_synthetic_walk_is_told_no_laps(tmp_path, start):
+    """Three laps of a circle after the mapping lap, with 8 % long odometry: the arc is the
+    truth; the loop filter's file and printout agree, it beats the odometry continued around
+    the loop, and its scale approaches 1 / 1.08."""
+    write_walk(tmp_path / "loop.mat", laps=4.0)
+    out = tmp_path / "out"
+    args = ("--seed", "2", "--scale-error", "0.08", "--start", start)
+    result = run(tmp_path / "loop.mat", "-o", out, *args)
+    assert result.returncode == 0, result.stderr
+    lines = (out / "trajectory.csv").read_text().splitlines()
+    assert lines[0] == "t,s_true,s_est,s_odom,scale"
+    t, s_true, s_est, s_odom, scale = np.loadtxt(lines[1:], delimiter=",", ndmin=2).T
+    loop = float(result.stdout.split("mapping lap of ")[1].split()[0])
+    assert loop == pytest.approx(2 * np.pi * RADIUS, abs=0.1)
+    assert np.max(np.abs((s_true - t * STEP / 0.1 + loop / 2) % loop - loop / 2)) < 0.3
+    wrap = lambda e: (e + loop / 2) % loop - loop / 2  # noqa: E731
+    err_est = np.sqrt(np.mean(wrap(s_est - s_true) ** 2))
+    err_odom = np.sqrt(np.mean(wrap(s_odom - s_true) ** 2))
+    assert printed_rmse(result.stdout) == pytest.approx((err_est, err_odom), abs=2e-3)
+    assert err_odom > 1.5
+    # an unknown start: four bumps per lap, the horizontal field flat; it is found within the
+    # first of the three localized laps
+    settled = slice(len(t) // 3 if start == "global" else 0, None)
+    assert np.sqrt(np.mean(wrap(s_est - s_true)[settled] ** 2)) < 0.25 * err_odom
+    assert np.mean(scale[len(scale) // 2 :]) == pytest.approx(1 / 1.08, abs=0.03)
 
 
 @pytest.mark.parametrize("name", ["eight", "square"])
@@ -152,7 +161,7 @@ def test_recorded_walks(shared_data, tmp_path, name):
     walk = shared_data / "magnetic" / "kok_1d" / f"{name}.mat"
     if not walk.is_file():
         pytest.skip(f"{walk} not found")
-    result = run(walk, "-o", tmp_path, "--seed", "0")
+    result = run(walk, "-o", tmp_path, "--seed", "0", *THESIS)
     assert result.returncode == 0, result.stderr
     t, s_true, s_est, s_odom = read_trajectory(tmp_path / "trajectory.csv").T
     err_est = np.sqrt(np.mean((s_est - s_true) ** 2))

@@ -1,0 +1,205 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""kiseki's loop filter (:mod:`kiseki.magnetic.loop_travel_distance`) on a recorded hand-held
+walk of repeated laps, as a user would run it:
+
+* The mapping lap is the walk's first lap (:func:`~kiseki.magnetic.travel_distance_walk.
+  split_laps`, its positions are the mapping run's); the loop's length L is that lap's
+  horizontal travel; one :class:`~kiseki.magnetic.loop_profile.LoopProfile` per
+  heading-invariant channel (m_z and |m_h|, G) of the lap's readings.
+* Everything after the mapping lap is one stream: odometry increments and readings only. The
+  filter is never told where a lap begins; with ``start="known"`` it starts where the mapping
+  lap ended (the loop's start), with ``"global"`` anywhere on the loop.
+* Odometry: as :class:`~kiseki.magnetic.travel_distance_walk.WalkOdometry` (the same increments
+  for the same seed).
+* Scoring only (the filter never sees it): ``s_true`` per later lap as in
+  :func:`~kiseki.magnetic.travel_distance_walk.localize_walk`; errors are taken around the loop
+  (wrapped to [-L/2, L/2)). Two dead reckonings beside it: ``s_dr``, the same odometry from the
+  same start, continued around the loop (what a user has without the filter), and ``s_dr_lap``,
+  odometry restarted at the map's start at each lap's true beginning (the thesis' filter's
+  baseline in ``localize_walk``, which is given the lap boundaries from the reference).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from kiseki.datasets.magnetic import MagneticSamples
+from kiseki.magnetic.linear_map import LinearMagneticMap, build_linear_map, path_identity
+from kiseki.magnetic.loop_profile import LoopProfile, fit_loop_profile, heading_invariant_channels
+from kiseki.magnetic.loop_travel_distance import LoopTravelConfig, LoopTravelDistanceLocalizer
+from kiseki.magnetic.travel_distance_walk import (
+    UT_PER_G,
+    WalkOdometry,
+    horizontal_travel,
+    path_frame_field,
+    split_laps,
+    truth_on_map,
+)
+
+NOISE_FLOOR = 1e-4
+"""G (0.01 uT): the least sigma_n of a profile, far below any magnetometer's noise, so that a
+noise-free (synthetic) mapping lap does not give a likelihood of zero width."""
+
+__all__ = ["LoopWalkMap", "LoopWalkResult", "localize_walk_loop", "map_walk_loop", "wrap_around"]
+
+
+def wrap_around(error: np.ndarray, length: float) -> np.ndarray:
+    """Errors along a loop of ``length`` m taken the short way round, in [-L/2, L/2)."""
+    return (np.asarray(error) + length / 2.0) % length - length / 2.0
+
+
+@dataclass(frozen=True)
+class LoopWalkResult:
+    """One row per scored sample (the later laps); the loop and the profiles."""
+
+    t: np.ndarray
+    s_true: np.ndarray
+    s_est: np.ndarray
+    s_dr: np.ndarray
+    s_dr_lap: np.ndarray
+    scale: np.ndarray  # the filter's mean odometry scale
+    lap: np.ndarray
+    scale_error: float
+    length: float
+    profiles: tuple[LoopProfile, ...]
+    laps: list[tuple[int, int]]
+
+    def rmse(self, column: str) -> float:
+        err = wrap_around(getattr(self, column) - self.s_true, self.length)
+        return float(np.sqrt(np.mean(err**2))) if err.size else math.nan
+
+
+@dataclass(frozen=True)
+class LoopWalkMap:
+    """What the mapping lap gives (module text): fitted once, localized against many times."""
+
+    source: str
+    times: np.ndarray  # (n,) s
+    xy: np.ndarray  # (n, 2) every sample's position (scoring only after the mapping lap)
+    travel: np.ndarray  # (n,) horizontal travel along the whole walk (the mapping lap's s)
+    channels: np.ndarray  # (n, 2) m_z and |m_h|, G
+    laps: list[tuple[int, int]]
+    length: float
+    profiles: tuple[LoopProfile, ...]
+    linear_map: LinearMagneticMap  # of the mapping lap, for scoring: s_true is read at its nodes
+
+
+def map_walk_loop(walk: MagneticSamples, odometry: WalkOdometry | None = None) -> LoopWalkMap:
+    """The mapping lap's loop and profiles (module text); ``odometry`` gives the lap rules."""
+    odometry = WalkOdometry() if odometry is None else odometry
+    if not isinstance(odometry, WalkOdometry):
+        raise ValueError("walk: odometry must be a WalkOdometry")
+    if walk.times is None:
+        raise ValueError(f"{walk.source}: the walk has no times")
+    unit = {"uT": 1.0 / UT_PER_G, "G": 1.0}.get(walk.units)
+    if unit is None or walk.dimension != 3:
+        raise ValueError(f"{walk.source}: a walk needs 3-D positions and a field in uT or G")
+    xy = np.asarray(walk.positions[:, :2])
+    laps = split_laps(xy, odometry.radius, odometry.min_travel)
+    if len(laps) < 2:
+        raise ValueError(f"{walk.source}: one lap only: nothing to localize against its map")
+    frame_field, heading = path_frame_field(np.asarray(walk.field) * unit, xy)
+    channels = heading_invariant_channels(frame_field)
+    travel = horizontal_travel(xy)
+    b, e = laps[0]
+    length = float(travel[e] - travel[b])
+    s_map = travel[b : e + 1] - travel[b]
+    profiles = tuple(
+        fit_loop_profile(s_map, channels[b : e + 1, c], length, noise_floor=NOISE_FLOOR)
+        for c in range(2)
+    )
+    m = build_linear_map(
+        s_map,
+        frame_field[b : e + 1],
+        heading[b : e + 1],
+        position=xy[b : e + 1],
+        path_id=path_identity(xy[b : e + 1]),
+    )
+    return LoopWalkMap(
+        str(walk.source),
+        np.asarray(walk.times, dtype=np.float64),
+        xy,
+        travel,
+        channels,
+        laps,
+        length,
+        profiles,
+        m,
+    )
+
+
+def localize_walk_loop(
+    walk: MagneticSamples | LoopWalkMap,
+    seed: int = 0,
+    odometry: WalkOdometry | None = None,
+    config: LoopTravelConfig | None = None,
+    *,
+    use_field: bool = True,
+) -> LoopWalkResult:
+    """Map the first lap (unless given its :class:`LoopWalkMap`), then localize the rest of the
+    walk as one stream (module text). ``use_field=False`` runs the filter without readings:
+    odometry with the scale's prior (a control)."""
+    odometry = WalkOdometry() if odometry is None else odometry
+    config = LoopTravelConfig() if config is None else config
+    if not isinstance(odometry, WalkOdometry) or not isinstance(config, LoopTravelConfig):
+        raise ValueError("walk: odometry must be a WalkOdometry and config a LoopTravelConfig")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
+        raise ValueError(f"walk: seed must be an integer in [0, 2**64), got {seed!r}")
+    wm = walk if isinstance(walk, LoopWalkMap) else map_walk_loop(walk, odometry)
+    xy, travel, laps, length, m = wm.xy, wm.travel, wm.laps, wm.length, wm.linear_map
+    rng = np.random.default_rng(seed)
+    e_scale = odometry.scale_error
+    e_scale = float(rng.normal(0.0, odometry.scale_sd)) if e_scale is None else float(e_scale)
+    step = np.concatenate([[0.0], np.linalg.norm(np.diff(xy, axis=0), axis=1)])
+    odo_step = (1.0 + e_scale) * step + rng.normal(0.0, 1.0, len(step)) * odometry.noise * step
+    stream = np.arange(laps[0][1], len(xy))
+    increments = odo_step[stream].copy()
+    increments[0] = 0.0
+    filter_config = replace(config, seed=(config.seed + seed * 1009) % 2**64)
+    profiles = wm.profiles if use_field else ()
+    localizer = LoopTravelDistanceLocalizer(profiles, filter_config, 0.0, length=length)
+    readings = wm.channels[stream][:, : len(profiles)]
+    est, scale = localizer.run(increments, readings)
+    dr = np.mod(np.cumsum(increments), length)
+    # scoring: the reference's lap boundaries and s_true, as localize_walk
+    truth = np.full(len(xy), np.nan)
+    dr_lap = np.full(len(xy), np.nan)
+    lap_of = np.zeros(len(xy), dtype=int)
+    full = m.s[-1] - m.s[0]
+    for number, (lb, le) in enumerate(laps[1:], start=2):
+        lap = slice(lb, le + 1)
+        lap_travel = travel[lap] - travel[lb]
+        closed = (
+            lap_travel[-1] >= odometry.min_travel
+            and np.linalg.norm(xy[le] - xy[0]) <= odometry.radius
+        )
+        ratio = full / lap_travel[-1] if closed else 1.0
+        s_true, offset = truth_on_map(
+            xy[lap], m, lap_travel * ratio + m.s[0], odometry.truth_window
+        )
+        keep = offset <= odometry.max_offset  # a sample off the map's path is not scored
+        rows = np.arange(lb, le + 1)[keep]
+        truth[rows] = s_true[keep]
+        lap_steps = odo_step[lap].copy()
+        lap_steps[0] = 0.0
+        dr_lap[rows] = (m.s[0] + np.cumsum(lap_steps))[keep]
+        lap_of[rows] = number
+    scored = np.isfinite(truth[stream])
+    rows = stream[scored]
+    return LoopWalkResult(
+        wm.times[rows] - wm.times[0],
+        truth[rows],
+        est[scored],
+        dr[scored],
+        dr_lap[rows],
+        scale[scored],
+        lap_of[rows],
+        e_scale,
+        length,
+        wm.profiles,
+        laps,
+    )
