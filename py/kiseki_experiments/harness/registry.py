@@ -12,7 +12,12 @@ from kiseki.errors import KisekiError
 from kiseki_experiments.coop import coop_forms
 from kiseki_experiments.gp import gp_aalto, gp_floor_mapping, gp_mcl, gp_table_6_2
 from kiseki_experiments.harness.base import Experiment
-from kiseki_experiments.magnav import magnav_fig_5_4, magnav_navigators, magnav_table_4_2
+from kiseki_experiments.magnav import (
+    magnav_fig_5_4,
+    magnav_navigators,
+    magnav_table_4_2,
+    magnav_walks,
+)
 from kiseki_experiments.mapping import carmen_maps, corridor_scans
 from kiseki_experiments.mcl import (
     mcl_excursions,
@@ -42,6 +47,7 @@ def _registry() -> dict[str, Experiment]:
         magnav_fig_5_4.EXPERIMENT,
         magnav_navigators.EXPERIMENT,
         magnav_table_4_2.EXPERIMENT,
+        magnav_walks.EXPERIMENT,
         mcl_excursions.EXPERIMENT,
         mcl_kidnapping.SIM,
         mcl_kidnapping.CARMEN,
