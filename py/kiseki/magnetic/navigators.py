@@ -115,6 +115,8 @@ class MultiNavigator:
     any of :data:`NAVIGATORS` (one alone: it always drives). :meth:`step` takes the node index,
     the heading estimate theta_t (rad), the reading (3,) G and g_t, and returns (navigator
     that drove, angular velocity rad/s); every navigator's PD state is updated each step.
+    ``mz_limits`` (one per node, G): kiseki's gate (:func:`kiseki.magnetic.gates.gate_limits`)
+    in place of the thesis' r_z >= 0.998.
     ``arbiter.history`` is the priority history of Fig. 4.12."""
 
     def __init__(
@@ -125,6 +127,7 @@ class MultiNavigator:
         derivative_gain: float = 0.0,
         geometric_gain: float = 0.3,
         max_rate: float = 0.5,
+        mz_limits: Any = None,
     ) -> None:
         names = tuple(navigators)
         bad = [n for n in names if n not in NAVIGATORS]
@@ -137,6 +140,15 @@ class MultiNavigator:
         if self.geometric_gain < 0:
             raise ValueError(f"MultiNavigator: geometric_gain must be >= 0, got {geometric_gain}")
         self.lmap, self.names, self.alone = lmap, names, len(names) == 1
+        self.mz_limits = None
+        if mz_limits is not None:
+            limits = np.asarray(mz_limits, dtype=np.float64)
+            if limits.shape != (len(lmap),) or not np.all(np.isfinite(limits) & (limits > 0)):
+                raise ValueError(
+                    f"MultiNavigator: mz_limits must be {len(lmap)} finite numbers > 0 (one "
+                    f"per node), got shape {limits.shape}"
+                )
+            self.mz_limits = limits
         self.steering = {n: PdSteering(heading_gain, derivative_gain, max_rate) for n in names}
         self.arbiter = PriorityArbiter({n: PRIORITIES[n] for n in names})
 
@@ -155,7 +167,10 @@ class MultiNavigator:
         e_m = _wrap(float(lm.m_theta[node]) - math.atan2(m[1], m[0]))  # eq. 4.3
         terms = geometric_terms(lm.g[node], g_t)
         g_part = self.geometric_gain * float(np.nansum(terms))
-        mag_ok = magnetic_valid(float(lm.field[node, 2]), float(m[2]))
+        if self.mz_limits is None:  # the thesis' gate, r_z >= 0.998 (eq. 4.5)
+            mag_ok = magnetic_valid(float(lm.field[node, 2]), float(m[2]))
+        else:  # kiseki's gate from the sensor's noise (kiseki.magnetic.gates)
+            mag_ok = bool(abs(float(lm.field[node, 2]) - float(m[2])) <= self.mz_limits[node])
         geo_ok = geometric_valid(lm.g[node], g_t)
         table = {
             "odometry": (e_o, True),
