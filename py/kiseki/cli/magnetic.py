@@ -246,13 +246,19 @@ def navigate(
     ),
     output: Path = typer.Option(..., "-o", "--output", help="Folder for the run and plots."),
     seed: int = typer.Option(1, parser=Seed(), help="Seed of the playback run."),
+    gates: str = typer.Option(
+        "thesis", help="Magnetic navigators' validity: thesis (r_z >= 0.998) or sensor."
+    ),
 ) -> None:
     """Plays the taught route back steering with one navigator (thesis ch. 3: rahok; ch. 4:
     the four navigators alone, or multi, arbitrated by priority). Writes OUT/run.mcap,
     OUT/navigation.csv and OUT/navigation.png (path, cross-track error, priority history).
+    --gates sensor: the magnetic navigators are valid while |m_z,n - m_z,t| <= 3 sigma
+    sqrt(1 + 1/c_n), sigma the sensor's noise read from the taught map, c_n the readings its
+    node averaged (kiseki's rule; the thesis' r_z >= 0.998 passes 0.002 G).
 
     Example: kiseki magnetic navigate data/worlds/magnetic_path.yaml --map taught -o nav"""
-    r = navigate_folder(scene, map_folder, navigator, output, seed)
+    r = navigate_folder(scene, map_folder, navigator, output, seed, gates)
     off = np.abs(r.cross_track)
     console.print(
         f"{output}: {navigator} {'reached' if r.reached_goal else 'did not reach'} the goal;"

@@ -31,8 +31,9 @@ import yaml
 
 from kiseki._support.inputs import YAML_LIMIT, read_input_text
 from kiseki._support.yaml import safe_load_12
-from kiseki.apps.magnetic.navigate_run import TaughtMaps, cross_track, navigate
+from kiseki.apps.magnetic.navigate_run import GATES, TaughtMaps, cross_track, navigate
 from kiseki.core import derive_seed
+from kiseki.magnetic.gates import reading_noise_sd
 from kiseki.magnetic.linear_map import path_identity
 from kiseki.magnetic.linear_map_run import linear_map_from_run
 from kiseki.magnetic.navigators import NAVIGATORS, RZ_MIN
@@ -63,6 +64,8 @@ class NavigatorsConfig:
     landmark_free_from: Real = 20.0  # m: the stretch without buildings (scene header)
     landmark_free_to: Real = 95.0
     disturbed: PositiveReal = 0.02  # G: a node whose mz is this far from the median is disturbed
+    # the magnetic navigators' validity: "thesis" (r_z >= 0.998) or "sensor" (kiseki's rule)
+    gates: str = "thesis"
 
 
 def _cut_scene(config: NavigatorsConfig, folder: Path) -> tuple[Path, np.ndarray]:
@@ -79,6 +82,8 @@ def _cut_scene(config: NavigatorsConfig, folder: Path) -> tuple[Path, np.ndarray
 def preflight(config: NavigatorsConfig) -> None:
     if not Path(config.scene).is_file():
         raise FileNotFoundError(f"magnav-navigators: {config.scene} not found")
+    if config.gates not in GATES:
+        raise ValueError(f"magnav-navigators: gates must be one of {GATES}, got {config.gates!r}")
     if config.length < 5.0:
         raise ValueError(f"magnav-navigators: length must be at least 5 m, got {config.length}")
     if not (config.changed_from < config.changed_to):
@@ -155,7 +160,14 @@ def trial(config: NavigatorsConfig, index: int, seed: int) -> TrialOutput:
         scene_path, waypoints = _cut_scene(config, folder)
         maps = _teach(scene_path, waypoints, derive_seed(seed, 0), folder)
         for method in METHODS:
-            r = navigate(scene_path, maps, method, folder / f"{method}.mcap", derive_seed(seed, 1))
+            r = navigate(
+                scene_path,
+                maps,
+                method,
+                folder / f"{method}.mcap",
+                derive_seed(seed, 1),
+                gates=config.gates,
+            )
             xte = np.abs(r.cross_track)
             out = np.flatnonzero(xte > config.leave_xte)
             leave = float(r.along_track[out[0]]) if len(out) else float("nan")
@@ -175,6 +187,8 @@ def trial(config: NavigatorsConfig, index: int, seed: int) -> TrialOutput:
                 record["multi:priorities"] = pack(np.column_stack([r.along_track, r.priorities]))
                 record["multi:navigators"] = ",".join(r.navigators)
                 record.update({f"multi:{k}": v for k, v in _validity(config, maps, r).items()})
+        lmap = maps.center
+        record["noise_sd_from_map"] = reading_noise_sd(lmap.field[:, 2], lmap.count)
         record["route_m"] = float(np.sum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1)))
     return TrialOutput(record)
 

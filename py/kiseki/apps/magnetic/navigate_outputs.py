@@ -23,7 +23,14 @@ from pathlib import Path
 import numpy as np
 
 from kiseki._support.atomic import atomic_write, check_writable_folder
-from kiseki.apps.magnetic.navigate_run import METHODS, NavigationResult, TaughtMaps, navigate, teach
+from kiseki.apps.magnetic.navigate_run import (
+    GATES,
+    METHODS,
+    NavigationResult,
+    TaughtMaps,
+    navigate,
+    teach,
+)
 from kiseki.magnetic.linear_map import path_identity
 from kiseki.magnetic.linear_map_folder import MAP_FILE, load_linear_map, save_linear_map
 from kiseki.plots import new_figure, save_figure
@@ -146,13 +153,15 @@ def teach_folder(scene: Path, folder: Path, seed: int, offset: float) -> TaughtM
 
 
 def navigate_folder(
-    scene: Path, map_folder: Path, method: str, folder: Path, seed: int
+    scene: Path, map_folder: Path, method: str, folder: Path, seed: int, gates: str = "thesis"
 ) -> NavigationResult:
     """``kiseki magnetic navigate``: the playback run ``folder/run.mcap`` and
     :func:`write_navigation`'s files."""
 
     if method not in METHODS:
         raise ValueError(f"--navigator must be one of {'|'.join(METHODS)}, got {method!r}")
+    if gates not in GATES:
+        raise ValueError(f"--gates must be one of {'|'.join(GATES)}, got {gates!r}")
     folder = Path(folder)
     _check_out(folder, "-o")
     waypoints = load_scene(scene, "playback").route.get("waypoints")
@@ -160,6 +169,6 @@ def navigate_folder(
         raise ValueError(f"{scene}: the scene has no route")
     maps = load_taught(map_folder, waypoints)
     folder.mkdir(parents=True, exist_ok=True)
-    result = navigate(scene, maps, method, folder / "run.mcap", seed)
+    result = navigate(scene, maps, method, folder / "run.mcap", seed, gates=gates)
     write_navigation(result, folder, waypoints)
     return result

@@ -40,6 +40,7 @@ import numpy as np
 
 from kiseki.control.pd_steering import PdSteering
 from kiseki.core import derive_seed
+from kiseki.magnetic.gates import gate_limits, reading_noise_sd
 from kiseki.magnetic.linear_map import LinearMagneticMap, geometric_features, path_identity
 from kiseki.magnetic.linear_map_run import linear_map_from_run
 from kiseki.magnetic.navigators import NAVIGATORS, MultiNavigator
@@ -57,6 +58,7 @@ from kiseki.sim.scene import load_scene
 
 __all__ = [
     "METHODS",
+    "GATES",
     "TRAVEL",
     "NavigationResult",
     "TaughtMaps",
@@ -67,6 +69,7 @@ __all__ = [
 
 METHODS = ("rahok", *NAVIGATORS, "multi")
 TRAVEL = ("odometry", "peaks", "filter")
+GATES = ("thesis", "sensor")
 OFFSET = 1.0
 """m: the parallel paths' distance from the taught one (Fig. 2.10's y = -1 and +1 m)."""
 GAINS = {"kp": 1.0, "kd": 0.5, "max_rate": 0.5}
@@ -187,7 +190,9 @@ def rahok_vectors(maps: TaughtMaps, smooth: float = 1.0) -> tuple[np.ndarray, np
 class _Controller:
     """simulate()'s controller: feeds odometry, magnetometer and laser to one method."""
 
-    def __init__(self, method: str, maps: TaughtMaps, travel: str, dt: float, speed: float):
+    def __init__(
+        self, method: str, maps: TaughtMaps, travel: str, dt: float, speed: float, gates: str
+    ):
         lmap = maps.center
         self.lmap, self.method, self.dt, self.speed = lmap, method, dt, speed
         peaks = taught_peaks(lmap.s, lmap.field[:, 2])
@@ -203,8 +208,11 @@ class _Controller:
             )
         else:
             names = NAVIGATORS if method == "multi" else (method,)
+            limits = None
+            if gates == "sensor":
+                limits = gate_limits(reading_noise_sd(lmap.field[:, 2], lmap.count), lmap.count)
             self.multi = MultiNavigator(
-                lmap, names, GAINS["kp"], GAINS["kd"], max_rate=GAINS["max_rate"]
+                lmap, names, GAINS["kp"], GAINS["kd"], max_rate=GAINS["max_rate"], mz_limits=limits
             )
         self.d = float(lmap.s[0])
         self.done = False
@@ -280,9 +288,14 @@ def navigate(
     out: str | os.PathLike,
     seed: int = 1,
     travel: str | None = None,
+    gates: str = "thesis",
 ) -> NavigationResult:
     """Playback of the taught route with ``method`` (one of :data:`METHODS`) on the scene's
-    ``playback`` variant; the run is written to the MCAP file ``out``."""
+    ``playback`` variant; the run is written to the MCAP file ``out``. ``gates``: the magnetic
+    navigators' validity, "thesis" (r_z >= 0.998) or "sensor" (kiseki's rule,
+    :mod:`kiseki.magnetic.gates`, the noise read from the taught map)."""
+    if gates not in GATES:
+        raise ValueError(f"navigate: gates must be one of {', '.join(GATES)}, got {gates!r}")
 
     if method not in METHODS:
         raise ValueError(f"navigate: method must be one of {', '.join(METHODS)}, got {method!r}")
@@ -301,7 +314,7 @@ def navigate(
     if path_identity(scene.route["waypoints"]) != maps.center.path_id:
         raise ValueError(f"{scene_path}: the maps were taught on another path")
     config = SimConfig(seed=seed, max_duration=3.0 * maps.center.s[-1] / scene.route["speed"])
-    controller = _Controller(method, maps, travel, config.dt, float(scene.route["speed"]))
+    controller = _Controller(method, maps, travel, config.dt, float(scene.route["speed"]), gates)
     summary = simulate(scene, out, config, controller=controller, overwrite=True, progress=False)
     log = controller.log
     truth = np.array(log["truth"], dtype=np.float64).reshape(-1, 3)
