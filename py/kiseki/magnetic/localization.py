@@ -29,6 +29,8 @@ __all__ = [
     "MagneticMapModel",
     "MagneticMclConfig",
     "localize_on_magnetic_map",
+    "map_noise_sd",
+    "sensor_offsets",
 ]
 
 # body: x forward, y left, z up (REP-103); sensor: the thesis' x forward, y right, z down;
@@ -36,7 +38,8 @@ __all__ = [
 FRAMES = ("body", "sensor", "world")
 
 
-def _offsets(offsets: Any) -> np.ndarray:
+def sensor_offsets(offsets: Any) -> np.ndarray:
+    """(s, 2) magnetometer offsets on the robot, checked."""
     o = np.asarray(offsets, dtype=float)
     if o.ndim == 1 and o.size == 2:
         o = o[None, :]
@@ -60,7 +63,7 @@ class MagneticMapModel:
             raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
         if not (isinstance(noise_sd, (int, float)) and math.isfinite(noise_sd) and noise_sd >= 0):
             raise ValueError(f"noise_sd must be a finite number >= 0, got {noise_sd!r}")
-        self.offsets = _offsets(offsets)
+        self.offsets = sensor_offsets(offsets)
         self.frame = frame
         self.field_map = field_map
         origin = np.asarray(field_map.origin, dtype=float)
@@ -143,7 +146,8 @@ class MagneticLocalization:
     extra: dict = field(default_factory=dict)
 
 
-def _noise_of(field_map: Any) -> float:
+def map_noise_sd(field_map: Any) -> float:
+    """The largest sigma_n of a field map's kernel(s): a reading's noise about the map."""
     kernel = field_map.kernel
     kernels = kernel if isinstance(kernel, Sequence) else (kernel,)
     return float(max(k.sigma_n for k in kernels))
@@ -172,13 +176,13 @@ def localize_on_magnetic_map(
             f"odometry: expected finite poses of shape (T, 3), got {np.shape(odometry)}"
         )
     z = np.asarray(readings, dtype=float)
-    off = _offsets(offsets)
+    off = sensor_offsets(offsets)
     if z.shape != (len(odo), len(off), 3):
         raise ValueError(f"readings: expected shape ({len(odo)}, {len(off)}, 3), got {z.shape}")
     bad = ~np.isfinite(z).all(axis=(1, 2))
     if bad.any():
         raise ValueError(f"readings: step {int(np.argmax(bad))} has NaN or infinite values")
-    noise = _noise_of(field_map) if config.noise_sd is None else config.noise_sd
+    noise = map_noise_sd(field_map) if config.noise_sd is None else config.noise_sd
     model = MagneticMapModel(field_map, off, noise, frame)
     localizer = MonteCarloLocalizer(config.mcl(), seed)
     localizer.initialize(np.asarray(initial_pose, dtype=float), config.initial_sd)
