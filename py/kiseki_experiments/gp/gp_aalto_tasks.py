@@ -19,7 +19,15 @@ from kiseki.magnetic.field_map import MagneticFieldMap
 from kiseki.magnetic.localization import MagneticMclConfig, localize_on_magnetic_map
 from kiseki_experiments.gp import gp_aalto_steps as st
 
-__all__ = ["change_task", "map_task", "mcl_task", "walks_task"]
+__all__ = [
+    "bounds",
+    "change_task",
+    "map_task",
+    "mcl_task",
+    "noisy_odometry",
+    "travel_subsample",
+    "walks_task",
+]
 
 EXACT_LIMIT = 2000  # readings; above, the denser-data sweep uses the reduced-rank GP
 
@@ -28,7 +36,8 @@ def _kernel_rows(gp) -> list[dict]:
     return [k.to_dict() for k in st.kernels_of(gp)]
 
 
-def _bounds(runs, margin: float) -> tuple[np.ndarray, np.ndarray]:
+def bounds(runs, margin: float) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) corners of the runs' positions, widened by ``margin`` m."""
     p = np.vstack([s.positions for s in runs.values()])
     return p.min(axis=0) - margin, p.max(axis=0) + margin
 
@@ -64,7 +73,7 @@ def map_task(config, folder: Path, sensor: str, timings: dict) -> dict:
             np.vstack([runs[r].positions[:: config.thinning] for r in config.train_runs]), 3
         ).tolist(),
     }
-    lower, upper = _bounds(runs, 0.3)
+    lower, upper = bounds(runs, 0.3)
     reach = 4 * max(k.length_scale for k in (*kernels, *st.kernels_of(sm.raw)))
     domain = (lower - reach, upper + reach)
     out |= _scalable(config, runs, sm, domain, (mean, var), timings)
@@ -193,7 +202,8 @@ def change_task(config, folder: Path, sensor: str, timings: dict) -> dict:
     return {"sensor": sensor, "rows": rows, "threshold": config.change_factor * reference}
 
 
-def _travel_subsample(positions: np.ndarray, step: float) -> np.ndarray:
+def travel_subsample(positions: np.ndarray, step: float) -> np.ndarray:
+    """Indices of the positions kept one per ``step`` m of travel (the first always)."""
     keep, last = [0], positions[0]
     for i in range(1, len(positions)):
         if math.hypot(*(positions[i] - last)) >= step:
@@ -223,12 +233,12 @@ def mcl_task(config, folder: Path, sensor: str, seed: int, timings: dict) -> dic
     runs = st.load_runs(folder, sensor, st.all_runs(config))
     sm = st.static_map(config, folder, sensor)
     test = runs[config.test_run]
-    lower, upper = _bounds({r: runs[r] for r in config.train_runs}, 0.5)
+    lower, upper = bounds({r: runs[r] for r in config.train_runs}, 0.5)
     gps = sm.gp if isinstance(sm.gp, list) else [sm.gp]
     start = time.perf_counter()
     field_map = MagneticFieldMap.from_gp(gps, lower, upper, config.map_resolution, units="uT")
     timings["mcl_map_seconds"] = time.perf_counter() - start
-    keep = _travel_subsample(test.positions, config.mcl_step)
+    keep = travel_subsample(test.positions, config.mcl_step)
     xy = test.positions[keep]
     readings = sm.corrected(config.test_run, test)[keep][:, None, :]
     d = np.diff(xy, axis=0)
