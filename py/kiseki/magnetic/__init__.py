@@ -33,6 +33,7 @@ from kiseki.magnetic.localization import (
 from kiseki.magnetic.loop_profile import LoopProfile, fit_loop_profile, heading_invariant_channels
 from kiseki.magnetic.loop_travel_distance import LoopTravelConfig, LoopTravelDistanceLocalizer
 from kiseki.magnetic.loop_walk import LoopWalkResult, localize_walk_loop, map_walk_loop
+from kiseki.magnetic.multi_sensor import DriftCheck, SensorDrop, localize_with_magnetometers
 from kiseki.magnetic.travel_distance import (
     TravelDistanceConfig,
     TravelDistanceLocalizer,
@@ -41,6 +42,7 @@ from kiseki.magnetic.travel_distance import (
 )
 
 __all__ = [
+    "DriftCheck",
     "EllipsoidCalibration",
     "LidarMclConfig",
     "LinearMagneticMap",
@@ -55,6 +57,7 @@ __all__ = [
     "MagneticMclConfig",
     "OtherPathError",
     "PathHeadingMap",
+    "SensorDrop",
     "SphereCalibration",
     "TeachingSamples",
     "TrainingData",
@@ -73,6 +76,7 @@ __all__ = [
     "load_linear_map",
     "localize_on_magnetic_map",
     "localize_walk_loop",
+    "localize_with_magnetometers",
     "map_walk_loop",
     "path_identity",
     "save_linear_map",
