@@ -28,16 +28,14 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from kiseki.datasets.magnetic import MagneticSamples
-from kiseki.magnetic.linear_map import LinearMagneticMap, build_linear_map, path_identity
 from kiseki.magnetic.loop_profile import LoopProfile, fit_loop_profile, heading_invariant_channels
 from kiseki.magnetic.loop_travel_distance import LoopTravelConfig, LoopTravelDistanceLocalizer
 from kiseki.magnetic.travel_distance_walk import (
-    UT_PER_G,
+    WalkLaps,
     WalkOdometry,
-    horizontal_travel,
-    path_frame_field,
-    split_laps,
-    truth_on_map,
+    lap_truth,
+    read_walk_laps,
+    walk_odometry,
 )
 
 NOISE_FLOOR = 1e-4
@@ -77,15 +75,11 @@ class LoopWalkResult:
 class LoopWalkMap:
     """What the mapping lap gives (module text): fitted once, localized against many times."""
 
-    source: str
     times: np.ndarray  # (n,) s
-    xy: np.ndarray  # (n, 2) every sample's position (scoring only after the mapping lap)
-    travel: np.ndarray  # (n,) horizontal travel along the whole walk (the mapping lap's s)
+    laps: WalkLaps  # positions, travel, laps, the first lap's linear map (for scoring)
     channels: np.ndarray  # (n, 2) m_z and |m_h|, G
-    laps: list[tuple[int, int]]
     length: float
     profiles: tuple[LoopProfile, ...]
-    linear_map: LinearMagneticMap  # of the mapping lap, for scoring: s_true is read at its nodes
 
 
 def map_walk_loop(walk: MagneticSamples, odometry: WalkOdometry | None = None) -> LoopWalkMap:
@@ -93,43 +87,16 @@ def map_walk_loop(walk: MagneticSamples, odometry: WalkOdometry | None = None) -
     odometry = WalkOdometry() if odometry is None else odometry
     if not isinstance(odometry, WalkOdometry):
         raise ValueError("walk: odometry must be a WalkOdometry")
-    if walk.times is None:
-        raise ValueError(f"{walk.source}: the walk has no times")
-    unit = {"uT": 1.0 / UT_PER_G, "G": 1.0}.get(walk.units)
-    if unit is None or walk.dimension != 3:
-        raise ValueError(f"{walk.source}: a walk needs 3-D positions and a field in uT or G")
-    xy = np.asarray(walk.positions[:, :2])
-    laps = split_laps(xy, odometry.radius, odometry.min_travel)
-    if len(laps) < 2:
-        raise ValueError(f"{walk.source}: one lap only: nothing to localize against its map")
-    frame_field, heading = path_frame_field(np.asarray(walk.field) * unit, xy)
-    channels = heading_invariant_channels(frame_field)
-    travel = horizontal_travel(xy)
-    b, e = laps[0]
-    length = float(travel[e] - travel[b])
-    s_map = travel[b : e + 1] - travel[b]
+    w = read_walk_laps(walk, odometry)
+    channels = heading_invariant_channels(w.frame_field)
+    b, e = w.laps[0]
+    length = float(w.travel[e] - w.travel[b])
+    s_map = w.travel[b : e + 1] - w.travel[b]
     profiles = tuple(
         fit_loop_profile(s_map, channels[b : e + 1, c], length, noise_floor=NOISE_FLOOR)
         for c in range(2)
     )
-    m = build_linear_map(
-        s_map,
-        frame_field[b : e + 1],
-        heading[b : e + 1],
-        position=xy[b : e + 1],
-        path_id=path_identity(xy[b : e + 1]),
-    )
-    return LoopWalkMap(
-        str(walk.source),
-        np.asarray(walk.times, dtype=np.float64),
-        xy,
-        travel,
-        channels,
-        laps,
-        length,
-        profiles,
-        m,
-    )
+    return LoopWalkMap(np.asarray(walk.times, dtype=np.float64), w, channels, length, profiles)
 
 
 def localize_walk_loop(
@@ -150,43 +117,28 @@ def localize_walk_loop(
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
         raise ValueError(f"walk: seed must be an integer in [0, 2**64), got {seed!r}")
     wm = walk if isinstance(walk, LoopWalkMap) else map_walk_loop(walk, odometry)
-    xy, travel, laps, length, m = wm.xy, wm.travel, wm.laps, wm.length, wm.linear_map
-    rng = np.random.default_rng(seed)
-    e_scale = odometry.scale_error
-    e_scale = float(rng.normal(0.0, odometry.scale_sd)) if e_scale is None else float(e_scale)
-    step = np.concatenate([[0.0], np.linalg.norm(np.diff(xy, axis=0), axis=1)])
-    odo_step = (1.0 + e_scale) * step + rng.normal(0.0, 1.0, len(step)) * odometry.noise * step
-    stream = np.arange(laps[0][1], len(xy))
+    w, length = wm.laps, wm.length
+    e_scale, odo_step = walk_odometry(w.xy, odometry, seed)
+    stream = np.arange(w.laps[0][1], len(w.xy))
     increments = odo_step[stream].copy()
     increments[0] = 0.0
     filter_config = replace(config, seed=(config.seed + seed * 1009) % 2**64)
     profiles = wm.profiles if use_field else ()
     localizer = LoopTravelDistanceLocalizer(profiles, filter_config, 0.0, length=length)
-    readings = wm.channels[stream][:, : len(profiles)]
-    est, scale = localizer.run(increments, readings)
+    est, scale = localizer.run(increments, wm.channels[stream][:, : len(profiles)])
     dr = np.mod(np.cumsum(increments), length)
-    # scoring: the reference's lap boundaries and s_true, as localize_walk
-    truth = np.full(len(xy), np.nan)
-    dr_lap = np.full(len(xy), np.nan)
-    lap_of = np.zeros(len(xy), dtype=int)
-    full = m.s[-1] - m.s[0]
-    for number, (lb, le) in enumerate(laps[1:], start=2):
-        lap = slice(lb, le + 1)
-        lap_travel = travel[lap] - travel[lb]
-        closed = (
-            lap_travel[-1] >= odometry.min_travel
-            and np.linalg.norm(xy[le] - xy[0]) <= odometry.radius
-        )
-        ratio = full / lap_travel[-1] if closed else 1.0
-        s_true, offset = truth_on_map(
-            xy[lap], m, lap_travel * ratio + m.s[0], odometry.truth_window
-        )
+    # scoring only: the reference's lap boundaries and s_true, as localize_walk
+    truth = np.full(len(w.xy), np.nan)
+    dr_lap = np.full(len(w.xy), np.nan)
+    lap_of = np.zeros(len(w.xy), dtype=int)
+    for number, (lb, le) in enumerate(w.laps[1:], start=2):
+        s_true, offset = lap_truth(w, (lb, le), odometry)
         keep = offset <= odometry.max_offset  # a sample off the map's path is not scored
         rows = np.arange(lb, le + 1)[keep]
         truth[rows] = s_true[keep]
-        lap_steps = odo_step[lap].copy()
+        lap_steps = odo_step[lb : le + 1].copy()
         lap_steps[0] = 0.0
-        dr_lap[rows] = (m.s[0] + np.cumsum(lap_steps))[keep]
+        dr_lap[rows] = (w.linear_map.s[0] + np.cumsum(lap_steps))[keep]
         lap_of[rows] = number
     scored = np.isfinite(truth[stream])
     rows = stream[scored]
@@ -201,5 +153,5 @@ def localize_walk_loop(
         e_scale,
         length,
         wm.profiles,
-        laps,
+        w.laps,
     )

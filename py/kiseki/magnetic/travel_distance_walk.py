@@ -38,13 +38,17 @@ from kiseki.magnetic.linear_map import LinearMagneticMap, build_linear_map, path
 from kiseki.magnetic.travel_distance import TravelDistanceConfig, TravelDistanceLocalizer
 
 __all__ = [
+    "WalkLaps",
     "WalkOdometry",
     "WalkResult",
     "horizontal_travel",
+    "lap_truth",
     "localize_walk",
     "path_frame_field",
+    "read_walk_laps",
     "split_laps",
     "truth_on_map",
+    "walk_odometry",
 ]
 
 UT_PER_G = 100.0
@@ -156,17 +160,22 @@ def truth_on_map(xy: np.ndarray, m: LinearMagneticMap, expected: np.ndarray, win
     return m.s[np.argmin(gated, axis=1)], offset
 
 
-def localize_walk(
-    walk: MagneticSamples,
-    seed: int = 0,
-    odometry: WalkOdometry | None = None,
-    config: TravelDistanceConfig | None = None,
-) -> WalkResult:
-    """Map the first lap, localize the later ones (module text)."""
-    odometry = WalkOdometry() if odometry is None else odometry
-    config = TravelDistanceConfig() if config is None else config
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
-        raise ValueError(f"walk: seed must be an integer in [0, 2**64), got {seed!r}")
+@dataclass(frozen=True)
+class WalkLaps:
+    """A walk read for travel distance (module text): horizontal positions, their travel, the
+    laps, the field in the path's frame (G) and the direction of travel, and the first lap's
+    linear map (``s`` from 0)."""
+
+    xy: np.ndarray
+    travel: np.ndarray
+    laps: list[tuple[int, int]]
+    frame_field: np.ndarray
+    heading: np.ndarray
+    linear_map: LinearMagneticMap
+
+
+def read_walk_laps(walk: MagneticSamples, odometry: WalkOdometry) -> WalkLaps:
+    """Checks a walk, splits its laps and maps the first (module text)."""
     if walk.times is None:
         raise ValueError(f"{walk.source}: the walk has no times")
     scale = {"uT": 1.0 / UT_PER_G, "G": 1.0}.get(walk.units)
@@ -181,33 +190,59 @@ def localize_walk(
     b, e = laps[0]
     lap = slice(b, e + 1)
     m = build_linear_map(
-        travel[lap],
+        travel[lap] - travel[b],
         frame_field[lap],
         heading[lap],
         position=xy[lap],
         path_id=path_identity(xy[lap]),
         provenance={"source": walk.source, "lap": "1"},
     )
+    return WalkLaps(xy, travel, laps, frame_field, heading, m)
+
+
+def walk_odometry(xy: np.ndarray, odometry: WalkOdometry, seed: int) -> tuple[float, np.ndarray]:
+    """(the scale error e, each sample's odometry step (n,), 0 first) (module text)."""
     rng = np.random.default_rng(seed)
     e_scale = odometry.scale_error
     e_scale = float(rng.normal(0.0, odometry.scale_sd)) if e_scale is None else float(e_scale)
     step = np.concatenate([[0.0], np.linalg.norm(np.diff(xy, axis=0), axis=1)])
-    odo_step = (1.0 + e_scale) * step + rng.normal(0.0, 1.0, len(step)) * odometry.noise * step
+    return e_scale, (1.0 + e_scale) * step + rng.normal(0.0, 1.0, len(step)) * odometry.noise * step
+
+
+def lap_truth(w: WalkLaps, lap: tuple[int, int], odometry: WalkOdometry):
+    """(s_true (module text), each sample's distance to the nearest map node) of a later lap
+    (first, last sample)."""
+    b, e = lap
+    m = w.linear_map
+    lap_travel = w.travel[b : e + 1] - w.travel[b]
+    closed = (
+        lap_travel[-1] >= odometry.min_travel
+        and np.linalg.norm(w.xy[e] - w.xy[0]) <= odometry.radius
+    )
+    ratio = (m.s[-1] - m.s[0]) / lap_travel[-1] if closed else 1.0  # 1: the partial last lap
+    return truth_on_map(w.xy[b : e + 1], m, lap_travel * ratio + m.s[0], odometry.truth_window)
+
+
+def localize_walk(
+    walk: MagneticSamples,
+    seed: int = 0,
+    odometry: WalkOdometry | None = None,
+    config: TravelDistanceConfig | None = None,
+) -> WalkResult:
+    """Map the first lap, localize the later ones (module text)."""
+    odometry = WalkOdometry() if odometry is None else odometry
+    config = TravelDistanceConfig() if config is None else config
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
+        raise ValueError(f"walk: seed must be an integer in [0, 2**64), got {seed!r}")
+    w = read_walk_laps(walk, odometry)
+    m, laps = w.linear_map, w.laps
+    e_scale, odo_step = walk_odometry(w.xy, odometry, seed)
     t0 = float(walk.times[0])
     rows: list[np.ndarray] = []
     off_path = []
-    full = m.s[-1] - m.s[0]
     for number, (b, e) in enumerate(laps[1:], start=2):
         lap = slice(b, e + 1)
-        lap_travel = travel[lap] - travel[b]
-        closed = (
-            lap_travel[-1] >= odometry.min_travel
-            and np.linalg.norm(xy[e] - xy[0]) <= odometry.radius
-        )
-        ratio = full / lap_travel[-1] if closed else 1.0  # 1: the partial last lap
-        s_true, offset = truth_on_map(
-            xy[lap], m, lap_travel * ratio + m.s[0], odometry.truth_window
-        )
+        s_true, offset = lap_truth(w, (b, e), odometry)
         if offset.max() > odometry.max_offset:
             k = int(np.argmax(offset))
             off_path.append((number, float(walk.times[b + k] - t0), float(offset[k])))
@@ -216,7 +251,7 @@ def localize_walk(
         increments[0] = 0.0
         lap_config = _with_seed(config, (config.seed + seed * 1009 + number) % 2**64)
         localizer = TravelDistanceLocalizer(m, lap_config, start=float(m.s[0]))
-        est = localizer.run(increments, frame_field[lap, 2])
+        est = localizer.run(increments, w.frame_field[lap, 2])
         odom = m.s[0] + np.cumsum(increments)
         t = walk.times[lap] - t0
         table = np.column_stack([t, s_true, est, odom, np.full(len(t), number)])

@@ -95,7 +95,7 @@ def trial(config: WalksConfig, index: int, seed: int) -> TrialOutput:
         "seed": seed,
         "scale_error_drawn": drawn.scale_error,
         "loop_m": wm.length,
-        "laps_localized": len(wm.laps) - 1,
+        "laps_localized": len(wm.laps.laps) - 1,
         "samples": len(drawn.t),
         "thesis": thesis.rmse("s_est"),
         "thesis_dr": thesis.rmse("s_odom"),
