@@ -28,6 +28,7 @@ __all__ = [
     "MagneticLocalization",
     "MagneticMapModel",
     "MagneticMclConfig",
+    "check_stream",
     "localize_on_magnetic_map",
     "map_noise_sd",
     "sensor_offsets",
@@ -153,6 +154,23 @@ def map_noise_sd(field_map: Any) -> float:
     return float(max(k.sigma_n for k in kernels))
 
 
+def check_stream(odometry: Any, readings: Any, sensors: int) -> tuple[np.ndarray, np.ndarray]:
+    """(odometry poses (T, 3), readings (T, sensors, 3)), finite, or ValueError naming the
+    first bad step."""
+    odo = np.asarray(odometry, dtype=float)
+    if odo.ndim != 2 or odo.shape[1] != 3 or len(odo) < 1 or not np.isfinite(odo).all():
+        raise ValueError(
+            f"odometry: expected finite poses of shape (T, 3), got {np.shape(odometry)}"
+        )
+    z = np.asarray(readings, dtype=float)
+    if z.shape != (len(odo), sensors, 3):
+        raise ValueError(f"readings: expected shape ({len(odo)}, {sensors}, 3), got {z.shape}")
+    bad = ~np.isfinite(z).all(axis=(1, 2))
+    if bad.any():
+        raise ValueError(f"readings: step {int(np.argmax(bad))} has NaN or infinite values")
+    return odo, z
+
+
 def localize_on_magnetic_map(
     field_map: Any,
     odometry: Any,
@@ -170,18 +188,8 @@ def localize_on_magnetic_map(
     config.initial_sd."""
     config = config or MagneticMclConfig()
     seed = check_seed(seed)
-    odo = np.asarray(odometry, dtype=float)
-    if odo.ndim != 2 or odo.shape[1] != 3 or len(odo) < 1 or not np.isfinite(odo).all():
-        raise ValueError(
-            f"odometry: expected finite poses of shape (T, 3), got {np.shape(odometry)}"
-        )
-    z = np.asarray(readings, dtype=float)
     off = sensor_offsets(offsets)
-    if z.shape != (len(odo), len(off), 3):
-        raise ValueError(f"readings: expected shape ({len(odo)}, {len(off)}, 3), got {z.shape}")
-    bad = ~np.isfinite(z).all(axis=(1, 2))
-    if bad.any():
-        raise ValueError(f"readings: step {int(np.argmax(bad))} has NaN or infinite values")
+    odo, z = check_stream(odometry, readings, len(off))
     noise = map_noise_sd(field_map) if config.noise_sd is None else config.noise_sd
     model = MagneticMapModel(field_map, off, noise, frame)
     localizer = MonteCarloLocalizer(config.mcl(), seed)

@@ -32,6 +32,7 @@ from kiseki.magnetic.localization import (
     MagneticLocalization,
     MagneticMapModel,
     MagneticMclConfig,
+    check_stream,
     map_noise_sd,
     sensor_offsets,
 )
@@ -106,14 +107,7 @@ def localize_with_magnetometers(
     off = sensor_offsets(offsets)
     if not maps or len(maps) != len(off):
         raise ValueError(f"{len(maps)} field map(s) for {len(off)} sensor offset(s)")
-    odo = np.asarray(odometry, dtype=float)
-    if odo.ndim != 2 or odo.shape[1] != 3 or len(odo) < 1 or not np.isfinite(odo).all():
-        raise ValueError(f"odometry: expected finite poses (T, 3), got {np.shape(odometry)}")
-    z = np.asarray(readings, dtype=float)
-    if z.shape != (len(odo), len(off), 3):
-        raise ValueError(f"readings: expected shape ({len(odo)}, {len(off)}, 3), got {z.shape}")
-    if not np.isfinite(z).all():
-        raise ValueError("readings: NaN or infinite values")
+    odo, z = check_stream(odometry, readings, len(off))
     if drift is not None and not isinstance(drift, DriftCheck):
         raise ValueError("drift must be a DriftCheck or None")
     noises = [map_noise_sd(m) if config.noise_sd is None else config.noise_sd for m in maps]
