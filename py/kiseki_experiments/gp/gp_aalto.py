@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from kiseki_experiments.gp import gp_aalto_tasks as work
+from kiseki_experiments.gp.gp_aalto_change import change_task
 from kiseki_experiments.gp.gp_aalto_report import analyze
 from kiseki_experiments.harness.base import Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
@@ -164,7 +165,7 @@ def trial(config: GpAaltoConfig, index: int, seed: int) -> TrialOutput:
     if task.startswith("map-"):
         payload = work.map_task(config, folder, task[4:], timings)
     elif task == "change":
-        payload = work.change_task(config, folder, _reference_sensor(config), timings)
+        payload = change_task(config, folder, _reference_sensor(config), timings)
     elif task == "mcl":
         payload = work.mcl_task(config, folder, _reference_sensor(config), seed, timings)
     else:

@@ -92,7 +92,10 @@ def _sweep_table(maps: dict) -> pd.DataFrame:
 def _change_table(change: dict) -> pd.DataFrame:
     rows = []
     for r in change["rows"]:
-        row = {k: r[k] for k in ("run", "role", "coverage", "share", "rms_z", "mlpd")}
+        keys = ("run", "role", "coverage", "share", "rms_z", "mlpd")
+        row = {k: r[k] for k in keys} | {
+            k: r.get(k, float("nan")) for k in ("near_others_share", "near_others_departed")
+        }
         rows.append(row | {"changed": bool(r["share"] > change["threshold"])})
     table = pd.DataFrame(rows)
     table["threshold"] = change["threshold"]
@@ -194,6 +197,14 @@ def _claims(config, maps, change, mcl) -> list[Claim]:
                     f"; RMS standardized residual {r['rms_z']:.2f} against {min(ref):.2f}-"
                     f"{max(ref):.2f} for the static runs held out"
                 )
+                if not static and "near_others_share" in r:
+                    note += (
+                        f"; {100 * r['near_others_share']:.1f} % of its covered readings lie "
+                        "within 0.2 m of where the other changed runs departed from the map, "
+                        f"and {100 * r['near_others_departed']:.1f} % of those depart: the "
+                        "field did not change along its own track, so no reading of it can "
+                        "flag it"
+                    )
             claims.append(
                 Claim(
                     f"run {r['run']} ({r['role']}) is {'not ' if static else ''}detected as a "

@@ -21,7 +21,6 @@ from kiseki_experiments.gp import gp_aalto_steps as st
 
 __all__ = [
     "bounds",
-    "change_task",
     "map_task",
     "mcl_task",
     "noisy_odometry",
@@ -157,49 +156,6 @@ def _offsets_vs_invensense(config, folder: Path, sensor: str) -> list[dict]:
         d = s.field - at
         rows.append({"run": r, "mean": d.mean(axis=0).tolist(), "sd": d.std(axis=0).tolist()})
     return rows
-
-
-def _change_score(config, gp, field, positions, kernels) -> dict:
-    mean, var = st.predict(gp, positions)
-    covered = (var < st.COVERED * st.sigma_f2(kernels)).all(axis=1)
-    z = np.abs(field - mean) / np.sqrt(var + st.sigma_n(kernels) ** 2)
-    outside = (z > config.change_sigma).any(axis=1)
-    s2 = var + st.sigma_n(kernels) ** 2
-    lpd = -0.5 * ((field - mean) ** 2 / s2 + np.log(2 * math.pi * s2)).sum(axis=1)
-    flagged = positions[covered & outside][::10]
-    return {
-        "coverage": float(covered.mean()),
-        "rms_z": float(np.sqrt((z[covered] ** 2).mean())) if covered.any() else float("nan"),
-        "share": float(outside[covered].mean()) if covered.any() else float("nan"),
-        "mlpd": float(lpd[covered].mean()) if covered.any() else float("nan"),
-        "flagged": np.round(flagged, 2).tolist(),
-        "track": np.round(positions[::25], 2).tolist(),
-    }
-
-
-def change_task(config, folder: Path, sensor: str, timings: dict) -> dict:
-    """Each run's share of readings beyond change_sigma under the map: the training runs held
-    out in turn against the others (the reference), the other runs against all of them."""
-    runs = st.load_runs(folder, sensor, st.all_runs(config))
-    sm = st.static_map(config, folder, sensor)
-    kernels = st.kernels_of(sm.gp)
-    fields = {r: sm.corrected(r, runs[r]) for r in runs}
-    rows = []
-    for r in config.train_runs:
-        others = [q for q in config.train_runs if q != r]
-        gp = st.fit_fixed(*st.stack_runs(runs, others, fields, config.thinning), kernels)
-        rows.append(
-            {"run": r, "role": "static, held out"}
-            | _change_score(config, gp, fields[r], runs[r].positions, kernels)
-        )
-    for r in [config.test_run, *config.changed_runs]:
-        role = "static, test" if r == config.test_run else "shelves moved in"
-        rows.append(
-            {"run": r, "role": role}
-            | _change_score(config, sm.gp, fields[r], runs[r].positions, kernels)
-        )
-    reference = max(row["share"] for row in rows[: len(config.train_runs)])
-    return {"sensor": sensor, "rows": rows, "threshold": config.change_factor * reference}
 
 
 def travel_subsample(positions: np.ndarray, step: float) -> np.ndarray:

@@ -128,6 +128,14 @@ def test_change_detection_and_mcl(small_run) -> None:
     assert change.loc[5, "share"] < threshold  # static run 5 is not a change
     for run in (6, 8, 9):  # shelves brought in: detected
         assert change.loc[run, "share"] > threshold
+        # where the other changed runs departed from the map, so does this one
+        assert change.loc[run, "near_others_departed"] > threshold
+    # run 7 is not detected: it passes where the others departed (over 5 % of its readings)
+    # and reads the static field there (departures below any static run's share)
+    assert change.loc[7, "share"] < threshold
+    assert change.loc[7, "near_others_share"] > 0.05
+    static = change[change["role"] == "static, held out"]["share"]
+    assert change.loc[7, "near_others_departed"] < static.min()
     mcl = _table(small_run, "mcl")
     assert (mcl["mcl_mean"] < 0.5 * mcl["odometry_mean"]).all()
     assert (mcl["mcl_max"] < 0.8).all()  # the thesis' position accuracy
