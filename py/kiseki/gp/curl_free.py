@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 import scipy.linalg
+import scipy.linalg.lapack
 import scipy.optimize
 
 from kiseki.core import check_seed
@@ -160,7 +161,10 @@ def _lml(x: np.ndarray, y: np.ndarray, k: CurlFreeKernel, gradient: bool):
     if not gradient:
         return float(value), None
     # dL/dtheta = 1/2 tr((alpha alpha^T - K^-1) dK/dtheta)
-    w = np.outer(alpha, alpha) - scipy.linalg.cho_solve(chol, np.eye(len(y)), check_finite=False)
+    inverse, info = scipy.linalg.lapack.dpotri(chol[0], lower=1)  # K^-1 from its factor
+    if info != 0:
+        return -math.inf, None
+    w = np.outer(alpha, alpha) - (np.tril(inverse) + np.tril(inverse, -1).T)
     lin = np.kron(np.ones((len(x), len(x))), np.eye(3))  # dK / d(sigma_lin^2)
     se = kmat - k.sigma_lin**2 * lin
     se[np.diag_indices_from(se)] -= k.sigma_n**2

@@ -107,10 +107,14 @@ class ReducedRankCurlFreeGP:
         prior = model.prior_variances()
         size = len(prior)
         gram, projected = np.zeros((size, size)), np.zeros(size)
+        columns = model.columns()
         for start in range(0, len(x), block):
-            phi = model.design(x[start : start + block])  # (3b, P)
-            gram += phi.T @ phi
-            projected += phi.T @ y[start : start + block].reshape(-1)
+            phi = model.design(x[start : start + block]).reshape(-1, 3, size)
+            part = y[start : start + block]
+            for c, cols in enumerate(columns):  # only the columns a component touches
+                d = phi[:, c, cols]
+                gram[np.ix_(cols, cols)] += d.T @ d
+                projected[cols] += d.T @ part[:, c]
         # weights' precision / sigma_n^-2: Phi^T Phi + sigma_n^2 Lambda^-1 (sec. IV, eq. 25)
         gram[np.diag_indices(size)] += kernel.sigma_n**2 / prior
         model._chol = scipy.linalg.cho_factor(gram, lower=True, check_finite=False)
@@ -136,6 +140,18 @@ class ReducedRankCurlFreeGP:
         density = k.sigma_f**2 * (2 * math.pi * l2) ** (d / 2) * np.exp(-0.5 * root**2 * l2)
         parts = [density] + ([density / l2] if d == 2 else []) + [np.full(3, k.sigma_lin**2)]
         return np.maximum(np.concatenate(parts), 1e-300)
+
+    def columns(self) -> list[np.ndarray]:
+        """Per field component, the design matrix's columns that can be non-zero in its rows:
+        the potential's (x, y, 3-D z) or the z weights (2-D z), and its linear term."""
+        m, d = self.basis_size, self.dimension
+        size = len(self.prior_variances())
+        potential = np.arange(m)
+        out = []
+        for c in range(3):
+            own = np.arange(m, 2 * m) if (d == 2 and c == 2) else potential
+            out.append(np.append(own, size - 3 + c))
+        return out
 
     def design(self, points: Any) -> np.ndarray:
         """(3 m, P) design matrix at points (m, d): rows (point, component), columns the
