@@ -10,7 +10,13 @@ from __future__ import annotations
 
 from kiseki.errors import KisekiError
 from kiseki_experiments.coop import coop_forms
-from kiseki_experiments.gp import gp_aalto, gp_floor_mapping, gp_mcl, gp_table_6_2
+from kiseki_experiments.gp import (
+    gp_aalto,
+    gp_aalto_defaults,
+    gp_floor_mapping,
+    gp_mcl,
+    gp_table_6_2,
+)
 from kiseki_experiments.harness.base import Experiment
 from kiseki_experiments.magnav import magnav_fig_5_4, magnav_navigators, magnav_table_4_2
 from kiseki_experiments.mapping import carmen_maps, corridor_scans
@@ -35,6 +41,7 @@ def _registry() -> dict[str, Experiment]:
         corridor_scans.EXPERIMENT,
         fig_3_14.EXPERIMENT,
         gp_aalto.EXPERIMENT,
+        gp_aalto_defaults.EXPERIMENT,
         gp_floor_mapping.EXPERIMENT,
         gp_mcl.EXPERIMENT,
         gp_table_6_2.EXPERIMENT,
