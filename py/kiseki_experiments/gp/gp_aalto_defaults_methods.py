@@ -80,12 +80,11 @@ def method_names(config) -> list[str]:
     return names
 
 
-def _shuffled(config, x: np.ndarray, seed: int) -> np.ndarray:
-    """The negative control's positions: the readings' positions permuted (kiseki's methods
-    only), so that the field no longer belongs to where it was read."""
-    if not config.shuffle_positions:
-        return x
-    return x[np.random.default_rng(seed).permutation(len(x))]
+def _lagged(config, y: np.ndarray) -> np.ndarray:
+    """The negative control's readings: each position paired with the reading taken
+    ``lag_readings`` samples later along the recorded track (circularly), kiseki's methods only:
+    a smooth, confident map of the field somewhere else."""
+    return np.roll(y, -config.lag_readings, axis=0) if config.lag_readings else y
 
 
 def _scaled(config, kernel: CurlFreeKernel) -> CurlFreeKernel:
@@ -100,7 +99,7 @@ def _scaled(config, kernel: CurlFreeKernel) -> CurlFreeKernel:
 
 
 def run_method(
-    name: str, config, x: np.ndarray, y: np.ndarray, points: np.ndarray, seed: int, cache: dict
+    name: str, config, x: np.ndarray, y: np.ndarray, points: np.ndarray, cache: dict
 ) -> Prediction:
     """(mean at points, fit seconds) of method `name` trained on all readings (x, y) of the
     training runs, in the order recorded. Hyperparameters fitted for one method are kept in
@@ -113,7 +112,7 @@ def run_method(
         mean, found = sklearn_baseline(x[::step], y[::step], points)
         cache[BASELINE] = found
         return mean, time.perf_counter() - start
-    x = _shuffled(config, x, seed)
+    y = _lagged(config, y)
     predict, hyper_seconds = _method(name, config, x, y, step, cache)
     seconds = time.perf_counter() - start + hyper_seconds
     return predict(points), seconds
