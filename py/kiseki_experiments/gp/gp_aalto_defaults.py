@@ -25,9 +25,9 @@ component, a paired interval over the cases):
 The Nexus' z axis drifts (+10 uT in run 5): every method misses run 5's z by about that much
 (its bias column shows it), and the paired differences keep it on both sides.
 
-Cost: about 2-4 minutes per case on 2 cores (scikit-learn's and the curl-free hyperparameter
-searches dominate). Modules: ``gp_aalto_defaults_methods`` (the methods),
-``gp_aalto_defaults_report`` (tables, rule and evidence).
+Cost: about 5 minutes per case, 50 minutes in all, on 2 shared cores (scikit-learn's and the
+curl-free hyperparameter searches dominate). Modules: ``gp_aalto_defaults_methods`` (the
+methods), ``gp_aalto_defaults_report`` (tables, rule and evidence).
 """
 
 from __future__ import annotations
