@@ -10,7 +10,14 @@ from __future__ import annotations
 
 from kiseki.errors import KisekiError
 from kiseki_experiments.coop import coop_forms
-from kiseki_experiments.gp import gp_aalto, gp_aalto_sensors, gp_floor_mapping, gp_mcl, gp_table_6_2
+from kiseki_experiments.gp import (
+    gp_aalto,
+    gp_aalto_defaults,
+    gp_aalto_sensors,
+    gp_floor_mapping,
+    gp_mcl,
+    gp_table_6_2,
+)
 from kiseki_experiments.harness.base import Experiment
 from kiseki_experiments.magnav import (
     magnav_fig_5_4,
@@ -40,6 +47,7 @@ def _registry() -> dict[str, Experiment]:
         corridor_scans.EXPERIMENT,
         fig_3_14.EXPERIMENT,
         gp_aalto.EXPERIMENT,
+        gp_aalto_defaults.EXPERIMENT,
         gp_aalto_sensors.EXPERIMENT,
         gp_floor_mapping.EXPERIMENT,
         gp_mcl.EXPERIMENT,
