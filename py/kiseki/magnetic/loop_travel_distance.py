@@ -30,6 +30,14 @@ changes, each for a reason measured on real walks:
   sum w_i exp(2 pi i d_i / L)).
 * Resampling (the engine's systematic) when ESS < n / 2, the usual rule for a filter whose
   weights accumulate.
+* **Re-entry** (``reentry``, on by default): after a walker has left the loop or the filter
+  has lost it, particles must reappear where it now is. Augmented MCL (Probabilistic Robotics,
+  Table 8.3): slow and fast averages of the mean likelihood (rates 0.001 and 0.1 per moving
+  reading, both from 0 as in the table), and after each resampling every particle is replaced
+  with probability max(0, 1 - fast / slow) by a draw from the uniform start. The slow average
+  starts low, so only a drop of the likelihood far below its usual level draws new particles
+  (on the shared walks it never did: the same estimates with and without it). The weighted
+  circular mean is not pulled by uniform particles, only widened.
 """
 
 from __future__ import annotations
@@ -61,6 +69,11 @@ class LoopTravelConfig:
     initial_sd: float = 0.1  # m, with start="known"
     resample_threshold: float = 0.5
     seed: int = 0
+    # re-entry: Augmented MCL's random particles (Thrun, Burgard and Fox, Probabilistic
+    # Robotics, Table 8.3) with the averages' rates AMCL's users set
+    reentry: bool = True
+    alpha_slow: float = 0.001
+    alpha_fast: float = 0.1
 
     def __post_init__(self) -> None:
         if isinstance(self.particles, bool) or not isinstance(self.particles, int):
@@ -82,6 +95,15 @@ class LoopTravelConfig:
             raise ValueError(f"loop filter: resample_threshold must be in [0, 1], got {r!r}")
         if self.start not in STARTS:
             raise ValueError(f"loop filter: start must be one of {STARTS}, got {self.start!r}")
+        if not isinstance(self.reentry, bool):
+            raise ValueError(f"loop filter: reentry must be true or false, got {self.reentry!r}")
+        a, b = self.alpha_slow, self.alpha_fast
+        if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in (a, b)) or not (
+            0 < a < b <= 1
+        ):
+            raise ValueError(
+                f"loop filter: 0 < alpha_slow < alpha_fast <= 1 is needed, got {a!r}, {b!r}"
+            )
         if isinstance(self.seed, bool) or not isinstance(self.seed, int):
             raise ValueError(f"loop filter: seed must be an integer, got {self.seed!r}")
         if not 0 <= self.seed < 2**64:
@@ -157,6 +179,9 @@ class LoopTravelDistanceLocalizer:
         self._filter.set_particles(d)
         k = 1.0 + c.scale_sd * rng.standard_normal(c.particles)
         self._filter.set_scales(np.maximum(k, 0.05))  # a prior draw below 0.05: 0.05
+        self._rng = rng
+        self._w_slow = self._w_fast = 0.0
+        self.injected = 0  # particles drawn anew by re-entry so far
         self.estimate = self._circular_mean()
 
     @property
@@ -192,9 +217,33 @@ class LoopTravelDistanceLocalizer:
         root = math.sqrt(abs(distance))
         self._filter.predict_scaled(float(distance), c.odometry_noise * root, c.scale_walk * root)
         log_l = loop_log_likelihood(self.profiles, self.particles, r, distance)
+        reentry = c.reentry and distance != 0.0 and bool(self.profiles)
+        if reentry:  # Table 8.3: the mean likelihood, and its slow and fast averages
+            top = float(log_l.max())
+            w_avg = float(np.dot(self.weights, np.exp(log_l - top))) * math.exp(top)
+            self._w_slow += c.alpha_slow * (w_avg - self._w_slow)
+            self._w_fast += c.alpha_fast * (w_avg - self._w_fast)
         self._filter.update(log_l)
+        w = self.weights
+        if reentry and self._w_slow > 0 and np.all(w == w[0]):  # just resampled
+            self._inject(max(0.0, 1.0 - self._w_fast / self._w_slow))
         self.estimate = self._circular_mean()
         return self.estimate
+
+    def _inject(self, share: float) -> None:
+        """Each particle replaced with probability ``share`` by one drawn from the start's
+        uniform prior over the loop (its scale from the scale's prior)."""
+        n = len(self.weights)
+        new = self._rng.random(n) < share
+        if not new.any():
+            return
+        c = self.config
+        d, k = self.particles.copy(), np.asarray(self._filter.scales).copy()
+        d[new] = self._rng.uniform(0.0, self.length, int(new.sum()))
+        k[new] = np.maximum(1.0 + c.scale_sd * self._rng.standard_normal(int(new.sum())), 0.05)
+        self._filter.set_particles(d)
+        self._filter.set_scales(k)
+        self.injected += int(new.sum())
 
     def run(self, distances: Any, readings: Any) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`step` over a stream: increments (n,) m and readings (n, channels); the
