@@ -49,3 +49,14 @@ def check_mean(mean: str) -> bool:
 
 def remove_mean(y: np.ndarray, constant: bool) -> np.ndarray:
     return y - y.mean(axis=0) if constant else y
+
+
+def check_iterations(max_iterations: Any) -> int:
+    """A hyperparameter search's iteration limit: an integer >= 1."""
+    if (
+        isinstance(max_iterations, bool)
+        or not isinstance(max_iterations, int)
+        or max_iterations < 1
+    ):
+        raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+    return max_iterations

@@ -31,8 +31,8 @@ import scipy.linalg
 import scipy.linalg.lapack
 import scipy.optimize
 
-from kiseki.core import check_seed
-from kiseki.gp._data import inputs_array, targets_array
+from kiseki.gp._data import check_iterations, inputs_array, targets_array
+from kiseki.gp.kernel import subsample
 
 __all__ = [
     "CurlFreeFit",
@@ -212,19 +212,11 @@ def fit_curl_free_hyperparameters(
     (each evaluation factorises a 3 max_points square matrix)."""
     x = field_inputs(x)
     y = field_targets(y, len(x))
-    if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
-        raise ValueError(f"max_points must be an integer >= 2, got {max_points!r}")
-    if (
-        isinstance(max_iterations, bool)
-        or not isinstance(max_iterations, int)
-        or max_iterations < 1
-    ):
-        raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+    check_iterations(max_iterations)
     if initial is not None and not isinstance(initial, CurlFreeKernel):
         raise ValueError(f"initial must be a CurlFreeKernel, got {type(initial).__name__}")
-    if len(x) > max_points:
-        rng = np.random.default_rng(check_seed(seed))
-        keep = np.sort(rng.choice(len(x), size=max_points, replace=False))
+    keep = subsample(len(x), max_points, seed)
+    if keep is not None:
         x, y = x[keep], y[keep]
     flat = y.reshape(-1)
     if initial is None:

@@ -12,7 +12,13 @@ import numpy as np
 
 from kiseki import _core
 from kiseki.core import check_seed
-from kiseki.gp._data import check_mean, inputs_array, remove_mean, targets_array
+from kiseki.gp._data import (
+    check_iterations,
+    check_mean,
+    inputs_array,
+    remove_mean,
+    targets_array,
+)
 
 __all__ = ["HyperparameterFit", "SquaredExponential", "fit_hyperparameters"]
 
@@ -95,12 +101,7 @@ def fit_hyperparameters(
     constant = check_mean(mean)
     if isinstance(restarts, bool) or not isinstance(restarts, int) or not 0 <= restarts <= 100:
         raise ValueError(f"restarts must be an integer in 0..100, got {restarts!r}")
-    if (
-        isinstance(max_iterations, bool)
-        or not isinstance(max_iterations, int)
-        or max_iterations < 1
-    ):
-        raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+    check_iterations(max_iterations)
     chosen = subsample(x.shape[0], max_points, seed)
     if chosen is not None:
         x, y = x[chosen], y[chosen]
