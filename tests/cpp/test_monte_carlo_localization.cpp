@@ -1,0 +1,253 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+// The Monte Carlo localization engine on a small synthetic room: tracking for any thread count,
+// global localization with KLD, resetting and the reliability, weights and bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <numeric>
+#include <vector>
+
+#include "filter_scenes.hpp"
+#include "kiseki/core/angle.hpp"
+#include "kiseki/core/random.hpp"
+#include "kiseki/filters/correlative_scan_matcher.hpp"
+#include "kiseki/filters/kld_sampling.hpp"
+#include "kiseki/filters/monte_carlo_localization.hpp"
+#include "kiseki/filters/motion_model.hpp"
+#include "kiseki/filters/resampling.hpp"
+#include "kiseki/filters/travel_distance_filter.hpp"
+#include "kiseki/grid/distance_field.hpp"
+#include "kiseki/grid/range_caster.hpp"
+#include "kiseki/grid/ray_casting.hpp"
+#include "kiseki/models/beam_model.hpp"
+#include "kiseki/models/likelihood_field.hpp"
+
+using namespace kiseki;
+using namespace kiseki::test;
+
+namespace {
+
+double error(const Pose2& a, const Pose2& b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+struct DriveLog {
+  std::vector<Pose2> estimates;
+  std::vector<std::size_t> counts;
+  std::vector<double> reliability;
+};
+
+// Drives a robot around the room; the filter sees scans cast from the truth. If kidnap >= 0, the
+// robot is carried to `kidnap_to` at that step without the odometry knowing.
+DriveLog drive(MclParams params, std::uint64_t seed, bool global, int steps, int kidnap = -1,
+          Pose2 kidnap_to = {}) {
+  const OccupancyGrid g = room();
+  const auto angles = scan_angles(61);
+  const cv::Mat clearance = distance_field(g);
+  LikelihoodFieldModel model(g, {});
+  MonteCarloLocalization mcl(params, seed);
+  mcl.set_free_space(g);
+  Pose2 truth(1.0, 4.5, 0.0), odom = truth;
+  if (global) mcl.initialize_uniform();
+  else mcl.initialize_gaussian(truth, 0.1, 0.1, 0.05);
+  DriveLog run;
+  for (int k = 0; k < steps; ++k) {
+    const Pose2 step(0.1, 0.0, k % 60 < 30 ? 0.05 : -0.05);
+    const Pose2 next = truth.compose(step);
+    const CellIndex c = g.world_to_cell({next.x, next.y});
+    if (g.contains(c) && clearance.at<float>(c.y, c.x) > 0.4f) {  // a robot keeps 0.4 m from walls
+      mcl.predict(odom, odom.compose(step));
+      truth = next, odom = odom.compose(step);
+    } else {
+      const Pose2 turn(0.0, 0.0, 0.5);
+      mcl.predict(odom, odom.compose(turn));
+      truth = truth.compose(turn), odom = odom.compose(turn);
+    }
+    if (k == kidnap) truth = kidnap_to;
+    const auto ranges = cast(g, truth, angles, 8.0);
+    model.set_scan(angles.data(), ranges.data(), ranges.size(), 8.0);
+    const UpdateReport rep = mcl.update(model);
+    run.estimates.push_back(mcl.estimate());
+    run.counts.push_back(mcl.particles().size());
+    run.reliability.push_back(mcl.reliability());
+    if (k + 1 == steps) run.estimates.push_back(truth);  // the last entry: the final truth
+  }
+  return run;
+}
+
+}  // namespace
+
+TEST(MonteCarloLocalization, TracksAndIsDeterministicForAnyThreadCount) {
+  MclParams p;
+  p.particles = 3000;
+  p.threads = 1;
+  const DriveLog one = drive(p, 9, false, 60);
+  p.threads = 2;
+  const DriveLog two = drive(p, 9, false, 60);
+  ASSERT_EQ(one.estimates.size(), two.estimates.size());
+  for (std::size_t i = 0; i < one.estimates.size(); ++i) {
+    ASSERT_EQ(one.estimates[i].x, two.estimates[i].x);
+    ASSERT_EQ(one.estimates[i].theta, two.estimates[i].theta);
+  }
+  EXPECT_LT(error(one.estimates[one.estimates.size() - 2], one.estimates.back()), 0.1);
+  EXPECT_GT(one.reliability.back(), 0.9);
+}
+
+TEST(MonteCarloLocalization, GlobalLocalizationWithKldEndsWithFewParticles) {
+  MclParams p;
+  p.particles = 20000;
+  p.kld = true;
+  p.kld_params.min_particles = 300;
+  p.resample_threshold = 1.0;
+  p.likelihood_power = 0.1;  // a sparse uniform start: temper the 61 beams (as kiseki's global)
+  const DriveLog run = drive(p, 3, true, 80);
+  EXPECT_LT(error(run.estimates[run.estimates.size() - 2], run.estimates.back()), 0.2);
+  EXPECT_LT(run.counts[run.counts.size() - 1], 2000u);  // converged: few bins
+  EXPECT_GE(run.counts.back(), 300u);
+  // A flat likelihood leaves the cloud spread over the room's ~8,600 bins: the bound asks for
+  // more than the maximum.
+  MonteCarloLocalization flat(p, 4);
+  flat.set_free_space(room());
+  flat.initialize_uniform();
+  flat.update(std::vector<double>(20000, -1.0), 1, NAN);
+  EXPECT_EQ(flat.particles().size(), 20000u);
+}
+
+TEST(MonteCarloLocalization, ResettingRecoversFromAKidnappingAndTheReliabilityFallsWithout) {
+  MclParams p;
+  p.particles = 2000;
+  p.recovery = Recovery::none;
+  const Pose2 elsewhere(7.5, 1.0, 2.0);
+  const DriveLog lost = drive(p, 5, false, 100, 30, elsewhere);
+  EXPECT_GT(error(lost.estimates[lost.estimates.size() - 2], lost.estimates.back()), 1.0);
+  EXPECT_GT(lost.reliability[29], 0.9);
+  EXPECT_LT(lost.reliability.back(), 0.2);  // lost, and it says so
+  p.recovery = Recovery::resetting;
+  const DriveLog found = drive(p, 5, false, 100, 30, elsewhere);
+  EXPECT_LT(error(found.estimates[found.estimates.size() - 2], found.estimates.back()), 0.2);
+  EXPECT_GT(found.reliability.back(), 0.8);
+}
+
+// A measurement seen only through its likelihood: log p = -|pose - target|^2 / (2 0.3^2) (position
+// in m and heading in rad alike) plus `ripple` sin(3x) cos(2y), over 30 readings, with a fixed
+// agreement with the map.
+class TargetModel : public SensorModel {
+ public:
+  Pose2 target;
+  double peak = 1.0;  ///< 0: a flat likelihood (the ripple only)
+  double ripple = 0.0;
+  double agree = 1.0;
+  void log_likelihoods(const Pose2* poses, std::size_t n, double* out) const override {
+    for (std::size_t i = 0; i < n; ++i) {
+      const Pose2& q = poses[i];
+      const double d2 = std::pow(q.x - target.x, 2) + std::pow(q.y - target.y, 2) +
+                        std::pow(angle_difference(q.theta, target.theta), 2);
+      out[i] = -0.5 * peak * d2 / 0.09 + ripple * std::sin(3 * q.x) * std::cos(2 * q.y);
+    }
+  }
+  std::size_t readings() const override { return 30; }
+  double agreement(const Pose2&) const override { return agree; }
+};
+
+TEST(MonteCarloLocalization, ALikelihoodDropResetsACloudCarriedToAPlaceThatLooksAlike) {
+  // The scans go on agreeing with the map (agreement 1), but the robot is elsewhere: only the
+  // likelihood has dropped against its long-term average.
+  for (const double drop : {0.0, 0.5}) {
+    MclParams p;
+    p.particles = 1000;
+    p.recovery = Recovery::resetting;
+    p.reset_likelihood_drop = drop;
+    MonteCarloLocalization mcl(p, 11);
+    mcl.set_free_space(room());
+    TargetModel model;
+    model.target = Pose2(1.0, 4.5, 0.0);
+    mcl.initialize_gaussian(model.target, 0.1, 0.1, 0.05);
+    for (int k = 0; k < 20; ++k) mcl.update(model);
+    model.target = Pose2(7.5, 1.0, 2.0);
+    int sensor_resets = 0;
+    for (int k = 0; k < 30; ++k) sensor_resets += mcl.update(model).reset == "sensor";
+    if (drop == 0.0) {
+      EXPECT_EQ(sensor_resets, 0);
+      EXPECT_GT(error(mcl.estimate(), model.target), 3.0);  // agreement alone cannot see it
+    } else {
+      EXPECT_GE(sensor_resets, 1);
+      EXPECT_LT(error(mcl.estimate(), model.target), 0.3);
+    }
+  }
+}
+
+TEST(MonteCarloLocalization, AResetNeedsEvidenceWhereTheLikelihoodIsFlat) {
+  // Every scan disagrees with the map (agreement 0), but the likelihood is flat to within
+  // 0.8 nats everywhere: the best of 20,000 uniform candidates beats the cloud's best by
+  // chance. With the default margin (a Bayes factor of 10) no reset is kept and the cloud
+  // stays; without one, the resets scatter it over the room.
+  for (const double evidence : {0.0, MclParams{}.reset_evidence}) {
+    MclParams p;
+    p.particles = 1000;
+    p.recovery = Recovery::resetting;
+    p.reset_evidence = evidence;
+    MonteCarloLocalization mcl(p, 12);
+    mcl.set_free_space(room());
+    TargetModel model;
+    model.peak = 0.0;
+    model.ripple = 0.4;
+    model.agree = 0.0;
+    const Pose2 start(1.0, 4.5, 0.0);
+    mcl.initialize_gaussian(start, 0.1, 0.1, 0.05);
+    int resets = 0;
+    for (int k = 0; k < 30; ++k) resets += mcl.update(model).reset != "none";
+    if (evidence > 0.0) {
+      EXPECT_EQ(resets, 0);
+      EXPECT_LT(error(mcl.estimate(), start), 0.5);  // the ripple alone moves it a little
+    } else {
+      EXPECT_GT(resets, 0);
+      EXPECT_GT(error(mcl.estimate(), start), 1.0);
+    }
+  }
+  MclParams bad;
+  bad.reset_evidence = -1.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = MclParams{};
+  bad.reset_likelihood_drop = 1.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+}
+
+TEST(MonteCarloLocalization, WeightsCanBeSetAndBadInputIsRefused) {
+  MclParams p;
+  p.particles = 4;
+  MonteCarloLocalization mcl(p, 1);
+  EXPECT_THROW(mcl.estimate(), std::logic_error);
+  mcl.set_particles({Pose2(0, 0, 0), Pose2(1, 0, 0), Pose2(2, 0, 0), Pose2(3, 0, 0)}, {1, 1, 2, 0});
+  EXPECT_NEAR(mcl.weights()[2], 0.5, 1e-12);
+  EXPECT_NEAR(mcl.estimate().x, (0 + 1 + 4) / 4.0, 1e-12);
+  EXPECT_THROW(mcl.set_weights({1, 1}), std::invalid_argument);
+  EXPECT_THROW(mcl.set_weights({0, 0, 0, 0}), std::invalid_argument);
+  EXPECT_THROW(mcl.set_particles({Pose2(NAN, 0, 0)}), std::invalid_argument);
+  EXPECT_THROW(mcl.predict(Pose2(0, 0, 0), Pose2(100, 0, 0)), std::invalid_argument);
+  EXPECT_THROW(mcl.update({0.0, NAN, 0.0, 0.0}, 1, NAN), std::invalid_argument);
+  EXPECT_THROW(mcl.initialize_uniform(), std::logic_error);  // no free space set
+  OccupancyGrid walls(3, 3, 0.1, Pose2(), kOccupied);
+  EXPECT_THROW(mcl.set_free_space(walls), std::invalid_argument);
+  MclParams bad;
+  bad.particles = 0;
+  EXPECT_THROW(MonteCarloLocalization(bad, 1), std::invalid_argument);
+}
+
+TEST(MonteCarloLocalization, AnOdometryJumpOverTheLimitIsRefusedAndOneJustUnderIsAMotion) {
+  MclParams p;
+  p.particles = 10;
+  MonteCarloLocalization mcl(p, 1);
+  mcl.initialize_gaussian(Pose2(0, 0, 0), 0.0, 0.0, 0.0);
+  EXPECT_DOUBLE_EQ(kMaxOdometryJump, 10.0);
+  const double under = kMaxOdometryJump - 0.01, over = kMaxOdometryJump + 0.01;
+  EXPECT_NO_THROW(mcl.predict(Pose2(0, 0, 0), Pose2(0.6 * under, 0.8 * under, 0)));
+  try {
+    mcl.predict(Pose2(0, 0, 0), Pose2(0.6 * over, 0.8 * over, 0));
+    FAIL() << "a jump of " << over << " m was taken as a motion";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "MCL: odometry jumps 10.01 m between two updates: more than kiseki's limit of 10 m");
+  }
+}
