@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from kiseki.datasets.kok import read_kok_walk
+from kiseki.datasets.magnetic import MagneticSamples
 from kiseki.magnetic.loop_travel_distance import LoopTravelConfig
 from kiseki.magnetic.loop_walk import LoopWalkMap, localize_walk_loop, map_walk_loop
 from kiseki.magnetic.travel_distance_walk import WalkOdometry, localize_walk
@@ -74,7 +75,8 @@ def preflight(config: WalksConfig) -> None:
 
 
 @functools.lru_cache(maxsize=4)
-def _walk(path: str) -> tuple:
+def _walk(path: str) -> tuple[MagneticSamples, LoopWalkMap]:
+    """The walk and its mapping lap's loop, fitted once per process."""
     walk = read_kok_walk(path)
     return walk, map_walk_loop(walk)
 
@@ -82,7 +84,6 @@ def _walk(path: str) -> tuple:
 def trial(config: WalksConfig, index: int, seed: int) -> TrialOutput:
     name = config.walks[index % len(config.walks)]
     walk, wm = _walk(str(_folder(config) / f"{name}.mat"))
-    assert isinstance(wm, LoopWalkMap)
 
     def loop(odometry: WalkOdometry, start: str = "known"):
         cfg = LoopTravelConfig(particles=config.particles, start=start)
