@@ -69,7 +69,9 @@ def predict(
     rows = np.column_stack([points, mean, var])
     text = header + "\n" + "\n".join(",".join(f"{v:.9g}" for v in r) for r in rows) + "\n"
     atomic_write(output, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
-    how = "the GP re-evaluated exactly" if exact else "interpolated from the grid"
+    stored = fmap.training is not None and fmap.training.predictor is not None
+    source = "its stored factor" if stored else "rebuilt from its readings, no optimisation"
+    how = f"the GP re-evaluated exactly ({source})" if exact else "interpolated from the grid"
     console.print(
         f"{output}: {len(points):,} points, {how} ({seconds:.2f} s); field in {fmap.units}"
     )

@@ -16,17 +16,32 @@ from kiseki._support.guard import guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import CELL_LIMITS, Count, Metres, Seed, refuse_given
 from kiseki.datasets.magnetic import concatenate_samples, read_magnetic_data
-from kiseki.gp import SquaredExponential, fit_hyperparameters
+from kiseki.gp import (
+    CurlFreeKernel,
+    SquaredExponential,
+    fit_curl_free_hyperparameters,
+    fit_hyperparameters,
+)
 from kiseki.gp.kernel import subsample
 from kiseki.magnetic.binning import bin_readings
-from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData, fit_component_gps
+from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
 from kiseki.magnetic.map_folder import check_map_destination
+from kiseki.magnetic.map_gp import MODELS, fit_component_gps, predictor_state
 
 __all__ = ["KERNEL_LIMITS", "fit"]
 
 console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
 EXACT_LIMIT = 10_000  # beyond this many measurements the default is the reduced-rank GP
 METHODS = ("exact", "hilbert")
+# The curl-free model's defaults are gp-aalto-defaults' pick (leave-one-run-out on both Aalto
+# sensors: the lowest mean held-out RMSE among the methods that use every reading given): the
+# exact curl-free GP on readings averaged per 0.1 m cell, its hyperparameters by marginal
+# likelihood on 400 of them. Its factor is (3n)^2 doubles: 2,000 cells keep it at 288 MB, and
+# beyond them the reduced-rank curl-free GP (kiseki.magnetic.map_gp.CURL_FREE_BASIS functions).
+CURL_FREE_BIN = 0.1  # m
+CURL_FREE_FIT_POINTS = 400
+CURL_FREE_EXACT_LIMIT = 2_000
+CURL_FREE_EXACT_MAX = 6_000  # --method exact refused beyond: a 2.6 GB factor
 
 
 # --kernel's numbers (kiseki.gp.SquaredExponential): the signal and noise SDs in the data's units
@@ -35,30 +50,44 @@ METHODS = ("exact", "hilbert")
 # d^2 / l^2, far from a double's overflow (1e200 squared is inf) and underflow (1e-200 squared
 # is 0: a noise-free kernel whose matrix cannot be factorised)
 KERNEL_LIMITS = (1e-6, 1e6)  # as the message writes them: [1e-6, 1e6]
-_KERNEL_PARTS = (("sigma_f", "the data's units"), ("l", "m"), ("sigma_n", "the data's units"))
+_UNITS = "the data's units"
+_KERNEL_PARTS = {
+    "independent": (("sigma_f", _UNITS), ("l", "m"), ("sigma_n", _UNITS)),
+    # the potential's sigma_f is in units times metres: sigma_f / l is the anomaly's SD
+    "curl-free": (("sigma_f", "units x m"), ("l", "m"), ("sigma_lin", _UNITS), ("sigma_n", _UNITS)),
+}
 
 
-def _parse_kernel(text: str):
-    """The kernel --kernel SIGMA_F,L,SIGMA_N gives; a ValueError naming --kernel and the number
-    outside :data:`KERNEL_LIMITS`."""
+def _parse_kernel(text: str, model: str):
+    """The kernel --kernel gives for `model` (SIGMA_F,L,SIGMA_N, or SIGMA_F,L,SIGMA_LIN,SIGMA_N
+    for the curl-free one); a ValueError naming --kernel and the number outside
+    :data:`KERNEL_LIMITS`."""
     parts = text.split(",")
+    names = _KERNEL_PARTS[model]
     try:
         values = [float(v) for v in parts]
     except ValueError:
         values = []
-    if len(values) != 3:
-        raise ValueError(f"--kernel must be three numbers sigma_f,l,sigma_n, got {text.strip()}")
+    if len(values) != len(names):
+        listed = ",".join(n for n, _ in names)
+        raise ValueError(
+            f"--kernel must be {len(names)} numbers {listed} (--model {model}), got {text.strip()}"
+        )
     lo, hi = KERNEL_LIMITS
-    for (name, unit), part, value in zip(_KERNEL_PARTS, parts, values, strict=True):
+    for (name, unit), part, value in zip(names, parts, values, strict=True):
         if not lo <= value <= hi:  # a NaN never is
             raise ValueError(
                 f"--kernel: {name} must be a number in [1e-6, 1e6] ({unit}), got {part.strip()}"
             )
-    return SquaredExponential(*values)
+    return CurlFreeKernel(*values) if model == "curl-free" else SquaredExponential(*values)
 
 
-def _check_fit_options(ctx: typer.Context, kernel, max_points, method, units) -> None:
+def _check_fit_options(ctx: typer.Context, kernel, max_points, method, units, model) -> None:
     """The fit's words and what its numbers do not apply to (the numbers have their ranges)."""
+    if model not in MODELS:
+        raise ValueError(f"--model must be curl-free or independent, got {model!r}")
+    if model == "curl-free":  # one potential for the three components
+        refuse_given(ctx, ["per_component"], "with --model curl-free (one potential)")
     if kernel is not None:  # the given hyperparameters: no search, so nothing per component
         refuse_given(ctx, ["per_component"], "with --kernel (its hyperparameters are given)")
         if max_points is None:  # no search and no subsample: nothing random
@@ -84,8 +113,17 @@ def _read_data(data: list[Path], units: str | None, dimension: int | None):
     return x, np.asarray(samples.field), height, units or samples.units
 
 
-def _fit_gps(x, y, kernel, per_component: bool, method: str, seed: int):
+def _fit_gps(x, y, kernel, per_component: bool, method: str, seed: int, model: str):
     """(GPs, kernels, seconds for the hyperparameters, seconds for the fit)."""
+    if model == "curl-free":
+        start = time.perf_counter()
+        if kernel is None:  # the log marginal likelihood's maximum on a seeded subsample
+            found = fit_curl_free_hyperparameters(x, y, max_points=CURL_FREE_FIT_POINTS, seed=seed)
+            kernel = found.kernel
+        hyper = time.perf_counter() - start
+        start = time.perf_counter()
+        gps = fit_component_gps(x, y, kernel, method)
+        return gps, [kernel], hyper, time.perf_counter() - start
     columns = [slice(k, k + 1) for k in range(3)] if per_component else [slice(0, 3)]
     start = time.perf_counter()
     if kernel is not None:
@@ -96,6 +134,11 @@ def _fit_gps(x, y, kernel, per_component: bool, method: str, seed: int):
     start = time.perf_counter()
     gps = fit_component_gps(x, y, kernels, method)
     return gps, kernels, hyper, time.perf_counter() - start
+
+
+def _default_method(model: str, points: int) -> str:
+    limit = CURL_FREE_EXACT_LIMIT if model == "curl-free" else EXACT_LIMIT
+    return "exact" if points <= limit else "hilbert"
 
 
 def _hilbert_settings(gp) -> dict | None:
@@ -129,13 +172,22 @@ def fit(
         parser=Metres("--margin", 0, 1000),
         help="Metres added around the data's bounding box.",
     ),
+    model: str = typer.Option(
+        "curl-free",
+        help="curl-free (the field as the gradient of a potential plus a constant, Solin et al. "
+        "2018; kiseki's default, chosen by leave-one-run-out on the Aalto data) or independent "
+        "(mx, my, mz as separate GPs, the thesis' ch. 6).",
+    ),
     per_component: bool = typer.Option(
-        False, "--per-component", help="Own hyperparameters for each of mx, my, mz."
+        False,
+        "--per-component",
+        help="Own hyperparameters for each of mx, my, mz (--model independent).",
     ),
     kernel: str | None = typer.Option(
         None,
-        help="sigma_f,l,sigma_n, each in [1e-6, 1e6] (SDs in the data's units, l in m; default: "
-        "maximise the log marginal likelihood).",
+        help="independent: sigma_f,l,sigma_n; curl-free: sigma_f,l,sigma_lin,sigma_n; each in "
+        "[1e-6, 1e6] (SDs in the data's units, the potential's sigma_f in units x m, l in m; "
+        "default: maximise the log marginal likelihood).",
     ),
     # a GP needs a few points; 10^8 readings of (x, y, z, mx, my, mz) are 4.8 GB of doubles
     max_points: int | None = typer.Option(
@@ -147,7 +199,9 @@ def fit(
         0, parser=Seed(), help="Seed of the subsample and the optimizer's restarts."
     ),
     method: str | None = typer.Option(
-        None, help=f"exact or hilbert (default: exact up to {EXACT_LIMIT:,} measurements)."
+        None,
+        help=f"exact or hilbert (reduced rank); default: exact up to {EXACT_LIMIT:,} "
+        f"measurements ({CURL_FREE_EXACT_LIMIT:,} for the curl-free model).",
     ),
     units: str | None = typer.Option(None, help="uT or G: the units of CSV data."),
     bin_size: float | None = typer.Option(
@@ -155,7 +209,8 @@ def fit(
         "--bin",
         parser=Metres("--bin", *CELL_LIMITS),
         help="Average the readings per cell of this size (m) first, one reading per place (the "
-        "thesis stores its 3-D survey per 0.2 m voxel); recommended for dense 50 Hz tracks.",
+        "thesis stores its 3-D survey per 0.2 m voxel); default: "
+        f"{CURL_FREE_BIN} m for the curl-free model, none for the independent one.",
     ),
 ) -> None:
     """Fit a GP to magnetic measurements and write the map of its mean and variance (the
@@ -163,22 +218,32 @@ def fit(
 
     Example: kiseki magnetic fit aalto/invensense/1 aalto/invensense/2 -o hall-map
     """
-    _check_fit_options(ctx, kernel, max_points, method, units)
-    fixed = _parse_kernel(kernel) if kernel is not None else None
+    _check_fit_options(ctx, kernel, max_points, method, units, model)
+    fixed = _parse_kernel(kernel, model) if kernel is not None else None
     check_map_destination(output)
     x, y, height, units = _read_data(data, units, dimension)
     n_read = len(x)
+    if bin_size is None and model == "curl-free":
+        bin_size = CURL_FREE_BIN
     if bin_size is not None:
         x, y, _ = bin_readings(x, y, bin_size)
     if max_points is not None and len(x) > max_points:  # after --bin: of the cells' readings
         keep = subsample(len(x), max_points, seed)
         x, y = x[keep], y[keep]
-    method = method or ("exact" if len(x) <= EXACT_LIMIT else "hilbert")
-    gps, kernels, t_hyper, t_fit = _fit_gps(x, y, fixed, per_component, method, seed)
+    method = method or _default_method(model, len(x))
+    if model == "curl-free" and method == "exact" and len(x) > CURL_FREE_EXACT_MAX:
+        raise ValueError(
+            f"--method exact: {len(x):,} readings need a {72 * len(x) ** 2 / 1e9:.1f} GB "
+            f"curl-free factor (at most {CURL_FREE_EXACT_MAX:,}); use --method hilbert or a "
+            "larger --bin"
+        )
+    gps, kernels, t_hyper, t_fit = _fit_gps(x, y, fixed, per_component, method, seed, model)
     lml = [float(g.log_marginal_likelihood()) for g in gps if hasattr(g, "log_marginal_likelihood")]
     start = time.perf_counter()
     lower, upper = x.min(axis=0) - margin, x.max(axis=0) + margin
-    training = TrainingData(x, y, method, "constant", _hilbert_settings(gps[0]))
+    mean = "zero" if model == "curl-free" else "constant"  # curl-free: the constant is a term
+    hilbert = _hilbert_settings(gps[0])
+    training = TrainingData(x, y, method, mean, hilbert, predictor_state(gps[0]))
     provenance = {
         "data": {
             "sources": [str(d) for d in data],
@@ -187,6 +252,7 @@ def fit(
             "used_points": len(x),
         },
         "fit": {
+            "model": model,
             "method": method,
             "per_component": per_component,
             "hyperparameters": "given"
@@ -216,17 +282,31 @@ def fit(
 def _report_fit(fmap, output: Path, kernels, lml: list, used: int, read: int, seconds) -> None:
     names = ("mx, my, mz",) if len(kernels) == 1 else ("mx", "my", "mz")
     u = "" if fmap.units == "unknown" else f" {fmap.units}"
-    for c, k in zip(names, kernels, strict=True):
+    if isinstance(kernels[0], CurlFreeKernel):
+        k = kernels[0]
         console.print(
-            f"{c}: sigma_f {k.sigma_f:.4g}{u}, length scale {k.length_scale:.4g} m, "
-            f"sigma_n {k.sigma_n:.4g}{u}"
+            f"curl-free potential: sigma_f {k.sigma_f:.4g}{u} m, length scale "
+            f"{k.length_scale:.4g} m (anomaly SD {k.anomaly_sd:.4g}{u}), constant field SD "
+            f"sigma_lin {k.sigma_lin:.4g}{u}, sigma_n {k.sigma_n:.4g}{u}"
         )
+    else:
+        for c, k in zip(names, kernels, strict=True):
+            console.print(
+                f"{c}: sigma_f {k.sigma_f:.4g}{u}, length scale {k.length_scale:.4g} m, "
+                f"sigma_n {k.sigma_n:.4g}{u}"
+            )
     if lml:
         console.print(f"log marginal likelihood {sum(lml):.6g} (eq. 6.11)")
     t_hyper, t_fit, t_map = seconds
     console.print(
         f"{output}: {fmap.dimension}-D map, {' x '.join(map(str, fmap.cells))} cells of "
         f"{fmap.resolution:g} m from {used:,} of {read:,} measurements "
-        f"({fmap.training.method} GP); hyperparameters {t_hyper:.2f} s, fit {t_fit:.2f} s, "
-        f"map {t_map:.2f} s"
+        f"({_describe(fmap.training.method, kernels)}); hyperparameters {t_hyper:.2f} s, "
+        f"fit {t_fit:.2f} s, map {t_map:.2f} s"
     )
+
+
+def _describe(method: str, kernels) -> str:
+    if isinstance(kernels[0], CurlFreeKernel):
+        return "exact curl-free GP" if method == "exact" else "reduced-rank curl-free GP"
+    return f"{method} GP"

@@ -292,6 +292,51 @@ class CurlFreeGP:
         alpha = scipy.linalg.cho_solve(chol, y.reshape(-1), check_finite=False)
         return cls(x, dimension, kernel, chol, alpha, fit)
 
+    def state(self) -> dict[str, np.ndarray]:
+        """What :meth:`from_state` needs besides the readings and the kernel: the lower
+        Cholesky factor of K + sigma_n^2 I (3n, 3n)."""
+        return {"factor": np.tril(self._chol[0])}
+
+    @classmethod
+    def from_state(cls, x: Any, y: Any, kernel: CurlFreeKernel, factor: Any) -> CurlFreeGP:
+        """The GP :meth:`fit` made from readings y at positions x with `kernel`, from its
+        :meth:`state`: no factorisation, the weights by two triangular solves. Rows spread over
+        the factor (the last one, which touches every column, among them) are checked against
+        the kernel: L L^T = K + sigma_n^2 I to 1e-8 of |L| |L^T| entry by entry; a ValueError
+        when they disagree."""
+        if not isinstance(kernel, CurlFreeKernel):
+            raise ValueError(f"kernel must be a CurlFreeKernel, got {type(kernel).__name__}")
+        dimension = inputs_array(x).shape[1]
+        x = field_inputs(x)
+        y = field_targets(y, len(x)).reshape(-1)
+        size = 3 * len(x)
+        chol = np.asarray(factor, dtype=np.float64)
+        if chol.shape != (size, size):
+            raise ValueError(f"factor {chol.shape} does not fit {len(x)} readings ({size} square)")
+        if not np.isfinite(chol).all() or not (np.diag(chol) > 0).all():
+            raise ValueError("factor is not a Cholesky factor (not finite, or a diagonal <= 0)")
+        rows = np.unique(np.linspace(0, size - 1, min(size, 24)).astype(int))
+        kmat, _ = _blocks(x[rows // 3], x, kernel)
+        kmat = kmat[np.arange(len(rows)) * 3 + rows % 3]
+        kmat[np.arange(len(rows)), rows] += kernel.sigma_n**2
+        lower = np.tril(chol)
+        # Cholesky's backward error is a few rounding errors of |L| |L^T|, entry by entry
+        size_of_terms = np.abs(lower[rows]) @ np.abs(lower).T
+        if (np.abs(lower[rows] @ lower.T - kmat) > 1e-8 * size_of_terms + 1e-300).any():
+            raise ValueError("factor is not the Cholesky factor of these readings' kernel matrix")
+        chol = (lower, True)
+        alpha = scipy.linalg.cho_solve(chol, y, check_finite=False)
+        return cls(x, dimension, kernel, chol, alpha, None)
+
+    def constant_field(self) -> tuple[np.ndarray, np.ndarray]:
+        """(mean (3,), variance (3,)) of the constant (Earth) field's posterior: with
+        E = [I I ... I] (3, 3n), mean sigma_lin^2 E weights and variance sigma_lin^2 -
+        sigma_lin^4 diag(E (K + sigma_n^2 I)^-1 E^T); the field far from every reading."""
+        s2 = self.kernel.sigma_lin**2
+        e = np.tile(np.eye(3), (self.size, 1))  # E^T
+        v = scipy.linalg.solve_triangular(self._chol[0], e, lower=True, check_finite=False)
+        return s2 * (e.T @ self._alpha), s2 - s2**2 * np.einsum("ij,ij->j", v, v)
+
     @property
     def size(self) -> int:
         return len(self._x)

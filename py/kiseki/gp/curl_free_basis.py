@@ -121,6 +121,78 @@ class ReducedRankCurlFreeGP:
         model.weights = scipy.linalg.cho_solve(model._chol, projected, check_finite=False)
         return model
 
+    def state(self) -> dict[str, np.ndarray]:
+        """What :meth:`from_state` needs besides the kernel: the box (centre, half widths), the
+        eigenfunctions' indices, the weights' mean and the lower Cholesky factor of their
+        precision / sigma_n^-2."""
+        return {
+            "centre": self.centre.copy(),
+            "half_widths": self.half_widths.copy(),
+            "indices": self.indices.copy(),
+            "weights": self.weights.copy(),
+            "factor": np.tril(self._chol[0]),
+        }
+
+    @classmethod
+    def from_state(
+        cls, x, y, kernel: CurlFreeKernel, centre, half_widths, indices, weights, factor
+    ) -> ReducedRankCurlFreeGP:
+        """The GP :meth:`fit` made from readings y at positions x, from its :meth:`state`
+        (no Phi^T Phi). A ValueError when the arrays' shapes do not fit each other or, on rows
+        spread over the weights (the three constant ones among them), the stored precision does
+        not turn the weights into Phi^T y (eq. 25's normal equations, to 1e-6 of the size of
+        their terms)."""
+        if not isinstance(kernel, CurlFreeKernel):
+            raise ValueError(f"kernel must be a CurlFreeKernel, got {type(kernel).__name__}")
+        arrays = [np.asarray(a, dtype=np.float64) for a in (centre, half_widths, weights, factor)]
+        centre, half, mean, chol = arrays
+        index = np.asarray(indices)
+        d = centre.shape[0] if centre.ndim == 1 else 0
+        if d not in (2, 3) or half.shape != (d,) or index.ndim != 2 or index.shape[1] != d:
+            raise ValueError(
+                f"centre {centre.shape}, half_widths {half.shape} and indices {index.shape} "
+                "must describe one 2-D or 3-D box"
+            )
+        if not all(np.isfinite(a).all() for a in arrays) or not (half > 0).all():
+            raise ValueError("the state must be finite, with half widths > 0")
+        if index.dtype.kind not in "iu" or (index < 1).any():
+            raise ValueError("indices must be integers >= 1 (the eigenfunctions' numbers)")
+        model = cls(kernel, centre, half, index.astype(np.int64), mean, None)
+        size = len(model.prior_variances())
+        if mean.shape != (size,) or chol.shape != (size, size):
+            raise ValueError(
+                f"weights {mean.shape} and factor {chol.shape} do not fit {len(index)} "
+                f"eigenfunctions (({size},) and ({size}, {size}))"
+            )
+        if not (np.diag(chol) > 0).all():
+            raise ValueError("factor is not a Cholesky factor (a diagonal entry is <= 0)")
+        chol = np.tril(chol)
+        model._chol = (chol, True)
+        x = inputs_array(x)
+        y = field_targets(y, len(x))
+        if x.shape[1] != d:
+            raise ValueError(f"X has {x.shape[1]} coordinates, the state's box {d}")
+        rows = np.unique(np.append(np.linspace(0, size - 4, min(size - 3, 21)).astype(int),
+                                   np.arange(size - 3, size)))  # fmt: skip
+        projected = np.zeros(len(rows))  # (Phi^T y)[rows], 2,000 readings at a time
+        for start in range(0, len(x), 2000):
+            phi = model.design(x[start : start + 2000])[:, rows]
+            projected += phi.T @ y[start : start + 2000].reshape(-1)
+        precision = chol[rows] @ chol.T
+        size_of_terms = np.abs(precision) @ np.abs(mean) + np.abs(projected)
+        if (np.abs(precision @ mean - projected) > 1e-6 * size_of_terms).any():
+            raise ValueError("factor and weights do not fit these readings (eq. 25)")
+        return model
+
+    def constant_field(self) -> tuple[np.ndarray, np.ndarray]:
+        """(mean (3,), variance (3,)) of the constant (Earth) field's posterior: the last three
+        weights, their variance sigma_n^2 diag(P^-1) with P = L L^T the stored precision."""
+        size = len(self.weights)
+        e = np.zeros((size, 3))
+        e[size - 3 :, :] = np.eye(3)
+        v = scipy.linalg.solve_triangular(self._chol[0], e, lower=True, check_finite=False)
+        return self.weights[-3:].copy(), self.kernel.sigma_n**2 * np.einsum("ij,ij->j", v, v)
+
     @property
     def dimension(self) -> int:
         return len(self.centre)
@@ -180,7 +252,7 @@ class ReducedRankCurlFreeGP:
         self, points: Any, *, variance: bool = True, block: int = 2000
     ) -> tuple[np.ndarray, np.ndarray | None]:
         """(mean (m, 3), variance of the noise-free field (m, 3) or None) at points (m, d);
-        outside the box the potential's part falls to zero."""
+        inside the box only (beyond it the eigenfunctions continue as sines: not the GP)."""
         if isinstance(block, bool) or not isinstance(block, int) or block < 1:
             raise ValueError(f"block must be an integer >= 1, got {block!r}")
         p = inputs_array(points, "points")

@@ -16,8 +16,8 @@ On disk a map is a folder (kind and dimension declared in ``magnetic_map.yaml``)
 :func:`save_map_folder` and :func:`load_map_folder` (and the map's ``save`` and ``load``) write
 and read it through :mod:`kiseki.magnetic.map_folder`, which holds the layout.
 
-Why one file over 400 lines: the map, its building from a GP, its evaluation on the
-grid and its folder round trip are one type's life; the folder files are in map_folder.py.
+The GP behind a map (fitting, evaluating on the cells, the predictor kept for predictions) is
+in :mod:`kiseki.magnetic.map_gp`; the folder's files in :mod:`kiseki.magnetic.map_folder`.
 """
 
 from __future__ import annotations
@@ -30,11 +30,17 @@ from pathlib import Path
 from types import MappingProxyType
 
 import numpy as np
-from tqdm import tqdm
 
 from kiseki.errors import MapFormatError
-from kiseki.gp import ExactGP, HilbertGP, SquaredExponential
+from kiseki.gp import CurlFreeKernel, SquaredExponential
 from kiseki.magnetic.map_folder import COMPONENTS, read_map_folder, write_map_folder
+from kiseki.magnetic.map_gp import (
+    as_gp_list,
+    column_kernels,
+    evaluate_on_cells,
+    predict_all,
+    rebuild,
+)
 
 __all__ = [
     "COMPONENTS",
@@ -47,8 +53,6 @@ __all__ = [
 
 MAX_CELLS = 20_000_000  # 6 float64 layers: about 1 GB in memory
 OCTOMAP_KEY_OFFSET = 32768  # tree_max_val of OctoMap's default 16-level tree
-_CHUNK = 20_000  # at most this many cells per gp.predict call
-_CHUNK_ENTRIES = 20_000_000  # and a (cells x training points) cross-covariance of <= 160 MB
 
 
 def _finite(name: str, value, shape: tuple | None = None) -> np.ndarray:
@@ -67,14 +71,17 @@ class TrainingData:
     GP exactly (eqs. 6.8-6.9) at any point instead of interpolating the grid.
 
     inputs (n, d) metres; outputs (n, 3) field in the map's units; method "exact" or
-    "hilbert"; mean "constant" or "zero" (the GP's prior mean); hilbert: the reduced-rank GP's
-    box ``{"domain": [lower, upper]}``, or None."""
+    "hilbert" (reduced rank); mean "constant" or "zero" (the independent GPs' prior mean);
+    hilbert: the reduced-rank GP's box ``{"domain": [lower, upper]}``, or None; predictor: the
+    fitted GP's arrays (:func:`kiseki.magnetic.map_gp.predictor_state`) for predictions with no
+    refit, or None."""
 
     inputs: np.ndarray
     outputs: np.ndarray
     method: str = "exact"
     mean: str = "constant"
     hilbert: Mapping | None = None  # {"domain": [lower, upper]} of the reduced-rank GP
+    predictor: Mapping[str, np.ndarray] | None = None
 
     def __post_init__(self) -> None:
         x = np.asarray(self.inputs)
@@ -86,10 +93,13 @@ class TrainingData:
             raise ValueError(f"training method must be exact or hilbert, got {self.method!r}")
         if self.mean not in ("constant", "zero"):
             raise ValueError(f"training mean must be constant or zero, got {self.mean!r}")
+        if self.predictor is not None:
+            arrays = {str(k): np.asarray(v) for k, v in dict(self.predictor).items()}
+            object.__setattr__(self, "predictor", MappingProxyType(arrays))
 
 
-def _check_kernel(kernel) -> SquaredExponential | tuple[SquaredExponential, ...]:
-    if isinstance(kernel, SquaredExponential):
+def _check_kernel(kernel) -> SquaredExponential | tuple[SquaredExponential, ...] | CurlFreeKernel:
+    if isinstance(kernel, (SquaredExponential, CurlFreeKernel)):
         return kernel
     if (
         isinstance(kernel, Sequence)
@@ -98,7 +108,8 @@ def _check_kernel(kernel) -> SquaredExponential | tuple[SquaredExponential, ...]
     ):
         return tuple(kernel)
     raise ValueError(
-        f"kernel must be a SquaredExponential or three of them (one per component), got {kernel!r}"
+        "kernel must be a SquaredExponential, three of them (one per component) or a "
+        f"CurlFreeKernel, got {kernel!r}"
     )
 
 
@@ -106,9 +117,12 @@ def _check_kernel(kernel) -> SquaredExponential | tuple[SquaredExponential, ...]
 class MagneticFieldMap:
     """Mean and variance of the field on a grid (2-D) or voxels (3-D); see the module text.
 
-    kernel: the GP's hyperparameters, one SquaredExponential shared by the three components or
-    a tuple of three (mx, my, mz). prior_mean (3,) and prior_variance (3,) (sigma_f^2) are the
-    GP's prior, returned outside the map. height: a 2-D map's sensor height (m) or None.
+    kernel: the GP's hyperparameters, one SquaredExponential shared by the three components, a
+    tuple of three (mx, my, mz), or the curl-free model's CurlFreeKernel. prior_mean (3,) and
+    prior_variance (3,) are what the map returns outside its cells: the independent GPs' prior
+    (their mean, sigma_f^2), or the curl-free GP's field far from every reading (the constant
+    field's posterior, the anomaly's prior variance added: kiseki.magnetic.map_gp). height: a
+    2-D map's sensor height (m) or None.
     provenance: what the map was fitted from (``data``: sources, points; ``fit``: method,
     log marginal likelihood, times), saved in the folder's YAML. training: the measurements,
     for exact predictions (:meth:`predict`), or None."""
@@ -119,7 +133,7 @@ class MagneticFieldMap:
     variance: np.ndarray
     prior_mean: np.ndarray
     prior_variance: np.ndarray
-    kernel: SquaredExponential | tuple[SquaredExponential, ...]
+    kernel: SquaredExponential | tuple[SquaredExponential, ...] | CurlFreeKernel
     units: str = "unknown"
     height: float | None = None
     provenance: Mapping = field(default_factory=dict)
@@ -227,8 +241,9 @@ class MagneticFieldMap:
 
     def predict(self, points) -> tuple[np.ndarray, np.ndarray]:
         """(mean (m, 3), variance (m, 3)) of the GP itself at world points (m, d) (eqs. 6.8,
-        6.9): the GP is rebuilt once from the stored training data with the stored
-        hyperparameters (no optimisation). A 2-D map made from a 3-D GP predicts at its
+        6.9): a curl-free map's GP comes from its stored factor (no refit); the independent
+        GPs are rebuilt once from the stored training data with the stored hyperparameters
+        (no optimisation). A 2-D map made from a 3-D GP predicts at its
         height. Raises ValueError when the map keeps no training data."""
         p = _points(points, self.dimension)
         if self.training is None:
@@ -236,8 +251,8 @@ class MagneticFieldMap:
         if self.training.inputs.shape[1] == self.dimension + 1:
             p = np.column_stack([p, np.full(len(p), self.height)])
         if self._regressors is None:
-            object.__setattr__(self, "_regressors", _rebuild(self.training, self.kernel))
-        return _predict_all(self._regressors, p)
+            object.__setattr__(self, "_regressors", rebuild(self.training, self.kernel))
+        return predict_all(self._regressors, p)
 
     @classmethod
     def from_gp(
@@ -253,12 +268,13 @@ class MagneticFieldMap:
         training: TrainingData | None = None,
         progress: bool = False,
     ) -> MagneticFieldMap:
-        """The map of a fitted GP (``ExactGP``/``HilbertGP``, or three one-output GPs for
-        mx, my, mz) over the box lower..upper (d,) at `resolution`: the grid is OctoMap-aligned
-        (origin floor(lower / resolution) * resolution, upper corner rounded up), and gp.predict
+        """The map of a fitted GP (``ExactGP``/``HilbertGP``, three one-output GPs for
+        mx, my, mz, or a curl-free GP) over the box lower..upper (d,) at `resolution`: the
+        grid is OctoMap-aligned (origin floor(lower / resolution) * resolution, upper corner
+        rounded up), and gp.predict
         is evaluated on the cell centres in chunks (a tqdm bar when `progress`). A 2-D box with
         a 3-D GP gives the horizontal slice at `height`."""
-        gps = _as_gp_list(gp)
+        gps = as_gp_list(gp)
         lo = _finite("lower", lower)
         hi = _finite("upper", upper)
         if lo.ndim != 1 or lo.shape not in ((2,), (3,)) or hi.shape != lo.shape:
@@ -286,8 +302,15 @@ class MagneticFieldMap:
             )
         origin = first * float(resolution)
         shape = tuple(int(k) for k in counts[::-1])
-        mean, var = _evaluate(gps, origin, resolution, shape, height if gd > d else None, progress)
-        kernels = _column_kernels(gps)
+        at = height if gd > d else None
+
+        def centres(start: int, stop: int) -> np.ndarray:
+            p = _centres(origin, resolution, shape, start, stop)
+            return p if at is None else np.column_stack([p, np.full(len(p), at)])
+
+        mean, var = evaluate_on_cells(gps, centres, total, progress)
+        mean, var = mean.reshape(*shape, 3), var.reshape(*shape, 3)
+        kernels = column_kernels(gps)
         kernel = kernels[0] if len(set(kernels)) == 1 else kernels
         return cls(
             origin=origin,
@@ -295,7 +318,7 @@ class MagneticFieldMap:
             mean=mean,
             variance=var,
             prior_mean=np.concatenate([np.atleast_1d(g.prior_mean) for g in gps]),
-            prior_variance=[k.sigma_f**2 for k in kernels],  # the prior k(x, x) = sigma_f^2
+            prior_variance=np.concatenate([np.atleast_1d(g.prior_variance) for g in gps]),
             kernel=kernel,
             units=units,
             height=height if d == 2 else None,
@@ -334,9 +357,15 @@ def load_map_folder(folder) -> MagneticFieldMap:
         except ValueError as err:
             raise MapFormatError(f"{contents.training_file}: {err}") from None
     try:
-        return MagneticFieldMap(**contents.fields, training=training)
+        fmap = MagneticFieldMap(**contents.fields, training=training)
     except ValueError as err:
         raise MapFormatError(f"{contents.description}: {err}") from None
+    if training is not None and training.predictor is not None:
+        try:  # the stored GP, checked against the readings and the kernel now
+            object.__setattr__(fmap, "_regressors", rebuild(training, fmap.kernel))
+        except (ValueError, KeyError, TypeError) as err:
+            raise MapFormatError(f"{contents.predictor_file}: {err}") from None
+    return fmap
 
 
 def _points(points, d: int) -> np.ndarray:
@@ -355,76 +384,3 @@ def _centres(origin, resolution, shape, start: int, stop: int) -> np.ndarray:
     ((ny, nx) or (nz, ny, nx)), in x, y[, z] order."""
     index = np.unravel_index(np.arange(start, stop), shape)
     return origin + (np.column_stack(index[::-1]) + 0.5) * resolution
-
-
-def _as_gp_list(gp) -> list:
-    gps = list(gp) if isinstance(gp, (list, tuple)) else [gp]
-    for g in gps:
-        for name in ("predict", "dimension", "outputs", "kernel", "prior_mean"):
-            if not hasattr(g, name):
-                raise ValueError(f"not a fitted GP (no {name}): {g!r}")
-    if sum(g.outputs for g in gps) != 3:
-        raise ValueError(f"the GPs give {sum(g.outputs for g in gps)} outputs; a map needs 3")
-    if len({g.dimension for g in gps}) != 1:
-        raise ValueError("the GPs of the three components must share their input dimension")
-    return gps
-
-
-def _column_kernels(gps: list) -> tuple:
-    """The kernel of each of the three components (a GP holds one shared kernel, or with
-    ``kernels`` one per output)."""
-    out = []
-    for g in gps:
-        kernels = tuple(getattr(g, "kernels", (g.kernel,)))
-        if len(kernels) not in (1, g.outputs):
-            raise ValueError(f"a GP with {g.outputs} outputs has {len(kernels)} kernels")
-        out += kernels * g.outputs if len(kernels) == 1 else kernels
-    return tuple(out)
-
-
-def _predict_all(gps: list, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    means, variances = [], []
-    for g in gps:
-        m, v = g.predict(points)
-        means.append(np.asarray(m, dtype=np.float64).reshape(len(points), -1))
-        variances.append(np.asarray(v, dtype=np.float64).reshape(len(points), -1))
-    # eq. 6.9 can fall a rounding error below zero where the data pin the field down
-    return np.hstack(means), np.maximum(np.hstack(variances), 0.0)
-
-
-def _evaluate(gps, origin, resolution, shape, height, progress):
-    total = int(np.prod(shape))
-    mean = np.empty((total, 3))
-    var = np.empty((total, 3))
-    # the exact GP's cross-covariance has a column per training point, the reduced-rank
-    # GP's one per basis function
-    training = max(int(getattr(g, "basis_size", getattr(g, "size", 1))) for g in gps)
-    chunk = max(1, min(_CHUNK, _CHUNK_ENTRIES // max(training, 1)))
-    starts = range(0, total, chunk)
-    bar = tqdm(starts, desc="map", unit="chunk", disable=not progress or total <= chunk)
-    for start in bar:
-        stop = min(start + chunk, total)
-        p = _centres(origin, resolution, shape, start, stop)
-        if height is not None:
-            p = np.column_stack([p, np.full(len(p), height)])
-        mean[start:stop], var[start:stop] = _predict_all(gps, p)
-    return mean.reshape(*shape, 3), var.reshape(*shape, 3)
-
-
-def fit_component_gps(x, y, kernels, method: str, *, mean: str = "constant", domain=None) -> list:
-    """GPs of the field's three columns: one GP of all three with one kernel, or one GP per
-    column with three; exact or reduced-rank ("hilbert", on `domain` or its default box)."""
-
-    kernels = [kernels] if isinstance(kernels, SquaredExponential) else list(kernels)
-    columns = [slice(0, 3)] if len(kernels) == 1 else [slice(k, k + 1) for k in range(3)]
-    pairs = zip(kernels, columns, strict=True)
-    if method == "exact":
-        return [ExactGP.fit(x, y[:, c], k, mean=mean) for k, c in pairs]
-    return [HilbertGP.fit(x, y[:, c], k, domain=domain, mean=mean) for k, c in pairs]
-
-
-def _rebuild(training: TrainingData, kernel) -> list:
-    """The GP(s) of the stored training data with the stored hyperparameters."""
-    domain = (training.hilbert or {}).get("domain")
-    x, y = training.inputs, training.outputs
-    return fit_component_gps(x, y, kernel, training.method, mean=training.mean, domain=domain)

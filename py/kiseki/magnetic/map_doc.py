@@ -12,14 +12,15 @@
     units: uT
     prior_mean: [0.0, 0.0, 0.0]
     prior_variance: [1.0, 1.0, 1.0]
-    kernel: {sigma_f: 3, length_scale: 1, sigma_n: 0.1}   # or one per mx, my, mz
+    kernel: {sigma_f: 3, length_scale: 1, sigma_n: 0.1}   # or one per mx, my, mz, or
+    # {model: curl-free, sigma_f: 3, length_scale: 1, sigma_lin: 40, sigma_n: 0.1}
     training: {points: 400, method: exact, mean: constant}   # when training.npz is kept
-    files: {...}                    # the layers, arrays and training data
+    files: {...}                    # the layers, arrays, training data and predictor
 
 A problem is one line naming the file, the field and the value
 (``magnetic_map.yaml: shape.x: must be less than or equal to 10000000, got 99999999``): the
 cell counts are limited (:data:`MAX_MAP_CELLS`) so that a hand-edited file cannot ask for any
-memory."""
+memory. :func:`describe_map` writes the description of a map."""
 
 from __future__ import annotations
 
@@ -27,11 +28,27 @@ import math
 import os
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
+from kiseki import __version__
 from kiseki._support.schema import FileModel, FiniteFloat, PositiveFloat, parse
+from kiseki.gp import CurlFreeKernel, SquaredExponential
 
-__all__ = ["MAX_MAP_CELLS", "MAX_TRAINING_POINTS", "MagneticMapDoc", "read_map_doc"]
+__all__ = [
+    "COMPONENTS",
+    "KIND",
+    "MAX_MAP_CELLS",
+    "MAX_TRAINING_POINTS",
+    "MagneticMapDoc",
+    "describe_map",
+    "read_map_doc",
+]
+
+COMPONENTS = ("mx", "my", "mz")
+"""The field's components, in the order of the maps' last axis and of the layers' names."""
+KIND = "magnetic_field_map"
+FORMAT_VERSION = 1
 
 MAX_MAP_CELLS = 10_000_000
 """Cells (2-D) or voxels (3-D) of a map, along one axis and in all: a cell's mean and variance
@@ -54,11 +71,14 @@ class Kernel(FileModel):
 
 
 class KernelDoc(FileModel):
-    """The map's kernel: one for the three components (sigma_f, length_scale, sigma_n) or one
-    per component (mx, my, mz)."""
+    """The map's kernel: one for the three components (sigma_f, length_scale, sigma_n), one
+    per component (mx, my, mz), or the curl-free model's (model: curl-free, sigma_f,
+    length_scale, sigma_lin, sigma_n)."""
 
+    model: Literal["independent", "curl-free"] = "independent"
     sigma_f: PositiveFloat | None = None
     length_scale: PositiveFloat | None = None
+    sigma_lin: PositiveFloat | None = None
     sigma_n: PositiveFloat | None = None
     mx: Kernel | None = None
     my: Kernel | None = None
@@ -68,16 +88,30 @@ class KernelDoc(FileModel):
     def _one_form(self) -> KernelDoc:
         one = (self.sigma_f, self.length_scale, self.sigma_n)
         each = (self.mx, self.my, self.mz)
+        if self.model == "curl-free":
+            if None in one or self.sigma_lin is None or each != (None,) * 3:
+                raise ValueError(
+                    "model curl-free must hold sigma_f, length_scale, sigma_lin and sigma_n"
+                )
+            return self
+        if self.sigma_lin is not None:
+            raise ValueError("sigma_lin is the curl-free model's (model: curl-free)")
         if not (None not in one and each == (None,) * 3 or None not in each and one == (None,) * 3):
             raise ValueError(
                 "must hold sigma_f, length_scale, sigma_n or one such entry per mx, my, mz"
             )
         return self
 
-    def kernels(self) -> Kernel | tuple[Kernel, Kernel, Kernel]:
+    def to_kernel(self) -> SquaredExponential | tuple[SquaredExponential, ...] | CurlFreeKernel:
+        """The kernel object a map holds."""
+        if self.model == "curl-free":
+            return CurlFreeKernel(self.sigma_f, self.length_scale, self.sigma_lin, self.sigma_n)
         if self.mx is not None:
-            return (self.mx, self.my, self.mz)  # type: ignore[return-value]
-        return Kernel(sigma_f=self.sigma_f, length_scale=self.length_scale, sigma_n=self.sigma_n)
+            return tuple(
+                SquaredExponential(k.sigma_f, k.length_scale, k.sigma_n)
+                for k in (self.mx, self.my, self.mz)  # type: ignore[union-attr]
+            )
+        return SquaredExponential(self.sigma_f, self.length_scale, self.sigma_n)
 
 
 class Shape(FileModel):
@@ -151,3 +185,65 @@ def read_map_doc(doc: Any, path: str | os.PathLike) -> MagneticMapDoc:
     :class:`MagneticMapDoc`: a :class:`~kiseki._support.schema.SchemaError` naming the file, the
     field and the value."""
     return parse(MagneticMapDoc, doc, path)
+
+
+def _plain(value):
+    if isinstance(value, dict | type(None)) or hasattr(value, "items"):
+        return None if value is None else {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple | np.ndarray):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _kernel_doc(kernel) -> dict:
+    def one(k: SquaredExponential) -> dict:
+        return {
+            "sigma_f": float(k.sigma_f),
+            "length_scale": float(k.length_scale),
+            "sigma_n": float(k.sigma_n),
+        }
+
+    if isinstance(kernel, CurlFreeKernel):
+        return {"model": "curl-free", **{k: float(v) for k, v in kernel.to_dict().items()}}
+    if isinstance(kernel, SquaredExponential):
+        return one(kernel)
+    return {c: one(k) for c, k in zip(COMPONENTS, kernel, strict=True)}
+
+
+def describe_map(fmap, files: dict) -> dict:
+    """The ``magnetic_map.yaml`` of a map (a MagneticFieldMap) whose files are `files`."""
+    d = fmap.dimension
+    doc = {
+        "kind": KIND,
+        "format_version": FORMAT_VERSION,
+        "dimension": d,
+        "origin": [float(v) for v in fmap.origin],
+        "resolution": fmap.resolution,
+        "shape": dict(zip("xyz", fmap.cells, strict=False)),
+        "units": fmap.units,
+        "variance_units": f"({fmap.units})^2",
+        "frame": "world",
+        "prior_mean": [float(v) for v in fmap.prior_mean],
+        "prior_variance": [float(v) for v in fmap.prior_variance],
+        "kernel": _kernel_doc(fmap.kernel),
+    }
+    if d == 2:
+        doc["height"] = fmap.height
+        doc["image_rows"] = "row 0 is the top of the map (highest y), as ROS map images"
+    else:
+        doc["layout"] = "octomap: voxel centre = origin + (index + 0.5) * resolution"
+        try:
+            doc["octomap_key_origin"] = [int(k) for k in fmap.octomap_key_origin()]
+        except ValueError:
+            doc["layout"] = "voxel centre = origin + (index + 0.5) * resolution"
+    if fmap.training is not None:
+        t = fmap.training
+        doc["training"] = {"points": len(t.inputs), "method": t.method, "mean": t.mean}
+        if t.hilbert is not None:
+            doc["training"]["hilbert"] = _plain(dict(t.hilbert))
+    doc["provenance"] = _plain(dict(fmap.provenance))
+    doc["kiseki_version"] = __version__
+    doc["files"] = files
+    return doc

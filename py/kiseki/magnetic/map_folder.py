@@ -24,7 +24,9 @@ k) + 0.5) * resolution`` with the origin a multiple of the resolution, which is 
 OctoMap key ``origin / resolution + 32768 + (i, j, k)`` (the YAML's ``octomap_key_origin``).
 
 ``training.npz`` (X (n, d), Y (n, 3)), when the map keeps its measurements, lets predictions
-re-evaluate the GP exactly. A folder is written under a temporary name and renamed into place.
+re-evaluate the GP exactly; ``predictor.npz`` (a curl-free map's) holds the fitted GP's factor
+(:func:`kiseki.magnetic.map_gp.predictor_state`), so that they need no refit. A folder is
+written under a temporary name and renamed into place.
 
 The files alone: :func:`write_map_folder` writes a map's fields, :func:`read_map_folder` reads
 them back checked; the map type (:mod:`kiseki.magnetic.field_map`) builds on this module.
@@ -42,14 +44,19 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from kiseki import __version__, _core
+from kiseki import _core
 from kiseki._support.atomic import record_written
 from kiseki._support.inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
 from kiseki._support.yaml import read_yaml_file, safe_load_12
 from kiseki.errors import MapFormatError
-from kiseki.gp import SquaredExponential
 from kiseki.io.ros_map import write_image
-from kiseki.magnetic.map_doc import Kernel, MagneticMapDoc, read_map_doc
+from kiseki.magnetic.map_doc import (
+    COMPONENTS,
+    KIND,
+    MagneticMapDoc,
+    describe_map,
+    read_map_doc,
+)
 
 __all__ = [
     "COMPONENTS",
@@ -62,13 +69,8 @@ __all__ = [
     "write_map_folder",
 ]
 
-COMPONENTS = ("mx", "my", "mz")
-"""The field's components, in the order of the maps' last axis and of the layers' names."""
-
 MAP_FILE = "magnetic_map.yaml"
 LINEAR_MAP_FILE = "linear_map.yaml"  # kiseki.magnetic.linear_map_folder.MAP_FILE: refused here
-KIND = "magnetic_field_map"
-FORMAT_VERSION = 1
 LAYERS = tuple(f"{c}_{q}" for q in ("mean", "variance") for c in COMPONENTS)
 MAX_FILE_BYTES = 2 * GIB
 """Each file of a map folder, and the arrays of each ``.npz``, hold at most this: a map of
@@ -103,66 +105,6 @@ def check_map_destination(folder) -> Path:
                 f"{folder} exists and is not a magnetic field map folder: refusing to replace it"
             )
     return folder
-
-
-def _plain(value):
-    if isinstance(value, dict | type(None)) or hasattr(value, "items"):
-        return None if value is None else {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple | np.ndarray):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
-
-
-def _kernel_doc(kernel) -> dict:
-    def one(k: SquaredExponential) -> dict:
-        return {
-            "sigma_f": float(k.sigma_f),
-            "length_scale": float(k.length_scale),
-            "sigma_n": float(k.sigma_n),
-        }
-
-    if isinstance(kernel, SquaredExponential):
-        return one(kernel)
-    return {c: one(k) for c, k in zip(COMPONENTS, kernel, strict=True)}
-
-
-def _document(fmap, files: dict) -> dict:
-
-    d = fmap.dimension
-    doc = {
-        "kind": KIND,
-        "format_version": FORMAT_VERSION,
-        "dimension": d,
-        "origin": [float(v) for v in fmap.origin],
-        "resolution": fmap.resolution,
-        "shape": dict(zip("xyz", fmap.cells, strict=False)),
-        "units": fmap.units,
-        "variance_units": f"({fmap.units})^2",
-        "frame": "world",
-        "prior_mean": [float(v) for v in fmap.prior_mean],
-        "prior_variance": [float(v) for v in fmap.prior_variance],
-        "kernel": _kernel_doc(fmap.kernel),
-    }
-    if d == 2:
-        doc["height"] = fmap.height
-        doc["image_rows"] = "row 0 is the top of the map (highest y), as ROS map images"
-    else:
-        doc["layout"] = "octomap: voxel centre = origin + (index + 0.5) * resolution"
-        try:
-            doc["octomap_key_origin"] = [int(k) for k in fmap.octomap_key_origin()]
-        except ValueError:
-            doc["layout"] = "voxel centre = origin + (index + 0.5) * resolution"
-    if fmap.training is not None:
-        t = fmap.training
-        doc["training"] = {"points": len(t.inputs), "method": t.method, "mean": t.mean}
-        if t.hilbert is not None:
-            doc["training"]["hilbert"] = _plain(dict(t.hilbert))
-    doc["provenance"] = _plain(dict(fmap.provenance))
-    doc["kiseki_version"] = __version__
-    doc["files"] = files
-    return doc
 
 
 def _write_layers_2d(fmap, tmp: Path) -> dict:
@@ -205,7 +147,10 @@ def write_map_folder(fmap, folder) -> Path:
         if fmap.training is not None:
             np.savez(tmp / "training.npz", X=fmap.training.inputs, Y=fmap.training.outputs)
             files["training"] = "training.npz"
-        text = yaml.safe_dump(_document(fmap, files), sort_keys=False, default_flow_style=None)
+            if fmap.training.predictor is not None:
+                np.savez(tmp / "predictor.npz", **fmap.training.predictor)
+                files["predictor"] = "predictor.npz"
+        text = yaml.safe_dump(describe_map(fmap, files), sort_keys=False, default_flow_style=None)
         (tmp / MAP_FILE).write_text(text, encoding="utf-8")
         mask = os.umask(0)
         os.umask(mask)
@@ -325,29 +270,46 @@ def _read_3d(folder: Path, doc: MagneticMapDoc, meta: Path, origin, resolution, 
 
 def _read_training(
     folder: Path, doc: MagneticMapDoc, meta: Path
-) -> tuple[dict | None, Path | None]:
+) -> tuple[dict | None, Path | None, Path | None]:
+    """(TrainingData's arguments, training.npz, predictor.npz), each None when absent."""
     if "training" not in doc.files:
-        return None, None
+        return None, None, None
     info = doc.training
     if info is None:
         raise _fail(meta, "training: missing (files names training data it does not describe)")
     path = _file(folder, doc.files, "training", meta)
     arrays = _read_npz(path, {"X": (info.points, None), "Y": (info.points, 3)})
-    names = ("inputs", "outputs", "method", "mean", "hilbert")
-    values = (arrays["X"], arrays["Y"], info.method, info.mean, info.hilbert)
-    return dict(zip(names, values, strict=True)), path
+    names = ("inputs", "outputs", "method", "mean", "hilbert", "predictor")
+    values = (arrays["X"], arrays["Y"], info.method, info.mean, info.hilbert, None)
+    training = dict(zip(names, values, strict=True))
+    if "predictor" in doc.files:
+        if doc.kernel.model != "curl-free":
+            raise _fail(meta, "files.predictor: a stored predictor is the curl-free model's")
+        n = 3 * info.points  # the exact GP's factor: (3n, 3n), its lower triangle packed
+        shapes = (
+            {"factor_lower": (n * (n + 1) // 2,)}
+            if info.method == "exact"
+            else dict.fromkeys(("centre", "half_widths", "weights", "factor_lower"), (None,))
+            | {"indices": (None, None)}
+        )
+        predictor = _file(folder, doc.files, "predictor", meta)
+        training["predictor"] = _read_npz(predictor, shapes)
+        return training, path, predictor
+    return training, path, None
 
 
 @dataclass(frozen=True, eq=False)
 class MapFolderContents:
     """A map folder, read and checked: the keyword arguments of ``MagneticFieldMap`` but
     ``training`` (``fields``) and of ``TrainingData`` (``training``, or None), and the files a
-    problem in them is reported against (``description``, the YAML; ``training_file``)."""
+    problem in them is reported against (``description``, the YAML; ``training_file``;
+    ``predictor_file``)."""
 
     fields: dict
     training: dict | None
-    description: Path
     training_file: Path | None
+    predictor_file: Path | None
+    description: Path
 
 
 def read_map_folder(folder) -> MapFolderContents:
@@ -377,9 +339,6 @@ def read_map_folder(folder) -> MapFolderContents:
     d, origin, resolution = doc.dimension, np.array(doc.origin), doc.resolution
     read = _read_2d if d == 2 else _read_3d
     mean, variance = read(folder, doc, meta, origin, resolution, doc.cells())
-    kernel = doc.kernel.kernels()
-    kernels = [kernel] if isinstance(kernel, Kernel) else list(kernel)
-    se = [SquaredExponential(k.sigma_f, k.length_scale, k.sigma_n) for k in kernels]
     fields = {
         "origin": origin,
         "resolution": resolution,
@@ -387,10 +346,9 @@ def read_map_folder(folder) -> MapFolderContents:
         "variance": variance,
         "prior_mean": np.array(doc.prior_mean),
         "prior_variance": np.array(doc.prior_variance),
-        "kernel": se[0] if isinstance(kernel, Kernel) else tuple(se),
+        "kernel": doc.kernel.to_kernel(),
         "units": doc.units,
         "height": doc.height if d == 2 else None,
         "provenance": doc.provenance or {},
     }
-    training, training_file = _read_training(folder, doc, meta)
-    return MapFolderContents(fields, training, meta, training_file)
+    return MapFolderContents(fields, *_read_training(folder, doc, meta), description=meta)

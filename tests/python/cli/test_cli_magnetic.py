@@ -47,13 +47,15 @@ def read_csv(path) -> tuple[list[str], np.ndarray]:
 
 @pytest.fixture(scope="module")
 def synthetic(tmp_path_factory):
-    """A 4 x 4 m floor measured at 300 random points (noise 0.05 uT), fitted once."""
+    """A 4 x 4 m floor measured at 300 random points (noise 0.05 uT), fitted once with the
+    independent GPs (smooth_field is not a gradient: the curl-free model is tested on one)."""
     folder = tmp_path_factory.mktemp("synthetic")
     rng = np.random.default_rng(0)
     p = rng.uniform(0.0, 4.0, (300, 2))
     field = smooth_field(p) + rng.normal(0.0, 0.05, (300, 3))
     write_csv(folder / "floor.csv", "x,y,mx,my,mz", np.column_stack([p, field]))
-    done = run("fit", "floor.csv", "-o", "map", "--units", "uT", "--resolution", 0.05, cwd=folder)
+    args = ("fit", "floor.csv", "-o", "map", "--units", "uT", "--resolution", 0.05)
+    done = run(*args, "--model", "independent", cwd=folder)
     assert done.returncode == 0, done.stderr
     return folder, done.stdout
 
@@ -76,7 +78,17 @@ def test_fit_prints_its_hyperparameters_and_times_and_writes_a_map_folder(synthe
 def test_bin_averages_the_readings_per_cell_before_the_fit(synthetic):
     folder, _ = synthetic
     done = run(
-        "fit", "floor.csv", "-o", "binned", "--bin", "1.0", "--kernel", "1,1,0.1", cwd=folder
+        "fit",
+        "floor.csv",
+        "-o",
+        "binned",
+        "--bin",
+        "1.0",
+        "--kernel",
+        "1,1,0.1",
+        "--model",
+        "independent",
+        cwd=folder,
     )
     assert done.returncode == 0, done.stderr
     # 300 random points on a 4 x 4 m floor fill its sixteen 1 m cells.
@@ -89,7 +101,7 @@ def test_max_points_subsamples_the_binned_readings(synthetic):
     # --max-points after --bin draws from the 16 cells' readings, not from the 300 read.
     folder, _ = synthetic
     args = ("fit", "floor.csv", "-o", "both", "--bin", "1.0", "--max-points", "10")
-    done = run(*args, "--kernel", "1,1,0.1", cwd=folder)
+    done = run(*args, "--kernel", "1,1,0.1", "--model", "independent", cwd=folder)
     assert done.returncode == 0, done.stderr
     assert "from 10 of 300 measurements" in done.stdout
 
@@ -134,7 +146,8 @@ def test_a_3d_map_from_3d_data(tmp_path):
     p = rng.uniform([0, 0, 0], [2, 2, 1], (150, 3))
     field = smooth_field(p) + rng.normal(0.0, 0.05, (150, 3))
     write_csv(tmp_path / "hall.csv", "x,y,z,mx,my,mz", np.column_stack([p, field]))
-    done = run("fit", "hall.csv", "-o", "voxels", "--resolution", 0.2, "--margin", 0, cwd=tmp_path)
+    args = ("fit", "hall.csv", "-o", "voxels", "--resolution", 0.2, "--margin", 0)
+    done = run(*args, "--model", "independent", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert "3-D map, 10 x 10 x 5 cells" in done.stdout
     points = rng.uniform([0.3, 0.3, 0.2], [1.7, 1.7, 0.8], (20, 3))
@@ -148,22 +161,26 @@ def test_a_3d_map_from_3d_data(tmp_path):
     assert done.returncode == 0, done.stderr
     with Image.open(tmp_path / "slices.png") as image:
         assert image.size == (1800, 3 * 300 + 60)  # one row of six panels per slice
-    done = run("fit", "hall.csv", "-o", "flat", "--dimension", 2, cwd=tmp_path)
+    done = run(
+        "fit", "hall.csv", "-o", "flat", "--dimension", 2, "--model", "independent", cwd=tmp_path
+    )
     assert done.returncode == 0, done.stderr
     doc = yaml.safe_load((tmp_path / "flat" / "magnetic_map.yaml").read_text())
     assert doc["dimension"] == 2 and doc["height"] == pytest.approx(np.median(p[:, 2]))
 
 
 def test_the_aalto_robot_map_predicts_a_held_out_run(shared_data, tmp_path):
-    """Solin et al. (2018)'s robot: fit on 400 readings of run 1, predict every 30th point of
-    run 2 (the same static field, driven along other paths: about half of its points lie
-    where run 1 did not pass). Measured: RMSE 5.1, 6.1, 8.7 uT overall (the field's spread
-    12.6, 9.1, 15.3 uT), 3.5, 3.6, 3.4 uT where the map is informed (predicted SD below half
-    the prior's, 45 % of the points); 91 % of the errors within 2 SD."""
+    """Solin et al. (2018)'s robot, the independent GPs: fit on 400 readings of run 1,
+    predict every 30th point of run 2 (the same static field, driven along other paths: about
+    half of its points lie where run 1 did not pass). Measured: RMSE 5.1, 6.1, 8.7 uT overall
+    (the field's spread 12.6, 9.1, 15.3 uT), 3.5, 3.6, 3.4 uT where the map is informed
+    (predicted SD below half the prior's, 45 % of the points); 91 % of the errors within 2
+    SD."""
     runs = shared_data / "magnetic" / "aalto" / "invensense"
     if not (runs / "2-mag.csv").is_file():
         pytest.skip(f"{runs}: the Aalto runs are absent")
-    done = run("fit", runs / "1", "-o", tmp_path / "aalto", "--max-points", 400, "--seed", 3)
+    args = ("fit", runs / "1", "-o", tmp_path / "aalto", "--max-points", 400, "--seed", 3)
+    done = run(*args, "--model", "independent")
     assert done.returncode == 0, done.stderr
     assert "from 400 of 8,875 measurements (exact GP)" in done.stdout
     loc = np.loadtxt(runs / "2-loc.csv", delimiter=",")[::30]
@@ -195,7 +212,9 @@ def inputs(tmp_path_factory):
     (tmp_path / "nan.csv").write_text("x,y,mx,my,mz\n0,0,1,2,3\n1,nan,1,2,3\n")
     (tmp_path / "stuff").mkdir()
     (tmp_path / "stuff" / "keep.txt").write_text("mine")
-    done = run("fit", "d.csv", "-o", "m", "--kernel", "3,1,0.1", cwd=tmp_path)
+    done = run(
+        "fit", "d.csv", "-o", "m", "--kernel", "3,1,0.1", "--model", "independent", cwd=tmp_path
+    )
     assert done.returncode == 0, done.stderr
     return tmp_path
 

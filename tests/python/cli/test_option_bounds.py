@@ -257,15 +257,16 @@ MAGNETIC_POINTS = "x,y,mx,my,mz\n0,0,1,2,3\n1,0,1.5,2,3\n0,1,1,2.5,3\n1,1,1,2,3.
         ("1,-0,0.5", "--kernel: l must be a number in [1e-6, 1e6] (m), got -0"),
         ("1,1,nan", "--kernel: sigma_n must be a number in [1e-6, 1e6] (the data's units), "
          "got nan"),
-        ("1,1", "--kernel must be three numbers sigma_f,l,sigma_n, got 1,1"),
-        ("1,x,1", "--kernel must be three numbers sigma_f,l,sigma_n, got 1,x,1"),
+        ("1,1", "--kernel must be 3 numbers sigma_f,l,sigma_n (--model independent), got 1,1"),
+        ("1,x,1", "--kernel must be 3 numbers sigma_f,l,sigma_n (--model independent), got "
+         "1,x,1"),
     ],
 )  # fmt: skip
 def test_the_kernels_numbers_have_limits(tmp_path, monkeypatch, capsys, kernel, line):
     monkeypatch.chdir(tmp_path)
     Path("pts.csv").write_text(MAGNETIC_POINTS)
     code, _, err = kiseki(monkeypatch, capsys, "magnetic", "fit", "pts.csv", "-o", "m",
-                          "--kernel", kernel)  # fmt: skip
+                          "--model", "independent", "--kernel", kernel)  # fmt: skip
     assert (code, err.splitlines()) == (1, [f"kiseki: error: {line}"]), err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["pts.csv"]  # nothing written
 
@@ -277,6 +278,37 @@ def test_the_kernels_numbers_have_limits(tmp_path, monkeypatch, capsys, kernel, 
 def test_the_kernels_limits_fit_or_say_why_in_one_line(tmp_path, monkeypatch, capsys, kernel,
                                                         method):  # fmt: skip
     """The controls: the limits themselves are taken, and the GP fits or refuses in one line."""
+    monkeypatch.chdir(tmp_path)
+    Path("pts.csv").write_text(MAGNETIC_POINTS)
+    code, _, err = kiseki(monkeypatch, capsys, "magnetic", "fit", "pts.csv", "-o", "m", "--model",
+                          "independent", "--kernel", kernel, "--method", method)  # fmt: skip
+    assert code in (0, 1) and len(err.splitlines()) == code, err
+
+
+@pytest.mark.parametrize(
+    ("kernel", "line"),
+    [
+        ("1,1,0.1", "--kernel must be 4 numbers sigma_f,l,sigma_lin,sigma_n (--model curl-free), "
+         "got 1,1,0.1"),
+        ("1,1,1e7,0.1", "--kernel: sigma_lin must be a number in [1e-6, 1e6] (the data's units), "
+         "got 1e7"),
+        ("0,1,1,0.1", "--kernel: sigma_f must be a number in [1e-6, 1e6] (units x m), got 0"),
+    ],
+)  # fmt: skip
+def test_the_curl_free_kernels_numbers_have_limits(tmp_path, monkeypatch, capsys, kernel, line):
+    monkeypatch.chdir(tmp_path)
+    Path("pts.csv").write_text(MAGNETIC_POINTS)
+    code, _, err = kiseki(monkeypatch, capsys, "magnetic", "fit", "pts.csv", "-o", "m",
+                          "--kernel", kernel)  # fmt: skip
+    assert (code, err.splitlines()) == (1, [f"kiseki: error: {line}"]), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pts.csv"]  # nothing written
+
+
+@pytest.mark.parametrize("kernel", ["1e-6,1e-6,1e-6,1e-6", "1e6,1e6,1e6,1e6", "1e6,1e-6,1e6,1e-6"])
+@pytest.mark.parametrize("method", ["exact", "hilbert"])
+def test_the_curl_free_kernels_limits_fit_or_say_why_in_one_line(
+    tmp_path, monkeypatch, capsys, kernel, method
+):
     monkeypatch.chdir(tmp_path)
     Path("pts.csv").write_text(MAGNETIC_POINTS)
     code, _, err = kiseki(monkeypatch, capsys, "magnetic", "fit", "pts.csv", "-o", "m",
@@ -317,9 +349,12 @@ WORLD = "data/worlds/factory_corridor.yaml"
         (["speed", "limits", "log.mcap", "--map", "room.yaml", "-o", "s.csv", "--method", "width",
           "--half-angle", "45"], "--half-angle does not apply to --method width (eq. 1's region "
          "only)"),
-        (["magnetic", "fit", "d.csv", "-o", "m", "--kernel", "1,1,0.1", "--per-component"],
+        (["magnetic", "fit", "d.csv", "-o", "m", "--model", "independent", "--kernel", "1,1,0.1",
+          "--per-component"],
          "--per-component does not apply with --kernel (its hyperparameters are given)"),
-        (["magnetic", "fit", "d.csv", "-o", "m", "--kernel", "1,1,0.1", "--seed", "3"],
+        (["magnetic", "fit", "d.csv", "-o", "m", "--per-component"],
+         "--per-component does not apply with --model curl-free (one potential)"),
+        (["magnetic", "fit", "d.csv", "-o", "m", "--kernel", "1,1,1,0.1", "--seed", "3"],
          "--seed does not apply with --kernel and without --max-points (nothing random)"),
         (["magnetic", "render", "flat", "-o", "f.png", "--slices", "3"],
          "--slices does not apply to flat: a 2-D map (slices are 3-D maps')"),

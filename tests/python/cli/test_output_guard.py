@@ -209,7 +209,7 @@ def test_a_magnetic_map_folder_takes_no_new_file_either(tmp_path):
     from kiseki.cli import app
 
     fit = ["magnetic", "fit", str(tmp_path / "d.csv"), "-o", str(tmp_path / "m")]
-    done = CliRunner().invoke(app, [*fit, "--kernel", "3,1,0.1"])  # in this process: faster
+    done = CliRunner().invoke(app, [*fit, "--kernel", "3,1,40,0.1"])  # in this process: faster
     assert done.exit_code == 0, done.output
     before = sha256s(tmp_path)
     done = run("magnetic", "predict", "m", "--at", "p.csv", "-o", "m/field.csv", cwd=tmp_path)

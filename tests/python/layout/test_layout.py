@@ -731,7 +731,6 @@ LONG_FILES = {
     "datasets/rosbag.py": "ROS 1 and ROS 2 bags share the message layout and the writer",
     "sim/robot.py": "the two simulated platforms share the odometry error model",
     "sim/magnetic.py": "the simulated field and the magnetometer that reads it",
-    "magnetic/field_map.py": "the GP field map, its evaluation and its folder round trip",
     "apps/teach/teaching.py": "a teaching run, its recovery from the log and its files",
 }
 

@@ -12,7 +12,7 @@ import yaml
 from kiseki import _core
 from kiseki.errors import MapFormatError
 from kiseki.gp import ExactGP, SquaredExponential
-from kiseki.magnetic import field_map as field_map_module
+from kiseki.magnetic import map_gp as map_gp_module
 from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
 from kiseki.magnetic.map_folder import MAP_FILE
 
@@ -145,7 +145,7 @@ def small_gp(dimension: int, seed: int = 0):
 
 def test_from_gp_evaluates_the_gp_on_octomap_aligned_cells(monkeypatch):
     gp, _, _ = small_gp(3)
-    monkeypatch.setattr(field_map_module, "_CHUNK", 7)  # several chunks
+    monkeypatch.setattr(map_gp_module, "_CHUNK", 7)  # several chunks
     fmap = MagneticFieldMap.from_gp(gp, [-0.33, 0.12, -0.05], [0.4, 0.5, 0.25], 0.1)
     np.testing.assert_allclose(fmap.origin, [-0.4, 0.1, -0.1], atol=1e-12)
     assert fmap.cells == (8, 4, 4)
