@@ -34,10 +34,8 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Annotated
 
 import numpy as np
-from pydantic import Field
 
 from kiseki.datasets.magnetic import read_aalto_run
 from kiseki_experiments.gp.gp_aalto_defaults_methods import BASELINE, method_names, run_method
@@ -48,6 +46,7 @@ from kiseki_experiments.harness.config import (
     Factor,
     FitPoints,
     Index,
+    Lag,
     PositiveReal,
     Resolution,
     Restarts,
@@ -59,7 +58,6 @@ from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion
 __all__ = ["CLAIMS", "EXPERIMENT", "GpAaltoDefaultsConfig", "cases", "training_readings"]
 
 SENSORS = ("invensense", "nexus")
-Lag = Annotated[int, Field(strict=True, ge=0, le=1_000_000)]  # readings
 COMPONENTS = ("x", "y", "z")
 
 

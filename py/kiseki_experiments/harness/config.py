@@ -34,6 +34,7 @@ from kiseki._support.schema import (
 from kiseki._support.yaml import safe_load_12
 
 __all__ = [
+    "Lag",
     "LIST_LIMIT",
     "PARTICLE_LIMIT",
     "RUN_LIMIT",
@@ -88,6 +89,8 @@ Restarts = Annotated[int, Field(strict=True, ge=0, le=100)]
 # Scans of a log or a run; 0 = all of them where the field says so. A million scans is over a
 # day of a 10 Hz laser (CARMEN's logs hold tens of thousands).
 Scans = Annotated[int, Field(strict=True, ge=0, le=1_000_000)]
+# readings or steps a control shifts a stream by (0: none)
+Lag = Annotated[int, Field(strict=True, ge=0, le=1_000_000)]
 # Threads of one trial: beyond a large machine's cores they only add overhead and memory.
 Threads = Annotated[int, Field(strict=True, gt=0, le=256)]
 # Unknown boxes placed at random (without overlap) into a scene: each is drawn into every

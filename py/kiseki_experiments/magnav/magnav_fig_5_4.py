@@ -30,7 +30,7 @@ from kiseki_experiments.harness.config import Count, NonNegativeReal, Particles,
 from kiseki_experiments.harness.paths import WORLDS
 from kiseki_experiments.harness.records import load_average, pack
 from kiseki_experiments.magnav.magnav_fig_5_4_claims import CLAIMS, evidence
-from kiseki_experiments.magnav.magnav_fig_5_4_report import NOTES, claims, figures
+from kiseki_experiments.magnav.magnav_fig_5_4_report import NOTES, figures
 from kiseki_experiments.magnav.magnav_lidar_drive import DRIVE_METHODS, drive, teach_heading_map
 
 __all__ = ["EXPERIMENT", "LidarMclFigureConfig", "blind_stretch"]
@@ -158,10 +158,9 @@ def analyze(config: LidarMclFigureConfig, trials: pd.DataFrame, timings, out: Pa
     ]
     per_run = per_run.merge(timings[["trial", *(f"{m}_s" for m in DRIVE_METHODS)]], on="trial")
     return Analysis(
-        {"summary": summary, "runs": per_run},
-        figures(ok, out),
-        claims(ok, summary),
-        NOTES,
+        tables={"summary": summary, "runs": per_run},
+        figures=figures(ok, out),
+        notes=NOTES,
         evidence=evidence(ok),
     )
 

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""magnav-fig-5-4's claims (the thesis' statements of sec. 5.3 beside kiseki's numbers), its
-figures (Figs. 5.4-5.6) and its notes."""
+"""magnav-fig-5-4's figures (Figs. 5.4-5.6) and its notes; its claims are in
+magnav_fig_5_4_claims."""
 
 from __future__ import annotations
 
@@ -11,73 +11,13 @@ import numpy as np
 import pandas as pd
 
 from kiseki.plots import new_figure, save_figure
-from kiseki_experiments.harness.base import Claim
 from kiseki_experiments.harness.records import unpack
+from kiseki_experiments.magnav.magnav_fig_5_4_claims import OFF_PATH
 
-__all__ = ["NOTES", "OFF_PATH", "claims", "figures"]
-
-OFF_PATH = 1.0
-"""m of |cross-track error| beyond which a run counts as having left the path (our reading:
-the thesis draws the trajectories, Fig. 5.4, and prints no number)."""
+__all__ = ["NOTES", "figures"]
 
 LABELS = {"odometry": "odometry", "laser": "LIDAR MCL", "magnetic": "LIDAR MCL + magnetic heading"}
 COLOURS = {"odometry": "k", "laser": "tab:orange", "magnetic": "tab:blue"}
-
-
-def claims(ok: pd.DataFrame, summary: pd.DataFrame) -> list[Claim]:
-    s = summary.set_index("method")
-    n = len(ok)
-    odo, las, mag = (s.loc[m] for m in ("odometry", "laser", "magnetic"))
-    beats = int((ok["magnetic_blind_end_xt"] < ok["laser_blind_end_xt"]).sum())
-    off = int((ok["odometry_max_xt"] > OFF_PATH).sum())
-    on = int((ok["magnetic_blind_max_xt"] <= OFF_PATH).sum())
-    return [
-        Claim(
-            "odometry alone cannot correct its accumulated error and leaves the path (Fig. 5.4)",
-            "largely deviates from the path",
-            f"max |cross-track| {odo['max_xt']:.2f} m (mean of {n}); over {OFF_PATH:g} m in "
-            f"{off} of {n} runs; goal reached in {int(odo['reached_goal'])}",
-            "m",
-            bool(off > n / 2),
-            f"left the path = |cross-track| > {OFF_PATH:g} m (our reading, see OFF_PATH)",
-        ),
-        Claim(
-            "both MCLs reach the goal (Fig. 5.4)",
-            "reached the destination",
-            f"LIDAR MCL {int(las['reached_goal'])} of {n}, with magnetic heading "
-            f"{int(mag['reached_goal'])} of {n}",
-            "runs",
-            bool(las["reached_goal"] == n and mag["reached_goal"] == n),
-            "reached: the route done by the estimate with the true pose within 1 m of the goal",
-        ),
-        Claim(
-            "LIDAR-only MCL deviates where no landmark is seen; the proposed method does less",
-            "LIDAR-only deviates in the landmark-free stretch; the proposed follows the path",
-            f"|cross-track| at the stretch's end {las['blind_end_xt']:.2f} vs "
-            f"{mag['blind_end_xt']:.2f} m (max in it {las['blind_max_xt']:.2f} vs "
-            f"{mag['blind_max_xt']:.2f}); proposed smaller in {beats} of {n} runs",
-            "m, mean of runs (LIDAR-only vs proposed)",
-            bool(beats == n),
-        ),
-        Claim(
-            "the proposed method stays on the path in the landmark-free stretch (Fig. 5.4)",
-            "accurate path following",
-            f"max |cross-track| in the stretch {mag['blind_max_xt']:.2f} m (mean); within "
-            f"{OFF_PATH:g} m in {on} of {n} runs",
-            "m",
-            bool(on == n),
-            "see report notes: the heading reset's own noise bounds what it can correct",
-        ),
-        Claim(
-            "r_z and r_theta exceed their thresholds at many points (Fig. 5.5)",
-            "the heading is corrected at many points",
-            f"both gates held (heading reset) in {100 * mag['resets']:.0f} % of the steps",
-            "% of 10 Hz steps",
-            bool(mag["resets"] >= 0.1),
-            "holds at 10 % or more; the sensor's 0.01 G noise alone moves m_theta by 1.9 deg "
-            "on the 0.30 G horizontal field, beside r_theta's 1.8 deg gate",
-        ),
-    ]
 
 
 def figures(ok: pd.DataFrame, out: Path) -> list[Path]:

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 import tempfile
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -44,6 +44,7 @@ from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import PositiveReal, Real
 from kiseki_experiments.harness.paths import WORLDS
 from kiseki_experiments.harness.records import pack
+from kiseki_experiments.magnav.magnav_navigators_claims import CLAIMS
 from kiseki_experiments.magnav.magnav_navigators_report import analyze_navigators
 from kiseki_experiments.magnav.magnav_table_4_2 import cut_route
 
@@ -66,6 +67,13 @@ class NavigatorsConfig:
     disturbed: PositiveReal = 0.02  # G: a node whose mz is this far from the median is disturbed
     # the magnetic navigators' validity: "thesis" (r_z >= 0.998) or "sensor" (kiseki's rule)
     gates: str = "thesis"
+    # the claims' controls (magnav_navigators_claims): the scene variant played back, the
+    # navigators the multi system arbitrates, the gate's limit times gate_scale, and random
+    # nodes (as many as the disturbed ones) called disturbed
+    variant: str = "playback"
+    multi_navigators: list[str] = field(default_factory=lambda: list(NAVIGATORS))
+    gate_scale: PositiveReal = 1.0
+    disturbed_placebo: bool = False
 
 
 def _cut_scene(config: NavigatorsConfig, folder: Path) -> tuple[Path, np.ndarray]:
@@ -84,6 +92,16 @@ def preflight(config: NavigatorsConfig) -> None:
         raise FileNotFoundError(f"magnav-navigators: {config.scene} not found")
     if config.gates not in GATES:
         raise ValueError(f"magnav-navigators: gates must be one of {GATES}, got {config.gates!r}")
+    if config.variant not in ("teach", "playback"):
+        raise ValueError(
+            f"magnav-navigators: variant must be teach or playback, got {config.variant!r}"
+        )
+    unknown = set(config.multi_navigators) - set(NAVIGATORS)
+    if not config.multi_navigators or unknown:
+        raise ValueError(
+            f"magnav-navigators: multi_navigators must be some of {', '.join(NAVIGATORS)}, "
+            f"got {config.multi_navigators}"
+        )
     if config.length < 5.0:
         raise ValueError(f"magnav-navigators: length must be at least 5 m, got {config.length}")
     if not (config.changed_from < config.changed_to):
@@ -109,7 +127,7 @@ def _teach(scene_path: Path, waypoints: np.ndarray, seed: int, folder: Path):
     return TaughtMaps(center, None, None, waypoints)
 
 
-def _validity(config, maps, result) -> dict:
+def _validity(config, maps, result, seed: int) -> dict:
     """Shares of the multi run's steps on which each navigator was valid, by stretch."""
     p = result.priorities
     fresh = p[:, list(result.navigators).index("odometry")] > 0
@@ -121,6 +139,8 @@ def _validity(config, maps, result) -> dict:
     k = np.searchsorted(node_along[order], result.along_track).clip(0, len(lmap) - 1)
     node = order[k]
     disturbed = np.abs(mz - np.median(mz)) > config.disturbed
+    if config.disturbed_placebo:  # as many nodes, drawn at random
+        disturbed = np.random.default_rng(seed).permutation(disturbed)
     at_dist = disturbed[node]
     free = (result.along_track >= config.landmark_free_from) & (
         result.along_track <= config.landmark_free_to
@@ -167,6 +187,9 @@ def trial(config: NavigatorsConfig, index: int, seed: int) -> TrialOutput:
                 folder / f"{method}.mcap",
                 derive_seed(seed, 1),
                 gates=config.gates,
+                variant=config.variant,
+                navigators=tuple(config.multi_navigators),
+                gate_scale=config.gate_scale,
             )
             xte = np.abs(r.cross_track)
             out = np.flatnonzero(xte > config.leave_xte)
@@ -186,7 +209,8 @@ def trial(config: NavigatorsConfig, index: int, seed: int) -> TrialOutput:
                     record[f"multi:drove_{name}"] = float(np.mean(drove == name))
                 record["multi:priorities"] = pack(np.column_stack([r.along_track, r.priorities]))
                 record["multi:navigators"] = ",".join(r.navigators)
-                record.update({f"multi:{k}": v for k, v in _validity(config, maps, r).items()})
+                valid = _validity(config, maps, r, derive_seed(seed, 2))
+                record.update({f"multi:{k}": v for k, v in valid.items()})
         lmap = maps.center
         record["noise_sd_from_map"] = reading_noise_sd(lmap.field[:, 2], lmap.count)
         record["route_m"] = float(np.sum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1)))
@@ -205,6 +229,7 @@ EXPERIMENT = Experiment(
     config_type=NavigatorsConfig,
     trial=trial,
     analyze=analyze,
-    default_runs=3,
+    default_runs=10,
     preflight=preflight,
+    claims=CLAIMS,
 )

@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""magnav-navigators' analysis: the per-navigator table, the claims of sec. 4.5.2 against the
-thesis, the evidence for the r_z gate's validity share, and the figures (trajectories of Fig.
-4.9, cross-track error, priority history of Fig. 4.12)."""
+"""magnav-navigators' analysis: the per-navigator table, the evidence of the claims of sec.
+4.5.2 (declared in magnav_navigators_claims), the r_z gate's validity share, and the figures
+(trajectories of Fig. 4.9, cross-track error, priority history of Fig. 4.12)."""
 
 from __future__ import annotations
 
@@ -14,8 +14,9 @@ from scipy.special import erfinv
 
 from kiseki.magnetic.navigators import NAVIGATORS, RZ_MIN
 from kiseki.plots import new_figure, save_figure
-from kiseki_experiments.harness.base import Analysis, Claim
+from kiseki_experiments.harness.base import Analysis
 from kiseki_experiments.harness.records import unpack
+from kiseki_experiments.magnav.magnav_navigators_claims import claim_evidence
 
 __all__ = ["analyze_navigators", "required_noise"]
 
@@ -91,93 +92,6 @@ def _validity_table(trials: pd.DataFrame, noise_sd: float) -> pd.DataFrame:
     return pd.DataFrame([row])
 
 
-def _claims(config, table: pd.DataFrame, valid: pd.DataFrame) -> list[Claim]:
-    t = table.set_index("navigator")
-    v = valid.iloc[0]
-    runs = int(t.loc["multi", "runs"])
-    # Not claimed: the odometry navigator leaving "after about 60 m", the figure the scene's
-    # wheel slip is calibrated to (magnetic_path.yaml's calibrated marks); the table shows it.
-    claims = []
-    geo = float(t.loc["geometric", "left_at_m"])
-    lo, hi = config.changed_from, config.changed_to
-    claims.append(
-        Claim(
-            "the geometric navigator fails at the changed section (the bicycle park)",
-            f"leaves the path at {lo:g}-{hi:g} m",
-            f"left in {int(t.loc['geometric', 'left_path_runs'])} of {runs} runs"
-            + ("" if math.isnan(geo) else f", at {geo:.1f} m")
-            + f"; max |xte| {t.loc['geometric', 'max_abs_xte_m']:.2f} m",
-            "m",
-            bool(not math.isnan(geo) and lo - 5.0 <= geo <= hi + 5.0),
-            "holds when it leaves within 5 m of the park's stretch",
-        )
-    )
-    done = int(t.loc["multi", "completed_runs"])
-    claims.append(
-        Claim(
-            "the multi-navigator system completes the route (Fig. 4.9)",
-            "completes",
-            f"{done} of {runs} runs; max |xte| {t.loc['multi', 'max_abs_xte_m']:.2f} m",
-            "runs",
-            bool(done == runs and runs > 0),
-        )
-    )
-    singles = t.drop(index="multi")["mean_abs_xte_m"]
-    best = singles.idxmin()
-    claims.append(
-        Claim(
-            "the multi-navigator system follows the path more closely than the single navigators "
-            "(sec. 4.5.2)",
-            "closest",
-            f"multi {t.loc['multi', 'mean_abs_xte_m']:.2f} vs best single ({best}) "
-            f"{singles.min():.2f}",
-            "m, mean |cross-track|",
-            bool(t.loc["multi", "mean_abs_xte_m"] <= singles.min()),
-        )
-    )
-    claims.append(
-        Claim(
-            "the geometric navigators' priority drops without landmarks and at the bicycle park "
-            "(Fig. 4.12)",
-            "lower there",
-            f"valid {v['valid_geometric_free']:.2f} without landmarks, "
-            f"{v['valid_geometric_park']:.2f} at the park, "
-            f"{v['valid_geometric_landmarks']:.2f} elsewhere",
-            "share of steps",
-            bool(
-                v["valid_geometric_free"] < v["valid_geometric_landmarks"]
-                and v["valid_geometric_park"] < v["valid_geometric_landmarks"]
-            ),
-            "the multi run's effective priorities",
-        )
-    )
-    claims.append(
-        Claim(
-            "the magnetic navigators' priority drops at the field's disturbances (Figs. 4.12, "
-            "4.13)",
-            "lower at disturbances",
-            f"valid {v['valid_magnetic_disturbed']:.3f} at disturbed nodes vs "
-            f"{v['valid_magnetic_quiet']:.3f} elsewhere",
-            "share of steps",
-            bool(v["valid_magnetic_disturbed"] < v["valid_magnetic_quiet"]),
-            f"disturbed: map mz more than {config.disturbed:g} G from its median",
-        )
-    )
-    claims.append(
-        Claim(
-            "outside the disturbances the magnetic navigators are valid most of the time "
-            "(Fig. 4.13: r_z above the threshold over much of the path; sec. 4.6)",
-            "most of the undisturbed path",
-            f"{v['valid_magnetic_quiet']:.3f} (noise alone predicts {v['closed_form_quiet']:.3f})",
-            "share of steps",
-            bool(v["valid_magnetic_quiet"] >= 0.5),
-            f"the r_z >= {RZ_MIN} gate is |dm_z| <= {1 - RZ_MIN:.3f} G; the sensor's noise is "
-            f"{v['sensor_noise_sd_G']:g} G per reading",
-        )
-    )
-    return claims
-
-
 def _plot_paths(config, trials, methods, figures: Path) -> Path:
     row = trials.iloc[0]
     fig = new_figure(figsize=(9, 6.5), dpi=120)
@@ -219,10 +133,10 @@ def analyze_navigators(config, trials, figures: Path, methods, noise_sd: float) 
     valid = _validity_table(ok, noise_sd)
     figs = [_plot_paths(config, ok, methods, figures)] if len(ok) else []
     return Analysis(
-        {"navigators": table, "validity": valid},
-        figs,
-        _claims(config, table, valid),
-        _notes(config, valid),
+        tables={"navigators": table, "validity": valid},
+        figures=figs,
+        notes=_notes(config, valid),
+        evidence=claim_evidence(config, ok),
     )
 
 

@@ -14,7 +14,7 @@ from kiseki_experiments.harness.paths import WORLDS
 from kiseki_experiments.harness.records import unpack
 from kiseki_experiments.harness.runner import run_experiment
 from kiseki_experiments.magnav.magnav_fig_5_4 import blind_stretch
-from kiseki_experiments.magnav.magnav_fig_5_4_claims import CLAIMS
+from kiseki_experiments.magnav.magnav_fig_5_4_claims import CLAIMS, OFF_PATH
 
 
 def test_one_small_run_reports_what_its_trial_measured(tmp_path):
@@ -42,14 +42,23 @@ def test_one_small_run_reports_what_its_trial_measured(tmp_path):
     assert np.isnan(summary.loc["odometry", "blind_sd_y"])
     assert summary.loc["laser", "resets"] == 0.0 < summary.loc["magnetic", "resets"]
     claims = pd.read_csv(run.run_dir / "claims.csv").set_index("claim")
-    assert len(claims) == 7  # 2 in the verdict form, 5 point claims not yet migrated
-    for spec in CLAIMS:  # one run: no interval yet, the ratio of its own record
-        row = claims.loc[spec.claim]
-        key = "blind_sd_y" if spec.key == "sd_y" else "blind_sd_theta_deg"
-        ratio = record[f"magnetic_{key}"] / record[f"laser_{key}"]
-        assert float(row["measured_value"].split()[0]) == pytest.approx(ratio, rel=1e-3)
-        assert row["verdict"] == "inconclusive" and row["trials"] == 1
+    assert list(claims.index) == [c.claim for c in CLAIMS]
+    assert (claims["trials"] == 1).all()
+    value = {c.key: float(str(claims.loc[c.claim, "measured_value"]).split()[0]) for c in CLAIMS}
+    # one run: no interval, except that 0 of 1 already excludes a share of 0.8
+    verdict = {c.key: claims.loc[c.claim, "verdict"] for c in CLAIMS}
+    assert verdict == {
+        c.key: "fails" if c.key == "both-reach-goal" else "inconclusive" for c in CLAIMS
+    }
+    for axis, key in (("y", "blind_sd_y"), ("theta", "blind_sd_theta_deg")):
+        ratio = record[f"magnetic_{key}"] / record[f"laser_{key}"]  # the ratio of its record
+        assert value[f"sd_{axis}"] == pytest.approx(ratio, rel=1e-3)
         assert ratio < 0.5  # Fig. 5.6's contrast shows even with 60 particles
+    blind = record["magnetic_blind_max_xt"] / record["laser_blind_max_xt"]
+    assert value["proposed-deviates-less"] == pytest.approx(blind, rel=1e-3)
+    assert value["resets-many"] == pytest.approx(record["magnetic_resets"], rel=1e-3)
+    assert value["odometry-leaves"] == float(record["odometry_max_xt"] > OFF_PATH)
+    assert value["both-reach-goal"] == 0.0  # stopped after 35 m: no goal
     for name in ("trajectories", "gates", "sd"):
         (png,) = (run.run_dir / "figures").glob(f"*{name}.png")
         assert png.stat().st_size > 20_000

@@ -219,6 +219,14 @@ def test_mcl_beats_odometry_on_both_routes(tmp_path):
     assert 25 < summary.loc["a", "length_m"] < 32 and summary.loc["b", "turns"] == 5
     for name in ("gp_mcl_route_a.png", "gp_mcl_errors_b.png"):
         assert (run.run_dir / "figures" / name).stat().st_size > 20_000
+    # the claims in the verdict form: the bounds per route, one run each (no interval yet)
+    claims = pd.read_csv(run.run_dir / "claims.csv")
+    bound = claims[claims["claim"].str.startswith("the position error stays below 0.8 m")]
+    assert sorted(bound["claim"].str.extract(r"\[(route .)\]")[0]) == ["route a", "route b"]
+    assert (bound["trials"] == 1).all()
+    ratio = claims[claims["claim"].str.startswith("magnetic-map MCL is more accurate")]
+    expected = (runs["mean_position_error"] / runs["odometry_mean_position_error"]).mean()
+    assert float(ratio["measured_value"].iloc[0]) == pytest.approx(expected, rel=1e-3)
 
 
 @pytest.mark.parametrize(

@@ -43,7 +43,7 @@ from kiseki.core import derive_seed
 from kiseki.magnetic.gates import gate_limits, reading_noise_sd
 from kiseki.magnetic.linear_map import LinearMagneticMap, geometric_features, path_identity
 from kiseki.magnetic.linear_map_run import linear_map_from_run
-from kiseki.magnetic.navigators import NAVIGATORS, MultiNavigator
+from kiseki.magnetic.navigators import DMZ_MAX, NAVIGATORS, RZ_MIN, MultiNavigator
 from kiseki.magnetic.rahok_navigation import (
     PeakCorrection,
     RahokNavigator,
@@ -191,7 +191,15 @@ class _Controller:
     """simulate()'s controller: feeds odometry, magnetometer and laser to one method."""
 
     def __init__(
-        self, method: str, maps: TaughtMaps, travel: str, dt: float, speed: float, gates: str
+        self,
+        method: str,
+        maps: TaughtMaps,
+        travel: str,
+        dt: float,
+        speed: float,
+        gates: str,
+        navigators: tuple[str, ...] = NAVIGATORS,
+        gate_scale: float = 1.0,
     ):
         lmap = maps.center
         self.lmap, self.method, self.dt, self.speed = lmap, method, dt, speed
@@ -207,10 +215,13 @@ class _Controller:
                 lmap, s_vec, w_vec, PdSteering(**GAINS), self.peaks, speed, AVERAGE
             )
         else:
-            names = NAVIGATORS if method == "multi" else (method,)
+            names = navigators if method == "multi" else (method,)
             limits = None
             if gates == "sensor":
                 limits = gate_limits(reading_noise_sd(lmap.field[:, 2], lmap.count), lmap.count)
+            if gate_scale != 1.0:  # the gate's limit times gate_scale (an experiment's control)
+                thesis = np.full(len(lmap), (1.0 - RZ_MIN) * DMZ_MAX)  # eq. 4.5 as a limit
+                limits = gate_scale * (thesis if limits is None else limits)
             self.multi = MultiNavigator(
                 lmap, names, GAINS["kp"], GAINS["kd"], max_rate=GAINS["max_rate"], mz_limits=limits
             )
@@ -289,13 +300,24 @@ def navigate(
     seed: int = 1,
     travel: str | None = None,
     gates: str = "thesis",
+    *,
+    variant: str = "playback",
+    navigators: tuple[str, ...] = NAVIGATORS,
+    gate_scale: float = 1.0,
 ) -> NavigationResult:
     """Playback of the taught route with ``method`` (one of :data:`METHODS`) on the scene's
-    ``playback`` variant; the run is written to the MCAP file ``out``. ``gates``: the magnetic
-    navigators' validity, "thesis" (r_z >= 0.998) or "sensor" (kiseki's rule,
-    :mod:`kiseki.magnetic.gates`, the noise read from the taught map)."""
+    ``variant`` (``playback``: the day after teaching); the run is written to the MCAP file
+    ``out``. ``gates``: the magnetic navigators' validity, "thesis" (r_z >= 0.998) or "sensor"
+    (kiseki's rule, :mod:`kiseki.magnetic.gates`, the noise read from the taught map), its limit
+    times ``gate_scale``. ``navigators``: the ones the multi-navigator system arbitrates."""
     if gates not in GATES:
         raise ValueError(f"navigate: gates must be one of {', '.join(GATES)}, got {gates!r}")
+    if not navigators or not set(navigators) <= set(NAVIGATORS):
+        raise ValueError(
+            f"navigate: navigators must be some of {', '.join(NAVIGATORS)}, got {navigators!r}"
+        )
+    if not (isinstance(gate_scale, (int, float)) and 0 < gate_scale < math.inf):
+        raise ValueError(f"navigate: gate_scale must be a number > 0, got {gate_scale!r}")
 
     if method not in METHODS:
         raise ValueError(f"navigate: method must be one of {', '.join(METHODS)}, got {method!r}")
@@ -310,11 +332,14 @@ def navigate(
         raise ValueError(
             f"navigate: maps must be TaughtMaps (see teach), got {type(maps).__name__}"
         )
-    scene = load_scene(scene_path, "playback")
+    scene = load_scene(scene_path, variant)
     if path_identity(scene.route["waypoints"]) != maps.center.path_id:
         raise ValueError(f"{scene_path}: the maps were taught on another path")
     config = SimConfig(seed=seed, max_duration=3.0 * maps.center.s[-1] / scene.route["speed"])
-    controller = _Controller(method, maps, travel, config.dt, float(scene.route["speed"]), gates)
+    speed = float(scene.route["speed"])
+    controller = _Controller(
+        method, maps, travel, config.dt, speed, gates, tuple(navigators), float(gate_scale)
+    )
     summary = simulate(scene, out, config, controller=controller, overwrite=True, progress=False)
     log = controller.log
     truth = np.array(log["truth"], dtype=np.float64).reshape(-1, 3)

@@ -1,0 +1,114 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""gp-mcl's claims (secs. 6.7-6.8, Figs. 6.15-6.18), declared before the run: each with the
+per-run quantity it is decided on and the control under which it must fail; and their evidence
+from the trials' records. The controls pair each position with the readings taken 30 s later
+along the route (``reading_lag_steps=300``): the filter then weighs its particles with the field
+of somewhere else."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion, Evidence
+
+__all__ = ["CLAIMS", "HEADING_BOUND", "POSITION_BOUND", "claim_evidence"]
+
+POSITION_BOUND, HEADING_BOUND = 0.8, 0.14  # m, rad: Fig. 6.16 (sec. 6.8)
+
+LAGGED = Control(
+    name="readings paired with the poses 30 s later",
+    overrides=("reading_lag_steps=300",),
+    runs=5,
+    why="the field of a place 9 m away: the filter follows a wrong field and its error grows "
+    "beyond the bounds, beyond odometry's",
+    minutes=True,
+)
+SWAPPED = Control(
+    name="the routes' names swapped",
+    overrides=("swap_route_names=true",),
+    runs=5,
+    why="route a, well surveyed, is then called b: the difference changes sign (a check that the "
+    "criterion can fail, not a change of method)",
+    minutes=True,
+)
+
+CLAIMS = (
+    ClaimSpec(
+        key="position-bound",
+        claim="the position error stays below 0.8 m all along (Figs. 6.16, 6.18)",
+        unit="m, largest error of a run",
+        criterion=Criterion(
+            paper_value="< 0.8 (route b: equivalent to route a)",
+            compare="<=",
+            threshold=POSITION_BOUND,
+            why="Fig. 6.16's bound",
+            bounds=(0.0, np.inf),
+            paper_number=POSITION_BOUND,
+        ),
+        control=LAGGED,
+        measure="one run's largest position error along its route",
+    ),
+    ClaimSpec(
+        key="heading-bound",
+        claim="the heading error stays within 0.14 rad all along (Figs. 6.16, 6.18)",
+        unit="rad, largest error of a run",
+        criterion=Criterion(
+            paper_value="<= 0.14 (route b: larger)",
+            compare="<=",
+            threshold=HEADING_BOUND,
+            why="Fig. 6.16's bound",
+            bounds=(0.0, np.pi),
+            paper_number=HEADING_BOUND,
+        ),
+        control=LAGGED,
+        measure="one run's largest heading error along its route",
+    ),
+    ClaimSpec(
+        key="better-than-odometry",
+        claim="magnetic-map MCL is more accurate than odometry (sec. 6.8, Fig. 1.2)",
+        unit="ratio of mean position errors",
+        criterion=Criterion(
+            paper_value="MCL corrects odometry's drift",
+            compare="<=",
+            threshold=0.5,
+            why="'corrects the drift' read as at most half of odometry's mean error",
+            bounds=(0.0, np.inf),
+        ),
+        control=LAGGED,
+        measure="one run's mean position error, MCL over odometry (the same odometry)",
+    ),
+    ClaimSpec(
+        key="sparse-heading",
+        claim="the heading error grows at the sparsely surveyed place (Fig. 6.18)",
+        unit="rad, mean heading error",
+        criterion=Criterion(
+            paper_value="b > a, heading especially",
+            compare=">=",
+            threshold=0.0,
+            why="larger on route b than on route a",
+            bounds=(-np.pi, np.pi),
+        ),
+        control=SWAPPED,
+        measure="the k-th run of route b's mean heading error minus the k-th of route a's",
+    ),
+)
+
+
+def claim_evidence(ok: pd.DataFrame) -> list[Evidence]:
+    """The per-run evidence of :data:`CLAIMS`, the bounds' once per route."""
+    out = []
+    for name in sorted(ok["route"].unique()):
+        runs = ok[ok["route"] == name]
+        subject = f"route {name}"
+        out.append(Evidence.of("position-bound", runs["max_position_error"], subject=subject))
+        out.append(Evidence.of("heading-bound", runs["max_heading_error"], subject=subject))
+    ratio = ok["mean_position_error"] / ok["odometry_mean_position_error"]
+    out.append(Evidence.of("better-than-odometry", ratio))
+    a = ok[ok["route"] == "a"]["mean_heading_error"].to_numpy(float)
+    b = ok[ok["route"] == "b"]["mean_heading_error"].to_numpy(float)
+    pairs = min(len(a), len(b))
+    if pairs:
+        out.append(Evidence.of("sparse-heading", b[:pairs] - a[:pairs]))
+    return out
