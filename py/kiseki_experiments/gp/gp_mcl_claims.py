@@ -20,7 +20,7 @@ POSITION_BOUND, HEADING_BOUND = 0.8, 0.14  # m, rad: Fig. 6.16 (sec. 6.8)
 LAGGED = Control(
     name="readings paired with the poses 30 s later",
     overrides=("reading_lag_steps=300",),
-    runs=5,
+    runs=10,  # 5 per route: an interval per route
     why="the field of a place 9 m away: the filter follows a wrong field and its error grows "
     "beyond the bounds, beyond odometry's",
     minutes=True,
@@ -28,7 +28,7 @@ LAGGED = Control(
 SWAPPED = Control(
     name="the routes' names swapped",
     overrides=("swap_route_names=true",),
-    runs=5,
+    runs=10,
     why="route a, well surveyed, is then called b: the difference changes sign (a check that the "
     "criterion can fail, not a change of method)",
     minutes=True,
