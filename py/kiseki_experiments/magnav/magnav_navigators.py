@@ -149,19 +149,21 @@ def _validity(config, maps, result, seed: int) -> dict:
 
     def share(flag, where):
         where = where & fresh
-        return float(flag[where].mean()) if where.any() else float("nan")
+        if flag is None or not where.any():  # a navigator the multi system was not given
+            return float("nan")
+        return float(flag[where].mean())
 
     every = np.ones(len(fresh), dtype=bool)
     others = ~free & ~park
     quiet_nodes = ~disturbed
     return {
-        "valid_magnetic": share(cols["magnetic"], every),
-        "valid_magnetic_quiet": share(cols["magnetic"], ~at_dist),
-        "valid_magnetic_disturbed": share(cols["magnetic"], at_dist),
-        "valid_geometric": share(cols["geometric"], every),
-        "valid_geometric_landmarks": share(cols["geometric"], others),
-        "valid_geometric_free": share(cols["geometric"], free),
-        "valid_geometric_park": share(cols["geometric"], park),
+        "valid_magnetic": share(cols.get("magnetic"), every),
+        "valid_magnetic_quiet": share(cols.get("magnetic"), ~at_dist),
+        "valid_magnetic_disturbed": share(cols.get("magnetic"), at_dist),
+        "valid_geometric": share(cols.get("geometric"), every),
+        "valid_geometric_landmarks": share(cols.get("geometric"), others),
+        "valid_geometric_free": share(cols.get("geometric"), free),
+        "valid_geometric_park": share(cols.get("geometric"), park),
         "closed_form_quiet": closed_form_validity(lmap.count[quiet_nodes], _noise_sd(config)),
         "mean_node_count": float(np.mean(lmap.count[lmap.count > 0])),
     }

@@ -37,7 +37,7 @@ LENIENT_LEAVE = Control(
 )
 ODOMETRY_ONLY = Control(
     name="the multi-navigator system with the odometry navigator only",
-    overrides=("multi_navigators=[odometry]",),
+    overrides=("multi_navigators=odometry",),
     runs=5,
     why="with nothing to arbitrate the multi-navigator system is the odometry navigator, "
     "farther from the path than the best single navigator",

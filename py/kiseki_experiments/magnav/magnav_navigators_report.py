@@ -115,8 +115,8 @@ def _plot_paths(config, trials, methods, figures: Path) -> Path:
     )
     axes[0].legend(fontsize=6, ncol=3)
     axes[1].set_ylabel("cross-track (m, left +)")
-    pri = unpack(row["multi:priorities"]).reshape(-1, 1 + len(NAVIGATORS))
     names = str(row["multi:navigators"]).split(",")
+    pri = unpack(row["multi:priorities"]).reshape(-1, 1 + len(names))
     for j, n in enumerate(names):
         axes[2].step(pri[:, 0], pri[:, 1 + j], where="post", color=COLOURS[n], lw=0.8, label=n)
     axes[2].set_ylabel("priority (0: invalid)")
