@@ -43,9 +43,15 @@ inline int fast_floor(double v) {
 }
 }  // namespace
 
-// Stopping cells along each column (prefix over rows) and each row (prefix over columns).
+// The summed-area table of the stopping cells: at[y * (w + 1) + x] counts those in columns < x
+// and rows < y, so any rectangle's count is four reads.
 struct SectorCaster::Prefix {
-  std::vector<std::int32_t> column, row;
+  std::vector<std::int32_t> at;
+  int w;
+  int count(int x0, int x1, int y0, int y1) const {  // cells x0..x1 x y0..y1
+    const auto row = [&](int y) { return static_cast<std::size_t>(y) * (w + 1); };
+    return at[row(y1 + 1) + x1 + 1] - at[row(y0) + x1 + 1] - at[row(y1 + 1) + x0] + at[row(y0) + x0];
+  }
 };
 
 SectorCaster::SectorCaster(const OccupancyGrid& grid, bool unknown_stops,
@@ -63,16 +69,12 @@ SectorCaster::SectorCaster(const OccupancyGrid& grid, bool unknown_stops,
       stops[static_cast<std::size_t>(y) * w + x] = v >= occupied_threshold || (unknown_stops && v < 0);
     }
   }
-  Prefix prefix;
-  prefix.column.assign(static_cast<std::size_t>(w) * (h + 1), 0);
-  prefix.row.assign(static_cast<std::size_t>(h) * (w + 1), 0);
+  Prefix prefix{std::vector<std::int32_t>(static_cast<std::size_t>(w + 1) * (h + 1), 0), w};
   for (int y = 0; y < h; ++y) {
+    std::int32_t in_row = 0;
     for (int x = 0; x < w; ++x) {
-      const int s = stops[static_cast<std::size_t>(y) * w + x];
-      prefix.column[static_cast<std::size_t>(x) * (h + 1) + y + 1] =
-          prefix.column[static_cast<std::size_t>(x) * (h + 1) + y] + s;
-      prefix.row[static_cast<std::size_t>(y) * (w + 1) + x + 1] =
-          prefix.row[static_cast<std::size_t>(y) * (w + 1) + x] + s;
+      in_row += stops[static_cast<std::size_t>(y) * w + x];
+      prefix.at[static_cast<std::size_t>(y + 1) * (w + 1) + x + 1] = prefix.at[static_cast<std::size_t>(y) * (w + 1) + x + 1] + in_row;
     }
   }
   cells_ = cells;
@@ -102,21 +104,37 @@ std::uint8_t SectorCaster::clear_lines(int cx, int cy, const Sector& s, const Pr
   const int n_major = s.axis == 0 ? grid_.width() : grid_.height();
   const int n_minor = s.axis == 0 ? grid_.height() : grid_.width();
   const int major = s.axis == 0 ? cx : cy, minor = s.axis == 0 ? cy : cx;
-  const std::int32_t* lines = s.axis == 0 ? prefix.column.data() : prefix.row.data();
-  for (int j = 0; j < kMaxLines; ++j) {
-    const int line = major + s.major_step * j;
-    if (line < 0 || line >= n_major) return static_cast<std::uint8_t>(j);
-    // Minor offsets (in the sector's direction) a ray can reach in this line.
-    const int lo = static_cast<int>(std::floor(s.slope_lo * std::max(0, j - 1)));
-    const int hi = static_cast<int>(std::floor(1.0 + s.slope_hi * (j + 1) + kMargin));
-    int a = s.minor_step > 0 ? minor + lo : minor - hi;
-    int b = s.minor_step > 0 ? minor + hi : minor - lo;
-    a = std::max(a, 0), b = std::min(b, n_minor - 1);
-    if (a > b) return static_cast<std::uint8_t>(j);  // every such ray has left the map
-    const std::int32_t* count = lines + static_cast<std::size_t>(line) * (n_minor + 1);
-    if (count[b + 1] > count[a]) return static_cast<std::uint8_t>(j);
+  // Minor offsets (in the sector's direction) a ray can reach in line j: lo(j) .. hi(j), both
+  // growing with j.
+  const auto lo = [&](int j) { return static_cast<int>(std::floor(s.slope_lo * std::max(0, j - 1))); };
+  const auto hi = [&](int j) { return static_cast<int>(std::floor(1.0 + s.slope_hi * (j + 1) + kMargin)); };
+  // Whether line j's cells meet the map (once they leave it, every such ray has left it).
+  const auto inside = [&](int j) { return s.minor_step > 0 ? minor + lo(j) < n_minor : minor - lo(j) >= 0; };
+  // Whether a stopping cell lies in the bounding box of lines j0..j1's cells.
+  const auto blocked = [&](int j0, int j1) {
+    const int a = s.minor_step > 0 ? minor + lo(j0) : std::max(minor - hi(j1), 0);
+    const int b = s.minor_step > 0 ? std::min(minor + hi(j1), n_minor - 1) : minor - lo(j0);
+    const int l0 = major + s.major_step * j0, l1 = major + s.major_step * j1;
+    const int m0 = std::min(l0, l1), m1 = std::max(l0, l1);
+    return (s.axis == 0 ? prefix.count(m0, m1, a, b) : prefix.count(a, b, m0, m1)) > 0;
+  };
+  const int limit = std::min(s.major_step > 0 ? n_major - major : major + 1, kMaxLines);
+  // Galloping: blocks of 1, 2, 4, ... lines whose box holds no stopping cell are all free; a
+  // blocked box is looked at again line by line.
+  int j = 0, block = 1;
+  while (j < limit) {
+    if (!inside(j)) return static_cast<std::uint8_t>(j);
+    int end = std::min(j + block, limit) - 1;
+    while (end > j && !inside(end)) end = j + (end - j) / 2;
+    if (blocked(j, end)) {
+      if (end == j) return static_cast<std::uint8_t>(j);
+      block = 1;
+      continue;
+    }
+    j = end + 1;
+    block *= 2;
   }
-  return static_cast<std::uint8_t>(kMaxLines);
+  return static_cast<std::uint8_t>(limit);
 }
 
 double SectorCaster::range(double x, double y, double heading, double max_range) const {

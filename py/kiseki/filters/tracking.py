@@ -33,7 +33,7 @@ from kiseki.filters.reliability import (
     LearnedReliability,
     ReliabilityModel,
 )
-from kiseki.grid import OccupancyGrid
+from kiseki.grid import DEFAULT_RAY_CASTER, RAY_CASTERS, OccupancyGrid
 from kiseki.mapping import scan_local_map
 from kiseki.scans import LaserScans, check_odometry_jumps
 
@@ -101,6 +101,9 @@ class LocalizeConfig:
       z_hit: equal prior odds that a beam's end is a mapped wall or an unmapped object) times
       the beam model's ``lambda_short`` density for a beam stopped short in free space.
     * ``combination`` product (beams independent) or nav2 (1 + sum pz^3).
+    * ``caster``: how the beam model casts z*, ``swept-sector`` or ``distance-field``
+      (:mod:`kiseki.grid.casters`; both exact, the same weights); the default is the C++
+      model's.
     * ``alphas`` None: :func:`motion_alphas` (the noise the odometry has).
     * the engine's settings (particles, KLD, resampling, recovery, update thresholds,
       threads) default to :class:`MclConfig`'s, which holds each of them once.
@@ -121,6 +124,7 @@ class LocalizeConfig:
     lambda_short: float = 0.1
     z_intrusion: float = 0.95
     combination: str = "product"
+    caster: str = DEFAULT_RAY_CASTER
     kld: bool = MclConfig.kld
     min_particles: int = MclConfig.min_particles
     resampling: str = MclConfig.resampling
@@ -157,6 +161,10 @@ class LocalizeConfig:
         _check(
             self.combination in ("product", "nav2"),
             f"combination must be product or nav2, got {self.combination!r}",
+        )
+        _check(
+            self.caster in RAY_CASTERS,
+            f"caster must be one of {', '.join(RAY_CASTERS)}, got {self.caster!r}",
         )
         for name in ("sigma_hit", "lambda_short"):
             value = getattr(self, name)
@@ -222,6 +230,7 @@ def scan_model(method: str, grid: OccupancyGrid, config: LocalizeConfig | None =
             lambda_short=config.lambda_short,
             max_beams=config.beams,
             combination=combination,
+            caster=RAY_CASTERS[config.caster],
         )
     if method == "ray-space-observation":
         return _core.RaySpaceObservationModel(

@@ -25,18 +25,20 @@ enum class RayCasterKind { distance_field, swept_sector };
 /// [i/s, (i+1)/s] of |minor| / |major|. For a cell c and a sector k the table holds J(c, k): how
 /// many lines of cells across the major axis (columns for an x-major sector, rows for a
 /// y-major one) every ray from anywhere in c with a heading in k crosses without meeting a
-/// stopping cell. A ray from a point (u0, v0) in c, |u0|, |v0| <= 1 in the sector's frame, with
+/// stopping cell. A ray from a point (u0, v0) of c, u0, v0 in [0, 1] in the sector's frame, with
 /// slope m in [m_lo, m_hi], lies within line j at minor offsets v0 + m (u - u0), u - u0 in
 /// [max(0, j - 1), j + 1]: the cells [floor(m_lo max(0, j - 1)), floor(1 + m_hi (j + 1))] of
-/// line j (per-line prefix counts of stopping cells answer whether any of them stops a ray).
+/// line j. A summed-area table of the stopping cells answers whether any cell of a box of
+/// lines holds one, so the lines are looked at in galloping blocks (1, 2, 4, ... lines).
 /// J(c, k) is the first line that holds one, or leaves the map; the walk jumps to where the
-/// ray enters line J (when J >= 2) and looks again from the cell it lands in.
+/// ray enters line J (when J >= 2) and looks again from the cell it lands in. No cell it
+/// passes over can stop it, so it meets the same first stopping cell as the cell walk.
 ///
 /// What stops a ray is nav2's rule (as RangeCaster): an occupied cell (>= threshold), an
 /// unknown cell when unknown_stops, and the edge of the map. Memory: 1 byte per cell and
 /// sector (8 x sectors_per_octant sectors), holding 0 at a stopping cell and 1 + J elsewhere
-/// (J capped at 254 lines: a longer free run is several jumps); the prefix counts, 8 bytes per
-/// cell, live only while the table is built.
+/// (J capped at 254 lines: a longer free run is several jumps); the summed-area table, 4 bytes
+/// per cell, lives only while the table is built.
 class SectorCaster {
  public:
   SectorCaster(const OccupancyGrid& grid, bool unknown_stops = true,
@@ -49,12 +51,14 @@ class SectorCaster {
                      double max_range) const;
   /// A scan from one sensor pose: beam b leaves it at heading sensor.theta + angle_b, given as
   /// cos and sin of angle_b (sensor frame), and reaches at most reach[b]. Writes n ranges to
-  /// out. The heading is a rotation of the beam's direction: one sine and cosine per scan.
+  /// out. The heading is a rotation of the beam's direction: one sine and cosine per scan. The
+  /// rays walk 16 at a time in turns, so that one ray's cache miss in the table overlaps the
+  /// others' work; each ray's result is its own walk's.
   void scan(const Pose2& sensor, const double* cos_beam, const double* sin_beam,
             const double* reach, std::size_t n, double* out) const;
   const OccupancyGrid& grid() const { return grid_; }
   int sectors() const { return sectors_; }
-  /// Bytes held by the table and the masks (what the caster adds to the map's own cells).
+  /// Bytes held by the table (what the caster adds to its copy of the map's cells).
   std::size_t memory_bytes() const;
 
  private:
