@@ -6,7 +6,13 @@ beam angles and a grid's summary; ray casters for many rays per map (`kiseki.gri
 
 from __future__ import annotations
 
-from kiseki.grid.casters import DEFAULT_RAY_CASTER, RAY_CASTERS, RangeCaster, SectorCaster
+from kiseki.grid.casters import (
+    DEFAULT_RAY_CASTER,
+    RAY_CASTERS,
+    RangeCaster,
+    SectorCaster,
+    ray_caster,
+)
 from kiseki.grid.occupancy import (
     FREE,
     OCCUPIED,
@@ -27,4 +33,5 @@ __all__ = [
     "SectorCaster",
     "beam_angles",
     "grid_summary",
+    "ray_caster",
 ]
