@@ -6,12 +6,14 @@ beam model weighs a log's scans the same with either."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from kiseki import FREE, OccupancyGrid
 from kiseki.datasets import read_carmen_log
-from kiseki.filters import LocalizeConfig, scan_model
+from kiseki.filters import LocalizeConfig, localize, scan_model
 from kiseki.grid import DEFAULT_RAY_CASTER, RAY_CASTERS, RangeCaster, SectorCaster
 from kiseki.mapping import MapBuildConfig, map_of_log
 
@@ -82,3 +84,18 @@ def test_casters_refuse_bad_input(intel):
         sector.scans(np.zeros((2, 3)), np.zeros(3), np.nan)
     with pytest.raises(ValueError, match="caster must be one of"):
         LocalizeConfig(method="beam", caster="lookup-table")
+
+
+def test_beam_tracking_with_the_swept_sector_caster_is_the_same_on_any_thread_count(intel):
+    scans, grid = intel
+    n = 40
+    part = dataclasses.replace(
+        scans,
+        times=scans.times[:n],
+        poses=scans.poses[:n],
+        odometry=scans.odometry[:n],
+        ranges=scans.ranges[:n],
+    )
+    config = LocalizeConfig(method="beam", particles=300, seed=3, caster="swept-sector")
+    runs = [localize(part, grid, dataclasses.replace(config, threads=t)) for t in (1, 2)]
+    np.testing.assert_array_equal(runs[0].estimates, runs[1].estimates)
