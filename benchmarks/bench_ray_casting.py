@@ -10,7 +10,8 @@ Rays: poses uniform over the map's free cells (uniform inside each cell, uniform
 beams a pose over the full circle, each cast to the log's max range (81.83 m) with nav2's rule
 (occupied and unknown cells stop a ray, as the beam model casts). The rays per second are timed
 in C++ around the casts only (the casters' ``time_ranges`` and ``scans(timed=True)``; no Python
-in the loop), one thread, the median of --repeats runs. "per ray" is one call per ray with its
+in the loop), one thread, the median of --repeats runs, by the thread's CPU time (and by wall
+time, which on a shared machine also counts other processes). "per ray" is one call per ray with its
 heading (``range``); "per scan" casts a pose's beams together as the beam model does
 (``scan``: one sine and cosine a pose, 16 rays walked in turns). Both casters' ranges are
 compared on every ray (the largest difference is printed).
@@ -29,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
 import statistics
 import sys
 import time
@@ -41,6 +43,7 @@ from kiseki.filters import LocalizeConfig, localize, motion_alphas, noisy_odomet
 from kiseki.grid import FREE, RangeCaster, SectorCaster
 from kiseki.mapping import MapBuildConfig, map_of_log
 
+BUILD_THREADS = os.environ.get("OMP_NUM_THREADS", os.cpu_count())
 GOAL = 25e6  # rays/s on one core: a beam model 5x nav2's
 BEAMS = 360
 LOG = "intel"
@@ -56,9 +59,14 @@ def free_poses(grid, n: int, seed: int) -> np.ndarray:
     return np.column_stack([xy, rng.uniform(-np.pi, np.pi, n)])
 
 
-def median_rate(timer, rays: int, repeats: int) -> float:
-    """Rays per second: the median over repeats of rays / the C++-timed seconds."""
-    return statistics.median(rays / timer() for _ in range(repeats))
+def median_rates(timer, rays: int, repeats: int) -> tuple[float, float]:
+    """Rays per second by the thread's CPU time and by wall time: the medians over repeats of
+    rays / the C++-timed (wall, CPU) seconds."""
+    runs = [timer() for _ in range(repeats)]
+    return (
+        statistics.median(rays / cpu for _, cpu in runs),
+        statistics.median(rays / wall for wall, _ in runs),
+    )
 
 
 def ray_table(grid, max_range: float, poses: int, repeats: int, seed: int) -> None:
@@ -79,22 +87,28 @@ def ray_table(grid, max_range: float, poses: int, repeats: int, seed: int) -> No
         float(np.abs(sector.scans(p, angles, max_range) - want).max()),
     )
     rays = len(p) * BEAMS
-    old = median_rate(lambda: field.time_ranges(p, angles, max_range), rays, repeats)
-    per_ray = median_rate(lambda: sector.time_ranges(p, angles, max_range), rays, repeats)
-    per_scan = median_rate(lambda: sector.scans(p, angles, max_range, timed=True), rays, repeats)
+    old = median_rates(lambda: field.time_ranges(p, angles, max_range), rays, repeats)
+    per_ray = median_rates(lambda: sector.time_ranges(p, angles, max_range), rays, repeats)
+    per_scan = median_rates(lambda: sector.scans(p, angles, max_range, timed=True), rays, repeats)
     cells = grid.width * grid.height
     print(
         f"Intel map {grid.width} x {grid.height} cells of {grid.resolution} m; {len(p)} poses on "
         f"free cells x {BEAMS} beams = {rays:,} rays to {max_range:.2f} m, one thread, median of "
         f"{repeats}; largest |swept-sector - distance-field| {diff:.1e} m"
     )
-    print(f"{'caster':<32}{'M rays/s':>10}{'x old':>8}{'x 25 M goal':>13}")
-    for name, rate in (
+    print(f"{'M rays/s on one core':<32}{'CPU time':>10}{'wall':>8}{'x old':>8}{'x 25 M goal':>13}")
+    for name, (cpu, wall) in (
         ("distance field (old), per ray", old),
         ("swept sector, per ray", per_ray),
         ("swept sector, per scan", per_scan),
     ):
-        print(f"{name:<32}{rate / 1e6:>10.2f}{rate / old:>8.2f}{rate / GOAL:>13.2f}")
+        print(
+            f"{name:<32}{cpu / 1e6:>10.2f}{wall / 1e6:>8.2f}{cpu / old[0]:>8.2f}{cpu / GOAL:>13.2f}"
+        )
+    print(
+        "(CPU time: the thread's own seconds; wall time also counts other processes on the core; "
+        "the ratios are of CPU time)"
+    )
     print(
         f"\nprecompute: distance field {field_build:.2f} s, {4 * cells / 1e6:.1f} MB (float per "
         f"cell); swept-sector table ({sector.sectors} sectors) {sector_build:.2f} s, "
