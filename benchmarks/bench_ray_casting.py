@@ -113,7 +113,8 @@ def ray_table(grid, max_range: float, poses: int, repeats: int, seed: int) -> No
         f"\nprecompute: distance field {field_build:.2f} s, {4 * cells / 1e6:.1f} MB (float per "
         f"cell); swept-sector table ({sector.sectors} sectors) {sector_build:.2f} s, "
         f"{sector.memory_bytes / 1e6:.1f} MB; the same with unknown cells passable "
-        f"{passable_build:.2f} s, {passable.memory_bytes / 1e6:.1f} MB (table built on all cores)"
+        f"{passable_build:.2f} s, {passable.memory_bytes / 1e6:.1f} MB (built by OpenMP on "
+        f"{BUILD_THREADS} threads; OMP_NUM_THREADS sets them)"
     )
 
 
