@@ -126,6 +126,23 @@ TEST(SectorCaster, StopsWhereNav2Stops) {
   EXPECT_DOUBLE_EQ(passes.range(-1.0, 0.52, 0.0, 2.0), 2.0);
 }
 
+TEST(SectorCaster, StartsFarOutsideTheMap) {
+  // 1 km away the walk starts where the ray enters the map, as cast_ray's; from 1e200 m the
+  // numbers lose every digit of the map, and the range is still one in [0, reach].
+  const OccupancyGrid g = room();
+  const SectorCaster c(g);
+  RayCastOptions o;
+  o.unknown_is_obstacle = true;
+  o.max_range = 2000.0;
+  Random rng(12);
+  for (int k = 0; k < 200; ++k) {
+    const double y = rng.uniform(-0.4, 5.4), heading = rng.uniform(-0.001, 0.001);
+    EXPECT_NEAR(c.range(-1000.0, y, heading, 2000.0), cast_ray(g, {-1000.0, y}, heading, o).range, 1e-6);
+  }
+  const double far = c.range(1e200, 1e200, -2.3, 1e201);
+  EXPECT_TRUE(far >= 0.0 && far <= 1e201);
+}
+
 TEST(SectorCaster, RefusesBadInput) {
   const OccupancyGrid g = room();
   EXPECT_THROW(SectorCaster(g, true, 65, 0), std::invalid_argument);

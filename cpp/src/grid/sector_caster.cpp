@@ -36,8 +36,10 @@ inline bool clip(double px, double py, double dx, double dy, const double* inv, 
   return t0 <= t1;
 }
 
-// floor for values well inside int's range, without a library call.
+// floor without a library call, for a coordinate that rounding may have put just outside
+// the map: clamped to [-2, 2^30] first, so that the conversion is defined.
 inline int fast_floor(double v) {
+  v = std::clamp(v, -2.0, 1073741824.0);
   const int i = static_cast<int>(v);
   return v < i ? i - 1 : i;
 }
