@@ -4,7 +4,8 @@
 distance-field caster (kiseki's RangeCaster) and the swept-sector caster (SectorCaster) on the
 Intel Research Lab map, their ratio and the goal of 25 M rays/s (a beam model 5x nav2's), what
 the swept-sector table costs (build seconds, MB), and the time per filter update with the beam
-model at 1,000 and 10,000 particles on one thread: kiseki with either caster beside nav2 AMCL.
+model at 1,000 and 10,000 particles on one thread: the model alone with either caster, and the
+whole filter update with either caster beside nav2 AMCL.
 
 Rays: poses uniform over the map's free cells (uniform inside each cell, uniform headings), 360
 beams a pose over the full circle, each cast to the log's max range (81.83 m) with nav2's rule
@@ -39,7 +40,13 @@ import numpy as np
 
 import bench_nav2_amcl as nav2_bench  # the side-by-side settings, shared
 from kiseki.datasets import read_carmen_log
-from kiseki.filters import LocalizeConfig, localize, motion_alphas, noisy_odometry
+from kiseki.filters import (
+    LocalizeConfig,
+    localize,
+    motion_alphas,
+    noisy_odometry,
+    scan_model,
+)
 from kiseki.grid import FREE, RangeCaster, SectorCaster
 from kiseki.mapping import MapBuildConfig, map_of_log
 
@@ -118,6 +125,34 @@ def ray_table(grid, max_range: float, poses: int, repeats: int, seed: int) -> No
     )
 
 
+def weighing_table(scans, grid, particle_counts, n_scans: int, seed: int) -> None:
+    """The beam model alone (kiseki's log_likelihoods, one thread): ms to weigh the particles
+    against one scan, each caster, particles spread around each scan's reference pose."""
+    idx = nav2_bench.nav2_beam_indices(scans.ranges.shape[1], FILTER_BEAMS)
+    angles = scans.angles[idx]
+    steps = range(0, len(scans), max(1, len(scans) // n_scans))
+    print(f"\nbeam model alone, {len(idx)} beams, {len(steps)} scans of the Intel log, 1 thread")
+    print(f"{'particles':>10}{'distance field ms':>20}{'swept sector ms':>18}{'x':>7}")
+    for particles in particle_counts:
+        ms = {}
+        for caster in ("distance-field", "swept-sector"):
+            config = LocalizeConfig(method="beam", beams=len(idx), caster=caster)
+            model = scan_model("beam", grid, config)
+            rng = np.random.default_rng(seed)
+            took = []
+            for k in steps:
+                poses = scans.poses[k] + rng.normal(0, [0.2, 0.2, 0.05], (particles, 3))
+                model.set_scan(angles, scans.ranges[k, idx], scans.max_range)
+                start = time.perf_counter()
+                model.log_likelihoods(poses)
+                took.append(time.perf_counter() - start)
+            ms[caster] = 1000 * statistics.median(took)
+        ratio = ms["distance-field"] / ms["swept-sector"]
+        print(
+            f"{particles:>10}{ms['distance-field']:>20.2f}{ms['swept-sector']:>18.2f}{ratio:>7.2f}"
+        )
+
+
 def update_table(scans, grid, particle_counts, n_scans: int, seed: int) -> None:
     alphas = motion_alphas(LocalizeConfig(odometry_noise=nav2_bench.ODOMETRY_NOISE), scans)
     odom = noisy_odometry(scans.odometry, nav2_bench.ODOMETRY_NOISE, seed)
@@ -190,6 +225,7 @@ def main(argv: list[str] | None = None) -> int:
     scans = read_carmen_log(path).scans
     grid = map_of_log(scans, MapBuildConfig(resolution=0.05))
     ray_table(grid, float(scans.max_range), args.poses, args.repeats, args.seed)
+    weighing_table(scans, grid, args.particles, args.scans, args.seed)
     update_table(scans, grid, args.particles, args.scans, args.seed)
     return 0
 

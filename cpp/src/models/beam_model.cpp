@@ -45,6 +45,14 @@ void BeamModel::expected_ranges(const Pose2& sensor, const double* reach, double
 
 void BeamModel::set_scan(const double* angles, const float* ranges, std::size_t n, double max_range) {
   beams_.set(angles, ranges, n, max_range, params_.max_beams, /*keep_no_return=*/true);
+  // The terms of pz that depend on the reading only, once a scan (as beam_probability has them).
+  const auto& p = params_;
+  short_term_.resize(beams_.size());
+  floor_term_.resize(beams_.size());
+  for (std::size_t b = 0; b < beams_.size(); ++b) {
+    short_term_[b] = p.z_short * p.lambda_short * std::exp(-p.lambda_short * beams_.range[b]);
+    floor_term_[b] = beams_.no_return[b] ? p.z_max : p.z_rand / beams_.max_range;
+  }
   has_scan_ = true;
 }
 
@@ -75,8 +83,13 @@ void BeamModel::log_likelihoods(const Pose2* poses, std::size_t n, double* out) 
     const Pose2 s = poses[k].compose(params_.sensor);
     expected_ranges(s, reach.data(), z_star.data());
     double sum = 0.0;
-    for (std::size_t b = 0; b < m; ++b) {
-      const double pz = beam_probability(beams_.range[b], z_star[b], beams_.no_return[b]);
+    for (std::size_t b = 0; b < m; ++b) {  // beam_probability, its reading's terms from set_scan
+      const double e = beams_.range[b] - z_star[b];
+      double g = std::exp(-e * e / (2.0 * params_.sigma_hit * params_.sigma_hit));
+      if (!nav2) g /= std::sqrt(2.0 * kPi) * params_.sigma_hit;
+      double pz = params_.z_hit * g;
+      if (e < 0.0) pz += short_term_[b];
+      pz += floor_term_[b];
       sum += nav2 ? pz * pz * pz : std::log(pz);
     }
     out[k] = nav2 ? std::log1p(sum) : sum;

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <vector>
 
 #include "kiseki/grid/occupancy_grid.hpp"
 #include "kiseki/grid/range_caster.hpp"
@@ -58,6 +59,7 @@ class BeamModel : public SensorModel {
   std::optional<RangeCaster> field_;    // the caster of z*: one of these two
   std::optional<SectorCaster> sector_;
   RangeCaster occupied_;
+  std::vector<double> short_term_, floor_term_;  // z_short's and z_max's or z_rand's, per beam
   bool has_scan_ = false;
 };
 
