@@ -192,7 +192,10 @@ def kiseki_api():
     return localize
 
 
-def run_kiseki(localize, scans, grid, method, particles, threads, seed, alphas):
+def run_kiseki(localize, scans, grid, method, particles, threads, seed, alphas, caster=None):
+    """kiseki's estimates and per-update seconds; `caster` the beam model's ray caster (None:
+    LocalizeConfig's default)."""
+    extra = {} if caster is None else {"caster": caster}
     config = LocalizeConfig(
         method=method,
         particles=particles,
@@ -215,6 +218,7 @@ def run_kiseki(localize, scans, grid, method, particles, threads, seed, alphas):
         recovery="none",
         update_min_d=UPDATE_MIN_D,
         update_min_a=UPDATE_MIN_A,
+        **extra,
     )
     result = localize(scans, grid, config)
     return np.asarray(result.estimates), np.asarray(result.update_seconds)

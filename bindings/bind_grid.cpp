@@ -3,13 +3,17 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <chrono>
 #include <cstring>
+#include <ctime>
 
 #include "kiseki/grid/distance_field.hpp"
 #include "kiseki/grid/local_window.hpp"
 #include "kiseki/grid/map_image.hpp"
 #include "kiseki/grid/occupancy_grid.hpp"
+#include "kiseki/grid/range_caster.hpp"
 #include "kiseki/grid/ray_casting.hpp"
+#include "kiseki/grid/sector_caster.hpp"
 #include "numpy_helpers.hpp"
 
 namespace kiseki::bindings {
@@ -226,6 +230,151 @@ void bind_map_image(py::module_& m) {
         "path"_a, "image"_a);
 }
 
+// Seconds of CPU time this thread has used (POSIX): a benchmark's measure on a shared machine,
+// where wall time also counts the time other processes hold the core.
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// Wall and CPU seconds of fn() on this thread.
+template <typename Fn>
+py::tuple timed(Fn&& fn) {
+  double wall = 0.0, cpu = 0.0;
+  {
+    py::gil_scoped_release release;
+    const auto start = std::chrono::steady_clock::now();
+    const double cpu_start = thread_cpu_seconds();
+    fn();
+    cpu = thread_cpu_seconds() - cpu_start;
+    wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  return py::make_tuple(wall, cpu);
+}
+
+// Every beam of every pose through a caster, row by row: out[i * b + j] is beam j of pose i.
+template <typename Caster>
+void cast_all(const Caster& c, const double* poses, std::size_t n, const double* angles,
+              std::size_t b, double max_range, double* out) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* p = poses + 3 * i;
+    for (std::size_t j = 0; j < b; ++j) out[i * b + j] = c.range(p[0], p[1], p[2] + angles[j], max_range);
+  }
+}
+
+// The casters' Python methods: ranges of scans, and the same casts timed in C++ (seconds on
+// this thread, no Python in the loop) for the benchmarks' rays per second.
+template <typename Caster, typename Cls>
+void bind_caster_methods(Cls& cls) {
+  const auto checked = [](const py::handle& poses_in, const py::handle& angles_in, double max_range) {
+    auto poses = as_doubles(poses_in, "poses");
+    auto angles = as_doubles(angles_in, "angles");
+    require_shape(poses, "poses", 2, 3);
+    require_shape(angles, "angles", 1);
+    require_finite(poses, "poses");
+    require_finite(angles, "angles");
+    if (!(max_range >= 0.0) || !std::isfinite(max_range)) {
+      throw std::invalid_argument("max_range must be finite and >= 0");
+    }
+    return std::make_pair(poses, angles);
+  };
+  cls.def(
+         "ranges",
+         [checked](const Caster& c, const py::handle& poses_in, const py::handle& angles_in,
+                   double max_range) {
+           const auto [poses, angles] = checked(poses_in, angles_in, max_range);
+           const auto n = poses.shape(0), b = angles.shape(0);
+           py::array_t<double> out({n, b});
+           double* dst = out.mutable_data();
+           {
+             py::gil_scoped_release release;
+             cast_all(c, poses.data(), static_cast<std::size_t>(n), angles.data(),
+                      static_cast<std::size_t>(b), max_range, dst);
+           }
+           return out;
+         },
+         "poses"_a, "angles"_a, "max_range"_a,
+         "Ranges (n, b): beam j leaves sensor pose i (n, 3) at heading theta + angles[j].")
+      .def(
+          "time_ranges",
+          [checked](const Caster& c, const py::handle& poses_in, const py::handle& angles_in,
+                    double max_range) {
+            const auto [poses, angles] = checked(poses_in, angles_in, max_range);
+            const auto n = static_cast<std::size_t>(poses.shape(0));
+            const auto b = static_cast<std::size_t>(angles.shape(0));
+            std::vector<double> out(n * b);
+            return timed([&] { cast_all(c, poses.data(), n, angles.data(), b, max_range, out.data()); });
+          },
+          "poses"_a, "angles"_a, "max_range"_a,
+          "(wall, CPU) seconds that ranges() takes in C++ on this thread (the casts only; for "
+          "benchmarks).")
+      .def_property_readonly("grid", &Caster::grid);
+}
+
+void bind_casters(py::module_& m) {
+  py::enum_<RayCasterKind>(m, "RayCaster", "The ray casters of a model (both exact to rounding).")
+      .value("distance_field", RayCasterKind::distance_field)
+      .value("swept_sector", RayCasterKind::swept_sector);
+  const auto threshold = [](int t) {
+    if (t < 0 || t > 127) throw std::invalid_argument("occupied_threshold must be in 0..127");
+    return static_cast<std::int8_t>(t);
+  };
+  py::class_<RangeCaster> field(m, "RangeCaster",
+                                "Exact ranges: the cell walk skipping free space with a distance field.");
+  field.def(py::init([threshold](const OccupancyGrid& g, bool unknown_stops, int occupied_threshold) {
+              return RangeCaster(g, unknown_stops, threshold(occupied_threshold));
+            }),
+            "grid"_a, "unknown_stops"_a = true, "occupied_threshold"_a = 65);
+  bind_caster_methods<RangeCaster>(field);
+  py::class_<SectorCaster> sector(
+      m, "SectorCaster",
+      "Exact ranges: the cell walk jumping over free lines with a swept-sector table.");
+  sector
+      .def(py::init([threshold](const OccupancyGrid& g, bool unknown_stops, int occupied_threshold,
+                                int sectors_per_octant) {
+             return SectorCaster(g, unknown_stops, threshold(occupied_threshold), sectors_per_octant);
+           }),
+           "grid"_a, "unknown_stops"_a = true, "occupied_threshold"_a = 65,
+           "sectors_per_octant"_a = 8)
+      .def(
+          "scans",
+          [](const SectorCaster& c, const py::handle& poses_in, const py::handle& angles_in,
+             double max_range, bool timed_) -> py::object {
+            auto poses = as_doubles(poses_in, "poses");
+            auto angles = as_doubles(angles_in, "angles");
+            require_shape(poses, "poses", 2, 3);
+            require_shape(angles, "angles", 1);
+            require_finite(poses, "poses");
+            require_finite(angles, "angles");
+            const auto n = static_cast<std::size_t>(poses.shape(0));
+            const auto b = static_cast<std::size_t>(angles.shape(0));
+            std::vector<double> cos_b(b), sin_b(b), reach(b, max_range), out(n * b);
+            for (std::size_t j = 0; j < b; ++j) cos_b[j] = std::cos(angles.data()[j]), sin_b[j] = std::sin(angles.data()[j]);
+            const auto cast = [&] {
+              for (std::size_t i = 0; i < n; ++i) {
+                c.scan(pose_from_row(poses.data() + 3 * i), cos_b.data(), sin_b.data(), reach.data(), b,
+                       out.data() + i * b);
+              }
+            };
+            if (timed_) return timed(cast);
+            {
+              py::gil_scoped_release release;
+              cast();
+            }
+            py::array_t<double> ranges({poses.shape(0), angles.shape(0)});
+            std::memcpy(ranges.mutable_data(), out.data(), out.size() * sizeof(double));
+            return ranges;
+          },
+          "poses"_a, "angles"_a, "max_range"_a, "timed"_a = false,
+          "Ranges (n, b) cast scan by scan (one sine and cosine per pose, as the beam model "
+          "casts); timed=True returns the (wall, CPU) seconds the casts took in C++ instead.")
+      .def_property_readonly("sectors", &SectorCaster::sectors)
+      .def_property_readonly("memory_bytes", &SectorCaster::memory_bytes,
+                             "Bytes of the table and mask the caster holds besides the map.");
+  bind_caster_methods<SectorCaster>(sector);
+}
+
 }  // namespace
 
 void bind_grid(py::module_& m) {
@@ -234,6 +383,7 @@ void bind_grid(py::module_& m) {
   m.attr("UNKNOWN") = kUnknown;
   bind_occupancy_grid(m);
   bind_map_image(m);
+  bind_casters(m);
 }
 
 }  // namespace kiseki::bindings

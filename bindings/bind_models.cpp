@@ -162,12 +162,14 @@ void bind_models(py::module_& m) {
       .def("table", [](const LikelihoodFieldModel& lf) { return mat_to_numpy(lf.table().clone()); },
            "The per-cell term (log pz, or pz^3 for nav2) for the current max range.");
 
+  m.attr("BEAM_MODEL_CASTER") = BeamModelParams().caster;  // the default, held in C++ once
   py::class_<BeamModel, SensorModel>(m, "BeamModel")
       .def(py::init([](const OccupancyGrid& map, double z_hit, double z_short, double z_max,
                        double z_rand, double sigma, double lambda_short, int max_beams,
                        bool unknown_stops, BeamCombination combination, const Pose2& sensor,
-                       double tolerance) {
+                       double tolerance, RayCasterKind caster) {
              BeamModelParams p;
+             p.caster = caster;
              p.z_hit = z_hit, p.z_short = z_short, p.z_max = z_max, p.z_rand = z_rand;
              p.sigma_hit = sigma, p.lambda_short = lambda_short, p.max_beams = max_beams;
              p.unknown_stops = unknown_stops, p.combination = combination, p.sensor = sensor;
@@ -177,7 +179,8 @@ void bind_models(py::module_& m) {
            "map"_a, "z_hit"_a = 0.5, "z_short"_a = 0.05, "z_max"_a = 0.05, "z_rand"_a = 0.5,
            "sigma_hit"_a = 0.2, "lambda_short"_a = 0.1, "max_beams"_a = 0,
            "unknown_stops"_a = true, "combination"_a = BeamCombination::product,
-           "sensor"_a = Pose2(), "agreement_tolerance"_a = 0.2)
+           "sensor"_a = Pose2(), "agreement_tolerance"_a = 0.2,
+           "caster"_a = BeamModelParams().caster)
       .def("set_scan",
            [](BeamModel& bm, const py::handle& a_in, const py::handle& r_in, double max_range) {
              const auto [a, r] = beams(a_in, r_in);

@@ -203,36 +203,64 @@ TEST(BeamModel, EqualsTheMixtureWithRaysCastCellByCell) {
   auto ranges = cast(g, truth, angles, 8.0);
   ranges[2] = INFINITY;  // no return
   ranges[3] = NAN;       // invalid
-  BeamModelParams p;
-  BeamModel m(g, p);
-  m.set_scan(angles.data(), ranges.data(), ranges.size(), 8.0);
-  EXPECT_EQ(m.readings(), 20u);
-  RayCastOptions o;
-  o.max_range = 8.0;
-  o.unknown_is_obstacle = true;
-  const std::vector<Pose2> poses = {truth, Pose2(3.3, 2.4, 0.6), Pose2(6, 4, -1)};
-  std::vector<double> got(3);
-  m.log_likelihoods(poses.data(), 3, got.data());
-  for (int k = 0; k < 3; ++k) {
-    double sum = 0;
-    for (int i = 0; i < 21; ++i) {
-      if (i == 3) continue;
-      const double zs = cast_ray(g, {poses[k].x, poses[k].y}, poses[k].theta + angles[i], o).range;
-      const bool none = i == 2;
-      const double z = none ? 8.0 : ranges[i];
-      double pz = 0.5 * std::exp(-(z - zs) * (z - zs) / 0.08) / (std::sqrt(2 * kPi) * 0.2);
-      if (z < zs) pz += 0.05 * 0.1 * std::exp(-0.1 * z);
-      pz += none ? 0.05 : 0.5 / 8.0;
-      sum += std::log(pz);
+  for (RayCasterKind caster : {RayCasterKind::distance_field, RayCasterKind::swept_sector}) {
+    BeamModelParams p;
+    p.caster = caster;
+    BeamModel m(g, p);
+    m.set_scan(angles.data(), ranges.data(), ranges.size(), 8.0);
+    EXPECT_EQ(m.readings(), 20u);
+    RayCastOptions o;
+    o.max_range = 8.0;
+    o.unknown_is_obstacle = true;
+    const std::vector<Pose2> poses = {truth, Pose2(3.3, 2.4, 0.6), Pose2(6, 4, -1)};
+    std::vector<double> got(3);
+    m.log_likelihoods(poses.data(), 3, got.data());
+    for (int k = 0; k < 3; ++k) {
+      double sum = 0;
+      for (int i = 0; i < 21; ++i) {
+        if (i == 3) continue;
+        const double zs = cast_ray(g, {poses[k].x, poses[k].y}, poses[k].theta + angles[i], o).range;
+        const bool none = i == 2;
+        const double z = none ? 8.0 : ranges[i];
+        double pz = 0.5 * std::exp(-(z - zs) * (z - zs) / 0.08) / (std::sqrt(2 * kPi) * 0.2);
+        if (z < zs) pz += 0.05 * 0.1 * std::exp(-0.1 * z);
+        pz += none ? 0.05 : 0.5 / 8.0;
+        sum += std::log(pz);
+      }
+      EXPECT_NEAR(got[k], sum, 1e-6);
     }
-    EXPECT_NEAR(got[k], sum, 1e-6);
+    EXPECT_GT(got[0], got[1]);
+    EXPECT_GT(got[0], got[2]);
+    EXPECT_NEAR(m.agreement(truth), 1.0, 1e-12);
+    // 1 m further along the heading, the beams ahead pass through the walls they end at.
+    EXPECT_LT(m.agreement(truth.compose(Pose2(1.0, 0.0, 0.0))), 0.8);
+    EXPECT_EQ(m.agreement(Pose2(30, 30, 0)), 0.0);  // outside the map
   }
-  EXPECT_GT(got[0], got[1]);
-  EXPECT_GT(got[0], got[2]);
-  EXPECT_NEAR(m.agreement(truth), 1.0, 1e-12);
-  // 1 m further along the heading, the beams ahead pass through the walls they end at.
-  EXPECT_LT(m.agreement(truth.compose(Pose2(1.0, 0.0, 0.0))), 0.8);
-  EXPECT_EQ(m.agreement(Pose2(30, 30, 0)), 0.0);  // outside the map
+}
+
+TEST(BeamModel, BothCastersGiveTheSameWeights) {
+  // The swept-sector caster is exact: the weights equal the distance-field caster's to rounding
+  // at poses anywhere in and around the room, for both combinations.
+  const OccupancyGrid g = room();
+  const auto angles = scan_angles(181);
+  const auto ranges = cast(g, Pose2(3.0, 2.5, 0.7), angles, 8.0);
+  std::vector<Pose2> poses;
+  Random rng(4);
+  for (int k = 0; k < 2000; ++k) poses.emplace_back(rng.uniform(-2, 10), rng.uniform(-1, 6.5), rng.uniform(-kPi, kPi));
+  for (auto comb : {BeamCombination::product, BeamCombination::nav2}) {
+    BeamModelParams p;
+    p.combination = comb;
+    p.caster = RayCasterKind::distance_field;
+    BeamModel field(g, p);
+    p.caster = RayCasterKind::swept_sector;
+    BeamModel sector(g, p);
+    std::vector<double> a(poses.size()), b(poses.size());
+    field.set_scan(angles.data(), ranges.data(), ranges.size(), 8.0);
+    sector.set_scan(angles.data(), ranges.data(), ranges.size(), 8.0);
+    field.log_likelihoods(poses.data(), poses.size(), a.data());
+    sector.log_likelihoods(poses.data(), poses.size(), b.data());
+    for (std::size_t k = 0; k < poses.size(); ++k) ASSERT_NEAR(a[k], b[k], 1e-9 * std::max(1.0, std::abs(a[k]))) << k;
+  }
 }
 
 TEST(TravelDistanceFilter, ConvergesOnTheDistanceAGaussianLikelihoodPoints) {

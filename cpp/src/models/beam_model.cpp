@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "kiseki/core/angle.hpp"
 
@@ -26,12 +27,32 @@ void BeamModelParams::validate() const {
 }
 
 BeamModel::BeamModel(const OccupancyGrid& map, const BeamModelParams& params)
-    : params_((params.validate(), params)),
-      caster_(map, params.unknown_stops),
-      occupied_(map, /*unknown_stops=*/false) {}
+    : params_((params.validate(), params)), occupied_(map, /*unknown_stops=*/false) {
+  if (params.caster == RayCasterKind::swept_sector) sector_.emplace(map, params.unknown_stops);
+  else field_.emplace(map, params.unknown_stops);
+}
+
+void BeamModel::expected_ranges(const Pose2& sensor, const double* reach, double* z_star) const {
+  const std::size_t m = beams_.size();
+  if (sector_) {
+    sector_->scan(sensor, beams_.cos.data(), beams_.sin.data(), reach, m, z_star);
+    return;
+  }
+  for (std::size_t b = 0; b < m; ++b) {
+    z_star[b] = field_->range(sensor.x, sensor.y, sensor.theta + beams_.angle[b], reach[b]);
+  }
+}
 
 void BeamModel::set_scan(const double* angles, const float* ranges, std::size_t n, double max_range) {
   beams_.set(angles, ranges, n, max_range, params_.max_beams, /*keep_no_return=*/true);
+  // The terms of pz that depend on the reading only, once a scan (as beam_probability has them).
+  const auto& p = params_;
+  short_term_.resize(beams_.size());
+  floor_term_.resize(beams_.size());
+  for (std::size_t b = 0; b < beams_.size(); ++b) {
+    short_term_[b] = p.z_short * p.lambda_short * std::exp(-p.lambda_short * beams_.range[b]);
+    floor_term_[b] = beams_.no_return[b] ? p.z_max : p.z_rand / beams_.max_range;
+  }
   has_scan_ = true;
 }
 
@@ -51,17 +72,24 @@ void BeamModel::log_likelihoods(const Pose2* poses, std::size_t n, double* out) 
   if (!has_scan_) throw std::logic_error("beam model: set a scan first");
   const std::size_t m = beams_.size();
   const bool nav2 = params_.combination == BeamCombination::nav2;
+  // Past reading + 8 sigma the Gaussian term is below exp(-32) of its peak, and every longer z*
+  // scores the same (the short term only asks z < z*): the ray stops there.
+  std::vector<double> reach(m), z_star(m);
+  for (std::size_t b = 0; b < m; ++b) {
+    reach[b] = beams_.no_return[b] ? beams_.max_range
+                                   : std::min(beams_.max_range, beams_.range[b] + 8.0 * params_.sigma_hit);
+  }
   for (std::size_t k = 0; k < n; ++k) {
     const Pose2 s = poses[k].compose(params_.sensor);
+    expected_ranges(s, reach.data(), z_star.data());
     double sum = 0.0;
-    for (std::size_t b = 0; b < m; ++b) {
-      const double heading = s.theta + beams_.angle[b];
-      // Past reading + 8 sigma the Gaussian term is below exp(-32) of its peak, and every
-      // longer z* scores the same (the short term only asks z < z*): the ray stops there.
-      const double reach = beams_.no_return[b] ? beams_.max_range
-                                               : std::min(beams_.max_range, beams_.range[b] + 8.0 * params_.sigma_hit);
-      const double z_star = caster_.range(s.x, s.y, heading, reach);
-      const double pz = beam_probability(beams_.range[b], z_star, beams_.no_return[b]);
+    for (std::size_t b = 0; b < m; ++b) {  // beam_probability, its reading's terms from set_scan
+      const double e = beams_.range[b] - z_star[b];
+      double g = std::exp(-e * e / (2.0 * params_.sigma_hit * params_.sigma_hit));
+      if (!nav2) g /= std::sqrt(2.0 * kPi) * params_.sigma_hit;
+      double pz = params_.z_hit * g;
+      if (e < 0.0) pz += short_term_[b];
+      pz += floor_term_[b];
       sum += nav2 ? pz * pz * pz : std::log(pz);
     }
     out[k] = nav2 ? std::log1p(sum) : sum;

@@ -33,7 +33,7 @@ from kiseki.filters.reliability import (
     LearnedReliability,
     ReliabilityModel,
 )
-from kiseki.grid import OccupancyGrid
+from kiseki.grid import DEFAULT_RAY_CASTER, OccupancyGrid, ray_caster
 from kiseki.mapping import scan_local_map
 from kiseki.scans import LaserScans, check_odometry_jumps
 
@@ -101,6 +101,8 @@ class LocalizeConfig:
       z_hit: equal prior odds that a beam's end is a mapped wall or an unmapped object) times
       the beam model's ``lambda_short`` density for a beam stopped short in free space.
     * ``combination`` product (beams independent) or nav2 (1 + sum pz^3).
+    * ``caster``: how the beam model casts z* (:mod:`kiseki.grid.casters`: both exact, the same
+      weights); the C++ model's default.
     * ``alphas`` None: :func:`motion_alphas` (the noise the odometry has).
     * the engine's settings (particles, KLD, resampling, recovery, update thresholds,
       threads) default to :class:`MclConfig`'s, which holds each of them once.
@@ -121,6 +123,7 @@ class LocalizeConfig:
     lambda_short: float = 0.1
     z_intrusion: float = 0.95
     combination: str = "product"
+    caster: str = DEFAULT_RAY_CASTER
     kld: bool = MclConfig.kld
     min_particles: int = MclConfig.min_particles
     resampling: str = MclConfig.resampling
@@ -158,6 +161,7 @@ class LocalizeConfig:
             self.combination in ("product", "nav2"),
             f"combination must be product or nav2, got {self.combination!r}",
         )
+        ray_caster(self.caster)  # ValueError unless it names one
         for name in ("sigma_hit", "lambda_short"):
             value = getattr(self, name)
             _check(value > 0 and math.isfinite(value), f"{name} must be > 0, got {value}")
@@ -222,6 +226,7 @@ def scan_model(method: str, grid: OccupancyGrid, config: LocalizeConfig | None =
             lambda_short=config.lambda_short,
             max_beams=config.beams,
             combination=combination,
+            caster=ray_caster(config.caster),
         )
     if method == "ray-space-observation":
         return _core.RaySpaceObservationModel(

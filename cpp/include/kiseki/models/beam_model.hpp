@@ -3,9 +3,12 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
+#include <vector>
 
 #include "kiseki/grid/occupancy_grid.hpp"
 #include "kiseki/grid/range_caster.hpp"
+#include "kiseki/grid/sector_caster.hpp"
 #include "kiseki/models/likelihood_field.hpp"
 #include "kiseki/models/scan_beams.hpp"
 #include "kiseki/models/sensor_model.hpp"
@@ -21,15 +24,16 @@ namespace kiseki {
 /// the Gaussian divided by sqrt(2 pi) sigma_hit in the product combination. A ray stops at an
 /// occupied cell and, as in nav2, at an unknown one (unknown_stops). Readings of +inf or at or
 /// beyond max range are no-returns and score with z_max; NaN, zero and negative readings are
-/// skipped. Ray casting skips free space with a distance field (RangeCaster), and a ray stops
-/// 8 sigma_hit past its reading, where the Gaussian term has vanished and a longer z* scores the
-/// same.
+/// skipped. Ray casting skips free space with the swept-sector table (SectorCaster) or a
+/// distance field (RangeCaster), both exact, and a ray stops 8 sigma_hit past its reading, where
+/// the Gaussian term has vanished and a longer z* scores the same.
 struct BeamModelParams {
   double z_hit = 0.5, z_short = 0.05, z_max = 0.05, z_rand = 0.5;  ///< nav2's defaults
   double sigma_hit = 0.2;     ///< m
   double lambda_short = 0.1;  ///< 1/m
   int max_beams = 0;          ///< nav2's max_beams; 0 = every beam
   bool unknown_stops = true;
+  RayCasterKind caster = RayCasterKind::swept_sector;  ///< how z* is cast (the same z*)
   BeamCombination combination = BeamCombination::product;
   Pose2 sensor;  ///< the laser in the robot frame
   double agreement_tolerance = 0.2;
@@ -49,8 +53,13 @@ class BeamModel : public SensorModel {
  private:
   BeamModelParams params_;
   ScanBeams beams_;
-  RangeCaster caster_;
+  // z* of every beam from a sensor pose, each ray cast up to reach[b].
+  void expected_ranges(const Pose2& sensor, const double* reach, double* z_star) const;
+
+  std::optional<RangeCaster> field_;    // the caster of z*: one of these two
+  std::optional<SectorCaster> sector_;
   RangeCaster occupied_;
+  std::vector<double> short_term_, floor_term_;  // z_short's and z_max's or z_rand's, per beam
   bool has_scan_ = false;
 };
 
