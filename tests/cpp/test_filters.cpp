@@ -263,6 +263,17 @@ TEST(BeamModel, BothCastersGiveTheSameWeights) {
   }
 }
 
+TEST(BeamModel, AMapTooLargeForTheSectorTableCastsWithTheDistanceField) {
+  // 8.4 million cells at 64 bytes are the 512 MB limit: one more row and the model falls back
+  // to the distance field (the same z*), without building the table.
+  const int width = 4096, rows = static_cast<int>(kMaxSectorTableBytes / 64 / width);
+  EXPECT_EQ(BeamModel(room()).caster(), RayCasterKind::swept_sector);
+  EXPECT_EQ(BeamModel(OccupancyGrid(width, rows + 1, 0.05)).caster(), RayCasterKind::distance_field);
+  BeamModelParams p;
+  p.caster = RayCasterKind::distance_field;
+  EXPECT_EQ(BeamModel(room(), p).caster(), RayCasterKind::distance_field);
+}
+
 TEST(TravelDistanceFilter, ConvergesOnTheDistanceAGaussianLikelihoodPoints) {
   TravelDistanceParams p;
   p.particles = 2000;

@@ -28,8 +28,13 @@ void BeamModelParams::validate() const {
 
 BeamModel::BeamModel(const OccupancyGrid& map, const BeamModelParams& params)
     : params_((params.validate(), params)), occupied_(map, /*unknown_stops=*/false) {
-  if (params.caster == RayCasterKind::swept_sector) sector_.emplace(map, params.unknown_stops);
-  else field_.emplace(map, params.unknown_stops);
+  // 64 sectors of one byte a cell (SectorCaster's default): past the limit, the distance field
+  const std::size_t table = static_cast<std::size_t>(map.width()) * static_cast<std::size_t>(map.height()) * 64;
+  if (params.caster == RayCasterKind::swept_sector && table <= kMaxSectorTableBytes) {
+    sector_.emplace(map, params.unknown_stops);
+  } else {
+    field_.emplace(map, params.unknown_stops);
+  }
 }
 
 void BeamModel::expected_ranges(const Pose2& sensor, const double* reach, double* z_star) const {

@@ -27,13 +27,19 @@ namespace kiseki {
 /// skipped. Ray casting skips free space with the swept-sector table (SectorCaster) or a
 /// distance field (RangeCaster), both exact, and a ray stops 8 sigma_hit past its reading, where
 /// the Gaussian term has vanished and a longer z* scores the same.
+/// The largest swept-sector table a beam model builds (bytes).
+inline constexpr std::size_t kMaxSectorTableBytes = std::size_t{512} << 20;
+
 struct BeamModelParams {
   double z_hit = 0.5, z_short = 0.05, z_max = 0.05, z_rand = 0.5;  ///< nav2's defaults
   double sigma_hit = 0.2;     ///< m
   double lambda_short = 0.1;  ///< 1/m
   int max_beams = 0;          ///< nav2's max_beams; 0 = every beam
   bool unknown_stops = true;
-  RayCasterKind caster = RayCasterKind::swept_sector;  ///< how z* is cast (the same z*)
+  /// How z* is cast (the same z* either way). A swept-sector table larger than
+  /// kMaxSectorTableBytes (64 bytes a cell: a map of over 8.4 million cells) is not built: the
+  /// distance field casts instead, and caster() says so.
+  RayCasterKind caster = RayCasterKind::swept_sector;
   BeamCombination combination = BeamCombination::product;
   Pose2 sensor;  ///< the laser in the robot frame
   double agreement_tolerance = 0.2;
@@ -49,6 +55,9 @@ class BeamModel : public SensorModel {
   double agreement(const Pose2& pose) const override;
   /// The mixture pz of one beam: reading z, expected range z_star.
   double beam_probability(double z, double z_star, bool no_return) const;
+  /// The caster that casts z*: the one asked for, or the distance field for a map whose
+  /// swept-sector table would exceed kMaxSectorTableBytes.
+  RayCasterKind caster() const { return sector_ ? RayCasterKind::swept_sector : RayCasterKind::distance_field; }
 
  private:
   BeamModelParams params_;
