@@ -12,7 +12,16 @@ DeprecationWarning naming their new home, for one release (``kiseki._support.mov
 
 from __future__ import annotations
 
-from kiseki._support import moved
+import os
+
+# libgomp (the C++ core's OpenMP) reads OMP_WAIT_POLICY once, when the core is loaded, below.
+# Its default lets idle workers spin between parallel regions; on a robot whose cores other
+# processes keep busy, the spinning takes the time slices the work needs, and two threads ran
+# slower than one (benchmarks/bench_threads_under_load.py). Passive workers sleep instead. A
+# value set by the user (OMP_WAIT_POLICY=active, or empty for libgomp's default) is kept.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+from kiseki._support import moved  # noqa: E402  (after the policy: it loads the core)
 from kiseki.core import Pose2, Pose3, Random, derive_seed, library_versions, normalize_angle
 from kiseki.errors import KisekiError, LogFormatError, MapFormatError
 from kiseki.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
