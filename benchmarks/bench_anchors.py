@@ -93,6 +93,8 @@ LIBRARIES = tuple(name for name, _, _ in RUNS)
 
 def harness_input(scans, grid, alphas) -> HarnessInput:
     """The harnesses' input for one log slice, beam choice and odometry."""
+    if abs(grid.origin.theta) > 1e-12:
+        raise ValueError("the harnesses take maps without rotation")
     parameters = dict(
         z_hit=Z_HIT,
         z_rand=Z_RAND,

@@ -32,7 +32,7 @@ from amcl_inputs import (  # noqa: E402
     log_odometry,
     select_scans,
 )
-from bench_anchors import harness_input, kiseki_engine_seed  # noqa: E402
+from bench_anchors import harness_input, kiseki_engine_seed, main  # noqa: E402
 from kiseki.filters import LocalizeConfig, localize  # noqa: E402
 from kiseki.metrics import ape  # noqa: E402
 
@@ -130,3 +130,23 @@ def test_all_three_track_the_start_of_intel(harnesses, intel, tmp_path):
         estimates, _ = ah.run_harness(harnesses[name], path, tmp_path / "out.bin", PARTICLES, seed)
         assert estimates.shape == (SCANS, 3)
         assert ape(estimates, scans.poses).rmse < TRACKING_RMSE, name
+
+
+def test_kiseki_harness_gives_one_result_for_any_thread_count(harnesses, intel, tmp_path):
+    inputs, _, scans = intel
+    path = tmp_path / "input.bin"
+    ah.write_input(path, harness_input(scans, inputs.grid, inputs.alphas))
+    # 600 particles: kiseki splits its loops in chunks of at least 256, so two threads share them
+    runs = [
+        ah.run_harness(harnesses["kiseki_harness"], path, tmp_path / "out.bin", 600, 7, threads=t)[
+            0
+        ]
+        for t in (1, 2)
+    ]
+    np.testing.assert_array_equal(runs[0], runs[1])
+
+
+def test_bench_skips_without_the_anchors(tmp_path, capsys):
+    assert main(["--anchors", str(tmp_path), "--quick"]) == 0
+    out = capsys.readouterr().out.strip().splitlines()
+    assert len(out) == 1 and "skipped" in out[0]
