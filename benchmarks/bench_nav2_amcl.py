@@ -38,10 +38,25 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from kiseki.datasets import read_carmen_log
-from kiseki.filters import LOCALIZATION_METHODS, LocalizeConfig, motion_alphas, noisy_odometry
+from amcl_inputs import (  # beside this file
+    ALPHA5,
+    CHI_OUTLIER,
+    DATA,
+    INITIAL_SD,
+    LAMBDA_SHORT,
+    LOGS,
+    ODOMETRY_NOISE,
+    SIGMA_HIT,
+    Z_HIT,
+    Z_MAX,
+    Z_RAND,
+    Z_SHORT,
+    load_log,
+    log_odometry,
+    select_scans,
+)
+from kiseki.filters import LOCALIZATION_METHODS, LocalizeConfig
 from kiseki.grid import FREE, OCCUPIED
-from kiseki.mapping import MapBuildConfig, map_of_log
 from kiseki.metrics import ape
 
 try:
@@ -49,31 +64,8 @@ try:
 except ImportError:
     amcl = None
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
-LOGS = ("intel", "aces", "csail", "freiburg-079")
-
-# --- the settings both filters share ---------------------------------------------------------
-# Odometry: the corrected logs' odometry is their reference path, so both filters get the same
-# noisy odometry made from it (kiseki.filters.noisy_odometry: each increment component with
-# SD = F x |component|).
-ODOMETRY_NOISE = 0.1  # F
-# Motion noise: nav2's defaults are alpha1..alpha5 = 0.2 each, far more than the odometry above
-# has. Both filters get the alphas that describe it (kiseki.filters.motion_alphas: alpha1 =
-# alpha3 = F^2 = 0.01, alpha2 = alpha4 = F^2 / 10 = 0.001), in the same convention (Probabilistic
-# Robotics Table 5.6; nav2's "differential" model: alpha1 rotation from rotation, alpha2
-# rotation from translation, alpha3 translation from translation, alpha4 translation from
-# rotation). alpha5 is used only by nav2's "omni" model: 0.
-ALPHA5 = 0.0
-# Beam model mixture: nav2's defaults (z_hit 0.5, z_short 0.05, z_max 0.05, z_rand 0.5,
-# sigma_hit 0.2 m, lambda_short 0.1 1/m), given to both. A likelihood field in kiseki gets the
-# same z_hit, z_rand and sigma_hit (nav2's likelihood-field defaults are the same three values,
-# with laser_likelihood_max_dist 2.0 m, which the amcl package does not take).
-Z_HIT, Z_SHORT, Z_MAX, Z_RAND = 0.5, 0.05, 0.05, 0.5
-SIGMA_HIT = 0.2
-LAMBDA_SHORT = 0.1
-CHI_OUTLIER = 0.05  # nav2's default; its beam model does not use it
-# Initial cloud: a Gaussian around the log's first reference pose, SD 0.1 m, 0.1 m, 3 degrees.
-INITIAL_SD = (0.1, 0.1, float(np.radians(3.0)))
+# The settings both filters share (odometry noise, alphas, the mixture, the initial cloud) and
+# the log loading are in amcl_inputs.py, beside this file; those of this script alone follow.
 # Update gates: nav2's node updates only after update_min_d (0.25 m) / update_min_a (0.2 rad) of
 # travel; the amcl package has no gate (every update() call is a motion + sensor + resampling
 # step) and kiseki gets update_min_d = update_min_a = 0, so every scan is an update in both.
@@ -106,13 +98,6 @@ COLUMNS = (
     "ratio_1",
     "ratio_N",
 )
-
-
-def nav2_beam_indices(count: int, max_beams: int) -> np.ndarray:
-    """nav2's max_beams rule: every step-th beam from the first, step = (count - 1) //
-    (max_beams - 1) (at least 1). Both filters are given these beams only."""
-    step = max(1, (count - 1) // max(1, max_beams - 1))
-    return np.arange(0, count, step)
 
 
 def nav2_map(grid):
@@ -319,30 +304,18 @@ def main(argv: list[str] | None = None) -> int:
         f"({'not run' if localize is None else args.kiseki_model}); odometry noise "
         f"{ODOMETRY_NOISE}, seed {args.seed}, every scan an update, resampling every update"
     )
-    rows, logs, maps = [], {}, {}
+    rows, logs = [], {}
     for log, beams, particles, n in tqdm(runs, desc="runs", unit="run"):
         if log not in logs:
-            full = read_carmen_log(DATA / "carmen" / f"{log}-corrected.log.gz").scans
-            grid = map_of_log(full, MapBuildConfig(resolution=0.05))
-            alphas = motion_alphas(LocalizeConfig(odometry_noise=ODOMETRY_NOISE), full)
-            odom = noisy_odometry(full.odometry, ODOMETRY_NOISE, args.seed)
-            logs[log] = (full, alphas, odom)
-            maps[log] = (grid, nav2_map(grid))
-        full, alphas, odom = logs[log]
-        grid, grid_nav2 = maps[log]
-        m = len(full) if n is None else min(n, len(full))
-        idx = nav2_beam_indices(full.ranges.shape[1], beams)
-        scans = dataclasses.replace(
-            full,
-            times=full.times[:m],
-            poses=full.poses[:m],
-            odometry=odom[:m],
-            ranges=np.ascontiguousarray(full.ranges[:m, idx]),
-            angles=full.angles[idx],
-        )
-        label = f"{log} {len(idx)} beams {particles} particles"
+            inputs = load_log(log)
+            logs[log] = (inputs, log_odometry(inputs, args.seed), nav2_map(inputs.grid))
+        inputs, odom, grid_nav2 = logs[log]
+        grid, alphas = inputs.grid, inputs.alphas
+        scans = select_scans(inputs.scans, odom, beams, n)
+        m = len(scans)
+        label = f"{log} {len(scans.angles)} beams {particles} particles"
         est, sec = run_nav2(scans, grid_nav2, odom[:m], alphas, particles, args.seed, label)
-        row = dict(log=log, beams=len(idx), particles=particles, scans=m)
+        row = dict(log=log, beams=len(scans.angles), particles=particles, scans=m)
         row["nav2_rmse_m"], row["nav2_heading_deg"] = errors(est, scans.poses)
         row["nav2_ms"] = 1000 * float(np.mean(sec))
         for key, t in (("kiseki1", 1), ("kisekiN", threads)):
