@@ -25,39 +25,27 @@ import sys
 import time
 from pathlib import Path
 
-LOG = (
-    Path(__file__).resolve().parents[2]
-    / "shared"
-    / "data"
-    / "carmen"
-    / "freiburg-079-corrected.log.gz"
-)
 # workers that spin between parallel regions (as libgomp's default does for its first 300,000
 # spins; ACTIVE keeps spinning) and kiseki's default (PASSIVE, set when kiseki is imported)
 POLICIES = {"spinning": "ACTIVE", "kiseki": None}
+SCRIPT = Path(__file__).resolve()
 
-# One setting, in a fresh process (the policy is read when libgomp loads): median ms per update.
-_MEASURE = """
-import json, sys, time
-import numpy as np
-from kiseki.datasets import read_carmen_log
-from kiseki.filters import LocalizeConfig, MclConfig, MonteCarloLocalizer, scan_model
-from kiseki.mapping import MapBuildConfig, map_of_log
-log, particles, threads, n = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
-scans = read_carmen_log(log).scans
-grid = map_of_log(scans, MapBuildConfig(0.05))
-config = MclConfig(particles=particles, threads=threads, resample_threshold=1.0)
-loc = MonteCarloLocalizer(config, 0, grid)
-loc.initialize(scans.poses[0], (0.1, 0.1, 0.05))
-model = scan_model("likelihood-field", grid, LocalizeConfig(method="likelihood-field", beams=360))
-times = []
-for k in range(n + 3):
-    start = time.perf_counter()
-    model.set_scan(scans.angles, scans.ranges[k], scans.max_range)
-    loc.step(scans.poses[k], lambda: model)
-    times.append(time.perf_counter() - start)
-print(json.dumps(1000.0 * float(np.median(times[3:]))))
-"""
+
+def child(particles: int, threads: int, scans: int, forever: bool) -> None:
+    """In a fresh process (libgomp reads the policy when it loads): bench_mcl's update timing,
+    printed as one number; or, as a load, the same updates for ever."""
+    sys.path.insert(0, str(SCRIPT.parent))
+    from bench_mcl import LOG, time_updates
+    from kiseki.datasets import read_carmen_log
+    from kiseki.mapping import MapBuildConfig, map_of_log
+
+    log = read_carmen_log(LOG).scans
+    grid = map_of_log(log, MapBuildConfig(0.05))
+    while True:
+        ms = time_updates(log, grid, "likelihood-field", particles, 360, threads, scans)
+        if not forever:
+            print(json.dumps(ms))
+            return
 
 
 def _environment(policy: str) -> dict:
@@ -68,8 +56,13 @@ def _environment(policy: str) -> dict:
     return env
 
 
+def _child_args(particles: int, threads: int, scans: int, forever: bool = False) -> list[str]:
+    args = [sys.executable, str(SCRIPT), "--child", str(particles), str(threads), str(scans)]
+    return args + (["--forever"] if forever else [])
+
+
 def measure(policy: str, particles: int, threads: int, scans: int) -> float:
-    args = [sys.executable, "-c", _MEASURE, str(LOG), str(particles), str(threads), str(scans)]
+    args = _child_args(particles, threads, scans)
     done = subprocess.run(args, capture_output=True, text=True, env=_environment(policy))
     if done.returncode != 0:
         raise SystemExit(done.stderr.strip().splitlines()[-1])
@@ -79,13 +72,8 @@ def measure(policy: str, particles: int, threads: int, scans: int) -> float:
 def start_load(count: int, particles: int) -> list[subprocess.Popen]:
     """`count` processes each running the engine on two threads with spinning workers, in a
     loop: another OpenMP program whose workers spin between its parallel regions."""
-    loop = _MEASURE.replace("for k in range(n + 3):", "while True:\n  for k in range(n + 3):")
-    loop = loop.replace("\n    ", "\n      ").replace("print(json.dumps", "#")
-    procs = []
-    for _ in range(count):
-        args = [sys.executable, "-c", loop, str(LOG), str(particles), "2", "50"]
-        spinning = _environment("spinning")
-        procs.append(subprocess.Popen(args, env=spinning, stdout=subprocess.DEVNULL))
+    args, spinning = _child_args(particles, 2, 50, forever=True), _environment("spinning")
+    procs = [subprocess.Popen(args, env=spinning, stdout=subprocess.DEVNULL) for _ in range(count)]
     time.sleep(8.0)  # their maps are built and their loops running
     return procs
 
@@ -95,7 +83,16 @@ def main() -> None:
     parser.add_argument("--scans", type=int, default=15, help="updates timed per setting")
     parser.add_argument("--busy", type=int, default=2, help="loading processes")
     parser.add_argument("--particles", type=int, nargs="+", default=[1000, 10_000, 50_000])
+    # a process this script starts: --child PARTICLES THREADS SCANS [--forever]
+    parser.add_argument("--child", type=int, nargs=3, help=argparse.SUPPRESS)
+    parser.add_argument("--forever", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.child:
+        child(*args.child, args.forever)
+        return
+    sys.path.insert(0, str(SCRIPT.parent))
+    from bench_mcl import LOG
+
     if not LOG.is_file():
         print(f"the Freiburg-079 log is not at {LOG}: skipped")
         return
