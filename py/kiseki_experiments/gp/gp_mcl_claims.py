@@ -34,36 +34,44 @@ SWAPPED = Control(
     minutes=True,
 )
 
+
+def _bound(key: str, what: str, unit: str, threshold: float, stays: str, paper: str, top: float):
+    """A run's largest error of `what` along its route at most Fig. 6.16's `threshold`."""
+    return ClaimSpec(
+        key=key,
+        claim=f"the {what} error stays {stays} all along (Figs. 6.16, 6.18)",
+        unit=f"{unit}, largest error of a run",
+        criterion=Criterion(
+            paper_value=paper,
+            compare="<=",
+            threshold=threshold,
+            why="Fig. 6.16's bound",
+            bounds=(0.0, top),
+            paper_number=threshold,
+        ),
+        control=LAGGED,
+        measure=f"one run's largest {what} error along its route",
+    )
+
+
 CLAIMS = (
-    ClaimSpec(
-        key="position-bound",
-        claim="the position error stays below 0.8 m all along (Figs. 6.16, 6.18)",
-        unit="m, largest error of a run",
-        criterion=Criterion(
-            paper_value="< 0.8 (route b: equivalent to route a)",
-            compare="<=",
-            threshold=POSITION_BOUND,
-            why="Fig. 6.16's bound",
-            bounds=(0.0, np.inf),
-            paper_number=POSITION_BOUND,
-        ),
-        control=LAGGED,
-        measure="one run's largest position error along its route",
+    _bound(
+        "position-bound",
+        "position",
+        "m",
+        POSITION_BOUND,
+        "below 0.8 m",
+        "< 0.8 (route b: equivalent to route a)",
+        np.inf,
     ),
-    ClaimSpec(
-        key="heading-bound",
-        claim="the heading error stays within 0.14 rad all along (Figs. 6.16, 6.18)",
-        unit="rad, largest error of a run",
-        criterion=Criterion(
-            paper_value="<= 0.14 (route b: larger)",
-            compare="<=",
-            threshold=HEADING_BOUND,
-            why="Fig. 6.16's bound",
-            bounds=(0.0, np.pi),
-            paper_number=HEADING_BOUND,
-        ),
-        control=LAGGED,
-        measure="one run's largest heading error along its route",
+    _bound(
+        "heading-bound",
+        "heading",
+        "rad",
+        HEADING_BOUND,
+        "within 0.14 rad",
+        "<= 0.14 (route b: larger)",
+        np.pi,
     ),
     ClaimSpec(
         key="better-than-odometry",

@@ -19,56 +19,51 @@ NEAR_PARK = 5.0  # m around the changed bicycle park that still counts as "at th
 SHARE = (0.0, 1.0)
 DROP = (-1.0, 1.0)
 
-UNCHANGED = Control(
-    name="played back on the day it was taught",
-    overrides=("variant=teach",),
-    runs=5,
-    why="the bicycle park as taught: nothing at the park misleads the geometric navigator",
-    minutes=True,
+
+def _control(name: str, overrides: tuple[str, ...], why: str) -> Control:
+    """A control of five trials, each a teaching run and five playbacks of the 118 m route:
+    minutes, so the test suite runs it only when asked (KISEKI_TEST_HEAVY=1)."""
+    return Control(name=name, overrides=overrides, runs=5, why=why, minutes=True)
+
+
+UNCHANGED = _control(
+    "played back on the day it was taught",
+    ("variant=teach",),
+    "the bicycle park as taught: nothing at the park misleads the geometric navigator",
 )
-LENIENT_LEAVE = Control(
-    name="leaving counted from 0.5 m",
-    overrides=("leave_xte=0.5",),
-    runs=5,
-    why="the multi-navigator's runs reach 0.9-1.2 m from the path: with leaving counted from "
+LENIENT_LEAVE = _control(
+    "leaving counted from 0.5 m",
+    ("leave_xte=0.5",),
+    "the multi-navigator's runs reach 0.9-1.2 m from the path: with leaving counted from "
     "0.5 m none completes (a check that the completion criterion can fail, not a change of "
     "method)",
-    minutes=True,
 )
-ODOMETRY_ONLY = Control(
-    name="the multi-navigator system with the odometry navigator only",
-    overrides=("multi_navigators=odometry",),
-    runs=5,
-    why="with nothing to arbitrate the multi-navigator system is the odometry navigator, "
+ODOMETRY_ONLY = _control(
+    "the multi-navigator system with the odometry navigator only",
+    ("multi_navigators=odometry",),
+    "with nothing to arbitrate the multi-navigator system is the odometry navigator, "
     "farther from the path than the best single navigator",
-    minutes=True,
 )
-PLACEBO_STRETCHES = Control(
-    name="the landmark-free stretch and the park moved to stretches with landmarks",
-    overrides=(
+PLACEBO_STRETCHES = _control(
+    "the landmark-free stretch and the park moved to stretches with landmarks",
+    (
         "landmark_free_from=0",
         "landmark_free_to=18",
         "changed_from=111",
         "changed_to=117",
     ),
-    runs=5,
-    why="compared with stretches that have buildings beside them, the geometric navigators' "
+    "compared with stretches that have buildings beside them, the geometric navigators' "
     "validity shows no drop",
-    minutes=True,
 )
-PLACEBO_NODES = Control(
-    name="as many nodes as the disturbed ones, drawn at random, called disturbed",
-    overrides=("disturbed_placebo=true",),
-    runs=5,
-    why="nodes drawn at random are no more disturbed than the others: no drop",
-    minutes=True,
+PLACEBO_NODES = _control(
+    "as many nodes as the disturbed ones, drawn at random, called disturbed",
+    ("disturbed_placebo=true",),
+    "nodes drawn at random are no more disturbed than the others: no drop",
 )
-NARROW_GATE = Control(
-    name="the r_z gate's limit a tenth of the thesis' (0.0002 G)",
-    overrides=("gate_scale=0.1",),
-    runs=5,
-    why="a tenth of the sensor's 0.01 G noise passes about 2 % of the readings",
-    minutes=True,
+NARROW_GATE = _control(
+    "the r_z gate's limit a tenth of the thesis' (0.0002 G)",
+    ("gate_scale=0.1",),
+    "a tenth of the sensor's 0.01 G noise passes about 2 % of the readings",
 )
 
 CLAIMS = (
