@@ -41,12 +41,14 @@ from pathlib import Path
 
 from kiseki_experiments.gp import gp_aalto_tasks as work
 from kiseki_experiments.gp.gp_aalto_change import change_task
+from kiseki_experiments.gp.gp_aalto_claims import CLAIMS
 from kiseki_experiments.gp.gp_aalto_report import analyze
 from kiseki_experiments.harness.base import Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
     Count,
     FitPoints,
     Index,
+    Lag,
     NonNegativeReal,
     Particles,
     PositiveReal,
@@ -94,6 +96,9 @@ class GpAaltoConfig:
     map_resolution: Resolution = 0.05  # m, the MCL's field map
     odometry_scale_sd: NonNegativeReal = 0.02  # SD of the per-run distance scale error
     heading_walk: NonNegativeReal = 0.1  # rad per sqrt(m): SD of the odometry heading's random walk
+    # the MCL claims' control (gp_aalto_claims): each pose paired with the reading this many
+    # updates later along the run (circularly)
+    mcl_reading_lag: Lag = 0
     alphas: list[NonNegativeReal] = field(default_factory=lambda: [0.05, 0.1, 0.05, 0.01])
     # hand-held walks (3-D)
     walks: list[str] = field(default_factory=lambda: list(WALKS))
@@ -186,5 +191,6 @@ EXPERIMENT = Experiment(
     analyze=analyze,
     default_runs=5,
     preflight=preflight,
+    claims=CLAIMS,
     trial_count=lambda config: len(tasks(config)),
 )

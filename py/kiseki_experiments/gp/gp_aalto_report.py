@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The analysis of gp-aalto: tables, claims and notes from the five tasks' payloads (the
-pictures are drawn by :mod:`kiseki_experiments.gp.gp_aalto_figures`)."""
+"""The analysis of gp-aalto: tables, claims and notes from the five tasks' payloads (the MCL's
+claims are declared in :mod:`kiseki_experiments.gp.gp_aalto_claims`, the pictures drawn by
+:mod:`kiseki_experiments.gp.gp_aalto_figures`)."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from kiseki_experiments.gp.gp_aalto_claims import mcl_evidence
 from kiseki_experiments.gp.gp_aalto_figures import draw_all
 from kiseki_experiments.gp.gp_aalto_notes import (
     SOLIN_LENGTH_SCALE,
@@ -102,7 +104,7 @@ def _change_table(change: dict) -> pd.DataFrame:
     return table
 
 
-def _claims(config, maps, change, mcl) -> list[Claim]:
+def _claims(config, maps, change) -> list[Claim]:
     claims: list[Claim] = []
     ref = maps.get("invensense") or next(iter(maps.values()), None)
     if ref is not None:
@@ -153,37 +155,6 @@ def _claims(config, maps, change, mcl) -> list[Claim]:
                     "RMSE within 2 % per component",
                 )
             )
-    if mcl is not None:
-        rows = pd.DataFrame(mcl["rows"])
-        claims += [
-            Claim(
-                f"magnetic-map MCL on run {config.test_run}: position error < 0.8 m",
-                "< 0.8 m",
-                f"max {rows['mcl_max'].max():.3f} m, mean {rows['mcl_mean'].mean():.3f} m "
-                f"over {len(rows)} odometry seeds",
-                "m",
-                bool(rows["mcl_max"].max() < 0.8),
-                "one sensor (the thesis: three), 0.1 m between updates",
-            ),
-            Claim(
-                "... and better than odometry alone",
-                "beats odometry (Figs. 6.15-6.18)",
-                f"mean {rows['mcl_mean'].mean():.3f} vs {rows['odometry_mean'].mean():.3f} m "
-                f"(worse in {int((rows['mcl_mean'] >= rows['odometry_mean']).sum())} of "
-                f"{len(rows)} seeds)",
-                "m",
-                bool((rows["mcl_mean"] < rows["odometry_mean"]).all()),
-            ),
-            Claim(
-                "... heading error",
-                "<= 0.14 rad",
-                f"mean {rows['heading_mean'].mean():.3f} rad (largest seed "
-                f"{rows['heading_mean'].max():.3f}), max {rows['heading_max'].max():.3f} rad",
-                "rad",
-                bool(rows["heading_mean"].max() <= 0.14),
-                "mean over the run per seed; truth: direction of travel over 0.1 m",
-            ),
-        ]
     if change is not None:
         for r in change["rows"]:
             if r["role"] == "static, held out":
@@ -249,9 +220,10 @@ def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) 
         tables["mcl"] = pd.DataFrame(mcl["rows"])[cols]
     if walks is not None:
         tables["walks_3d"] = _walks_table(walks)
-    claims = _claims(config, maps, change, mcl)
+    claims = _claims(config, maps, change)
     paths = draw_all(config, maps, change, mcl, walks, figures)
-    return Analysis(tables, paths, claims, notes(config, maps, change, mcl, walks))
+    text = notes(config, maps, change, mcl, walks)
+    return Analysis(tables, paths, claims, text, evidence=mcl_evidence(mcl))
 
 
 def _walks_table(walks: dict) -> pd.DataFrame:

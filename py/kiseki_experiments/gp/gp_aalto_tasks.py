@@ -197,6 +197,7 @@ def mcl_task(config, folder: Path, sensor: str, seed: int, timings: dict) -> dic
     keep = travel_subsample(test.positions, config.mcl_step)
     xy = test.positions[keep]
     readings = sm.corrected(config.test_run, test)[keep][:, None, :]
+    readings = np.roll(readings, -config.mcl_reading_lag, axis=0)
     d = np.diff(xy, axis=0)
     heading = np.arctan2(d[:, 1], d[:, 0])  # of the step that arrives at each update
     truth = np.column_stack([xy, np.concatenate([heading[:1], heading])])

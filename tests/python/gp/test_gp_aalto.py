@@ -143,6 +143,12 @@ def test_change_detection_and_mcl(small_run) -> None:
     hilbert = claims[claims["claim"].str.startswith("the reduced-rank GP equals")]
     # not yet migrated to the verdict form: the point verdict is in the note
     assert hilbert["note"].item().startswith("point verdict without an interval: holds")
+    # the MCL's declared claims: one value per odometry seed (2 here: too few to decide)
+    declared = claims[claims["claim"].str.startswith("magnetic-map MCL on the held-out run")]
+    assert len(declared) == 3 and (declared["trials"] == 2).all()
+    assert set(declared["verdict"]) == {"inconclusive"}
+    worst = declared[declared["claim"].str.contains("below 0.8 m")]["measured_value"].item()
+    assert float(str(worst).split()[0]) == pytest.approx(mcl["mcl_max"].mean(), rel=1e-3)
 
 
 def test_walks_3d_and_figures(small_run) -> None:
