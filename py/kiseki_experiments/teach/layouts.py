@@ -8,11 +8,10 @@ leg's wall. Trial i runs both experiments on layout i (kiseki.sim.layouts.genera
 the trial's seed): ``runs_per_layout`` runs, each one call of exp2-turn's trial (teaching, then
 playback with the four methods) and one of exp3-boxes' trial (the same seed, so the same
 teaching; proposal 2 with three unknown boxes, and the same run without them). exp2-turn's
-claims are judged on the runs of all layouts together (exp2-turn's own evidence, paired per
-run); per layout, exp2-turn's and exp3-boxes' own analyses give each claim's point value and
-whether it meets the criterion, the share of layouts where it does (95 % Wilson interval; the
-claims of exp3-boxes, not yet migrated, are these shares) and the maps of the layouts where it
-does not. Every simulation parameter
+and exp3-boxes' claims are judged on the runs of all layouts together (their own evidence, one
+value per run); per layout, their own analyses give each claim's point value and whether it
+meets the criterion, the share of layouts where it does (95 % Wilson interval: a table row,
+not a verdict) and the maps of the layouts where it does not. Every simulation parameter
 (noise, particles, motion model) is the same for every method and every layout.
 
     kiseki experiment run layouts-exp2-exp3 --workers 2      # 20 layouts x 2 runs, ~42 CPU-min

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pandas as pd
 
 from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion, Evidence
@@ -240,7 +241,11 @@ def exp3_evidence(ok: pd.DataFrame, methods) -> list[Evidence]:
     if "proposal2" in methods and "proposal2_stop_error" in ok:
         for key, column in (("boxes_stop", "stop_error"), ("boxes_estimate", "estimate_error")):
             v = ok[f"proposal2_{column}"]
-            evidence.append(Evidence.of(key, v, shown=f"SD {v.std(ddof=1):.3f} m"))
+            kept = v[np.isfinite(v)]  # a refused route (layouts-exp2-exp3) never stopped: inf
+            shown = f"SD {kept.std(ddof=1):.3f} m" + (
+                f", {len(v) - len(kept)} run(s) refused" if len(kept) < len(v) else ""
+            )
+            evidence.append(Evidence.of(key, v, shown=shown))
     m = list(methods)[0]
     if f"{m}_ray_stop_error" in ok:
         thesis, ray = ok[f"{m}_stop_error"], ok[f"{m}_ray_stop_error"]
