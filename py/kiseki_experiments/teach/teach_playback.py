@@ -22,29 +22,30 @@ from __future__ import annotations
 
 import math
 import tempfile
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import yaml
-from matplotlib.patches import Circle
 
-from kiseki._support.inputs import YAML_LIMIT, read_input_text
-from kiseki._support.yaml import safe_load_12
 from kiseki.apps.teach import PlaybackConfig, playback, teach
-from kiseki.core import Random, derive_seed
+from kiseki.core import derive_seed
 from kiseki.io.ros_map import load_map
-from kiseki.models import SpaceObservationModel
-from kiseki.plots import new_figure
 from kiseki.sim.scene import load_scene
-from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import MERGE_RULES
-from kiseki.teach.local_maps import METHODS, LocalMapMaker
+from kiseki.teach.local_maps import METHODS
 from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
-from kiseki_experiments.harness.config import Boxes, Count, Factor, Particles
-from kiseki_experiments.harness.paths import WORLDS
 from kiseki_experiments.harness.verdict import Evidence
+from kiseki_experiments.teach.teach_boxes import (  # noqa: F401 (tp.BOX_*)
+    BOX_OFFSET_M,
+    BOX_SIZE_M,
+    boxes_beside_final_leg,
+    with_boxes,
+)
+from kiseki_experiments.teach.teach_goal_profile import (  # noqa: F401 (tp.PROFILE_OFFSETS)
+    PROFILE_OFFSETS,
+    goal_profile,
+)
+from kiseki_experiments.teach.teach_goal_profile import profile_figure as _profile_figure
 from kiseki_experiments.teach.teach_playback_claims import (  # noqa: F401 (tp.X for the tests)
     ALL_CONVENTIONAL,
     EXP1_CLAIMS,
@@ -59,69 +60,21 @@ from kiseki_experiments.teach.teach_playback_claims import (  # noqa: F401 (tp.X
     exp2_evidence,
     exp3_evidence,
 )
+from kiseki_experiments.teach.teach_playback_config import (  # noqa: F401 (tp.X)
+    RAY_MODEL,
+    Exp1Config,
+    Exp2Config,
+    Exp3Config,
+    stand_ins,
+)
 from kiseki_experiments.teach.teach_playback_tables import (  # noqa: F401 (tp.TAUGHT_SHARES)
     TAUGHT_SHARES,
     _diagnosis,
     _diagnostics,
+    _stop_figure,
     _stop_table,
     _taught_table,
 )
-
-
-@dataclass(frozen=True)
-class Exp1Config:
-    scene: str = str(WORLDS / "factory_corridor.yaml")
-    methods: list[str] = field(default_factory=lambda: ["proposal2"])
-    particles: Particles = 1000
-    boxes: Boxes = 0  # unknown boxes placed at random for playback (Exp. 3)
-    merge: str = "thesis"  # the taught maps' merge rule: thesis or evidence
-    # negative controls: "proposal2=conventional" plays the method named proposal2 with
-    # conventional's local map and expected map (its records keep the name); "" = none
-    plays: str = ""
-
-
-@dataclass(frozen=True)
-class Exp2Config:
-    scene: str = str(WORLDS / "factory_turn.yaml")
-    methods: list[str] = field(
-        default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
-    )
-    particles: Particles = 1000
-    boxes: Boxes = 0
-    merge: str = "thesis"
-    plays: str = ""  # negative controls, as in Exp1Config
-
-
-@dataclass(frozen=True)
-class Exp3Config:
-    scene: str = str(WORLDS / "factory_turn.yaml")
-    methods: list[str] = field(default_factory=lambda: ["proposal2"])
-    particles: Particles = 1000
-    boxes: Boxes = 3
-    merge: str = "thesis"
-    plays: str = ""  # negative controls, as in Exp1Config
-    # also play each method with kiseki's ray space observation model (PlaybackConfig.model)
-    # on the same teaching, boxes and seeds, reading L as a scan of ray_beams rays
-    ray: bool = False
-    ray_beams: Count = PlaybackConfig.scan_beams
-    # the ray model's readings times this (1: as read; the control's miscalibrated range)
-    ray_range_scale: Factor = PlaybackConfig.scan_range_scale
-
-
-RAY_MODEL = "ray-space-observation"
-
-
-def stand_ins(config) -> dict[str, str]:
-    """The config's `plays`: method name -> the method played under that name."""
-    out = {}
-    for item in filter(None, (p.strip() for p in getattr(config, "plays", "").split(","))):
-        name, _, played = (v.strip() for v in item.partition("="))
-        if name not in METHODS or played not in METHODS:
-            raise ValueError(
-                f"plays: expected method=method pairs of {', '.join(METHODS)}, got {item!r}"
-            )
-        out[name] = played
-    return out
 
 
 def _errors(result, goal: dict) -> dict:
@@ -135,104 +88,6 @@ def _errors(result, goal: dict) -> dict:
         "estimate_error": math.hypot(ex - tx, ey - ty),
         "reached": bool(result.reached),
     }
-
-
-BOX_SIZE_M = (0.4, 0.4, 0.6)  # Exp. 3's unknown boxes (the thesis' cardboard boxes)
-BOX_OFFSET_M = (0.8, 1.1)  # their centres' distance beside the route
-
-
-def _with_boxes(scene_file: Path, count: int, seed: int, tmp: Path) -> Path:
-    """A copy of the scene with `count` unknown BOX_SIZE_M boxes, playback only, placed at
-    random BOX_OFFSET_M beside the route (kept 0.6 m clear of it so the robot can pass)."""
-    doc = safe_load_12(read_input_text(scene_file, "scene files", YAML_LIMIT))
-    rng = Random(seed)
-    pts = np.asarray(doc["route"]["waypoints"], dtype=float)
-    placed = 0
-    while placed < count:
-        i = int(rng.below(len(pts) - 1))
-        f = rng.uniform(0.15, 0.85, 1)[0]
-        side = 1 if rng.uniform(0, 1, 1)[0] < 0.5 else -1
-        a, b = pts[i], pts[i + 1]
-        normal = np.array([-(b - a)[1], (b - a)[0]]) / np.linalg.norm(b - a)
-        c = a + f * (b - a) + side * rng.uniform(*BOX_OFFSET_M, 1)[0] * normal
-        doc["objects"].append(
-            {
-                "type": "box",
-                "center": [float(c[0]), float(c[1])],
-                "size": list(BOX_SIZE_M),
-                "only_in": "playback",
-            }
-        )
-        placed += 1
-    out = tmp / scene_file.name
-    out.write_text(yaml.safe_dump(doc), encoding="utf-8")
-    return out
-
-
-PROFILE_OFFSETS = np.round(np.arange(-0.4, 0.401, 0.05), 2)
-
-
-def _goal_profile(scene, environment, goal: dict, method: str) -> dict:
-    """The method's one-step likelihood around the true goal pose (the taught mark, map frame)
-    with a noise-free local map taken there: along the goal heading (sideways offset 0) and
-    sideways (along offset 0), normalised to the peak of the whole along x sideways grid, and
-    where that peak is. A model without bias peaks at offset 0."""
-    band, occlusion = METHODS[method]
-    setup = build_robot(scene, 0)
-    cameras = [s.device for s in build_sensors(scene, setup, 0, 0.1) if s.kind == "depth_camera"]
-    model = SpaceObservationModel(environment, occlusion_aware=occlusion)
-    truth = tuple(goal["truth"])
-    images = [c.render(scene.world, truth, noise=False) for c in cameras]
-    model.set_local_map(LocalMapMaker(cameras, band).make(images))
-    x, y, th = goal["x"], goal["y"], goal["theta"]
-    c, s = math.cos(th), math.sin(th)
-    fine = np.arange(-0.4, 0.401, 0.01)
-    a, b = (v.ravel() for v in np.meshgrid(fine, fine, indexing="ij"))
-    poses = np.column_stack([x + c * a - s * b, y + s * a + c * b, np.full(a.size, th)])
-    like = model.likelihoods(poses)
-    peak = like.max()
-    out = {"goal_peak_along": float(a[like.argmax()]), "goal_peak_side": float(b[like.argmax()])}
-    grid = like.reshape(len(fine), len(fine)) / peak
-    idx = np.round((PROFILE_OFFSETS + 0.4) / 0.01).astype(int)
-    mid = len(fine) // 2
-    for off, i in zip(PROFILE_OFFSETS, idx, strict=True):
-        out[f"goal_like_along_{off:+.2f}"] = float(grid[i, mid])
-        out[f"goal_like_side_{off:+.2f}"] = float(grid[mid, i])
-    return out
-
-
-def _profile_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
-    fig = new_figure(figsize=(9, 3.5), dpi=120)
-    axes = fig.subplots(1, 2, sharey=True)
-    for ax, axis in zip(axes, ("along", "side"), strict=True):
-        for method in config.methods:
-            cols = [f"{method}_goal_like_{axis}_{o:+.2f}" for o in PROFILE_OFFSETS]
-            ax.plot(PROFILE_OFFSETS, trials[cols].mean().to_numpy(), "o-", ms=3, label=method)
-        ax.axvline(0.0, color="grey", lw=0.8)
-        ax.set_xlabel(f"{'along-track' if axis == 'along' else 'sideways (left +)'} offset (m)")
-    axes[0].set_ylabel("one-step likelihood / peak")
-    axes[0].legend(fontsize=7)
-    fig.suptitle("around the true goal pose: taught map, noise-free local map", fontsize=9)
-    path = figures / "goal_likelihood_profiles.png"
-    fig.savefig(path, bbox_inches="tight")
-    return path
-
-
-def _boxes_beside_final_leg(scene_file: Path) -> dict:
-    """How many of the playback-only boxes stand beside the route's final leg, left and right
-    (the cameras see them on the way to the goal)."""
-    doc = safe_load_12(read_input_text(scene_file, "scene files", YAML_LIMIT))
-    a, b = (np.asarray(p, dtype=float) for p in doc["route"]["waypoints"][-2:])
-    along = (b - a) / np.linalg.norm(b - a)
-    left = right = 0
-    for o in doc["objects"]:
-        if o.get("only_in") != "playback":
-            continue
-        d = np.asarray(o["center"], dtype=float) - a
-        if 0.0 <= d @ along <= np.linalg.norm(b - a):
-            side = along[0] * d[1] - along[1] * d[0]
-            left, right = left + int(side > 0), right + int(side < 0)
-    return {"final_leg_boxes_left": left, "final_leg_boxes_right": right}
 
 
 def teach_route(config: Exp1Config, seed: int, folder: Path):
@@ -257,8 +112,8 @@ def trial(config: Exp1Config, index: int, seed: int, taught=None) -> TrialOutput
                 record[f"taught_{band}_{key}"] = t[key]
         play_file = scene_file
         if config.boxes:
-            play_file = _with_boxes(scene_file, config.boxes, derive_seed(seed, 3), Path(tmp))
-            record.update(_boxes_beside_final_leg(play_file))
+            play_file = with_boxes(scene_file, config.boxes, derive_seed(seed, 3), Path(tmp))
+            record.update(boxes_beside_final_leg(play_file))
         scene = load_scene(play_file, "playback")
         maps = {band: load_map(path) for band, path in taught.maps.items()}
         goal = taught.marks[-1]
@@ -310,7 +165,7 @@ def _play(
     out = dict(_errors(result, goal))
     if model == RAY_MODEL:
         return identity, out
-    out.update(_goal_profile(scene, maps[band], goal, method))
+    out.update(goal_profile(scene, maps[band], goal, method))
     if config.boxes:  # the control: the same run without the boxes
         plain = load_scene(Path(config.scene), "playback")
         control = playback(plain, maps[band], taught.marks, play, taught_scene=taught.scene)
@@ -326,22 +181,6 @@ def _play(
         out[f"{name}_odo_dx"] = o[0] - t[0]
         out[f"{name}_odo_dy"] = o[1] - t[1]
     return identity, out
-
-
-def _stop_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
-    fig = new_figure(figsize=(5, 5), dpi=120)
-    ax = fig.subplots()
-    for method in config.methods:
-        ax.plot(trials[f"{method}_stop_dx"], trials[f"{method}_stop_dy"], "o", label=method)
-    circle = Circle((0, 0), 0.1, fill=False, linestyle="--", color="grey")
-    ax.add_patch(circle)
-    ax.set_aspect("equal")
-    ax.set_xlabel("stop error x (m)")
-    ax.set_ylabel("stop error y (m)")
-    ax.legend(fontsize=8)
-    path = figures / "stop_positions.png"
-    fig.savefig(path, bbox_inches="tight")
-    return path
 
 
 def analyze_exp1(config, trials, timings, figures) -> Analysis:

@@ -1,17 +1,20 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The teaching experiments' tables (stops, taught maps, likelihood diagnostics) and the
-diagnosis prose of their reports, every number from the run's trials (exp1-corridor,
-exp2-turn, exp3-boxes: kiseki_experiments.teach.teach_playback)."""
+"""The teaching experiments' tables (stops, taught maps, likelihood diagnostics), the figure
+of the stops and the diagnosis prose of their reports, every number from the run's trials
+(exp1-corridor, exp2-turn, exp3-boxes: kiseki_experiments.teach.teach_playback)."""
 
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from matplotlib.patches import Circle
 
 from kiseki.metrics import wilson_interval
+from kiseki.plots import new_figure
 from kiseki_experiments.teach.teach_playback_claims import STOP_TOLERANCE_M, THESIS_TABLE_4_5
 
 __all__ = ["TAUGHT_SHARES"]
@@ -173,3 +176,19 @@ def _turn_route_causes(d: pd.DataFrame, ok: pd.DataFrame) -> str:
             f"{float(ok[odo].abs().to_numpy().max()):.3f} m off sideways at a waypoint."
         )
     return " ".join(text)
+
+
+def _stop_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
+    fig = new_figure(figsize=(5, 5), dpi=120)
+    ax = fig.subplots()
+    for method in config.methods:
+        ax.plot(trials[f"{method}_stop_dx"], trials[f"{method}_stop_dy"], "o", label=method)
+    circle = Circle((0, 0), 0.1, fill=False, linestyle="--", color="grey")
+    ax.add_patch(circle)
+    ax.set_aspect("equal")
+    ax.set_xlabel("stop error x (m)")
+    ax.set_ylabel("stop error y (m)")
+    ax.legend(fontsize=8)
+    path = figures / "stop_positions.png"
+    fig.savefig(path, bbox_inches="tight")
+    return path
