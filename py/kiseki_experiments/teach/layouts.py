@@ -8,11 +8,10 @@ leg's wall. Trial i runs both experiments on layout i (kiseki.sim.layouts.genera
 the trial's seed): ``runs_per_layout`` runs, each one call of exp2-turn's trial (teaching, then
 playback with the four methods) and one of exp3-boxes' trial (the same seed, so the same
 teaching; proposal 2 with three unknown boxes, and the same run without them). exp2-turn's
-claims are judged on the runs of all layouts together (exp2-turn's own evidence, paired per
-run); per layout, exp2-turn's and exp3-boxes' own analyses give each claim's point value and
-whether it meets the criterion, the share of layouts where it does (95 % Wilson interval; the
-claims of exp3-boxes, not yet migrated, are these shares) and the maps of the layouts where it
-does not. Every simulation parameter
+and exp3-boxes' claims are judged on the runs of all layouts together (their own evidence, one
+value per run); per layout, their own analyses give each claim's point value and whether it
+meets the criterion, the share of layouts where it does (95 % Wilson interval: a table row,
+not a verdict) and the maps of the layouts where it does not. Every simulation parameter
 (noise, particles, motion model) is the same for every method and every layout.
 
     kiseki experiment run layouts-exp2-exp3 --workers 2      # 20 layouts x 2 runs, ~42 CPU-min
@@ -41,7 +40,7 @@ from kiseki.sim.layouts import generate_layout, write_layout
 from kiseki.sim.scene import load_scene
 from kiseki.teach.environment_map import MERGE_RULES
 from kiseki.teach.local_maps import METHODS
-from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
+from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import Boxes, Particles, Runs
 from kiseki_experiments.harness.verdict import Evidence
 from kiseki_experiments.teach import teach_playback as tp
@@ -187,7 +186,7 @@ def _layout_claims(config: LayoutsConfig, ok: pd.DataFrame, scratch: Path) -> pd
     (exp2-turn's and exp3-boxes' own analyses on the layout's runs). A claim that names a
     method whose playback refused the route in some run does not hold there."""
     analyses = {"exp2": tp.analyze_exp2, "exp3": tp.analyze_exp3}
-    found: dict[tuple[int, str], list[Claim]] = {}
+    found: dict[tuple[int, str], list[Point]] = {}
     refusals: dict[tuple[int, str], list[str]] = {}
     for _, row in ok.iterrows():
         for name, cfg in _configs(config, Path("layout.yaml")).items():
@@ -196,7 +195,7 @@ def _layout_claims(config: LayoutsConfig, ok: pd.DataFrame, scratch: Path) -> pd
             refusals[key] = _refused(frame)
             if any(c.endswith("_stop_error") and np.isfinite(frame[c]).any() for c in frame):
                 analysis = analyses[name](cfg, frame, pd.DataFrame(), scratch)
-                found[key] = analysis.claims + [_point(e) for e in analysis.evidence]
+                found[key] = [_point(e) for e in analysis.evidence]
     templates = {name: claims for (_, name), claims in found.items()}
     rows = []
     for _, row in ok.iterrows():
@@ -222,15 +221,27 @@ def _layout_claims(config: LayoutsConfig, ok: pd.DataFrame, scratch: Path) -> pd
     return pd.DataFrame(rows)
 
 
-def _point(evidence: Evidence) -> Claim:
-    """One layout's value of an exp2-turn claim (the mean of its few runs' paired values) and
-    whether that value meets the claim's criterion: a point verdict, for the per-layout
-    table; the claim itself is judged on all layouts' runs (`_pooled`)."""
-    spec = next(s for s in tp.EXP2_CLAIMS if s.key == evidence.key)
+@dataclass(frozen=True)
+class Point:
+    """One layout's value of a claim and whether it meets the criterion (no interval: a row of
+    the per-layout table, never a verdict)."""
+
+    claim: str
+    paper_value: str
+    measured_value: str
+    unit: str
+    holds: bool
+
+
+def _point(evidence: Evidence) -> Point:
+    """One layout's value of an exp2-turn or exp3-boxes claim (the mean of its few runs'
+    values) and whether that value meets the claim's criterion: a point verdict, for the
+    per-layout table; the claim itself is judged on all layouts' runs (`_pooled`)."""
+    spec = next(s for s in (*tp.EXP2_CLAIMS, *tp.EXP3_CLAIMS) if s.key == evidence.key)
     values = np.asarray(evidence.values, dtype=float)
     value = float(values[np.isfinite(values)].mean()) if np.isfinite(values).any() else np.nan
     low, high = spec.criterion.band()
-    return Claim(
+    return Point(
         spec.claim,
         spec.criterion.paper_value,
         f"{value:.3f} ({evidence.shown})",
@@ -240,18 +251,20 @@ def _point(evidence: Evidence) -> Claim:
 
 
 def _pooled(config: LayoutsConfig, ok: pd.DataFrame, scratch: Path) -> list[Evidence]:
-    """exp2-turn's evidence over every run of every layout (a run: a random layout and its
-    seeds), one Evidence per exp2-turn claim."""
+    """exp2-turn's and exp3-boxes' evidence over every run of every layout (a run: a random
+    layout and its seeds), one Evidence per claim. A run whose route playback refused counts
+    with an infinite stop error (exp3-boxes' claims: the robot never stopped at the goal)."""
     values: dict[str, list[float]] = {}
     layouts: dict[str, int] = {}
-    cfg = _configs(config, Path("layout.yaml"))["exp2"]
-    for _, row in ok.iterrows():
-        frame = _runs(row, "exp2", config.runs_per_layout)
-        if not any(c.endswith("_stop_error") and np.isfinite(frame[c]).any() for c in frame):
-            continue  # every method refused the route in every run: no stop to compare
-        for e in tp.analyze_exp2(cfg, frame, pd.DataFrame(), scratch).evidence:
-            values.setdefault(e.key, []).extend(e.values)
-            layouts[e.key] = layouts.get(e.key, 0) + 1
+    analyses = {"exp2": tp.analyze_exp2, "exp3": tp.analyze_exp3}
+    for name, cfg in _configs(config, Path("layout.yaml")).items():
+        for _, row in ok.iterrows():
+            frame = _runs(row, name, config.runs_per_layout)
+            if not any(c.endswith("_stop_error") and np.isfinite(frame[c]).any() for c in frame):
+                continue  # every method refused the route in every run: no stop to compare
+            for e in analyses[name](cfg, frame, pd.DataFrame(), scratch).evidence:
+                values.setdefault(e.key, []).extend(e.values)
+                layouts[e.key] = layouts.get(e.key, 0) + 1
     return [
         Evidence.of(key, v, shown=f"{layouts[key]} layouts x {config.runs_per_layout} run(s)")
         for key, v in values.items()
@@ -275,6 +288,7 @@ def _shares(per: pd.DataFrame) -> pd.DataFrame:
                 "ci95_low": lo,
                 "ci95_high": hi,
                 "fails_in_layouts": fails,
+                "generalises": _verdict(lo, hi),
             }
         )
     return pd.DataFrame(rows)
@@ -403,19 +417,6 @@ def analyze(config: LayoutsConfig, trials, timings, figures: Path) -> Analysis:
             figs.append(_draw_layouts(pictures, sorted(measured), title, path, measured))
     with tempfile.TemporaryDirectory() as scratch:
         evidence = _pooled(config, ok, Path(scratch))
-    claims = [  # exp3-boxes' claims are still point claims (not yet migrated)
-        Claim(
-            f"{s['experiment']}: {s['claim']} (holds in >= {GENERAL:.0%} of layouts)",
-            f"{s['paper_value']} (thesis' factory)",
-            f"{s['layouts_holding']}/{s['layouts']} layouts ({s['share']:.0%}, "
-            f"95 % CI {s['ci95_low']:.0%}-{s['ci95_high']:.0%})",
-            "layouts",
-            bool(s["share"] >= GENERAL),
-            _verdict(s["ci95_low"], s["ci95_high"]),
-        )
-        for _, s in shares.iterrows()
-        if s["experiment"] == "exp3"
-    ]
     return Analysis(
         tables={
             "claim_shares": shares,
@@ -426,7 +427,6 @@ def analyze(config: LayoutsConfig, trials, timings, figures: Path) -> Analysis:
             "refusals": _refusals(ok),
         },
         figures=figs,
-        claims=claims,
         notes=_notes(config, len(ok), len(trials)),
         evidence=evidence,
     )
@@ -448,6 +448,22 @@ CLAIMS = tuple(
         ),
     )
     for spec in tp.EXP2_CLAIMS
+) + tuple(
+    # exp3-boxes' claims on proposal 2 with the boxes, judged on the runs of all layouts
+    # together (a refused route counts as never stopping at the goal); their control is
+    # exp3-boxes' own (one particle: dead reckoning) on 6 layouts, one run each
+    replace(
+        spec,
+        claim=f"exp3: {spec.claim} (all layouts' runs)",
+        control=replace(
+            spec.control,
+            overrides=(*spec.control.overrides, "runs_per_layout=1"),
+            runs=6,
+            minutes=True,
+        ),
+    )
+    for spec in tp.EXP3_CLAIMS
+    if spec.key.startswith("boxes_")
 )
 
 
@@ -470,14 +486,14 @@ def _notes(config: LayoutsConfig, ok: int, total: int) -> str:
         f"trial ({config.boxes} unknown boxes, proposal 2, and the control without them), "
         f"{config.particles} particles, merge rule {config.merge!r}; a layout's claims are "
         "exp2-turn's and exp3-boxes' own analyses applied to its runs. exp2-turn's claims "
-        "(paired differences between methods) are judged on the runs of all layouts together "
+        "(paired differences between methods) and exp3-boxes' (proposal 2's stop and "
+        "estimate errors with the boxes) are judged on the runs of all layouts together "
         "(claims.csv); per layout, table `claims_per_layout` gives the mean of its "
         f"{n} run(s) and whether that point value meets the criterion (the thesis ran "
-        f"{tp.THESIS_RUNS}; {n} run(s) per layout decide no interval). exp3-boxes' claims are "
-        "still point claims (not yet migrated), counted per layout: such a claim generalises "
-        "when it "
-        f"holds in >= {GENERAL:.0%} of layouts; the note of each claim says whether the 95 % "
-        "Wilson interval lies above that (general), below it (layout-specific) or across it. "
+        f"{tp.THESIS_RUNS}; {n} run(s) per layout decide no interval). Table `claim_shares` "
+        "counts the layouts whose point value meets each criterion (a table row, not a "
+        f"verdict): column `generalises` says whether the share's 95 % Wilson interval lies "
+        f"above {GENERAL:.0%} of layouts (general), below it (layout-specific) or across it. "
         "Table `by_behind` splits the shares by what lies behind the final leg's boundary "
         "lines; figures `fails_*.png` draw the layouts where a claim fails (ground truth "
         f"{LOW_BAND_M[0]:g}-{HIGH_BAND_M[1]:g} m, route P0 -> T1 -> T2 -> G)."

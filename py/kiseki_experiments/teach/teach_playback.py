@@ -22,86 +22,59 @@ from __future__ import annotations
 
 import math
 import tempfile
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import yaml
-from matplotlib.patches import Circle
 
-from kiseki._support.inputs import YAML_LIMIT, read_input_text
-from kiseki._support.yaml import safe_load_12
 from kiseki.apps.teach import PlaybackConfig, playback, teach
-from kiseki.core import Random, derive_seed
+from kiseki.core import derive_seed
 from kiseki.io.ros_map import load_map
-from kiseki.metrics import wilson_interval
-from kiseki.models import SpaceObservationModel
-from kiseki.plots import new_figure
 from kiseki.sim.scene import load_scene
-from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import MERGE_RULES
-from kiseki.teach.local_maps import METHODS, LocalMapMaker
-from kiseki_experiments.harness.base import Analysis, Claim, Experiment, TrialOutput
-from kiseki_experiments.harness.config import Boxes, Count, Factor, Particles
-from kiseki_experiments.harness.paths import WORLDS
-from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion, Evidence
-
-
-@dataclass(frozen=True)
-class Exp1Config:
-    scene: str = str(WORLDS / "factory_corridor.yaml")
-    methods: list[str] = field(default_factory=lambda: ["proposal2"])
-    particles: Particles = 1000
-    boxes: Boxes = 0  # unknown boxes placed at random for playback (Exp. 3)
-    merge: str = "thesis"  # the taught maps' merge rule: thesis or evidence
-    # negative controls: "proposal2=conventional" plays the method named proposal2 with
-    # conventional's local map and expected map (its records keep the name); "" = none
-    plays: str = ""
-
-
-@dataclass(frozen=True)
-class Exp2Config:
-    scene: str = str(WORLDS / "factory_turn.yaml")
-    methods: list[str] = field(
-        default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
-    )
-    particles: Particles = 1000
-    boxes: Boxes = 0
-    merge: str = "thesis"
-    plays: str = ""  # negative controls, as in Exp1Config
-
-
-@dataclass(frozen=True)
-class Exp3Config:
-    scene: str = str(WORLDS / "factory_turn.yaml")
-    methods: list[str] = field(default_factory=lambda: ["proposal2"])
-    particles: Particles = 1000
-    boxes: Boxes = 3
-    merge: str = "thesis"
-    plays: str = ""  # negative controls, as in Exp1Config
-    # also play each method with kiseki's ray space observation model (PlaybackConfig.model)
-    # on the same teaching, boxes and seeds, reading L as a scan of ray_beams rays
-    ray: bool = False
-    ray_beams: Count = PlaybackConfig.scan_beams
-    # the ray model's readings times this (1: as read; the control's miscalibrated range)
-    ray_range_scale: Factor = PlaybackConfig.scan_range_scale
-
-
-RAY_MODEL = "ray-space-observation"
-
-
-def stand_ins(config) -> dict[str, str]:
-    """The config's `plays`: method name -> the method played under that name."""
-    out = {}
-    for item in filter(None, (p.strip() for p in getattr(config, "plays", "").split(","))):
-        name, _, played = (v.strip() for v in item.partition("="))
-        if name not in METHODS or played not in METHODS:
-            raise ValueError(
-                f"plays: expected method=method pairs of {', '.join(METHODS)}, got {item!r}"
-            )
-        out[name] = played
-    return out
+from kiseki.teach.local_maps import METHODS
+from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
+from kiseki_experiments.harness.verdict import Evidence
+from kiseki_experiments.teach.teach_boxes import (  # noqa: F401 (tp.BOX_*)
+    BOX_OFFSET_M,
+    BOX_SIZE_M,
+    boxes_beside_final_leg,
+    with_boxes,
+)
+from kiseki_experiments.teach.teach_goal_profile import (  # noqa: F401 (tp.PROFILE_OFFSETS)
+    PROFILE_OFFSETS,
+    goal_profile,
+)
+from kiseki_experiments.teach.teach_goal_profile import profile_figure as _profile_figure
+from kiseki_experiments.teach.teach_playback_claims import (  # noqa: F401 (tp.X for the tests)
+    ALL_CONVENTIONAL,
+    EXP1_CLAIMS,
+    EXP2_CLAIMS,
+    EXP3_CLAIMS,
+    STOP_TOLERANCE_M,
+    THESIS_ODOMETRY_P2_M,
+    THESIS_ODOMETRY_Y_WORST_M,
+    THESIS_RUNS,
+    THESIS_TABLE_4_5,
+    THESIS_TABLE_4_7,
+    exp2_evidence,
+    exp3_evidence,
+)
+from kiseki_experiments.teach.teach_playback_config import (  # noqa: F401 (tp.X)
+    RAY_MODEL,
+    Exp1Config,
+    Exp2Config,
+    Exp3Config,
+    stand_ins,
+)
+from kiseki_experiments.teach.teach_playback_tables import (  # noqa: F401 (tp.TAUGHT_SHARES)
+    TAUGHT_SHARES,
+    _diagnosis,
+    _diagnostics,
+    _stop_figure,
+    _stop_table,
+    _taught_table,
+)
 
 
 def _errors(result, goal: dict) -> dict:
@@ -115,104 +88,6 @@ def _errors(result, goal: dict) -> dict:
         "estimate_error": math.hypot(ex - tx, ey - ty),
         "reached": bool(result.reached),
     }
-
-
-BOX_SIZE_M = (0.4, 0.4, 0.6)  # Exp. 3's unknown boxes (the thesis' cardboard boxes)
-BOX_OFFSET_M = (0.8, 1.1)  # their centres' distance beside the route
-
-
-def _with_boxes(scene_file: Path, count: int, seed: int, tmp: Path) -> Path:
-    """A copy of the scene with `count` unknown BOX_SIZE_M boxes, playback only, placed at
-    random BOX_OFFSET_M beside the route (kept 0.6 m clear of it so the robot can pass)."""
-    doc = safe_load_12(read_input_text(scene_file, "scene files", YAML_LIMIT))
-    rng = Random(seed)
-    pts = np.asarray(doc["route"]["waypoints"], dtype=float)
-    placed = 0
-    while placed < count:
-        i = int(rng.below(len(pts) - 1))
-        f = rng.uniform(0.15, 0.85, 1)[0]
-        side = 1 if rng.uniform(0, 1, 1)[0] < 0.5 else -1
-        a, b = pts[i], pts[i + 1]
-        normal = np.array([-(b - a)[1], (b - a)[0]]) / np.linalg.norm(b - a)
-        c = a + f * (b - a) + side * rng.uniform(*BOX_OFFSET_M, 1)[0] * normal
-        doc["objects"].append(
-            {
-                "type": "box",
-                "center": [float(c[0]), float(c[1])],
-                "size": list(BOX_SIZE_M),
-                "only_in": "playback",
-            }
-        )
-        placed += 1
-    out = tmp / scene_file.name
-    out.write_text(yaml.safe_dump(doc), encoding="utf-8")
-    return out
-
-
-PROFILE_OFFSETS = np.round(np.arange(-0.4, 0.401, 0.05), 2)
-
-
-def _goal_profile(scene, environment, goal: dict, method: str) -> dict:
-    """The method's one-step likelihood around the true goal pose (the taught mark, map frame)
-    with a noise-free local map taken there: along the goal heading (sideways offset 0) and
-    sideways (along offset 0), normalised to the peak of the whole along x sideways grid, and
-    where that peak is. A model without bias peaks at offset 0."""
-    band, occlusion = METHODS[method]
-    setup = build_robot(scene, 0)
-    cameras = [s.device for s in build_sensors(scene, setup, 0, 0.1) if s.kind == "depth_camera"]
-    model = SpaceObservationModel(environment, occlusion_aware=occlusion)
-    truth = tuple(goal["truth"])
-    images = [c.render(scene.world, truth, noise=False) for c in cameras]
-    model.set_local_map(LocalMapMaker(cameras, band).make(images))
-    x, y, th = goal["x"], goal["y"], goal["theta"]
-    c, s = math.cos(th), math.sin(th)
-    fine = np.arange(-0.4, 0.401, 0.01)
-    a, b = (v.ravel() for v in np.meshgrid(fine, fine, indexing="ij"))
-    poses = np.column_stack([x + c * a - s * b, y + s * a + c * b, np.full(a.size, th)])
-    like = model.likelihoods(poses)
-    peak = like.max()
-    out = {"goal_peak_along": float(a[like.argmax()]), "goal_peak_side": float(b[like.argmax()])}
-    grid = like.reshape(len(fine), len(fine)) / peak
-    idx = np.round((PROFILE_OFFSETS + 0.4) / 0.01).astype(int)
-    mid = len(fine) // 2
-    for off, i in zip(PROFILE_OFFSETS, idx, strict=True):
-        out[f"goal_like_along_{off:+.2f}"] = float(grid[i, mid])
-        out[f"goal_like_side_{off:+.2f}"] = float(grid[mid, i])
-    return out
-
-
-def _profile_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
-    fig = new_figure(figsize=(9, 3.5), dpi=120)
-    axes = fig.subplots(1, 2, sharey=True)
-    for ax, axis in zip(axes, ("along", "side"), strict=True):
-        for method in config.methods:
-            cols = [f"{method}_goal_like_{axis}_{o:+.2f}" for o in PROFILE_OFFSETS]
-            ax.plot(PROFILE_OFFSETS, trials[cols].mean().to_numpy(), "o-", ms=3, label=method)
-        ax.axvline(0.0, color="grey", lw=0.8)
-        ax.set_xlabel(f"{'along-track' if axis == 'along' else 'sideways (left +)'} offset (m)")
-    axes[0].set_ylabel("one-step likelihood / peak")
-    axes[0].legend(fontsize=7)
-    fig.suptitle("around the true goal pose: taught map, noise-free local map", fontsize=9)
-    path = figures / "goal_likelihood_profiles.png"
-    fig.savefig(path, bbox_inches="tight")
-    return path
-
-
-def _boxes_beside_final_leg(scene_file: Path) -> dict:
-    """How many of the playback-only boxes stand beside the route's final leg, left and right
-    (the cameras see them on the way to the goal)."""
-    doc = safe_load_12(read_input_text(scene_file, "scene files", YAML_LIMIT))
-    a, b = (np.asarray(p, dtype=float) for p in doc["route"]["waypoints"][-2:])
-    along = (b - a) / np.linalg.norm(b - a)
-    left = right = 0
-    for o in doc["objects"]:
-        if o.get("only_in") != "playback":
-            continue
-        d = np.asarray(o["center"], dtype=float) - a
-        if 0.0 <= d @ along <= np.linalg.norm(b - a):
-            side = along[0] * d[1] - along[1] * d[0]
-            left, right = left + int(side > 0), right + int(side < 0)
-    return {"final_leg_boxes_left": left, "final_leg_boxes_right": right}
 
 
 def teach_route(config: Exp1Config, seed: int, folder: Path):
@@ -237,8 +112,8 @@ def trial(config: Exp1Config, index: int, seed: int, taught=None) -> TrialOutput
                 record[f"taught_{band}_{key}"] = t[key]
         play_file = scene_file
         if config.boxes:
-            play_file = _with_boxes(scene_file, config.boxes, derive_seed(seed, 3), Path(tmp))
-            record.update(_boxes_beside_final_leg(play_file))
+            play_file = with_boxes(scene_file, config.boxes, derive_seed(seed, 3), Path(tmp))
+            record.update(boxes_beside_final_leg(play_file))
         scene = load_scene(play_file, "playback")
         maps = {band: load_map(path) for band, path in taught.maps.items()}
         goal = taught.marks[-1]
@@ -290,7 +165,7 @@ def _play(
     out = dict(_errors(result, goal))
     if model == RAY_MODEL:
         return identity, out
-    out.update(_goal_profile(scene, maps[band], goal, method))
+    out.update(goal_profile(scene, maps[band], goal, method))
     if config.boxes:  # the control: the same run without the boxes
         plain = load_scene(Path(config.scene), "playback")
         control = playback(plain, maps[band], taught.marks, play, taught_scene=taught.scene)
@@ -306,211 +181,6 @@ def _play(
         out[f"{name}_odo_dx"] = o[0] - t[0]
         out[f"{name}_odo_dy"] = o[1] - t[1]
     return identity, out
-
-
-def _stop_table(config, trials: pd.DataFrame) -> pd.DataFrame:
-    rows = []
-    for method in config.methods:
-        stop, est = trials[f"{method}_stop_error"], trials[f"{method}_estimate_error"]
-        within = int((stop <= STOP_TOLERANCE_M).sum())
-        low, high = wilson_interval(within, len(stop))
-        rows.append(
-            {
-                "method": method,
-                "runs": len(stop),
-                "stop_error_mean_m": stop.mean(),
-                "stop_error_sd_m": stop.std(ddof=1),
-                "estimate_error_mean_m": est.mean(),
-                "stops_within_0.1m": within,
-                "within_ci95_low": low,
-                "within_ci95_high": high,
-                "along_track_share": float(
-                    (trials[f"{method}_stop_dx"].abs() > trials[f"{method}_stop_dy"].abs()).mean()
-                ),
-            }
-        )
-    return pd.DataFrame(rows)
-
-
-# kiseki.metrics.taught_map_truth's shares: forgiving a one-cell shift (a taught cell counts
-# only with its 8 neighbours agreeing), and cell by cell
-TAUGHT_SHARES = (
-    "erased_share",
-    "false_occupied_share",
-    "erased_share_cellwise",
-    "false_occupied_share_cellwise",
-)
-
-
-def _taught_table(config, trials: pd.DataFrame) -> pd.DataFrame:
-    """The taught maps against the scene's truth (kiseki.metrics.taught_map_truth), per band:
-    mean and worst share of obstacle cells in reach erased, and of visible free cells marked
-    occupied, over the trials (each teaches its own map), both with the one-cell shift forgiven
-    and cell by cell."""
-    rows = []
-    for band in ("plane", "band"):
-        if f"taught_{band}_erased_share" not in trials:
-            continue
-        row = {"map": band, "merge": config.merge}
-        for key in TAUGHT_SHARES:
-            values = trials.get(f"taught_{band}_{key}", pd.Series(dtype=float))
-            row[f"{key}_mean"], row[f"{key}_max"] = values.mean(), values.max()
-        rows.append(row)
-    return pd.DataFrame(rows)
-
-
-def _stop_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
-    fig = new_figure(figsize=(5, 5), dpi=120)
-    ax = fig.subplots()
-    for method in config.methods:
-        ax.plot(trials[f"{method}_stop_dx"], trials[f"{method}_stop_dy"], "o", label=method)
-    circle = Circle((0, 0), 0.1, fill=False, linestyle="--", color="grey")
-    ax.add_patch(circle)
-    ax.set_aspect("equal")
-    ax.set_xlabel("stop error x (m)")
-    ax.set_ylabel("stop error y (m)")
-    ax.legend(fontsize=8)
-    path = figures / "stop_positions.png"
-    fig.savefig(path, bbox_inches="tight")
-    return path
-
-
-def _diagnostics(config, trials: pd.DataFrame) -> pd.DataFrame:
-    """Per method: where the robot stopped relative to the goal (x along the final leg, y to
-    its left in the scenes' frames), the estimate's error at the stop, and the one-step
-    likelihood around the true goal pose: where it peaks and how much it drops 0.1 m / 0.3 m
-    off the truth along the track and sideways (1 - mean of the two sides)."""
-    rows = []
-    for m in config.methods:
-
-        def drop(axis, off, m=m):
-            cols = [f"{m}_goal_like_{axis}_{o:+.2f}" for o in (-off, off)]
-            return float(1.0 - trials[cols].to_numpy().mean())
-
-        rows.append(
-            {
-                "method": m,
-                "stop_dx_mean_m": trials[f"{m}_stop_dx"].mean(),
-                "stop_dy_mean_m": trials[f"{m}_stop_dy"].mean(),
-                "estimate_error_mean_m": trials[f"{m}_estimate_error"].mean(),
-                "goal_peak_along_mean_m": trials[f"{m}_goal_peak_along"].mean(),
-                "goal_peak_side_mean_m": trials[f"{m}_goal_peak_side"].mean(),
-                "drop_along_0.1m": drop("along", 0.1),
-                "drop_side_0.1m": drop("side", 0.1),
-                "drop_along_0.3m": drop("along", 0.3),
-                "drop_side_0.3m": drop("side", 0.3),
-            }
-        )
-    return pd.DataFrame(rows)
-
-
-def _diagnosis(diag: pd.DataFrame, ok: pd.DataFrame, turn_route: bool = True) -> str:
-    """Why the stops differ from the thesis, every number from this run's trials (and the
-    thesis' Table 4.5 and kiseki's constants, named where they are used)."""
-    d = diag.set_index("method")
-    lines = [
-        "Stop error = where the robot comes to rest (it decelerates within its acceleration "
-        f"limit after the estimate is within {STOP_TOLERANCE_M:g} m of the goal) minus where "
-        "it rested when the goal was marked in teaching; the estimate error is the estimate's "
-        "error at that moment. Both stop poses are taken at rest, so the braking distance "
-        "mostly cancels. Diagnostics per method (table `diagnostics`, figure "
-        "`goal_likelihood_profiles.png`):",
-    ]
-    for m, r in d.iterrows():
-        a1, a3 = 100 * r["drop_along_0.1m"], 100 * r["drop_along_0.3m"]
-        s1, s3 = 100 * r["drop_side_0.1m"], 100 * r["drop_side_0.3m"]
-        lines.append(
-            f"- {m}: mean stop offset ({r.stop_dx_mean_m:+.3f}, {r.stop_dy_mean_m:+.3f}) m, "
-            f"estimate error {r.estimate_error_mean_m:.3f} m; one-step likelihood around the "
-            f"true goal peaks at ({r.goal_peak_along_mean_m:+.2f} along, "
-            f"{r.goal_peak_side_mean_m:+.2f} left) m and drops by only {a1:.1f} % / {a3:.1f} % "
-            f"0.1 / 0.3 m along the track vs {s1:.1f} % / {s3:.1f} % sideways."
-        )
-    if not turn_route:
-        return "\n".join(lines)
-    return "\n".join([*lines, "", _turn_route_causes(d, ok)])
-
-
-def _turn_route_causes(d: pd.DataFrame, ok: pd.DataFrame) -> str:
-    """The route with a turn: the causes found with scripts/teach_playback_diagnostics.py,
-    each number taken from this run's trials."""
-    drop = 100 * float(d[["drop_along_0.1m", "drop_side_0.1m"]].to_numpy().mean())
-    means = {m: ok[f"{m}_stop_error"].mean() for m in d.index}
-    spread = max(means.values()) - min(means.values())
-    sd = float(np.mean([ok[f"{m}_stop_error"].std(ddof=1) for m in d.index]))
-    thesis = " > ".join(f"{m} {THESIS_TABLE_4_5[m][0]:.2f}" for m in THESIS_TABLE_4_5 if m in means)
-    measured = ", ".join(f"{m} {v:.3f}" for m, v in means.items())
-    compare = "less" if spread < sd else "more"
-    text = [
-        "Why the numbers differ from the thesis (scripts/teach_playback_diagnostics.py "
-        "reproduces perfect-teacher runs): (1) one local map constrains the pose only weakly "
-        f"(the drops above: {drop:.1f} % on average 0.1 m off the truth), so the filter "
-        "integrates many steps; the sideways cameras see little along the track, as the "
-        f"thesis says. (2) The methods' mean stop errors here ({measured} m) span "
-        f"{spread:.3f} m, {compare} than the mean spread of each method's stops (SD "
-        f"{sd:.3f} m); the thesis' Table 4.5 has {thesis} m.",
-    ]
-    taught = [
-        f"{band} map {100 * ok[f'taught_{band}_erased_share'].mean():.1f} % erased / "
-        f"{100 * ok[f'taught_{band}_false_occupied_share'].mean():.1f} % falsely occupied "
-        f"with a one-cell shift forgiven, "
-        f"{100 * ok[f'taught_{band}_erased_share_cellwise'].mean():.1f} % / "
-        f"{100 * ok[f'taught_{band}_false_occupied_share_cellwise'].mean():.1f} % cell by cell"
-        for band in ("plane", "band")
-        if f"taught_{band}_erased_share_cellwise" in ok
-    ]
-    if taught:
-        text.append(
-            "(3) The taught maps against the scene's truth (table `taught_maps`, mean over the "
-            "runs): " + "; ".join(taught) + ". The maps are built in the odometry frame and "
-            "measured in the world frame, so a teaching run's drift shifts walls and counts "
-            "in both measures; the cell-by-cell one also counts walls drawn one cell too "
-            "thick, which the forgiving one hides."
-        )
-    odo = [c for c in ok.columns if c.endswith("_odo_dy")]
-    if odo and "final_leg_m" in ok:
-        leg = float(ok["final_leg_m"].mean())
-        text.append(
-            "(4) The heading likelihood is nearly flat within a few degrees, so the heading "
-            "that leaves the turn is mostly the filter's own motion noise; 1 deg becomes "
-            f"{leg * math.sin(math.radians(1.0)):.3f} m sideways over the {leg:.2f} m final "
-            "leg (stop_dx, stop_dy above). The motion noise is set from the simulated "
-            "odometry's error model (PlaybackConfig.alphas, the same for every method); in "
-            "these runs' playback the odometry was up to "
-            f"{float(ok[odo].abs().to_numpy().max()):.3f} m off sideways at a waypoint."
-        )
-    return " ".join(text)
-
-
-THESIS_ODOMETRY_Y_WORST_M = -0.49  # thesis sec. 4 Exp. 1: the largest odometry y error at P2
-THESIS_ODOMETRY_P2_M = (0.01, -0.20)  # thesis Tables 4.1-4.4: mean odometry error at P2 (x, y)
-# Exp. 1's control: one particle, on which the space observation model's weights change
-# nothing (resampling one particle keeps it): dead reckoning with the motion model's noise
-DEAD_RECKONING = Control(
-    name="one particle (the space observation update has no effect: dead reckoning)",
-    overrides=("particles=1",),
-    runs=5,
-    why="without the update the estimate drifts with the odometry: the stops miss P2",
-    # 5 playbacks of the corridor: 18 s beside another test (47 s before the tiled depth cast)
-)
-EXP1_CLAIMS = (
-    ClaimSpec(
-        key="exp1_within",
-        claim="the stops at P2 are within 0.1 m (share of runs)",
-        unit="share of runs",
-        criterion=Criterion(
-            paper_value="11/11",
-            compare=">=",
-            threshold=0.7,
-            why="the thesis' 11 of 11 have a 95 % Wilson interval from 0.74: a share of at "
-            "least 0.7 is what its runs show",
-            bounds=(0.0, 1.0),
-            paper_number=1.0,
-        ),
-        control=DEAD_RECKONING,
-        measure="1 if the robot came to rest within 0.1 m of where P2 was taught",
-    ),
-)
 
 
 def analyze_exp1(config, trials, timings, figures) -> Analysis:
@@ -562,107 +232,6 @@ def analyze_exp1(config, trials, timings, figures) -> Analysis:
     )
 
 
-THESIS_TABLE_4_5 = {  # thesis Table 4.5, 5 runs each: stop error mean, SD, estimate, within 0.1 m
-    "conventional": (0.13, 0.01, 0.13, 0),
-    "proposal1": (0.09, 0.01, 0.08, 4),
-    "proposal2": (0.07, 0.01, 0.05, 5),
-}
-THESIS_RUNS = 5
-STOP_TOLERANCE_M = 0.1  # the thesis' stop rule (sec. 2.2)
-
-
-# Exp. 2's claims: the thesis' findings (Table 4.5, 5 runs per method) as comparisons between
-# methods on the same teaching and seeds, one paired value per run. Their control plays every
-# method as conventional: each difference is then 0, a margin away from each criterion.
-ALL_CONVENTIONAL = Control(
-    name="proposals 1 and 2 played as conventional",
-    overrides=(
-        "plays=proposal1=conventional,proposal2=conventional",
-        "methods=conventional,proposal1,proposal2",
-        "particles=50",  # the control's trials are test time; the differences are 0 at any
-    ),
-    runs=5,
-    why="every method is conventional's run on the same seed: every difference is 0",
-    # a teaching and 15 playbacks of the turn route: 25 s beside another test
-)
-WITHIN_MARGIN = 0.2  # one run in five more within 0.1 m
-WITHIN_WHY = (
-    f"one run in {THESIS_RUNS} (the thesis' runs per method) more within 0.1 m; a difference of "
-    "shares from paired runs"
-)
-FARTHER_MARGIN = 0.01  # m
-FARTHER_WHY = (
-    "the thesis' stop errors have an SD of 0.01 m for every method (Table 4.5): a difference "
-    "of one SD; paired runs"
-)
-WITHIN_PAIRS = (("proposal2", "conventional"), ("proposal1", "conventional"))
-FARTHER_PAIRS = (
-    ("conventional", "proposal2"),
-    ("conventional", "proposal1"),
-    ("proposal1", "proposal2"),
-)
-
-
-def _within_claim(better: str, worse: str) -> ClaimSpec:
-    b, w = THESIS_TABLE_4_5[better][3], THESIS_TABLE_4_5[worse][3]
-    return ClaimSpec(
-        key=f"within_{better}_vs_{worse}",
-        claim=f"{better} stops within 0.1 m in more runs than {worse}: {better}'s share "
-        f"minus {worse}'s",
-        unit="difference of shares of runs",
-        criterion=Criterion(
-            paper_value=f"{b}/{THESIS_RUNS} vs {w}/{THESIS_RUNS} ({(b - w) / THESIS_RUNS:+.1f})",
-            compare=">=",
-            threshold=WITHIN_MARGIN,
-            why=WITHIN_WHY,
-            bounds=(-1.0, 1.0),
-            paper_number=(b - w) / THESIS_RUNS,
-        ),
-        control=ALL_CONVENTIONAL,
-        measure=f"1 if {better} stopped within 0.1 m, minus the same for {worse}",
-    )
-
-
-def _farther_claim(farther: str, nearer: str) -> ClaimSpec:
-    f, n = THESIS_TABLE_4_5[farther][0], THESIS_TABLE_4_5[nearer][0]
-    return ClaimSpec(
-        key=f"farther_{farther}_than_{nearer}",
-        claim=f"{farther} stops farther from the goal than {nearer}: mean stop error difference",
-        unit="m",
-        criterion=Criterion(
-            paper_value=f"{f:.2f} - {n:.2f} = {f - n:+.2f}",
-            compare=">=",
-            threshold=FARTHER_MARGIN,
-            why=FARTHER_WHY,
-            paper_number=round(f - n, 2),
-        ),
-        control=ALL_CONVENTIONAL,
-        measure=f"{farther}'s stop error minus {nearer}'s",
-    )
-
-
-EXP2_CLAIMS = (
-    *(_within_claim(b, w) for b, w in WITHIN_PAIRS),
-    *(_farther_claim(f, n) for f, n in FARTHER_PAIRS),
-)
-
-
-def _exp2_evidence(ok: pd.DataFrame, methods) -> list[Evidence]:
-    evidence = []
-    for better, worse in WITHIN_PAIRS:
-        if better in methods and worse in methods:
-            a = (ok[f"{better}_stop_error"] <= STOP_TOLERANCE_M).astype(float)
-            b = (ok[f"{worse}_stop_error"] <= STOP_TOLERANCE_M).astype(float)
-            shown = f"{int(a.sum())}/{len(a)} vs {int(b.sum())}/{len(b)}"
-            evidence.append(Evidence.of(f"within_{better}_vs_{worse}", a - b, shown=shown))
-    for farther, nearer in FARTHER_PAIRS:
-        if farther in methods and nearer in methods:
-            a, b = ok[f"{farther}_stop_error"], ok[f"{nearer}_stop_error"]
-            shown = f"{a.mean():.3f} - {b.mean():.3f} m"
-            evidence.append(Evidence.of(f"farther_{farther}_than_{nearer}", a - b, shown=shown))
-    return evidence
-
-
 def analyze_exp2(config, trials, timings, figures) -> Analysis:
     ok = trials[trials["error"].isna()]
     stops = _stop_table(config, ok)
@@ -677,7 +246,7 @@ def analyze_exp2(config, trials, timings, figures) -> Analysis:
     return Analysis(
         tables={"stops": stops, "diagnostics": diag, "taught_maps": _taught_table(config, ok)},
         figures=[_stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
-        evidence=_exp2_evidence(ok, set(config.methods)),
+        evidence=exp2_evidence(ok, set(config.methods)),
         notes=f"Thesis Tables 4.5/4.6: {THESIS_RUNS} runs per method; 'both' is not in the "
         "thesis. Each method's own stop error and share within 0.1 m (with its 95 % Wilson "
         "interval) stand in table `stops` beside the thesis' (table rows, not claims: the "
@@ -688,36 +257,20 @@ def analyze_exp2(config, trials, timings, figures) -> Analysis:
 def analyze_exp3(config, trials, timings, figures) -> Analysis:
     ok = trials[trials["error"].isna()]
     stops = _stop_table(config, ok)
-    row = stops.iloc[0]
-    claims = [
-        Claim(
-            "proposal 2 with unknown boxes: stop error mean",
-            "0.07 (SD 0.02)",
-            f"{row['stop_error_mean_m']:.3f} (SD {row['stop_error_sd_m']:.3f})",
-            "m",
-            bool(row["stop_error_mean_m"] <= 0.09),
-        ),
-        Claim(
-            "proposal 2 with unknown boxes: estimate error mean",
-            "0.06",
-            f"{row['estimate_error_mean_m']:.3f}",
-            "m",
-            bool(row["estimate_error_mean_m"] <= 0.08),
-        ),
-    ]
+    thesis = pd.DataFrame(
+        [
+            {
+                "method": m,
+                "thesis_stop_error_mean_m": v[0],
+                "thesis_stop_error_sd_m": v[1],
+                "thesis_estimate_error_mean_m": v[2],
+            }  # fmt: skip
+            for m, v in THESIS_TABLE_4_7.items()
+        ]
+    )
+    stops = stops.merge(thesis, on="method", how="left")
     diag = _diagnostics(config, ok)
     m = config.methods[0]
-    evidence = []
-    if f"{m}_ray_stop_error" in ok:
-        thesis, ray = ok[f"{m}_stop_error"], ok[f"{m}_ray_stop_error"]
-        evidence.append(
-            Evidence.of(
-                "ray-stop-within",
-                ray - thesis,
-                subject=m,
-                shown=f"kiseki's {ray.mean():.3f} m vs the thesis' {thesis.mean():.3f} m",
-            )
-        )
     cols = ["final_leg_boxes_left", "final_leg_boxes_right", f"{m}_stop_dx", f"{m}_stop_dy"]
     cols += [f"{m}_nobox_stop_dx", f"{m}_nobox_stop_dy"]
     boxes = ok[["trial", *cols]] if "final_leg_boxes_left" in ok else pd.DataFrame()
@@ -755,38 +308,9 @@ def analyze_exp3(config, trials, timings, figures) -> Analysis:
             "taught_maps": _taught_table(config, ok),
         },
         figures=[_stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
-        claims=claims,
         notes=notes,
-        evidence=evidence,
+        evidence=exp3_evidence(ok, config.methods),
     )
-
-
-EXP3_CLAIMS = (
-    ClaimSpec(
-        key="ray-stop-within",
-        claim="with unknown boxes, kiseki's ray space observation model stops the robot as "
-        "closely as the thesis' model (mean stop error within 0.02 m, same runs)",
-        unit="m, stop error of kiseki's model minus the thesis' (same teaching, boxes, seeds)",
-        criterion=Criterion(
-            paper_value="(kiseki's model; the thesis' model reaches 0.07 m, SD 0.02, Table 4.7)",
-            compare="within",
-            threshold=0.0,
-            tolerance=0.02,
-            why="the issue's target: the thesis' stop error's SD (0.02 m, Table 4.7) is the "
-            "difference no run could tell apart",
-            bounds=(-math.inf, math.inf),
-        ),
-        control=Control(
-            name="kiseki's model with every reading 20 % long (a miscalibrated range)",
-            overrides=("ray=true", "ray_range_scale=1.2"),
-            runs=5,
-            why="walls read 20 % further away than they are pull every estimate along the "
-            "route, and the stop with it, far beyond 0.02 m",
-            minutes=True,
-        ),
-        measure="a run's stop error with kiseki's model minus the thesis' model's",
-    ),
-)
 
 
 def _preflight(config: Exp1Config) -> None:

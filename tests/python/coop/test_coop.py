@@ -437,7 +437,7 @@ def test_form1_readings_meet_at_their_closed_form_sight_angles(deg) -> None:
 def test_per_repeat_argmin_against_brute_force() -> None:
     import pandas as pd
 
-    from kiseki_experiments.coop.coop_forms import _per_repeat_argmin, _per_repeat_min
+    from kiseki_experiments.coop.coop_claims import _per_repeat_argmin, _per_repeat_min
 
     rng = np.random.default_rng(3)
     values = rng.uniform(0.01, 0.1, (6, 5))  # 6 settings, 5 repeats

@@ -25,7 +25,7 @@ from kiseki_experiments.harness.registry import all_experiments
 from kiseki_experiments.harness.verdict import Control, Criterion
 
 # the experiments whose inputs are the recorded datasets (skipped without them, as elsewhere)
-RECORDED = ("carmen-maps", "mcl-", "gp-aalto", "magnetic-walks")
+RECORDED = ("carmen-maps", "mcl-", "gp-aalto", "magnetic-walks", "merge-rules")
 
 
 # A control declared as taking minutes (layouts-exp2-exp3's: six layouts taught and played

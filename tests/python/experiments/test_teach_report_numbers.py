@@ -147,3 +147,24 @@ def test_exp2_claims_hold_on_the_thesis_numbers_and_fail_when_the_methods_are_on
     control = tp.analyze_exp2(config, same, None, tmp_path)
     verdicts = {v.claim: v.verdict for v in judge(tp.EXP2_CLAIMS, control.evidence, draw)}
     assert set(verdicts.values()) == {"fails"}, verdicts
+
+
+@pytest.mark.parametrize("draw", range(3))
+def test_exp3_box_claims_hold_near_the_thesis_numbers_and_fail_off_by_dead_reckonings(
+    tmp_path, draw
+):
+    """Exp. 3's claims (proposal 2 with the boxes: mean stop error <= 0.09 m, estimate error
+    <= 0.08 m) on five runs near Table 4.7's 0.07 / 0.06 m hold; on runs whose errors are a
+    drifting estimate's (0.2-0.5 m) they fail."""
+    config = tp.Exp3Config()
+    rng = np.random.default_rng(draw)
+    keys = {s.claim: s.key for s in tp.EXP3_CLAIMS}
+    for stop, estimate, want in (
+        (rng.normal(0.07, 0.005, 5), rng.normal(0.06, 0.005, 5), "holds"),
+        (rng.uniform(0.2, 0.5, 5), rng.uniform(0.2, 0.5, 5), "fails"),
+    ):
+        trials = _trials(rng)
+        trials["proposal2_stop_error"], trials["proposal2_estimate_error"] = stop, estimate
+        analysis = tp.analyze_exp3(config, trials, None, tmp_path)
+        verdicts = {keys[v.claim]: v.verdict for v in judge(tp.EXP3_CLAIMS, analysis.evidence, 0)}
+        assert verdicts == {"boxes_stop": want, "boxes_estimate": want}, verdicts

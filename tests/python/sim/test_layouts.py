@@ -116,12 +116,19 @@ def test_the_experiment_runs_on_two_layouts_and_writes_the_table(tmp_path):
     assert {"exp2", "exp3"} == set(shares["experiment"])
     assert (result.run_dir / "figures" / "layouts.png").is_file()
     claims = pd.read_csv(result.run_dir / "claims.csv", keep_default_na=False)
-    pooled = claims[claims["claim"].str.startswith("exp2: ")]
-    # exp2-turn's two claims on conventional and proposal 2, on both layouts' runs (2 values:
-    # too few for an interval), the rest exp3-boxes' point claims per layout
-    assert len(pooled) == 2 and (pooled["trials"] == 2).all()
-    assert (pooled["verdict"] == "inconclusive").all()
-    assert claims.loc[~claims.index.isin(pooled.index), "claim"].str.contains("of layouts").all()
+    # exp2-turn's two claims on conventional and proposal 2 and exp3-boxes' two on proposal 2
+    # with the boxes, each on both layouts' runs (2 values: too few for an interval)
+    assert claims["claim"].str.endswith("(all layouts' runs)").all()
+    assert claims["claim"].str[:6].value_counts().to_dict() == {"exp2: ": 2, "exp3: ": 2}
+    assert (claims["trials"] == 2).all() and (claims["verdict"] == "inconclusive").all()
+    # the exp3 claims' values are the mean of the two layouts' runs
+    trials = pd.read_parquet(result.run_dir / "trials.parquet")
+    stop = claims[claims["claim"].str.startswith("exp3: proposal 2 with unknown boxes: stop")]
+    want = trials["exp3_r0_proposal2_stop_error"].mean()
+    assert stop["measured_value"].iloc[0].startswith(f"{want:.4g} ")
+    assert set(shares["generalises"].str.split(":").str[0]) <= {
+        "general", "layout-specific", "undecided by this many layouts (the 95 % interval spans 80%)"
+    }  # fmt: skip
     assert "claim_shares" in (result.run_dir / "report.md").read_text(encoding="utf-8")
 
 
