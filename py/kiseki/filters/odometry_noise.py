@@ -6,7 +6,7 @@ increments with added noise) and the motion noise the filter assumes for it
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
@@ -14,13 +14,18 @@ from kiseki.core import Pose2, Random
 from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS
 from kiseki.scans import LaserScans
 
-if TYPE_CHECKING:  # the config's module imports this one
-    from kiseki.filters.tracking import LocalizeConfig
+
+class OdometrySettings(Protocol):
+    """What :func:`motion_alphas` reads of a config (kiseki.filters.LocalizeConfig)."""
+
+    alphas: tuple[float, ...] | None
+    odometry_noise: float
+
 
 __all__ = ["motion_alphas", "noisy_odometry"]
 
 
-def motion_alphas(config: LocalizeConfig, scans: LaserScans) -> tuple[float, ...]:
+def motion_alphas(config: OdometrySettings, scans: LaserScans) -> tuple[float, ...]:
     """The filter's motion noise: `config.alphas` if given, else the noise the odometry has.
 
     That is the log's own odometry error plus the noise `noisy_odometry` adds. The log's own:
