@@ -109,6 +109,10 @@ void bind_filters(py::module_& m) {
       .def_readwrite("sensor_reset_after", &MclParams::sensor_reset_after)
       .def_readwrite("sensor_reset_share", &MclParams::sensor_reset_share)
       .def_readwrite("sensor_reset_candidates", &MclParams::sensor_reset_candidates)
+      .def_property("sensor_reset_proposal",
+                    [](const MclParams& p) { return std::string(reset_proposal_name(p.sensor_reset_proposal)); },
+                    [](MclParams& p, const std::string& v) { p.sensor_reset_proposal = reset_proposal_from_name(v); })
+      .def_readwrite("reset_look_elsewhere", &MclParams::reset_look_elsewhere)
       .def_readwrite("reliability_rate", &MclParams::reliability_rate)
       .def_readwrite("threads", &MclParams::threads)
       .def("validate", &MclParams::validate);
@@ -143,6 +147,17 @@ void bind_filters(py::module_& m) {
              py::gil_scoped_release release;
              return f.update(model);
            }, "model"_a, "Weighs with a model holding the current measurement; releases the GIL.")
+      .def("update",
+           [](MonteCarloLocalization& f, const SensorModel& model, const py::handle& a_in, const py::handle& r_in) {
+             const auto [a, r] = beams(a_in, r_in);
+             py::gil_scoped_release release;
+             return f.update(model, ScanView{a.data(), r.data(), static_cast<std::size_t>(a.shape(0))});
+           }, "model"_a, "angles"_a, "ranges"_a,
+           "The same with the scan the model holds (angles rad, ranges m, laser frame), which a sensor reset with "
+           "the matcher proposal searches; releases the GIL.")
+      .def("set_matcher", [](MonteCarloLocalization& f, const CorrelativeScanMatcher* m) { f.set_matcher(m); },
+           "matcher"_a, py::keep_alive<1, 2>(),
+           "The correlative scan matcher of the matcher proposal (None removes it).")
       .def("update_log_likelihoods",
            [](MonteCarloLocalization& f, const py::handle& log_l, std::size_t readings, double agreement) {
              auto l = doubles_1d(log_l, "log_likelihoods");

@@ -215,6 +215,76 @@ TEST(MonteCarloLocalization, AResetNeedsEvidenceWhereTheLikelihoodIsFlat) {
   EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
+TEST(MonteCarloLocalization, TheLookElsewhereTermAsksForLnNMoreOfTheBestOfNCandidates) {
+  // One particle 1.04 m from the target: the cloud's best log-likelihood is -6.0 (d^2 / (2
+  // 0.3^2)); the best of 20,000 uniform candidates in the 10 m x 6 m room lies within about
+  // 0.2 m of the target (-0.2 or better), so it beats the cloud by about 6 nats: more than ln 10
+  // (2.3), less than ln 10 + ln 20,000 (12.2). Without the term the sensor reset is kept, with
+  // it not; the expansion (radius 0) never explains better.
+  EXPECT_DOUBLE_EQ(look_elsewhere_term(20000.0), std::log(20000.0));
+  EXPECT_DOUBLE_EQ(look_elsewhere_term(0.5), 0.0);
+  for (const bool look : {false, true}) {
+    MclParams p;
+    p.particles = 1;
+    p.recovery = Recovery::resetting;
+    p.reset_after = p.sensor_reset_after = 1;
+    p.expansion_position = p.expansion_orientation = 0.0;
+    p.reset_look_elsewhere = look;
+    MonteCarloLocalization mcl(p, 21);
+    mcl.set_free_space(room());
+    TargetModel model;
+    model.target = Pose2(4.0, 3.0, 0.5);
+    model.agree = 0.0;  // every scan disagrees: lost at once
+    mcl.set_particles({Pose2(4.0 + 1.04, 3.0, 0.5)});
+    EXPECT_EQ(mcl.update(model).reset, look ? "none" : "sensor");
+    EXPECT_EQ(error(mcl.estimate(), model.target) < 0.5, !look);
+  }
+}
+
+TEST(SensorResetProposal, PosesAroundHypothesesTakeTheirSharesByTemperedScoreAndTheStatedSpread) {
+  // scores 0, -ln 3 and -40 at power 1: shares 3 : 1 : 4e-18 of 4,000 poses, 3,000 and 1,000
+  std::vector<PoseHypothesis> found(3);
+  found[0].pose = Pose2(1.0, 2.0, 3.0);
+  found[1].pose = Pose2(5.0, -1.0, -1.0);
+  found[2].pose = Pose2(-4.0, 0.0, 0.0);
+  found[0].score = 0.0, found[1].score = -std::log(3.0), found[2].score = -40.0;
+  Random rng(5);
+  const std::vector<Pose2> out = poses_around_hypotheses(found, 4000, 0.05, 0.02, 1.0, rng);
+  ASSERT_EQ(out.size(), 4000u);
+  for (std::size_t h = 0; h < 2; ++h) {
+    const std::size_t begin = h == 0 ? 0 : 3000, end = h == 0 ? 3000 : 4000;
+    double mx = 0, sx = 0, st = 0;
+    for (std::size_t i = begin; i < end; ++i) mx += out[i].x;
+    mx /= static_cast<double>(end - begin);
+    for (std::size_t i = begin; i < end; ++i) {
+      sx += std::pow(out[i].x - mx, 2);
+      st += std::pow(angle_difference(out[i].theta, found[h].pose.theta), 2);
+      EXPECT_LT(std::hypot(out[i].x - found[h].pose.x, out[i].y - found[h].pose.y), 0.05 * 6);
+    }
+    EXPECT_NEAR(mx, found[h].pose.x, 4 * 0.05 / std::sqrt(static_cast<double>(end - begin)));
+    EXPECT_NEAR(std::sqrt(sx / static_cast<double>(end - begin)), 0.05, 0.005);
+    EXPECT_NEAR(std::sqrt(st / static_cast<double>(end - begin)), 0.02, 0.002);
+  }
+  // a heading near pi stays in [-pi, pi); no hypothesis or a negative spread is refused
+  found[0].pose.theta = kPi - 1e-3;
+  for (const Pose2& q : poses_around_hypotheses(found, 500, 0.0, 0.05, 1.0, rng)) {
+    EXPECT_GE(q.theta, -kPi);
+    EXPECT_LT(q.theta, kPi);
+  }
+  EXPECT_THROW(poses_around_hypotheses({}, 10, 0.1, 0.1, 1.0, rng), std::invalid_argument);
+  EXPECT_THROW(poses_around_hypotheses(found, 10, -0.1, 0.1, 1.0, rng), std::invalid_argument);
+  EXPECT_THROW(reset_proposal_from_name("grid"), std::invalid_argument);
+  // the matcher proposal refuses an update without the scan, or without a matcher
+  MclParams p;
+  p.recovery = Recovery::resetting;
+  p.sensor_reset_proposal = ResetProposal::matcher;
+  MonteCarloLocalization mcl(p, 1);
+  mcl.set_particles({Pose2(1.0, 1.0, 0.0)});
+  TargetModel model;
+  EXPECT_THROW(mcl.update(model), std::logic_error);
+  EXPECT_THROW(mcl.update(model, ScanView{}), std::logic_error);
+}
+
 TEST(MonteCarloLocalization, WeightsCanBeSetAndBadInputIsRefused) {
   MclParams p;
   p.particles = 4;

@@ -90,6 +90,10 @@ bool CorrelativeScanMatcher::has_free(int level, int x, int y) const {
   return free_[static_cast<std::size_t>(level)][static_cast<std::size_t>(yy) * pw + xx] != 0;
 }
 
+std::size_t CorrelativeScanMatcher::lattice_cells() const {
+  return static_cast<std::size_t>(std::count(free_[0].begin(), free_[0].end(), std::uint8_t{1}));
+}
+
 Pose2 CorrelativeScanMatcher::lattice_pose(int cell_x, int cell_y, int heading, int headings) const {
   if (headings < 1) throw std::invalid_argument("correlative matcher: headings must be >= 1");
   const double r = frame_.resolution();

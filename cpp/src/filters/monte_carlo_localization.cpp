@@ -170,8 +170,22 @@ double MonteCarloLocalization::agreement_of(const SensorModel& model) const {
 
 UpdateReport MonteCarloLocalization::update(const SensorModel& model) {
   check_ready();
+  if (params_.recovery == Recovery::resetting && params_.sensor_reset_proposal == ResetProposal::matcher) {
+    throw std::logic_error("MCL: the matcher proposal needs the scan: update(model, scan)");
+  }
   const std::vector<double> log_l = evaluate(model, particles_);
-  return update_impl(log_l, model.readings(), std::numeric_limits<double>::quiet_NaN(), &model);
+  return update_impl(log_l, model.readings(), std::numeric_limits<double>::quiet_NaN(), &model, nullptr);
+}
+
+UpdateReport MonteCarloLocalization::update(const SensorModel& model, const ScanView& scan) {
+  check_ready();
+  if (scan.n > 0 && (scan.angles == nullptr || scan.ranges == nullptr)) throw std::invalid_argument("MCL: a scan without beams");
+  if (params_.recovery == Recovery::resetting && params_.sensor_reset_proposal == ResetProposal::matcher &&
+      matcher_ == nullptr) {
+    throw std::logic_error("MCL: the matcher proposal needs a correlative scan matcher (set_matcher)");
+  }
+  const std::vector<double> log_l = evaluate(model, particles_);
+  return update_impl(log_l, model.readings(), std::numeric_limits<double>::quiet_NaN(), &model, &scan);
 }
 
 UpdateReport MonteCarloLocalization::update(const std::vector<double>& log_l, std::size_t readings, double agreement) {
@@ -179,11 +193,12 @@ UpdateReport MonteCarloLocalization::update(const std::vector<double>& log_l, st
   if (!std::isnan(agreement) && !(agreement >= 0.0 && agreement <= 1.0)) {
     throw std::invalid_argument("MCL: agreement must lie in [0, 1] (or be NaN)");
   }
-  return update_impl(log_l, readings, agreement, nullptr);
+  return update_impl(log_l, readings, agreement, nullptr, nullptr);
 }
 
 UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_l, std::size_t readings,
-                                                 double agreement, const SensorModel* model) {
+                                                 double agreement, const SensorModel* model,
+                                                 const ScanView* scan) {
   if (log_l.size() != particles_.size()) throw std::invalid_argument("MCL: one log-likelihood per particle is needed");
   UpdateReport report;
   // Augmented MCL's average likelihood: the weighted mean of the per-reading (geometric mean)
@@ -226,7 +241,7 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
     for (double l : log_l) best = std::max(best, l);
     bool sensed = false;
     if (model != nullptr && has_free_space() && lost_updates_ >= params_.sensor_reset_after) {
-      sensed = sensor_reset(*model, best);
+      sensed = sensor_reset(*model, best, scan);
       if (sensed) lost_updates_ = 0;
     }
     const bool expanded = !sensed && expansion_reset(model, best);
@@ -290,69 +305,6 @@ void MonteCarloLocalization::resample_to(std::size_t n) {
   particles_.swap(out);
   weights_.assign(n, 1.0 / static_cast<double>(n));
   target_ = n;
-}
-
-bool MonteCarloLocalization::explains_better(double proposed_best, double cloud_best) const {
-  // The best of many proposed poses beats the cloud's best by chance where the likelihood is
-  // flat (a scan of open space): the proposal must be better by a likelihood ratio of
-  // exp(reset_evidence), on the scale the weights use.
-  return params_.likelihood_power * (proposed_best - cloud_best) > params_.reset_evidence;
-}
-
-bool MonteCarloLocalization::expansion_reset(const SensorModel* model, double cloud_best) {
-  const std::size_t n = particles_.size();
-  const std::vector<std::size_t> idx = resample_indices(weights_, n, params_.resampling, rng_);
-  std::vector<Pose2> out(n);
-  const std::uint64_t seed = rng_.below(~std::uint64_t{0});
-  const double rp = params_.expansion_position, ro = params_.expansion_orientation;
-  parallel_for(n, params_.threads, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      StreamRandom g(seed, i);
-      const Pose2& q = particles_[idx[i]];
-      const double dx = g.uniform(-rp, rp), dy = g.uniform(-rp, rp), dt = g.uniform(-ro, ro);
-      out[i] = Pose2(q.x + dx, q.y + dy, q.theta + dt);
-    }
-  }, 4096);
-  if (model == nullptr) {  // log-likelihoods from elsewhere: cannot weigh again, so keep it
-    particles_.swap(out);
-    weights_.assign(n, 1.0 / static_cast<double>(n));
-    return true;
-  }
-  // Kept only if some expanded particle explains the measurement better than the best particle
-  // did: a cloud that is right but sees an odd scan is not scattered.
-  const std::vector<double> l = evaluate(*model, out);
-  if (!explains_better(*std::max_element(l.begin(), l.end()), cloud_best)) return false;
-  particles_.swap(out);
-  weights_.assign(n, 1.0 / static_cast<double>(n));
-  apply_log_likelihoods(weights_, l, params_.likelihood_power);
-  return true;
-}
-
-bool MonteCarloLocalization::sensor_reset(const SensorModel& model, double cloud_best) {
-  const std::size_t n = particles_.size();
-  const auto from_sensor = static_cast<std::size_t>(std::llround(params_.sensor_reset_share * static_cast<double>(n)));
-  const std::vector<Pose2> candidates = uniform_poses(params_.sensor_reset_candidates);
-  const std::vector<double> cand_l = evaluate(model, candidates);
-  // The measurement proposes another place only if some pose there explains it better than
-  // the best particle of the cloud does.
-  if (!explains_better(*std::max_element(cand_l.begin(), cand_l.end()), cloud_best)) return false;
-  std::vector<double> w(candidates.size(), 1.0);
-  std::vector<Pose2> out;
-  out.reserve(n);
-  if (from_sensor < n) {
-    for (std::size_t i : resample_indices(weights_, n - from_sensor, params_.resampling, rng_)) out.push_back(particles_[i]);
-  }
-  if (from_sensor > 0) {
-    const bool any = apply_log_likelihoods(w, cand_l, params_.likelihood_power);
-    if (!any) w.assign(w.size(), 1.0);
-    for (std::size_t i : resample_indices(w, from_sensor, params_.resampling, rng_)) out.push_back(candidates[i]);
-  }
-  particles_.swap(out);
-  weights_.assign(n, 1.0 / static_cast<double>(n));
-  // Weigh the mixed set, so that the estimate is that of the better part, not the mean of two
-  // places.
-  apply_log_likelihoods(weights_, evaluate(model, particles_), params_.likelihood_power);
-  return true;
 }
 
 Pose2 MonteCarloLocalization::estimate() const {

@@ -108,6 +108,18 @@ def localize_command(
         help="none, augmented (Augmented MCL) or resetting (expansion, then sensor resetting); "
         f"with --global from the cloud's convergence on (default {LocalizeConfig.recovery}).",
     ),
+    reset_proposal: str | None = typer.Option(
+        None,
+        help="With --recovery resetting: the sensor reset's candidates, uniform over the free "
+        "cells or around the correlative scan matcher's best poses for the scan (matcher); "
+        f"default {LocalizeConfig.sensor_reset_proposal}; not with --global.",
+    ),
+    reset_look_elsewhere: bool = typer.Option(
+        False,
+        "--reset-look-elsewhere",
+        help="A sensor reset must beat the cloud by a margin that grows by ln N for its best of "
+        "N poses searched (N the candidates, or the matcher's lattice poses); not with --global.",
+    ),
     threads: int | None = typer.Option(
         None,
         parser=Count("--threads", 0, THREAD_LIMIT, "0 = every core"),
@@ -190,8 +202,12 @@ def localize_command(
         result = global_localize(scans, grid, gconfig, progress=True)
         trajectory, reliability = result.estimates, result.reliability
     else:
+        resets = dict(sensor_reset_proposal=reset_proposal)
+        if reset_look_elsewhere:
+            resets.update(reset_look_elsewhere=True)
         config = LocalizeConfig(
-            **_given(**shared, odometry_noise=odometry_noise, reliability=reliability_estimate)
+            **_given(**shared, odometry_noise=odometry_noise, reliability=reliability_estimate),
+            **_given(**resets),
         )
         if not scans.has_reference_poses:
             raise ValueError(f"{log}: the log has no reference poses to start from: use --global")
@@ -239,13 +255,19 @@ def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bo
     if method == "odometry":  # the odometry alone: no filter, no sensor model, no start
         refuse_given(
             ctx,
-            ["particles", "kld", "beams", "recovery", "threads", "global_start"],
+            ["particles", "kld", "beams", "recovery", "threads", "global_start"]
+            + ["reset_proposal", "reset_look_elsewhere"],
             "to --method odometry (the odometry alone: no particle filter)",
         )
     elif method == "space-observation":  # a local map of the whole scan: no beam selection
         refuse_given(ctx, ["beams"], "to --method space-observation (it weighs the whole scan)")
     if global_start:
         refuse_given(ctx, ["odometry_noise"], "with --global (it is for logs with reference poses)")
+        refuse_given(
+            ctx,
+            ["reset_proposal", "reset_look_elsewhere"],
+            "with --global (its start is --one-scan; its resets are the uniform ones)",
+        )
 
 
 def _print_report(lines: list[str], summary: dict, as_json: bool) -> None:

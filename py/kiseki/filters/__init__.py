@@ -23,6 +23,7 @@ from kiseki.filters.engine import (
     REAL_ODOMETRY_ALPHAS,
     RECOVERY_MODES,
     RESAMPLING_METHODS,
+    RESET_PROPOSALS,
     MclConfig,
     MonteCarloLocalizer,
 )
@@ -33,6 +34,7 @@ from kiseki.filters.global_localization import (
     render_global,
     write_report,
 )
+from kiseki.filters.odometry_noise import motion_alphas, noisy_odometry
 from kiseki.filters.reliability import (
     LEARNED_RELIABILITY,
     RELIABILITY_ESTIMATES,
@@ -54,8 +56,6 @@ from kiseki.filters.tracking import (
     LocalizeConfig,
     ScanSpaceObservation,
     localize,
-    motion_alphas,
-    noisy_odometry,
     scan_model,
     scan_preparer,
 )
@@ -67,6 +67,7 @@ __all__ = [
     "RECOVERY_MODES",
     "RELIABILITY_ESTIMATES",
     "RESAMPLING_METHODS",
+    "RESET_PROPOSALS",
     "ConvergenceReport",
     "GlobalConfig",
     "GlobalResult",

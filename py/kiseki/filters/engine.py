@@ -34,12 +34,14 @@ __all__ = [
     "RECOVERY_MODES",
     "REAL_ODOMETRY_ALPHAS",
     "RESAMPLING_METHODS",
+    "RESET_PROPOSALS",
     "MclConfig",
     "MonteCarloLocalizer",
 ]
 
 RECOVERY_MODES = ("none", "augmented", "resetting")
 RESAMPLING_METHODS = ("multinomial", "systematic", "stratified", "residual")
+RESET_PROPOSALS = ("uniform", "matcher")
 # The motion noise for a log's own odometry, whose error is unknown: wide, AMCL-like values.
 REAL_ODOMETRY_ALPHAS = (0.05, 0.01, 0.05, 0.01)
 
@@ -68,6 +70,12 @@ class MclConfig:
       explains the scan better than the cloud did by ``reset_evidence`` ln 10, a Bayes factor
       of 10); ``resetting_injects`` adds Augmented MCL's injection (off: on real logs an
       injected pose that fits one odd scan better than the cloud pulls the estimate away).
+    * ``sensor_reset_proposal`` uniform (the candidates uniform over the free cells, as before
+      the matcher existed) or matcher (around the correlative scan matcher's hypotheses for the
+      current scan: :meth:`MonteCarloLocalizer.set_matcher` and the scan in :meth:`step`);
+      ``reset_look_elsewhere`` False: with True a sensor reset's margin grows by ln N for a
+      best of N poses searched (the engine's look_elsewhere_term: even prior odds of "here" and
+      "elsewhere", the second spread over the N poses).
     * ``update_min_d`` / ``update_min_a``: 0 (every scan is an update); nav2 uses 0.25 m / 0.2 rad.
     """
 
@@ -94,6 +102,8 @@ class MclConfig:
     sensor_reset_after: int = 4
     sensor_reset_share: float = 0.5
     sensor_reset_candidates: int = 20_000
+    sensor_reset_proposal: str = "uniform"
+    reset_look_elsewhere: bool = False
     update_min_d: float = 0.0
     update_min_a: float = 0.0
     threads: int = 0
@@ -132,6 +142,15 @@ class MclConfig:
             isinstance(self.threads, int) and 0 <= self.threads <= 1024,
             f"threads must be an integer in 0..1024 (0 = every core), got {self.threads!r}",
         )
+        _check(
+            self.sensor_reset_proposal in RESET_PROPOSALS,
+            f"sensor_reset_proposal must be one of {', '.join(RESET_PROPOSALS)}, "
+            f"got {self.sensor_reset_proposal!r}",
+        )
+        _check(
+            isinstance(self.reset_look_elsewhere, bool),
+            f"reset_look_elsewhere must be True or False, got {self.reset_look_elsewhere!r}",
+        )
         for name in ("update_min_d", "update_min_a"):
             value = getattr(self, name)
             _check(value >= 0 and math.isfinite(value), f"{name} must be >= 0, got {value}")
@@ -167,6 +186,8 @@ class MclConfig:
         p.sensor_reset_after = self.sensor_reset_after
         p.sensor_reset_share = self.sensor_reset_share
         p.sensor_reset_candidates = self.sensor_reset_candidates
+        p.sensor_reset_proposal = self.sensor_reset_proposal
+        p.reset_look_elsewhere = self.reset_look_elsewhere
         p.threads = self.threads
         return p
 
@@ -224,6 +245,12 @@ class MonteCarloLocalizer:
         self.engine.initialize_uniform()
         self.estimate = self.engine.estimate().to_array()
 
+    def set_matcher(self, relocalizer) -> None:
+        """The matcher (a :class:`kiseki.filters.Relocalizer` of the filter's map) that a sensor
+        reset with the matcher proposal searches the scan given to :meth:`step` with."""
+        self._relocalizer = relocalizer  # kept alive with the engine's reference to its core
+        self.engine.set_matcher(relocalizer.core)
+
     def due(self, odometry: np.ndarray) -> bool:
         """Whether a measurement update is due at this odometry pose (AMCL's gate)."""
         if self._last_update is None:
@@ -232,18 +259,26 @@ class MonteCarloLocalizer:
         return d >= self.config.update_min_d or a >= self.config.update_min_a
 
     def step(
-        self, odometry, prepare: Callable[[], _core.SensorModel] | None
+        self,
+        odometry,
+        prepare: Callable[[], _core.SensorModel] | None,
+        scan: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> _core.UpdateReport | None:
         """Moves the particles by the odometry since the last update and weighs them with the
         model ``prepare()`` returns (called only when an update is due), or, when none is due,
-        moves the estimate with the odometry. Returns the update's report or None."""
+        moves the estimate with the odometry. ``scan``: the (angles, ranges) the model holds,
+        which a sensor reset with the matcher proposal searches. Returns the update's report or
+        None."""
         odometry = _odometry_pose(odometry, self._last_update)
         if prepare is None:
             self._follow(odometry)
             return None
         if not self._predict_if_due(odometry):
             return None
-        return self._updated(odometry, self.engine.update(prepare()))
+        model = prepare()
+        if scan is None:
+            return self._updated(odometry, self.engine.update(model))
+        return self._updated(odometry, self.engine.update(model, scan[0], scan[1]))
 
     def step_log_likelihoods(
         self,

@@ -180,6 +180,11 @@ class Relocalizer:
             threads=config.threads,
         )
 
+    @property
+    def core(self) -> _core.CorrelativeScanMatcher:
+        """The C++ matcher (what the engine's matcher proposal of a sensor reset searches)."""
+        return self._matcher
+
     def match(
         self, angles: np.ndarray, ranges: np.ndarray, disc: SearchDisc | None = None
     ) -> list[Hypothesis]:

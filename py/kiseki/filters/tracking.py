@@ -25,14 +25,16 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki import _core
-from kiseki.core import Pose2, Random, check_seed, derive_seed
+from kiseki.core import check_seed, derive_seed
 from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
+from kiseki.filters.odometry_noise import motion_alphas, noisy_odometry
 from kiseki.filters.reliability import (
     LEARNED_RELIABILITY,
     RELIABILITY_ESTIMATES,
     LearnedReliability,
     ReliabilityModel,
 )
+from kiseki.filters.relocalization import RelocalizeConfig, Relocalizer
 from kiseki.grid import DEFAULT_RAY_CASTER, OccupancyGrid, ray_caster
 from kiseki.mapping import scan_local_map
 from kiseki.scans import LaserScans, check_odometry_jumps
@@ -43,8 +45,6 @@ __all__ = [
     "LocalizeConfig",
     "ScanSpaceObservation",
     "localize",
-    "motion_alphas",
-    "noisy_odometry",
     "scan_model",
     "scan_preparer",
 ]
@@ -134,6 +134,9 @@ class LocalizeConfig:
     threads: int = MclConfig.threads
     global_start: bool = False  # start uniformly over the map (no initial pose)
     resetting_injects: bool = MclConfig.resetting_injects  # Augmented MCL's injection
+    # the sensor reset's candidates: uniform or around the matcher's hypotheses (MclConfig)
+    sensor_reset_proposal: str = MclConfig.sensor_reset_proposal
+    reset_look_elsewhere: bool = MclConfig.reset_look_elsewhere
     likelihood_power: float = MclConfig.likelihood_power
     # the `reliability` of the result: the engine's "agreement" or the "learned" probability
     # (kiseki.filters.reliability)
@@ -193,6 +196,8 @@ class LocalizeConfig:
             likelihood_power=self.likelihood_power,
             recovery=self.recovery,
             resetting_injects=self.resetting_injects,
+            sensor_reset_proposal=self.sensor_reset_proposal,
+            reset_look_elsewhere=self.reset_look_elsewhere,
             update_min_d=self.update_min_d,
             update_min_a=self.update_min_a,
             threads=self.threads,
@@ -244,45 +249,6 @@ def scan_model(method: str, grid: OccupancyGrid, config: LocalizeConfig | None =
         f"no sensor model for method {method!r}: use likelihood-field, beam, space-observation "
         "or ray-space-observation"
     )
-
-
-def motion_alphas(config: LocalizeConfig, scans: LaserScans) -> tuple[float, ...]:
-    """The filter's motion noise: `config.alphas` if given, else the noise the odometry has.
-
-    That is the log's own odometry error plus the noise `noisy_odometry` adds. The log's own:
-    none when its odometry equals its reference poses (the CARMEN "corrected" logs), else
-    unknown, and then `REAL_ODOMETRY_ALPHAS`. The added noise has SD F |component| on each
-    increment, so in the motion model's terms a rotation SD of F |rotation| and a translation
-    SD of F |translation|: alpha1 = alpha3 = F^2; the cross terms (translation turning the
-    heading, rotation moving the robot) get a tenth of that. A filter told of more noise than
-    the odometry has spreads its particles further than one scan can pull them back, which the
-    weakly peaked space observation model does not survive on long corridors."""
-    if config.alphas is not None:
-        return tuple(config.alphas)
-    exact = scans.odometry.shape == scans.poses.shape and np.allclose(
-        scans.odometry, scans.poses, atol=1e-6
-    )
-    base = (0.0, 0.0, 0.0, 0.0) if exact else REAL_ODOMETRY_ALPHAS
-    f2 = config.odometry_noise**2
-    added = (f2, 0.1 * f2, f2, 0.1 * f2)
-    return tuple(max(b + a, 1e-6) for b, a in zip(base, added, strict=True))
-
-
-def noisy_odometry(poses: np.ndarray, fraction: float, seed: int) -> np.ndarray:
-    """Odometry rebuilt from the increments of `poses` (in each previous pose's frame), each
-    component perturbed by zero-mean Gaussian noise with SD = fraction x |component|."""
-    poses = np.asarray(poses, dtype=float)
-    rng = Random(seed)
-    out = np.empty_like(poses)
-    out[0] = poses[0]
-    current = Pose2(*poses[0])
-    for k in range(1, len(poses)):
-        step = Pose2(*poses[k - 1]).between(Pose2(*poses[k])).to_array()
-        if fraction > 0:
-            step = step + fraction * np.abs(step) * rng.normal(0.0, 1.0, 3)
-        current = current * Pose2(*step)
-        out[k] = current.to_array()
-    return out
 
 
 @dataclass(frozen=True)
@@ -352,6 +318,11 @@ def localize(
         localizer.initialize_global()
     else:
         localizer.initialize(scans.poses[0], config.initial_sd)
+    matcher = config.recovery == "resetting" and config.sensor_reset_proposal == "matcher"
+    if matcher:  # scores with this config's likelihood-field terms, RelocalizeConfig's beams
+        terms = dict(sigma_hit=config.sigma_hit, z_hit=config.z_hit, z_rand=config.z_rand)
+        rc = RelocalizeConfig(**terms, threads=config.threads)
+        localizer.set_matcher(Relocalizer(grid, scans.max_range, rc))
     prepare = scan_preparer(scan_model(config.method, grid, config), scans)
     learned = LearnedReliability(reliability_model) if config.reliability == "learned" else None
     estimates = np.empty((n, 3))
@@ -373,7 +344,8 @@ def localize(
 
     for k in tqdm(range(n), desc=config.method, unit="scan", disable=not progress):
         start = time.perf_counter()
-        report = localizer.step(odom[k], lambda k=k: prepared(k))
+        scan = (scans.angles, scans.ranges[k]) if matcher else None
+        report = localizer.step(odom[k], lambda k=k: prepared(k), scan)
         if report is not None:
             seconds.append(time.perf_counter() - start)
             updated[k] = True

@@ -66,6 +66,9 @@ class ExcursionsConfig:
     # kiseki's ray space observation model's weight of an unmapped object (LocalizeConfig's)
     z_intrusion: PositiveReal = LocalizeConfig.z_intrusion
     max_scans: Scans = 0  # 0 = whole logs
+    # the sensor reset's candidates (uniform or matcher) and its look-elsewhere term
+    sensor_reset_proposal: str = LocalizeConfig.sensor_reset_proposal
+    reset_look_elsewhere: bool = LocalizeConfig.reset_look_elsewhere
     threads: Threads = 1
 
 
@@ -143,6 +146,8 @@ def trial(config: ExcursionsConfig, index: int, seed: int) -> TrialOutput:
                 recovery=recovery,
                 threads=config.threads,
                 z_intrusion=config.z_intrusion,
+                sensor_reset_proposal=config.sensor_reset_proposal,
+                reset_look_elsewhere=config.reset_look_elsewhere,
             )
             result = localize(scans, maps[method], lc)
             d = result.estimates - scans.poses

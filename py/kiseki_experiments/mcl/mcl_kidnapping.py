@@ -86,6 +86,9 @@ class KidnapConfig:
     recover_heading: PositiveReal = 10.0  # deg
     recover_hold: Scans = 10  # updates
     threads: Threads = 1  # per trial (trials run in parallel)
+    # the sensor reset's candidates (uniform or matcher) and its look-elsewhere term
+    sensor_reset_proposal: str = LocalizeConfig.sensor_reset_proposal
+    reset_look_elsewhere: bool = LocalizeConfig.reset_look_elsewhere
     # the claims' controls: the recovery that runs in the arm named "resetting", and whether
     # the robot is carried at all (false: the log goes on from scan k, no jump)
     resetting_runs: str = "resetting"
@@ -196,6 +199,8 @@ def _trial(scans: LaserScans, grid, config: KidnapConfig, seed: int, name: str) 
             beams=config.beams,
             recovery=recovery.split("+")[0],
             resetting_injects=recovery == "resetting+injection",
+            sensor_reset_proposal=config.sensor_reset_proposal,
+            reset_look_elsewhere=config.reset_look_elsewhere,
             threads=config.threads,
             reliability=config.reliability,
         )

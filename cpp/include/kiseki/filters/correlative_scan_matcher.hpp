@@ -89,6 +89,10 @@ class CorrelativeScanMatcher {
   int headings(const double* angles, const float* ranges, std::size_t n) const;
   const CorrelativeMatcherParams& params() const { return params_; }
   double max_range() const { return max_range_; }
+  double resolution() const { return frame_.resolution(); }
+  /// Cells the laser is placed at (free_only: the known free cells; else every cell): the
+  /// lattice holds this many poses per heading.
+  std::size_t lattice_cells() const;
 
  private:
   struct Search;

@@ -14,6 +14,7 @@
 #include "kiseki/filters/kld_sampling.hpp"
 #include "kiseki/filters/motion_model.hpp"
 #include "kiseki/filters/resampling.hpp"
+#include "kiseki/filters/sensor_reset_proposal.hpp"
 #include "kiseki/grid/occupancy_grid.hpp"
 #include "kiseki/models/sensor_model.hpp"
 
@@ -78,6 +79,12 @@ struct MclParams {
   int sensor_reset_after = 4;  ///< ... before a sensor reset (expansions until then)
   double sensor_reset_share = 0.5;
   std::size_t sensor_reset_candidates = 20000;
+  /// Where the sensor reset's candidates come from (the matcher needs set_matcher and the scan).
+  ResetProposal sensor_reset_proposal = ResetProposal::uniform;
+  /// Add ln N to reset_evidence for a sensor reset that took its best of N poses: N =
+  /// sensor_reset_candidates (uniform) or the matcher's lattice poses (matcher). See
+  /// look_elsewhere_term. Off: the acceptance of kiseki before the matcher proposal.
+  bool reset_look_elsewhere = false;
   double reliability_rate = 0.1;       ///< smoothing of the reliability estimate per update
   int threads = 0;                     ///< 0 = every core
   void validate() const;
@@ -131,6 +138,12 @@ class MonteCarloLocalization {
   /// Weighs the particles with a model that holds the current measurement, then recovers and
   /// resamples as configured.
   UpdateReport update(const SensorModel& model);
+  /// The same, with the scan the model holds as the matcher reads it: a sensor reset with the
+  /// matcher proposal searches it (the pointers are read during this call only).
+  UpdateReport update(const SensorModel& model, const ScanView& scan);
+  /// The correlative scan matcher of the matcher proposal (not owned: it must outlive its use
+  /// here; nullptr removes it). Its lattice cells should be the free cells set here.
+  void set_matcher(const CorrelativeScanMatcher* matcher) { matcher_ = matcher; }
   /// The same with log-likelihoods computed elsewhere (one per particle), the number of
   /// readings they hold and their agreement (NaN if unknown). Resetting then expands without
   /// weighing again and never sensor-resets (that needs the model).
@@ -158,13 +171,14 @@ class MonteCarloLocalization {
 
  private:
   UpdateReport update_impl(const std::vector<double>& log_l, std::size_t readings, double agreement,
-                           const SensorModel* model);
+                           const SensorModel* model, const ScanView* scan);
   std::vector<double> evaluate(const SensorModel& model, const std::vector<Pose2>& poses) const;
   double agreement_of(const SensorModel& model) const;
   void resample(double inject_probability, UpdateReport& report);
   bool explains_better(double proposed_best, double cloud_best) const;
   bool expansion_reset(const SensorModel* model, double cloud_best);
-  bool sensor_reset(const SensorModel& model, double cloud_best);
+  bool sensor_reset(const SensorModel& model, double cloud_best, const ScanView* scan);
+  std::vector<Pose2> reset_candidates(const ScanView* scan, double& searched);
   void check_ready() const;
 
   MclParams params_;
@@ -182,6 +196,7 @@ class MonteCarloLocalization {
   int lost_updates_ = 0;
   double reliability_ = 1.0;
   Pose2 posterior_;
+  const CorrelativeScanMatcher* matcher_ = nullptr;
 };
 
 }  // namespace kiseki

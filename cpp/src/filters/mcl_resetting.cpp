@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Copyright (c) 2026 the kiseki authors
+// The resets of MonteCarloLocalization's resetting recovery: expansion resetting (Ueda et al.,
+// emcl) and sensor resetting (Lenser and Veloso, 2000), with their acceptance test.
+#include <algorithm>
+#include <cmath>
+
+#include "kiseki/core/angle.hpp"
+#include "kiseki/core/parallel.hpp"
+#include "kiseki/filters/monte_carlo_localization.hpp"
+
+namespace kiseki {
+
+bool MonteCarloLocalization::explains_better(double proposed_best, double cloud_best) const {
+  // The best of many proposed poses beats the cloud's best by chance where the likelihood is
+  // flat (a scan of open space): the proposal must be better by a likelihood ratio of
+  // exp(reset_evidence), on the scale the weights use.
+  return params_.likelihood_power * (proposed_best - cloud_best) > params_.reset_evidence;
+}
+
+bool MonteCarloLocalization::expansion_reset(const SensorModel* model, double cloud_best) {
+  const std::size_t n = particles_.size();
+  const std::vector<std::size_t> idx = resample_indices(weights_, n, params_.resampling, rng_);
+  std::vector<Pose2> out(n);
+  const std::uint64_t seed = rng_.below(~std::uint64_t{0});
+  const double rp = params_.expansion_position, ro = params_.expansion_orientation;
+  parallel_for(n, params_.threads, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      StreamRandom g(seed, i);
+      const Pose2& q = particles_[idx[i]];
+      const double dx = g.uniform(-rp, rp), dy = g.uniform(-rp, rp), dt = g.uniform(-ro, ro);
+      out[i] = Pose2(q.x + dx, q.y + dy, q.theta + dt);
+    }
+  }, 4096);
+  if (model == nullptr) {  // log-likelihoods from elsewhere: cannot weigh again, so keep it
+    particles_.swap(out);
+    weights_.assign(n, 1.0 / static_cast<double>(n));
+    return true;
+  }
+  // Kept only if some expanded particle explains the measurement better than the best particle
+  // did: a cloud that is right but sees an odd scan is not scattered.
+  const std::vector<double> l = evaluate(*model, out);
+  if (!explains_better(*std::max_element(l.begin(), l.end()), cloud_best)) return false;
+  particles_.swap(out);
+  weights_.assign(n, 1.0 / static_cast<double>(n));
+  apply_log_likelihoods(weights_, l, params_.likelihood_power);
+  return true;
+}
+
+std::vector<Pose2> MonteCarloLocalization::reset_candidates(const ScanView* scan, double& searched) {
+  const std::size_t count = params_.sensor_reset_candidates;
+  if (params_.sensor_reset_proposal == ResetProposal::uniform) {
+    searched = static_cast<double>(count);
+    return uniform_poses(count);
+  }
+  // The matcher's k best distinct lattice poses; the candidates spread around them by one
+  // lattice step (a cell per axis, a heading step), as the one-scan start's cloud is.
+  const std::vector<PoseHypothesis> found = matcher_->match(scan->angles, scan->ranges, scan->n);
+  if (found.empty()) return {};  // no beam returned: nothing proposes a place
+  const int headings = matcher_->headings(scan->angles, scan->ranges, scan->n);
+  searched = static_cast<double>(matcher_->lattice_cells()) * headings;
+  return poses_around_hypotheses(found, count, matcher_->resolution(), 2.0 * kPi / headings,
+                                 params_.likelihood_power, rng_);
+}
+
+bool MonteCarloLocalization::sensor_reset(const SensorModel& model, double cloud_best, const ScanView* scan) {
+  const std::size_t n = particles_.size();
+  const auto from_sensor = static_cast<std::size_t>(std::llround(params_.sensor_reset_share * static_cast<double>(n)));
+  double searched = 1.0;
+  const std::vector<Pose2> candidates = reset_candidates(scan, searched);
+  if (candidates.empty()) return false;
+  const std::vector<double> cand_l = evaluate(model, candidates);
+  // The measurement proposes another place only if some pose there explains it better than
+  // the best particle of the cloud does; with the look-elsewhere term, by a margin that grows
+  // with the number of poses the best was taken from.
+  const double penalty = params_.reset_look_elsewhere ? look_elsewhere_term(searched) : 0.0;
+  if (!explains_better(*std::max_element(cand_l.begin(), cand_l.end()) - penalty / params_.likelihood_power,
+                       cloud_best)) {
+    return false;
+  }
+  std::vector<double> w(candidates.size(), 1.0);
+  std::vector<Pose2> out;
+  out.reserve(n);
+  if (from_sensor < n) {
+    for (std::size_t i : resample_indices(weights_, n - from_sensor, params_.resampling, rng_)) out.push_back(particles_[i]);
+  }
+  if (from_sensor > 0) {
+    const bool any = apply_log_likelihoods(w, cand_l, params_.likelihood_power);
+    if (!any) w.assign(w.size(), 1.0);
+    for (std::size_t i : resample_indices(w, from_sensor, params_.resampling, rng_)) out.push_back(candidates[i]);
+  }
+  particles_.swap(out);
+  weights_.assign(n, 1.0 / static_cast<double>(n));
+  // Weigh the mixed set, so that the estimate is that of the better part, not the mean of two
+  // places.
+  apply_log_likelihoods(weights_, evaluate(model, particles_), params_.likelihood_power);
+  return true;
+}
+
+}  // namespace kiseki

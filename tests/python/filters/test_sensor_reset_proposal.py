@@ -1,0 +1,140 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The sensor reset's matcher proposal: in a synthetic room without symmetry, a cloud tracking
+the wrong place is reset around the correlative matcher's hypotheses for the scan (every
+candidate drawn within a few lattice steps of one), where the uniform proposal's candidates,
+the reference, spread over the room; both end at the truth; the same particles for one and two
+threads; bad settings refused in one line."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from _helpers.room_log import write_inputs
+from kiseki import OccupancyGrid, Pose2, _core
+from kiseki.filters import MclConfig, MonteCarloLocalizer, RelocalizeConfig, Relocalizer
+from kiseki.filters.tracking import LocalizeConfig
+
+RES = 0.05
+ANGLES = np.linspace(-math.pi / 2, math.pi / 2, 181)
+TRUTH = np.array([3.0, 5.5, 0.3])
+WRONG = np.array([9.0, 2.5, 2.0])  # where the cloud tracks before the first update
+
+
+def room() -> OccupancyGrid:
+    """A 12 x 9 m room with walls, a pillar, a box and a shelf placed without symmetry."""
+    cells = np.zeros((180, 240), np.int8)
+    cells[[0, -1], :] = 100
+    cells[:, [0, -1]] = 100
+    cells[60, 0:100] = 100
+    cells[100:180, 150] = 100
+    cells[30:50, 180:200] = 100
+    cells[120:130, 40:60] = 100
+    cells[140, 160:220] = 100
+    return OccupancyGrid(cells, RES, Pose2(0.0, 0.0, 0.0))
+
+
+def _config(proposal: str, threads: int = 1, **more) -> MclConfig:
+    # a sensor reset at the first lost update, every particle from the candidates
+    return MclConfig(
+        particles=500,
+        recovery="resetting",
+        reset_after=1,
+        sensor_reset_after=1,
+        sensor_reset_share=1.0,
+        sensor_reset_candidates=2000,
+        sensor_reset_proposal=proposal,
+        threads=threads,
+        **more,
+    )
+
+
+def _run(proposal: str, threads: int = 1, updates: int = 6, **more):
+    """The robot stands at TRUTH; the cloud starts around WRONG. Returns the particles after
+    the first update (the reset's), the reports and the final estimate."""
+    grid = room()
+    ranges = grid.cast_scans(TRUTH[None, :], ANGLES, max_range=20.0)[0]
+    model = _core.LikelihoodFieldModel(grid, sigma_hit=0.2, z_hit=0.95, z_rand=0.05, max_beams=90)
+    model.set_scan(ANGLES, np.asarray(ranges, np.float32), 20.0)
+    localizer = MonteCarloLocalizer(_config(proposal, threads, **more), seed=3, free_space=grid)
+    if proposal == "matcher":
+        localizer.set_matcher(Relocalizer(grid, 20.0, RelocalizeConfig(threads=threads)))
+    localizer.initialize(WRONG, (0.1, 0.1, 0.05))
+    reports, first = [], None
+    for _ in range(updates):
+        reports.append(localizer.step(TRUTH, lambda: model, (ANGLES, ranges)).reset)
+        if first is None:
+            first = localizer.poses.copy()
+    return first, reports, localizer.estimate, (grid, ranges)
+
+
+def _near_hypotheses(poses: np.ndarray, grid, ranges) -> np.ndarray:
+    """Whether each pose lies within 5 SDs of the proposal's spread (one cell per axis, one
+    heading step) of one of the matcher's hypotheses for the scan."""
+    relocalizer = Relocalizer(grid, 20.0)
+    found = relocalizer.match(ANGLES, ranges)
+    step = 2 * math.pi / relocalizer.headings(ANGLES, ranges)
+    near = np.zeros(len(poses), dtype=bool)
+    for h in found:
+        d = np.hypot(poses[:, 0] - h.x, poses[:, 1] - h.y)
+        a = np.abs(np.remainder(poses[:, 2] - h.theta + math.pi, 2 * math.pi) - math.pi)
+        near |= (d < 5 * math.sqrt(2) * RES) & (a < 5 * step)
+    return near
+
+
+def test_the_matcher_proposal_resets_around_the_hypotheses_and_ends_at_the_truth():
+    first, reports, estimate, (grid, ranges) = _run("matcher")
+    assert reports[0] == "sensor"
+    assert _near_hypotheses(first, grid, ranges).all()
+    assert math.hypot(*(estimate[:2] - TRUTH[:2])) < 0.3
+    # the reference: the uniform proposal's candidates spread over the room, and it too ends
+    # at the truth (one scan of this room fits one place)
+    first_u, reports_u, estimate_u, _ = _run("uniform")
+    assert reports_u[0] == "sensor"
+    assert _near_hypotheses(first_u, grid, ranges).mean() < 0.5
+    assert math.hypot(*(estimate_u[:2] - TRUTH[:2])) < 0.3
+
+
+def test_the_matcher_proposal_gives_the_same_particles_for_one_and_two_threads():
+    one, reports_one, _, _ = _run("matcher", threads=1, updates=3)
+    two, reports_two, _, _ = _run("matcher", threads=2, updates=3)
+    assert reports_one == reports_two
+    np.testing.assert_array_equal(one, two)
+
+
+def test_bad_settings_are_refused_in_one_line(tmp_path):
+    for bad, word in (
+        (dict(sensor_reset_proposal="grid"), "sensor_reset_proposal must be one of"),
+        (dict(reset_look_elsewhere=1), "reset_look_elsewhere must be True or False"),
+    ):
+        with pytest.raises(ValueError, match=word) as caught:
+            LocalizeConfig(**bad)
+        assert "\n" not in str(caught.value)
+    # the matcher proposal without a matcher, or without the scan, is refused at the update
+    grid = room()
+    ranges = grid.cast_scans(TRUTH[None, :], ANGLES, max_range=20.0)[0]
+    model = _core.LikelihoodFieldModel(grid, max_beams=90)
+    model.set_scan(ANGLES, np.asarray(ranges, np.float32), 20.0)
+    localizer = MonteCarloLocalizer(_config("matcher"), seed=3, free_space=grid)
+    localizer.initialize(WRONG, (0.1, 0.1, 0.05))
+    with pytest.raises(RuntimeError, match="needs a correlative scan matcher"):
+        localizer.step(TRUTH, lambda: model, (ANGLES, ranges))
+    with pytest.raises(RuntimeError, match="needs the scan"):
+        localizer.step(TRUTH, lambda: model)
+    write_inputs(tmp_path)  # the helpers' room and a run log through it
+    for args, word in (
+        (["--reset-proposal", "grid"], "sensor_reset_proposal must be one of"),
+        (["--global", "--reset-proposal", "matcher"], "does not apply with --global"),
+    ):
+        done = subprocess.run(
+            [sys.executable, "-m", "kiseki.cli", "localize", "log.mcap", "--map", "room.yaml",
+             "-o", "out.csv", *args],
+            cwd=tmp_path, capture_output=True, text=True, timeout=300,
+        )  # fmt: skip
+        assert done.returncode != 0
+        assert word in done.stderr and "Traceback" not in done.stderr
