@@ -139,7 +139,7 @@ void bind_filters(py::module_& m) {
            "weights"_a)
       .def("predict", &MonteCarloLocalization::predict, "odom_before"_a, "odom_after"_a,
            py::call_guard<py::gil_scoped_release>())
-      .def("update", [](MonteCarloLocalization& f, const SensorModel& model) {
+      .def("update", [](MonteCarloLocalization& f, SensorModel& model) {
              py::gil_scoped_release release;
              return f.update(model);
            }, "model"_a, "Weighs with a model holding the current measurement; releases the GIL.")

@@ -168,6 +168,12 @@ double MonteCarloLocalization::agreement_of(const SensorModel& model) const {
   return model.agreement(estimate());
 }
 
+UpdateReport MonteCarloLocalization::update(SensorModel& model) {
+  check_ready();
+  model.select_readings(particles_.data(), particles_.size(), params_.threads);
+  return update(static_cast<const SensorModel&>(model));
+}
+
 UpdateReport MonteCarloLocalization::update(const SensorModel& model) {
   check_ready();
   const std::vector<double> log_l = evaluate(model, particles_);

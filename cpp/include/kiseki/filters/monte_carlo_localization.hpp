@@ -129,7 +129,10 @@ class MonteCarloLocalization {
   /// metres is refused (an odometry jump is a fault of the log, not a motion).
   void predict(const Pose2& odom_before, const Pose2& odom_after);
   /// Weighs the particles with a model that holds the current measurement, then recovers and
-  /// resamples as configured.
+  /// resamples as configured. The model first chooses its readings from the cloud
+  /// (SensorModel::select_readings, e.g. the likelihood field's beam skipping); a const model
+  /// cannot, and is weighed with as it is.
+  UpdateReport update(SensorModel& model);
   UpdateReport update(const SensorModel& model);
   /// The same with log-likelihoods computed elsewhere (one per particle), the number of
   /// readings they hold and their agreement (NaN if unknown). Resetting then expands without
