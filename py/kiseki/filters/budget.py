@@ -20,7 +20,8 @@ The choice (:func:`choose_counts`) is a pure function of the budget, the cost mo
 particle bounds and the beams asked for, never of a time measured during the run, so one seed
 and one cost model give one trajectory, for any thread count. Its rule, with T = share x
 budget (``budget_share`` 0.8: the prediction leaves a fifth of the budget to what the model
-does not hold):
+does not hold), and the particle bounds [``min_particles``, ``particles``] (KLD sampling's;
+without KLD ``min_particles`` is only the budget's floor):
 
 1. Keep the beams asked for, B, and take the largest N with t(N, B) <= T, capped at the
    maximum particle count (with KLD sampling its maximum: KLD then adapts below it, down to
