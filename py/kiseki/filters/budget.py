@@ -49,6 +49,7 @@ from scipy.optimize import nnls
 from kiseki._support.atomic import atomic_write
 from kiseki.filters.engine import MonteCarloLocalizer
 from kiseki.filters.localize_config import LocalizeConfig
+from kiseki.filters.scan_models import scan_model
 from kiseki.grid import OccupancyGrid
 from kiseki.scans import LaserScans
 
@@ -214,8 +215,6 @@ def budgeted_config(
 def _update_times(scans, grid, config: LocalizeConfig, alphas, particles: int, beams: int):
     """Seconds per update of the engine along the log's first scans, as localize() times them
     (the scan given to the model, motion, weighing, resampling); every update resamples."""
-    from kiseki.filters.tracking import scan_model  # tracking imports this module
-
     run = dataclasses.replace(config, particles=particles, beams=beams, min_particles=particles)
     mcl = dataclasses.replace(run.mcl(alphas), resample_threshold=1.0)
     localizer = MonteCarloLocalizer(mcl, 0, grid)
