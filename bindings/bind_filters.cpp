@@ -143,12 +143,12 @@ void bind_filters(py::module_& m) {
            "weights"_a)
       .def("predict", &MonteCarloLocalization::predict, "odom_before"_a, "odom_after"_a,
            py::call_guard<py::gil_scoped_release>())
-      .def("update", [](MonteCarloLocalization& f, const SensorModel& model) {
+      .def("update", [](MonteCarloLocalization& f, SensorModel& model) {
              py::gil_scoped_release release;
              return f.update(model);
            }, "model"_a, "Weighs with a model holding the current measurement; releases the GIL.")
       .def("update",
-           [](MonteCarloLocalization& f, const SensorModel& model, const py::handle& a_in, const py::handle& r_in) {
+           [](MonteCarloLocalization& f, SensorModel& model, const py::handle& a_in, const py::handle& r_in) {
              const auto [a, r] = beams(a_in, r_in);
              py::gil_scoped_release release;
              return f.update(model, ScanView{a.data(), r.data(), static_cast<std::size_t>(a.shape(0))});

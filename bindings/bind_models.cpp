@@ -143,16 +143,37 @@ void bind_models(py::module_& m) {
   py::class_<LikelihoodFieldModel, SensorModel>(m, "LikelihoodFieldModel")
       .def(py::init([](const OccupancyGrid& map, double sigma, double z_hit, double z_rand,
                        int max_beams, double max_distance, BeamCombination combination,
-                       const Pose2& sensor, double tolerance) {
+                       const Pose2& sensor, double tolerance, bool beam_skip, double skip_distance,
+                       double skip_threshold, double skip_error_threshold) {
              LikelihoodFieldParams p;
              p.sigma_hit = sigma, p.z_hit = z_hit, p.z_rand = z_rand, p.max_beams = max_beams;
              p.max_distance = max_distance, p.combination = combination, p.sensor = sensor;
-             p.agreement_tolerance = tolerance;
+             p.agreement_tolerance = tolerance, p.beam_skip = beam_skip;
+             p.beam_skip_distance = skip_distance, p.beam_skip_threshold = skip_threshold;
+             p.beam_skip_error_threshold = skip_error_threshold;
              return std::make_unique<LikelihoodFieldModel>(map, p);
            }),
            "map"_a, "sigma_hit"_a = 0.2, "z_hit"_a = 0.95, "z_rand"_a = 0.05, "max_beams"_a = 0,
            "max_distance"_a = 2.0, "combination"_a = BeamCombination::product,
-           "sensor"_a = Pose2(), "agreement_tolerance"_a = 0.2)
+           "sensor"_a = Pose2(), "agreement_tolerance"_a = 0.2,
+           "beam_skip"_a = LikelihoodFieldParams().beam_skip,
+           "beam_skip_distance"_a = LikelihoodFieldParams().beam_skip_distance,
+           "beam_skip_threshold"_a = LikelihoodFieldParams().beam_skip_threshold,
+           "beam_skip_error_threshold"_a = LikelihoodFieldParams().beam_skip_error_threshold)
+      .def("select_readings",
+           [](LikelihoodFieldModel& lf, const py::handle& poses, int threads) {
+             const auto a = as_doubles(poses, "poses");
+             require_shape(a, "poses", 2, 3);
+             std::vector<Pose2> p(static_cast<std::size_t>(a.shape(0)));
+             for (std::size_t i = 0; i < p.size(); ++i) p[i] = pose_from_row(a.data() + 3 * i);
+             py::gil_scoped_release release;
+             lf.select_readings(p.data(), p.size(), threads);
+           }, "poses"_a, "threads"_a = 1,
+           "Beam skipping over these poses (n, 3); the engine's update() does it itself.")
+      .def_property_readonly("used_beams", [](const LikelihoodFieldModel& lf) { return lf.used_beams(); })
+      .def_property_readonly("beams", &LikelihoodFieldModel::beams)
+      .def_property_readonly("outside", &LikelihoodFieldModel::outside,
+                             "The term of an end off the map, for the current max range.")
       .def("set_scan",
            [](LikelihoodFieldModel& lf, const py::handle& a_in, const py::handle& r_in,
               double max_range) {

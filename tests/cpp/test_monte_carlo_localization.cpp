@@ -321,3 +321,36 @@ TEST(MonteCarloLocalization, AnOdometryJumpOverTheLimitIsRefusedAndOneJustUnderI
     EXPECT_STREQ(e.what(), "MCL: odometry jumps 10.01 m between two updates: more than kiseki's limit of 10 m");
   }
 }
+
+// Beam skipping (the likelihood field's, nav2's idea): the engine has the model choose its beams
+// from the cloud before weighing; beams ending in free space (a person the map does not hold)
+// are skipped, and the choice and the weights are the same on one thread and on two.
+TEST(BeamSkipping, TheEngineSkipsBeamsEndingInFreeSpaceTheSameForAnyThreadCount) {
+  const OccupancyGrid g = room();
+  const auto angles = scan_angles(61);
+  const Pose2 truth(5.0, 0.8, kPi);  // facing the L-shaped block, the unknown corner behind
+  auto ranges = cast(g, truth, angles, 8.0);
+  for (int i = 25; i < 35; ++i) ranges[i] = 0.3f;  // 1 m or more from any wall
+  LikelihoodFieldParams lp;
+  lp.beam_skip = true;
+  std::vector<std::vector<double>> weights;
+  std::vector<std::vector<std::size_t>> used;
+  for (int threads : {1, 2}) {
+    LikelihoodFieldModel model(g, lp);
+    model.set_scan(angles.data(), ranges.data(), ranges.size(), 8.0);
+    ASSERT_EQ(model.beams(), 61u);
+    EXPECT_EQ(model.readings(), 61u);  // every beam until a cloud is seen
+    MclParams p;
+    p.particles = 3000, p.threads = threads, p.resample_threshold = 0.0;  // keep the weights
+    MonteCarloLocalization mcl(p, 7);
+    mcl.initialize_gaussian(truth, 0.05, 0.05, 0.02);
+    mcl.update(model);
+    for (std::size_t b : model.used_beams()) EXPECT_TRUE(b < 25 || b >= 35) << b;
+    EXPECT_GE(model.used_beams().size(), 45u);
+    EXPECT_EQ(model.readings(), model.used_beams().size());
+    weights.push_back(mcl.weights());
+    used.push_back(model.used_beams());
+  }
+  EXPECT_EQ(used[0], used[1]);
+  EXPECT_EQ(weights[0], weights[1]);
+}

@@ -168,6 +168,12 @@ double MonteCarloLocalization::agreement_of(const SensorModel& model) const {
   return model.agreement(estimate());
 }
 
+UpdateReport MonteCarloLocalization::update(SensorModel& model) {
+  check_ready();
+  model.select_readings(particles_.data(), particles_.size(), params_.threads);
+  return update(static_cast<const SensorModel&>(model));
+}
+
 UpdateReport MonteCarloLocalization::update(const SensorModel& model) {
   check_ready();
   if (params_.recovery == Recovery::resetting && params_.sensor_reset_proposal == ResetProposal::matcher) {
@@ -175,6 +181,12 @@ UpdateReport MonteCarloLocalization::update(const SensorModel& model) {
   }
   const std::vector<double> log_l = evaluate(model, particles_);
   return update_impl(log_l, model.readings(), std::numeric_limits<double>::quiet_NaN(), &model, nullptr);
+}
+
+UpdateReport MonteCarloLocalization::update(SensorModel& model, const ScanView& scan) {
+  check_ready();
+  model.select_readings(particles_.data(), particles_.size(), params_.threads);
+  return update(static_cast<const SensorModel&>(model), scan);
 }
 
 UpdateReport MonteCarloLocalization::update(const SensorModel& model, const ScanView& scan) {

@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <cstddef>
 #include <cmath>
+#include <mutex>
+#include <numeric>
 #include <stdexcept>
 
 #include "kiseki/core/angle.hpp"
+#include "kiseki/core/parallel.hpp"
 #include "kiseki/grid/distance_field.hpp"
 
 namespace kiseki {
@@ -23,6 +26,13 @@ void LikelihoodFieldParams::validate() const {
   }
   if (!(agreement_tolerance >= 0.0) || !std::isfinite(agreement_tolerance)) {
     throw std::invalid_argument("likelihood field: agreement_tolerance must be >= 0");
+  }
+  if (!(beam_skip_distance >= 0.0) || !std::isfinite(beam_skip_distance)) {
+    throw std::invalid_argument("likelihood field: beam_skip_distance must be finite and >= 0");
+  }
+  if (!(beam_skip_threshold >= 0.0 && beam_skip_threshold <= 1.0) ||
+      !(beam_skip_error_threshold >= 0.0 && beam_skip_error_threshold <= 1.0)) {
+    throw std::invalid_argument("likelihood field: beam skip thresholds must lie in [0, 1]");
   }
 }
 
@@ -69,6 +79,55 @@ void LikelihoodFieldModel::set_scan(const double* angles, const float* ranges, s
     end_x_[b] = beams_.range[b] * beams_.cos[b] * inv_res;
     end_y_[b] = beams_.range[b] * beams_.sin[b] * inv_res;
   }
+  std::vector<std::size_t> all(beams_.size());
+  std::iota(all.begin(), all.end(), std::size_t{0});
+  use(std::move(all));
+}
+
+void LikelihoodFieldModel::use(std::vector<std::size_t> beams) {
+  used_ = std::move(beams);
+  used_x_.resize(used_.size());
+  used_y_.resize(used_.size());
+  for (std::size_t i = 0; i < used_.size(); ++i) used_x_[i] = end_x_[used_[i]], used_y_[i] = end_y_[used_[i]];
+}
+
+void LikelihoodFieldModel::select_readings(const Pose2* poses, std::size_t n, int threads) {
+  if (!params_.beam_skip || n == 0) return;
+  if (table_range_ < 0.0) throw std::logic_error("likelihood field: set a scan first");
+  const std::size_t m = beams_.size();
+  const Pose2 to_grid = frame_.origin().inverse();
+  const double inv_res = 1.0 / frame_.resolution();
+  const int w = frame_.width(), h = frame_.height();
+  const float near = static_cast<float>(params_.beam_skip_distance);
+  std::vector<std::size_t> near_wall(m, 0);  // per beam: particles whose end is near a wall
+  std::mutex merge;
+  parallel_for(n, threads, [&](std::size_t begin, std::size_t end) {
+    std::vector<std::size_t> local(m, 0);
+    for (std::size_t k = begin; k < end; ++k) {
+      const Pose2 s = to_grid.compose(poses[k].compose(params_.sensor));
+      const double px = s.x * inv_res, py = s.y * inv_res, c = std::cos(s.theta), sn = std::sin(s.theta);
+      for (std::size_t b = 0; b < m; ++b) {
+        const double gx = px + c * end_x_[b] - sn * end_y_[b], gy = py + sn * end_x_[b] + c * end_y_[b];
+        if (gx >= 0.0 && gy >= 0.0 && gx < w && gy < h &&
+            distance_.at<float>(static_cast<int>(gy), static_cast<int>(gx)) <= near) {
+          ++local[b];
+        }
+      }
+    }
+    const std::lock_guard<std::mutex> lock(merge);  // integer sums: any order gives the same
+    for (std::size_t b = 0; b < m; ++b) near_wall[b] += local[b];
+  }, 256);
+  std::vector<std::size_t> kept;
+  const double needed = params_.beam_skip_threshold * static_cast<double>(n);
+  for (std::size_t b = 0; b < m; ++b) {
+    if (static_cast<double>(near_wall[b]) >= needed) kept.push_back(b);
+  }
+  const double skipped = static_cast<double>(m - kept.size());
+  if (skipped > params_.beam_skip_error_threshold * static_cast<double>(m)) {
+    kept.resize(m);
+    std::iota(kept.begin(), kept.end(), std::size_t{0});
+  }
+  use(std::move(kept));
 }
 
 void LikelihoodFieldModel::log_likelihoods(const Pose2* poses, std::size_t n, double* out) const {
@@ -77,9 +136,9 @@ void LikelihoodFieldModel::log_likelihoods(const Pose2* poses, std::size_t n, do
   const Pose2 to_grid = frame_.origin().inverse();
   const double inv_res = 1.0 / frame_.resolution();
   const int w = frame_.width(), h = frame_.height();
-  const std::size_t m = beams_.size();
-  const double* bx = end_x_.data();
-  const double* by = end_y_.data();
+  const std::size_t m = used_.size();
+  const double* bx = used_x_.data();
+  const double* by = used_y_.data();
   const bool nav2 = params_.combination == BeamCombination::nav2;
   const float* table = table_.ptr<float>(0);  // continuous (created by tabulate)
   const double width = w, height = h;

@@ -22,6 +22,7 @@ from kiseki._support.options import (
     THREAD_LIMIT,
     Count,
     Fraction,
+    Quantity,
     Seed,
     refuse_given,
 )
@@ -30,6 +31,7 @@ from kiseki._support.table import show_fields
 from kiseki.cli._defaults import default_of
 from kiseki.datasets import open_scans
 from kiseki.filters import (
+    CostModel,
     GlobalConfig,
     LocalizeConfig,
     describe,
@@ -50,6 +52,14 @@ console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
 _CONFIG_BESIDE = Derived(
     "its config", lambda a: a["output"].with_name(a["output"].stem + ".config.yaml")
 )
+_COST_MODEL = Derived(  # the cost model a budget calibrated (one given is not rewritten)
+    "its cost model",
+    lambda a: (
+        _cost_path(a["output"])
+        if a.get("budget_ms") is not None and a.get("cost_model") is None
+        else None
+    ),
+)
 _GLOBAL_REPORT = Derived(
     "its report", lambda a: a["output"].with_suffix(".json") if a["global_start"] is True else None
 )
@@ -57,8 +67,8 @@ _GLOBAL_REPORT = Derived(
 
 @app.command("localize")
 @guarded(
-    inputs=("log", "map_file"),
-    outputs=("output", _CONFIG_BESIDE, _GLOBAL_REPORT, "plot"),
+    inputs=("log", "map_file", "cost_model"),
+    outputs=("output", _CONFIG_BESIDE, _GLOBAL_REPORT, _COST_MODEL, "plot"),
 )
 @interruptible()
 def localize_command(
@@ -132,6 +142,25 @@ def localize_command(
         "with the map) or learned (a probability of being within 1 m and 10 deg, fitted on "
         f"simulated updates); default {LocalizeConfig.reliability}; not with --global.",
     ),
+    budget_ms: float | None = typer.Option(
+        None,
+        parser=Quantity("--budget-ms", 0, 1e6, "ms", lo_open=True),
+        help="Time budget per update: the particle count (with --kld its maximum) and the beams "
+        "are chosen from a cost model so that the predicted update time fits it (tracking, "
+        "likelihood-field and beam); the choice is printed and saved with the config.",
+    ),
+    cost_model: Path | None = typer.Option(
+        None,
+        help="With --budget-ms: the cost model (JSON) of an earlier run, so that a rerun with the "
+        "same seed gives the same output; without it the model is calibrated on this log and "
+        "written beside the output as OUTPUT-STEM.cost.json.",
+    ),
+    beam_skip: bool = typer.Option(
+        False,
+        "--beam-skip",
+        help="Likelihood field: nav2's beam skipping (weigh only beams that end near a wall for "
+        "enough particles).",
+    ),
     global_start: bool = typer.Option(
         False,
         "--global",
@@ -174,6 +203,8 @@ def localize_command(
 
     Example: kiseki localize run.mcap --map data/maps/factory_corridor.yaml -o track.csv --json"""
     _refuse_unused_by_localize(ctx, method, global_start)
+    if cost_model is not None and budget_ms is None:
+        raise ValueError("--cost-model applies only with --budget-ms")
 
     check_suffix("--plot", plot, FIGURE_SUFFIXES)
     if not global_start:
@@ -205,15 +236,22 @@ def localize_command(
         resets = dict(sensor_reset_proposal=reset_proposal)
         if reset_look_elsewhere:
             resets.update(reset_look_elsewhere=True)
+        budget = dict(budget_ms=budget_ms, beam_skip=beam_skip or None)
         config = LocalizeConfig(
-            **_given(**shared, odometry_noise=odometry_noise, reliability=reliability_estimate),
+            **_given(
+                **shared, odometry_noise=odometry_noise, reliability=reliability_estimate, **budget
+            ),
             **_given(**resets),
         )
+        cost = CostModel.load(cost_model) if cost_model is not None else None
         if not scans.has_reference_poses:
             raise ValueError(f"{log}: the log has no reference poses to start from: use --global")
         saved_config = {"command": "localize", **config.to_dict()}
-        tracked = localize(scans, grid, config, progress=True)
+        tracked = localize(scans, grid, config, progress=True, cost_model=cost)
         trajectory, reliability = tracked.estimates, tracked.reliability
+        if tracked.budget is not None:
+            saved_config.update(budget=asdict(tracked.budget))
+            saved_config.update(cost_model=tracked.cost_model.to_dict())
     saved_config.update(log=str(log), map=str(map_file))
     _write_trajectory(output, scans.times, trajectory, reliability)
     if not global_start:
@@ -235,6 +273,12 @@ def localize_command(
             f"(max {position.max:.3f} m), heading RMSE {heading.rmse:.2f} deg"
         ]
     lines[0] += f"; {scans.invalid_ranges} invalid range readings skipped"
+    if not global_start and tracked.budget is not None:
+        source = cost_model if cost_model is not None else _cost_path(output)
+        if cost_model is None:
+            tracked.cost_model.save(source)
+        lines.append(f"{tracked.budget.describe()}; cost model: {source}")
+        summary.update(budget=asdict(tracked.budget), cost_model_file=str(source))
     if global_start:
         report_path = write_report(result, output.with_suffix(".json"))
         lines.append(describe(result.report) + f" (report: {report_path})")
@@ -242,6 +286,11 @@ def localize_command(
     _print_report(lines, summary, as_json)
     if global_start and plot is not None:
         render_global(grid, result, plot, title=f"{log.name}: global {method}")
+
+
+def _cost_path(output: Path) -> Path:
+    """Where a calibrated cost model is written: OUTPUT-STEM.cost.json beside the output."""
+    return output.with_name(output.stem + ".cost.json")
 
 
 def _given(**settings) -> dict:
@@ -261,6 +310,8 @@ def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bo
         )
     elif method == "space-observation":  # a local map of the whole scan: no beam selection
         refuse_given(ctx, ["beams"], "to --method space-observation (it weighs the whole scan)")
+    if method != "likelihood-field":
+        refuse_given(ctx, ["beam_skip"], f"to --method {method} (a likelihood-field option)")
     if global_start:
         refuse_given(ctx, ["odometry_noise"], "with --global (it is for logs with reference poses)")
         refuse_given(
@@ -268,6 +319,7 @@ def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bo
             ["reset_proposal", "reset_look_elsewhere"],
             "with --global (its start is --one-scan; its resets are the uniform ones)",
         )
+        refuse_given(ctx, ["budget_ms", "cost_model", "beam_skip"], "with --global (tracking only)")
 
 
 def _print_report(lines: list[str], summary: dict, as_json: bool) -> None:

@@ -2,7 +2,8 @@
 # Copyright (c) 2026 the kiseki authors
 """The Monte Carlo engine as Python drives it: its config and the filter (`engine`), tracking
 along a log with the scan sensor models (`tracking`), and localization from a uniform start
-(`global_localization`, with its convergence report in `convergence`), the reliability
+(`global_localization`, with its convergence report in `convergence`), a time budget per
+update (`budget`), the reliability
 estimate (`reliability`), and relocalization from one scan by branch-and-bound correlative
 matching (`relocalization`). The engine itself, its motion models, resampling, KLD sampling and
 recovery are C++ (``kiseki._core``).
@@ -11,6 +12,13 @@ recovery are C++ (``kiseki._core``).
 
 from __future__ import annotations
 
+from kiseki.filters.budget import (
+    BudgetChoice,
+    CostModel,
+    budgeted_config,
+    calibrate,
+    choose_counts,
+)
 from kiseki.filters.convergence import (
     ConvergenceReport,
     ScanFit,
@@ -68,7 +76,9 @@ __all__ = [
     "RELIABILITY_ESTIMATES",
     "RESAMPLING_METHODS",
     "RESET_PROPOSALS",
+    "BudgetChoice",
     "ConvergenceReport",
+    "CostModel",
     "GlobalConfig",
     "GlobalResult",
     "Hypothesis",
@@ -83,6 +93,9 @@ __all__ = [
     "ScanFit",
     "ScanSpaceObservation",
     "SearchDisc",
+    "budgeted_config",
+    "calibrate",
+    "choose_counts",
     "convergence_report",
     "describe",
     "global_localize",

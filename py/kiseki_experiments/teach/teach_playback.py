@@ -69,11 +69,11 @@ from kiseki_experiments.teach.teach_playback_config import (  # noqa: F401 (tp.X
 )
 from kiseki_experiments.teach.teach_playback_tables import (  # noqa: F401 (tp.TAUGHT_SHARES)
     TAUGHT_SHARES,
-    _diagnosis,
-    _diagnostics,
-    _stop_figure,
-    _stop_table,
-    _taught_table,
+    diagnosis,
+    diagnostics_table,
+    stop_figure,
+    stop_table,
+    taught_table,
 )
 
 
@@ -199,7 +199,7 @@ def analyze_exp1(config, trials, timings, figures) -> Analysis:
             }
         )
     errors = pd.DataFrame(rows)
-    stops = _stop_table(config, ok)
+    stops = stop_table(config, ok)
     within = int(stops.iloc[0]["stops_within_0.1m"])
     loc = np.hypot(ok[f"{m}_P2_loc_dx"], ok[f"{m}_P2_loc_dy"])
     odo = np.hypot(ok[f"{m}_P2_odo_dx"], ok[f"{m}_P2_odo_dy"])
@@ -218,23 +218,23 @@ def analyze_exp1(config, trials, timings, figures) -> Analysis:
         "per run |odometry - truth| - |estimate's offset - true offset|): dead reckoning "
         "(one particle) left it undecided, not failed, so no control fails it."
     )
-    diag = _diagnostics(config, ok)
+    diag = diagnostics_table(config, ok)
     return Analysis(
         tables={
             "errors_at_waypoints": errors,
             "stops": stops,
             "diagnostics": diag,
-            "taught_maps": _taught_table(config, ok),
+            "taught_maps": taught_table(config, ok),
         },
-        figures=[_stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
+        figures=[stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
         evidence=evidence,
-        notes=notes + "\n\n" + _diagnosis(diag, ok, turn_route=False),
+        notes=notes + "\n\n" + diagnosis(diag, ok, turn_route=False),
     )
 
 
 def analyze_exp2(config, trials, timings, figures) -> Analysis:
     ok = trials[trials["error"].isna()]
-    stops = _stop_table(config, ok)
+    stops = stop_table(config, ok)
     thesis = pd.DataFrame(
         [
             {"method": m, "thesis_stop_error_mean_m": v[0], "thesis_stops_within_0.1m": v[3]}
@@ -242,21 +242,21 @@ def analyze_exp2(config, trials, timings, figures) -> Analysis:
         ]
     )
     stops = stops.merge(thesis, on="method", how="left")
-    diag = _diagnostics(config, ok)
+    diag = diagnostics_table(config, ok)
     return Analysis(
-        tables={"stops": stops, "diagnostics": diag, "taught_maps": _taught_table(config, ok)},
-        figures=[_stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
+        tables={"stops": stops, "diagnostics": diag, "taught_maps": taught_table(config, ok)},
+        figures=[stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
         evidence=exp2_evidence(ok, set(config.methods)),
         notes=f"Thesis Tables 4.5/4.6: {THESIS_RUNS} runs per method; 'both' is not in the "
         "thesis. Each method's own stop error and share within 0.1 m (with its 95 % Wilson "
         "interval) stand in table `stops` beside the thesis' (table rows, not claims: the "
-        "thesis' findings are the comparisons between methods).\n\n" + _diagnosis(diag, ok),
+        "thesis' findings are the comparisons between methods).\n\n" + diagnosis(diag, ok),
     )
 
 
 def analyze_exp3(config, trials, timings, figures) -> Analysis:
     ok = trials[trials["error"].isna()]
-    stops = _stop_table(config, ok)
+    stops = stop_table(config, ok)
     thesis = pd.DataFrame(
         [
             {
@@ -269,7 +269,7 @@ def analyze_exp3(config, trials, timings, figures) -> Analysis:
         ]
     )
     stops = stops.merge(thesis, on="method", how="left")
-    diag = _diagnostics(config, ok)
+    diag = diagnostics_table(config, ok)
     m = config.methods[0]
     cols = ["final_leg_boxes_left", "final_leg_boxes_right", f"{m}_stop_dx", f"{m}_stop_dy"]
     cols += [f"{m}_nobox_stop_dx", f"{m}_nobox_stop_dy"]
@@ -298,16 +298,16 @@ def analyze_exp3(config, trials, timings, figures) -> Analysis:
             else ""
         )
         + "\n\n"
-        + _diagnosis(diag, ok)
+        + diagnosis(diag, ok)
     )
     return Analysis(
         tables={
             "stops": stops,
             "diagnostics": diag,
             "boxes_final_leg": boxes,
-            "taught_maps": _taught_table(config, ok),
+            "taught_maps": taught_table(config, ok),
         },
-        figures=[_stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
+        figures=[stop_figure(config, ok, figures), _profile_figure(config, ok, figures)],
         notes=notes,
         evidence=exp3_evidence(ok, config.methods),
     )

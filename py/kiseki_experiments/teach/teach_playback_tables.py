@@ -17,10 +17,17 @@ from kiseki.metrics import wilson_interval
 from kiseki.plots import new_figure
 from kiseki_experiments.teach.teach_playback_claims import STOP_TOLERANCE_M, THESIS_TABLE_4_5
 
-__all__ = ["TAUGHT_SHARES"]
+__all__ = [
+    "TAUGHT_SHARES",
+    "diagnosis",
+    "diagnostics_table",
+    "stop_figure",
+    "stop_table",
+    "taught_table",
+]
 
 
-def _stop_table(config, trials: pd.DataFrame) -> pd.DataFrame:
+def stop_table(config, trials: pd.DataFrame) -> pd.DataFrame:
     rows = []
     for method in config.methods:
         stop, est = trials[f"{method}_stop_error"], trials[f"{method}_estimate_error"]
@@ -54,7 +61,7 @@ TAUGHT_SHARES = (
 )
 
 
-def _taught_table(config, trials: pd.DataFrame) -> pd.DataFrame:
+def taught_table(config, trials: pd.DataFrame) -> pd.DataFrame:
     """The taught maps against the scene's truth (kiseki.metrics.taught_map_truth), per band:
     mean and worst share of obstacle cells in reach erased, and of visible free cells marked
     occupied, over the trials (each teaches its own map), both with the one-cell shift forgiven
@@ -71,7 +78,7 @@ def _taught_table(config, trials: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _diagnostics(config, trials: pd.DataFrame) -> pd.DataFrame:
+def diagnostics_table(config, trials: pd.DataFrame) -> pd.DataFrame:
     """Per method: where the robot stopped relative to the goal (x along the final leg, y to
     its left in the scenes' frames), the estimate's error at the stop, and the one-step
     likelihood around the true goal pose: where it peaks and how much it drops 0.1 m / 0.3 m
@@ -100,7 +107,7 @@ def _diagnostics(config, trials: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _diagnosis(diag: pd.DataFrame, ok: pd.DataFrame, turn_route: bool = True) -> str:
+def diagnosis(diag: pd.DataFrame, ok: pd.DataFrame, turn_route: bool = True) -> str:
     """Why the stops differ from the thesis, every number from this run's trials (and the
     thesis' Table 4.5 and kiseki's constants, named where they are used)."""
     d = diag.set_index("method")
@@ -178,7 +185,7 @@ def _turn_route_causes(d: pd.DataFrame, ok: pd.DataFrame) -> str:
     return " ".join(text)
 
 
-def _stop_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
+def stop_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
     fig = new_figure(figsize=(5, 5), dpi=120)
     ax = fig.subplots()
     for method in config.methods:

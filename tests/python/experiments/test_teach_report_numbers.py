@@ -54,7 +54,7 @@ def _trials(rng: np.random.Generator, runs: int = 5) -> pd.DataFrame:
 @pytest.fixture(autouse=True)
 def _no_figures(monkeypatch):
     """The notes are what is tested here; drawing the figures would take most of the time."""
-    for name in ("_stop_figure", "_profile_figure"):
+    for name in ("stop_figure", "_profile_figure"):
         monkeypatch.setattr(tp, name, lambda config, trials, figures: figures / "none.png")
 
 

@@ -136,10 +136,14 @@ class MonteCarloLocalization {
   /// metres is refused (an odometry jump is a fault of the log, not a motion).
   void predict(const Pose2& odom_before, const Pose2& odom_after);
   /// Weighs the particles with a model that holds the current measurement, then recovers and
-  /// resamples as configured.
+  /// resamples as configured. The model first chooses its readings from the cloud
+  /// (SensorModel::select_readings, e.g. the likelihood field's beam skipping); a const model
+  /// cannot, and is weighed with as it is.
+  UpdateReport update(SensorModel& model);
   UpdateReport update(const SensorModel& model);
   /// The same, with the scan the model holds as the matcher reads it: a sensor reset with the
   /// matcher proposal searches it (the pointers are read during this call only).
+  UpdateReport update(SensorModel& model, const ScanView& scan);
   UpdateReport update(const SensorModel& model, const ScanView& scan);
   /// The correlative scan matcher of the matcher proposal (not owned: it must outlive its use
   /// here; nullptr removes it). Its lattice cells should be the free cells set here.

@@ -34,6 +34,16 @@ enum class BeamCombination {
 /// range (log pz for the product, pz^3 for nav2's sum), as nav2 and beluga do: a beam then
 /// costs a transform and one table read. Poses given to the model are robot poses; the laser's
 /// mount in the robot frame is `sensor`.
+///
+/// Beam skipping (nav2's do_beamskip, off by default): a beam that ends near a wall for few
+/// particles probably hit something the map does not hold (a person, a door left open), and
+/// weighing with it only spreads the cloud. select_readings(cloud) counts, per beam, the
+/// particles whose end of that beam lies within beam_skip_distance of an occupied cell; a beam
+/// is used when that count is at least beam_skip_threshold x the cloud's size. When more than
+/// beam_skip_error_threshold of the beams would be skipped the cloud itself is probably wrong
+/// (not the beams), and every beam is used. The counts are integers summed over disjoint
+/// ranges of particles, so the choice is the same for any thread count. set_scan() uses every
+/// beam until select_readings() is called (the engine calls it in update()).
 struct LikelihoodFieldParams {
   double sigma_hit = 0.2;  ///< m (nav2's default)
   double z_hit = 0.95;
@@ -43,6 +53,10 @@ struct LikelihoodFieldParams {
   BeamCombination combination = BeamCombination::product;
   Pose2 sensor;  ///< the laser in the robot frame
   double agreement_tolerance = 0.2;  ///< m: a ray may enter a wall this far before its reading
+  bool beam_skip = false;               ///< nav2's do_beamskip
+  double beam_skip_distance = 0.5;      ///< m, nav2's beam_skip_distance
+  double beam_skip_threshold = 0.3;     ///< share of particles, nav2's beam_skip_threshold
+  double beam_skip_error_threshold = 0.9;  ///< share of beams, nav2's beam_skip_error_threshold
   void validate() const;
 };
 
@@ -52,7 +66,14 @@ class LikelihoodFieldModel : public SensorModel {
   /// The scan of this step.
   void set_scan(const double* angles, const float* ranges, std::size_t n, double max_range);
   void log_likelihoods(const Pose2* poses, std::size_t n, double* out) const override;
-  std::size_t readings() const override { return beams_.size(); }
+  /// The beams weighed with: every beam of the scan, or those beam skipping keeps.
+  std::size_t readings() const override { return used_.size(); }
+  /// Beam skipping over this cloud (see above); nothing unless params().beam_skip.
+  void select_readings(const Pose2* poses, std::size_t n, int threads) override;
+  /// The indices, among the scan's beams with a return, of the beams weighed with.
+  const std::vector<std::size_t>& used_beams() const { return used_; }
+  /// How many beams the scan has after max_beams and without the beams with no return.
+  std::size_t beams() const { return beams_.size(); }
   double agreement(const Pose2& pose) const override;
   const LikelihoodFieldParams& params() const { return params_; }
   /// The tabulated per-cell term (log pz or pz^3) for the current max range, for tests.
@@ -70,7 +91,10 @@ class LikelihoodFieldModel : public SensorModel {
   float outside_ = 0.0f;
   double table_range_ = -1.0;
   ScanBeams beams_;
+  void use(std::vector<std::size_t> beams);
   std::vector<double> end_x_, end_y_;  // beam ends in the sensor frame, in cells
+  std::vector<std::size_t> used_;       // the beams weighed with
+  std::vector<double> used_x_, used_y_;  // their ends (end_x_, end_y_ of used_)
   RangeCaster occupied_;
 };
 

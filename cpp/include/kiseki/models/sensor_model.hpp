@@ -34,6 +34,11 @@ class SensorModel {
   virtual double agreement(const Pose2& /*pose*/) const {
     return std::numeric_limits<double>::quiet_NaN();
   }
+  /// Called by the engine with the whole cloud before it weighs it, once per update (after
+  /// the measurement was set): a model that chooses which readings to use from where the
+  /// particles are (the likelihood field's beam skipping) does it here, on up to `threads`
+  /// threads, with a result that must not depend on their number. Nothing by default.
+  virtual void select_readings(const Pose2* /*poses*/, std::size_t /*n*/, int /*threads*/) {}
 };
 
 }  // namespace kiseki

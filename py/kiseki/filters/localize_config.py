@@ -1,0 +1,193 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The settings of localization along a log (:class:`LocalizeConfig`), each default held once;
+saved with every result."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+from kiseki.core import check_seed
+from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS, MclConfig
+from kiseki.filters.reliability import RELIABILITY_ESTIMATES
+from kiseki.grid import DEFAULT_RAY_CASTER, ray_caster
+
+__all__ = ["LOCALIZATION_METHODS", "LocalizeConfig"]
+
+LOCALIZATION_METHODS = (
+    "odometry",
+    "space-observation",
+    "ray-space-observation",
+    "likelihood-field",
+    "beam",
+)
+
+
+def _check(condition: bool, message: str) -> None:
+    """A config's check: ValueError with `message` unless `condition` holds."""
+    if not condition:
+        raise ValueError(message)
+
+
+@dataclass(frozen=True)
+class LocalizeConfig:
+    """Localization along a log: the method, its sensor model and the engine's settings.
+
+    * ``method`` likelihood-field: nav2 AMCL's model and the baseline MCL (Probabilistic Robotics);
+      what ``kiseki localize`` runs by default (it reads this default).
+    * ``beams`` 90: nav2's max_beams rule (every k-th beam); 90 is half of a 180-beam scan.
+    * ``sigma_hit`` 0.2 m (nav2); ``z_hit`` 0.95 / ``z_rand`` 0.05 (Probabilistic Robotics'
+      likelihood field); the beam model adds ``z_short``, ``z_max``, ``lambda_short`` (nav2's).
+    * ``ray-space-observation`` (kiseki's, ``kiseki._core.RaySpaceObservationModel``): the
+      likelihood field's terms, the thesis' penetration per ray, and ``z_intrusion`` 0.95 (=
+      z_hit: equal prior odds that a beam's end is a mapped wall or an unmapped object) times
+      the beam model's ``lambda_short`` density for a beam stopped short in free space.
+    * ``combination`` product (beams independent) or nav2 (1 + sum pz^3).
+    * ``caster``: how the beam model casts z* (:mod:`kiseki.grid.casters`: both exact, the same
+      weights); the C++ model's default.
+    * ``alphas`` None: :func:`motion_alphas` (the noise the odometry has).
+    * the engine's settings (particles, KLD, resampling, recovery, update thresholds,
+      threads) default to :class:`MclConfig`'s, which holds each of them once.
+    * ``beam_skip`` (likelihood-field only; off): nav2's beam skipping, a beam is weighed with
+      only when at least ``beam_skip_threshold`` 0.3 of the particles see its end within
+      ``beam_skip_distance`` 0.5 m of a wall, unless more than ``beam_skip_error_threshold`` 0.9
+      of the beams would be skipped (then every beam is); nav2's defaults
+      (``kiseki._core.LikelihoodFieldModel``'s header states the rule).
+    * ``budget_ms`` (None: no budget): the time per update the particle and beam counts are
+      chosen for, from a calibrated cost model (:mod:`kiseki.filters.budget`);
+      ``budget_share`` 0.8 of it is what the model's prediction may fill (the rest absorbs
+      what the model does not hold: the scheduler, other processes, caches);
+      ``budget_min_beams`` 30 (half nav2's default max_beams 60) is the fewest beams it cuts to.
+    """
+
+    method: str = "likelihood-field"
+    seed: int = 0
+    odometry_noise: float = 0.0  # SD as a fraction of each odometry increment's component
+    particles: int = MclConfig.particles
+    initial_sd: tuple[float, float, float] = (0.1, 0.1, math.radians(3.0))
+    alphas: tuple[float, ...] | None = None
+    beams: int = 90
+    sigma_hit: float = 0.2
+    z_hit: float = 0.95
+    z_rand: float = 0.05
+    z_short: float = 0.05
+    z_max: float = 0.05
+    lambda_short: float = 0.1
+    z_intrusion: float = 0.95
+    combination: str = "product"
+    caster: str = DEFAULT_RAY_CASTER
+    kld: bool = MclConfig.kld
+    min_particles: int = MclConfig.min_particles
+    resampling: str = MclConfig.resampling
+    resample_threshold: float = MclConfig.resample_threshold
+    recovery: str = MclConfig.recovery
+    update_min_d: float = MclConfig.update_min_d
+    update_min_a: float = MclConfig.update_min_a
+    threads: int = MclConfig.threads
+    global_start: bool = False  # start uniformly over the map (no initial pose)
+    resetting_injects: bool = MclConfig.resetting_injects  # Augmented MCL's injection
+    # the sensor reset's candidates: uniform or around the matcher's hypotheses (MclConfig)
+    sensor_reset_proposal: str = MclConfig.sensor_reset_proposal
+    reset_look_elsewhere: bool = MclConfig.reset_look_elsewhere
+    likelihood_power: float = MclConfig.likelihood_power
+    # the `reliability` of the result: the engine's "agreement" or the "learned" probability
+    # (kiseki.filters.reliability)
+    reliability: str = "agreement"
+    beam_skip: bool = False
+    beam_skip_distance: float = 0.5
+    beam_skip_threshold: float = 0.3
+    beam_skip_error_threshold: float = 0.9
+    budget_ms: float | None = None
+    budget_share: float = 0.8
+    budget_min_beams: int = 30
+
+    def __post_init__(self) -> None:
+        _check(
+            self.method in LOCALIZATION_METHODS,
+            f"method must be one of {', '.join(LOCALIZATION_METHODS)}, got {self.method!r}",
+        )
+        check_seed(self.seed)
+        _check(
+            self.odometry_noise >= 0 and math.isfinite(self.odometry_noise),
+            f"odometry noise must be >= 0, got {self.odometry_noise}",
+        )
+        _check(
+            len(self.initial_sd) == 3 and all(s >= 0 and math.isfinite(s) for s in self.initial_sd),
+            f"initial_sd must be three finite numbers >= 0, got {self.initial_sd}",
+        )
+        _check(
+            isinstance(self.beams, int) and self.beams >= 0,
+            f"beams must be an integer >= 0 (0 = every beam), got {self.beams!r}",
+        )
+        _check(
+            self.combination in ("product", "nav2"),
+            f"combination must be product or nav2, got {self.combination!r}",
+        )
+        ray_caster(self.caster)  # ValueError unless it names one
+        for name in ("sigma_hit", "lambda_short"):
+            value = getattr(self, name)
+            _check(value > 0 and math.isfinite(value), f"{name} must be > 0, got {value}")
+        for name in ("z_hit", "z_rand", "z_short", "z_max"):
+            value = getattr(self, name)
+            _check(value >= 0 and math.isfinite(value), f"{name} must be >= 0, got {value}")
+        _check(self.z_hit + self.z_rand > 0, "z_hit and z_rand must not both be 0")
+        if self.alphas is not None:
+            _check(
+                len(self.alphas) in (4, 5)
+                and all(a >= 0 and math.isfinite(a) for a in self.alphas),
+                f"alphas must be 4 (or 5) finite numbers >= 0, got {self.alphas}",
+            )
+        _check(
+            self.reliability in RELIABILITY_ESTIMATES,
+            f"reliability must be one of {', '.join(RELIABILITY_ESTIMATES)}, "
+            f"got {self.reliability!r}",
+        )
+        _check(
+            not self.beam_skip or self.method == "likelihood-field",
+            f"beam skipping applies only to the likelihood field, not to {self.method}",
+        )
+        _check(
+            self.beam_skip_distance >= 0 and math.isfinite(self.beam_skip_distance),
+            f"beam_skip_distance must be >= 0, got {self.beam_skip_distance}",
+        )
+        for name in ("beam_skip_threshold", "beam_skip_error_threshold"):
+            value = getattr(self, name)
+            _check(0 <= value <= 1, f"{name} must lie in [0, 1], got {value}")
+        _check(
+            self.budget_ms is None or (self.budget_ms > 0 and math.isfinite(self.budget_ms)),
+            f"budget_ms must be > 0 (or None: no budget), got {self.budget_ms}",
+        )
+        _check(
+            self.budget_ms is None or self.method in ("likelihood-field", "beam"),
+            f"a time budget applies to the likelihood-field and beam models, not to {self.method}",
+        )
+        _check(
+            0 < self.budget_share <= 1, f"budget_share must lie in (0, 1], got {self.budget_share}"
+        )
+        _check(
+            isinstance(self.budget_min_beams, int) and self.budget_min_beams >= 1,
+            f"budget_min_beams must be an integer >= 1, got {self.budget_min_beams!r}",
+        )
+        self.mcl(REAL_ODOMETRY_ALPHAS)  # the engine's checks, as ValueError
+
+    def mcl(self, alphas: tuple[float, ...]) -> MclConfig:
+        return MclConfig(
+            particles=self.particles,
+            kld=self.kld,
+            min_particles=self.min_particles,
+            alphas=tuple(alphas),
+            resampling=self.resampling,
+            resample_threshold=self.resample_threshold,
+            likelihood_power=self.likelihood_power,
+            recovery=self.recovery,
+            resetting_injects=self.resetting_injects,
+            sensor_reset_proposal=self.sensor_reset_proposal,
+            reset_look_elsewhere=self.reset_look_elsewhere,
+            update_min_d=self.update_min_d,
+            update_min_a=self.update_min_a,
+            threads=self.threads,
+        )
+
+    def to_dict(self) -> dict:
+        return asdict(self)
