@@ -11,25 +11,11 @@ import math
 import numpy as np
 import pytest
 
-from kiseki import OccupancyGrid, Pose2
+from _helpers.asymmetric_room import RES, room
+from kiseki import OccupancyGrid
 from kiseki.errors import RelocalizationError
 from kiseki.filters import GlobalConfig, Hypothesis, global_localize, hypothesis_cloud
 from kiseki.scans import LaserScans
-
-RES = 0.05
-
-
-def room() -> OccupancyGrid:
-    """A 12 x 9 m room with walls, a pillar, a box and a shelf placed without symmetry."""
-    cells = np.zeros((180, 240), np.int8)
-    cells[[0, -1], :] = 100
-    cells[:, [0, -1]] = 100
-    cells[60, 0:100] = 100
-    cells[100:180, 150] = 100
-    cells[30:50, 180:200] = 100
-    cells[120:130, 40:60] = 100
-    cells[140, 160:220] = 100
-    return OccupancyGrid(cells, RES, Pose2(0.0, 0.0, 0.0))
 
 
 def cast(grid: OccupancyGrid, pose, angles, max_range: float) -> np.ndarray:

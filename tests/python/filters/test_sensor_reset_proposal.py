@@ -15,28 +15,15 @@ import sys
 import numpy as np
 import pytest
 
+from _helpers.asymmetric_room import RES, room
 from _helpers.room_log import write_inputs
-from kiseki import OccupancyGrid, Pose2, _core
+from kiseki import _core
 from kiseki.filters import MclConfig, MonteCarloLocalizer, RelocalizeConfig, Relocalizer
 from kiseki.filters.tracking import LocalizeConfig
 
-RES = 0.05
 ANGLES = np.linspace(-math.pi / 2, math.pi / 2, 181)
 TRUTH = np.array([3.0, 5.5, 0.3])
 WRONG = np.array([9.0, 2.5, 2.0])  # where the cloud tracks before the first update
-
-
-def room() -> OccupancyGrid:
-    """A 12 x 9 m room with walls, a pillar, a box and a shelf placed without symmetry."""
-    cells = np.zeros((180, 240), np.int8)
-    cells[[0, -1], :] = 100
-    cells[:, [0, -1]] = 100
-    cells[60, 0:100] = 100
-    cells[100:180, 150] = 100
-    cells[30:50, 180:200] = 100
-    cells[120:130, 40:60] = 100
-    cells[140, 160:220] = 100
-    return OccupancyGrid(cells, RES, Pose2(0.0, 0.0, 0.0))
 
 
 def _config(proposal: str, threads: int = 1, **more) -> MclConfig:
