@@ -136,6 +136,13 @@ def test_change_detection_and_mcl(small_run) -> None:
     assert change.loc[7, "near_others_share"] > 0.05
     static = change[change["role"] == "static, held out"]["share"]
     assert change.loc[7, "near_others_departed"] < static.min()
+    # a table, not claims: each run's verdict against its role, and run 7's reason in the notes
+    assert change.loc[7, "expected"] and not change.loc[7, "as_expected"]
+    assert change.loc[[6, 8, 9], "as_expected"].all() and change.loc[5, "as_expected"]
+    claims_text = " ".join(pd.read_csv(small_run / "claims.csv")["claim"])
+    assert "map change" not in claims_text
+    report = (small_run / "report.md").read_text(encoding="utf-8")
+    assert "Run 7 (shelves moved in) is not flagged" in report
     mcl = _table(small_run, "mcl")
     assert (mcl["mcl_mean"] < 0.5 * mcl["odometry_mean"]).all()
     assert (mcl["mcl_max"] < 0.8).all()  # the thesis' position accuracy
