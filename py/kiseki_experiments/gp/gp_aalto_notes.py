@@ -168,7 +168,7 @@ def notes(config, maps: dict, change: dict | None, mcl: dict | None, walks: dict
             "Change detection is a table, not a claim: one verdict per recorded run, on four "
             "changed runs and one static one, which no interval can decide."
         )
-        parts += [_unexpected(r, change) for r in change["rows"] if _unexpected(r, change)]
+        parts += [text for r in change["rows"] if (text := _unexpected(r, change))]
     if mcl is not None:
         parts.append(
             f"MCL: {config.particles} particles, resampling at ESS < n/2 (eqs. 6.17-6.18, the "

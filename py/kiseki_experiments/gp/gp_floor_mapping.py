@@ -14,12 +14,10 @@
   magnitude per voxel; a shared kernel makes the three components cost one factorisation, so
   kiseki maps all three (the magnitude's error is reported from them).
 
-Compute times are wall times beside the thesis' 30 min (2-D) and 29 h (3-D) of GP regression
-on all points (sec. 6.9.1), with the machine's load average (other work slows them): kiseki fits
-the hyperparameters on a subsample, so its time on all points extrapolates one evaluation of
-eq. 6.11 measured on all of them (:func:`_on_all_points`). The surveys' sizes are no results
-(the scene's routes were fitted to the thesis' counts). A trial is one survey of one map with its
-own noise seed; ``runs_per_map`` of each give the claims their intervals.
+Compute times (wall, with the load average) are rows beside the thesis' 30 min and 29 h (sec.
+6.9.1), not claims; the time on all points extrapolates one evaluation of eq. 6.11 on all of them
+(:func:`_on_all_points`). The surveys' sizes are no results (the routes were fitted to the
+thesis' counts). A trial is one survey of one map; ``runs_per_map`` of each give the intervals.
 """
 
 from __future__ import annotations
