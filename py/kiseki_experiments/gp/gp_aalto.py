@@ -5,8 +5,10 @@
 The Aalto robot runs (Solin et al., IEEE T-RO 2018: a small robot under Vicon, an InvenSense
 and a Nexus 5 magnetometer, readings already turned into the world frame; runs 1-5 in a static
 field, runs 6-9 with metal shelves brought in) and the hand-held walks of Kok and Solin (MFI
-2024). Five trials, one per task:
+2024). One trial per task:
 
+* ``fold-<run>`` (one per static run, on the reference sensor): the held-out map's claims over
+  leave-one-run-out folds (:mod:`kiseki_experiments.gp.gp_aalto_folds`);
 * ``map-<sensor>`` (one per sensor): GP maps (eqs. 6.7-6.15, one GP per component as the thesis
   fits them) of every ``thinning``-th sample of runs 1-4, predicting held-out run 5: RMSE per
   component, the share of errors inside 1 and 2 predictive sigma (sigma^2 = variance of the
@@ -28,7 +30,8 @@ folder holding ``aalto/`` and ``kok_1d/``; by default ``../shared/data/magnetic`
 project.
 
 Modules: ``gp_aalto_steps`` (the static map, the robot-frame offset, the scores),
-``gp_aalto_tasks`` (the tasks), ``gp_aalto_report`` (tables and claims), ``gp_aalto_notes``
+``gp_aalto_tasks`` (the tasks), ``gp_aalto_folds`` (the folds and their claims),
+``gp_aalto_report`` (tables and evidence), ``gp_aalto_notes``
 (the report's text), ``gp_aalto_figures`` (the pictures).
 """
 
@@ -42,6 +45,13 @@ from pathlib import Path
 from kiseki_experiments.gp import gp_aalto_tasks as work
 from kiseki_experiments.gp.gp_aalto_change import change_task
 from kiseki_experiments.gp.gp_aalto_claims import CLAIMS
+from kiseki_experiments.gp.gp_aalto_folds import (
+    FOLD_CLAIMS,
+    FOLD_MODELS,
+    FOLD_VARIANCES,
+    fold_task,
+    static_runs,
+)
 from kiseki_experiments.gp.gp_aalto_report import analyze
 from kiseki_experiments.harness.base import Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
@@ -85,6 +95,13 @@ class GpAaltoConfig:
     sweep: list[Count] = field(default_factory=lambda: [1, 5, 10, 25, 50, 100])
     sweep_raw: bool = True  # the sweep also on the readings as recorded
     hilbert: bool = True  # the reduced-rank GP on all readings of the training runs
+    hilbert_tolerance: Share = 1e-4  # its basis' spectral tolerance (HilbertGP.fit's)
+    # leave-one-run-out over the static runs on the reference sensor (gp_aalto_folds): the
+    # held-out map's claims; their controls: "mean" (the training readings' mean everywhere),
+    # "prior" (the predictive variance without the readings' shrinkage)
+    folds: bool = True
+    fold_model: str = "gp"
+    fold_variance: str = "posterior"
     grid_resolution: Resolution = 0.1  # m, the pictures' grid
     # map change detection
     change_sigma: PositiveReal = 3.0  # a reading departs from the map beyond this many sigma
@@ -111,8 +128,10 @@ def data_dir(config: GpAaltoConfig) -> Path:
 
 
 def tasks(config: GpAaltoConfig) -> list[str]:
-    """The trials, in order: one map per sensor, change, mcl, walks."""
-    out = [f"map-{s}" for s in config.sensors] + ["change", "mcl"]
+    """The trials, in order: the folds (one per static run), one map per sensor, change, mcl,
+    walks. The folds come first, so that their controls run them alone."""
+    out = [f"fold-{r}" for r in static_runs(config)] if config.folds else []
+    out += [f"map-{s}" for s in config.sensors] + ["change", "mcl"]
     if config.walks:
         out.append("walks")
     return out
@@ -147,6 +166,13 @@ def preflight(config: GpAaltoConfig) -> None:
     missing += [f"{w}.mat" for w in config.walks if not (folder / "kok_1d" / f"{w}.mat").is_file()]
     if missing:
         raise FileNotFoundError(f"gp-aalto: {folder}: missing {', '.join(missing[:6])}")
+    if config.fold_model not in FOLD_MODELS or config.fold_variance not in FOLD_VARIANCES:
+        raise ValueError(
+            f"gp-aalto: fold_model must be one of {', '.join(FOLD_MODELS)}, fold_variance one "
+            f"of {', '.join(FOLD_VARIANCES)}"
+        )
+    if not 0 < config.hilbert_tolerance < 1:
+        raise ValueError("gp-aalto: hilbert_tolerance must lie in (0, 1)")
     if config.thinning < 1 or any(s < 1 for s in config.sweep):
         raise ValueError("gp-aalto: thinning and the sweep's steps must be >= 1")
     if not 0.1 <= config.walk_train_share <= 0.9:
@@ -167,7 +193,10 @@ def trial(config: GpAaltoConfig, index: int, seed: int) -> TrialOutput:
     folder = data_dir(config)
     timings: dict[str, float] = {}
     start = time.perf_counter()
-    if task.startswith("map-"):
+    if task.startswith("fold-"):
+        sensor = _reference_sensor(config)
+        payload = fold_task(config, folder, sensor, int(task[5:]), timings)
+    elif task.startswith("map-"):
         payload = work.map_task(config, folder, task[4:], timings)
     elif task == "change":
         payload = change_task(config, folder, _reference_sensor(config), timings)
@@ -189,8 +218,8 @@ EXPERIMENT = Experiment(
     config_type=GpAaltoConfig,
     trial=trial,
     analyze=analyze,
-    default_runs=5,
+    default_runs=10,
     preflight=preflight,
-    claims=CLAIMS,
+    claims=FOLD_CLAIMS + CLAIMS,
     trial_count=lambda config: len(tasks(config)),
 )

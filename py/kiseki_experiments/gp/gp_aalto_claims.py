@@ -36,6 +36,7 @@ LAGGED = Control(
         "sweep=50",
         "sweep_raw=false",
         "hilbert=false",
+        "folds=false",
     ),
     runs=3,  # the tasks: the map of the reference sensor, change detection, MCL
     why="the field of another place: the filter follows it away from the run, beyond the "

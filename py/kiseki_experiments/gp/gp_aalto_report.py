@@ -1,19 +1,22 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The analysis of gp-aalto: tables, claims and notes from the five tasks' payloads (the MCL's
-claims are declared in :mod:`kiseki_experiments.gp.gp_aalto_claims`, the pictures drawn by
-:mod:`kiseki_experiments.gp.gp_aalto_figures`)."""
+"""The analysis of gp-aalto: tables, evidence and notes from the tasks' payloads (the claims are
+declared in :mod:`kiseki_experiments.gp.gp_aalto_folds`, the held-out map's, and
+:mod:`kiseki_experiments.gp.gp_aalto_claims`, the MCL's; the pictures drawn by
+:mod:`kiseki_experiments.gp.gp_aalto_figures`). Change detection is a table, not a claim: one
+verdict per recorded run, on four changed runs and one static one, which no interval can
+decide."""
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from kiseki_experiments.gp.gp_aalto_claims import mcl_evidence
 from kiseki_experiments.gp.gp_aalto_figures import draw_all
+from kiseki_experiments.gp.gp_aalto_folds import fold_evidence, fold_table
 from kiseki_experiments.gp.gp_aalto_notes import (
     SOLIN_LENGTH_SCALE,
     SOLIN_SIGMA_N,
@@ -21,7 +24,7 @@ from kiseki_experiments.gp.gp_aalto_notes import (
     comparison_table,
     notes,
 )
-from kiseki_experiments.harness.base import Analysis, Claim
+from kiseki_experiments.harness.base import Analysis
 
 __all__ = ["analyze", "payloads"]
 
@@ -32,10 +35,6 @@ def payloads(trials: pd.DataFrame) -> dict[str, dict]:
     """task name -> its decoded payload (failed trials left out)."""
     ok = trials[trials["error"].isna()]
     return {row.task: json.loads(row.payload) for row in ok.itertuples()}
-
-
-def _fmt(values, digits: int = 2) -> str:
-    return ", ".join(f"{v:.{digits}f}" for v in values)
 
 
 def _held_out_table(maps: dict) -> pd.DataFrame:
@@ -107,66 +106,10 @@ def _change_table(change: dict) -> pd.DataFrame:
     return table
 
 
-def _claims(config, maps) -> list[Claim]:
-    """The held-out map's point verdicts (not yet declared claims: one held-out run gives no
-    interval). Change detection is a table, not a claim: one verdict per recorded run, on four
-    changed runs and one static one, which no interval can decide."""
-    claims: list[Claim] = []
-    ref = maps.get("invensense") or next(iter(maps.values()), None)
-    if ref is not None:
-        s = ref["corrected"]
-        ratio = max(r / sd for r, sd in zip(s["rmse"], s["sd"], strict=True))
-        claims.append(
-            Claim(
-                f"{ref['sensor']}: the map of runs {config.train_runs} predicts held-out run "
-                f"{config.test_run} (RMSE per component under half the run's own SD)",
-                "thesis Table 6.2: mean error 0.65-1.44 uT on its hall",
-                f"RMSE {_fmt(s['rmse'])} uT; SD {_fmt(s['sd'])} uT",
-                "uT",
-                bool(ratio < 0.5),
-                "readings less the robot-frame offset fitted on the training runs",
-            )
-        )
-        claims.append(
-            Claim(
-                "... its predictive variance is calibrated: errors inside 2 sigma",
-                "95.4 % (Gaussian)",
-                f"{100 * s['in2_all']:.1f} % ({_fmt(100 * np.asarray(s['in2']), 1)} % x, y, z)",
-                "% of readings",
-                bool(0.90 <= s["in2_all"] <= 0.99),
-                "sigma^2 = variance of the noise-free field + sigma_n^2; bound 90-99 %",
-            )
-        )
-        claims.append(
-            Claim(
-                "... and inside 1 sigma",
-                "68.3 % (Gaussian)",
-                f"{100 * s['in1_all']:.1f} % ({_fmt(100 * np.asarray(s['in1']), 1)} % x, y, z)",
-                "% of readings",
-                bool(0.583 <= s["in1_all"] <= 0.783),
-                "bound 68.3 +- 10 points",
-            )
-        )
-        if "hilbert_same" in ref:
-            h, e = ref["hilbert_same"]["rmse"], s["rmse"]
-            worst = max(abs(a / b - 1) for a, b in zip(h, e, strict=True))
-            claims.append(
-                Claim(
-                    "the reduced-rank GP equals the exact GP on the same readings",
-                    "(issue: accuracy against the exact GP on the same data)",
-                    f"RMSE {_fmt(h)} vs {_fmt(e)} uT; max |mean difference| "
-                    f"{ref['hilbert_same']['max_abs_mean_difference']:.3f} uT",
-                    "uT",
-                    bool(worst < 0.02),
-                    "RMSE within 2 % per component",
-                )
-            )
-    return claims
-
-
 def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) -> Analysis:
     p = payloads(trials)
     maps = {k[4:]: v for k, v in p.items() if k.startswith("map-")}
+    folds = [p[k] for k in sorted(p, key=_fold_order) if k.startswith("fold-")]
     change, mcl, walks = p.get("change"), p.get("mcl"), p.get("walks")
     tables: dict[str, pd.DataFrame] = {}
     tables["thesis_solin_kiseki"] = comparison_table(config, maps, mcl, timings)
@@ -186,6 +129,8 @@ def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) 
                     for r in v["offset_vs_invensense"]
                 ]
                 tables[f"{s}_minus_invensense"] = pd.DataFrame(rows)
+    if folds:
+        tables["leave_one_run_out"] = fold_table(folds)
     if change is not None:
         tables["change_detection"] = _change_table(change)
     if mcl is not None:
@@ -194,10 +139,15 @@ def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) 
         tables["mcl"] = pd.DataFrame(mcl["rows"])[cols]
     if walks is not None:
         tables["walks_3d"] = _walks_table(walks)
-    claims = _claims(config, maps)
     paths = draw_all(config, maps, change, mcl, walks, figures)
     text = notes(config, maps, change, mcl, walks)
-    return Analysis(tables, paths, claims, text, evidence=mcl_evidence(mcl))
+    evidence = fold_evidence(folds) + mcl_evidence(mcl)
+    return Analysis(tables, paths, [], text, evidence=evidence)
+
+
+def _fold_order(task: str) -> tuple[int, str]:
+    """Folds by held-out run number (fold-10 after fold-9), other tasks after them."""
+    return (int(task[5:]), task) if task.startswith("fold-") else (1 << 30, task)
 
 
 def _walks_table(walks: dict) -> pd.DataFrame:

@@ -235,9 +235,13 @@ def all_runs(config) -> list[int]:
     return sorted({*config.train_runs, config.test_run, *config.changed_runs})
 
 
-def hilbert_fit(x: np.ndarray, y: np.ndarray, kernels, domain) -> list:
-    """Reduced-rank GPs, one per component (one kernel each), on a shared box."""
-    return [HilbertGP.fit(x, y[:, [c]], k, domain=domain) for c, k in enumerate(kernels)]
+def hilbert_fit(x: np.ndarray, y: np.ndarray, kernels, domain, tolerance: float) -> list:
+    """Reduced-rank GPs, one per component (one kernel each), on a shared box; ``tolerance``:
+    the spectral tolerance of the basis (HilbertGP.fit's)."""
+    return [
+        HilbertGP.fit(x, y[:, [c]], k, domain=domain, tolerance=tolerance)
+        for c, k in enumerate(kernels)
+    ]
 
 
 def grid_prediction(gp, lower, upper, resolution: float, height: float | None = None) -> dict:

@@ -108,7 +108,8 @@ def _scalable(config, runs, sm, domain, exact, timings) -> dict:
                 out["hilbert_all"] = row
     if config.hilbert:
         x, y = st.stack_runs(runs, config.train_runs, fields, config.thinning)
-        m, v = st.predict(st.hilbert_fit(x, y, kernels, domain), test.positions)
+        gp = st.hilbert_fit(x, y, kernels, domain, config.hilbert_tolerance)
+        m, v = st.predict(gp, test.positions)
         mean, var = exact
         out["hilbert_same"] = {
             "rmse": st.held_out(corrected_test, m, v, kernels)["rmse"],
@@ -131,7 +132,8 @@ def _denser(config, runs, data, kernels, domain, timings) -> list[dict]:
             continue
         start = time.perf_counter()
         if len(x) > EXACT_LIMIT:
-            gp, method = st.hilbert_fit(x, y, kernels, domain), "hilbert"
+            gp = st.hilbert_fit(x, y, kernels, domain, config.hilbert_tolerance)
+            method = "hilbert"
         else:
             gp, method = st.fit_fixed(x, y, kernels), "exact"
         score = st.held_out(truth, *st.predict(gp, positions), kernels)

@@ -147,15 +147,42 @@ def test_change_detection_and_mcl(small_run) -> None:
     assert (mcl["mcl_mean"] < 0.5 * mcl["odometry_mean"]).all()
     assert (mcl["mcl_max"] < 0.8).all()  # the thesis' position accuracy
     claims = pd.read_csv(small_run / "claims.csv")
-    hilbert = claims[claims["claim"].str.startswith("the reduced-rank GP equals")]
-    # not yet migrated to the verdict form: the point verdict is in the note
-    assert hilbert["note"].item().startswith("point verdict without an interval: holds")
     # the MCL's declared claims: one value per odometry seed (2 here: too few to decide)
     declared = claims[claims["claim"].str.startswith("magnetic-map MCL on the held-out run")]
     assert len(declared) == 3 and (declared["trials"] == 2).all()
     assert set(declared["verdict"]) == {"inconclusive"}
     worst = declared[declared["claim"].str.contains("below 0.8 m")]["measured_value"].item()
     assert float(str(worst).split()[0]) == pytest.approx(mcl["mcl_max"].mean(), rel=1e-3)
+
+
+def test_held_out_claims_are_decided_over_leave_one_run_out_folds(small_run) -> None:
+    folds = _table(small_run, "leave_one_run_out").set_index("held_out")
+    assert list(folds.index) == [1, 2, 3, 4, 5]
+    for run, row in folds.iterrows():  # each fold trains on the other four static runs
+        assert row["train_runs"] == " ".join(str(r) for r in range(1, 6) if r != run)
+    # the fold that holds out run 5 is the map task's map of runs 1-4: the same numbers
+    exact = _table(small_run, "held_out").set_index(["readings", "method"])
+    exact = exact.loc[("corrected", "exact")]
+    for c in ("rmse_x", "rmse_y", "rmse_z", "in1_all", "in2_all"):
+        assert folds.loc[5, c] == pytest.approx(exact[c], rel=1e-9)
+    ratio = folds[["rmse_x", "rmse_y", "rmse_z"]].to_numpy() / folds[["sd_x", "sd_y", "sd_z"]]
+    np.testing.assert_allclose(folds["rmse_over_sd"], ratio.to_numpy().max(axis=1), rtol=1e-12)
+    claims = pd.read_csv(small_run / "claims.csv").set_index("claim")
+    held = claims[claims.index.str.endswith("[invensense, runs 1 2 3 4 5]")]
+    assert len(held) == 3 and (held["trials"] == 5).all()
+    rmse = held[held.index.str.contains("half the run's own SD")].iloc[0]
+    # the claim's value is the mean of the folds' ratios; a map of the other runs halves the SD
+    assert float(str(rmse["measured_value"]).split()[0]) == pytest.approx(
+        folds["rmse_over_sd"].mean(), rel=1e-3
+    )
+    assert rmse["verdict"] == "holds" and rmse["ci_high"] < 0.5
+    gap = claims[claims.index.str.startswith("the reduced-rank GP equals")].iloc[0]
+    assert gap["trials"] == 5 and gap["verdict"] == "holds"
+    assert float(str(gap["measured_value"]).split()[0]) == pytest.approx(
+        folds["hilbert_gap"].mean(), rel=1e-3
+    )
+    # no point verdict is left in gp-aalto: every claim has an interval
+    assert not claims["note"].astype(str).str.startswith("point verdict").any()
 
 
 def test_walks_3d_and_figures(small_run) -> None:
