@@ -15,21 +15,7 @@ import pandas as pd
 
 from kiseki_experiments.harness.verdict import ClaimSpec, Evidence
 
-__all__ = ["Analysis", "Claim", "ClaimSpec", "Evidence", "Experiment", "TrialOutput"]
-
-
-@dataclass(frozen=True)
-class Claim:
-    """The old form of a claim: a point value and whether it holds, with no interval. Still
-    accepted so that experiments not yet migrated to :class:`ClaimSpec` run; reported as
-    "no interval (not yet migrated)" and never counted as decided."""
-
-    claim: str
-    paper_value: str
-    measured_value: str
-    unit: str
-    holds: bool
-    note: str = ""
+__all__ = ["Analysis", "ClaimSpec", "Evidence", "Experiment", "TrialOutput"]
 
 
 @dataclass(frozen=True)
@@ -48,7 +34,6 @@ class Analysis:
 
     tables: dict[str, pd.DataFrame] = field(default_factory=dict)
     figures: list[Path] = field(default_factory=list)
-    claims: list[Claim] = field(default_factory=list)  # the old form (not yet migrated)
     notes: str = ""
     evidence: list[Evidence] = field(default_factory=list)  # of the declared claims
 

@@ -22,7 +22,7 @@ from kiseki._support.inputs import CSV_LIMIT, YAML_LIMIT, check_input, read_inpu
 from kiseki._support.table import show
 from kiseki_experiments.harness.base import Analysis, Experiment
 from kiseki_experiments.harness.registry import all_experiments
-from kiseki_experiments.harness.verdict import UNMIGRATED, VERDICT_COLUMNS, judge, legacy
+from kiseki_experiments.harness.verdict import UNMIGRATED, VERDICT_COLUMNS, judge
 
 __all__ = [
     "claims_frame",
@@ -54,15 +54,16 @@ def markdown_table(frame: pd.DataFrame) -> str:
 
 def claims_frame(experiment: Experiment, analysis: Analysis, seed: int) -> pd.DataFrame:
     """Every claim's verdict row (:class:`~.verdict.Verdict`): the declared claims judged on
-    their evidence with the run's seed, then the old point claims, shown as not migrated."""
-    rows = judge(experiment.claims, analysis.evidence, seed) + [legacy(c) for c in analysis.claims]
+    their evidence with the run's seed."""
+    rows = judge(experiment.claims, analysis.evidence, seed)
     return pd.DataFrame(
         [[getattr(r, k) for k in VERDICT_COLUMNS] for r in rows], columns=VERDICT_COLUMNS
     )
 
 
 def tally(claims: pd.DataFrame) -> dict[str, int]:
-    """Claims by verdict; ``decided`` = holds + fails (an unmigrated claim is never decided)."""
+    """Claims by verdict; ``decided`` = holds + fails (a point verdict of an old results folder
+    is never decided)."""
     verdicts = claims["verdict"].astype(str)
     out = {k: int(verdicts.eq(k).sum()) for k in ("holds", "fails", "inconclusive")}
     out["not_migrated"] = int(verdicts.eq(UNMIGRATED).sum())

@@ -37,7 +37,6 @@ __all__ = [
     "decide",
     "estimate",
     "judge",
-    "legacy",
     "trials_to_decide",
 ]
 
@@ -48,7 +47,8 @@ MIN_TRIALS = 5
 """Fewest per-trial values a bootstrap interval is computed from: below it the resamples take
 too few distinct values and the interval is far too narrow (no verdict, ``inconclusive``)."""
 UNMIGRATED = "no interval (not yet migrated)"
-"""The verdict shown for a claim still built as the old point ``Claim``: never decided."""
+"""The verdict shown for a claim of a results folder written before claims had intervals (a
+point verdict): never counted as decided."""
 
 Compare = Literal["<=", ">=", "within"]
 Outcome = Literal["holds", "fails", "inconclusive"]
@@ -266,8 +266,8 @@ class Verdict:
     trials_to_decide: float  # NaN when decided (or when no number of trials decides it)
     control: str
     note: str
-    # Kept while experiments migrate (their tests read it): verdict == "holds" for a declared
-    # claim, the point verdict for an old Claim. No report counts it; the verdict decides.
+    # verdict == "holds" (the tests read it; in an old results folder, the point verdict). No
+    # report counts it; the verdict decides.
     holds: bool = False
 
 
@@ -305,23 +305,3 @@ def judge(specs: tuple[ClaimSpec, ...], evidence: list[Evidence], seed: int) -> 
             )
         )
     return out
-
-
-def legacy(claim) -> Verdict:
-    """An old point ``Claim`` (no interval): shown, never counted as decided."""
-    return Verdict(
-        claim=claim.claim,
-        paper_value=claim.paper_value,
-        measured_value=claim.measured_value,
-        ci_low=math.nan,
-        ci_high=math.nan,
-        unit=claim.unit,
-        criterion="",
-        verdict=UNMIGRATED,
-        trials=0,
-        trials_to_decide=math.nan,
-        control="",
-        note=f"point verdict without an interval: {'holds' if claim.holds else 'fails'}"
-        + (f"; {claim.note}" if claim.note else ""),
-        holds=bool(claim.holds),
-    )

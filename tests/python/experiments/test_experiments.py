@@ -6,6 +6,7 @@ recorded, results folder, reproduction report, and bad input."""
 from __future__ import annotations
 
 import errno
+import math
 import os
 import signal
 import subprocess
@@ -23,7 +24,7 @@ from kiseki_experiments.harness import base, registry
 from kiseki_experiments.harness.config import ConfigError, apply_overrides
 from kiseki_experiments.harness.report import write_reproduction
 from kiseki_experiments.harness.runner import run_experiment
-from kiseki_experiments.harness.verdict import VERDICT_COLUMNS
+from kiseki_experiments.harness.verdict import VERDICT_COLUMNS, Control, Criterion
 from kiseki_experiments.mapping.corridor_scans import CorridorScansConfig
 
 
@@ -130,8 +131,7 @@ def _flaky_experiment() -> base.Experiment:
 
     def analyze(config, trials, timings, figures):
         ok = trials[trials["error"].isna()]
-        claim = base.Claim("values recorded", "4", str(len(ok)), "trials", len(ok) == 4)
-        return base.Analysis(tables={"ok": ok}, claims=[claim])
+        return base.Analysis(tables={"ok": ok}, notes=f"{len(ok)} values recorded")
 
     return base.Experiment(
         "flaky",
@@ -308,12 +308,13 @@ def test_a_run_whose_every_trial_fails_says_so_and_resumes_after_the_fix(tmp_pat
         return base.TrialOutput({"value": float(index)})
 
     def analyze(config, trials, timings, figures):  # needs the records: KeyError without them
-        claim = base.Claim("values", "3", str(trials["value"].count()), "trials", True)
-        return base.Analysis(claims=[claim])
+        return base.Analysis(evidence=[base.Evidence.of("values", trials["value"])])
 
+    criterion = Criterion("1", "<=", 5.0, "the trials' indices", bounds=(0.0, math.inf))
+    spec = base.ClaimSpec("values", "the values", "index", criterion, Control("c", ("x=1",), 3))
     experiment = base.Experiment(
         "doomed", "test paper", "Table 0", "fails until fixed", CorridorScansConfig, trial, analyze,
-        default_runs=3,
+        default_runs=3, claims=(spec,),
     )  # fmt: skip
     real = registry._registry()
     monkeypatch.setattr(registry, "_registry", lambda: {**real, "doomed": experiment})
@@ -334,7 +335,7 @@ def test_a_run_whose_every_trial_fails_says_so_and_resumes_after_the_fix(tmp_pat
     result = run_experiment("doomed", out=out, resume=True, progress=False)
     assert (result.runs, result.failed, result.executed) == (3, 0, 3)
     assert frame(out)["value"].tolist() == [0.0, 1.0, 2.0]
-    assert pd.read_csv(out / "claims.csv")["measured_value"].tolist() == [3]
+    assert pd.read_csv(out / "claims.csv")["measured_value"].tolist() == [1.0]  # mean of 0, 1, 2
 
 
 def test_an_analysis_error_is_raised_as_it_is_not_as_a_disk_problem(tmp_path, monkeypatch):

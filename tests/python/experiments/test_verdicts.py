@@ -13,7 +13,7 @@ import pytest
 
 from kiseki.metrics import wilson_interval
 from kiseki_experiments.harness import base
-from kiseki_experiments.harness.report import _undecided, claims_frame, tally
+from kiseki_experiments.harness.report import _old_claims, _undecided, claims_frame, tally
 from kiseki_experiments.harness.verdict import (
     UNMIGRATED,
     ClaimSpec,
@@ -86,15 +86,18 @@ def _experiment(claims=()) -> base.Experiment:
     )
 
 
-def test_reports_count_unmigrated_claims_as_undecided_and_price_the_undecided():
+def test_reports_count_old_point_verdicts_as_undecided_and_price_the_undecided():
     spec = ClaimSpec("k", "a share", "share", AT_LEAST, Control("c", ("x=1",), 5))
     analysis = base.Analysis(
-        claims=[base.Claim("old", "1", "1", "m", True)],
         evidence=[Evidence.share("k", 11, 20)],  # 0.55, Wilson 0.34-0.74: inconclusive
     )
     claims = claims_frame(_experiment((spec,)), analysis, 0)
-    assert claims["verdict"].tolist() == ["inconclusive", UNMIGRATED]
-    counts = tally(claims)
+    # a results folder written before claims had intervals: a point verdict, never decided
+    old = _old_claims(pd.DataFrame([{"claim": "old", "measured_value": "1", "holds": True}]))
+    both = pd.concat([claims, old], ignore_index=True)
+    assert both["verdict"].tolist() == ["inconclusive", UNMIGRATED]
+    assert old["note"].item() == "point verdict without an interval: holds"
+    counts = tally(both)
     assert (counts["decided"], counts["inconclusive"], counts["not_migrated"]) == (0, 1, 1)
     need = int(claims["trials_to_decide"].iloc[0])
     assert need == trials_to_decide(AT_LEAST, estimate(Evidence.share("k", 11, 20), 0))
