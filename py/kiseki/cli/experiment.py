@@ -14,11 +14,14 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from kiseki._support.atomic import atomic_write
 from kiseki._support.guard import guarded
+from kiseki._support.inputs import YAML_LIMIT, read_input_text
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import RUN_LIMIT, WORKER_LIMIT, Count, Seed
 from kiseki._support.table import show_fields
 from kiseki.errors import KisekiError
+from kiseki_experiments.harness.readme_blocks import update_readme
 from kiseki_experiments.harness.registry import all_experiments
 from kiseki_experiments.harness.report import write_reproduction
 from kiseki_experiments.harness.runner import run_experiment
@@ -107,11 +110,17 @@ def experiment_run(
 
 
 @app.command("report")
-@guarded(inputs=("results",), outputs=("output",))
+@guarded(inputs=("results",), outputs=("output", "readme"))
 @interruptible()
 def report(
     results: Path = typer.Option(Path("results"), help="Results folder of the experiments."),
     output: Path = typer.Option(Path("REPRODUCTION.md"), "-o", "--output", help="File to write."),
+    readme: Path | None = typer.Option(
+        None,
+        help="Also regenerate this Markdown file's marked tables (<!-- claims: NAME --> ... "
+        "<!-- /claims -->, <!-- reproduction-summary --> ... <!-- /reproduction-summary -->) "
+        "from the same results; every other line is kept.",
+    ),
     as_json: bool = typer.Option(False, "--json", help="Print the summary as one JSON object."),
 ) -> None:
     """Gather the latest result of every experiment into REPRODUCTION.md (each claim: the
@@ -119,8 +128,14 @@ def report(
     verdict, the share decided, the experiments without a result): a table on a terminal,
     tab-separated field/value lines when piped, or JSON with --json.
 
-    Example: kiseki experiment report --results results -o REPRODUCTION.md"""
+    Example: kiseki experiment report --results results -o REPRODUCTION.md --readme README.md"""
+    if readme is not None:  # read and checked before anything is written
+        text, blocks = update_readme(
+            read_input_text(readme, "Markdown files", YAML_LIMIT), readme, results
+        )
     totals, missing = write_reproduction(results, output)
+    if readme is not None:
+        atomic_write(readme, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
     decided = totals["decided"] / totals["claims"] if totals["claims"] else 0.0
     summary = {
         "output": str(output),
@@ -132,4 +147,6 @@ def report(
         "decided_share": round(decided, 4),
         "missing": missing,
     }
+    if readme is not None:
+        summary["readme_blocks"] = len(blocks)
     show_fields(str(output), summary, as_json=as_json, console=console)

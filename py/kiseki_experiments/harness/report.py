@@ -27,6 +27,7 @@ from kiseki_experiments.harness.verdict import UNMIGRATED, VERDICT_COLUMNS, judg
 __all__ = [
     "claims_frame",
     "print_claims",
+    "read_result",
     "tally",
     "markdown_table",
     "write_failed_outputs",
@@ -305,7 +306,7 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[dict[str, int], l
         run_dir = latest.resolve()
         if not run_dir.is_relative_to(results_root.resolve()):  # a link moved or made by hand
             raise ValueError(f"{latest}: the link points outside --results ({run_dir})")
-        claims, manifest = _read_result(latest)
+        claims, manifest = read_result(latest)
         frames.append(claims)
         timings_path = latest / "timings.parquet"
         timings = pd.read_parquet(timings_path) if timings_path.is_file() else None
@@ -328,7 +329,7 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[dict[str, int], l
     return totals, missing
 
 
-def _read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
+def read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
     """A run's claims.csv and manifest.json, refused in one line naming the file when unreadable
     or without the columns and fields the report needs. A claims table of the old form (a
     column ``holds``, no interval) is read as not yet migrated."""

@@ -1,0 +1,135 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The README's reproduction tables, regenerated from the results the report reads.
+
+A README marks what the report writes with HTML comments, which Markdown does not show:
+
+* ``<!-- claims: NAME -->`` ... ``<!-- /claims -->``: experiment NAME's claims from its latest
+  result (the claim, the paper's value, kiseki's with its 95 % interval, the verdict, the
+  trials) and the run they come from;
+* ``<!-- reproduction-summary -->`` ... ``<!-- /reproduction-summary -->``: one row per
+  registered experiment (claims by verdict, trials, commit) and the totals.
+
+:func:`update_readme` replaces the text between each pair and leaves every other line as it
+was, so the prose around a table stays the authors' while the numbers are the run's."""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from kiseki_experiments.harness.registry import all_experiments
+from kiseki_experiments.harness.report import markdown_table, read_result, tally, tally_text
+
+__all__ = ["Result", "claims_block", "gather", "summary_block", "update_readme"]
+
+_CLAIMS = re.compile(r"(<!-- claims: ([a-z0-9-]+) -->\n)(.*?)(<!-- /claims -->)", re.S)
+_SUMMARY = re.compile(
+    r"(<!-- reproduction-summary -->\n)(.*?)(<!-- /reproduction-summary -->)", re.S
+)
+
+
+@dataclass(frozen=True)
+class Result:
+    """An experiment's latest result: its claims (claims.csv) and where it was run from."""
+
+    name: str
+    claims: pd.DataFrame
+    trials: int
+    failed: int
+    commit: str
+
+
+def gather(results_root: Path) -> dict[str, Result]:
+    """The latest result of every registered experiment that has one, by name."""
+    if not results_root.is_dir():
+        raise FileNotFoundError(f"{results_root}: results folder not found")
+    out = {}
+    for name in sorted(all_experiments()):
+        latest = results_root / name / "latest"
+        if not (latest / "claims.csv").is_file():
+            continue
+        run_dir = latest.resolve()
+        if not run_dir.is_relative_to(results_root.resolve()):
+            raise ValueError(f"{latest}: the link points outside --results ({run_dir})")
+        claims, manifest = read_result(latest)
+        commit = str(manifest["git"].get("commit") or "unknown")[:7]
+        out[name] = Result(name, claims, manifest["trials"], manifest["trials_failed"], commit)
+    return out
+
+
+def _interval(row) -> str:
+    lo, hi = float(row.ci_low), float(row.ci_high)
+    ci = "" if math.isnan(lo) or math.isnan(hi) else f" [{lo:.3g}, {hi:.3g}]"
+    return f"{row.measured_value}{ci}"
+
+
+def claims_block(result: Result | None, name: str) -> str:
+    """The text between an experiment's claims markers."""
+    if result is None:
+        return f"No result yet: `kiseki experiment run {name}`.\n"
+    c = result.claims
+    table = pd.DataFrame(
+        {
+            "claim": c["claim"],
+            "paper": c["paper_value"],
+            "kiseki [95 %]": [_interval(r) for r in c.itertuples(False)],
+            "unit": c["unit"],
+            "verdict": c["verdict"],
+            "trials": c["trials"],
+        }
+    )
+    head = (
+        f"`kiseki experiment run {name}`: {result.trials} trials, {result.failed} failed, "
+        f"commit {result.commit}; {tally_text(tally(c))}."
+    )
+    return f"{head}\n\n{markdown_table(table)}\n"
+
+
+def summary_block(results: dict[str, Result]) -> str:
+    """The text between the summary markers: every registered experiment, a row each."""
+    rows, frames = [], []
+    for name in sorted(all_experiments()):
+        r = results.get(name)
+        if r is None:
+            rows.append({"experiment": name, "claims": "no result yet"})
+            continue
+        t = tally(r.claims)
+        frames.append(r.claims)
+        rows.append(
+            {
+                "experiment": name,
+                "claims": t["claims"],
+                "hold": t["holds"],
+                "fail": t["fails"],
+                "inconclusive": t["inconclusive"],
+                "trials": r.trials,
+                "commit": r.commit,
+            }
+        )
+    table = pd.DataFrame(rows).astype(object).fillna("")
+    empty = pd.DataFrame({"verdict": pd.Series([], dtype=str)})
+    total = tally(pd.concat(frames, ignore_index=True) if frames else empty)
+    return f"{markdown_table(table)}\n\nAll results: {tally_text(total)}.\n"
+
+
+def update_readme(text: str, readme: Path, results_root: Path) -> tuple[str, list[str]]:
+    """(``text``, the README's, with every marked block regenerated from ``results_root``; the
+    names of the experiments whose blocks were written). A block naming no registered
+    experiment is a ValueError naming the README and the name."""
+    known = all_experiments()
+    results = gather(results_root)
+    named = [m.group(2) for m in _CLAIMS.finditer(text)]
+    unknown = [n for n in named if n not in known]
+    if unknown:
+        raise ValueError(f"{readme}: a claims block names no experiment: {unknown[0]!r}")
+    text = _CLAIMS.sub(
+        lambda m: m.group(1) + claims_block(results.get(m.group(2)), m.group(2)) + m.group(4),
+        text,
+    )
+    text = _SUMMARY.sub(lambda m: m.group(1) + summary_block(results) + m.group(3), text)
+    return text, named

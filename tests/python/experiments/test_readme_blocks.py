@@ -1,0 +1,97 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The README's marked reproduction tables are regenerated from the results folder the report
+reads: the numbers are those of claims.csv, the prose around them is kept byte for byte."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from _helpers.cli_main import kiseki
+from kiseki_experiments.harness.readme_blocks import update_readme
+from kiseki_experiments.harness.registry import all_experiments
+from kiseki_experiments.harness.runner import run_experiment
+
+PROSE = "# A project\n\nText before, with a | pipe.\n\n"
+README = (
+    PROSE
+    + "<!-- claims: corridor-scans -->\nstale numbers 0.5 [0.1, 0.9]\n<!-- /claims -->\n"
+    + "\nText between.\n\n"
+    + "<!-- claims: exp1-corridor -->\nold\n<!-- /claims -->\n"
+    + "<!-- reproduction-summary -->\n<!-- /reproduction-summary -->\nText after.\n"
+)
+
+
+@pytest.fixture(scope="module")
+def results(tmp_path_factory) -> Path:
+    root = tmp_path_factory.mktemp("results")
+    out = root / "corridor-scans" / "r"
+    assert run_experiment("corridor-scans", runs=5, out=out, progress=False).failed == 0
+    assert (root / "corridor-scans" / "latest").resolve() == out.resolve()  # the runner's link
+    return root
+
+
+def _outside_blocks(text: str) -> list[str]:
+    keep, inside = [], False
+    for line in text.splitlines():
+        if line.startswith("<!-- claims:") or line == "<!-- reproduction-summary -->":
+            keep.append(line)
+            inside = True
+        elif line in ("<!-- /claims -->", "<!-- /reproduction-summary -->"):
+            keep.append(line)
+            inside = False
+        elif not inside:
+            keep.append(line)
+    return keep
+
+
+def test_blocks_hold_the_claims_of_the_latest_result_and_the_prose_is_kept(results, tmp_path):
+    text, named = update_readme(README, tmp_path / "README.md", results)
+    assert named == ["corridor-scans", "exp1-corridor"]
+    assert _outside_blocks(text) == _outside_blocks(README)
+    assert "stale numbers" not in text
+    claims = pd.read_csv(results / "corridor-scans" / "latest" / "claims.csv")
+    row = claims.iloc[0]
+    shown = f"{row.measured_value} [{row.ci_low:.3g}, {row.ci_high:.3g}]"
+    block = text.split("<!-- claims: corridor-scans -->\n")[1].split("<!-- /claims -->")[0]
+    cells = [row.claim, row.paper_value, shown, row.unit, row.verdict, 5]
+    assert "| " + " | ".join(map(str, cells)) + " |" in block
+    assert block.startswith("`kiseki experiment run corridor-scans`: 5 trials, 0 failed")
+    # an experiment without a result says so, and how to make one
+    assert "No result yet: `kiseki experiment run exp1-corridor`." in text
+    summary = text.split("<!-- reproduction-summary -->\n")[1].split("<!-- /reproduction-")[0]
+    rows = [line for line in summary.splitlines() if line.startswith("| ")][1:]
+    assert len(rows) == len(all_experiments())  # every registered experiment, a row each
+    mine = next(r for r in rows if r.startswith("| corridor-scans |"))
+    assert mine.split(" | ")[1:5] == ["1", "1", "0", "0"]  # claims, hold, fail, inconclusive
+    # regenerating what was regenerated changes nothing
+    assert update_readme(text, tmp_path / "README.md", results)[0] == text
+
+
+def test_a_block_naming_no_experiment_is_refused_with_the_file(results, tmp_path):
+    text = PROSE + "<!-- claims: no-such-experiment -->\n<!-- /claims -->\n"
+    with pytest.raises(ValueError, match=r"README\.md: a claims block names no experiment"):
+        update_readme(text, tmp_path / "README.md", results)
+
+
+def test_report_command_rewrites_the_readme_in_place(results, tmp_path, monkeypatch, capsys):
+    readme = tmp_path / "README.md"
+    readme.write_text(README, encoding="utf-8")
+    status, out, err = kiseki(
+        monkeypatch, capsys, "experiment", "report", "--results", results,
+        "-o", tmp_path / "R.md", "--readme", readme, "--json",
+    )  # fmt: skip
+    assert status == 0, err
+    assert '"readme_blocks": 2' in out
+    assert readme.read_text(encoding="utf-8") == update_readme(README, readme, results)[0]
+    # a README that is not there: one line naming it, nothing written
+    gone = tmp_path / "gone.md"
+    status, out, err = kiseki(
+        monkeypatch, capsys, "experiment", "report", "--results", results,
+        "-o", tmp_path / "R2.md", "--readme", gone,
+    )  # fmt: skip
+    assert status != 0 and str(gone) in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "R2.md").exists()
