@@ -89,20 +89,30 @@ def experiment_run(
 ) -> None:
     """Run an experiment's trials and write its results folder. NAME may be a pattern
     ('speed-*'): every matching experiment runs in turn, each into its own results folder
-    (--out/NAME with --out), with its default trials.
+    (--out/NAME with --out), with its default trials; with --resume, the experiments already
+    started are finished and the others started.
 
-    Example: kiseki experiment run 'speed-*' --seed 0"""
+    Example: kiseki experiment run '*' --out full --resume"""
 
     names, pattern = [name], any(c in name for c in "*?[")
     if pattern:
         names = sorted(fnmatch.filter(all_experiments(), name))
         if not names:
             raise KisekiError(f"no experiment matches {name!r} (see: kiseki experiment list)")
-        if runs is not None or overrides or resume:
-            raise KisekiError("a pattern runs several experiments: no --runs, --set or --resume")
+        if runs is not None or overrides or (resume and seed is not None):
+            raise KisekiError(
+                "a pattern runs several experiments: no --runs or --set (and --resume takes "
+                "each run's own seed)"
+            )
     for each in names:
         where = out / each if out is not None and pattern else out
-        result = run_experiment(each, runs, seed, overrides, workers, scheduler, where, resume)
+        again = resume
+        if resume and pattern:  # a run stopped part way: finish the started, start the others
+            folder = where if where is not None else Path("results") / each / "latest"
+            again = (folder / "config.yaml").is_file()
+            if not again:
+                console.print(f"{each}: no run in {folder} yet: starting one")
+        result = run_experiment(each, runs, seed, overrides, workers, scheduler, where, again)
         console.print(
             f"{result.run_dir}: {result.runs} trials ({result.executed} run now, "
             f"{result.failed} failed) in {result.wall_seconds:.1f} s"

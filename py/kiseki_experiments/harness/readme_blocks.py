@@ -23,7 +23,13 @@ from pathlib import Path
 import pandas as pd
 
 from kiseki_experiments.harness.registry import all_experiments
-from kiseki_experiments.harness.report import markdown_table, read_result, tally, tally_text
+from kiseki_experiments.harness.report import (
+    latest_run,
+    markdown_table,
+    read_result,
+    tally,
+    tally_text,
+)
 
 __all__ = ["Result", "claims_block", "gather", "summary_block", "update_readme"]
 
@@ -50,8 +56,8 @@ def gather(results_root: Path) -> dict[str, Result]:
         raise FileNotFoundError(f"{results_root}: results folder not found")
     out = {}
     for name in sorted(all_experiments()):
-        latest = results_root / name / "latest"
-        if not (latest / "claims.csv").is_file():
+        latest = latest_run(results_root, name)
+        if latest is None:
             continue
         run_dir = latest.resolve()
         if not run_dir.is_relative_to(results_root.resolve()):

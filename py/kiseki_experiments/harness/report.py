@@ -26,6 +26,7 @@ from kiseki_experiments.harness.verdict import UNMIGRATED, VERDICT_COLUMNS, judg
 
 __all__ = [
     "claims_frame",
+    "latest_run",
     "print_claims",
     "read_result",
     "tally",
@@ -296,10 +297,9 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[dict[str, int], l
     missing: list[str] = []
     for name, experiment in sorted(all_experiments().items()):
         section = by_paper.setdefault(experiment.paper, [])
-        latest = results_root / name / "latest"
-        claims_path = latest / "claims.csv"
+        latest = latest_run(results_root, name)
         section += ["", f"### {name} ({experiment.artefact}): {experiment.description}", ""]
-        if not claims_path.is_file():
+        if latest is None:
             missing.append(name)
             section.append(f"**missing**: no result yet; run `kiseki experiment run {name}`.")
             continue
@@ -327,6 +327,16 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[dict[str, int], l
         lines += ["", f"## {paper}", *section]
     _text(out, "\n".join(lines) + "\n")
     return totals, missing
+
+
+def latest_run(results_root: Path, name: str) -> Path | None:
+    """The run of ``name`` the report reads: ``results_root/name/latest`` (the runner's link),
+    else ``results_root/name`` itself when it is a run (``run 'PATTERN' --out``'s layout); None
+    when neither holds a claims table."""
+    for folder in (results_root / name / "latest", results_root / name):
+        if (folder / "claims.csv").is_file():
+            return folder
+    return None
 
 
 def read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
