@@ -95,3 +95,15 @@ def test_report_command_rewrites_the_readme_in_place(results, tmp_path, monkeypa
     )  # fmt: skip
     assert status != 0 and str(gone) in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "R2.md").exists()
+
+
+def test_the_readme_tables_are_the_committed_results():
+    """The README's reproduction tables are what `kiseki experiment report --readme` makes of
+    the results committed in docs/reproduction: edited by hand, or left behind by a new run,
+    they fail here."""
+    root = Path(__file__).resolve().parents[3]
+    readme = root / "README.md"
+    text = readme.read_text(encoding="utf-8")
+    assert "<!-- reproduction-summary -->" in text
+    regenerated, _ = update_readme(text, readme, root / "docs" / "reproduction" / "results")
+    assert regenerated == text
