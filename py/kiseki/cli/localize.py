@@ -40,6 +40,7 @@ from kiseki.filters import (
     render_global,
     write_report,
 )
+from kiseki.grid import RAY_CASTERS
 from kiseki.io.ros_map import load_map
 from kiseki.mapping import endpoint_agreement
 from kiseki.metrics import ape
@@ -155,6 +156,11 @@ def localize_command(
         "same seed gives the same output; without it the model is calibrated on this log and "
         "written beside the output as OUTPUT-STEM.cost.json.",
     ),
+    caster: str | None = typer.Option(
+        None,
+        help=f"Beam model: how the expected ranges z* are cast ({', '.join(RAY_CASTERS)}; "
+        f"both exact, the same weights); default {LocalizeConfig.caster}.",
+    ),
     beam_skip: bool = typer.Option(
         False,
         "--beam-skip",
@@ -236,7 +242,7 @@ def localize_command(
         resets = dict(sensor_reset_proposal=reset_proposal)
         if reset_look_elsewhere:
             resets.update(reset_look_elsewhere=True)
-        budget = dict(budget_ms=budget_ms, beam_skip=beam_skip or None)
+        budget = dict(budget_ms=budget_ms, beam_skip=beam_skip or None, caster=caster)
         config = LocalizeConfig(
             **_given(
                 **shared, odometry_noise=odometry_noise, reliability=reliability_estimate, **budget
@@ -312,6 +318,8 @@ def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bo
         refuse_given(ctx, ["beams"], "to --method space-observation (it weighs the whole scan)")
     if method != "likelihood-field":
         refuse_given(ctx, ["beam_skip"], f"to --method {method} (a likelihood-field option)")
+    if method != "beam":
+        refuse_given(ctx, ["caster"], f"to --method {method} (a beam-model option)")
     if global_start:
         refuse_given(ctx, ["odometry_noise"], "with --global (it is for logs with reference poses)")
         refuse_given(
@@ -319,7 +327,9 @@ def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bo
             ["reset_proposal", "reset_look_elsewhere"],
             "with --global (its start is --one-scan; its resets are the uniform ones)",
         )
-        refuse_given(ctx, ["budget_ms", "cost_model", "beam_skip"], "with --global (tracking only)")
+        refuse_given(
+            ctx, ["budget_ms", "cost_model", "beam_skip", "caster"], "with --global (tracking only)"
+        )
 
 
 def _print_report(lines: list[str], summary: dict, as_json: bool) -> None:
