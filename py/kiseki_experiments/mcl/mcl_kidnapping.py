@@ -22,6 +22,9 @@ recovery time is from the jump to the first of those updates.
 * ``mcl-kidnapping-carmen``: the four CARMEN logs, trial i on log i mod 4 with its own seed; the
   map is built from the corrected poses (0.05 m), the odometry is rebuilt from them with noise
   (F = 0.1 of each increment, as the README's runs).
+
+The config and its checks are in ``mcl_kidnapping_config``, the claims in
+``mcl_kidnapping_claims``, the tables, figures and evidence in ``mcl_kidnapping_report``.
 """
 
 from __future__ import annotations
@@ -29,18 +32,14 @@ from __future__ import annotations
 import copy
 import math
 import tempfile
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 from kiseki.core import Pose2, derive_seed
 from kiseki.datasets import read_carmen_log
 from kiseki.filters import (
     LEARNED_RELIABILITY,
-    RECOVERY_MODES,
-    RELIABILITY_ESTIMATES,
     LocalizeConfig,
     ReliabilityModel,
     localize,
@@ -48,86 +47,18 @@ from kiseki.filters import (
 from kiseki.grid import OccupancyGrid
 from kiseki.io.runlog import read_run
 from kiseki.mapping import MapBuildConfig, map_of_log
-from kiseki.metrics import area_under_roc
-from kiseki.plots import new_figure
 from kiseki.scans import LaserScans
 from kiseki.sim.run import SimConfig, simulate
 from kiseki.sim.scene import load_scene
-from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
-from kiseki_experiments.harness.config import (
-    Count,
-    NonNegativeReal,
-    Particles,
-    PositiveReal,
-    Real,
-    Scans,
-    Threads,
-)
+from kiseki_experiments.harness.base import Experiment, TrialOutput
 from kiseki_experiments.harness.paths import CARMEN_LOGS, PROJECT, shared_data
-from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion, Evidence
-
-
-@dataclass(frozen=True)
-class KidnapConfig:
-    scene: str = "data/worlds/factory_turn.yaml"  # mcl-kidnapping: relative to the project
-    data_dir: str = ""  # mcl-kidnapping-carmen: folder of the logs; "" = ../shared/data/carmen
-    logs: list[str] = field(default_factory=lambda: list(CARMEN_LOGS))
-    method: str = "likelihood-field"
-    particles: Particles = 1000
-    beams: Count = 90
-    # "resetting+injection": resetting with Augmented MCL's injection as well
-    recoveries: list[str] = field(default_factory=lambda: [*RECOVERY_MODES, "resetting+injection"])
-    odometry_noise: NonNegativeReal = 0.1  # CARMEN: added to the corrected poses' increments
-    min_jump: NonNegativeReal = 2.0  # m between the pose before and after the kidnapping
-    before_scans: Scans = 200  # scans of tracking before the kidnapping (at most)
-    after_scans: Scans = 400  # scans after it (at most)
-    min_after: Scans = 80  # a trial needs at least this many scans after the jump
-    recover_distance: PositiveReal = 0.5  # m
-    recover_heading: PositiveReal = 10.0  # deg
-    recover_hold: Scans = 10  # updates
-    threads: Threads = 1  # per trial (trials run in parallel)
-    # the sensor reset's candidates (uniform or matcher) and its look-elsewhere term
-    sensor_reset_proposal: str = LocalizeConfig.sensor_reset_proposal
-    reset_look_elsewhere: bool = LocalizeConfig.reset_look_elsewhere
-    # the claims' controls: the recovery that runs in the arm named "resetting", and whether
-    # the robot is carried at all (false: the log goes on from scan k, no jump)
-    resetting_runs: str = "resetting"
-    kidnap: bool = True
-    # the reliability reported: "learned" (kiseki.filters.reliability) or the engine's
-    # "agreement" (both are recorded); the learned one's controls: its log-likelihood drop
-    # weighed by drop_weight (0: agreement alone) and its log-odds moved by odds_offset
-    reliability: str = "learned"
-    drop_weight: NonNegativeReal = 1.0
-    odds_offset: Real = 0.0
-
-
-def _check(config: KidnapConfig) -> None:
-    for r in [*config.recoveries, config.resetting_runs]:
-        if r not in (*RECOVERY_MODES, "resetting+injection"):
-            raise ValueError(f"kidnapping: unknown recovery {r!r} ({', '.join(RECOVERY_MODES)})")
-    if not config.recoveries:
-        raise ValueError("kidnapping: recoveries is empty")
-    if config.reliability not in RELIABILITY_ESTIMATES:
-        raise ValueError(f"kidnapping: reliability must be one of {RELIABILITY_ESTIMATES}")
-    if not (config.min_jump > 0 and config.recover_distance > 0 and config.recover_hold >= 1):
-        raise ValueError("kidnapping: min_jump, recover_distance and recover_hold must be > 0")
-    if config.before_scans < 20 or config.after_scans < config.min_after:
-        raise ValueError("kidnapping: need before_scans >= 20 and after_scans >= min_after")
-
-
-def preflight_sim(config: KidnapConfig) -> None:
-    _check(config)
-    path = PROJECT / config.scene
-    if not path.is_file():
-        raise FileNotFoundError(f"mcl-kidnapping: scene {path} not found")
-
-
-def preflight_carmen(config: KidnapConfig) -> None:
-    _check(config)
-    folder = shared_data("carmen", config.data_dir)
-    missing = [n for n in config.logs if not (folder / f"{n}.log.gz").is_file()]
-    if missing:
-        raise FileNotFoundError(f"mcl-kidnapping-carmen: {folder}: missing {', '.join(missing)}")
+from kiseki_experiments.mcl.mcl_kidnapping_claims import CARMEN_CLAIMS, SIM_CLAIMS
+from kiseki_experiments.mcl.mcl_kidnapping_config import (
+    KidnapConfig,
+    preflight_carmen,
+    preflight_sim,
+)
+from kiseki_experiments.mcl.mcl_kidnapping_report import analyze
 
 
 def splice(scans: LaserScans, k: int, j: int, before: int, after: int) -> LaserScans:
@@ -296,244 +227,6 @@ def trial_carmen(config: KidnapConfig, index: int, seed: int) -> TrialOutput:
     return _trial(scans, grid, config, seed, name)
 
 
-def analyze(config: KidnapConfig, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path):
-    ok = trials[trials["error"].isna()]
-    rows = []
-    for r in config.recoveries:
-        rec = ok[f"{r}_recovered"].astype(bool)
-        scans_to = ok.loc[rec, f"{r}_recovery_scans"]
-        rows.append(
-            {
-                "recovery": r,
-                "trials": len(ok),
-                "tracked_before": float(ok[f"{r}_tracked_before"].mean()),
-                "recovered": float(rec.mean()),
-                "median_recovery_scans": float(scans_to.median()) if len(scans_to) else None,
-                "max_recovery_scans": float(scans_to.max()) if len(scans_to) else None,
-                "reliability_before": float(ok[f"{r}_reliability_before"].mean()),
-                "reliability_after": float(ok[f"{r}_reliability_after"].mean()),
-                "agreement_reliability_after": float(ok[f"{r}_agreement_reliability_after"].mean()),
-                **_reliability_shares(ok, r),
-                "ms_per_update": float(timings[f"{r}_ms_per_update"].median()),
-            }
-        )
-    table = pd.DataFrame(rows)
-    tables = {"recovery": table}
-    if "none" in config.recoveries:
-        tables["reliability_auc"] = _auc_table(ok)
-    by = table.set_index("recovery")
-    evidence = []
-    if "resetting" in by.index:
-        rec = ok["resetting_recovered"].astype(bool)
-        scans_to = by.loc["resetting", "median_recovery_scans"]
-        evidence.append(
-            Evidence.share(
-                "recovers",
-                int(rec.sum()),
-                len(rec),
-                shown=f"{int(rec.sum())} of {len(rec)}; median {scans_to} scans to recover",
-            )
-        )
-    if "none" in by.index:
-        before = by.loc["none", "reliability_before"]
-        evidence.append(
-            Evidence.of(
-                "falls",
-                ok["none_reliability_after"],
-                shown=f"mean 10 updates after the jump; {before:.2f} before it",
-            )
-        )
-        evidence += _reliability_evidence(ok)
-    fig = new_figure(figsize=(10, 3.6), dpi=120)
-    axes = fig.subplots(1, 2)
-    colours = ("tab:red", "tab:orange", "tab:blue", "tab:green")
-    for r, colour in zip(config.recoveries, colours, strict=False):
-        errors = [np.asarray(e) for e in ok[f"{r}_errors"]]
-        rel = [np.asarray(e) for e in ok[f"{r}_reliability"]]
-        if not errors:
-            continue
-        length = min(len(e) for e in errors)
-        t = np.arange(length) - 20
-        axes[0].plot(t, np.median([e[:length] for e in errors], axis=0), color=colour, label=r)
-        axes[1].plot(t, np.mean([e[:length] for e in rel], axis=0), color=colour, label=r)
-    axes[0].set_yscale("log")
-    axes[0].set_ylabel("median position error (m)")
-    axes[1].set_ylabel("mean reliability estimate")
-    for ax in axes:
-        ax.axvline(0, color="k", lw=0.8, ls=":")
-        ax.set_xlabel("updates after the kidnapping")
-        ax.legend(fontsize=7)
-    path = figures / "kidnapping.png"
-    fig.savefig(path, bbox_inches="tight")
-    notes = (
-        f"{len(ok)} trials; {config.method}, {config.particles} particles, {config.beams} beams; "
-        f"the robot is carried at least {config.min_jump} m; recovered = back within "
-        f"{config.recover_distance} m and {config.recover_heading} deg for "
-        f"{config.recover_hold} updates. Reliability: the engine's estimate (the recent share "
-        "of updates whose scan agrees with the map seen from the particles)."
-    )
-    paths = [path]
-    if "none" in config.recoveries and len(ok):
-        paths.append(_roc_figure(ok, figures / "reliability_roc.png"))
-    return Analysis(tables=tables, figures=paths, notes=notes, evidence=evidence)
-
-
-def _reliability_shares(ok: pd.DataFrame, arm: str) -> dict:
-    """The reliability claims' shares for one arm, the reported estimate's and the engine's."""
-    lost = ok[f"{arm}_lost_after"].astype(bool)
-    updates = ok[f"{arm}_tracking_updates"].sum()
-    out: dict = {"trials_lost": int(lost.sum())}
-    for name in ("", "agreement_"):
-        low = ok.loc[lost, f"{arm}_{name}low_within_10"].astype(bool)
-        out[f"{name}low_within_10"] = float(low.mean()) if len(low) else None
-        high = ok[f"{arm}_{name}tracking_high"].sum()
-        out[f"{name}high_when_tracking"] = float(high / updates) if updates else None
-    return out
-
-
-def _lost_and_scores(group: pd.DataFrame):
-    """The none arm's recorded updates (from 20 before the jump on) of some trials: whether
-    each is more than 1 m off, and 1 - reliability of each estimate (learned, engine's)."""
-    errors = np.concatenate([np.asarray(e) for e in group["none_errors"]])
-    scores = {
-        name: 1.0 - np.concatenate([np.asarray(r) for r in group[f"none_{name}reliability"]])
-        for name in ("", "agreement_")
-    }
-    return errors > 1.0, scores
-
-
-def _auc_table(ok: pd.DataFrame) -> pd.DataFrame:
-    """Per source (simulation or log), the area under the ROC curve of 1 - reliability for
-    "error above 1 m"."""
-    rows = []
-    for source, group in ok.groupby("source", sort=True):
-        lost, scores = _lost_and_scores(group)
-        row = {"source": source, "updates": len(lost), "share_lost": float(lost.mean())}
-        row |= {f"{name}auc": area_under_roc(score, lost) for name, score in scores.items()}
-        rows.append(row)
-    return pd.DataFrame(rows)
-
-
-def _roc_figure(ok: pd.DataFrame, path: Path) -> Path:
-    """ROC curves of both estimates for "error above 1 m", one panel per source."""
-    groups = list(ok.groupby("source", sort=True))
-    fig = new_figure(figsize=(3.2 * len(groups), 3.2), dpi=120)
-    axes = np.atleast_1d(fig.subplots(1, len(groups)))
-    for ax, (source, group) in zip(axes, groups, strict=True):
-        lost, scores = _lost_and_scores(group)
-        for (name, score), colour in zip(scores.items(), ("tab:blue", "tab:grey"), strict=True):
-            order = np.argsort(-score, kind="stable")
-            hit = np.concatenate([[0.0], np.cumsum(lost[order]) / max(lost.sum(), 1)])
-            false = np.concatenate([[0.0], np.cumsum(~lost[order]) / max((~lost).sum(), 1)])
-            label = f"{'engine' if name else 'learned'} {area_under_roc(score, lost):.3f}"
-            ax.plot(false, hit, color=colour, label=label)
-        ax.plot([0, 1], [0, 1], color="k", lw=0.6, ls=":")
-        ax.set_title(source, fontsize=8)
-        ax.set_xlabel("false alarms (share within 1 m)")
-        ax.legend(fontsize=7, loc="lower right")
-    fig.axes[0].set_ylabel("lost updates caught (> 1 m)")
-    fig.savefig(path, bbox_inches="tight")
-    return path
-
-
-def _reliability_evidence(ok: pd.DataFrame) -> list[Evidence]:
-    lost = ok["none_lost_after"].astype(bool)
-    low = ok.loc[lost, "none_low_within_10"].astype(bool)
-    old = ok.loc[lost, "none_agreement_low_within_10"].astype(bool)
-    high, updates = int(ok["none_tracking_high"].sum()), int(ok["none_tracking_updates"].sum())
-    old_high = int(ok["none_agreement_tracking_high"].sum())
-    return [
-        Evidence.share(
-            "low_when_lost",
-            int(low.sum()),
-            len(low),
-            shown=f"{int(low.sum())} of {len(low)} (the engine's estimate: {int(old.sum())})",
-        ),
-        Evidence.share(
-            "high_when_tracking",
-            high,
-            updates,
-            shown=f"{high} of {updates} updates (the engine's estimate: {old_high})",
-        ),
-    ]
-
-
-def _issue_target(why: str) -> Criterion:
-    """A share of at least 0.95, the issue's target for recovery and reliability."""
-    return Criterion(
-        paper_value=">= 0.95 (the issue's target)",
-        compare=">=",
-        threshold=0.95,
-        why=f"the issue's target: {why}",
-        bounds=(0.0, 1.0),
-    )
-
-
-def _claims(small: tuple[str, ...] = ()) -> tuple[ClaimSpec, ...]:
-    """The claims; ``small`` adds overrides that keep a control's trials small (one log)."""
-    return (
-        ClaimSpec(
-            key="recovers",
-            claim="with resetting, kidnapped trials recover (0.5 m, 10 deg, held 10 updates)",
-            unit="share of trials",
-            criterion=_issue_target("at most 1 kidnapping in 20 left unrecovered"),
-            control=Control(
-                name="no recovery in the resetting arm",
-                overrides=("resetting_runs=none", "recoveries=resetting", *small),
-                runs=5,
-                why="without a recovery the filter's particles stay where the robot was",
-            ),
-            measure="whether a trial's resetting arm recovered",
-        ),
-        ClaimSpec(
-            key="falls",
-            claim="the reliability estimate falls when the robot is lost (no recovery)",
-            unit="mean reliability over the 10 updates after the jump",
-            criterion=Criterion(
-                paper_value="falls (als_ros users report 99.99 % while lost)",
-                compare="<=",
-                threshold=0.5,
-                why="below half: most recent scans disagree with the map seen from the particles",
-                bounds=(0.0, 1.0),
-            ),
-            control=Control(
-                name="no kidnapping",
-                overrides=("kidnap=false", "recoveries=none", *small),
-                runs=5,
-                why="a robot that is not carried stays localised and its scans agree with the map",
-            ),
-            measure="a trial's mean reliability over the 10 updates after the jump (no recovery)",
-        ),
-        ClaimSpec(
-            key="low_when_lost",
-            claim="without recovery, the reliability falls below 0.5 within 10 updates of the "
-            "jump in trials more than 1 m off",
-            unit="share of trials more than 1 m off at each of the 10 updates",
-            criterion=_issue_target("a lost robot says so within 10 updates in 19 of 20"),
-            control=Control(
-                name="the learned estimate without its likelihood drop (agreement alone)",
-                overrides=("drop_weight=0", "recoveries=none", *small),
-                runs=3,  # decides: its estimate never goes under sigmoid(b0) = 0.72
-                why="in a look-alike place the scan agrees with the map from the wrong pose",
-            ),
-            measure="whether the reliability of a lost trial's none arm went below 0.5",
-        ),
-        ClaimSpec(
-            key="high_when_tracking",
-            claim="the reliability is above 0.9 while the error is under 0.3 m (and 10 deg)",
-            unit="share of updates within 0.3 m and 10 deg (no recovery)",
-            criterion=_issue_target("a tracking robot is not called lost in 1 update of 20"),
-            control=Control(
-                name="the learned estimate's odds divided by e^2",
-                overrides=("odds_offset=-2", "recoveries=none", *small),
-                runs=3,  # decides: hundreds of tracking updates a trial
-                why="an estimate that underrates every update stays below 0.9 while tracking",
-            ),
-            measure="updates of the none arm within 0.3 m and 10 deg whose reliability > 0.9",
-        ),
-    )
-
-
 SIM = Experiment(
     name="mcl-kidnapping",
     paper="localization engine (beyond the papers)",
@@ -546,7 +239,7 @@ SIM = Experiment(
     # 0.95; from 73 of 73 on it is above (n / (n + 1.96^2) >= 0.95): 80 decide it
     default_runs=80,
     preflight=preflight_sim,
-    claims=_claims(),
+    claims=SIM_CLAIMS,
 )
 
 CARMEN = Experiment(
@@ -559,6 +252,5 @@ CARMEN = Experiment(
     analyze=analyze,
     default_runs=20 * len(CARMEN_LOGS),  # as the simulated runs: 80 decide a share >= 0.95
     preflight=preflight_carmen,
-    # the controls on the Intel log alone (about 1 s a trial; Freiburg's 4,791 scans take 4 s)
-    claims=_claims(("logs=intel-corrected",)),
+    claims=CARMEN_CLAIMS,
 )

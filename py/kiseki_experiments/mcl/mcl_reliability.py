@@ -23,12 +23,8 @@ import numpy as np
 
 from kiseki.filters import LocalizeConfig, localize
 from kiseki.filters.reliability import FEATURES, ReliabilityModel, fit_logistic, localised
-from kiseki_experiments.mcl.mcl_kidnapping import (
-    KidnapConfig,
-    choose_jump,
-    simulated_run,
-    splice,
-)
+from kiseki_experiments.mcl.mcl_kidnapping import choose_jump, simulated_run, splice
+from kiseki_experiments.mcl.mcl_kidnapping_config import KidnapConfig
 
 FIT_SEEDS = tuple(range(101, 131))
 ARMS = ("none", "resetting")

@@ -1,0 +1,115 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Cooperative positioning: triangulation against the paper's closed forms (eqs. 1-4), against
+Monte Carlo on random geometry, in 3-D against 2-D, and its refusals of bad geometry."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from kiseki.coop import paper_error, paper_position, triangulate
+
+SIGMA = math.radians(0.1)  # the paper's bearing noise
+
+
+@pytest.mark.parametrize("theta1", [0.35, 0.785, 1.1])
+@pytest.mark.parametrize("theta2", [0.5, 0.785, 1.3])
+def test_symmetric_case_matches_equations_1_to_4(theta1: float, theta2: float) -> None:
+    d = 1.5
+    standing = [[-d, 0.0], [d, 0.0]]
+    bearings = [theta1, math.pi - theta2]  # robot 1 sees theta1 from +x, robot 2 from -x
+    position, covariance = triangulate(standing, bearings, bearing_sigma=SIGMA)
+    np.testing.assert_allclose(position, paper_position(d, theta1, theta2), atol=1e-12)
+    jac = np.column_stack(
+        [paper_error(d, theta1, theta2, 1.0, 0.0), paper_error(d, theta1, theta2, 0.0, 1.0)]
+    )
+    np.testing.assert_allclose(covariance, SIGMA**2 * jac @ jac.T, rtol=1e-9, atol=1e-18)
+
+
+def test_equation_3_as_printed_contradicts_equation_1() -> None:
+    d, t1, t2, h = 1.0, 0.6, 1.0, 1e-7
+    numeric = (paper_position(d, t1 + h, t2) - paper_position(d, t1 - h, t2)) / (2 * h)
+    np.testing.assert_allclose(paper_error(d, t1, t2, 1.0, 0.0), numeric, rtol=1e-6)
+    s2 = math.sin(t1 + t2) ** 2
+    printed_dx = d * math.sin(2 * t2) / s2  # eq. 3 as printed, dth1 = 1, dth2 = 0
+    assert printed_dx == pytest.approx(-numeric[0], rel=1e-6)  # the sign is the misprint
+    # sec. 3.2: opposite errors make the cross-track error (x), equal ones none on the centre line
+    assert abs(paper_error(d, 0.8, 0.8, 1.0, -1.0)[0]) > 1.0
+    assert paper_error(d, 0.8, 0.8, 1.0, 1.0)[0] == pytest.approx(0.0, abs=1e-12)
+
+
+def _bearings(standing: np.ndarray, target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    d = target - standing
+    return np.arctan2(d[:, 1], d[:, 0]), np.arctan2(d[:, 2], np.hypot(d[:, 0], d[:, 1]))
+
+
+def test_covariance_matches_monte_carlo_in_3d() -> None:
+    rng = np.random.default_rng(5)
+    standing = np.array([[0.0, 0.0, 0.0], [4.0, 0.5, 0.4], [1.0, 5.0, -0.3]])
+    target = np.array([2.5, 2.0, 1.0])
+    bearings, elevations = _bearings(standing, target)
+    sigma = math.radians(0.5)
+    position, covariance = triangulate(
+        standing, bearings, elevations, bearing_sigma=sigma, elevation_sigma=2 * sigma
+    )
+    np.testing.assert_allclose(position, target, atol=1e-9)
+    samples = np.array(
+        [
+            triangulate(
+                standing,
+                bearings + rng.normal(0, sigma, 3),
+                elevations + rng.normal(0, 2 * sigma, 3),
+                bearing_sigma=sigma,
+                elevation_sigma=2 * sigma,
+            )[0]
+            for _ in range(4000)
+        ]
+    )
+    sample_cov = np.cov(samples.T)
+    assert np.linalg.norm(sample_cov - covariance) < 0.08 * np.linalg.norm(covariance)
+
+
+def test_three_d_on_a_plane_is_two_d() -> None:
+    standing = np.array([[0.0, 0.0], [3.0, 0.0], [0.0, 3.0]])
+    target = np.array([1.0, 1.5])
+    b = np.arctan2(target[1] - standing[:, 1], target[0] - standing[:, 0])
+    p2, c2 = triangulate(standing, b + [0.001, -0.002, 0.0015], bearing_sigma=SIGMA)
+    flat = np.column_stack([standing, np.zeros(3)])
+    p3, c3 = triangulate(flat, b + [0.001, -0.002, 0.0015], np.zeros(3), bearing_sigma=SIGMA)
+    np.testing.assert_allclose(p3[:2], p2, atol=1e-12)
+    np.testing.assert_allclose(c3[:2, :2], c2, rtol=1e-9)
+    assert p3[2] == pytest.approx(0.0, abs=1e-12)
+    assert triangulate(standing, b).shape == (2,)
+
+
+@pytest.mark.parametrize(
+    ("standing", "bearings", "message"),
+    [
+        ([[0.0, 0.0]], [0.3], "at least two standing robots"),
+        ([[1.0, 2.0], [1.0, 2.0]], [0.3, 1.2], "coincide"),
+        ([[0.0, 0.0], [1.0, 0.0]], [0.3, float("nan")], "bearing 1 is not finite"),
+        ([[0.0, 0.0], [1.0, 0.0]], [0.3], "2 standing robots but 1 bearings"),
+        ([[-1.0, 0.0], [1.0, 0.0]], [math.pi / 2, math.pi / 2 + 0.005], "nearly parallel"),
+        ([[-1.0, 0.0], [1.0, 0.0]], [0.0, math.pi], "nearly parallel"),  # on the baseline
+        ([[1.0, 0.0], [-1.0, 0.0]], [-math.pi / 4, -3 * math.pi / 4], "points away"),
+        ([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], [0.3, 1.0], "shape (n, 2)"),
+        ([["a", "b"], ["c", "d"]], [0.3, 1.0], "standing"),
+    ],
+)
+def test_bad_geometry_and_input_are_named(standing, bearings, message: str) -> None:
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        triangulate(standing, bearings)
+
+
+def test_bad_sigma_and_paper_angles() -> None:
+    with pytest.raises(ValueError, match="bearing_sigma"):
+        triangulate([[-1.0, 0.0], [1.0, 0.0]], [0.8, 2.3], bearing_sigma=-1.0)
+    with pytest.raises(ValueError, match="elevation 0"):
+        triangulate([[0.0, 0, 0], [1.0, 0, 0]], [0.5, 2.0], [math.pi / 2, 0.0])
+    with pytest.raises(ValueError, match="interior angles"):
+        paper_position(1.0, 2.0, 1.5)
+    with pytest.raises(ValueError, match="nearly parallel"):
+        paper_position(1.0, 1e-4, 1e-4)
