@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <numeric>
 #include <set>
@@ -176,7 +177,7 @@ double CorrelationSearch::score(const Level& level, float cx, float cy, float cz
   }
   // Eq. 4 over the cells with data in both maps, in the slots' (the cells') order.
   const Eq4Sums terms = eq4_sums(zbuffer, level.current.data(), level.weight.data(), level.current.size(),
-                                   s.range.data(), s.w.data());
+                                 s.range.data(), s.w.data());
   const double sum = terms.sum, weights = terms.weights;
   const std::size_t shared = terms.shared;
   if (overlap) *overlap = shared;
@@ -224,43 +225,53 @@ CorrelationResult CorrelationSearch::exhaustive(const TranslationGrid& grid) con
   // data from any candidate of a block are left out of its scores, which they would not change.
   const int nx = grid.nx(), ny = grid.ny(), nz = grid.nz();
   const int bx = (nx + kBlock - 1) / kBlock, by = (ny + kBlock - 1) / kBlock, bz = (nz + kBlock - 1) / kBlock;
-  parallel_for(
-      static_cast<std::size_t>(bx) * by * bz, options_.threads,
-      [&](std::size_t begin, std::size_t end) {
-        Scratch s(fine_.current.size(), points());
-        for (std::size_t b = begin; b < end; ++b) {
-          const int x0 = static_cast<int>(b / (static_cast<std::size_t>(by) * bz)) * kBlock;
-          const int y0 = static_cast<int>((b / bz) % by) * kBlock, z0 = static_cast<int>(b % bz) * kBlock;
-          const int x1 = std::min(nx, x0 + kBlock), y1 = std::min(ny, y0 + kBlock), z1 = std::min(nz, z0 + kBlock);
-          // the block's centre and the largest distance of its candidates from it
-          const Eigen::Vector3d half(x1 - 1 - x0, y1 - 1 - y0, z1 - 1 - z0);
-          const Eigen::Vector3d centre = rotation_t_ * (Eigen::Vector3d(grid.x_min + x0 * grid.step,
-                                                                        grid.y_min + y0 * grid.step,
-                                                                        grid.z_min + z0 * grid.step) +
-                                                        0.5 * grid.step * half);
-          const std::size_t m =
-              points_that_may_land(all_.x.data(), all_.y.data(), all_.z.data(), points(), centre.x(), centre.y(),
-                                   centre.z(), 0.5 * grid.step * half.norm(), grid_, fine_.data_sat, s.bounds,
-                                   s.kept.data());
-          for (std::size_t i = 0; i < m; ++i) {
-            s.x[i] = all_.x[s.kept[i]];
-            s.y[i] = all_.y[s.kept[i]];
-            s.z[i] = all_.z[s.kept[i]];
-          }
-          for (int ix = x0; ix < x1; ++ix) {
-            for (int iy = y0; iy < y1; ++iy) {
-              for (int iz = z0; iz < z1; ++iz) {
-                const std::size_t k = (static_cast<std::size_t>(ix) * ny + iy) * nz + iz;
-                const Eigen::Vector3d c = rotation_t_ * grid.at(k);
-                result.costs[k] = score(fine_, static_cast<float>(c.x()), static_cast<float>(c.y()),
-                                        static_cast<float>(c.z()), s, &overlaps[k], s.x.data(), s.y.data(),
-                                        s.z.data(), m);
-              }
+  // One block after another to whichever thread is free (the blocks' work differs with the
+  // points they keep); each writes only its own candidates, so the result is the same.
+  const auto blocks = static_cast<long long>(bx) * by * bz;
+  std::exception_ptr error;
+#pragma omp parallel num_threads(resolve_threads(options_.threads))
+  {
+    try {
+      Scratch s(fine_.current.size(), points());
+#pragma omp for schedule(dynamic, 1)
+      for (long long block = 0; block < blocks; ++block) {
+        const auto b = static_cast<std::size_t>(block);
+        const int x0 = static_cast<int>(b / (static_cast<std::size_t>(by) * bz)) * kBlock;
+        const int y0 = static_cast<int>((b / bz) % by) * kBlock, z0 = static_cast<int>(b % bz) * kBlock;
+        const int x1 = std::min(nx, x0 + kBlock), y1 = std::min(ny, y0 + kBlock), z1 = std::min(nz, z0 + kBlock);
+        // the block's centre and the largest distance of its candidates from it
+        const Eigen::Vector3d half(x1 - 1 - x0, y1 - 1 - y0, z1 - 1 - z0);
+        const Eigen::Vector3d centre =
+            rotation_t_ * (Eigen::Vector3d(grid.x_min + x0 * grid.step, grid.y_min + y0 * grid.step,
+                                           grid.z_min + z0 * grid.step) +
+                           0.5 * grid.step * half);
+        const std::size_t m =
+            points_that_may_land(all_.x.data(), all_.y.data(), all_.z.data(), points(), centre.x(), centre.y(),
+                                 centre.z(), 0.5 * grid.step * half.norm(), grid_, fine_.data_sat, s.bounds,
+                                 s.kept.data());
+        for (std::size_t i = 0; i < m; ++i) {
+          s.x[i] = all_.x[s.kept[i]];
+          s.y[i] = all_.y[s.kept[i]];
+          s.z[i] = all_.z[s.kept[i]];
+        }
+        for (int ix = x0; ix < x1; ++ix) {
+          for (int iy = y0; iy < y1; ++iy) {
+            for (int iz = z0; iz < z1; ++iz) {
+              const std::size_t k = (static_cast<std::size_t>(ix) * ny + iy) * nz + iz;
+              const Eigen::Vector3d c = rotation_t_ * grid.at(k);
+              result.costs[k] = score(fine_, static_cast<float>(c.x()), static_cast<float>(c.y()),
+                                      static_cast<float>(c.z()), s, &overlaps[k], s.x.data(), s.y.data(),
+                                      s.z.data(), m);
             }
           }
         }
-      },
-      1);
+      }
+    } catch (...) {
+#pragma omp critical
+      error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
   std::size_t best = 0;
   for (std::size_t k = 1; k < n; ++k) {
     if (result.costs[k] < result.costs[best]) best = k;
