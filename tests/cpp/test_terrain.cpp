@@ -172,7 +172,7 @@ struct SparseScene {
 double previous_eq4(const SparseScene& s, const Eigen::Vector3d& t, CorrelationCost cost, std::size_t* overlap) {
   const Eigen::Matrix3Xd turned = s.R.transpose() * s.points;
   const auto n = static_cast<std::size_t>(turned.cols());
-  std::vector<float> px(n), py(n), pz(n), r2(n);
+  std::vector<float> px(n), py(n), pz(n), range(n);
   for (std::size_t i = 0; i < n; ++i) {
     px[i] = static_cast<float>(turned(0, static_cast<Eigen::Index>(i)));
     py[i] = static_cast<float>(turned(1, static_cast<Eigen::Index>(i)));
@@ -181,13 +181,13 @@ double previous_eq4(const SparseScene& s, const Eigen::Vector3d& t, CorrelationC
   const Eigen::Vector3d c = s.R.transpose() * t;
   std::vector<int> cell(n);
   project_points(px.data(), py.data(), pz.data(), n, static_cast<float>(c.x()), static_cast<float>(c.y()),
-                 static_cast<float>(c.z()), CellProjection(s.g, 1, s.g.rows(), s.g.cols()), cell.data(), r2.data());
+                 static_cast<float>(c.z()), CellProjection(s.g, 1, s.g.rows(), s.g.cols()), cell.data(), range.data());
   std::vector<float> zbuffer(s.g.cells() + 1, std::numeric_limits<float>::infinity());
   std::vector<int> touched;
   for (std::size_t i = 0; i < n; ++i) {
     float& slot = zbuffer[static_cast<std::size_t>(cell[i])];
     if (std::isinf(slot)) touched.push_back(cell[i]);
-    slot = std::min(slot, std::sqrt(r2[i]));
+    slot = std::min(slot, range[i]);
   }
   double sum = 0, weights = 0;
   *overlap = 0;
@@ -208,7 +208,7 @@ double previous_eq4(const SparseScene& s, const Eigen::Vector3d& t, CorrelationC
 TEST(VirtualSdem, PointsLeftOutCannotLandInACellWithData) {
   const SparseScene s;
   const auto n = static_cast<std::size_t>(s.points.cols());
-  std::vector<float> px(n), py(n), pz(n), r2(n);
+  std::vector<float> px(n), py(n), pz(n), range(n);
   for (std::size_t i = 0; i < n; ++i) {
     px[i] = static_cast<float>(s.points(0, static_cast<Eigen::Index>(i)));
     py[i] = static_cast<float>(s.points(1, static_cast<Eigen::Index>(i)));
@@ -239,7 +239,7 @@ TEST(VirtualSdem, PointsLeftOutCannotLandInACellWithData) {
       d *= rho / d.norm() * (k % 3 == 0 ? 1.0 : std::abs(unit(rng)));
       const Eigen::Vector3d c = c0 + d;
       project_points(px.data(), py.data(), pz.data(), n, static_cast<float>(c.x()), static_cast<float>(c.y()),
-                     static_cast<float>(c.z()), CellProjection(s.g, 1, s.g.rows(), s.g.cols()), cell.data(), r2.data());
+                     static_cast<float>(c.z()), CellProjection(s.g, 1, s.g.rows(), s.g.cols()), cell.data(), range.data());
       for (std::size_t i = 0; i < n; ++i) {
         const auto at = static_cast<std::size_t>(cell[i]);
         if (at < s.g.cells() && !std::isnan(s.current.ranges()[at])) {

@@ -67,17 +67,17 @@ void CorrelationOptions::validate() const {
 }
 
 struct CorrelationSearch::Scratch {
-  /// The virtual map: the nearest squared range per slot of a cell with data, +inf where empty,
+  /// The virtual map: the nearest range per slot of a cell with data, +inf where empty,
   /// then the dummy slots at -inf.
   std::vector<float> zbuffer;
   std::vector<int> cell;     ///< each point's cell
-  std::vector<float> r2;     ///< each point's squared range
+  std::vector<float> range_of;  ///< each point's range
   std::vector<std::uint32_t> kept;  ///< the points that may land in a cell with data (exhaustive)
   std::vector<float> x, y, z;       ///< those points
   std::vector<int> bounds;
   std::vector<float> range, w;  ///< per slot, for eq. 4's sums
   Scratch(std::size_t slots, std::size_t points)
-      : zbuffer(slots + kDummySlots, kInf), cell(points), r2(points), kept(points),
+      : zbuffer(slots + kDummySlots, kInf), cell(points), range_of(points), kept(points),
         x(points), y(points), z(points), range(slots), w(slots) {
     std::fill(zbuffer.begin() + static_cast<std::ptrdiff_t>(slots), zbuffer.end(), -kInf);
   }
@@ -159,12 +159,11 @@ CorrelationSearch::Level CorrelationSearch::make_level(int factor) const {
 double CorrelationSearch::score(const Level& level, float cx, float cy, float cz, Scratch& s,
                                 std::size_t* overlap, const float* px, const float* py, const float* pz,
                                 std::size_t n) const {
-  // Pass 1: each point's cell and squared range in the candidate's frame (eq. 3).
+  // Pass 1: each point's cell and range in the candidate's frame (eq. 3).
   project_points(px, py, pz, n, cx, cy, cz, CellProjection(grid_, level.factor, level.rows, level.cols),
-                 s.cell.data(), s.r2.data());
-  // Pass 2: the virtual S-DEM keeps the nearest point per cell with data (the nearest squared
-  // range: sqrt is monotone, so its root is the nearest range); the other points land in the
-  // dummy slots, in turn so that consecutive points do not wait on one another's store.
+                 s.cell.data(), s.range_of.data());
+  // Pass 2: the virtual S-DEM keeps the nearest point per cell with data; the other points land
+  // in the dummy slots, in turn so that consecutive points do not wait on one another's store.
   const int* slot_of = level.slot.data();
   const int dummy = static_cast<int>(level.current.size());
   float* zbuffer = s.zbuffer.data();
@@ -173,7 +172,7 @@ double CorrelationSearch::score(const Level& level, float cx, float cy, float cz
     const int elsewhere = found >> 31;  // all ones where the cell has no data (found = -1)
     const int slot = (found & ~elsewhere) | ((dummy + static_cast<int>(i % kDummySlots)) & elsewhere);
     float& nearest = zbuffer[slot];
-    nearest = std::min(nearest, s.r2[i]);
+    nearest = std::min(nearest, s.range_of[i]);
   }
   // Eq. 4 over the cells with data in both maps, in the slots' (the cells') order.
   const Eq4Sums terms = eq4_sums(zbuffer, level.current.data(), level.weight.data(), level.current.size(),

@@ -93,7 +93,7 @@ CellProjection::CellProjection(const SphereGrid& grid, int factor, int level_row
 
 __attribute__((target_clones("avx512f", "avx2", "default"))) void project_points(
     const float* px, const float* py, const float* pz, std::size_t n, float cx, float cy, float cz,
-    const CellProjection& projection, int* __restrict cell_of, float* __restrict r2_of) {
+    const CellProjection& projection, int* __restrict cell_of, float* __restrict range_of) {
   const CellProjection g = projection;
   for (std::size_t i = 0; i < n; ++i) {
     const float x = px[i] - cx, y = py[i] - cy, z = pz[i] - cz;
@@ -105,7 +105,7 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void project_points
     const int row = static_cast<int>(std::min(std::max(vr, 0.0f), g.rows - 1.0f) * g.inv_factor);
     const int col = static_cast<int>(std::min(std::max(vc, 0.0f), g.cols - 1.0f) * g.inv_factor);
     cell_of[i] = inside ? row * g.level_cols + col : g.outside;
-    r2_of[i] = r2;
+    range_of[i] = std::sqrt(r2);
   }
 }
 
@@ -144,7 +144,7 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) Eq4Sums eq4_sums(fl
   for (std::size_t j = 0; j < slots; ++j) {  // an empty slot's term: (finite)^2 * 0 = 0
     const float nearest = zbuffer[j];
     const bool hit = nearest < kInf;
-    range[j] = std::sqrt(std::min(nearest, 1e30f));
+    range[j] = std::min(nearest, 1e30f);
     w[j] = hit ? weight[j] : 0.0f;
     shared += hit;
     zbuffer[j] = kInf;

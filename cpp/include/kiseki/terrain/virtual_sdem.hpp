@@ -24,11 +24,11 @@ struct CellProjection {
 
 /// Eq. 3 for points q = p - c (p: three float arrays of n, c the candidate centre): each point's
 /// cell (theta row, phi column, through a polynomial arctangent in float arithmetic, error
-/// below 2e-7 rad; `outside` beyond the grid or max_range) and its squared range. Branch-free
+/// below 2e-7 rad; `outside` beyond the grid or max_range) and its range. Branch-free
 /// and vectorised (AVX-512 or AVX2 where the CPU has them, with the same results: the file is
 /// compiled without contraction to fused multiply-adds).
 void project_points(const float* px, const float* py, const float* pz, std::size_t n, float cx, float cy,
-                    float cz, const CellProjection& projection, int* cell_of, float* r2_of);
+                    float cz, const CellProjection& projection, int* cell_of, float* range_of);
 
 /// The points that may land in a cell with data from some centre within `rho` of (cx, cy, cz):
 /// a point q0 = p - c0 moves by at most rho, so its direction turns by at most asin(rho / |q0|)
@@ -42,8 +42,8 @@ std::size_t points_that_may_land(const float* px, const float* py, const float* 
                                  const std::vector<int>& data_sat, std::vector<int>& scratch,
                                  std::uint32_t* kept);
 
-/// Eq. 4's sums over the slots of the cells with data, given the virtual map's nearest squared
-/// range per slot (+inf where no point landed): sum of (r_v - r_cur)^2 w, sum of w, and the slots
+/// Eq. 4's sums over the slots of the cells with data, given the virtual map's nearest range
+/// per slot (+inf where no point landed): sum of (r_v - r_cur)^2 w, sum of w, and the slots
 /// with a point. `slots` is a multiple of 8; slot j adds to lane j % 8 of the sums and the lanes
 /// are added last, so the result does not depend on the thread count. Resets the slots to +inf;
 /// `range` and `w` are scratch of `slots`.
