@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <numeric>
 #include <set>
@@ -11,6 +12,7 @@
 #include <string>
 
 #include "kiseki/core/parallel.hpp"
+#include "kiseki/terrain/virtual_sdem.hpp"
 
 namespace kiseki {
 
@@ -24,62 +26,11 @@ int axis_count(double low, double high, double step) {
   return static_cast<int>(std::floor((high - low) / step + 1e-9)) + 1;
 }
 
-/// atan(t) for |t| <= 1: an odd polynomial of degree 15 fitted for the least maximum error
-/// (4e-8 rad; in float arithmetic 1.4e-7 rad, the rounding of the result itself).
-inline float atan_unit(float t) {
-  const float t2 = t * t;
-  float p = -4.054586057e-03f;
-  p = p * t2 + 2.186301495e-02f;
-  p = p * t2 - 5.591239031e-02f;
-  p = p * t2 + 9.642200350e-02f;
-  p = p * t2 - 1.390862997e-01f;
-  p = p * t2 + 1.994656555e-01f;
-  p = p * t2 - 3.332986076e-01f;
-  p = p * t2 + 9.999993356e-01f;
-  return t * p;
-}
-
-/// atan2 on the unit polynomial, branch-free so that the compiler can vectorise the loop.
-inline float fast_atan2(float y, float x) {
-  const float ax = std::fabs(x), ay = std::fabs(y);
-  const float hi = std::max(ax, ay), lo = std::min(ax, ay);
-  const float a = atan_unit(lo / std::max(hi, 1e-30f));
-  float r = ay > ax ? static_cast<float>(M_PI_2) - a : a;
-  r = x < 0.0f ? static_cast<float>(M_PI) - r : r;
-  return y < 0.0f ? -r : r;
-}
-
-/// The constants for projecting points onto the cells of one level: the fine grid's lower
-/// edges (rad), its cells per rad and its extent in cells, and the level's block of
-/// factor x factor fine cells.
-struct Projection {
-  float th_edge, ph_edge, inv, rows, cols;
-  float inv_factor;  ///< 1 / factor
-  int level_cols;
-  float max_r2;
-  int outside;  ///< the cell of points outside the grid or the range cut
-};
-
-/// Pass 1 of a candidate's score: each point's range and cell in the candidate's frame (eq. 3),
-/// branch-free so that it vectorises; compiled for AVX2 and for the baseline, chosen at run time.
-__attribute__((target_clones("avx2", "default"))) void project_points(const float* px, const float* py,
-                                                                       const float* pz, std::size_t n, float cx,
-                                                                       float cy, float cz, Projection g,
-                                                                       int* __restrict cell_of,
-                                                                       float* __restrict range_of) {
-  for (std::size_t i = 0; i < n; ++i) {
-    const float x = px[i] - cx, y = py[i] - cy, z = pz[i] - cz;
-    const float xz2 = x * x + z * z, r2 = xz2 + y * y;
-    const float vr = (fast_atan2(z, x) - g.th_edge) * g.inv;  // fine cells from the lower edge
-    const float vc = (fast_atan2(y, std::sqrt(xz2)) - g.ph_edge) * g.inv;
-    const bool inside =
-        (r2 > 0.0f) & (r2 < g.max_r2) & (vr >= 0.0f) & (vr < g.rows) & (vc >= 0.0f) & (vc < g.cols);
-    const int row = static_cast<int>(std::min(std::max(vr, 0.0f), g.rows - 1.0f) * g.inv_factor);
-    const int col = static_cast<int>(std::min(std::max(vc, 0.0f), g.cols - 1.0f) * g.inv_factor);
-    cell_of[i] = inside ? row * g.level_cols + col : g.outside;
-    range_of[i] = std::sqrt(r2);
-  }
-}
+/// Slots after the data cells' for the points that land elsewhere (outside, or in a cell
+/// without data): they hold -inf, so such a point never enters eq. 4.
+constexpr int kDummySlots = 8;
+/// Candidates per side of the blocks that the exhaustive search leaves points out for.
+constexpr int kBlock = 4;
 
 }  // namespace
 
@@ -116,12 +67,20 @@ void CorrelationOptions::validate() const {
 }
 
 struct CorrelationSearch::Scratch {
-  std::vector<float> zbuffer;  ///< the virtual map: nearest range per cell (+1 outside), +inf where empty
-  std::vector<int> cell;       ///< each point's cell
-  std::vector<float> range;
-  std::vector<int> touched;    ///< the cells with a point, in the order of their first point
-  explicit Scratch(std::size_t cells, std::size_t points)
-      : zbuffer(cells + 1, kInf), cell(points), range(points), touched(points + 1) {}
+  /// The virtual map: the nearest range per slot of a cell with data, +inf where empty,
+  /// then the dummy slots at -inf.
+  std::vector<float> zbuffer;
+  std::vector<int> cell;     ///< each point's cell
+  std::vector<float> range_of;  ///< each point's range
+  std::vector<std::uint32_t> kept;  ///< the points that may land in a cell with data (exhaustive)
+  std::vector<float> x, y, z;       ///< those points
+  std::vector<int> bounds;
+  std::vector<float> range, w;  ///< per slot, for eq. 4's sums
+  Scratch(std::size_t slots, std::size_t points)
+      : zbuffer(slots + kDummySlots, kInf), cell(points), range_of(points), kept(points),
+        x(points), y(points), z(points), range(slots), w(slots) {
+    std::fill(zbuffer.begin() + static_cast<std::ptrdiff_t>(slots), zbuffer.end(), -kInf);
+  }
 };
 
 CorrelationSearch::CorrelationSearch(const Eigen::Matrix3Xd& previous_points, const SphereElevationMap& current,
@@ -152,73 +111,74 @@ CorrelationSearch::CorrelationSearch(const Eigen::Matrix3Xd& previous_points, co
 }
 
 CorrelationSearch::Level CorrelationSearch::make_level(int factor) const {
-  // Blocks of factor x factor fine cells; per block (and one extra for points outside): the
-  // nearest range of the current map and eq. 4's weight cos(phi) at the block's centre, both 0
-  // where the current map has no data. Factor 1 is the S-DEM itself.
+  // Blocks of factor x factor fine cells; per block with data, in block order: the nearest
+  // range of the current map and eq. 4's weight cos(phi) at the block's centre. Factor 1 is the
+  // S-DEM itself.
   Level level;
   level.factor = factor;
   level.rows = (grid_.rows() + factor - 1) / factor;
   level.cols = (grid_.cols() + factor - 1) / factor;
-  const std::size_t cells = static_cast<std::size_t>(level.rows) * level.cols;
-  level.current.assign(cells + 1, 0.0f);
-  level.weight.assign(cells + 1, 0.0f);
+  const std::size_t blocks = static_cast<std::size_t>(level.rows) * level.cols;
+  std::vector<float> current(blocks, kInf), weight(blocks, 0.0f);
   for (int row = 0; row < grid_.rows(); ++row) {
     for (int col = 0; col < grid_.cols(); ++col) {
       const double r = current_map_[static_cast<std::size_t>(row) * grid_.cols() + col];
       if (std::isnan(r)) continue;
       const std::size_t block = static_cast<std::size_t>(row / factor) * level.cols + col / factor;
-      const auto rf = static_cast<float>(r);
-      level.current[block] = level.weight[block] > 0 ? std::min(level.current[block], rf) : rf;
+      current[block] = std::min(current[block], static_cast<float>(r));
       const double centre = grid_.phi_min_deg + ((col / factor) * factor + 0.5 * (factor - 1)) * grid_.step_deg;
-      level.weight[block] = static_cast<float>(std::cos(std::min(90.0, std::abs(centre)) * kDeg));
-      if (level.weight[block] <= 0) level.weight[block] = 1e-6f;  // a block on the pole keeps its data
+      weight[block] = static_cast<float>(std::cos(std::min(90.0, std::abs(centre)) * kDeg));
+      if (weight[block] <= 0) weight[block] = 1e-6f;  // a block on the pole keeps its data
+    }
+  }
+  level.slot.assign(blocks + 1, -1);  // the last: points outside the grid
+  for (std::size_t block = 0; block < blocks; ++block) {
+    if (weight[block] == 0.0f) continue;
+    level.slot[block] = static_cast<int>(level.current.size());
+    level.current.push_back(current[block]);
+    level.weight.push_back(weight[block]);
+  }
+  while (level.current.size() % 8) {  // padding: never a point's slot, weight 0
+    level.current.push_back(0.0f);
+    level.weight.push_back(0.0f);
+  }
+  // The summed-area table of the fine cells whose block has data.
+  const auto stride = static_cast<std::size_t>(grid_.cols()) + 1;
+  level.data_sat.assign((static_cast<std::size_t>(grid_.rows()) + 1) * stride, 0);
+  for (int row = 0; row < grid_.rows(); ++row) {
+    for (int col = 0; col < grid_.cols(); ++col) {
+      const std::size_t block = static_cast<std::size_t>(row / factor) * level.cols + col / factor;
+      const std::size_t at = static_cast<std::size_t>(row + 1) * stride + col + 1;
+      level.data_sat[at] = (level.slot[block] >= 0) + level.data_sat[at - 1] + level.data_sat[at - stride] -
+                           level.data_sat[at - stride - 1];
     }
   }
   return level;
 }
 
 double CorrelationSearch::score(const Level& level, float cx, float cy, float cz, Scratch& s,
-                                std::size_t* overlap) const {
-  const Points& points = all_;
-  const std::size_t n = points.x.size();
-  const double half = 0.5 * grid_.step_deg;
-  Projection g;
-  g.th_edge = static_cast<float>((grid_.theta_min_deg - half) * kDeg);
-  g.ph_edge = static_cast<float>((grid_.phi_min_deg - half) * kDeg);
-  g.inv = static_cast<float>(1.0 / (grid_.step_deg * kDeg));
-  g.rows = static_cast<float>(grid_.rows());
-  g.cols = static_cast<float>(grid_.cols());
-  g.inv_factor = 1.0f / static_cast<float>(level.factor);
-  g.level_cols = level.cols;
-  g.max_r2 = static_cast<float>(grid_.max_range * grid_.max_range);
-  g.outside = level.rows * level.cols;
-  project_points(points.x.data(), points.y.data(), points.z.data(), n, cx, cy, cz, g, s.cell.data(),
-                 s.range.data());
-  // Pass 2: the virtual S-DEM keeps the nearest point per cell; points outside the grid all
-  // land in one extra cell that the current map never has data in. Branch-free: a cell enters
-  // the touched list when its first point arrives.
+                                std::size_t* overlap, const float* px, const float* py, const float* pz,
+                                std::size_t n) const {
+  // Pass 1: each point's cell and range in the candidate's frame (eq. 3).
+  project_points(px, py, pz, n, cx, cy, cz, CellProjection(grid_, level.factor, level.rows, level.cols),
+                 s.cell.data(), s.range_of.data());
+  // Pass 2: the virtual S-DEM keeps the nearest point per cell with data; the other points land
+  // in the dummy slots, in turn so that consecutive points do not wait on one another's store.
+  const int* slot_of = level.slot.data();
+  const int dummy = static_cast<int>(level.current.size());
   float* zbuffer = s.zbuffer.data();
-  int* touched = s.touched.data();
-  std::size_t touched_count = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const int c = s.cell[i];
-    float& slot = zbuffer[c];
-    touched[touched_count] = c;
-    touched_count += slot == kInf;
-    slot = std::min(slot, s.range[i]);
+    const int found = slot_of[s.cell[i]];
+    const int elsewhere = found >> 31;  // all ones where the cell has no data (found = -1)
+    const int slot = (found & ~elsewhere) | ((dummy + static_cast<int>(i % kDummySlots)) & elsewhere);
+    float& nearest = zbuffer[slot];
+    nearest = std::min(nearest, s.range_of[i]);
   }
-  // Eq. 4 over the cells with data in both maps (weight 0 where the current map has none).
-  double sum = 0.0, weights = 0.0;
-  std::size_t shared = 0;
-  for (std::size_t k = 0; k < touched_count; ++k) {
-    const auto cell = static_cast<std::size_t>(touched[k]);
-    const double w = level.weight[cell];
-    const double d = static_cast<double>(zbuffer[cell]) - level.current[cell];
-    sum += d * d * w;
-    weights += w;
-    shared += w > 0.0;
-    zbuffer[cell] = kInf;
-  }
+  // Eq. 4 over the cells with data in both maps, in the slots' (the cells') order.
+  const Eq4Sums terms = eq4_sums(zbuffer, level.current.data(), level.weight.data(), level.current.size(),
+                                 s.range.data(), s.w.data());
+  const double sum = terms.sum, weights = terms.weights;
+  const std::size_t shared = terms.shared;
   if (overlap) *overlap = shared;
   // The overlap a coarse level needs: the fine one's over the cells of a block.
   const auto block = static_cast<std::size_t>(level.factor) * static_cast<std::size_t>(level.factor);
@@ -227,11 +187,17 @@ double CorrelationSearch::score(const Level& level, float cx, float cy, float cz
   return options_.cost == CorrelationCost::sum ? sum : sum / weights;
 }
 
+double CorrelationSearch::score(const Level& level, const Eigen::Vector3d& translation, Scratch& s,
+                                std::size_t* overlap) const {
+  const Eigen::Vector3d c = rotation_t_ * translation;
+  return score(level, static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z()), s, overlap,
+               all_.x.data(), all_.y.data(), all_.z.data(), points());
+}
+
 double CorrelationSearch::cost(const Eigen::Vector3d& translation, std::size_t* overlap) const {
   if (!translation.allFinite()) throw std::invalid_argument("correlation search: the translation holds NaN");
-  Scratch scratch(grid_.cells(), points());
-  const Eigen::Vector3d c = rotation_t_ * translation;
-  return score(fine_, static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z()), scratch, overlap);
+  Scratch scratch(fine_.current.size(), points());
+  return score(fine_, translation, scratch, overlap);
 }
 
 namespace {
@@ -254,17 +220,57 @@ CorrelationResult CorrelationSearch::exhaustive(const TranslationGrid& grid) con
   CorrelationResult result;
   result.costs.assign(n, 0.0);
   std::vector<std::size_t> overlaps(n, 0);
-  parallel_for(
-      n, options_.threads,
-      [&](std::size_t begin, std::size_t end) {
-        Scratch scratch(grid_.cells(), points());
-        for (std::size_t k = begin; k < end; ++k) {
-          const Eigen::Vector3d c = rotation_t_ * grid.at(k);
-          result.costs[k] = score(fine_, static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z()),
-                                  scratch, &overlaps[k]);
+  // Blocks of kBlock^3 neighbouring candidates: the points that cannot land in a cell with
+  // data from any candidate of a block are left out of its scores, which they would not change.
+  const int nx = grid.nx(), ny = grid.ny(), nz = grid.nz();
+  const int bx = (nx + kBlock - 1) / kBlock, by = (ny + kBlock - 1) / kBlock, bz = (nz + kBlock - 1) / kBlock;
+  // One block after another to whichever thread is free (the blocks' work differs with the
+  // points they keep); each writes only its own candidates, so the result is the same.
+  const auto blocks = static_cast<long long>(bx) * by * bz;
+  std::exception_ptr error;
+#pragma omp parallel num_threads(resolve_threads(options_.threads))
+  {
+    try {
+      Scratch s(fine_.current.size(), points());
+#pragma omp for schedule(dynamic, 1)
+      for (long long block = 0; block < blocks; ++block) {
+        const auto b = static_cast<std::size_t>(block);
+        const int x0 = static_cast<int>(b / (static_cast<std::size_t>(by) * bz)) * kBlock;
+        const int y0 = static_cast<int>((b / bz) % by) * kBlock, z0 = static_cast<int>(b % bz) * kBlock;
+        const int x1 = std::min(nx, x0 + kBlock), y1 = std::min(ny, y0 + kBlock), z1 = std::min(nz, z0 + kBlock);
+        // the block's centre and the largest distance of its candidates from it
+        const Eigen::Vector3d half(x1 - 1 - x0, y1 - 1 - y0, z1 - 1 - z0);
+        const Eigen::Vector3d centre =
+            rotation_t_ * (Eigen::Vector3d(grid.x_min + x0 * grid.step, grid.y_min + y0 * grid.step,
+                                           grid.z_min + z0 * grid.step) +
+                           0.5 * grid.step * half);
+        const std::size_t m =
+            points_that_may_land(all_.x.data(), all_.y.data(), all_.z.data(), points(), centre.x(), centre.y(),
+                                 centre.z(), 0.5 * grid.step * half.norm(), grid_, fine_.data_sat, s.bounds,
+                                 s.kept.data());
+        for (std::size_t i = 0; i < m; ++i) {
+          s.x[i] = all_.x[s.kept[i]];
+          s.y[i] = all_.y[s.kept[i]];
+          s.z[i] = all_.z[s.kept[i]];
         }
-      },
-      8);
+        for (int ix = x0; ix < x1; ++ix) {
+          for (int iy = y0; iy < y1; ++iy) {
+            for (int iz = z0; iz < z1; ++iz) {
+              const std::size_t k = (static_cast<std::size_t>(ix) * ny + iy) * nz + iz;
+              const Eigen::Vector3d c = rotation_t_ * grid.at(k);
+              result.costs[k] = score(fine_, static_cast<float>(c.x()), static_cast<float>(c.y()),
+                                      static_cast<float>(c.z()), s, &overlaps[k], s.x.data(), s.y.data(),
+                                      s.z.data(), m);
+            }
+          }
+        }
+      }
+    } catch (...) {
+#pragma omp critical
+      error = std::current_exception();
+    }
+  }
+  if (error) std::rethrow_exception(error);
   std::size_t best = 0;
   for (std::size_t k = 1; k < n; ++k) {
     if (result.costs[k] < result.costs[best]) best = k;
@@ -308,11 +314,9 @@ CorrelationResult CorrelationSearch::coarse_to_fine(const TranslationGrid& grid,
     parallel_for(
         candidates.size(), options_.threads,
         [&](std::size_t begin, std::size_t end) {
-          Scratch scratch(grid_.cells(), points());
+          Scratch scratch(used.current.size(), points());
           for (std::size_t k = begin; k < end; ++k) {
-            const Eigen::Vector3d c = rotation_t_ * grid.at(candidates[k]);
-            costs[k] = score(used, static_cast<float>(c.x()), static_cast<float>(c.y()), static_cast<float>(c.z()),
-                             scratch, &overlaps[k]);
+            costs[k] = score(used, grid.at(candidates[k]), scratch, &overlaps[k]);
           }
         },
         8);

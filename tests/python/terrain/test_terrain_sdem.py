@@ -215,6 +215,33 @@ def test_search_is_the_same_for_any_thread_count():
     np.testing.assert_array_equal(one.costs, two.costs)
 
 
+def test_exhaustive_costs_equal_one_candidates_cost_and_numpy_on_a_sparse_rotated_scene():
+    """The exhaustive search leaves out, per block of candidates, the points that cannot land in
+    a cell with data (most, when the current map keeps only the mounds, as after plane removal):
+    every candidate's cost equals the single-candidate cost from every point bit for bit, and
+    numpy's eq. 4; one thread and two give the same surface."""
+    from kiseki import _core
+
+    pts = rubble_points(12, 4000)
+    rot = attitude_matrix(-2 * DEG, -10 * DEG, 15 * DEG)
+    true_t = np.array([0.36, 0.30, 0.06])
+    prev = sdem_from_points(pts)
+    prev_points, _ = prev.to_points()
+    blocks = prev_points[prev_points[:, 2] > -0.42]  # the scattered blocks, not the floor
+    current = sdem_from_points((blocks - true_t) @ rot)
+    grid = search_grid((0.30, 0.42), (0.20, 0.36), (0.0, 0.12), 0.02)  # 7 x 9 x 7
+    search = _core.CorrelationSearch(prev_points, current, rot, "sum", 50, 1)
+    found = correlation_search(prev, current, rot, grid, threads=2)
+    np.testing.assert_allclose(found.translation, true_t, atol=1e-9)
+    one = correlation_search(prev, current, rot, grid, threads=1)
+    np.testing.assert_array_equal(one.costs, found.costs)
+    for (i, j, k), got in np.ndenumerate(found.costs):
+        t = np.array([0.30 + 0.02 * i, 0.20 + 0.02 * j, 0.02 * k])
+        assert got == search.cost(t)[0]
+        want, _ = brute_force_eq4(prev_points, current, rot, t, "sum")
+        assert got == pytest.approx(want, rel=2e-3, abs=1e-9)
+
+
 @pytest.mark.parametrize(
     ("call", "message"),
     [

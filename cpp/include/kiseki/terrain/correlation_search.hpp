@@ -63,7 +63,9 @@ struct CorrelationResult {
 /// (R_prev^T R_cur), so a previous point p is q = R^T (p - t) in the current frame.
 ///
 /// The angles of eq. 3 use a polynomial arctangent in float arithmetic (error below 2e-7 rad,
-/// the float rounding itself); results do not depend on the thread count.
+/// the float rounding itself); results do not depend on the thread count. The exhaustive search
+/// leaves out, per block of 4 x 4 x 4 candidates, the points that cannot land in a cell with data
+/// from any of them (virtual_sdem.hpp), which changes no cost.
 class CorrelationSearch {
  public:
   CorrelationSearch(const Eigen::Matrix3Xd& previous_points, const SphereElevationMap& current,
@@ -90,15 +92,21 @@ class CorrelationSearch {
   struct Points {
     std::vector<float> x, y, z;
   };
-  /// The search at one resolution: blocks of factor x factor cells and the current map's
-  /// nearest range and weight per block (every point is projected at every level: a subset
-  /// would not see the nearest point of a block that the current map sees).
+  /// The search at one resolution: blocks of factor x factor cells and, per block with data
+  /// (a slot), the current map's nearest range and eq. 4's weight (every point is projected at
+  /// every level: a subset would not see the nearest point of a block that the current map sees).
   struct Level {
     int factor = 1, rows = 0, cols = 0;
-    std::vector<float> current, weight;
+    std::vector<int> slot;               ///< per block (+1: outside the grid): its slot, or -1
+    std::vector<float> current, weight;  ///< per slot
+    std::vector<int> data_sat;           ///< summed-area table of the fine cells whose block has data
   };
   Level make_level(int factor) const;
-  double score(const Level& level, float cx, float cy, float cz, Scratch& scratch, std::size_t* overlap) const;
+  /// Eq. 4 at the centre (cx, cy, cz) = R^T t from the given points (R^T p).
+  double score(const Level& level, float cx, float cy, float cz, Scratch& scratch, std::size_t* overlap,
+               const float* px, const float* py, const float* pz, std::size_t n) const;
+  /// Eq. 4 at translation t from every point.
+  double score(const Level& level, const Eigen::Vector3d& translation, Scratch& scratch, std::size_t* overlap) const;
 
   SphereGrid grid_;
   CorrelationOptions options_;
