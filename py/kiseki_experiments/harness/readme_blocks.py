@@ -8,7 +8,7 @@ A README marks what the report writes with HTML comments, which Markdown does no
   result (the claim, the paper's value, kiseki's with its 95 % interval, the verdict, the
   trials) and the run they come from;
 * ``<!-- reproduction-summary -->`` ... ``<!-- /reproduction-summary -->``: one row per
-  registered experiment (claims by verdict, trials, commit) and the totals.
+  registered experiment (claims by verdict, the share decided, trials, commit) and the totals.
 
 :func:`update_readme` replaces the text between each pair and leaves every other line as it
 was, so the prose around a table stays the authors' while the numbers are the run's."""
@@ -113,6 +113,7 @@ def summary_block(results: dict[str, Result]) -> str:
                 "hold": t["holds"],
                 "fail": t["fails"],
                 "inconclusive": t["inconclusive"],
+                "decided": f"{100 * t['decided'] / t['claims']:.0f} %" if t["claims"] else "",
                 "trials": r.trials,
                 "commit": r.commit,
             }

@@ -66,7 +66,8 @@ def test_blocks_hold_the_claims_of_the_latest_result_and_the_prose_is_kept(resul
     rows = [line for line in summary.splitlines() if line.startswith("| ")][1:]
     assert len(rows) == len(all_experiments())  # every registered experiment, a row each
     mine = next(r for r in rows if r.startswith("| corridor-scans |"))
-    assert mine.split(" | ")[1:5] == ["1", "1", "0", "0"]  # claims, hold, fail, inconclusive
+    # claims, hold, fail, inconclusive, decided
+    assert mine.split(" | ")[1:6] == ["1", "1", "0", "0", "100 %"]
     # regenerating what was regenerated changes nothing
     assert update_readme(text, tmp_path / "README.md", results)[0] == text
 
