@@ -32,6 +32,9 @@ for folder in "$results"/*/; do
   cp "$run"/claims.csv "$run"/config.yaml "$run"/manifest.json "$target.new/"
   [ -f "$run/timings.parquet" ] && cp "$run/timings.parquet" "$target.new/"
   cp "$run"/tables/*.csv "$target.new/tables/" 2>/dev/null || true
+  # the run's own checkout's absolute paths to the repository's data/ as data/...: the same
+  # files in any clone, and no machine's folders in the repository
+  sed -i -E 's#: /[^ ]*/(data(/[^ ]*)?)$#: \1#' "$target.new/config.yaml"
   rm -rf "$target"
   mv "$target.new" "$target"
   ln -sfn run "$snapshot/$name/latest"
