@@ -36,6 +36,45 @@ void LikelihoodFieldParams::validate() const {
   }
 }
 
+namespace {
+
+/// A robot pose's sensor in grid cells, (px, py), with its heading's cosine and sine: the value
+/// of to_grid.compose(pose.compose(sensor)) (Pose2::compose, the same operations in the same
+/// order, so the same bits), with the constant rotations' cos and sin taken once per call
+/// instead of once per particle. A sensor at the robot's origin leaves its position as it is
+/// (c * 0 - s * 0 adds a zero), so its rotation is not computed at all.
+class SensorInGrid {
+ public:
+  SensorInGrid(const Pose2& origin, const Pose2& sensor, double resolution)
+      : to_grid_(origin.inverse()),
+        sensor_(sensor),
+        at_origin_(sensor.x == 0.0 && sensor.y == 0.0),
+        inv_res_(1.0 / resolution),
+        cg_(std::cos(to_grid_.theta)),
+        sg_(std::sin(to_grid_.theta)) {}
+
+  void operator()(const Pose2& pose, double& px, double& py, double& c, double& sn) const {
+    double x = pose.x, y = pose.y;
+    if (!at_origin_) {
+      const double cr = std::cos(pose.theta), sr = std::sin(pose.theta);
+      x = pose.x + cr * sensor_.x - sr * sensor_.y;
+      y = pose.y + sr * sensor_.x + cr * sensor_.y;
+    }
+    const double theta = normalize_angle(to_grid_.theta + normalize_angle(pose.theta + sensor_.theta));
+    px = (to_grid_.x + cg_ * x - sg_ * y) * inv_res_;
+    py = (to_grid_.y + sg_ * x + cg_ * y) * inv_res_;
+    c = std::cos(theta);
+    sn = std::sin(theta);
+  }
+
+ private:
+  Pose2 to_grid_, sensor_;
+  bool at_origin_;
+  double inv_res_, cg_, sg_;
+};
+
+}  // namespace
+
 LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& map,
                                            const LikelihoodFieldParams& params)
     : params_((params.validate(), params)),
@@ -95,8 +134,7 @@ void LikelihoodFieldModel::select_readings(const Pose2* poses, std::size_t n, in
   if (!params_.beam_skip || n == 0) return;
   if (table_range_ < 0.0) throw std::logic_error("likelihood field: set a scan first");
   const std::size_t m = beams_.size();
-  const Pose2 to_grid = frame_.origin().inverse();
-  const double inv_res = 1.0 / frame_.resolution();
+  const SensorInGrid place(frame_.origin(), params_.sensor, frame_.resolution());
   const int w = frame_.width(), h = frame_.height();
   const float near = static_cast<float>(params_.beam_skip_distance);
   std::vector<std::size_t> near_wall(m, 0);  // per beam: particles whose end is near a wall
@@ -104,8 +142,8 @@ void LikelihoodFieldModel::select_readings(const Pose2* poses, std::size_t n, in
   parallel_for(n, threads, [&](std::size_t begin, std::size_t end) {
     std::vector<std::size_t> local(m, 0);
     for (std::size_t k = begin; k < end; ++k) {
-      const Pose2 s = to_grid.compose(poses[k].compose(params_.sensor));
-      const double px = s.x * inv_res, py = s.y * inv_res, c = std::cos(s.theta), sn = std::sin(s.theta);
+      double px, py, c, sn;
+      place(poses[k], px, py, c, sn);
       for (std::size_t b = 0; b < m; ++b) {
         const double gx = px + c * end_x_[b] - sn * end_y_[b], gy = py + sn * end_x_[b] + c * end_y_[b];
         if (gx >= 0.0 && gy >= 0.0 && gx < w && gy < h &&
@@ -133,24 +171,24 @@ void LikelihoodFieldModel::select_readings(const Pose2* poses, std::size_t n, in
 void LikelihoodFieldModel::log_likelihoods(const Pose2* poses, std::size_t n, double* out) const {
   if (table_range_ < 0.0) throw std::logic_error("likelihood field: set a scan first");
   // Everything in grid cells: a pose's sensor in the grid frame, then per beam one rotation.
-  const Pose2 to_grid = frame_.origin().inverse();
-  const double inv_res = 1.0 / frame_.resolution();
-  const int w = frame_.width(), h = frame_.height();
+  const SensorInGrid place(frame_.origin(), params_.sensor, frame_.resolution());
+  const int w = frame_.width();
   const std::size_t m = used_.size();
   const double* bx = used_x_.data();
   const double* by = used_y_.data();
   const bool nav2 = params_.combination == BeamCombination::nav2;
   const float* table = table_.ptr<float>(0);  // continuous (created by tabulate)
-  const double width = w, height = h;
+  const float outside = outside_;
+  const double width = w, height = frame_.height();
   for (std::size_t k = 0; k < n; ++k) {
-    const Pose2 s = to_grid.compose(poses[k].compose(params_.sensor));
-    const double px = s.x * inv_res, py = s.y * inv_res, c = std::cos(s.theta), sn = std::sin(s.theta);
+    double px, py, c, sn;
+    place(poses[k], px, py, c, sn);
     double sum = 0.0;
     for (std::size_t b = 0; b < m; ++b) {
       const double gx = px + c * bx[b] - sn * by[b], gy = py + sn * bx[b] + c * by[b];
       // Inside the grid the coordinates are >= 0, where truncation is floor.
       const bool inside = gx >= 0.0 && gy >= 0.0 && gx < width && gy < height;
-      sum += inside ? table[static_cast<std::ptrdiff_t>(gy) * w + static_cast<std::ptrdiff_t>(gx)] : outside_;
+      sum += inside ? table[static_cast<std::ptrdiff_t>(gy) * w + static_cast<std::ptrdiff_t>(gx)] : outside;
     }
     out[k] = nav2 ? std::log1p(sum) : sum;
   }
