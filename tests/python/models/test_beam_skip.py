@@ -145,4 +145,5 @@ def test_every_pose_gets_its_brute_force_likelihood_wherever_it_falls_in_the_bat
     assert together[-1] == pytest.approx(model.beams * model.outside, rel=1e-12)
     for start in range(6):
         np.testing.assert_array_equal(model.log_likelihoods(poses[start:]), together[start:])
-        np.testing.assert_array_equal(model.log_likelihoods(poses[start : start + 1]), together[start])
+        alone = model.log_likelihoods(poses[start : start + 1])
+        np.testing.assert_array_equal(alone, together[start])
