@@ -233,11 +233,12 @@ namespace {
 // The likelihood field's evaluation as it was before the sensor's placement was taken out of
 // Pose2::compose (two calls per particle, with the map's rotation's cos and sin each time): the
 // beam ends (model.used_beams, in the sensor frame, in cells) rotated in doubles, a per-beam
-// bounds test, the table read.
+// bounds test in doubles (the model's is in integers on x86-64), the table read.
 std::vector<double> likelihoods_one_at_a_time(const LikelihoodFieldModel& m, const OccupancyGrid& g,
                                               const std::vector<double>& end_x,
                                               const std::vector<double>& end_y,
-                                              const std::vector<Pose2>& poses) {
+                                              const std::vector<Pose2>& poses,
+                                              int& just_below_zero) {
   const Pose2 to_grid = g.origin().inverse();
   const double inv_res = 1.0 / g.resolution();
   const double width = g.width(), height = g.height();
@@ -249,6 +250,7 @@ std::vector<double> likelihoods_one_at_a_time(const LikelihoodFieldModel& m, con
     for (std::size_t b : m.used_beams()) {
       const double gx = px + c * end_x[b] - sn * end_y[b], gy = py + sn * end_x[b] + c * end_y[b];
       const bool inside = gx >= 0.0 && gy >= 0.0 && gx < width && gy < height;
+      just_below_zero += (gx > -1.0 && gx < 0.0) || (gy > -1.0 && gy < 0.0);  // truncated to 0
       sum += inside ? m.table().at<float>(static_cast<int>(gy), static_cast<int>(gx)) : m.outside();
     }
     out.push_back(m.params().combination == BeamCombination::nav2 ? std::log1p(sum) : sum);
@@ -258,7 +260,7 @@ std::vector<double> likelihoods_one_at_a_time(const LikelihoodFieldModel& m, con
 
 }  // namespace
 
-TEST(LikelihoodField, ThePlacedSensorGivesTheBitsOfPose2Compose) {
+TEST(LikelihoodField, ThePlacedSensorAndTheIntegerBoundsTestGiveTheBitsOfTheOldPath) {
   OccupancyGrid g = room();
   g.set_origin(Pose2(-1.0, -0.5, 0.3));
   const auto angles = scan_angles(61);
@@ -267,8 +269,10 @@ TEST(LikelihoodField, ThePlacedSensorGivesTheBitsOfPose2Compose) {
   ranges[7] = NAN;  // skipped
   Random rng(5);
   std::vector<Pose2> poses;  // some near or past the map's edges
-  for (int k = 0; k < 15; ++k) poses.emplace_back(rng.uniform(-2.0, 12.0), rng.uniform(-2.0, 8.0), rng.uniform(-kPi, kPi));
+  for (int k = 0; k < 40; ++k) poses.emplace_back(rng.uniform(-2.0, 12.0), rng.uniform(-2.0, 8.0), rng.uniform(-kPi, kPi));
   poses.emplace_back(1e-300, -0.0, 0.0);  // zeros of either sign at the sensor
+  poses.emplace_back(1e30, -1e300, 1.0);  // ends beyond any integer type
+  poses.emplace_back(INFINITY, 2.0, 0.5);  // NaN end points
   for (const Pose2 sensor : {Pose2(), Pose2(0.0, 0.0, 0.4), Pose2(0.2, -0.1, 0.05)}) {
     for (auto comb : {BeamCombination::product, BeamCombination::nav2}) {
       LikelihoodFieldParams p;
@@ -283,7 +287,9 @@ TEST(LikelihoodField, ThePlacedSensorGivesTheBitsOfPose2Compose) {
         end_y.push_back(ranges[i] * std::sin(angles[i]) * (1.0 / g.resolution()));
       }
       ASSERT_EQ(end_x.size(), m.beams());
-      const std::vector<double> want = likelihoods_one_at_a_time(m, g, end_x, end_y, poses);
+      int just_below_zero = 0;
+      const std::vector<double> want = likelihoods_one_at_a_time(m, g, end_x, end_y, poses, just_below_zero);
+      EXPECT_GT(just_below_zero, 0);  // ends in (-1, 0): off the map, though truncated to cell 0
       std::vector<double> got(poses.size());
       m.log_likelihoods(poses.data(), poses.size(), got.data());
       for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_EQ(got[k], want[k]) << k;
