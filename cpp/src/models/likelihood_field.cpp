@@ -138,7 +138,7 @@ __attribute__((target("avx2"))) void sums_avx2(const float* table, float outside
 }
 
 bool has_avx2() {
-  static const bool yes = __builtin_cpu_supports("avx2");
+  static const bool yes = (__builtin_cpu_init(), __builtin_cpu_supports("avx2"));
   return yes;
 }
 #endif
