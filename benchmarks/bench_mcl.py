@@ -8,7 +8,8 @@ x 360 beams with the likelihood field in under 100 ms per update on 2 cores (10 
 
 The side-by-side comparison with nav2's AMCL is benchmarks/bench_nav2_amcl.py.
 
-Run: python benchmarks/bench_mcl.py [--scans 30]
+Run: python benchmarks/bench_mcl.py [--scans 30] [--particles 50000 200000] [--models
+likelihood-field]
 """
 
 from __future__ import annotations
@@ -51,7 +52,22 @@ def time_updates(scans, grid, method: str, particles: int, beams: int, threads: 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--scans", type=int, default=20, help="updates timed per setting")
+    parser.add_argument(
+        "--particles",
+        nargs="+",
+        type=int,
+        default=[1000, 10_000, 50_000],
+        help="the likelihood field's particle counts (360 beams)",
+    )
+    parser.add_argument(
+        "--models",
+        nargs="+",
+        choices=("likelihood-field", "beam"),
+        default=["likelihood-field", "beam"],
+    )
     args = parser.parse_args()
+    if args.scans < 1 or min(args.particles) < 1:
+        parser.error("scans and particles must be >= 1")
     if not LOG.is_file():
         raise SystemExit(f"the Freiburg-079 log is not at {LOG}")
     scans = read_carmen_log(LOG).scans
@@ -60,13 +76,9 @@ def main() -> None:
     print(f"Freiburg-079: {scans.ranges.shape[1]} beams, map {grid.width} x {grid.height}")
     head = f"{'model':<17}{'particles':>10}{'beams':>7}{'1 thread ms':>13}"
     print(head + f"{f'{cores} threads ms':>14}{'speed-up':>10}")
-    settings = [
-        ("likelihood-field", 1000, 360),
-        ("likelihood-field", 10_000, 360),
-        ("likelihood-field", 50_000, 360),
-        ("beam", 1000, 60),
-        ("beam", 10_000, 60),
-    ]
+    settings = [("likelihood-field", n, 360) for n in args.particles]
+    settings += [("beam", 1000, 60), ("beam", 10_000, 60)]
+    settings = [s for s in settings if s[0] in args.models]
     for method, particles, beams in settings:
         one = time_updates(scans, grid, method, particles, beams, 1, args.scans)
         all_ = time_updates(scans, grid, method, particles, beams, 0, args.scans)

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <set>
+#include <vector>
 
 #include "kiseki/core/angle.hpp"
 #include "kiseki/core/pose.hpp"
@@ -24,6 +25,21 @@ TEST(Angle, NormalizeWrapsIntoHalfOpenInterval) {
     EXPECT_NEAR(std::cos(n), std::cos(a), 1e-12);
   }
   EXPECT_NEAR(angle_difference(kPi - 0.1, -kPi + 0.1), -0.2, 1e-12);
+}
+
+TEST(Angle, NormalizeSkipsFmodOnlyWhereFmodWouldReturnItsArgument) {
+  // The reference: fmod(a + pi, 2 pi) on every call, then shifted back.
+  const auto reference = [](double a) {
+    double w = std::fmod(a + kPi, 2.0 * kPi);
+    if (w < 0.0) w += 2.0 * kPi;
+    return w - kPi;
+  };
+  std::vector<double> angles = {0.0, -0.0, kPi, -kPi, 3 * kPi, -3 * kPi, 1e-300, -1e-20,
+                                std::nextafter(kPi, 0.0), std::nextafter(-kPi, -4.0),
+                                std::nextafter(-3 * kPi, 0.0), 1e9, -1e9};
+  Random rng(11);
+  for (int i = 0; i < 20000; ++i) angles.push_back(rng.uniform(-12.0, 12.0));
+  for (double a : angles) ASSERT_EQ(normalize_angle(a), reference(a)) << a;
 }
 
 TEST(Pose2, ComposeMatchesHomogeneousMatrices) {

@@ -84,6 +84,38 @@ TEST(Weights, LogLikelihoodsAreAppliedWithoutUnderflow) {
   EXPECT_THROW(apply_log_likelihoods(u, {0.0}, 1.0), std::invalid_argument);
 }
 
+TEST(Weights, EqualWeightsShareOneLogWithTheBitsOfALogEach) {
+  // The reference: w_i <- w_i l_i^power / sum, with log w_i taken for every particle.
+  const auto reference = [](std::vector<double> w, const std::vector<double>& log_l, double power) {
+    double top = -INFINITY, total = 0.0;
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      if (w[i] > 0.0) top = std::max(top, power * log_l[i] + std::log(w[i]));
+    }
+    std::vector<double> e(w.size());
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      e[i] = w[i] > 0.0 ? std::exp(power * log_l[i] + std::log(w[i]) - top) : 0.0;
+      total += e[i];
+    }
+    for (std::size_t i = 0; i < w.size(); ++i) w[i] = e[i] / total;
+    return w;
+  };
+  Random rng(3);
+  std::vector<double> log_l(500), runs(500);
+  for (std::size_t i = 0; i < 500; ++i) {
+    log_l[i] = rng.uniform(-900.0, -300.0);
+    runs[i] = i % 7 == 3 ? 0.0 : (i < 200 ? 0.002 : rng.uniform());  // equal, zero and distinct
+  }
+  log_l[42] = -INFINITY;
+  for (const std::vector<double>& w0 : {std::vector<double>(500, 1.0 / 500.0), runs}) {
+    for (double power : {1.0, 0.3}) {
+      std::vector<double> w = w0;
+      ASSERT_TRUE(apply_log_likelihoods(w, log_l, power));
+      const std::vector<double> want = reference(w0, log_l, power);
+      for (std::size_t i = 0; i < w.size(); ++i) ASSERT_EQ(w[i], want[i]) << i;
+    }
+  }
+}
+
 TEST(Kld, BoundMatchesFoxsFormulaAndGrowsWithTheBins) {
   // k = 10, err = 0.05, z = 0.99 computed by hand from eq. 14.
   const double a = 2.0 / 81.0, b = 1.0 - a + std::sqrt(a) * 0.99;
@@ -192,6 +224,76 @@ TEST(LikelihoodField, TableEqualsTheFormulaAtEveryBeamEnd) {
       }
       const double want = comb == BeamCombination::product ? sum : std::log(1.0 + sum);
       EXPECT_NEAR(got[k], want, 1e-4 * std::max(1.0, std::abs(want)));
+    }
+  }
+}
+
+namespace {
+
+// The likelihood field's evaluation as it was before the sensor's placement was taken out of
+// Pose2::compose (two calls per particle, with the map's rotation's cos and sin each time): the
+// beam ends (model.used_beams, in the sensor frame, in cells) rotated in doubles, a per-beam
+// bounds test in doubles (the model's is in integers on x86-64, and with AVX2 it takes two
+// particles and four beams at a time), the table read, one particle and one beam at a time.
+std::vector<double> likelihoods_one_at_a_time(const LikelihoodFieldModel& m, const OccupancyGrid& g,
+                                              const std::vector<double>& end_x,
+                                              const std::vector<double>& end_y,
+                                              const std::vector<Pose2>& poses,
+                                              int& just_below_zero) {
+  const Pose2 to_grid = g.origin().inverse();
+  const double inv_res = 1.0 / g.resolution();
+  const double width = g.width(), height = g.height();
+  std::vector<double> out;
+  for (const Pose2& pose : poses) {
+    const Pose2 s = to_grid.compose(pose.compose(m.params().sensor));
+    const double px = s.x * inv_res, py = s.y * inv_res, c = std::cos(s.theta), sn = std::sin(s.theta);
+    double sum = 0.0;
+    for (std::size_t b : m.used_beams()) {
+      const double gx = px + c * end_x[b] - sn * end_y[b], gy = py + sn * end_x[b] + c * end_y[b];
+      const bool inside = gx >= 0.0 && gy >= 0.0 && gx < width && gy < height;
+      just_below_zero += (gx > -1.0 && gx < 0.0) || (gy > -1.0 && gy < 0.0);  // truncated to 0
+      sum += inside ? m.table().at<float>(static_cast<int>(gy), static_cast<int>(gx)) : m.outside();
+    }
+    out.push_back(m.params().combination == BeamCombination::nav2 ? std::log1p(sum) : sum);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(LikelihoodField, EveryFasterPathGivesTheBitsOfTheOldOne) {
+  OccupancyGrid g = room();
+  g.set_origin(Pose2(-1.0, -0.5, 0.3));
+  const auto angles = scan_angles(61);
+  std::vector<float> ranges(61);
+  for (int i = 0; i < 61; ++i) ranges[i] = 0.3f + 0.13f * static_cast<float>(i);
+  ranges[7] = ranges[9] = NAN;  // skipped: 59 beams, not a multiple of the 4 taken at a time
+  Random rng(5);
+  std::vector<Pose2> poses;  // some near or past the map's edges; an odd count (pairs + 1)
+  for (int k = 0; k < 40; ++k) poses.emplace_back(rng.uniform(-2.0, 12.0), rng.uniform(-2.0, 8.0), rng.uniform(-kPi, kPi));
+  poses.emplace_back(1e-300, -0.0, 0.0);  // zeros of either sign at the sensor
+  poses.emplace_back(1e30, -1e300, 1.0);  // ends beyond any integer type
+  poses.emplace_back(INFINITY, 2.0, 0.5);  // NaN end points
+  for (const Pose2 sensor : {Pose2(), Pose2(0.0, 0.0, 0.4), Pose2(0.2, -0.1, 0.05)}) {
+    for (auto comb : {BeamCombination::product, BeamCombination::nav2}) {
+      LikelihoodFieldParams p;
+      p.combination = comb;
+      p.sensor = sensor;
+      LikelihoodFieldModel m(g, p);
+      m.set_scan(angles.data(), ranges.data(), ranges.size(), 9.0);
+      std::vector<double> end_x, end_y;  // every beam with a return, in the sensor frame, in cells
+      for (int i = 0; i < 61; ++i) {
+        if (std::isnan(ranges[i]) || !(ranges[i] < 9.0f)) continue;
+        end_x.push_back(ranges[i] * std::cos(angles[i]) * (1.0 / g.resolution()));
+        end_y.push_back(ranges[i] * std::sin(angles[i]) * (1.0 / g.resolution()));
+      }
+      ASSERT_EQ(end_x.size(), m.beams());
+      int just_below_zero = 0;
+      const std::vector<double> want = likelihoods_one_at_a_time(m, g, end_x, end_y, poses, just_below_zero);
+      EXPECT_GT(just_below_zero, 0);  // ends in (-1, 0): off the map, though truncated to cell 0
+      std::vector<double> got(poses.size());
+      m.log_likelihoods(poses.data(), poses.size(), got.data());
+      for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_EQ(got[k], want[k]) << k;
     }
   }
 }

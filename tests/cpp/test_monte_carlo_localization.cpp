@@ -96,6 +96,55 @@ TEST(MonteCarloLocalization, TracksAndIsDeterministicForAnyThreadCount) {
   EXPECT_GT(one.reliability.back(), 0.9);
 }
 
+TEST(MonteCarloLocalization, ManyParticlesSplitTheirExponentialsAndSinesAmongThreadsWithTheSameResult) {
+  // 20,000 particles: the weights' and the average likelihood's exponentials, the mean's
+  // cosines and sines and multinomial resampling's logarithms are split among the threads
+  // (2 x kParallelExps and more), their sums taken in particle order.
+  ASSERT_GT(20000u, 2 * kParallelExps);
+  MclParams p;
+  p.particles = 20000;
+  p.resampling = ResamplingMethod::multinomial;
+  p.resample_threshold = 1.0;
+  p.recovery = Recovery::augmented;
+  p.threads = 1;
+  const DriveLog one = drive(p, 4, false, 6);
+  for (int threads : {2, 3}) {
+    p.threads = threads;
+    const DriveLog more = drive(p, 4, false, 6);
+    for (std::size_t i = 0; i < one.estimates.size(); ++i) {
+      ASSERT_EQ(one.estimates[i].x, more.estimates[i].x) << threads;
+      ASSERT_EQ(one.estimates[i].y, more.estimates[i].y) << threads;
+      ASSERT_EQ(one.estimates[i].theta, more.estimates[i].theta) << threads;
+    }
+    ASSERT_EQ(one.reliability, more.reliability) << threads;
+  }
+  // Without resampling the weights stay unequal: the posterior is the weighted mean summed in
+  // particle order, as one thread sums it.
+  const OccupancyGrid g = room();
+  const auto angles = scan_angles(61);
+  LikelihoodFieldModel model(g, {});
+  p.resample_threshold = 0.0;
+  p.recovery = Recovery::none;
+  p.threads = 2;
+  MonteCarloLocalization mcl(p, 8);
+  const Pose2 truth(1.0, 4.5, 0.3);
+  mcl.initialize_gaussian(truth, 0.3, 0.3, 0.2);
+  const auto ranges = cast(g, truth, angles, 8.0);
+  model.set_scan(angles.data(), ranges.data(), ranges.size(), 8.0);
+  mcl.update(model);
+  double x = 0, y = 0, c = 0, s = 0;
+  for (std::size_t i = 0; i < mcl.particles().size(); ++i) {
+    const double w = mcl.weights()[i];
+    x += w * mcl.particles()[i].x, y += w * mcl.particles()[i].y;
+    c += w * std::cos(mcl.particles()[i].theta), s += w * std::sin(mcl.particles()[i].theta);
+  }
+  EXPECT_GT(mcl.weights()[0] / mcl.weights()[1] + mcl.weights()[1] / mcl.weights()[0], 2.0 + 1e-9);
+  EXPECT_EQ(mcl.posterior().x, x);
+  EXPECT_EQ(mcl.posterior().y, y);
+  EXPECT_EQ(mcl.posterior().theta, Pose2(0.0, 0.0, std::atan2(s, c)).theta);  // wrapped as a Pose2 is
+  EXPECT_EQ(mcl.estimate().x, x);
+}
+
 TEST(MonteCarloLocalization, GlobalLocalizationWithKldEndsWithFewParticles) {
   MclParams p;
   p.particles = 20000;

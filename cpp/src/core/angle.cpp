@@ -8,7 +8,11 @@ namespace kiseki {
 
 double normalize_angle(double angle) {
   if (!std::isfinite(angle)) return angle;
-  double wrapped = std::fmod(angle + kPi, 2.0 * kPi);
+  const double shifted = angle + kPi;
+  // fmod is exact, and returns its argument unchanged when that is smaller than the divisor in
+  // magnitude: the call is skipped there (an angle near [-pi, pi), nearly every call) with the
+  // same result.
+  double wrapped = std::abs(shifted) < 2.0 * kPi ? shifted : std::fmod(shifted, 2.0 * kPi);
   if (wrapped < 0.0) wrapped += 2.0 * kPi;
   return wrapped - kPi;
 }

@@ -162,10 +162,10 @@ std::vector<double> MonteCarloLocalization::evaluate(const SensorModel& model, c
   return out;
 }
 
-double MonteCarloLocalization::agreement_of(const SensorModel& model) const {
+double MonteCarloLocalization::agreement_of(const SensorModel& model, const Pose2& weighed) const {
   // At the filter's answer, the weighted mean after weighing: a single particle of a tracking
   // cloud is further off than the mean, and long beams turn its heading error into metres.
-  return model.agreement(estimate());
+  return model.agreement(weighed);
 }
 
 UpdateReport MonteCarloLocalization::update(SensorModel& model) {
@@ -223,11 +223,17 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
   }
   double w_avg = 0.0;
   if (std::isfinite(top)) {
-    for (std::size_t i = 0; i < log_l.size(); ++i) w_avg += weights_[i] * std::exp(log_l[i] / r - top);
+    // The terms on the threads, their sum in particle order: the same for any thread count.
+    std::vector<double> terms(log_l.size());
+    parallel_for(terms.size(), params_.threads, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) terms[i] = weights_[i] * std::exp(log_l[i] / r - top);
+    }, kParallelExps);
+    for (double t : terms) w_avg += t;
     w_avg *= std::exp(top);
   }
   report.average_likelihood = w_avg;
-  report.informative = readings > 0 && apply_log_likelihoods(weights_, log_l, params_.likelihood_power);
+  report.informative =
+      readings > 0 && apply_log_likelihoods(weights_, log_l, params_.likelihood_power, params_.threads);
   report.effective_sample_size = kiseki::effective_sample_size(weights_);
   if (report.informative && std::isfinite(w_avg)) {
     if (w_slow_ == 0.0) w_slow_ = w_fast_ = w_avg;
@@ -235,7 +241,10 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
     w_fast_ += params_.alpha_fast * (w_avg - w_fast_);
   }
   const double ratio = w_slow_ > 0.0 ? w_fast_ / w_slow_ : 1.0;
-  if (model != nullptr) agreement = agreement_of(*model);
+  // The weighted mean after weighing: where the agreement is taken and, unless a reset moves
+  // the particles, the posterior (computed once for both).
+  const Pose2 weighed = estimate();
+  if (model != nullptr) agreement = agreement_of(*model, weighed);
   report.agreement = agreement;
   const bool knows = !std::isnan(agreement);
   const bool lost = knows ? agreement < params_.reset_threshold : ratio < 0.5;
@@ -266,7 +275,7 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
     }
   }
   if (!lost && !dropped) lost_updates_ = 0;
-  posterior_ = estimate();  // before resampling: injected poses have no weight in it
+  posterior_ = weighed;  // before resampling: injected poses have no weight in it
   double inject = 0.0;
   const bool injects = params_.recovery == Recovery::augmented ||
                        (params_.recovery == Recovery::resetting && params_.resetting_injects);
@@ -281,8 +290,14 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
 
 void MonteCarloLocalization::resample(double inject, UpdateReport& report) {
   const std::size_t n = params_.kld ? params_.particles : target_;
-  std::vector<Pose2> out =
-      resample_states(particles_, weights_, n, params_.resampling, params_.kld, params_.kld_params, rng_);
+  std::vector<Pose2> out;
+  if (params_.kld) {
+    out = resample_states(particles_, weights_, n, params_.resampling, true, params_.kld_params, rng_);
+  } else {  // resample_states without KLD, with the logarithms of the draws on the threads
+    const std::vector<std::size_t> idx = resample_indices(weights_, n, params_.resampling, rng_, params_.threads);
+    out.resize(idx.size());
+    for (std::size_t i = 0; i < idx.size(); ++i) out[i] = particles_[idx[i]];
+  }
   if (inject > 0.0) {
     std::size_t m = 0;
     for (std::size_t i = 0; i < out.size(); ++i) m += rng_.uniform() < inject;
@@ -321,13 +336,29 @@ void MonteCarloLocalization::resample_to(std::size_t n) {
 
 Pose2 MonteCarloLocalization::estimate() const {
   check_ready();
+  const std::size_t n = particles_.size();
   double x = 0, y = 0, c = 0, s = 0;
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
+  if (n < 2 * kParallelExps || resolve_threads(params_.threads) < 2) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const double w = weights_[i];
+      x += w * particles_[i].x;
+      y += w * particles_[i].y;
+      c += w * std::cos(particles_[i].theta);
+      s += w * std::sin(particles_[i].theta);
+    }
+    return {x, y, std::atan2(s, c)};
+  }
+  // The headings' cosines and sines on the threads, the sums in particle order as above.
+  std::vector<double> cosines(n), sines(n);
+  parallel_for(n, params_.threads, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) cosines[i] = std::cos(particles_[i].theta), sines[i] = std::sin(particles_[i].theta);
+  }, kParallelExps);
+  for (std::size_t i = 0; i < n; ++i) {
     const double w = weights_[i];
     x += w * particles_[i].x;
     y += w * particles_[i].y;
-    c += w * std::cos(particles_[i].theta);
-    s += w * std::sin(particles_[i].theta);
+    c += w * cosines[i];
+    s += w * sines[i];
   }
   return {x, y, std::atan2(s, c)};
 }

@@ -8,6 +8,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "kiseki/core/parallel.hpp"
+
 namespace kiseki {
 
 ResamplingMethod resampling_method_from_name(const std::string& name) {
@@ -57,7 +59,7 @@ void walk(const std::vector<double>& cum, const std::vector<double>& u, std::vec
 }  // namespace
 
 std::vector<std::size_t> resample_indices(const std::vector<double>& weights, std::size_t n,
-                                          ResamplingMethod method, Random& rng) {
+                                          ResamplingMethod method, Random& rng, int threads) {
   if (weights.empty()) throw std::invalid_argument("resampling: no particles");
   const std::vector<double> cum = cumulative(weights);
   std::vector<std::size_t> out;
@@ -66,11 +68,16 @@ std::vector<std::size_t> resample_indices(const std::vector<double>& weights, st
   std::vector<double> u(n);
   switch (method) {
     case ResamplingMethod::multinomial: {
-      // Sorted uniforms from normalised exponential spacings, so one pass suffices.
+      // Sorted uniforms from normalised exponential spacings, so one pass suffices. The draws
+      // in order, their logs on the threads, the running sum in order: the same for any count.
+      std::vector<double> e(n + 1);
+      for (double& v : e) v = rng.uniform();
+      parallel_for(e.size(), threads, [&](std::size_t b, std::size_t end) {
+        for (std::size_t m = b; m < end; ++m) e[m] = -std::log(1.0 - e[m]);
+      }, kParallelExps);
       double acc = 0.0;
       for (std::size_t m = 0; m <= n; ++m) {
-        const double e = -std::log(1.0 - rng.uniform());
-        acc += e;
+        acc += e[m];
         if (m < n) u[m] = acc;
       }
       for (double& v : u) v /= acc;
@@ -118,23 +125,31 @@ double effective_sample_size(const std::vector<double>& weights) {
   return s > 0.0 ? 1.0 / s : 0.0;
 }
 
-bool apply_log_likelihoods(std::vector<double>& weights, const std::vector<double>& log_l, double power) {
+bool apply_log_likelihoods(std::vector<double>& weights, const std::vector<double>& log_l, double power,
+                           int threads) {
   if (log_l.size() != weights.size()) throw std::invalid_argument("weights: one log-likelihood per particle is needed");
   if (!(power > 0.0) || !std::isfinite(power)) throw std::invalid_argument("weights: the likelihood power must be > 0");
+  // log w_i + power log l_i for every particle; after a resampling every weight is the same,
+  // so the log of a weight equal to the one before is that one's (the same value, once).
+  std::vector<double> w(weights.size());
   double top = -std::numeric_limits<double>::infinity();
+  double last_weight = std::numeric_limits<double>::quiet_NaN(), last_log = 0.0;
   for (std::size_t i = 0; i < log_l.size(); ++i) {
     if (std::isnan(log_l[i]) || log_l[i] == std::numeric_limits<double>::infinity()) {
       throw std::invalid_argument("weights: a log-likelihood is NaN or +inf");
     }
-    if (weights[i] > 0.0) top = std::max(top, power * log_l[i] + std::log(weights[i]));
+    if (weights[i] > 0.0) {
+      if (weights[i] != last_weight) last_weight = weights[i], last_log = std::log(weights[i]);
+      w[i] = power * log_l[i] + last_log;
+      top = std::max(top, w[i]);
+    }
   }
   if (!std::isfinite(top)) return false;
-  std::vector<double> w(weights.size());
+  parallel_for(w.size(), threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) w[i] = weights[i] > 0.0 ? std::exp(w[i] - top) : 0.0;
+  }, kParallelExps);
   double total = 0.0;
-  for (std::size_t i = 0; i < w.size(); ++i) {
-    w[i] = weights[i] > 0.0 ? std::exp(power * log_l[i] + std::log(weights[i]) - top) : 0.0;
-    total += w[i];
-  }
+  for (double v : w) total += v;  // in particle order, for any thread count
   if (!(total > 0.0) || !std::isfinite(total)) return false;
   for (std::size_t i = 0; i < w.size(); ++i) weights[i] = w[i] / total;
   return true;

@@ -115,3 +115,36 @@ def test_a_cloud_that_sees_no_wall_uses_every_beam(intel):
     off.set_scan(scans.angles, scans.ranges[k], scans.max_range)
     off.select_readings(scans.poses[k][None, :], 1)
     assert off.used_beams == list(range(off.beams))
+
+
+def test_every_pose_gets_its_brute_force_likelihood_wherever_it_falls_in_the_batch(intel):
+    """The model places the laser once per pose with the map's rotation taken once per call,
+    and (with AVX2) weighs poses two at a time, four beams at a time: each pose's value must be
+    the numpy reference's, with a laser mounted off the robot's centre, and the same bits
+    whether the pose is evaluated alone (one at a time) or with others."""
+    scans, grid = intel
+    k = 500
+    sensor = _core.Pose2(0.12, -0.04, 0.03)
+    rng = np.random.default_rng(7)
+    poses = scans.poses[k] + rng.normal(0.0, 1.0, (23, 3)) * (0.4, 0.4, 0.2)
+    poses[-1] = (-30.0, 0.0, 0.0)  # every end off the map
+    model = _core.LikelihoodFieldModel(grid, sensor=sensor)
+    model.set_scan(scans.angles, scans.ranges[k], scans.max_range)
+    # the reference takes the laser's pose in the world
+    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    lasers = np.column_stack(
+        (
+            poses[:, 0] + c * sensor.x - s * sensor.y,
+            poses[:, 1] + s * sensor.x + c * sensor.y,
+            poses[:, 2] + sensor.theta,
+        )
+    )
+    _, ends = reference(grid, scans, k, lasers)
+    expected = log_likelihood_reference(model, grid, ends, np.arange(model.beams))
+    together = model.log_likelihoods(poses)
+    np.testing.assert_allclose(together, expected, rtol=1e-9)
+    assert together[-1] == pytest.approx(model.beams * model.outside, rel=1e-12)
+    for start in range(6):
+        np.testing.assert_array_equal(model.log_likelihoods(poses[start:]), together[start:])
+        alone = model.log_likelihoods(poses[start : start + 1])
+        np.testing.assert_array_equal(alone, together[start])

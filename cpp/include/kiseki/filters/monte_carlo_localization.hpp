@@ -177,7 +177,7 @@ class MonteCarloLocalization {
   UpdateReport update_impl(const std::vector<double>& log_l, std::size_t readings, double agreement,
                            const SensorModel* model, const ScanView* scan);
   std::vector<double> evaluate(const SensorModel& model, const std::vector<Pose2>& poses) const;
-  double agreement_of(const SensorModel& model) const;
+  double agreement_of(const SensorModel& model, const Pose2& weighed) const;
   void resample(double inject_probability, UpdateReport& report);
   bool explains_better(double proposed_best, double cloud_best) const;
   bool expansion_reset(const SensorModel* model, double cloud_best);

@@ -21,9 +21,16 @@ enum class ResamplingMethod {
 ResamplingMethod resampling_method_from_name(const std::string& name);
 const char* resampling_method_name(ResamplingMethod method);
 
+/// The fewest particles a thread takes in the engine's loops of a few arithmetic operations and
+/// an exponential or a sine per particle (weights, the weighted mean): about 100 us of work,
+/// well over what waking a sleeping OpenMP worker costs.
+inline constexpr std::size_t kParallelExps = 8192;
+
 /// n indices into weights (normalised or not, all finite and >= 0, positive sum), drawn by method.
+/// `threads`: multinomial's logarithms are taken on up to that many threads (the draws and the
+/// sums stay in order on the calling one: the same indices for any count).
 std::vector<std::size_t> resample_indices(const std::vector<double>& weights, std::size_t n,
-                                          ResamplingMethod method, Random& rng);
+                                          ResamplingMethod method, Random& rng, int threads = 1);
 
 /// Effective sample size 1 / sum w_i^2 of normalised weights (Liu 1996).
 double effective_sample_size(const std::vector<double>& weights);
@@ -32,7 +39,9 @@ double effective_sample_size(const std::vector<double>& weights);
 /// underflow (the largest term is taken out). -inf log-likelihoods give weight 0; NaN throws.
 /// Returns false and leaves the weights unchanged when no particle has a finite
 /// log-likelihood or every product underflows (the measurement carries no usable information).
+/// The exponentials are taken on up to `threads` threads and summed in particle order on the
+/// calling one, so the weights are the same for any thread count.
 bool apply_log_likelihoods(std::vector<double>& weights, const std::vector<double>& log_likelihoods,
-                           double power);
+                           double power, int threads = 1);
 
 }  // namespace kiseki
