@@ -135,7 +135,7 @@ void bind_gp(py::module_& m) {
   m.def(
       "gp_fit_hyperparameters",
       [](const py::handle& inputs, const py::handle& targets, double sigma_f, double length_scale, double sigma_n,
-         int restarts, std::uint64_t seed, int max_iterations, double tolerance) {
+         int restarts, std::uint64_t seed, int max_iterations, double tolerance, bool scan) {
         const Rows x(inputs, "inputs");
         const Rows y(targets, "targets");
         const SquaredExponential initial = kernel_of(sigma_f, length_scale, sigma_n);
@@ -144,6 +144,7 @@ void bind_gp(py::module_& m) {
         o.seed = seed;
         o.max_iterations = max_iterations;
         o.tolerance = tolerance;
+        o.scan = scan;
         HyperparameterFit fit;
         {
           py::gil_scoped_release release;
@@ -153,7 +154,7 @@ void bind_gp(py::module_& m) {
                               fit.log_marginal_likelihood, fit.evaluations, fit.gradients, fit.start_values);
       },
       "inputs"_a, "targets"_a, "sigma_f"_a, "length_scale"_a, "sigma_n"_a, "restarts"_a = 3, "seed"_a = 0,
-      "max_iterations"_a = 100, "tolerance"_a = 1e-6,
+      "max_iterations"_a = 100, "tolerance"_a = 1e-6, "scan"_a = true,
       "(sigma_f, l, sigma_n, LML, likelihood values, gradients, best LML per start); targets used as given.");
 }
 

@@ -198,7 +198,7 @@ HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
   // wrong side of it never leaves it, so the scan looks at the whole range first. The data's
   // default start is one of the scan's points and is then not run twice.
   Eigen::Vector3d scanned = to_log(initial);
-  {
+  if (options.scan) {
     double best = std::numeric_limits<double>::infinity();
     for (int i = 0; i <= 8; ++i) {
       for (const double noise : {0.01, 0.1}) {

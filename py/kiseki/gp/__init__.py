@@ -4,6 +4,7 @@
 
 * :class:`SquaredExponential`: the kernel sigma_f^2 exp(-|p - q|^2 / (2 l^2)) and noise sigma_n;
 * :func:`fit_hyperparameters`: maximum of the log marginal likelihood (eqs. 6.11-6.15), BFGS;
+  :func:`refine_hyperparameters` carries a subsample's maximum to every reading;
 * :class:`ExactGP`: exact regression (eqs. 6.7-6.9), one factorisation for all field components;
 * :class:`HilbertGP`: the reduced-rank approximation for maps of tens of thousands of readings;
 * :class:`CurlFreeGP`, :class:`ReducedRankCurlFreeGP`: the field as the gradient of a scalar
@@ -23,7 +24,12 @@ from kiseki.gp.curl_free import (
 from kiseki.gp.curl_free_basis import ReducedRankCurlFreeGP
 from kiseki.gp.exact import ExactGP
 from kiseki.gp.hilbert import HilbertGP
-from kiseki.gp.kernel import HyperparameterFit, SquaredExponential, fit_hyperparameters
+from kiseki.gp.kernel import (
+    HyperparameterFit,
+    SquaredExponential,
+    fit_hyperparameters,
+    refine_hyperparameters,
+)
 
 __all__ = [
     "CurlFreeFit",
@@ -36,4 +42,5 @@ __all__ = [
     "SquaredExponential",
     "fit_curl_free_hyperparameters",
     "fit_hyperparameters",
+    "refine_hyperparameters",
 ]

@@ -10,7 +10,12 @@ import numpy as np
 
 from kiseki import _core
 from kiseki.gp._data import check_mean, inputs_array, targets_array
-from kiseki.gp.kernel import HyperparameterFit, SquaredExponential, fit_hyperparameters
+from kiseki.gp.kernel import (
+    HyperparameterFit,
+    SquaredExponential,
+    fit_hyperparameters,
+    refine_hyperparameters,
+)
 
 __all__ = ["ExactGP"]
 
@@ -45,12 +50,15 @@ class ExactGP:
         seed: int = 0,
         max_points: int = 2000,
         per_component: bool = False,
+        refine: bool = False,
     ) -> ExactGP:
         """Fits to readings y (n,) or (n, k) at positions x (n, d). Without a kernel the
         hyperparameters are chosen by :func:`fit_hyperparameters` (restarts, seed, max_points
         as there). mean: "constant" (the training mean of each column) or "zero" (as
         scikit-learn's GaussianProcessRegressor with normalize_y=False). per_component: one
-        kernel per column, as the thesis fits mx, my and mz (three factorisations)."""
+        kernel per column, as the thesis fits mx, my and mz (three factorisations). refine: with
+        more readings than max_points, the subsample's hyperparameters are then refined on every
+        reading (:func:`refine_hyperparameters`), so that they maximise eq. 6.11 on all of them."""
         x = inputs_array(x)
         y, _ = targets_array(y, x.shape[0])
         constant = check_mean(mean)
@@ -65,6 +73,8 @@ class ExactGP:
                 hyper = fit_hyperparameters(
                     x, part, restarts=restarts, seed=seed, max_points=max_points, mean=mean
                 )
+                if refine and hyper.points_used < len(x):
+                    hyper = refine_hyperparameters(x, part, hyper, mean=mean)
                 k = hyper.kernel
             cores.append(
                 _core.ExactGaussianProcess(x, part, k.sigma_f, k.length_scale, k.sigma_n, constant)

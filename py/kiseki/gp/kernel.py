@@ -20,7 +20,12 @@ from kiseki.gp._data import (
     targets_array,
 )
 
-__all__ = ["HyperparameterFit", "SquaredExponential", "fit_hyperparameters"]
+__all__ = [
+    "HyperparameterFit",
+    "SquaredExponential",
+    "fit_hyperparameters",
+    "refine_hyperparameters",
+]
 
 
 @dataclass(frozen=True)
@@ -67,6 +72,8 @@ class HyperparameterFit:
     gradients: int  # of which also with the gradient (two more n^3 / 3 each)
     start_values: tuple[float, ...]  # the best likelihood reached from each start
     points_used: int
+    # a refinement's (refine_hyperparameters): the subsample's fit it started from
+    refined_from: HyperparameterFit | None = None
 
 
 def subsample(n: int, max_points: int, seed: int) -> np.ndarray | None:
@@ -125,6 +132,33 @@ def fit_hyperparameters(
         int(gradients),
         tuple(starts),
         len(x),
+    )
+
+
+def refine_hyperparameters(
+    x: Any,
+    y: Any,
+    start: HyperparameterFit,
+    *,
+    max_iterations: int = 100,
+    mean: str = "constant",
+) -> HyperparameterFit:
+    """The hyperparameters that maximise eq. 6.11 on every reading, by the same L-BFGS from the
+    optimum ``start`` found on a subsample (:func:`fit_hyperparameters` with ``max_points``):
+    no scan and no random restarts, which on every reading would cost the most. It climbs to the
+    optimum of all readings nearest the subsample's (on the thesis' 3-D floor, 9 evaluations
+    from a 1,000-point subsample's, where a full fit on 2,000 points takes 195)."""
+    x = inputs_array(x)
+    y, _ = targets_array(y, x.shape[0])
+    y = remove_mean(y, check_mean(mean))
+    check_iterations(max_iterations)
+    k = start.kernel
+    sf, ls, sn, lml, evaluations, gradients, starts = _core.gp_fit_hyperparameters(
+        x, y, k.sigma_f, k.length_scale, k.sigma_n, 0, 0, max_iterations, scan=False
+    )
+    kernel = SquaredExponential(sf, ls, sn)
+    return HyperparameterFit(
+        kernel, float(lml), int(evaluations), int(gradients), tuple(starts), len(x), start
     )
 
 

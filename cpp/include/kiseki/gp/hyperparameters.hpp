@@ -32,6 +32,9 @@ struct HyperparameterOptions {
   int restarts = 3;           ///< random starts after the first
   std::uint64_t seed = 0;     ///< for the random starts
   int max_iterations = 100;   ///< BFGS iterations per start
+  /// The coarse scan as a start (18 values). Off for a refinement from a start known to be near
+  /// the optimum (a subsample's), where the scan's values on every reading would cost the most.
+  bool scan = true;
   double tolerance = 1e-6;    ///< on the largest projected gradient component of LML / (n k)
   /// A start stops when an iteration lowers -LML by at most this share of its size: factr x
   /// machine epsilon with L-BFGS-B's default factr of 1e7 (the setting scikit-learn uses).
@@ -49,7 +52,7 @@ struct HyperparameterFit {
 /// Maximises eq. 6.11 over (sigma_f, l, sigma_n) by projected BFGS in log-parameters with a
 /// backtracking line search on likelihood values (the gradient only at accepted points), from
 /// `initial`, from the best point of a coarse scan of length scales and noise levels (18 values;
-/// skipped as a start when it is `initial`), and from `restarts` random starts (log-uniform
+/// skipped as a start when it is `initial`; not made without `options.scan`), and from `restarts` random starts (log-uniform
 /// within the bounds below, drawn from kiseki::Random(seed)); the best start wins. Bounds, from the
 /// data: sigma_f and sigma_n in [1e-6, 1e3] x the targets' RMS, l in [1e-3, 1e2] x the inputs'
 /// largest extent. Targets are used as given (remove a mean first).
