@@ -124,7 +124,9 @@ CORRIDOR = Experiment(
     config_type=CorridorConfig,
     trial=trial,
     analyze=analyze,
-    default_runs=10,
+    # 100: at 10 the share of seeds with a large along-track error (0.4) was undecided; the
+    # report asked 98 trials (issue 29: the default trials decide at least 80 % of the claims)
+    default_runs=100,
     preflight=preflight,
     claims=CLAIMS_CORRIDOR,
 )
