@@ -142,7 +142,7 @@ def analyze(config, trials: pd.DataFrame, timings: pd.DataFrame, figures: Path) 
     paths = draw_all(config, maps, change, mcl, walks, figures)
     text = notes(config, maps, change, mcl, walks)
     evidence = fold_evidence(folds) + mcl_evidence(mcl)
-    return Analysis(tables, paths, [], text, evidence=evidence)
+    return Analysis(tables, paths, notes=text, evidence=evidence)
 
 
 def _fold_order(task: str) -> tuple[int, str]:
