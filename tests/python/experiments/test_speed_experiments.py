@@ -136,7 +136,7 @@ def test_a_pattern_runs_every_matching_experiment(tmp_path):
     for args, message in [
         (["nothing-*"], "no experiment matches"),
         (["speed-*", "--runs", "2"], "no --runs"),
-        (["speed-*", "--set", "v_max=1"], "no --runs, --set"),
+        (["speed-*", "--set", "v_max=1"], "no --runs or --set"),
     ]:
         bad = subprocess.run([*kiseki, *args], capture_output=True, text=True)
         assert bad.returncode == 1 and message in bad.stderr, bad.stderr
