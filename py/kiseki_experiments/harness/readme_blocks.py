@@ -24,9 +24,8 @@ import pandas as pd
 
 from kiseki_experiments.harness.registry import all_experiments
 from kiseki_experiments.harness.report import (
-    latest_run,
     markdown_table,
-    read_result,
+    read_latest,
     tally,
     tally_text,
 )
@@ -56,13 +55,10 @@ def gather(results_root: Path) -> dict[str, Result]:
         raise FileNotFoundError(f"{results_root}: results folder not found")
     out = {}
     for name in sorted(all_experiments()):
-        latest = latest_run(results_root, name)
-        if latest is None:
+        found = read_latest(results_root, name)
+        if found is None:
             continue
-        run_dir = latest.resolve()
-        if not run_dir.is_relative_to(results_root.resolve()):
-            raise ValueError(f"{latest}: the link points outside --results ({run_dir})")
-        claims, manifest = read_result(latest)
+        _, claims, manifest = found
         commit = str(manifest["git"].get("commit") or "unknown")[:7]
         out[name] = Result(name, claims, manifest["trials"], manifest["trials_failed"], commit)
     return out

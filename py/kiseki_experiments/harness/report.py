@@ -28,6 +28,7 @@ __all__ = [
     "claims_frame",
     "latest_run",
     "print_claims",
+    "read_latest",
     "read_result",
     "tally",
     "markdown_table",
@@ -297,16 +298,14 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[dict[str, int], l
     missing: list[str] = []
     for name, experiment in sorted(all_experiments().items()):
         section = by_paper.setdefault(experiment.paper, [])
-        latest = latest_run(results_root, name)
+        found = read_latest(results_root, name)
         section += ["", f"### {name} ({experiment.artefact}): {experiment.description}", ""]
-        if latest is None:
+        if found is None:
             missing.append(name)
             section.append(f"**missing**: no result yet; run `kiseki experiment run {name}`.")
             continue
+        latest, claims, manifest = found
         run_dir = latest.resolve()
-        if not run_dir.is_relative_to(results_root.resolve()):  # a link moved or made by hand
-            raise ValueError(f"{latest}: the link points outside --results ({run_dir})")
-        claims, manifest = read_result(latest)
         frames.append(claims)
         timings_path = latest / "timings.parquet"
         timings = pd.read_parquet(timings_path) if timings_path.is_file() else None
@@ -337,6 +336,20 @@ def latest_run(results_root: Path, name: str) -> Path | None:
         if (folder / "claims.csv").is_file():
             return folder
     return None
+
+
+def read_latest(results_root: Path, name: str) -> tuple[Path, pd.DataFrame, dict] | None:
+    """The run of ``name`` the report reads (:func:`latest_run`) with its claims and manifest
+    (:func:`read_result`), or None when there is none. A ``latest`` link that leads outside
+    ``results_root`` (moved or made by hand) is refused in one line."""
+    latest = latest_run(results_root, name)
+    if latest is None:
+        return None
+    run_dir = latest.resolve()
+    if not run_dir.is_relative_to(results_root.resolve()):
+        raise ValueError(f"{latest}: the link points outside --results ({run_dir})")
+    claims, manifest = read_result(latest)
+    return latest, claims, manifest
 
 
 def read_result(latest: Path) -> tuple[pd.DataFrame, dict]:

@@ -13,6 +13,7 @@ import pytest
 from _helpers.cli_main import kiseki
 from kiseki_experiments.harness.readme_blocks import update_readme
 from kiseki_experiments.harness.registry import all_experiments
+from kiseki_experiments.harness.report import write_reproduction
 from kiseki_experiments.harness.runner import run_experiment
 
 PROSE = "# A project\n\nText before, with a | pipe.\n\n"
@@ -108,3 +109,21 @@ def test_the_readme_tables_are_the_committed_results():
     assert "<!-- reproduction-summary -->" in text
     regenerated, _ = update_readme(text, readme, root / "docs" / "reproduction" / "results")
     assert regenerated == text
+
+
+def test_a_latest_link_leading_outside_the_results_is_refused_by_report_and_readme(
+    results, tmp_path
+):
+    """The report and the README tables read a run through one function: a ``latest`` link
+    moved or made by hand to lead outside --results is refused by both, naming the link."""
+    root = tmp_path / "results"
+    (root / "corridor-scans").mkdir(parents=True)
+    elsewhere = (results / "corridor-scans" / "latest").resolve()
+    (root / "corridor-scans" / "latest").symlink_to(elsewhere, target_is_directory=True)
+    link = str(root / "corridor-scans" / "latest")
+    with pytest.raises(ValueError, match="the link points outside --results") as err:
+        update_readme(README, tmp_path / "README.md", root)
+    assert link in str(err.value)
+    with pytest.raises(ValueError, match="the link points outside --results") as err:
+        write_reproduction(root, tmp_path / "R.md")
+    assert link in str(err.value) and not (tmp_path / "R.md").exists()
