@@ -46,45 +46,27 @@ from __future__ import annotations
 
 import argparse
 import os
-import time
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial import cKDTree
 from sklearn.gaussian_process import GaussianProcessRegressor
 
-from gp_reference import run_sklearn_limited, sklearn_kernel, start_kernel  # beside this file
+from gp_cases_3d import best_of, case_hilbert, case_volume, rmse  # beside this file
+from gp_reference import run_sklearn_limited, sklearn_kernel, start_kernel
 from kiseki.datasets import read_aalto_run
-from kiseki.gp import ExactGP, HilbertGP, fit_hyperparameters, refine_hyperparameters
+from kiseki.gp import ExactGP
 from kiseki.gp.kernel import log_marginal_likelihood
 from kiseki.sim.scene import load_scene
 from kiseki_experiments.gp.gp_common import (
     FLOOR,
-    HALL,
-    SENSOR_NOISE,
     free_mask,
     magnetic_world,
     survey_2d,
-    survey_3d,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
 AALTO = ROOT.parent / "shared" / "data" / "magnetic" / "aalto" / "invensense"
-THESIS_2D_S, THESIS_3D_S = 30 * 60.0, 29 * 3600.0  # sec. 6.5: about 30 min and about 29 h
-MENZEN_S = 120.0  # Menzen, Fetter and Kok (FUSION 2023): 40,000 readings, under 2 min
-
-
-def best_of(fn, repeats: int):
-    best, out = np.inf, None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, out
-
-
-def rmse(a: np.ndarray, b: np.ndarray) -> float:
-    return float(np.sqrt(np.mean((np.asarray(a) - np.asarray(b)) ** 2)))
+THESIS_2D_S = 30 * 60.0  # sec. 6.5: about 30 min
 
 
 # --- the exact GP in both libraries -----------------------------------------------------------
@@ -233,127 +215,6 @@ def floor_2d(seed: int):
     grid = scene.measurement_grid.points()
     grid = grid[free_mask(scene, grid, grid[0, 2])]
     return survey.positions, survey.field, grid[:, :2], magnetic_world(scene).static_field_at(grid)
-
-
-def hall(n: int, seed: int, voxel: float = 0.05):
-    """n noisy readings at uniform random points of the hall's measured volume, its field and
-    the volume's voxel centres."""
-    scene = load_scene(HALL)
-    world = magnetic_world(scene)
-    lo, hi = (np.array(c) for c in (scene.measurement_grid.lower, scene.measurement_grid.upper))
-    rng = np.random.default_rng(seed)
-    x = lo + (hi - lo) * rng.random((n, 3))
-    y = world.static_field_at(x) + rng.normal(0.0, SENSOR_NOISE, (n, 3))
-    axes = [
-        a + voxel * (np.arange(round((b - a) / voxel)) + 0.5) for a, b in zip(lo, hi, strict=True)
-    ]
-    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    return x, y, world, grid
-
-
-# --- the 3-D cases ----------------------------------------------------------------------------
-
-
-def case_volume(args, rows) -> None:
-    scene = load_scene(FLOOR)
-    survey, world = survey_3d(scene, args.seed), magnetic_world(scene)
-    x, y, raw = survey.positions, survey.field, survey.readings
-    axes = [0.2 * (np.arange(n) + 0.5) for n in (150, 75, 11)]  # 30 x 15 x 2.2 m, 0.2 m
-    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    if args.quick:
-        keep = np.random.default_rng(args.seed).choice(len(x), 1500, replace=False)
-        x, y, grid = x[keep], y[keep], grid[::10]
-    print(f"\n3-D floor: {raw:,} readings in {len(x):,} voxels -> {len(grid):,}", flush=True)
-    hyper_s, hyper = best_of(lambda: fit_hyperparameters(x, y, seed=0), args.repeats)
-    factor_s, gp = best_of(lambda: ExactGP.fit(x, y, hyper.kernel), args.repeats)
-    predict_s, (mean, var) = best_of(lambda: gp.predict(grid), args.repeats)
-    near = cKDTree(x).query(grid, distance_upper_bound=0.3)[0] < np.inf
-    total = hyper_s + factor_s + predict_s
-    print(
-        f"  hyperparameters ({hyper.points_used:,}-point subsample, {hyper.evaluations} "
-        f"evaluations, {hyper.gradients} with the gradient, "
-        f"{hyper_s / hyper.evaluations:.2f} s each): {hyper_s:.1f} s; "
-        f"factorisation of {len(x):,}: {factor_s:.2f} s; prediction with variance: "
-        f"{predict_s:.1f} s\n  {gp.kernel}; RMSE against the field at the {near.sum():,} "
-        f"voxels within 0.3 m of data: {rmse(mean[near], world.static_field_at(grid[near])):.4f} G",
-        flush=True,
-    )
-    name = f"3-D floor, {len(x):,} voxels of 0.2 m -> {len(grid):,}"
-    parts = f"{hyper_s:.1f} + {factor_s:.2f} + {predict_s:.1f} s"
-    rows.append((f"{name}: hyperparameters + factorisation + prediction", parts, "", ""))
-    ratio = f"{THESIS_3D_S / total:,.0f}x"
-    rows.append((f"{name}: total (goal 2 min)", f"{total:.1f} s", "thesis: 29 h", ratio))
-
-    # the hyperparameters fitted on every reading: a 1,000-point subsample's optimum refined
-    def on_all():
-        start = fit_hyperparameters(x, y, seed=0, max_points=min(1000, len(x)))
-        return start, refine_hyperparameters(x, y, start)
-
-    all_s, (start, refined) = best_of(on_all, args.repeats)
-    factor_s, gp = best_of(lambda: ExactGP.fit(x, y, refined.kernel), args.repeats)
-    predict_s, (mean, var) = best_of(lambda: gp.predict(grid), args.repeats)
-    total = all_s + factor_s + predict_s
-    print(
-        f"  hyperparameters on all {len(x):,} readings ({start.evaluations} evaluations on "
-        f"{start.points_used:,}, then {refined.evaluations} on all; LML on all "
-        f"{refined.log_marginal_likelihood:.2f}): {all_s:.1f} s; factorisation {factor_s:.2f} s; "
-        f"prediction with variance {predict_s:.1f} s\n  {refined.kernel}; RMSE near data: "
-        f"{rmse(mean[near], world.static_field_at(grid[near])):.4f} G",
-        flush=True,
-    )
-    parts = f"{all_s:.1f} + {factor_s:.2f} + {predict_s:.1f} s"
-    label = f"{name}, hyperparameters on all readings ({refined.evaluations} evaluations on all)"
-    rows.append((f"{label}: total (goal 2 min)", f"{total:.1f} s = {parts}", "thesis: 29 h", ""))
-
-
-def basis_count(sides: np.ndarray, length_scale: float, tolerance: float = 1e-4) -> int:
-    """HilbertGP's basis size on a box (its rule: the Laplacian's eigenfunctions whose
-    frequency is below w_max, S(w_max) = tolerance S(0))."""
-    w_max = np.sqrt(-2.0 * np.log(tolerance)) / length_scale
-    axes = [np.pi * np.arange(1, int(w_max * L / np.pi) + 1) / L for L in sides]
-    w2 = sum(a**2 for a in np.meshgrid(*axes, indexing="ij", sparse=True))
-    return int((w2 <= w_max**2).sum())
-
-
-def case_hilbert(args, rows) -> None:
-    n, subset = (5000, 1500) if args.quick else (40000, 6000)
-    x, y, world, grid = hall(n, args.seed)
-    if args.quick:
-        grid = grid[::8]
-    print(f"\nHilbertGP, hall: {n:,} readings -> {len(grid):,} voxels of 0.05 m", flush=True)
-    hyper_s, hyper = best_of(
-        lambda: fit_hyperparameters(x, y, seed=0, max_points=args.hilbert_points), args.repeats
-    )
-    k = hyper.kernel
-    fit_s, hg = best_of(lambda: HilbertGP.fit(x, y, k), args.repeats)
-    predict_s, (mean, _) = best_of(lambda: hg.predict(grid), args.repeats)
-    total = hyper_s + fit_s + predict_s
-    truth = world.static_field_at(grid)
-    print(
-        f"  hyperparameters ({hyper.points_used:,} points, {hyper.evaluations} evaluations): "
-        f"{hyper_s:.1f} s; fit, {hg.basis_size:,} basis functions: {fit_s:.2f} s; prediction "
-        f"with variance: {predict_s:.1f} s; total {total:.1f} s\n  {k}; RMSE against the "
-        f"field: {rmse(mean, truth):.4f} G (field SD {truth.std(axis=0).mean():.4f} G)",
-        flush=True,
-    )
-    # the same `subset` readings, the same kernel: exact against reduced-rank
-    sub, probe = slice(0, subset), slice(None, None, max(1, len(grid) // 10000))
-    exact_mean, exact_var = ExactGP.fit(x[sub], y[sub], k).predict(grid[probe])
-    approx_mean, approx_var = HilbertGP.fit(x[sub], y[sub], k).predict(grid[probe])
-    gap = rmse(approx_mean, exact_mean)
-    sd_gap = rmse(np.sqrt(approx_var[:, 0]), np.sqrt(exact_var[:, 0]))
-    print(
-        f"  on {subset:,} readings, {len(exact_mean):,} voxels: Hilbert - exact mean RMS "
-        f"{gap:.2e} G, SD RMS {sd_gap:.2e} G; RMSE against the field: exact "
-        f"{rmse(exact_mean, truth[probe]):.4f} G, Hilbert {rmse(approx_mean, truth[probe]):.4f} G",
-        flush=True,
-    )
-    floor = basis_count(np.array([30.0, 15.0, 2.2]) + 8 * k.length_scale, k.length_scale)
-    print(f"  (the 30 x 15 x 2.2 m floor, this length scale: {floor:,} basis functions)")
-    name = f"HilbertGP, {n:,} 3-D readings -> {len(grid):,} voxels, m = {hg.basis_size:,}"
-    ratio = f"{MENZEN_S / total:.1f}x"
-    rows.append((f"{name} (goal 60 s)", f"{total:.1f} s", "Menzen et al.: < 120 s", ratio))
-    rows.append((f"HilbertGP - exact, same {subset:,} readings: means", f"{gap:.2e} G", "", ""))
 
 
 def main() -> None:

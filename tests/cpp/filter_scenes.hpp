@@ -4,6 +4,7 @@
 // cast in it.
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include "kiseki/core/angle.hpp"
@@ -39,5 +40,8 @@ inline std::vector<float> cast(const OccupancyGrid& g, const Pose2& sensor, cons
   cast_scan(g, sensor, angles.data(), angles.size(), o, r.data());
   return std::vector<float>(r.begin(), r.end());
 }
+
+// The distance between two poses' positions (m).
+inline double position_error(const Pose2& a, const Pose2& b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
 }  // namespace kiseki::test

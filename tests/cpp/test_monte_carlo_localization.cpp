@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Copyright (c) 2026 the kiseki authors
 // The Monte Carlo localization engine on a small synthetic room: tracking for any thread count,
-// global localization with KLD, resetting and the reliability, weights and bad input.
+// global localization with KLD, resetting and the reliability, weights and bad input (resetting
+// on a likelihood seen alone: test_resetting.cpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -31,8 +32,6 @@ using namespace kiseki;
 using namespace kiseki::test;
 
 namespace {
-
-double error(const Pose2& a, const Pose2& b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
 struct DriveLog {
   std::vector<Pose2> estimates;
@@ -92,7 +91,7 @@ TEST(MonteCarloLocalization, TracksAndIsDeterministicForAnyThreadCount) {
     ASSERT_EQ(one.estimates[i].x, two.estimates[i].x);
     ASSERT_EQ(one.estimates[i].theta, two.estimates[i].theta);
   }
-  EXPECT_LT(error(one.estimates[one.estimates.size() - 2], one.estimates.back()), 0.1);
+  EXPECT_LT(position_error(one.estimates[one.estimates.size() - 2], one.estimates.back()), 0.1);
   EXPECT_GT(one.reliability.back(), 0.9);
 }
 
@@ -153,7 +152,7 @@ TEST(MonteCarloLocalization, GlobalLocalizationWithKldEndsWithFewParticles) {
   p.resample_threshold = 1.0;
   p.likelihood_power = 0.1;  // a sparse uniform start: temper the 61 beams (as kiseki's global)
   const DriveLog run = drive(p, 3, true, 80);
-  EXPECT_LT(error(run.estimates[run.estimates.size() - 2], run.estimates.back()), 0.2);
+  EXPECT_LT(position_error(run.estimates[run.estimates.size() - 2], run.estimates.back()), 0.2);
   EXPECT_LT(run.counts[run.counts.size() - 1], 2000u);  // converged: few bins
   EXPECT_GE(run.counts.back(), 300u);
   // A flat likelihood leaves the cloud spread over the room's ~8,600 bins: the bound asks for
@@ -171,167 +170,13 @@ TEST(MonteCarloLocalization, ResettingRecoversFromAKidnappingAndTheReliabilityFa
   p.recovery = Recovery::none;
   const Pose2 elsewhere(7.5, 1.0, 2.0);
   const DriveLog lost = drive(p, 5, false, 100, 30, elsewhere);
-  EXPECT_GT(error(lost.estimates[lost.estimates.size() - 2], lost.estimates.back()), 1.0);
+  EXPECT_GT(position_error(lost.estimates[lost.estimates.size() - 2], lost.estimates.back()), 1.0);
   EXPECT_GT(lost.reliability[29], 0.9);
   EXPECT_LT(lost.reliability.back(), 0.2);  // lost, and it says so
   p.recovery = Recovery::resetting;
   const DriveLog found = drive(p, 5, false, 100, 30, elsewhere);
-  EXPECT_LT(error(found.estimates[found.estimates.size() - 2], found.estimates.back()), 0.2);
+  EXPECT_LT(position_error(found.estimates[found.estimates.size() - 2], found.estimates.back()), 0.2);
   EXPECT_GT(found.reliability.back(), 0.8);
-}
-
-// A measurement seen only through its likelihood: log p = -|pose - target|^2 / (2 0.3^2) (position
-// in m and heading in rad alike) plus `ripple` sin(3x) cos(2y), over 30 readings, with a fixed
-// agreement with the map.
-class TargetModel : public SensorModel {
- public:
-  Pose2 target;
-  double peak = 1.0;  ///< 0: a flat likelihood (the ripple only)
-  double ripple = 0.0;
-  double agree = 1.0;
-  void log_likelihoods(const Pose2* poses, std::size_t n, double* out) const override {
-    for (std::size_t i = 0; i < n; ++i) {
-      const Pose2& q = poses[i];
-      const double d2 = std::pow(q.x - target.x, 2) + std::pow(q.y - target.y, 2) +
-                        std::pow(angle_difference(q.theta, target.theta), 2);
-      out[i] = -0.5 * peak * d2 / 0.09 + ripple * std::sin(3 * q.x) * std::cos(2 * q.y);
-    }
-  }
-  std::size_t readings() const override { return 30; }
-  double agreement(const Pose2&) const override { return agree; }
-};
-
-TEST(MonteCarloLocalization, ALikelihoodDropResetsACloudCarriedToAPlaceThatLooksAlike) {
-  // The scans go on agreeing with the map (agreement 1), but the robot is elsewhere: only the
-  // likelihood has dropped against its long-term average.
-  for (const double drop : {0.0, 0.5}) {
-    MclParams p;
-    p.particles = 1000;
-    p.recovery = Recovery::resetting;
-    p.reset_likelihood_drop = drop;
-    MonteCarloLocalization mcl(p, 11);
-    mcl.set_free_space(room());
-    TargetModel model;
-    model.target = Pose2(1.0, 4.5, 0.0);
-    mcl.initialize_gaussian(model.target, 0.1, 0.1, 0.05);
-    for (int k = 0; k < 20; ++k) mcl.update(model);
-    model.target = Pose2(7.5, 1.0, 2.0);
-    int sensor_resets = 0;
-    for (int k = 0; k < 30; ++k) sensor_resets += mcl.update(model).reset == "sensor";
-    if (drop == 0.0) {
-      EXPECT_EQ(sensor_resets, 0);
-      EXPECT_GT(error(mcl.estimate(), model.target), 3.0);  // agreement alone cannot see it
-    } else {
-      EXPECT_GE(sensor_resets, 1);
-      EXPECT_LT(error(mcl.estimate(), model.target), 0.3);
-    }
-  }
-}
-
-TEST(MonteCarloLocalization, AResetNeedsEvidenceWhereTheLikelihoodIsFlat) {
-  // Every scan disagrees with the map (agreement 0), but the likelihood is flat to within
-  // 0.8 nats everywhere: the best of 20,000 uniform candidates beats the cloud's best by
-  // chance. With the default margin (a Bayes factor of 10) no reset is kept and the cloud
-  // stays; without one, the resets scatter it over the room.
-  for (const double evidence : {0.0, MclParams{}.reset_evidence}) {
-    MclParams p;
-    p.particles = 1000;
-    p.recovery = Recovery::resetting;
-    p.reset_evidence = evidence;
-    MonteCarloLocalization mcl(p, 12);
-    mcl.set_free_space(room());
-    TargetModel model;
-    model.peak = 0.0;
-    model.ripple = 0.4;
-    model.agree = 0.0;
-    const Pose2 start(1.0, 4.5, 0.0);
-    mcl.initialize_gaussian(start, 0.1, 0.1, 0.05);
-    int resets = 0;
-    for (int k = 0; k < 30; ++k) resets += mcl.update(model).reset != "none";
-    if (evidence > 0.0) {
-      EXPECT_EQ(resets, 0);
-      EXPECT_LT(error(mcl.estimate(), start), 0.5);  // the ripple alone moves it a little
-    } else {
-      EXPECT_GT(resets, 0);
-      EXPECT_GT(error(mcl.estimate(), start), 1.0);
-    }
-  }
-  MclParams bad;
-  bad.reset_evidence = -1.0;
-  EXPECT_THROW(bad.validate(), std::invalid_argument);
-  bad = MclParams{};
-  bad.reset_likelihood_drop = 1.0;
-  EXPECT_THROW(bad.validate(), std::invalid_argument);
-}
-
-TEST(MonteCarloLocalization, TheLookElsewhereTermAsksForLnNMoreOfTheBestOfNCandidates) {
-  // One particle 1.04 m from the target: the cloud's best log-likelihood is -6.0 (d^2 / (2
-  // 0.3^2)); the best of 20,000 uniform candidates in the 10 m x 6 m room lies within about
-  // 0.2 m of the target (-0.2 or better), so it beats the cloud by about 6 nats: more than ln 10
-  // (2.3), less than ln 10 + ln 20,000 (12.2). Without the term the sensor reset is kept, with
-  // it not; the expansion (radius 0) never explains better.
-  EXPECT_DOUBLE_EQ(look_elsewhere_term(20000.0), std::log(20000.0));
-  EXPECT_DOUBLE_EQ(look_elsewhere_term(0.5), 0.0);
-  for (const bool look : {false, true}) {
-    MclParams p;
-    p.particles = 1;
-    p.recovery = Recovery::resetting;
-    p.reset_after = p.sensor_reset_after = 1;
-    p.expansion_position = p.expansion_orientation = 0.0;
-    p.reset_look_elsewhere = look;
-    MonteCarloLocalization mcl(p, 21);
-    mcl.set_free_space(room());
-    TargetModel model;
-    model.target = Pose2(4.0, 3.0, 0.5);
-    model.agree = 0.0;  // every scan disagrees: lost at once
-    mcl.set_particles({Pose2(4.0 + 1.04, 3.0, 0.5)});
-    EXPECT_EQ(mcl.update(model).reset, look ? "none" : "sensor");
-    EXPECT_EQ(error(mcl.estimate(), model.target) < 0.5, !look);
-  }
-}
-
-TEST(SensorResetProposal, PosesAroundHypothesesTakeTheirSharesByTemperedScoreAndTheStatedSpread) {
-  // scores 0, -ln 3 and -40 at power 1: shares 3 : 1 : 4e-18 of 4,000 poses, 3,000 and 1,000
-  std::vector<PoseHypothesis> found(3);
-  found[0].pose = Pose2(1.0, 2.0, 3.0);
-  found[1].pose = Pose2(5.0, -1.0, -1.0);
-  found[2].pose = Pose2(-4.0, 0.0, 0.0);
-  found[0].score = 0.0, found[1].score = -std::log(3.0), found[2].score = -40.0;
-  Random rng(5);
-  const std::vector<Pose2> out = poses_around_hypotheses(found, 4000, 0.05, 0.02, 1.0, rng);
-  ASSERT_EQ(out.size(), 4000u);
-  for (std::size_t h = 0; h < 2; ++h) {
-    const std::size_t begin = h == 0 ? 0 : 3000, end = h == 0 ? 3000 : 4000;
-    double mx = 0, sx = 0, st = 0;
-    for (std::size_t i = begin; i < end; ++i) mx += out[i].x;
-    mx /= static_cast<double>(end - begin);
-    for (std::size_t i = begin; i < end; ++i) {
-      sx += std::pow(out[i].x - mx, 2);
-      st += std::pow(angle_difference(out[i].theta, found[h].pose.theta), 2);
-      EXPECT_LT(std::hypot(out[i].x - found[h].pose.x, out[i].y - found[h].pose.y), 0.05 * 6);
-    }
-    EXPECT_NEAR(mx, found[h].pose.x, 4 * 0.05 / std::sqrt(static_cast<double>(end - begin)));
-    EXPECT_NEAR(std::sqrt(sx / static_cast<double>(end - begin)), 0.05, 0.005);
-    EXPECT_NEAR(std::sqrt(st / static_cast<double>(end - begin)), 0.02, 0.002);
-  }
-  // a heading near pi stays in [-pi, pi); no hypothesis or a negative spread is refused
-  found[0].pose.theta = kPi - 1e-3;
-  for (const Pose2& q : poses_around_hypotheses(found, 500, 0.0, 0.05, 1.0, rng)) {
-    EXPECT_GE(q.theta, -kPi);
-    EXPECT_LT(q.theta, kPi);
-  }
-  EXPECT_THROW(poses_around_hypotheses({}, 10, 0.1, 0.1, 1.0, rng), std::invalid_argument);
-  EXPECT_THROW(poses_around_hypotheses(found, 10, -0.1, 0.1, 1.0, rng), std::invalid_argument);
-  EXPECT_THROW(reset_proposal_from_name("grid"), std::invalid_argument);
-  // the matcher proposal refuses an update without the scan, or without a matcher
-  MclParams p;
-  p.recovery = Recovery::resetting;
-  p.sensor_reset_proposal = ResetProposal::matcher;
-  MonteCarloLocalization mcl(p, 1);
-  mcl.set_particles({Pose2(1.0, 1.0, 0.0)});
-  TargetModel model;
-  EXPECT_THROW(mcl.update(model), std::logic_error);
-  EXPECT_THROW(mcl.update(model, ScanView{}), std::logic_error);
 }
 
 TEST(MonteCarloLocalization, WeightsCanBeSetAndBadInputIsRefused) {
