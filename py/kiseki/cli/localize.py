@@ -140,8 +140,9 @@ def localize_command(
         None,
         "--reliability",
         help="The CSV's reliability: agreement (the engine's recent share of scans that agree "
-        "with the map) or learned (a probability of being within 1 m and 10 deg, fitted on "
-        f"simulated updates); default {LocalizeConfig.reliability}; not with --global.",
+        "with the map), learned (a probability of being within 1 m and 10 deg, fitted on "
+        "simulated updates) or learned-real (the same, fitted on recorded laser logs); "
+        f"default {LocalizeConfig.reliability}; not with --global.",
     ),
     budget_ms: float | None = typer.Option(
         None,

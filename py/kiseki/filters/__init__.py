@@ -45,6 +45,7 @@ from kiseki.filters.global_localization import (
 from kiseki.filters.odometry_noise import motion_alphas, noisy_odometry
 from kiseki.filters.reliability import (
     LEARNED_RELIABILITY,
+    REAL_LOG_RELIABILITY,
     RELIABILITY_ESTIMATES,
     LearnedReliability,
     ReliabilityModel,
@@ -70,6 +71,7 @@ from kiseki.filters.tracking import (
 
 __all__ = [
     "LEARNED_RELIABILITY",
+    "REAL_LOG_RELIABILITY",
     "LOCALIZATION_METHODS",
     "REAL_ODOMETRY_ALPHAS",
     "RECOVERY_MODES",

@@ -91,7 +91,8 @@ class LocalizeConfig:
     sensor_reset_proposal: str = MclConfig.sensor_reset_proposal
     reset_look_elsewhere: bool = MclConfig.reset_look_elsewhere
     likelihood_power: float = MclConfig.likelihood_power
-    # the `reliability` of the result: the engine's "agreement" or the "learned" probability
+    # the `reliability` of the result: the engine's "agreement" or a learned probability,
+    # fitted on simulated ("learned") or recorded ("learned-real") updates
     # (kiseki.filters.reliability)
     reliability: str = "agreement"
     beam_skip: bool = False

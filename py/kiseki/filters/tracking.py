@@ -18,9 +18,9 @@ from kiseki.filters.engine import MonteCarloLocalizer
 from kiseki.filters.localize_config import LOCALIZATION_METHODS, LocalizeConfig
 from kiseki.filters.odometry_noise import motion_alphas, noisy_odometry
 from kiseki.filters.reliability import (
-    LEARNED_RELIABILITY,
     LearnedReliability,
     ReliabilityModel,
+    learned_model,
 )
 from kiseki.filters.relocalization import RelocalizeConfig, Relocalizer
 from kiseki.filters.scan_models import ScanSpaceObservation, scan_model, scan_preparer
@@ -78,13 +78,15 @@ def localize(
     grid: OccupancyGrid,
     config: LocalizeConfig,
     progress: bool = False,
-    reliability_model: ReliabilityModel = LEARNED_RELIABILITY,
+    reliability_model: ReliabilityModel | None = None,
     cost_model: CostModel | None = None,
 ) -> LocalizationResult:
     """Localization along a log: tracking from its first reference pose, or from a uniform start
     over the map's free cells with ``config.global_start``. Estimates are sensor poses. With
     ``config.budget_ms`` the particle and beam counts are chosen by ``cost_model``, calibrated
-    here on this log when none is given (:mod:`kiseki.filters.budget`)."""
+    here on this log when none is given (:mod:`kiseki.filters.budget`). The learned reliability
+    estimates use ``reliability_model`` when given, else the coefficients their name stands
+    for (:func:`kiseki.filters.reliability.learned_model`)."""
     _check_scans(scans, grid)
     odom = noisy_odometry(scans.odometry, config.odometry_noise, derive_seed(config.seed, 1))
     noise = f" with noise {config.odometry_noise:g}" if config.odometry_noise else ""
@@ -120,7 +122,8 @@ def localize(
         rc = RelocalizeConfig(**terms, threads=config.threads)
         localizer.set_matcher(Relocalizer(grid, scans.max_range, rc))
     prepare = scan_preparer(scan_model(config.method, grid, run), scans)
-    learned = LearnedReliability(reliability_model) if config.reliability == "learned" else None
+    model = reliability_model or learned_model(config.reliability)
+    learned = None if config.reliability == "agreement" else LearnedReliability(model)
     estimates = np.empty((n, 3))
     reliability = np.empty(n)
     engine_reliability = np.empty(n)

@@ -44,6 +44,7 @@ from kiseki.filters import (
     ReliabilityModel,
     localize,
 )
+from kiseki.filters.reliability import learned_model
 from kiseki.grid import OccupancyGrid
 from kiseki.io.runlog import read_run
 from kiseki.mapping import MapBuildConfig, map_of_log
@@ -54,11 +55,13 @@ from kiseki_experiments.harness.base import Experiment, TrialOutput
 from kiseki_experiments.harness.paths import CARMEN_LOGS, PROJECT, shared_data
 from kiseki_experiments.mcl.mcl_kidnapping_claims import CARMEN_CLAIMS, SIM_CLAIMS
 from kiseki_experiments.mcl.mcl_kidnapping_config import (
+    CarmenKidnapConfig,
     KidnapConfig,
     preflight_carmen,
     preflight_sim,
 )
 from kiseki_experiments.mcl.mcl_kidnapping_report import analyze
+from kiseki_experiments.mcl.mcl_reliability_folds import REAL_LOG_FOLDS
 
 
 def splice(scans: LaserScans, k: int, j: int, before: int, after: int) -> LaserScans:
@@ -135,7 +138,7 @@ def _trial(scans: LaserScans, grid, config: KidnapConfig, seed: int, name: str) 
             threads=config.threads,
             reliability=config.reliability,
         )
-        result = localize(spliced, grid, lc, reliability_model=_reliability_model(config))
+        result = localize(spliced, grid, lc, reliability_model=_reliability_model(config, name))
         d = result.estimates - spliced.poses
         errors = np.hypot(d[:, 0], d[:, 1])
         headings = np.degrees(np.abs(np.remainder(d[:, 2] + np.pi, 2 * np.pi) - np.pi))
@@ -158,11 +161,16 @@ def _trial(scans: LaserScans, grid, config: KidnapConfig, seed: int, name: str) 
     return TrialOutput(record, timings)
 
 
-def _reliability_model(config: KidnapConfig) -> ReliabilityModel:
-    b0, b_agreement, b_drop = LEARNED_RELIABILITY.coefficients
+def _reliability_model(config: KidnapConfig, log: str) -> ReliabilityModel:
+    """The learned estimate's coefficients for a trial on ``log`` ("sim" for a simulated run):
+    with ``learned-real``, those fitted without that log (leave one log out; a log none of
+    them was fitted on gets the model of every log); then the controls' changes."""
+    base = learned_model(config.reliability) or LEARNED_RELIABILITY
+    if config.reliability == "learned-real":
+        base = REAL_LOG_FOLDS.get(log, base)
+    b0, b_agreement, b_drop = base.coefficients
     return ReliabilityModel(
-        (b0 + config.odds_offset, b_agreement, b_drop * config.drop_weight),
-        LEARNED_RELIABILITY.provenance,
+        (b0 + config.odds_offset, b_agreement, b_drop * config.drop_weight), base.provenance
     )
 
 
@@ -219,7 +227,7 @@ def simulated_run(scene_path: str, seed: int) -> tuple[LaserScans, OccupancyGrid
     return scans, scene.ground_truth(0.35, 0.45, resolution=0.05)
 
 
-def trial_carmen(config: KidnapConfig, index: int, seed: int) -> TrialOutput:
+def trial_carmen(config: CarmenKidnapConfig, index: int, seed: int) -> TrialOutput:
     name = config.logs[index % len(config.logs)]
     path = shared_data("carmen", config.data_dir) / f"{name}.log.gz"
     scans = read_carmen_log(path).scans
@@ -247,7 +255,7 @@ CARMEN = Experiment(
     paper="localization engine (beyond the papers)",
     artefact="kidnapped robot, CARMEN logs",
     description="kidnapping recovery and reliability: none / augmented / resetting (real logs)",
-    config_type=KidnapConfig,
+    config_type=CarmenKidnapConfig,
     trial=trial_carmen,
     analyze=analyze,
     default_runs=20 * len(CARMEN_LOGS),  # as the simulated runs: 80 decide a share >= 0.95

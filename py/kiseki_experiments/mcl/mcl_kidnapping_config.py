@@ -19,7 +19,7 @@ from kiseki_experiments.harness.config import (
 )
 from kiseki_experiments.harness.paths import CARMEN_LOGS, PROJECT, shared_data
 
-__all__ = ["KidnapConfig", "preflight_carmen", "preflight_sim"]
+__all__ = ["CarmenKidnapConfig", "KidnapConfig", "preflight_carmen", "preflight_sim"]
 
 
 @dataclass(frozen=True)
@@ -48,12 +48,21 @@ class KidnapConfig:
     # the robot is carried at all (false: the log goes on from scan k, no jump)
     resetting_runs: str = "resetting"
     kidnap: bool = True
-    # the reliability reported: "learned" (kiseki.filters.reliability) or the engine's
-    # "agreement" (both are recorded); the learned one's controls: its log-likelihood drop
-    # weighed by drop_weight (0: agreement alone) and its log-odds moved by odds_offset
+    # the reliability reported: "learned" or "learned-real" (kiseki.filters.reliability) or
+    # the engine's "agreement" (the engine's is recorded too); the learned one's controls: its
+    # log-likelihood drop weighed by drop_weight (0: agreement alone) and its log-odds moved
+    # by odds_offset
     reliability: str = "learned"
     drop_weight: NonNegativeReal = 1.0
     odds_offset: Real = 0.0
+
+
+@dataclass(frozen=True)
+class CarmenKidnapConfig(KidnapConfig):
+    """mcl-kidnapping-carmen's config: on recorded logs the reliability reported is the one
+    fitted on recorded logs, each trial's with its own log left out of the fit."""
+
+    reliability: str = "learned-real"
 
 
 def _check(config: KidnapConfig) -> None:

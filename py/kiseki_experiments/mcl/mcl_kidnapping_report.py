@@ -93,12 +93,13 @@ def analyze(config: KidnapConfig, trials: pd.DataFrame, timings: pd.DataFrame, f
         f"{len(ok)} trials; {config.method}, {config.particles} particles, {config.beams} beams; "
         f"the robot is carried at least {config.min_jump} m; recovered = back within "
         f"{config.recover_distance} m and {config.recover_heading} deg for "
-        f"{config.recover_hold} updates. Reliability: the engine's estimate (the recent share "
-        "of updates whose scan agrees with the map seen from the particles)."
+        f"{config.recover_hold} updates. Reliability reported: {config.reliability} "
+        "(kiseki.filters.reliability); beside it the engine's estimate (the recent share of "
+        "updates whose scan agrees with the map seen from the particles)."
     )
     paths = [path]
     if "none" in config.recoveries and len(ok):
-        paths.append(_roc_figure(ok, figures / "reliability_roc.png"))
+        paths.append(_roc_figure(ok, figures / "reliability_roc.png", config.reliability))
     return Analysis(tables=tables, figures=paths, notes=notes, evidence=evidence)
 
 
@@ -138,8 +139,9 @@ def _auc_table(ok: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _roc_figure(ok: pd.DataFrame, path: Path) -> Path:
-    """ROC curves of both estimates for "error above 1 m", one panel per source."""
+def _roc_figure(ok: pd.DataFrame, path: Path, reported: str) -> Path:
+    """ROC curves of both estimates (the reported one, named ``reported``, and the engine's)
+    for "error above 1 m", one panel per source."""
     groups = list(ok.groupby("source", sort=True))
     fig = new_figure(figsize=(3.2 * len(groups), 3.2), dpi=120)
     axes = np.atleast_1d(fig.subplots(1, len(groups)))
@@ -149,7 +151,7 @@ def _roc_figure(ok: pd.DataFrame, path: Path) -> Path:
             order = np.argsort(-score, kind="stable")
             hit = np.concatenate([[0.0], np.cumsum(lost[order]) / max(lost.sum(), 1)])
             false = np.concatenate([[0.0], np.cumsum(~lost[order]) / max((~lost).sum(), 1)])
-            label = f"{'engine' if name else 'learned'} {area_under_roc(score, lost):.3f}"
+            label = f"{'engine' if name else reported} {area_under_roc(score, lost):.3f}"
             ax.plot(false, hit, color=colour, label=label)
         ax.plot([0, 1], [0, 1], color="k", lw=0.6, ls=":")
         ax.set_title(source, fontsize=8)
