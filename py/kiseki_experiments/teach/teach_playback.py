@@ -332,7 +332,9 @@ EXP1 = Experiment(
     config_type=Exp1Config,
     trial=trial,
     analyze=analyze_exp1,
-    default_runs=11,
+    # 15: at the thesis' 11 runs the share of stops within 0.1 m (10 of 11) was undecided and the
+    # report asked 15 (51 s) (issue 29: the default trials decide at least 80 % of the claims)
+    default_runs=15,
     preflight=_preflight,
     claims=EXP1_CLAIMS,
 )

@@ -370,7 +370,10 @@ ENV_A = Experiment(
     config_type=EnvAConfig,
     trial=trial,
     analyze=analyze_a,
-    default_runs=10,
+    # 26: at 10 the sum's share of seeds within 5.10 cm (0.3) was undecided and the report
+    # asked 26 (575 s); the mean cost's share sits on the threshold (0.5), which no number of
+    # trials decides (issue 29: the default trials decide at least 80 % of the claims)
+    default_runs=26,
     preflight=preflight,
     claims=CLAIMS_A,
 )
