@@ -24,6 +24,7 @@ import numpy as np
 from kiseki.datasets import read_carmen_log
 from kiseki.grid import OccupancyGrid, beam_angles
 from kiseki.mapping import build_map, endpoint_agreement
+from timing import best_of  # beside this file
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 
@@ -54,15 +55,6 @@ def cpu_name() -> str:
     except OSError:
         pass
     return platform.machine()
-
-
-def best_of(fn, repeats: int = 3) -> tuple[float, object]:
-    best, result = np.inf, None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        result = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, result
 
 
 def main() -> int:

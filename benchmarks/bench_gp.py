@@ -51,7 +51,7 @@ from pathlib import Path
 import numpy as np
 from sklearn.gaussian_process import GaussianProcessRegressor
 
-from gp_cases_3d import best_of, case_hilbert, case_volume, rmse  # beside this file
+from gp_cases_3d import case_hilbert, case_volume, rmse  # beside this file
 from gp_reference import run_sklearn_limited, sklearn_kernel, start_kernel
 from kiseki.datasets import read_aalto_run
 from kiseki.gp import ExactGP
@@ -63,6 +63,7 @@ from kiseki_experiments.gp.gp_common import (
     magnetic_world,
     survey_2d,
 )
+from timing import best_of
 
 ROOT = Path(__file__).resolve().parents[1]
 AALTO = ROOT.parent / "shared" / "data" / "magnetic" / "aalto" / "invensense"

@@ -14,7 +14,6 @@ Run: python benchmarks/bench_sim.py
 from __future__ import annotations
 
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -23,17 +22,9 @@ from kiseki import _core
 from kiseki.sim.run import SimConfig, simulate
 from kiseki.sim.scene import load_scene
 from kiseki.sim.sensors import LASER_PRESETS, DepthCamera, DepthCameraParams, Mount
+from timing import best_of  # beside this file
 
 WORLDS = Path(__file__).resolve().parents[1] / "data" / "worlds"
-
-
-def best_of(fn, repeats: int = 3) -> tuple[float, object]:
-    best, out = np.inf, None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, out
 
 
 def main() -> None:

@@ -2,12 +2,10 @@
 # Copyright (c) 2026 the kiseki authors
 """The 3-D cases of bench_gp.py (printed, never asserted): the thesis' 3-D floor with the exact
 GP, its hyperparameters on a subsample and on every reading, and the reduced-rank HilbertGP on
-the elevator hall against Menzen, Fetter and Kok (FUSION 2023); with the timing and error
-helpers every case of bench_gp.py uses."""
+the elevator hall against Menzen, Fetter and Kok (FUSION 2023); and the RMSE every case of
+bench_gp.py reports."""
 
 from __future__ import annotations
-
-import time
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -21,18 +19,10 @@ from kiseki_experiments.gp.gp_common import (
     magnetic_world,
     survey_3d,
 )
+from timing import best_of  # beside this file
 
 THESIS_3D_S = 29 * 3600.0  # sec. 6.5: about 29 h
 MENZEN_S = 120.0  # Menzen, Fetter and Kok (FUSION 2023): 40,000 readings, under 2 min
-
-
-def best_of(fn, repeats: int):
-    best, out = np.inf, None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, out
 
 
 def rmse(a: np.ndarray, b: np.ndarray) -> float:
