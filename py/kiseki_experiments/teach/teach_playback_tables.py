@@ -27,6 +27,12 @@ __all__ = [
 ]
 
 
+def _stop_sd(stop: pd.Series) -> float:
+    """The SD of stop errors; NaN (and no warning) when a refused route never stopped (inf,
+    layouts-exp2-exp3)."""
+    return float(stop.std(ddof=1)) if not np.isinf(stop).any() else float("nan")
+
+
 def stop_table(config, trials: pd.DataFrame) -> pd.DataFrame:
     rows = []
     for method in config.methods:
@@ -38,7 +44,7 @@ def stop_table(config, trials: pd.DataFrame) -> pd.DataFrame:
                 "method": method,
                 "runs": len(stop),
                 "stop_error_mean_m": stop.mean(),
-                "stop_error_sd_m": stop.std(ddof=1),
+                "stop_error_sd_m": _stop_sd(stop),
                 "estimate_error_mean_m": est.mean(),
                 "stops_within_0.1m": within,
                 "within_ci95_low": low,
@@ -140,7 +146,7 @@ def _turn_route_causes(d: pd.DataFrame, ok: pd.DataFrame) -> str:
     drop = 100 * float(d[["drop_along_0.1m", "drop_side_0.1m"]].to_numpy().mean())
     means = {m: ok[f"{m}_stop_error"].mean() for m in d.index}
     spread = max(means.values()) - min(means.values())
-    sd = float(np.mean([ok[f"{m}_stop_error"].std(ddof=1) for m in d.index]))
+    sd = float(np.mean([_stop_sd(ok[f"{m}_stop_error"]) for m in d.index]))
     thesis = " > ".join(f"{m} {THESIS_TABLE_4_5[m][0]:.2f}" for m in THESIS_TABLE_4_5 if m in means)
     measured = ", ".join(f"{m} {v:.3f}" for m, v in means.items())
     compare = "less" if spread < sd else "more"

@@ -116,3 +116,30 @@ def test_exp3_with_kisekis_ray_model_stops_by_the_rule_and_its_claim_is_the_pair
     difference = t["proposal2_ray_stop_error"] - t["proposal2_stop_error"]
     assert row["measured_value"].startswith(f"{difference:.4g} ")
     assert row["verdict"] == "inconclusive"  # one run gives no interval
+
+
+def test_a_refused_route_has_no_stop_sd_and_raises_no_warning():
+    """layouts-exp2-exp3 records a refused route as a stop error of inf (it never stopped): its
+    mean is inf, its SD is undefined (NaN), and neither warns; the other methods' are as
+    pandas computes them."""
+    import warnings
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from kiseki_experiments.teach.teach_playback_tables import stop_table
+
+    trials = pd.DataFrame({"conventional_stop_error": [np.inf, np.inf, 0.2],
+                           "proposal2_stop_error": [0.05, 0.07, 0.04]})  # fmt: skip
+    for m in ("conventional", "proposal2"):
+        trials[f"{m}_estimate_error"] = 0.1
+        trials[f"{m}_stop_dx"], trials[f"{m}_stop_dy"] = 0.01, 0.02
+    config = SimpleNamespace(methods=["conventional", "proposal2"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        table = stop_table(config, trials).set_index("method")
+    assert table.loc["conventional", "stop_error_mean_m"] == np.inf
+    assert np.isnan(table.loc["conventional", "stop_error_sd_m"])
+    sd = trials["proposal2_stop_error"].std(ddof=1)
+    assert table.loc["proposal2", "stop_error_sd_m"] == pytest.approx(sd, rel=1e-12)
+    assert table.loc["conventional", "stops_within_0.1m"] == 0
