@@ -17,9 +17,9 @@ __all__ = ["LayoutsConfig", "experiment_configs"]
 @dataclass(frozen=True)
 class LayoutsConfig:
     # Runs of each experiment per layout. The thesis' claims are means and counts over runs:
-    # 2 is the fewest with a mean over runs and an SD (Exp. 3). One run of both experiments
-    # took 63 s of CPU (1000 particles; 89 s when a refused route makes exp2 run per method),
-    # so 20 layouts x 2 runs take about 42 min on one core; 3 runs would take over an hour.
+    # 2 is the fewest with a mean over runs and an SD (Exp. 3). 20 layouts x 2 runs took 603 s
+    # on one core (1000 particles; a refused route makes exp2 run once per method), so the
+    # default 44 layouts take about 22 min; 3 runs per layout would take a third longer.
     runs_per_layout: Runs = 2
     methods: list[str] = field(
         default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
