@@ -55,6 +55,7 @@ from kiseki_experiments.harness.base import Experiment, TrialOutput
 from kiseki_experiments.harness.paths import CARMEN_LOGS, PROJECT, shared_data
 from kiseki_experiments.mcl.mcl_kidnapping_claims import CARMEN_CLAIMS, SIM_CLAIMS
 from kiseki_experiments.mcl.mcl_kidnapping_config import (
+    BLIND_RELIABILITY,
     CarmenKidnapConfig,
     KidnapConfig,
     preflight_carmen,
@@ -165,6 +166,9 @@ def _reliability_model(config: KidnapConfig, log: str) -> ReliabilityModel:
     """The learned estimate's coefficients for a trial on ``log`` ("sim" for a simulated run):
     with ``learned-real``, those fitted without that log (leave one log out; a log none of
     them was fitted on gets the model of every log); then the controls' changes."""
+    if config.blind:  # the control: no feature moves it
+        odds = math.log(BLIND_RELIABILITY / (1.0 - BLIND_RELIABILITY))
+        return ReliabilityModel((odds, 0.0, 0.0), "blind to the scan (a control)")
     base = learned_model(config.reliability) or LEARNED_RELIABILITY
     if config.reliability == "learned-real":
         base = REAL_LOG_FOLDS.get(log, base)
