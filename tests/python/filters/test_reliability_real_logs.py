@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from kiseki.filters import LEARNED_RELIABILITY, REAL_LOG_RELIABILITY, LocalizeConfig
+from kiseki.filters import LEARNED_RELIABILITY, REAL_LOG_RELIABILITY, LocalizeConfig, localize
 from kiseki.filters.reliability import learned_model
 from kiseki.metrics import area_under_roc
 from kiseki_experiments.harness.paths import CARMEN_LOGS
@@ -65,3 +65,24 @@ def test_each_fold_leaves_its_own_log_out_and_the_users_model_has_them_all() -> 
     assert LocalizeConfig(reliability="learned-real").reliability == "learned-real"
     with pytest.raises(ValueError, match="reliability must be one of agreement, learned, learned-"):
         learned_model("real")
+
+
+def test_localize_reports_the_named_estimate(shared_data: Path) -> None:
+    """``LocalizeConfig(reliability="learned-real")`` reports (1) with the recorded logs'
+    coefficients at every update, and differs from the simulator's on the same updates."""
+    from kiseki.datasets import read_carmen_log
+    from kiseki.mapping import MapBuildConfig, map_of_log
+
+    scans = read_carmen_log(shared_data / "carmen" / "intel-corrected.log.gz").scans.first(150)
+    grid = map_of_log(scans, MapBuildConfig(resolution=0.05))
+    runs = {
+        name: localize(scans, grid, LocalizeConfig(particles=300, reliability=name, threads=1))
+        for name in ("learned-real", "learned")
+    }
+    real, sim = runs["learned-real"], runs["learned"]
+    rows = real.updated & np.isfinite(real.reliability_features).all(axis=1)
+    assert rows.sum() > 100
+    expected = REAL_LOG_RELIABILITY.probability(real.reliability_features[rows])
+    np.testing.assert_allclose(real.reliability[rows], expected, rtol=1e-12)
+    np.testing.assert_array_equal(real.estimates, sim.estimates)  # the estimate reads, not steers
+    assert np.abs(real.reliability[rows] - sim.reliability[rows]).max() > 0.01
