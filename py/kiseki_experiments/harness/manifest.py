@@ -64,11 +64,21 @@ def build_manifest(
     scheduler: str | None,
     executed: int,
     trials: pd.DataFrame,
+    git_at_start: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
+    """The run's manifest. ``git`` is the checkout the trials ran from: its state when they
+    started (``git_at_start``); when the checkout moved while they ran, it is marked dirty and
+    ``changed_during_run`` holds the state at the end."""
+    git = dict(git_at_start) if git_at_start is not None else git_state()
+    if git_at_start is not None:
+        at_end = git_state()
+        if at_end != git_at_start:
+            git["dirty"] = True
+            git["changed_during_run"] = at_end
     return {
         "experiment": name,
         "finished": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
-        "git": git_state(),
+        "git": git,
         "versions": _versions(),
         "seed": seed,
         "trials": runs,

@@ -35,7 +35,7 @@ from kiseki_experiments.harness.config import (
     config_from_dict,
     config_to_dict,
 )
-from kiseki_experiments.harness.manifest import build_manifest
+from kiseki_experiments.harness.manifest import build_manifest, git_state
 from kiseki_experiments.harness.registry import get_experiment
 from kiseki_experiments.harness.report import write_failed_outputs, write_outputs
 from kiseki_experiments.harness.trials_log import TrialLog
@@ -238,6 +238,7 @@ def run_experiment(
         )
         if experiment.preflight is not None:
             experiment.preflight(config)
+        git_at_start = git_state()  # the checkout the trials run from, not the one at the end
         log = TrialLog(run_dir / "trials.jsonl")
         done = log.read()
         # a resumed run also runs its failed trials again (after their cause was fixed)
@@ -260,7 +261,9 @@ def run_experiment(
                     bar.update(1)
         wall = time.perf_counter() - start  # the trials only, not the cluster's start and stop
     trials, timings = TrialLog.frames(done)
-    manifest = build_manifest(name, runs, seed, wall, workers, scheduler, len(jobs), trials)
+    manifest = build_manifest(
+        name, runs, seed, wall, workers, scheduler, len(jobs), trials, git_at_start
+    )
     failed = int(trials["error"].notna().sum())
     if failed == len(trials):
         first = write_failed_outputs(experiment, trials, timings, manifest, run_dir)

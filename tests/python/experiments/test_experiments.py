@@ -369,3 +369,23 @@ def test_an_analysis_error_is_raised_as_it_is_not_as_a_disk_problem(tmp_path, mo
     with pytest.raises(OSError, match=r"trials are kept .* --resume") as full:
         run_experiment("needs_input", out=tmp_path / "run", resume=True, progress=False)
     assert full.value.errno == errno.ENOSPC and str(tmp_path / "run") in str(full.value)
+
+
+def test_the_manifest_names_the_checkout_the_trials_ran_from(tmp_path, monkeypatch):
+    """The commit recorded is the one when the trials started; a checkout that moved while they
+    ran makes the manifest dirty and keeps the state at the end beside it."""
+    import json
+
+    from kiseki_experiments.harness import manifest, runner
+
+    start = {"commit": "a" * 40, "dirty": False}
+    end = {"commit": "b" * 40, "dirty": False}
+    monkeypatch.setattr(runner, "git_state", lambda: dict(start))
+    monkeypatch.setattr(manifest, "git_state", lambda: dict(end))
+    run_experiment("corridor-scans", runs=2, out=tmp_path / "moved", progress=False)
+    git = json.loads((tmp_path / "moved" / "manifest.json").read_text())["git"]
+    assert git == {"commit": "a" * 40, "dirty": True, "changed_during_run": end}
+    monkeypatch.setattr(manifest, "git_state", lambda: dict(start))
+    run_experiment("corridor-scans", runs=2, out=tmp_path / "still", progress=False)
+    git = json.loads((tmp_path / "still" / "manifest.json").read_text())["git"]
+    assert git == start
