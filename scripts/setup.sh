@@ -24,6 +24,7 @@ APT_PACKAGES=(
   chromium  # the serve page's browser tests (Playwright drives it; it downloads no browser)
   clang libclang-rt-dev  # libFuzzer targets of the C++ readers (tests/fuzz/cpp)
   ccache  # the compiler cache every build here goes through (below)
+  librange-v3-dev libtbb-dev  # beluga's dependencies: the side-by-side harnesses (benchmarks/anchors)
 )
 
 log() { printf '[setup] %s\n' "$*" >&2; }
