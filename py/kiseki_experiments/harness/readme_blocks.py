@@ -23,12 +23,8 @@ from pathlib import Path
 import pandas as pd
 
 from kiseki_experiments.harness.registry import all_experiments
-from kiseki_experiments.harness.report import (
-    markdown_table,
-    read_latest,
-    tally,
-    tally_text,
-)
+from kiseki_experiments.harness.report import markdown_table, tally, tally_text
+from kiseki_experiments.harness.run_reader import read_latest
 
 __all__ = ["Result", "claims_block", "gather", "summary_block", "update_readme"]
 

@@ -18,18 +18,15 @@ import pandas as pd
 from rich.console import Console
 
 from kiseki._support.atomic import atomic_write, atomic_write_all, reworded
-from kiseki._support.inputs import CSV_LIMIT, YAML_LIMIT, check_input, read_input_text
 from kiseki._support.table import show
 from kiseki_experiments.harness.base import Analysis, Experiment
 from kiseki_experiments.harness.registry import all_experiments
+from kiseki_experiments.harness.run_reader import read_latest
 from kiseki_experiments.harness.verdict import UNMIGRATED, VERDICT_COLUMNS, judge
 
 __all__ = [
     "claims_frame",
-    "latest_run",
     "print_claims",
-    "read_latest",
-    "read_result",
     "tally",
     "markdown_table",
     "write_failed_outputs",
@@ -326,81 +323,3 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[dict[str, int], l
         lines += ["", f"## {paper}", *section]
     _text(out, "\n".join(lines) + "\n")
     return totals, missing
-
-
-def latest_run(results_root: Path, name: str) -> Path | None:
-    """The run of ``name`` the report reads: ``results_root/name/latest`` (the runner's link),
-    else ``results_root/name`` itself when it is a run (``run 'PATTERN' --out``'s layout); None
-    when neither holds a claims table."""
-    for folder in (results_root / name / "latest", results_root / name):
-        if (folder / "claims.csv").is_file():
-            return folder
-    return None
-
-
-def read_latest(results_root: Path, name: str) -> tuple[Path, pd.DataFrame, dict] | None:
-    """The run of ``name`` the report reads (:func:`latest_run`) with its claims and manifest
-    (:func:`read_result`), or None when there is none. A ``latest`` link that leads outside
-    ``results_root`` (moved or made by hand) is refused in one line."""
-    latest = latest_run(results_root, name)
-    if latest is None:
-        return None
-    run_dir = latest.resolve()
-    if not run_dir.is_relative_to(results_root.resolve()):
-        raise ValueError(f"{latest}: the link points outside --results ({run_dir})")
-    claims, manifest = read_result(latest)
-    return latest, claims, manifest
-
-
-def read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
-    """A run's claims.csv and manifest.json, refused in one line naming the file when unreadable
-    or without the columns and fields the report needs. A claims table of the old form (a
-    column ``holds``, no interval) is read as not yet migrated."""
-    claims_path, manifest_path = latest / "claims.csv", latest / "manifest.json"
-    check_input(claims_path, "claims tables", CSV_LIMIT)
-    try:
-        claims = pd.read_csv(claims_path, keep_default_na=False)
-    except (ValueError, UnicodeDecodeError) as err:
-        raise ValueError(f"{claims_path}: not a claims table ({err})") from None
-    if "verdict" not in claims.columns and {"claim", "holds"} <= set(claims.columns):
-        claims = _old_claims(claims)
-    lacking = [c for c in VERDICT_COLUMNS if c not in claims.columns]
-    if lacking:
-        raise ValueError(
-            f"{claims_path}: no column {lacking[0]} (a claims table has "
-            f"{', '.join(VERDICT_COLUMNS)})"
-        )
-    for column in ("ci_low", "ci_high", "trials_to_decide"):
-        claims[column] = pd.to_numeric(claims[column], errors="coerce")
-    try:
-        manifest = json.loads(read_input_text(manifest_path, "JSON manifests", YAML_LIMIT))
-    except (ValueError, UnicodeDecodeError) as err:
-        raise ValueError(f"{manifest_path}: not a JSON manifest ({err})") from None
-    needed = ("trials", "trials_failed", "git")
-    if not isinstance(manifest, dict) or any(k not in manifest for k in needed):
-        raise ValueError(f"{manifest_path}: a manifest needs the fields {', '.join(needed)}")
-    return claims, manifest
-
-
-def _old_claims(claims: pd.DataFrame) -> pd.DataFrame:
-    """A claims table written before verdicts had intervals: every row not yet migrated."""
-    rows = []
-    for row in claims.to_dict("records"):
-        holds = str(row.get("holds", "")).lower() == "true"
-        rows.append(
-            {
-                **{c: "" for c in VERDICT_COLUMNS},
-                "claim": row.get("claim", ""),
-                "paper_value": row.get("paper_value", ""),
-                "measured_value": row.get("measured_value", ""),
-                "unit": row.get("unit", ""),
-                "ci_low": math.nan,
-                "ci_high": math.nan,
-                "trials": 0,
-                "trials_to_decide": math.nan,
-                "verdict": UNMIGRATED,
-                "note": f"point verdict without an interval: {'holds' if holds else 'fails'}",
-                "holds": holds,
-            }
-        )
-    return pd.DataFrame(rows, columns=VERDICT_COLUMNS)

@@ -13,7 +13,8 @@ import pytest
 
 from kiseki.metrics import wilson_interval
 from kiseki_experiments.harness import base
-from kiseki_experiments.harness.report import _old_claims, _undecided, claims_frame, tally
+from kiseki_experiments.harness.report import _undecided, claims_frame, tally
+from kiseki_experiments.harness.run_reader import _old_claims
 from kiseki_experiments.harness.verdict import (
     UNMIGRATED,
     ClaimSpec,
