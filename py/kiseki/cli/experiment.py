@@ -85,7 +85,11 @@ def experiment_run(
     ),
     scheduler: str | None = typer.Option(None, "--scheduler", help="Dask scheduler tcp://H:P."),
     out: Path | None = typer.Option(None, "--out", help="Results folder (default results/NAME/…)."),
-    resume: bool = typer.Option(False, "--resume", help="Run only the missing trials of a run."),
+    resume: bool = typer.Option(
+        False,
+        "--resume",
+        help="Run only the missing trials of a run (with --runs N: extended to N trials first).",
+    ),
 ) -> None:
     """Run an experiment's trials and write its results folder. NAME may be a pattern
     ('speed-*'): every matching experiment runs in turn, each into its own results folder

@@ -167,6 +167,24 @@ def _on_dask(client, jobs, name, values) -> Iterator[dict[str, Any]]:
         yield future.result()
 
 
+def _extend(experiment, config, saved: SavedRun, runs: int, path: Path) -> None:
+    """``--resume --runs N``: more trials for a run. A trial's seed depends only on the run's
+    seed and the trial's index, so the run extended equals a fresh run of N trials; fewer than
+    it holds would drop finished trials and is refused."""
+    if runs < saved.runs:
+        raise KisekiError(
+            f"{path}: --resume --runs {runs} would drop trials: the run has {saved.runs} (give "
+            f"at least {saved.runs}, or start a new run with another --out)"
+        )
+    settings = experiment.trial_count(config) if experiment.trial_count else None
+    if settings is not None and runs > settings:
+        raise ConfigError(
+            f"{experiment.name}: its config has {settings} settings (one trial each), not {runs}"
+        )
+    text = yaml.safe_dump({**saved.model_dump(), "runs": runs}, sort_keys=False)
+    atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+
+
 def _prepare(name, runs, seed, overrides, out, resume, results_root):
     experiment = get_experiment(name)
     if resume:
@@ -175,12 +193,8 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
         check_writable_folder(run_dir, "results")
         if saved.experiment != name:
             raise KisekiError(f"{run_dir}: holds a run of {saved.experiment!r}, not {name!r}")
-        if (
-            overrides
-            or (runs is not None and runs != saved.runs)
-            or (seed is not None and seed != saved.seed)
-        ):
-            raise KisekiError("--resume continues a run as it was: drop --set, --runs and --seed")
+        if overrides or (seed is not None and seed != saved.seed):
+            raise KisekiError("--resume continues a run as it was: drop --set and --seed")
         run_dir = run_dir.resolve()
         path = run_dir / "config.yaml"
         try:  # edited by hand since the run: the message names the file and the key
@@ -188,6 +202,9 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
         except (TypeError, ValueError) as err:  # the model's message names the file already
             text = str(err) if str(err).startswith(f"{path}: ") else f"{path}: {err}"
             raise ConfigError(text) from None
+        if runs is not None and runs != saved.runs:
+            _extend(experiment, config, saved, _option(Runs, runs, "--runs"), path)
+            return experiment, run_dir, config, runs, saved.seed
         return experiment, run_dir, config, saved.runs, saved.seed
     config = apply_overrides(experiment.config_type(), list(overrides), name)
     settings = experiment.trial_count(config) if experiment.trial_count else None

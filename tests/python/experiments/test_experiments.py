@@ -123,6 +123,27 @@ def test_resume_after_kill_equals_an_uninterrupted_run(tmp_path):
     pd.testing.assert_frame_equal(frame(tmp_path / "killed"), frame(tmp_path / "full"))
 
 
+def test_resume_with_more_runs_extends_a_run_to_what_a_fresh_run_gives(tmp_path):
+    args = ["experiment", "run", "corridor-scans", "--set", "scan_spacing=0.3"]
+    first = cli(*args, "--runs", "2", "--out", "grown", cwd=tmp_path)
+    assert first.returncode == 0, first.stderr
+    grown = cli(*args[:3], "--resume", "--runs", "4", "--out", "grown", cwd=tmp_path)
+    assert grown.returncode == 0, grown.stderr
+    assert "2 run now" in grown.stdout.replace("\n", " ")
+    fresh = run_experiment(
+        "corridor-scans", runs=4, overrides=[args[-1]], out=tmp_path / "fresh", progress=False
+    )
+    assert fresh.failed == 0
+    pd.testing.assert_frame_equal(frame(tmp_path / "grown"), frame(tmp_path / "fresh"))
+    saved = yaml.safe_load((tmp_path / "grown" / "config.yaml").read_text())
+    assert saved["runs"] == 4  # a later --resume continues the run of 4
+    # fewer trials than the run holds would drop finished ones: refused in one line
+    fewer = cli(*args[:3], "--resume", "--runs", "3", "--out", "grown", cwd=tmp_path)
+    assert fewer.returncode == 1
+    lines = fewer.stderr.strip().splitlines()
+    assert len(lines) == 1 and "would drop trials: the run has 4" in lines[0], fewer.stderr
+
+
 def _flaky_experiment() -> base.Experiment:
     def trial(config, index, seed):
         if index % 3 == 1:
