@@ -103,6 +103,8 @@ void bind_filters(py::module_& m) {
       .def_readwrite("reset_threshold", &MclParams::reset_threshold)
       .def_readwrite("reset_likelihood_drop", &MclParams::reset_likelihood_drop)
       .def_readwrite("reset_evidence", &MclParams::reset_evidence)
+      .def_readwrite("reset_needs_agreement", &MclParams::reset_needs_agreement)
+      .def_readwrite("sensor_reset_confirm", &MclParams::sensor_reset_confirm)
       .def_readwrite("expansion_position", &MclParams::expansion_position)
       .def_readwrite("expansion_orientation", &MclParams::expansion_orientation)
       .def_readwrite("reset_after", &MclParams::reset_after)

@@ -35,13 +35,16 @@ namespace {
 
 // A measurement seen only through its likelihood: log p = -|pose - target|^2 / (2 0.3^2) (position
 // in m and heading in rad alike) plus `ripple` sin(3x) cos(2y), over 30 readings, with a fixed
-// agreement with the map.
+// agreement with the map (agree_near within near_radius of near, agree elsewhere).
 class TargetModel : public SensorModel {
  public:
   Pose2 target;
   double peak = 1.0;  ///< 0: a flat likelihood (the ripple only)
   double ripple = 0.0;
   double agree = 1.0;
+  Pose2 near;
+  double near_radius = 0.0;  ///< 0: the same agreement everywhere
+  double agree_near = 1.0;
   void log_likelihoods(const Pose2* poses, std::size_t n, double* out) const override {
     for (std::size_t i = 0; i < n; ++i) {
       const Pose2& q = poses[i];
@@ -51,7 +54,9 @@ class TargetModel : public SensorModel {
     }
   }
   std::size_t readings() const override { return 30; }
-  double agreement(const Pose2&) const override { return agree; }
+  double agreement(const Pose2& q) const override {
+    return std::hypot(q.x - near.x, q.y - near.y) < near_radius ? agree_near : agree;
+  }
 };
 
 TEST(MonteCarloLocalization, ALikelihoodDropResetsACloudCarriedToAPlaceThatLooksAlike) {
@@ -91,6 +96,7 @@ TEST(MonteCarloLocalization, AResetNeedsEvidenceWhereTheLikelihoodIsFlat) {
     p.particles = 1000;
     p.recovery = Recovery::resetting;
     p.reset_evidence = evidence;
+    p.reset_needs_agreement = false;  // the likelihood's margin alone (the map agrees nowhere)
     MonteCarloLocalization mcl(p, 12);
     mcl.set_free_space(room());
     TargetModel model;
@@ -132,6 +138,7 @@ TEST(MonteCarloLocalization, TheLookElsewhereTermAsksForLnNMoreOfTheBestOfNCandi
     p.reset_after = p.sensor_reset_after = 1;
     p.expansion_position = p.expansion_orientation = 0.0;
     p.reset_look_elsewhere = look;
+    p.reset_needs_agreement = p.sensor_reset_confirm = false;  // the likelihood's test alone
     MonteCarloLocalization mcl(p, 21);
     mcl.set_free_space(room());
     TargetModel model;
@@ -140,6 +147,93 @@ TEST(MonteCarloLocalization, TheLookElsewhereTermAsksForLnNMoreOfTheBestOfNCandi
     mcl.set_particles({Pose2(4.0 + 1.04, 3.0, 0.5)});
     EXPECT_EQ(mcl.update(model).reset, look ? "none" : "sensor");
     EXPECT_EQ(position_error(mcl.estimate(), model.target) < 0.5, !look);
+  }
+}
+
+TEST(MonteCarloLocalization, AResetNeverMovesTheCloudWhereTheMapAgreesLessThanWhereItIs) {
+  // The cloud tracks A, where the map agrees with 80 % of the beams; then the likelihood moves
+  // to B (the drop trigger). A sensor reset to B is made only if the map agrees there at least
+  // as well as at A and at least reset_threshold (0.6); without the check it is made always.
+  const Pose2 a(1.0, 4.5, 0.0), b(7.5, 1.0, 2.0);
+  struct Case {
+    double agree_b;
+    bool check;
+    bool moves;
+  };
+  for (const Case c : {Case{0.9, true, true}, Case{0.7, true, false}, Case{0.3, true, false},
+                       Case{0.3, false, true}}) {
+    MclParams p;
+    p.particles = 1000;
+    p.recovery = Recovery::resetting;
+    p.reset_needs_agreement = c.check;
+    p.expansion_position = p.expansion_orientation = 0.0;  // only a sensor reset can move it
+    MonteCarloLocalization mcl(p, 31);
+    mcl.set_free_space(room());
+    TargetModel model;
+    model.target = a;
+    model.agree = 0.8;
+    model.near = b;
+    model.near_radius = 1.0;
+    model.agree_near = c.agree_b;
+    mcl.initialize_gaussian(a, 0.1, 0.1, 0.05);
+    for (int k = 0; k < 20; ++k) mcl.update(model);
+    model.target = b;
+    int sensor_resets = 0;
+    for (int k = 0; k < 30; ++k) sensor_resets += mcl.update(model).reset == "sensor";
+    SCOPED_TRACE(c.agree_b);
+    SCOPED_TRACE(c.check);
+    if (c.moves) {
+      EXPECT_GE(sensor_resets, 1);
+      EXPECT_LT(position_error(mcl.estimate(), b), 0.3);
+    } else {
+      EXPECT_EQ(sensor_resets, 0);
+      EXPECT_LT(position_error(mcl.estimate(), a), 0.5);
+    }
+  }
+}
+
+TEST(MonteCarloLocalization, ASensorResetIsMadeOnlyWhenTheNextScanConfirmsIt) {
+  // Reset on the first lost update. One odd scan fits B (the map disagrees everywhere else):
+  // without confirmation the cloud jumps to B; with it, the next scan fits A again and the
+  // held reset is dropped. A robot really carried to B is found one update later.
+  const Pose2 a(1.0, 4.5, 0.0), b(7.5, 1.0, 2.0);
+  for (const bool confirm : {false, true}) {
+    SCOPED_TRACE(confirm);
+    MclParams p;
+    p.particles = 1000;
+    p.recovery = Recovery::resetting;
+    p.reset_after = p.sensor_reset_after = 1;
+    p.sensor_reset_confirm = confirm;
+    MonteCarloLocalization mcl(p, 32);
+    mcl.set_free_space(room());
+    TargetModel model;
+    model.near = b;
+    model.near_radius = 1.0;
+    const auto fit = [&](const Pose2& where, double agree_elsewhere) {
+      model.target = where;
+      model.agree = agree_elsewhere;
+    };
+    fit(a, 1.0);
+    mcl.initialize_gaussian(a, 0.1, 0.1, 0.05);
+    for (int k = 0; k < 20; ++k) mcl.update(model);
+    fit(b, 0.0);  // the odd scan
+    EXPECT_EQ(mcl.update(model).reset, confirm ? "none" : "sensor");
+    EXPECT_LT(position_error(mcl.estimate(), confirm ? a : b), 0.5);
+    if (confirm) {
+      fit(a, 1.0);
+      EXPECT_EQ(mcl.update(model).reset, "none");
+      EXPECT_LT(position_error(mcl.estimate(), a), 0.5);
+    }
+
+    fit(a, 1.0);
+    mcl.initialize_gaussian(a, 0.1, 0.1, 0.05);
+    for (int k = 0; k < 20; ++k) mcl.update(model);
+    fit(b, 0.0);  // carried to B for good
+    EXPECT_EQ(mcl.update(model).reset, confirm ? "none" : "sensor");
+    if (confirm) {
+      EXPECT_EQ(mcl.update(model).reset, "sensor");
+    }
+    EXPECT_LT(position_error(mcl.estimate(), b), 0.5);
   }
 }
 

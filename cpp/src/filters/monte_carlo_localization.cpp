@@ -96,12 +96,14 @@ void MonteCarloLocalization::initialize_gaussian(const Pose2& mean, double sd_x,
   std::vector<Pose2> p(params_.particles);
   for (auto& q : p) q = Pose2(rng_.normal(mean.x, sd_x), rng_.normal(mean.y, sd_y), rng_.normal(mean.theta, sd_theta));
   set_particles(p);
+  challenger_.clear();
   posterior_ = estimate();
   reliability_ = 1.0;
 }
 
 void MonteCarloLocalization::initialize_uniform() {
   set_particles(uniform_poses(params_.particles));
+  challenger_.clear();
   posterior_ = estimate();
   reliability_ = 0.0;
 }
@@ -153,6 +155,10 @@ void MonteCarloLocalization::predict(const Pose2& a, const Pose2& b) {
   }
   const std::uint64_t step_seed = rng_.below(~std::uint64_t{0});
   sample_motion(params_.motion, a, b, particles_.data(), particles_.size(), step_seed, params_.threads);
+  if (!challenger_.empty()) {
+    sample_motion(params_.motion, a, b, challenger_.data(), challenger_.size(), rng_.below(~std::uint64_t{0}),
+                  params_.threads);
+  }
 }
 
 std::vector<double> MonteCarloLocalization::evaluate(const SensorModel& model, const std::vector<Pose2>& poses) const {
@@ -261,11 +267,12 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
     double best = -std::numeric_limits<double>::infinity();
     for (double l : log_l) best = std::max(best, l);
     bool sensed = false;
-    if (model != nullptr && has_free_space() && lost_updates_ >= params_.sensor_reset_after) {
-      sensed = sensor_reset(*model, best, scan);
-      if (sensed) lost_updates_ = 0;
+    if (model != nullptr && !challenger_.empty()) sensed = confirm_challenger(*model, {best, agreement});
+    if (!sensed && model != nullptr && has_free_space() && lost_updates_ >= params_.sensor_reset_after) {
+      sensed = sensor_reset(*model, {best, agreement}, scan);
     }
-    const bool expanded = !sensed && expansion_reset(model, best);
+    if (sensed) lost_updates_ = 0;
+    const bool expanded = !sensed && expansion_reset(model, {best, agreement});
     if (sensed || expanded) {
       report.reset = sensed ? "sensor" : "expansion";
       posterior_ = estimate();
@@ -274,7 +281,10 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
       return report;
     }
   }
-  if (!lost && !dropped) lost_updates_ = 0;
+  if (!lost && !dropped) {
+    lost_updates_ = 0;
+    challenger_.clear();  // the cloud agrees again: nothing to confirm
+  }
   posterior_ = weighed;  // before resampling: injected poses have no weight in it
   double inject = 0.0;
   const bool injects = params_.recovery == Recovery::augmented ||
@@ -321,6 +331,7 @@ void MonteCarloLocalization::set_recovery(Recovery recovery) {
   params_.recovery = recovery;
   w_slow_ = w_fast_ = 0.0;  // the averages start again from the next update
   lost_updates_ = 0;
+  challenger_.clear();
 }
 
 void MonteCarloLocalization::resample_to(std::size_t n) {

@@ -75,7 +75,14 @@ class MclConfig:
       current scan: :meth:`MonteCarloLocalizer.set_matcher` and the scan in :meth:`step`);
       ``reset_look_elsewhere`` False: with True a sensor reset's margin grows by ln N for a
       best of N poses searched (the engine's look_elsewhere_term: even prior odds of "here" and
-      "elsewhere", the second spread over the N poses).
+      "elsewhere", the second spread over the N poses). ``reset_needs_agreement`` True: a
+      reset is kept only if the map also agrees with the scan from its best pose (agreement at
+      least ``reset_threshold``), so that it never moves the cloud to a place where it would
+      count as lost at once; without it, beams cut short by unknown obstacles draw the cloud to
+      cluttered places elsewhere (mcl-unknown-obstacles). ``sensor_reset_confirm`` True: a
+      sensor reset that passes is held, moved with the odometry, and made only if it passes
+      again on the next scan (one scan that fits a place elsewhere better does not move a
+      cloud that is right).
     * ``update_min_d`` / ``update_min_a``: 0 (every scan is an update); nav2 uses 0.25 m / 0.2 rad.
     """
 
@@ -104,6 +111,8 @@ class MclConfig:
     sensor_reset_candidates: int = 20_000
     sensor_reset_proposal: str = "uniform"
     reset_look_elsewhere: bool = False
+    reset_needs_agreement: bool = True
+    sensor_reset_confirm: bool = True
     update_min_d: float = 0.0
     update_min_a: float = 0.0
     threads: int = 0
@@ -147,10 +156,9 @@ class MclConfig:
             f"sensor_reset_proposal must be one of {', '.join(RESET_PROPOSALS)}, "
             f"got {self.sensor_reset_proposal!r}",
         )
-        _check(
-            isinstance(self.reset_look_elsewhere, bool),
-            f"reset_look_elsewhere must be True or False, got {self.reset_look_elsewhere!r}",
-        )
+        for name in ("reset_look_elsewhere", "reset_needs_agreement", "sensor_reset_confirm"):
+            value = getattr(self, name)
+            _check(isinstance(value, bool), f"{name} must be True or False, got {value!r}")
         for name in ("update_min_d", "update_min_a"):
             value = getattr(self, name)
             _check(value >= 0 and math.isfinite(value), f"{name} must be >= 0, got {value}")
@@ -188,6 +196,8 @@ class MclConfig:
         p.sensor_reset_candidates = self.sensor_reset_candidates
         p.sensor_reset_proposal = self.sensor_reset_proposal
         p.reset_look_elsewhere = self.reset_look_elsewhere
+        p.reset_needs_agreement = self.reset_needs_agreement
+        p.sensor_reset_confirm = self.sensor_reset_confirm
         p.threads = self.threads
         return p
 

@@ -90,6 +90,10 @@ class LocalizeConfig:
     # the sensor reset's candidates: uniform or around the matcher's hypotheses (MclConfig)
     sensor_reset_proposal: str = MclConfig.sensor_reset_proposal
     reset_look_elsewhere: bool = MclConfig.reset_look_elsewhere
+    # a reset must also agree with the map from its best pose (MclConfig)
+    reset_needs_agreement: bool = MclConfig.reset_needs_agreement
+    # ... and must pass again on the next scan before it is made (MclConfig)
+    sensor_reset_confirm: bool = MclConfig.sensor_reset_confirm
     likelihood_power: float = MclConfig.likelihood_power
     # the `reliability` of the result: the engine's "agreement" or a learned probability,
     # fitted on simulated ("learned") or recorded ("learned-real") updates
@@ -185,6 +189,8 @@ class LocalizeConfig:
             resetting_injects=self.resetting_injects,
             sensor_reset_proposal=self.sensor_reset_proposal,
             reset_look_elsewhere=self.reset_look_elsewhere,
+            reset_needs_agreement=self.reset_needs_agreement,
+            sensor_reset_confirm=self.sensor_reset_confirm,
             update_min_d=self.update_min_d,
             update_min_a=self.update_min_a,
             threads=self.threads,

@@ -72,6 +72,9 @@ class ExcursionsConfig:
     # the sensor reset's candidates (uniform or matcher) and its look-elsewhere term
     sensor_reset_proposal: str = LocalizeConfig.sensor_reset_proposal
     reset_look_elsewhere: bool = LocalizeConfig.reset_look_elsewhere
+    # the resets' agreement check and confirmation (false: the resets before them)
+    reset_needs_agreement: bool = LocalizeConfig.reset_needs_agreement
+    sensor_reset_confirm: bool = LocalizeConfig.sensor_reset_confirm
     threads: Threads = 1
 
 
@@ -151,6 +154,8 @@ def trial(config: ExcursionsConfig, index: int, seed: int) -> TrialOutput:
                 z_intrusion=config.z_intrusion,
                 sensor_reset_proposal=config.sensor_reset_proposal,
                 reset_look_elsewhere=config.reset_look_elsewhere,
+                reset_needs_agreement=config.reset_needs_agreement,
+                sensor_reset_confirm=config.sensor_reset_confirm,
             )
             result = localize(scans, maps[method], lc)
             d = result.estimates - scans.poses

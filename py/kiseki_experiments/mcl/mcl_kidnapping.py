@@ -136,6 +136,8 @@ def _trial(scans: LaserScans, grid, config: KidnapConfig, seed: int, name: str) 
             resetting_injects=recovery == "resetting+injection",
             sensor_reset_proposal=config.sensor_reset_proposal,
             reset_look_elsewhere=config.reset_look_elsewhere,
+            reset_needs_agreement=config.reset_needs_agreement,
+            sensor_reset_confirm=config.sensor_reset_confirm,
             threads=config.threads,
             reliability=config.reliability,
         )

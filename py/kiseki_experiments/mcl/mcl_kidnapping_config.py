@@ -55,6 +55,9 @@ class KidnapConfig:
     # the sensor reset's candidates (uniform or matcher) and its look-elsewhere term
     sensor_reset_proposal: str = LocalizeConfig.sensor_reset_proposal
     reset_look_elsewhere: bool = LocalizeConfig.reset_look_elsewhere
+    # the resets' agreement check and confirmation (false: the resets before them)
+    reset_needs_agreement: bool = LocalizeConfig.reset_needs_agreement
+    sensor_reset_confirm: bool = LocalizeConfig.sensor_reset_confirm
     # the claims' controls: the recovery that runs in the arm named "resetting", and whether
     # the robot is carried at all (false: the log goes on from scan k, no jump)
     resetting_runs: str = "resetting"

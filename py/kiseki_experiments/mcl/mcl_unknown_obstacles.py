@@ -85,6 +85,9 @@ class UnknownObstaclesConfig:
     band: PositiveReal = 3.0  # m: the farthest an obstacle is put from the route point drawn
     max_scans: Scans = 0  # 0 = whole logs
     threads: Threads = 1
+    # the resets' agreement check and confirmation (false: the resets before them)
+    reset_needs_agreement: bool = LocalizeConfig.reset_needs_agreement
+    sensor_reset_confirm: bool = LocalizeConfig.sensor_reset_confirm
 
 
 def preflight(config: UnknownObstaclesConfig) -> None:
@@ -193,6 +196,8 @@ def trial(config: UnknownObstaclesConfig, index: int, seed: int) -> TrialOutput:
                 particles=config.particles,
                 recovery=recovery or "none",
                 threads=config.threads,
+                reset_needs_agreement=config.reset_needs_agreement,
+                sensor_reset_confirm=config.sensor_reset_confirm,
             )
             grid = teaching if method == TEACHING_MAP else log_odds
             result = localize(seen, grid, lc)

@@ -27,17 +27,17 @@ WRONG = np.array([9.0, 2.5, 2.0])  # where the cloud tracks before the first upd
 
 
 def _config(proposal: str, threads: int = 1, **more) -> MclConfig:
-    # a sensor reset at the first lost update, every particle from the candidates
+    # a sensor reset at the first lost update, made at once (the proposal is what is tested,
+    # not its confirmation), every particle from the candidates
     return MclConfig(
         particles=500,
         recovery="resetting",
         reset_after=1,
         sensor_reset_after=1,
         sensor_reset_share=1.0,
-        sensor_reset_candidates=2000,
         sensor_reset_proposal=proposal,
         threads=threads,
-        **more,
+        **({"sensor_reset_candidates": 2000, "sensor_reset_confirm": False} | more),
     )
 
 
@@ -80,11 +80,20 @@ def test_the_matcher_proposal_resets_around_the_hypotheses_and_ends_at_the_truth
     assert _near_hypotheses(first, grid, ranges).all()
     assert math.hypot(*(estimate[:2] - TRUTH[:2])) < 0.3
     # the reference: the uniform proposal's candidates spread over the room, and it too ends
-    # at the truth (one scan of this room fits one place)
-    first_u, reports_u, estimate_u, _ = _run("uniform")
+    # at the truth (one scan of this room fits one place); its successive resets are each
+    # accepted on the likelihood alone
+    first_u, reports_u, estimate_u, _ = _run("uniform", reset_needs_agreement=False)
     assert reports_u[0] == "sensor"
     assert _near_hypotheses(first_u, grid, ranges).mean() < 0.5
     assert math.hypot(*(estimate_u[:2] - TRUTH[:2])) < 0.3
+    # with the agreement check (the default), no place that 2,000 uniform candidates propose
+    # lies close enough to the truth for the map to agree with the scan from it: refused; of
+    # the engine's 20,000, one does, and the first reset lands near the truth
+    _, reports_few, _, _ = _run("uniform")
+    assert "sensor" not in reports_few
+    _, reports_many, estimate_many, _ = _run("uniform", sensor_reset_candidates=20_000)
+    assert reports_many[0] == "sensor"
+    assert math.hypot(*(estimate_many[:2] - TRUTH[:2])) < 0.5
 
 
 def test_the_matcher_proposal_gives_the_same_particles_for_one_and_two_threads():
@@ -98,6 +107,8 @@ def test_bad_settings_are_refused_in_one_line(tmp_path):
     for bad, word in (
         (dict(sensor_reset_proposal="grid"), "sensor_reset_proposal must be one of"),
         (dict(reset_look_elsewhere=1), "reset_look_elsewhere must be True or False"),
+        (dict(reset_needs_agreement="yes"), "reset_needs_agreement must be True or False"),
+        (dict(sensor_reset_confirm=0), "sensor_reset_confirm must be True or False"),
     ):
         with pytest.raises(ValueError, match=word) as caught:
             LocalizeConfig(**bad)

@@ -74,6 +74,15 @@ struct MclParams {
   /// A reset is kept only if its best pose beats the cloud's best by this log-likelihood ratio
   /// (tempered by likelihood_power): ln 10, a Bayes factor of 10 (Jeffreys' "strong").
   double reset_evidence = 2.302585092994046;
+  /// ... and only if the map agrees with the measurement from the place it proposes (the
+  /// weighted mean of its poses within 0.5 m and 0.3 rad of its best) at least as well as from
+  /// the cloud's estimate, and at least reset_threshold (where the model can tell): a
+  /// reset never moves the cloud to a place where, by the trigger's own measure, it would count
+  /// as lost, or to one that fits the map worse than where it is. Beams cut short by obstacles
+  /// the map does not hold make the likelihood drop and fit a cluttered place elsewhere better
+  /// than the truth under the likelihood field, but from there much of the scan passes through
+  /// walls or ends in free space.
+  bool reset_needs_agreement = true;
   double expansion_position = 0.2, expansion_orientation = 0.2;  ///< m, rad (half-widths)
   int reset_after = 2;         ///< disagreeing updates in a row before the first reset
   int sensor_reset_after = 4;  ///< ... before a sensor reset (expansions until then)
@@ -85,6 +94,11 @@ struct MclParams {
   /// sensor_reset_candidates (uniform) or the matcher's lattice poses (matcher). See
   /// look_elsewhere_term. Off: the acceptance of kiseki before the matcher proposal.
   bool reset_look_elsewhere = false;
+  /// A sensor reset that passes its tests is held as a challenger, moved with the odometry,
+  /// and made only if it passes them again on the next update's measurement: one scan that a
+  /// place elsewhere explains better (people, clutter, a glass wall) must not move a cloud that
+  /// is right, and two independent scans rarely both favour the same wrong place.
+  bool sensor_reset_confirm = true;
   double reliability_rate = 0.1;       ///< smoothing of the reliability estimate per update
   int threads = 0;                     ///< 0 = every core
   void validate() const;
@@ -180,8 +194,19 @@ class MonteCarloLocalization {
   double agreement_of(const SensorModel& model, const Pose2& weighed) const;
   void resample(double inject_probability, UpdateReport& report);
   bool explains_better(double proposed_best, double cloud_best) const;
-  bool expansion_reset(const SensorModel* model, double cloud_best);
-  bool sensor_reset(const SensorModel& model, double cloud_best, const ScanView* scan);
+  /// What a reset must beat: the cloud's best log-likelihood and the agreement at its estimate.
+  struct CloudScore {
+    double best_log_likelihood;
+    double agreement;  ///< NaN: the model cannot tell
+  };
+  bool agrees_at(const SensorModel& model, const std::vector<Pose2>& poses, const std::vector<double>& log_l,
+                 const CloudScore& cloud) const;
+  bool expansion_reset(const SensorModel* model, const CloudScore& cloud);
+  bool sensor_reset(const SensorModel& model, const CloudScore& cloud, const ScanView* scan);
+  /// The confirmation of a held sensor reset on this update's measurement (and its end).
+  bool confirm_challenger(const SensorModel& model, const CloudScore& cloud);
+  /// Replaces the cloud by its resampled part and the proposed poses drawn by their weights.
+  void mix_in(const SensorModel& model, const std::vector<Pose2>& proposed, const std::vector<double>& log_l);
   std::vector<Pose2> reset_candidates(const ScanView* scan, double& searched);
   void check_ready() const;
 
@@ -198,6 +223,7 @@ class MonteCarloLocalization {
   // recovery state
   double w_slow_ = 0.0, w_fast_ = 0.0;
   int lost_updates_ = 0;
+  std::vector<Pose2> challenger_;  // a sensor reset held for confirmation (sensor_reset_confirm)
   double reliability_ = 1.0;
   Pose2 posterior_;
   const CorrelativeScanMatcher* matcher_ = nullptr;
