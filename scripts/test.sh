@@ -48,5 +48,10 @@ cmake --build build/fuzz
 tests/fuzz/cpp/run.sh build/fuzz "${KISEKI_FUZZ_CPP_RUNS:-20000}"
 
 stage "pytest"
+# two workers on two cores: each worker's BLAS (numpy's OpenBLAS) on one thread. With two
+# threads per worker, each waits for a core the other worker holds (a hyperparameter fit of
+# 1 s took 113 s in a full run, and 3.4 s instead of 1.4 s beside one other BLAS process).
+# kiseki's own threads are the tests' to set; a value given by the caller is kept.
+export OPENBLAS_NUM_THREADS="${OPENBLAS_NUM_THREADS:-1}"
 # two workers, each taking the next test when free; the slowest tests listed in every run
 python -m pytest -n "${KISEKI_TEST_WORKERS:-2}" --dist worksteal --durations=15 "$@"
