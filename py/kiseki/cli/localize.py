@@ -131,6 +131,13 @@ def localize_command(
         help="A sensor reset must beat the cloud by a margin that grows by ln N for its best of "
         "N poses searched (N the candidates, or the matcher's lattice poses); not with --global.",
     ),
+    reset_unchecked: bool = typer.Option(
+        False,
+        "--reset-unchecked",
+        help="Resets are kept on the likelihood alone, without the map's agreement at the place "
+        "they propose, and a sensor reset is made at once, without the next scan's "
+        "confirmation (kiseki's resets before both checks); not with --global.",
+    ),
     threads: int | None = typer.Option(
         None,
         parser=Count("--threads", 0, THREAD_LIMIT, "0 = every core"),
@@ -243,6 +250,8 @@ def localize_command(
         resets = dict(sensor_reset_proposal=reset_proposal)
         if reset_look_elsewhere:
             resets.update(reset_look_elsewhere=True)
+        if reset_unchecked:
+            resets.update(reset_needs_agreement=False, sensor_reset_confirm=False)
         budget = dict(budget_ms=budget_ms, beam_skip=beam_skip or None, caster=caster)
         config = LocalizeConfig(
             **_given(
@@ -312,7 +321,7 @@ def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bo
         refuse_given(
             ctx,
             ["particles", "kld", "beams", "recovery", "threads", "global_start"]
-            + ["reset_proposal", "reset_look_elsewhere"],
+            + ["reset_proposal", "reset_look_elsewhere", "reset_unchecked"],
             "to --method odometry (the odometry alone: no particle filter)",
         )
     elif method == "space-observation":  # a local map of the whole scan: no beam selection
@@ -325,7 +334,7 @@ def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bo
         refuse_given(ctx, ["odometry_noise"], "with --global (it is for logs with reference poses)")
         refuse_given(
             ctx,
-            ["reset_proposal", "reset_look_elsewhere"],
+            ["reset_proposal", "reset_look_elsewhere", "reset_unchecked"],
             "with --global (its start is --one-scan; its resets are the uniform ones)",
         )
         refuse_given(

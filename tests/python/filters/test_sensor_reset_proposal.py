@@ -14,6 +14,7 @@ import sys
 
 import numpy as np
 import pytest
+import yaml
 
 from _helpers.asymmetric_room import RES, room
 from _helpers.room_log import write_inputs
@@ -128,6 +129,7 @@ def test_bad_settings_are_refused_in_one_line(tmp_path):
     for args, word in (
         (["--reset-proposal", "grid"], "sensor_reset_proposal must be one of"),
         (["--global", "--reset-proposal", "matcher"], "does not apply with --global"),
+        (["--global", "--reset-unchecked"], "does not apply with --global"),
     ):
         done = subprocess.run(
             [sys.executable, "-m", "kiseki.cli", "localize", "log.mcap", "--map", "room.yaml",
@@ -136,3 +138,17 @@ def test_bad_settings_are_refused_in_one_line(tmp_path):
         )  # fmt: skip
         assert done.returncode != 0
         assert word in done.stderr and "Traceback" not in done.stderr
+
+
+def test_reset_unchecked_runs_the_resets_without_both_checks_and_saves_it(tmp_path):
+    write_inputs(tmp_path)
+    for name, args, checked in (("a", [], True), ("b", ["--reset-unchecked"], False)):
+        done = subprocess.run(
+            [sys.executable, "-m", "kiseki.cli", "localize", "log.mcap", "--map", "room.yaml",
+             "-o", f"{name}.csv", "--recovery", "resetting", *args],
+            cwd=tmp_path, capture_output=True, text=True, timeout=300,
+        )  # fmt: skip
+        assert done.returncode == 0, done.stderr
+        saved = yaml.safe_load((tmp_path / f"{name}.config.yaml").read_text())
+        assert saved["reset_needs_agreement"] is checked
+        assert saved["sensor_reset_confirm"] is checked
