@@ -96,14 +96,12 @@ void MonteCarloLocalization::initialize_gaussian(const Pose2& mean, double sd_x,
   std::vector<Pose2> p(params_.particles);
   for (auto& q : p) q = Pose2(rng_.normal(mean.x, sd_x), rng_.normal(mean.y, sd_y), rng_.normal(mean.theta, sd_theta));
   set_particles(p);
-  challenger_.clear();
   posterior_ = estimate();
   reliability_ = 1.0;
 }
 
 void MonteCarloLocalization::initialize_uniform() {
   set_particles(uniform_poses(params_.particles));
-  challenger_.clear();
   posterior_ = estimate();
   reliability_ = 0.0;
 }
@@ -120,6 +118,7 @@ void MonteCarloLocalization::set_particles(const std::vector<Pose2>& poses, cons
     throw std::invalid_argument("MCL: one weight per particle is needed");
   }
   particles_ = poses;
+  challenger_.clear();  // a new cloud: a sensor reset held for the old one is void
   if (weights.empty()) {
     weights_.assign(particles_.size(), 1.0 / static_cast<double>(particles_.size()));
   } else {
