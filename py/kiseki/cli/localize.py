@@ -29,6 +29,7 @@ from kiseki._support.options import (
 from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki._support.table import show_fields
 from kiseki.cli._defaults import default_of
+from kiseki.cli._off_map import warn_if_off_the_map
 from kiseki.datasets import open_scans
 from kiseki.filters import (
     CostModel,
@@ -42,7 +43,6 @@ from kiseki.filters import (
 )
 from kiseki.grid import RAY_CASTERS
 from kiseki.io.ros_map import load_map
-from kiseki.mapping import endpoint_agreement
 from kiseki.metrics import ape
 
 __all__ = ["app"]
@@ -271,9 +271,9 @@ def localize_command(
     saved_config.update(log=str(log), map=str(map_file))
     _write_trajectory(output, scans.times, trajectory, reliability)
     if not global_start:
-        _warn_if_off_the_map(grid, trajectory, scans, map_file)
+        warn_if_off_the_map(grid, trajectory, scans, map_file)
     elif result.report.converged and result.report.fit is not None:  # from convergence on
-        _warn_if_off_the_map(grid, trajectory, scans, map_file, result.report.fit.within_1_cell)
+        warn_if_off_the_map(grid, trajectory, scans, map_file, result.report.fit.within_1_cell)
     config_path = output.with_name(output.stem + ".config.yaml")
     _write_yaml(config_path, saved_config)
     summary: dict = {"output": str(output), "poses": len(scans), "method": method}
@@ -353,35 +353,6 @@ def _print_report(lines: list[str], summary: dict, as_json: bool) -> None:
     else:
         for line in lines:
             typer.echo(line)
-
-
-OFF_MAP_SHARE = 0.5  # below this share of endpoints near a wall the map is not the log's
-
-
-def _warn_if_off_the_map(
-    grid, trajectory: np.ndarray, scans, map_file: Path, share: float | None = None
-) -> None:
-    """One warning line when most scan endpoints, at the estimated poses, miss the map's walls
-    (a map of another building, a 1x1 map): the poses alone look fine in such a case.
-    ``share``: the share already measured (global localization's, from convergence on)."""
-    if share is None:
-        finite = np.isfinite(trajectory).all(axis=1)
-        # endpoint_agreement's endpoints: finite readings in (0, max_range), float32 as the core
-        # reads them, compared in double as it does; with none (no estimate, or every reading
-        # at max_range) the share is undefined and there is nothing to warn about
-        ranges = np.asarray(scans.ranges, dtype=np.float32)[finite].astype(np.float64)
-        if not (np.isfinite(ranges) & (ranges > 0.0) & (ranges < scans.max_range)).any():
-            return
-        share = endpoint_agreement(
-            grid, trajectory[finite], scans.ranges[finite], scans.angles, scans.max_range
-        )
-    if share < OFF_MAP_SHARE:
-        typer.echo(
-            f"kiseki: warning: only {100 * share:.1f} % of the scan endpoints fall on or next to "
-            f"an occupied cell of {map_file} at the estimated poses: the map is probably not "
-            "the log's building, or the localization is lost",
-            err=True,
-        )
 
 
 def _write_trajectory(

@@ -174,7 +174,7 @@ def test_a_map_that_is_not_the_logs_building_warns(inputs):
 def test_the_off_map_check_skips_only_what_it_cannot_measure(capsys):
     """No estimate, or no endpoint below max_range: no share, no warning. Any other error of
     endpoint_agreement (here ranges one column short) is raised: it was swallowed with them."""
-    from kiseki.cli.localize import _warn_if_off_the_map
+    from kiseki.cli._off_map import warn_if_off_the_map
 
     grid, poses = room(), np.array([[0.0, -1.0, 0.0], [0.5, -1.0, 0.0]])
 
@@ -182,15 +182,15 @@ def test_the_off_map_check_skips_only_what_it_cannot_measure(capsys):
         return SimpleNamespace(ranges=np.asarray(ranges, np.float32), angles=ANGLES, max_range=8.0)
 
     seen = scans(grid.cast_scans(poses, ANGLES, max_range=8.0))
-    _warn_if_off_the_map(grid, poses, seen, Path("room.yaml"))  # on the walls: no warning
-    _warn_if_off_the_map(grid, np.full_like(poses, np.nan), seen, Path("room.yaml"))
-    _warn_if_off_the_map(grid, poses, scans(np.full((2, ANGLES.size), 8.0)), Path("room.yaml"))
+    warn_if_off_the_map(grid, poses, seen, Path("room.yaml"))  # on the walls: no warning
+    warn_if_off_the_map(grid, np.full_like(poses, np.nan), seen, Path("room.yaml"))
+    warn_if_off_the_map(grid, poses, scans(np.full((2, ANGLES.size), 8.0)), Path("room.yaml"))
     assert capsys.readouterr().err == ""
     empty = OccupancyGrid(np.zeros_like(grid.cells), grid.resolution, grid.origin)
-    _warn_if_off_the_map(empty, poses, seen, Path("empty.yaml"))
+    warn_if_off_the_map(empty, poses, seen, Path("empty.yaml"))
     assert "only 0.0 % of the scan endpoints" in capsys.readouterr().err
     with pytest.raises(ValueError, match="ranges"):
-        _warn_if_off_the_map(grid, poses, scans(np.ones((2, ANGLES.size - 1))), Path("room.yaml"))
+        warn_if_off_the_map(grid, poses, scans(np.ones((2, ANGLES.size - 1))), Path("room.yaml"))
 
 
 def test_global_localization_on_another_map_warns_and_prints_no_nan(inputs):

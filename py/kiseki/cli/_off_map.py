@@ -1,0 +1,41 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""``kiseki localize``'s check that the map is the log's: a warning when most scan endpoints,
+at the estimated poses, miss the map's walls."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from kiseki.mapping import endpoint_agreement
+
+OFF_MAP_SHARE = 0.5  # below this share of endpoints near a wall the map is not the log's
+
+
+def warn_if_off_the_map(
+    grid, trajectory: np.ndarray, scans, map_file: Path, share: float | None = None
+) -> None:
+    """One warning line when most scan endpoints, at the estimated poses, miss the map's walls
+    (a map of another building, a 1x1 map): the poses alone look fine in such a case.
+    ``share``: the share already measured (global localization's, from convergence on)."""
+    if share is None:
+        finite = np.isfinite(trajectory).all(axis=1)
+        # endpoint_agreement's endpoints: finite readings in (0, max_range), float32 as the core
+        # reads them, compared in double as it does; with none (no estimate, or every reading
+        # at max_range) the share is undefined and there is nothing to warn about
+        ranges = np.asarray(scans.ranges, dtype=np.float32)[finite].astype(np.float64)
+        if not (np.isfinite(ranges) & (ranges > 0.0) & (ranges < scans.max_range)).any():
+            return
+        share = endpoint_agreement(
+            grid, trajectory[finite], scans.ranges[finite], scans.angles, scans.max_range
+        )
+    if share < OFF_MAP_SHARE:
+        typer.echo(
+            f"kiseki: warning: only {100 * share:.1f} % of the scan endpoints fall on or next to "
+            f"an occupied cell of {map_file} at the estimated poses: the map is probably not "
+            "the log's building, or the localization is lost",
+            err=True,
+        )
