@@ -76,13 +76,14 @@ class MclConfig:
       ``reset_look_elsewhere`` False: with True a sensor reset's margin grows by ln N for a
       best of N poses searched (the engine's look_elsewhere_term: even prior odds of "here" and
       "elsewhere", the second spread over the N poses). ``reset_needs_agreement`` True: a
-      reset is kept only if the map also agrees with the scan from its best pose (agreement at
-      least ``reset_threshold``), so that it never moves the cloud to a place where it would
-      count as lost at once; without it, beams cut short by unknown obstacles draw the cloud to
-      cluttered places elsewhere (mcl-unknown-obstacles). ``sensor_reset_confirm`` True: a
-      sensor reset that passes is held, moved with the odometry, and made only if it passes
-      again on the next scan (one scan that fits a place elsewhere better does not move a
-      cloud that is right).
+      reset is kept only if the map also agrees with the scan from the place it proposes (the
+      likelihood-weighted mean of its poses within 0.5 m and 0.3 rad of its best) at least as
+      well as from the estimate and by at least ``reset_threshold``, so that it never moves the
+      cloud to a place where it would count as lost; without it, beams cut short by unknown
+      obstacles draw the cloud to cluttered places elsewhere (mcl-unknown-obstacles).
+      ``sensor_reset_confirm`` True: a sensor reset that passes is held, moved with the
+      odometry, and made only if it passes again on the next scan (one scan that fits a place
+      elsewhere better does not move a cloud that is right).
     * ``update_min_d`` / ``update_min_a``: 0 (every scan is an update); nav2 uses 0.25 m / 0.2 rad.
     """
 

@@ -90,7 +90,7 @@ class LocalizeConfig:
     # the sensor reset's candidates: uniform or around the matcher's hypotheses (MclConfig)
     sensor_reset_proposal: str = MclConfig.sensor_reset_proposal
     reset_look_elsewhere: bool = MclConfig.reset_look_elsewhere
-    # a reset must also agree with the map from its best pose (MclConfig)
+    # a reset must also agree with the map from the place it proposes (MclConfig)
     reset_needs_agreement: bool = MclConfig.reset_needs_agreement
     # ... and must pass again on the next scan before it is made (MclConfig)
     sensor_reset_confirm: bool = MclConfig.sensor_reset_confirm
