@@ -7,17 +7,13 @@ from __future__ import annotations
 
 import errno
 import math
-import os
-import signal
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import pandas as pd
 import pytest
 import yaml
 
+from _helpers.experiment_runs import cli, frame
 from kiseki.core import derive_seed
 from kiseki.errors import KisekiError
 from kiseki_experiments.harness import base, registry
@@ -26,16 +22,6 @@ from kiseki_experiments.harness.report import write_reproduction
 from kiseki_experiments.harness.runner import run_experiment
 from kiseki_experiments.harness.verdict import VERDICT_COLUMNS, Control, Criterion
 from kiseki_experiments.mapping.corridor_scans import CorridorScansConfig
-
-
-def cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "kiseki.cli", *args], cwd=cwd, capture_output=True, text=True
-    )
-
-
-def frame(run_dir: Path) -> pd.DataFrame:
-    return pd.read_parquet(run_dir / "trials.parquet")
 
 
 def test_serial_and_two_worker_local_cluster_give_identical_records(tmp_path):
@@ -74,74 +60,6 @@ def test_carmen_maps_serial_equals_local_cluster(shared_data, tmp_path):
     assert (tmp_path / "s" / "claims.csv").read_bytes() == (
         tmp_path / "p" / "claims.csv"
     ).read_bytes()
-
-
-def test_resume_after_kill_equals_an_uninterrupted_run(tmp_path):
-    args = [
-        sys.executable,
-        "-m",
-        "kiseki.cli",
-        "experiment",
-        "run",
-        "corridor-scans",
-        "--runs",
-        "6",
-        "--set",
-        "scan_spacing=0.03",
-    ]  # about a second per trial (0.4 s at the default 0.1 m: the kill could miss the run);
-    # resume's equality does not depend on the scans per trial: a third as many as at 0.01 m
-    proc = subprocess.Popen(
-        [*args, "--out", "killed"],
-        cwd=tmp_path,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    log = tmp_path / "killed" / "trials.jsonl"
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline:
-        if log.exists() and len(log.read_bytes().splitlines()) >= 2:
-            break
-        time.sleep(0.02)
-    os.kill(proc.pid, signal.SIGKILL)
-    proc.wait()
-    finished = len(log.read_bytes().splitlines())
-    assert 2 <= finished < 6, "the kill must land mid-run"
-    assert not (tmp_path / "killed" / "trials.parquet").exists()
-    resumed = subprocess.run(
-        [*args[:4], "run", "corridor-scans", "--resume", "--out", "killed"],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-    )
-    assert resumed.returncode == 0, resumed.stderr
-    assert f"{6 - finished} run now" in resumed.stdout.replace("\n", " ")
-    # the uninterrupted reference is not about the process: run in-process, as the command does
-    full = run_experiment(
-        "corridor-scans", runs=6, overrides=[args[-1]], out=tmp_path / "full", progress=False
-    )
-    assert full.failed == 0
-    pd.testing.assert_frame_equal(frame(tmp_path / "killed"), frame(tmp_path / "full"))
-
-
-def test_resume_with_more_runs_extends_a_run_to_what_a_fresh_run_gives(tmp_path):
-    args = ["experiment", "run", "corridor-scans", "--set", "scan_spacing=0.3"]
-    first = cli(*args, "--runs", "2", "--out", "grown", cwd=tmp_path)
-    assert first.returncode == 0, first.stderr
-    grown = cli(*args[:3], "--resume", "--runs", "4", "--out", "grown", cwd=tmp_path)
-    assert grown.returncode == 0, grown.stderr
-    assert "2 run now" in grown.stdout.replace("\n", " ")
-    fresh = run_experiment(
-        "corridor-scans", runs=4, overrides=[args[-1]], out=tmp_path / "fresh", progress=False
-    )
-    assert fresh.failed == 0
-    pd.testing.assert_frame_equal(frame(tmp_path / "grown"), frame(tmp_path / "fresh"))
-    saved = yaml.safe_load((tmp_path / "grown" / "config.yaml").read_text())
-    assert saved["runs"] == 4  # a later --resume continues the run of 4
-    # fewer trials than the run holds would drop finished ones: refused in one line
-    fewer = cli(*args[:3], "--resume", "--runs", "3", "--out", "grown", cwd=tmp_path)
-    assert fewer.returncode == 1
-    lines = fewer.stderr.strip().splitlines()
-    assert len(lines) == 1 and "would drop trials: the run has 4" in lines[0], fewer.stderr
 
 
 def _flaky_experiment() -> base.Experiment:
