@@ -135,7 +135,7 @@ void bind_gp(py::module_& m) {
   m.def(
       "gp_fit_hyperparameters",
       [](const py::handle& inputs, const py::handle& targets, double sigma_f, double length_scale, double sigma_n,
-         int restarts, std::uint64_t seed, int max_iterations, double tolerance, bool scan) {
+         int restarts, std::uint64_t seed, int max_iterations, double tolerance, bool scan, bool stop_at_repeat) {
         const Rows x(inputs, "inputs");
         const Rows y(targets, "targets");
         const SquaredExponential initial = kernel_of(sigma_f, length_scale, sigma_n);
@@ -145,6 +145,7 @@ void bind_gp(py::module_& m) {
         o.max_iterations = max_iterations;
         o.tolerance = tolerance;
         o.scan = scan;
+        o.stop_at_repeat = stop_at_repeat;
         HyperparameterFit fit;
         {
           py::gil_scoped_release release;
@@ -154,8 +155,8 @@ void bind_gp(py::module_& m) {
                               fit.log_marginal_likelihood, fit.evaluations, fit.gradients, fit.start_values);
       },
       "inputs"_a, "targets"_a, "sigma_f"_a, "length_scale"_a, "sigma_n"_a, "restarts"_a = 3, "seed"_a = 0,
-      "max_iterations"_a = 100, "tolerance"_a = 1e-6, "scan"_a = true,
-      "(sigma_f, l, sigma_n, LML, likelihood values, gradients, best LML per start); targets used as given.");
+      "max_iterations"_a = 100, "tolerance"_a = 1e-6, "scan"_a = true, "stop_at_repeat"_a = true,
+      "(sigma_f, l, sigma_n, LML, likelihood values, gradients, best LML per start made); targets used as given.");
 }
 
 }  // namespace kiseki::bindings

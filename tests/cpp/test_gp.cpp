@@ -114,6 +114,9 @@ TEST(ExactGp, HyperparametersOfASampledFieldAreFound) {
   // The same seed gives the same answer.
   const HyperparameterFit again = fit_hyperparameters(x, y, initial_kernel(x, y));
   EXPECT_EQ(fit.kernel.length_scale, again.kernel.length_scale);
+  HyperparameterOptions bad;
+  bad.repeat_tolerance = -1e-6;
+  EXPECT_THROW(fit_hyperparameters(x, y, initial_kernel(x, y), bad), std::invalid_argument);
 }
 
 TEST(HilbertGp, ApproachesTheExactGp) {

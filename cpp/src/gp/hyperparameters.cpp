@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "dense.hpp"
@@ -161,6 +162,9 @@ HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
   if (options.restarts < 0 || options.max_iterations < 1 || !(options.tolerance > 0.0)) {
     throw std::invalid_argument("fit_hyperparameters: restarts >= 0, max_iterations >= 1 and tolerance > 0 needed");
   }
+  if (!(options.repeat_tolerance >= 0.0) || !(options.repeat_parameter_tolerance >= 0.0)) {
+    throw std::invalid_argument("fit_hyperparameters: repeat tolerances must be >= 0");
+  }
   const RowMatrix x = inputs.rowwise() - inputs.colwise().mean();
   const double s = rms(targets);
   const double e = extent(x);
@@ -212,6 +216,17 @@ HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
     }
   }
   const bool scan_is_initial = (scanned - to_log(initial)).cwiseAbs().maxCoeff() < 1e-12;
+  // Where each start ended (log-parameters, LML), for the stop at a repeated optimum.
+  std::vector<std::pair<Eigen::Vector3d, double>> ends;
+  const auto repeats_an_earlier_end = [&](const Eigen::Vector3d& p, double lml) {
+    for (const auto& [q, v] : ends) {
+      if (std::abs(lml - v) <= options.repeat_tolerance * std::max(std::abs(v), 1.0) &&
+          (p - q).cwiseAbs().maxCoeff() <= options.repeat_parameter_tolerance) {
+        return true;
+      }
+    }
+    return false;
+  };
   for (int start = 0; start <= options.restarts + 1; ++start) {
     if (start == 1 && scan_is_initial) continue;
     Eigen::Vector3d p = (start == 1 ? scanned : to_log(initial)).cwiseMax(lower).cwiseMin(upper);
@@ -295,6 +310,8 @@ HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
       fit.log_marginal_likelihood = lml;
       fit.kernel = from_log(p);
     }
+    if (options.stop_at_repeat && repeats_an_earlier_end(p, lml)) break;
+    ends.emplace_back(p, lml);
   }
   if (!std::isfinite(fit.log_marginal_likelihood)) {
     throw std::runtime_error("fit_hyperparameters: no start gave a covariance matrix that could be factorised");

@@ -96,18 +96,24 @@ def fit_hyperparameters(
     max_points: int = 2000,
     max_iterations: int = 100,
     mean: str = "constant",
+    stop_at_repeat: bool = True,
 ) -> HyperparameterFit:
     """Hyperparameters that maximise the log marginal likelihood (eq. 6.11) summed over Y's
     columns (one kernel shared by the field's components), by projected L-BFGS in
     log-parameters with the analytic gradient (eqs. 6.12-6.15), from `initial` (default: from
-    the data's spread), from the best of a coarse scan of l and sigma_n, and from `restarts`
-    seeded random starts. Above `max_points` readings the likelihood is that of a
-    seeded random subsample of that size (its cost grows as n^3)."""
+    the data's spread), from the best of a coarse scan of l and sigma_n, and from up to
+    `restarts` seeded random starts: with `stop_at_repeat` they stop once a start ends at an
+    optimum an earlier start reached (the same log marginal likelihood to 1e-6 of its size and
+    every hyperparameter within 1 %), so ``len(start_values)`` says how many were made. Above
+    `max_points` readings the likelihood is that of a seeded random subsample of that size
+    (its cost grows as n^3)."""
     x = inputs_array(x)
     y, _ = targets_array(y, x.shape[0])
     constant = check_mean(mean)
     if isinstance(restarts, bool) or not isinstance(restarts, int) or not 0 <= restarts <= 100:
         raise ValueError(f"restarts must be an integer in 0..100, got {restarts!r}")
+    if not isinstance(stop_at_repeat, bool):
+        raise ValueError(f"stop_at_repeat must be True or False, got {stop_at_repeat!r}")
     check_iterations(max_iterations)
     chosen = subsample(x.shape[0], max_points, seed)
     if chosen is not None:
@@ -124,6 +130,7 @@ def fit_hyperparameters(
         restarts,
         check_seed(seed),
         max_iterations,
+        stop_at_repeat=stop_at_repeat,
     )
     return HyperparameterFit(
         SquaredExponential(sf, ls, sn),

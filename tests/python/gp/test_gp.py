@@ -126,6 +126,34 @@ def test_hilbert_gp_approaches_the_exact_gp(data):
     assert np.abs(coarse.predict(q[inside])[0] - e_mean).max() > np.abs(h_mean - e_mean).max()
 
 
+def test_restarts_stop_once_a_start_ends_at_an_earlier_optimum(data):
+    """The stop at a repeated optimum against the full search with the same seed: the starts it
+    makes are the full search's first ones, to the same values; the last of them repeats an
+    earlier one's log marginal likelihood (to 1e-6) and none before it does; the optimum is the
+    full search's, for fewer likelihood evaluations. Its control: starts cut to one L-BFGS
+    iteration end at different points, so every restart is made."""
+    x, y, _ = data
+    full = fit_hyperparameters(x, y, restarts=6, seed=3, stop_at_repeat=False)
+    stopped = fit_hyperparameters(x, y, restarts=6, seed=3)
+    made = len(stopped.start_values)
+    assert len(full.start_values) == 8  # the data's start, the scan's best, 6 random
+    assert 2 <= made < 8
+    np.testing.assert_allclose(stopped.start_values, full.start_values[:made], rtol=1e-12)
+
+    def same(a, b):
+        return abs(a - b) <= 1e-6 * max(abs(b), 1.0)
+
+    values = stopped.start_values
+    assert any(same(values[-1], v) for v in values[:-1])
+    assert not any(same(values[i], v) for i in range(1, made - 1) for v in values[:i])
+    assert stopped.log_marginal_likelihood == pytest.approx(
+        full.log_marginal_likelihood, rel=1e-8
+    )
+    assert stopped.evaluations < full.evaluations
+    short = fit_hyperparameters(x, y, restarts=6, seed=3, max_iterations=1)
+    assert len(short.start_values) == 8
+
+
 @pytest.mark.parametrize(
     ("x", "y", "message"),
     [
@@ -152,5 +180,7 @@ def test_bad_kernels_and_options_are_refused(data):
         ExactGP.fit(x, y, SquaredExponential(1.0, 0.5, 0.1)).predict(np.zeros((2, 3)))
     with pytest.raises(ValueError, match="outside the domain"):
         HilbertGP.fit(x, y, SquaredExponential(1.0, 0.5, 0.1), domain=([0.5, 0.5], [2.0, 2.0]))
+    with pytest.raises(ValueError, match="stop_at_repeat must be True or False"):
+        fit_hyperparameters(x, y, stop_at_repeat=1)
     with pytest.raises(ValueError, match="more than 10 basis functions"):
         HilbertGP.fit(x, y, SquaredExponential(1.0, 0.1, 0.1), max_basis=10)

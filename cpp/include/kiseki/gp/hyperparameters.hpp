@@ -29,7 +29,14 @@ LogMarginalLikelihood log_marginal_likelihood(const Eigen::Ref<const RowMatrix>&
                                               const SquaredExponential& kernel);
 
 struct HyperparameterOptions {
-  int restarts = 3;           ///< random starts after the first
+  int restarts = 3;           ///< random starts after the first (at most; see stop_at_repeat)
+  /// The random starts stop once a start ends where an earlier one ended (the same log marginal
+  /// likelihood to repeat_tolerance of its size and every log-parameter within
+  /// repeat_parameter_tolerance): a second arrival at one optimum from another start is what
+  /// the restarts are run to learn, and every further start costs as much as the first.
+  bool stop_at_repeat = true;
+  double repeat_tolerance = 1e-6;
+  double repeat_parameter_tolerance = 0.01;  ///< in log-parameters: 1 % of each value
   std::uint64_t seed = 0;     ///< for the random starts
   int max_iterations = 100;   ///< BFGS iterations per start
   /// The coarse scan as a start (18 values). Off for a refinement from a start known to be near
@@ -46,14 +53,15 @@ struct HyperparameterFit {
   double log_marginal_likelihood = 0.0;
   int evaluations = 0;                  ///< likelihood values (one Cholesky factorisation each), all starts
   int gradients = 0;                    ///< of which also with the gradient (the inverse as well)
-  std::vector<double> start_values;     ///< the best LML reached from each start
+  std::vector<double> start_values;     ///< the best LML reached from each start made
 };
 
 /// Maximises eq. 6.11 over (sigma_f, l, sigma_n) by projected BFGS in log-parameters with a
 /// backtracking line search on likelihood values (the gradient only at accepted points), from
 /// `initial`, from the best point of a coarse scan of length scales and noise levels (18 values;
-/// skipped as a start when it is `initial`; not made without `options.scan`), and from `restarts` random starts (log-uniform
-/// within the bounds below, drawn from kiseki::Random(seed)); the best start wins. Bounds, from the
+/// skipped as a start when it is `initial`; not made without `options.scan`), and from up to `restarts` random starts
+/// (log-uniform within the bounds below, drawn from kiseki::Random(seed); with
+/// `options.stop_at_repeat`, none after a start that ends at an earlier start's optimum); the best start wins. Bounds, from the
 /// data: sigma_f and sigma_n in [1e-6, 1e3] x the targets' RMS, l in [1e-3, 1e2] x the inputs'
 /// largest extent. Targets are used as given (remove a mean first).
 HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
