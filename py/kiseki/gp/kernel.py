@@ -70,7 +70,7 @@ class HyperparameterFit:
     log_marginal_likelihood: float  # at the optimum, on the points used
     evaluations: int  # likelihood values (one Cholesky factorisation each)
     gradients: int  # of which also with the gradient (two more n^3 / 3 each)
-    start_values: tuple[float, ...]  # the best likelihood reached from each start
+    start_values: tuple[float, ...]  # the best likelihood reached from each start made
     points_used: int
     # a refinement's (refine_hyperparameters): the subsample's fit it started from
     refined_from: HyperparameterFit | None = None
