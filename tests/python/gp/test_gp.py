@@ -146,9 +146,7 @@ def test_restarts_stop_once_a_start_ends_at_an_earlier_optimum(data):
     values = stopped.start_values
     assert any(same(values[-1], v) for v in values[:-1])
     assert not any(same(values[i], v) for i in range(1, made - 1) for v in values[:i])
-    assert stopped.log_marginal_likelihood == pytest.approx(
-        full.log_marginal_likelihood, rel=1e-8
-    )
+    assert stopped.log_marginal_likelihood == pytest.approx(full.log_marginal_likelihood, rel=1e-8)
     assert stopped.evaluations < full.evaluations
     short = fit_hyperparameters(x, y, restarts=6, seed=3, max_iterations=1)
     assert len(short.start_values) == 8
