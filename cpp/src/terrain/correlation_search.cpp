@@ -75,10 +75,9 @@ struct CorrelationSearch::Scratch {
   std::vector<std::uint32_t> kept;  ///< the points that may land in a cell with data (exhaustive)
   std::vector<float> x, y, z;       ///< those points
   std::vector<int> bounds;
-  std::vector<float> range, w;  ///< per slot, for eq. 4's sums
   Scratch(std::size_t slots, std::size_t points)
       : zbuffer(slots + kDummySlots, kInf), cell(points), range_of(points), kept(points),
-        x(points), y(points), z(points), range(slots), w(slots) {
+        x(points), y(points), z(points) {
     std::fill(zbuffer.begin() + static_cast<std::ptrdiff_t>(slots), zbuffer.end(), -kInf);
   }
 };
@@ -175,8 +174,7 @@ double CorrelationSearch::score(const Level& level, float cx, float cy, float cz
     nearest = std::min(nearest, s.range_of[i]);
   }
   // Eq. 4 over the cells with data in both maps, in the slots' (the cells') order.
-  const Eq4Sums terms = eq4_sums(zbuffer, level.current.data(), level.weight.data(), level.current.size(),
-                                 s.range.data(), s.w.data());
+  const Eq4Sums terms = eq4_sums(zbuffer, level.current.data(), level.weight.data(), level.current.size());
   const double sum = terms.sum, weights = terms.weights;
   const std::size_t shared = terms.shared;
   if (overlap) *overlap = shared;

@@ -45,13 +45,11 @@ std::size_t points_that_may_land(const float* px, const float* py, const float* 
 /// Eq. 4's sums over the slots of the cells with data, given the virtual map's nearest range
 /// per slot (+inf where no point landed): sum of (r_v - r_cur)^2 w, sum of w, and the slots
 /// with a point. `slots` is a multiple of 8; slot j adds to lane j % 8 of the sums and the lanes
-/// are added last, so the result does not depend on the thread count. Resets the slots to +inf;
-/// `range` and `w` are scratch of `slots`.
+/// are added last, so the result does not depend on the thread count. Resets the slots to +inf.
 struct Eq4Sums {
   double sum = 0, weights = 0;
   std::size_t shared = 0;
 };
-Eq4Sums eq4_sums(float* zbuffer, const float* current, const float* weight, std::size_t slots, float* range,
-                 float* w);
+Eq4Sums eq4_sums(float* zbuffer, const float* current, const float* weight, std::size_t slots);
 
 }  // namespace kiseki
