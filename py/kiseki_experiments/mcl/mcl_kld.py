@@ -200,10 +200,11 @@ EXPERIMENT = Experiment(
     config_type=KldConfig,
     trial=trial,
     analyze=analyze,
-    # 6 seeds per log: at 5 (the fewest an interval is computed from) the report asked 6 per
-    # log to decide Intel's claim (issue 29: the default trials decide at least 80 % of the
-    # claims)
-    default_runs=12,
+    # 24 seeds per log. The accuracy claim is a mean over seeds, and a lost seed is rare (Intel:
+    # 1 of 6, 7.6 m); its bootstrap interval clears the criterion only when a resample without
+    # the lost seed is rarer than 2.5 %: (5/6)^n < 0.025, n >= 21 (the report's estimate, 7,
+    # scales the interval's width by 1/sqrt(n), which a rare large value does not follow).
+    default_runs=48,
     preflight=preflight,
     claims=CLAIMS,
 )
