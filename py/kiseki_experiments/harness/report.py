@@ -111,8 +111,8 @@ def _mean_trial_seconds(timings: pd.DataFrame | None) -> float:
 
 
 def _undecided(claims: pd.DataFrame, runs: int, timings: pd.DataFrame | None) -> list[str]:
-    """For each inconclusive claim: the trials that would decide it (its interval's half-width
-    scaling as 1/sqrt(n)) and their wall time at the run's mean trial time (one core)."""
+    """For each inconclusive claim: the trials that would decide it (verdict.trials_to_decide)
+    and their wall time at the run's mean trial time (one core)."""
     rows = claims[claims["verdict"].astype(str).eq("inconclusive")]
     if rows.empty:
         return []

@@ -43,6 +43,12 @@ __all__ = [
 BOOTSTRAP_RESAMPLES = 4000
 """Resamples of a percentile bootstrap: the 2.5 % and 97.5 % quantiles of 4000 resampled means
 move by well under a tenth of the interval's width between generators."""
+SEARCH_RESAMPLES = 1000
+"""Resamples per trial count tried when searching the trials that would decide a claim: an
+estimate, so fewer than the interval's own."""
+MOST_TRIALS = 10_000
+"""The most trials that search tries for per-trial values: a claim no count up to it decides
+sits on its threshold for any run kiseki would make."""
 MIN_TRIALS = 5
 """Fewest per-trial values a bootstrap interval is computed from: below it the resamples take
 too few distinct values and the interval is far too narrow (no verdict, ``inconclusive``)."""
@@ -169,8 +175,11 @@ class Estimate:
 def _generator(seed: int, evidence: Evidence) -> np.random.Generator:
     """One generator per (run seed, claim, subject): a claim's interval does not depend on
     which other claims were judged before it."""
-    tag = zlib.crc32(f"{evidence.key}\0{evidence.subject}".encode())
-    return np.random.default_rng([int(seed) % 2**63, tag])
+    return np.random.default_rng([int(seed) % 2**63, _tag(evidence)])
+
+
+def _tag(evidence: Evidence) -> int:
+    return zlib.crc32(f"{evidence.key}\0{evidence.subject}".encode())
 
 
 def estimate(evidence: Evidence, seed: int) -> Estimate:
@@ -208,19 +217,30 @@ def decide(criterion: Criterion, est: Estimate) -> Outcome:
     return "inconclusive"
 
 
-def trials_to_decide(criterion: Criterion, est: Estimate) -> int | None:
-    """Trials that would decide an undecided claim, from the interval's half-width h at n
-    trials scaling as 1/sqrt(n): n * (h / d)^2, d the distance from the value to the nearest
-    edge of the criterion's band and h the interval's arm on that side (the interval must shrink
-    inside the band, or away from it); for a share, the Wilson interval at the same share,
-    searched. An estimate: the value itself moves with more trials. None
-    when the value sits on an edge (d = 0: no number of trials decides it)."""
+def trials_to_decide(
+    criterion: Criterion, est: Estimate, evidence: Evidence | None = None, seed: int = 0
+) -> int | None:
+    """Trials that would decide an undecided claim. An estimate: the value itself moves with
+    more trials. None when no count decides it (the value sits on an edge of the band).
+
+    * a share: the fewest trials whose Wilson interval at the same share is decided (searched);
+    * per-trial values given (``evidence``): the fewest trials m whose bootstrap interval, of m
+      values drawn from the ones measured, is decided (searched up to :data:`MOST_TRIALS`). A
+      rare large value (a lost seed among tracked ones) keeps the interval wide until a
+      resample without it is rarer than 2.5 %, which no 1/sqrt(n) scaling foresees;
+    * an interval alone: its half-width h at n trials scaling as 1/sqrt(n): n * (h / d)^2, d
+      the distance from the value to the nearest edge of the criterion's band and h the
+      interval's arm on that side (the interval must shrink inside the band, or away from it).
+    """
     if est.n == 0 or math.isnan(est.value):
         return None
     if est.share:
-        return _share_trials(criterion, est)
+        return _searched(est.n, _share_decides(criterion, est), 10**7)
     if math.isnan(est.low):  # too few trials for an interval
         return MIN_TRIALS
+    if evidence is not None and evidence.values:
+        decided = _bootstrap_decides(criterion, est, evidence, seed)
+        return _searched(est.n, decided, MOST_TRIALS)
     a, b = criterion.band()
     edge = a if abs(est.value - a) <= abs(est.value - b) else b
     d = abs(est.value - edge)
@@ -231,15 +251,43 @@ def trials_to_decide(criterion: Criterion, est: Estimate) -> int | None:
     return max(est.n + 1, math.ceil(est.n * (half / d) ** 2))
 
 
-def _share_trials(criterion: Criterion, est: Estimate, most: int = 10**7) -> int | None:
-    """For a share, the fewest trials whose Wilson interval at the same share is decided
-    (found by doubling, then bisection): a share at 0 or 1 narrows as 1/n, not 1/sqrt(n)."""
+def _share_decides(criterion: Criterion, est: Estimate):
+    """Whether m trials at the same share decide the claim (a share at 0 or 1 narrows as 1/m,
+    not 1/sqrt(m))."""
 
     def decided(m: int) -> bool:
         low, high = wilson_interval(round(est.value * m), m)
         return decide(criterion, Estimate(est.value, low, high, m)) != "inconclusive"
 
-    low, high = est.n, max(est.n + 1, 2 * est.n)
+    return decided
+
+
+def _bootstrap_decides(criterion: Criterion, est: Estimate, evidence: Evidence, seed: int):
+    """Whether the bootstrap interval of m values drawn from the measured ones decides the
+    claim; each m with its own generator (from the run's seed), so the answer is reproducible."""
+    x = np.asarray(evidence.values, dtype=float)
+    x = x[~np.isnan(x)]
+    stat = np.median if evidence.statistic == "median" else np.mean
+
+    def decided(m: int) -> bool:
+        rng = np.random.default_rng([int(seed) % 2**63, _tag(evidence), m])
+        rows = max(1, 10**6 // m)  # resamples per block: about a million draws at a time
+        stats = np.concatenate(
+            [
+                stat(x[rng.integers(0, x.size, (min(rows, SEARCH_RESAMPLES - k), m))], axis=1)
+                for k in range(0, SEARCH_RESAMPLES, rows)
+            ]
+        )
+        low, high = np.quantile(stats, [0.025, 0.975], method="inverted_cdf")
+        return decide(criterion, Estimate(est.value, float(low), float(high), m)) != "inconclusive"
+
+    return decided
+
+
+def _searched(n: int, decided, most: int) -> int | None:
+    """The fewest trials m > n with decided(m), found by doubling, then bisection; None when
+    no m up to ``most`` decides it."""
+    low, high = n, max(n + 1, 2 * n)
     while not decided(high):
         low, high = high, 2 * high
         if high > most:
@@ -285,7 +333,7 @@ def judge(specs: tuple[ClaimSpec, ...], evidence: list[Evidence], seed: int) -> 
         spec = by_key[e.key]
         est = estimate(e, seed)
         outcome = decide(spec.criterion, est)
-        more = trials_to_decide(spec.criterion, est) if outcome == "inconclusive" else None
+        more = trials_to_decide(spec.criterion, est, e, seed) if outcome == "inconclusive" else None
         shown = f"{est.value:.4g}" + (f" ({e.shown})" if e.shown else "")
         out.append(
             Verdict(

@@ -6,6 +6,7 @@ trials that would decide an undecided claim, and how the reports count and show 
 from __future__ import annotations
 
 import math
+from statistics import NormalDist
 
 import numpy as np
 import pandas as pd
@@ -79,6 +80,39 @@ def test_trials_to_decide_scale_the_half_width_as_one_over_sqrt_n():
         assert decide(AT_LEAST, estimate(share, 0)) == verdict, (m, need)
     target = Criterion("0.95", ">=", 0.95, "the issue's target", bounds=(0.0, 1.0))
     assert trials_to_decide(target, estimate(Evidence.share("k", 10, 10), 0)) == 73
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_trials_to_decide_from_the_values_follow_the_normal_scaling(seed):
+    # 20 values at the quantiles of N(0.55, 0.2) against >= 0.5 (an interval of about +-0.09):
+    # the bootstrap search and the 1/sqrt(n) scaling of the interval's arm estimate the same
+    # count, about 20 (0.09 / 0.05)^2 = 65
+    x = [NormalDist(0.55, 0.2).inv_cdf((i + 0.5) / 20) for i in range(20)]
+    evidence = Evidence.of("k", x)
+    est = estimate(evidence, seed)
+    assert decide(AT_LEAST, est) == "inconclusive"
+    scaled = trials_to_decide(AT_LEAST, est)
+    searched = trials_to_decide(AT_LEAST, est, evidence, seed)
+    assert searched == pytest.approx(scaled, rel=0.3)
+    assert trials_to_decide(AT_LEAST, est, evidence, seed) == searched  # one seed, one result
+
+
+def test_trials_to_decide_a_mean_with_a_rare_large_value():
+    # five tracked seeds and one lost (7.6 m) against <= 0.05: the interval's low end stays
+    # near the tracked seeds' mean while a resample without the lost seed is more likely than
+    # 2.5 %: (5/6)^m < 0.025 from m = 21 on; the 1/sqrt(n) scaling of the arm asks for 7
+    values = [0.002, 7.59, 0.0017, 0.0022, 0.0027, 0.0015]
+    within = Criterion("0", "<=", 0.05, "a test's tolerance")
+    evidence = Evidence.of("k", values)
+    est = estimate(evidence, 0)
+    assert decide(within, est) == "inconclusive"
+    closed_form = next(m for m in range(6, 100) if (5 / 6) ** m < 0.025)
+    assert closed_form == 21
+    assert trials_to_decide(within, est) < 10
+    assert abs(trials_to_decide(within, est, evidence, 0) - closed_form) <= 3
+    # a value on the edge: no count decides it
+    on_edge = Evidence.of("k", [0.04, 0.06] * 5)
+    assert trials_to_decide(within, estimate(on_edge, 0), on_edge, 0) is None
 
 
 def _experiment(claims=()) -> base.Experiment:
