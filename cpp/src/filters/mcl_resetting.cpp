@@ -100,9 +100,11 @@ std::vector<Pose2> MonteCarloLocalization::reset_candidates(const ScanView* scan
                                  params_.likelihood_power, rng_);
 }
 
+std::size_t MonteCarloLocalization::drawn_from_sensor() const {
+  return static_cast<std::size_t>(std::llround(params_.sensor_reset_share * static_cast<double>(particles_.size())));
+}
+
 bool MonteCarloLocalization::sensor_reset(const SensorModel& model, const CloudScore& cloud, const ScanView* scan) {
-  const std::size_t n = particles_.size();
-  const auto from_sensor = static_cast<std::size_t>(std::llround(params_.sensor_reset_share * static_cast<double>(n)));
   double searched = 1.0;
   const std::vector<Pose2> candidates = reset_candidates(scan, searched);
   if (candidates.empty()) return false;
@@ -121,7 +123,7 @@ bool MonteCarloLocalization::sensor_reset(const SensorModel& model, const CloudS
     std::vector<double> w(candidates.size(), 1.0);
     if (!apply_log_likelihoods(w, cand_l, params_.likelihood_power)) w.assign(w.size(), 1.0);
     challenger_.clear();
-    for (std::size_t i : resample_indices(w, std::max<std::size_t>(from_sensor, 1), params_.resampling, rng_)) {
+    for (std::size_t i : resample_indices(w, std::max<std::size_t>(drawn_from_sensor(), 1), params_.resampling, rng_)) {
       challenger_.push_back(candidates[i]);
     }
     return false;
@@ -144,8 +146,7 @@ bool MonteCarloLocalization::confirm_challenger(const SensorModel& model, const 
 
 void MonteCarloLocalization::mix_in(const SensorModel& model, const std::vector<Pose2>& proposed,
                                     const std::vector<double>& log_l) {
-  const std::size_t n = particles_.size();
-  const auto from_sensor = static_cast<std::size_t>(std::llround(params_.sensor_reset_share * static_cast<double>(n)));
+  const std::size_t n = particles_.size(), from_sensor = drawn_from_sensor();
   std::vector<double> w(proposed.size(), 1.0);
   std::vector<Pose2> out;
   out.reserve(n);

@@ -205,6 +205,8 @@ class MonteCarloLocalization {
   bool sensor_reset(const SensorModel& model, const CloudScore& cloud, const ScanView* scan);
   /// The confirmation of a held sensor reset on this update's measurement (and its end).
   bool confirm_challenger(const SensorModel& model, const CloudScore& cloud);
+  /// The particles a sensor reset draws from the proposed poses: sensor_reset_share of the cloud.
+  std::size_t drawn_from_sensor() const;
   /// Replaces the cloud by its resampled part and the proposed poses drawn by their weights.
   void mix_in(const SensorModel& model, const std::vector<Pose2>& proposed, const std::vector<double>& log_l);
   std::vector<Pose2> reset_candidates(const ScanView* scan, double& searched);
