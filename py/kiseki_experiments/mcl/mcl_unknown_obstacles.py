@@ -250,7 +250,7 @@ def _table(config: UnknownObstaclesConfig, ok: pd.DataFrame) -> pd.DataFrame:
 def _plot(config: UnknownObstaclesConfig, table: pd.DataFrame, figures: Path) -> Path:
     logs = list(dict.fromkeys(table["log"]))
     rows = len(config.recoveries)
-    fig = new_figure(figsize=(3.2 * len(logs), 3.0 * rows), dpi=120)
+    fig = new_figure(figsize=(3.2 * len(logs), 3.0 * rows), dpi=120, layout="constrained")
     axes = fig.subplots(rows, len(logs), squeeze=False)
     for i, recovery in enumerate(config.recoveries):
         for j, log in enumerate(logs):
