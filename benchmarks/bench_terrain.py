@@ -6,9 +6,9 @@ asserted). Data: the first two stops of ``kiseki terrain run data/worlds/rubble_
 removed by the paper's Hough step.
 
 * exhaustive search over the paper's 56,916 candidates (x 0..70, y -50..50, z -30..30 cm,
-  2 cm) on every core, median of 3 (goal < 0.5 s on 2 cores), against a straightforward numpy version of
-  eq. 4 (per candidate: reproject every kept point, nearest per cell, compare), timed on 40
-  candidates and scaled to the grid (goal: kiseki >= 100x), both goals on one line;
+  2 cm) on every core, median of 3 (goal < 0.5 s on 2 cores), against a straightforward numpy
+  version of eq. 4 (per candidate: reproject every kept point, nearest per cell, compare),
+  timed on 40 candidates and scaled to the grid (goal: kiseki >= 100x), both goals on one line;
 * coarse to fine (goal < 50 ms, the same minimum);
 * PCL's ICP and GICP on the same pair from the same initial guess (no motion);
 * OctoMap insertion of one sweep (27,331 rays, 5 m cut): kiseki's GlobalVoxelMap.insert
