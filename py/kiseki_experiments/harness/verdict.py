@@ -26,6 +26,8 @@ from kiseki.metrics import wilson_interval
 __all__ = [
     "BOOTSTRAP_RESAMPLES",
     "MIN_TRIALS",
+    "MOST_TRIALS",
+    "SEARCH_RESAMPLES",
     "UNMIGRATED",
     "VERDICT_COLUMNS",
     "ClaimSpec",
