@@ -190,20 +190,39 @@ def estimate(evidence: Evidence, seed: int) -> Estimate:
         k, n = int(evidence.successes or 0), int(evidence.trials)
         low, high = wilson_interval(k, n)
         return Estimate(k / n if n else math.nan, low, high, n, share=True)
-    x = np.asarray(evidence.values, dtype=float)
-    x = x[~np.isnan(x)]  # an infinite value (never back, never converged) stays and counts
-    stat = np.median if evidence.statistic == "median" else np.mean
+    x, stat = _values(evidence)
     if x.size == 0:
         return Estimate(math.nan, math.nan, math.nan, 0)
     value = float(stat(x))
     if x.size < MIN_TRIALS:
         return Estimate(value, math.nan, math.nan, int(x.size))
-    picks = _generator(seed, evidence).integers(0, x.size, (BOOTSTRAP_RESAMPLES, x.size))
-    resampled = stat(x[picks], axis=1)
-    # the empirical quantiles themselves (no interpolation between resamples: an infinite
-    # value, never back or never converged, gives an infinite end, not inf - inf)
+    low, high = _percentile_interval(
+        x, stat, x.size, BOOTSTRAP_RESAMPLES, _generator(seed, evidence)
+    )
+    return Estimate(value, low, high, int(x.size))
+
+
+def _values(evidence: Evidence):
+    """The per-trial values (an infinite one, never back or never converged, stays and counts)
+    and the statistic over them."""
+    x = np.asarray(evidence.values, dtype=float)
+    return x[~np.isnan(x)], np.median if evidence.statistic == "median" else np.mean
+
+
+def _percentile_interval(x, stat, size: int, resamples: int, rng) -> tuple[float, float]:
+    """The percentile bootstrap's 95 % interval of ``stat`` over ``resamples`` samples of
+    ``size`` values drawn from ``x``: the empirical quantiles themselves (no interpolation
+    between resamples: an infinite value gives an infinite end, not inf - inf). Drawn in blocks
+    of about four million values; up to 1,000 values at 4,000 resamples that is one draw."""
+    rows = max(1, 4 * 10**6 // size)
+    resampled = np.concatenate(
+        [
+            stat(x[rng.integers(0, x.size, (min(rows, resamples - k), size))], axis=1)
+            for k in range(0, resamples, rows)
+        ]
+    )
     low, high = np.quantile(resampled, [0.025, 0.975], method="inverted_cdf")
-    return Estimate(value, float(low), float(high), int(x.size))
+    return float(low), float(high)
 
 
 def decide(criterion: Criterion, est: Estimate) -> Outcome:
@@ -267,21 +286,12 @@ def _share_decides(criterion: Criterion, est: Estimate):
 def _bootstrap_decides(criterion: Criterion, est: Estimate, evidence: Evidence, seed: int):
     """Whether the bootstrap interval of m values drawn from the measured ones decides the
     claim; each m with its own generator (from the run's seed), so the answer is reproducible."""
-    x = np.asarray(evidence.values, dtype=float)
-    x = x[~np.isnan(x)]
-    stat = np.median if evidence.statistic == "median" else np.mean
+    x, stat = _values(evidence)
 
     def decided(m: int) -> bool:
         rng = np.random.default_rng([int(seed) % 2**63, _tag(evidence), m])
-        rows = max(1, 10**6 // m)  # resamples per block: about a million draws at a time
-        stats = np.concatenate(
-            [
-                stat(x[rng.integers(0, x.size, (min(rows, SEARCH_RESAMPLES - k), m))], axis=1)
-                for k in range(0, SEARCH_RESAMPLES, rows)
-            ]
-        )
-        low, high = np.quantile(stats, [0.025, 0.975], method="inverted_cdf")
-        return decide(criterion, Estimate(est.value, float(low), float(high), m)) != "inconclusive"
+        low, high = _percentile_interval(x, stat, m, SEARCH_RESAMPLES, rng)
+        return decide(criterion, Estimate(est.value, low, high, m)) != "inconclusive"
 
     return decided
 
