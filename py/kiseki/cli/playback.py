@@ -22,6 +22,7 @@ from kiseki.io.ros_map import load_map
 from kiseki.sim.scene import load_scene
 from kiseki.speed import SpeedLimiter, SpeedLimiterConfig
 from kiseki.teach.local_maps import METHODS
+from kiseki.teach.route_check import read_travelled
 from kiseki.teach.scene_identity import check_scene, taught_scene_of
 
 __all__ = ["app"]
@@ -99,7 +100,10 @@ def playback_command(
         raise FileExistsError(f"--log {log} exists; give a new file")
     scene, environment = load_scene(scene_file, "playback"), load_map(map_path)
     limiter = _speed_limiter(speed_limit, scene, environment, config.speed)
-    result = playback(scene, environment, marks, config, limiter, log, taught_scene, variant)
+    travelled = read_travelled(waypoints)  # the teaching log's odometry (None without it)
+    result = playback(
+        scene, environment, marks, config, limiter, log, taught_scene, variant, travelled
+    )
     console.print(_stop_summary(method, result, marks[-1]))
     if variant is not None:
         console.print(

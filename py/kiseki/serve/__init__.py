@@ -123,7 +123,9 @@ def build_server(
     if not all("truth" in w for w in taught.waypoints):
         raise ValueError(f"{taught.path}: waypoints without their taught truth (not simulated)")
     config = replace(PlaybackConfig(), method=method, particles=particles, seed=seed)
-    robot = SimulatedAgv(load_scene(scene_file, "playback"), taught.environment, config)
+    robot = SimulatedAgv(
+        load_scene(scene_file, "playback"), taught.environment, config, travelled=taught.travelled
+    )
     runner = RouteRunner(robot, taught, dwell, speed_up, finished)
     app = create_app(taught, runner, token, static, loopback_hosts(host, port))
     return Server(app, runner, taught, scene_file)

@@ -16,6 +16,7 @@ import numpy as np
 from kiseki.apps.teach.playback import PlaybackConfig, PlaybackRun
 from kiseki.grid import OccupancyGrid
 from kiseki.sim.scene import Scene
+from kiseki.sim.setup import build_robot
 
 __all__ = ["Robot", "RobotState", "SimulatedAgv"]
 
@@ -40,6 +41,7 @@ class Robot(Protocol):
     """What the server needs of a robot."""
 
     dt: float  # s, the control period
+    footprint: tuple[float, float]  # m, (length, width): the route check's robot body
 
     def start(self, waypoints: list[dict]) -> None:
         """Begins following the route through `waypoints` (taught marks, map frame)."""
@@ -67,8 +69,11 @@ class SimulatedAgv:
         environment: OccupancyGrid,
         config: PlaybackConfig | None = None,
         particles_shown: int = 200,
+        travelled: np.ndarray | None = None,
     ) -> None:
-        self.scene, self.environment = scene, environment
+        self.scene, self.environment, self.travelled = scene, environment, travelled
+        setup = build_robot(scene, 0)
+        self.footprint = (setup.length, setup.width)  # for the route check
         self.config = config or PlaybackConfig()
         self.dt = self.config.dt
         self.particles_shown = particles_shown
@@ -82,7 +87,9 @@ class SimulatedAgv:
         if self.run is not None and self.resting_at == waypoints[0].get("id"):
             self.run.follow(waypoints)
         else:
-            self.run = PlaybackRun(self.scene, self.environment, waypoints, self.config)
+            self.run = PlaybackRun(
+                self.scene, self.environment, waypoints, self.config, travelled=self.travelled
+            )
         self.resting_at = None
         self._state = self._snapshot()
 

@@ -156,8 +156,10 @@ class RouteRunner:
         out_marks = [self.taught.by_name(n) for n in names]
         back_marks = [self.taught.by_name(n) for n in back]
         try:
-            check_route(self.taught.environment, out_marks)
-            check_route(self.taught.environment, back_marks)
+            for marks in (out_marks, back_marks):
+                check_route(
+                    self.taught.environment, marks, self.taught.travelled, self.robot.footprint
+                )
         except ValueError as err:
             raise RouteRefusedError(str(err)) from None
         return {"out": out_marks, "back": back_marks}

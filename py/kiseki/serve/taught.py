@@ -23,6 +23,7 @@ from kiseki.grid import OccupancyGrid
 from kiseki.io.ros_map import load_map, write_image
 from kiseki.io.runlog import read_run
 from kiseki.teach.local_maps import METHODS
+from kiseki.teach.route_check import read_travelled
 from kiseki.teach.waypoint_schema import MAX_NAME_LENGTH, read_waypoint_file
 
 __all__ = ["NAME_RULE", "TaughtRun", "WaypointError", "taught_scene"]
@@ -74,6 +75,7 @@ class TaughtRun:
         self.map_path, _ = load_route(self.path, self.band, names)  # checks the map's SHA-1
         self.environment: OccupancyGrid = load_map(self.map_path)
         self.waypoints: list[dict] = [dict(w) for w in doc["waypoints"]]
+        self.travelled = read_travelled(self.path)  # the teaching run's odometry poses, or None
         self._lock = threading.Lock()
         self._png: bytes | None = None
 

@@ -38,7 +38,7 @@ from kiseki_experiments.teach import teach_playback as tp
 from kiseki_experiments.teach.layouts_config import LayoutsConfig, experiment_configs
 from kiseki_experiments.teach.layouts_report import analyze
 
-REFUSED = "crosses occupied space"  # kiseki.apps.teach.playback.check_route's refusal
+REFUSED = "crosses occupied space"  # kiseki.teach.route_check.check_route's refusal
 
 
 def _run(cfg, index: int, seed: int, prefix: str, refusals: bool = True, taught=None) -> dict:
@@ -101,8 +101,8 @@ def trial(config: LayoutsConfig, index: int, seed: int) -> TrialOutput:
 
 # exp2-turn's claims judged on the runs of all layouts together; their control plays the
 # proposals as conventional (cheap: one run per layout, no boxes, few particles) on 6
-# layouts: the first 5 of seed 0 hold one whose route playback refuses, and an interval needs
-# 5 runs with stops; 6 layouts, each taught and played back: 63 s beside another test
+# layouts: an interval needs 5 runs with stops, and one more stands in for a refused route
+# (layout 3's, before the route check knew the taught poses); each taught and played back
 CLAIMS = tuple(
     replace(
         spec,

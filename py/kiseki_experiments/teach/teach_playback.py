@@ -33,6 +33,7 @@ from kiseki.io.ros_map import load_map
 from kiseki.sim.scene import load_scene
 from kiseki.teach.environment_map import MERGE_RULES
 from kiseki.teach.local_maps import METHODS
+from kiseki.teach.route_check import travelled_poses
 from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.verdict import Evidence
 from kiseki_experiments.teach.teach_boxes import (  # noqa: F401 (tp.BOX_*)
@@ -120,25 +121,27 @@ def trial(config: Exp1Config, index: int, seed: int, taught=None) -> TrialOutput
         before = taught.marks[-2] if len(taught.marks) > 1 else goal
         record["final_leg_m"] = math.hypot(goal["x"] - before["x"], goal["y"] - before["y"])
         played, runs = stand_ins(config), {}
+        travelled = travelled_poses(taught.log)
         for method in methods:
             actual = played.get(method, method)  # a negative control plays another method
             if actual not in runs:  # a method played twice on one seed is the same run
-                runs[actual] = _play(config, scene, maps, taught, actual, seed)
+                runs[actual] = _play(config, scene, maps, taught, actual, seed, travelled)
             identity, out = runs[actual]
             record.update(identity)
             record.update({f"{method}_{k}": v for k, v in out.items()})
             if getattr(config, "ray", False):
-                _, ray = _play(config, scene, maps, taught, actual, seed, RAY_MODEL)
+                _, ray = _play(config, scene, maps, taught, actual, seed, travelled, RAY_MODEL)
                 record.update({f"{method}_ray_{k}": v for k, v in ray.items()})
     return TrialOutput(record)
 
 
 def _play(
-    config, scene, maps, taught, method: str, seed: int, model: str = "space-observation"
+    config, scene, maps, taught, method: str, seed: int, travelled, model: str = "space-observation"
 ) -> tuple[dict, dict]:
     """One playback of `method` on the trial's taught maps (and, with boxes and the thesis'
     model, the same run without them): which scene it played in, and its record (keys without
-    the method). With kiseki's ray model (`model`), only the stop and estimate errors."""
+    the method). With kiseki's ray model (`model`), only the stop and estimate errors.
+    `travelled`: the teaching run's odometry poses, for the route check."""
     goal = taught.marks[-1]
     band, _ = METHODS[method]
     play = PlaybackConfig(
@@ -156,6 +159,7 @@ def _play(
         play,
         taught_scene=taught.scene,
         variant="exp3-boxes" if config.boxes else None,  # the copy with the boxes
+        travelled=travelled,
     )
     # which scene file it played in: its SHA-1 and the variant label of a changed copy
     identity = {
@@ -168,7 +172,9 @@ def _play(
     out.update(goal_profile(scene, maps[band], goal, method))
     if config.boxes:  # the control: the same run without the boxes
         plain = load_scene(Path(config.scene), "playback")
-        control = playback(plain, maps[band], taught.marks, play, taught_scene=taught.scene)
+        control = playback(
+            plain, maps[band], taught.marks, play, taught_scene=taught.scene, travelled=travelled
+        )
         for k, v in _errors(control, goal).items():
             if k.startswith("stop_"):
                 out[f"nobox_{k}"] = v

@@ -32,26 +32,10 @@ from kiseki.sim.scene import Scene
 from kiseki.sim.setup import SensorSetup, build_robot, build_sensors
 from kiseki.teach.local_maps import METHODS, LocalMapMaker, local_map_scan
 from kiseki.teach.playback_log import PlaybackLog
+from kiseki.teach.route_check import check_route
 from kiseki.teach.scene_identity import TaughtScene, check_scene
 
 __all__ = ["PlaybackConfig", "PlaybackResult", "PlaybackRun", "check_route", "playback"]
-
-
-def check_route(environment: OccupancyGrid, waypoints: list[dict]) -> None:
-    """Raises ValueError when a straight leg between consecutive waypoints crosses occupied
-    cells of the taught map (the robot follows the legs, so such a route is unreachable)."""
-    for a, b in zip(waypoints, waypoints[1:], strict=False):
-        length = math.hypot(b["x"] - a["x"], b["y"] - a["y"])
-        if length == 0:
-            continue
-        heading = math.atan2(b["y"] - a["y"], b["x"] - a["x"])
-        rng, hit, cell = environment.cast_ray(a["x"], a["y"], heading, max_range=length)
-        if hit and rng < length - environment.resolution:
-            x, y = environment.cell_to_world(np.array([cell], dtype=float))[0]
-            raise ValueError(
-                f"the route leg {a['name']} -> {b['name']} crosses occupied space "
-                f"at ({x:.2f}, {y:.2f}) m of the taught map"
-            )
 
 
 @dataclass(frozen=True)
@@ -140,6 +124,7 @@ def playback(
     log: str | os.PathLike | None = None,
     taught_scene: TaughtScene | None = None,
     variant: str | None = None,
+    travelled: np.ndarray | None = None,
 ) -> PlaybackResult:
     """Runs the route through `waypoints` (taught marks, map frame) in the scene; the follower's
     speed is capped by `speed_limiter` when given (the scene needs a laser), and the run is
@@ -149,10 +134,12 @@ def playback(
     `taught_scene` (a :class:`TeachResult`'s ``scene``) is the scene the route was taught in: a
     scene file whose bytes differ is refused (ValueError) unless `variant` labels the change;
     the scene's and the taught scene's SHA-1s and the label go into the log's metadata and the
-    result's ``scene_identity``."""
+    result's ``scene_identity``. `travelled` (the teaching run's odometry poses,
+    :func:`kiseki.teach.route_check.travelled_poses`) lets the route cross occupied cells of
+    the map that the robot's body covered while it was taught."""
     config = config or PlaybackConfig()
     identity = check_scene(taught_scene, scene.path, variant)
-    run = PlaybackRun(scene, environment, waypoints, config, speed_limiter)
+    run = PlaybackRun(scene, environment, waypoints, config, speed_limiter, travelled=travelled)
     meta = {
         **identity,
         "scene_file": str(scene.path),
@@ -190,9 +177,11 @@ class PlaybackRun:
         config: PlaybackConfig | None = None,
         speed_limiter: SpeedLimitSource | None = None,
         writer: PlaybackLog | None = None,
+        travelled: np.ndarray | None = None,
     ) -> None:
         self.config = config = config or PlaybackConfig()
-        _check_waypoints(environment, waypoints)
+        self.travelled = travelled
+        _need_start_and_goal(waypoints)
         band, occlusion = METHODS[config.method]
         if "truth" in waypoints[0]:  # in simulation the robot starts where the start was taught
             x, y, th = waypoints[0]["truth"]
@@ -204,6 +193,7 @@ class PlaybackRun:
             }
         self.scene, self.environment, self.writer = scene, environment, writer
         self.setup = build_robot(scene, derive_seed(config.seed, 1))
+        check_route(environment, waypoints, travelled, self._footprint())
         sensors = build_sensors(scene, self.setup, config.seed, config.dt)
         self.cameras = [s.device for s in sensors if s.kind == "depth_camera"]
         self.limiter = None
@@ -222,6 +212,9 @@ class PlaybackRun:
         start = waypoints[0]
         self.localizer.initialize((start["x"], start["y"], start["theta"]), config.initial_sd)
         self._begin(waypoints)
+
+    def _footprint(self) -> tuple[float, float]:
+        return (self.setup.length, self.setup.width)
 
     def _begin(self, waypoints: list[dict]) -> None:
         self.waypoints = list(waypoints)
@@ -244,7 +237,8 @@ class PlaybackRun:
         (the filter is not reset: the start waypoint should be where the robot is)."""
         if not self.done:
             raise ValueError("the robot is still on its route: stop it or let it finish first")
-        _check_waypoints(self.environment, waypoints)
+        _need_start_and_goal(waypoints)
+        check_route(self.environment, waypoints, self.travelled, self._footprint())
         self._begin(waypoints)
 
     @property
@@ -347,10 +341,9 @@ class PlaybackRun:
         )
 
 
-def _check_waypoints(environment: OccupancyGrid, waypoints: list[dict]) -> None:
+def _need_start_and_goal(waypoints: list[dict]) -> None:
     if len(waypoints) < 2:
         raise ValueError("a route needs a start and a goal waypoint")
-    check_route(environment, waypoints)
 
 
 class _ScanLimiter:
