@@ -14,8 +14,8 @@ meets the criterion, the share of layouts where it does (95 % Wilson interval: a
 not a verdict) and the maps of the layouts where it does not. Every simulation parameter
 (noise, particles, motion model) is the same for every method and every layout.
 
-    kiseki experiment run layouts-exp2-exp3 --workers 2      # 44 layouts x 2 runs, ~22 CPU-min
-    kiseki experiment run layouts-exp2-exp3 --set runs_per_layout=1 --workers 2   # ~11 CPU-min
+    kiseki experiment run layouts-exp2-exp3 --workers 2      # 150 layouts x 2 runs, ~50 min
+    kiseki experiment run layouts-exp2-exp3 --set runs_per_layout=1 --workers 2   # ~25 min
 
 A layout is regenerated from the seed in the per-layout table with
 ``kiseki.sim.layouts.generate_layout(seed)``. The config is in ``layouts_config``, the analysis
@@ -149,16 +149,17 @@ EXPERIMENT = Experiment(
     name="layouts-exp2-exp3",
     paper="000_7c5a0f8de3fa28f5.txt",
     artefact="Tables 4.5-4.7 across layouts",
-    description="Exp. 2 and Exp. 3 on 44 seeded factory layouts: share of layouts per claim",
+    description="Exp. 2 and Exp. 3 on seeded factory layouts (one per trial): share of layouts "
+    "per claim",
     config_type=LayoutsConfig,
     trial=trial,
     analyze=analyze,
-    # 70: at 44 layouts 3 of 7 claims were decided, and the report (the bootstrap search of
-    # verdict.trials_to_decide) asked 92-121 runs, 46-61 layouts at two runs each, for three
-    # more and 967 runs (484 layouts, 3.2 h on one core) for the fourth; 70 leave room for
-    # values that move with more layouts (issue 29: the default trials decide at least 80 % of
-    # the claims)
-    default_runs=70,
+    # 150: at 70 layouts (once the route check knew the taught poses, no route refused) 5 of 7
+    # claims were decided and the report (the bootstrap search of verdict.trials_to_decide)
+    # asked 297 runs, 149 layouts at two runs each, for Exp. 3's estimate error and 522 runs
+    # (261 layouts) for the last; at 150, 6 of 7 are decided (issue 29: the default trials
+    # decide at least 80 % of the claims). 50 min on two workers.
+    default_runs=150,
     preflight=_preflight,
     claims=CLAIMS,
 )

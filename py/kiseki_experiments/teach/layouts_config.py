@@ -17,9 +17,8 @@ __all__ = ["LayoutsConfig", "experiment_configs"]
 @dataclass(frozen=True)
 class LayoutsConfig:
     # Runs of each experiment per layout. The thesis' claims are means and counts over runs:
-    # 2 is the fewest with a mean over runs and an SD (Exp. 3). 20 layouts x 2 runs took 603 s
-    # on one core (1000 particles; a refused route makes exp2 run once per method), so the
-    # default 44 layouts take about 22 min; 3 runs per layout would take a third longer.
+    # 2 is the fewest with a mean over runs and an SD (Exp. 3). 150 layouts x 2 runs took
+    # 50 min on two workers (1000 particles); 3 runs per layout would take a third longer.
     runs_per_layout: Runs = 2
     methods: list[str] = field(
         default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
