@@ -45,7 +45,8 @@ snap() { mkdir "$OUT/$1"; tar -C "$DISK" --exclude=./filler -cf - . | tar -C "$O
 
 
 TIMEOUT = 600  # s, for any one command: a hang fails the test instead of holding up the suite
-PROGRESS = r"[\w-]+: +(\d+%\|.*\| )?\d+(/\d+)? ?(step|trial)?s? ?\[.*\]"  # a tqdm update
+# a tqdm update; spaces after it blank out the rest of a longer update before it
+PROGRESS = r"[\w-]+: +(\d+%\|.*\| )?\d+(/\d+)? ?(step|trial)?s? ?\[.*\] *"
 
 
 def _namespace_refusal() -> str | None:
