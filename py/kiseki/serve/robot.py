@@ -72,8 +72,7 @@ class SimulatedAgv:
         travelled: np.ndarray | None = None,
     ) -> None:
         self.scene, self.environment, self.travelled = scene, environment, travelled
-        setup = build_robot(scene, 0)
-        self.footprint = (setup.length, setup.width)  # for the route check
+        self.footprint = build_robot(scene, 0).footprint  # for the route check
         self.config = config or PlaybackConfig()
         self.dt = self.config.dt
         self.particles_shown = particles_shown

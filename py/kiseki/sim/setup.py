@@ -58,6 +58,11 @@ class RobotSetup:
     width: float
     height: float
 
+    @property
+    def footprint(self) -> tuple[float, float]:
+        """(length, width) in m: the robot's body seen from above, centred on its pose."""
+        return (self.length, self.width)
+
 
 @dataclass
 class SensorSetup:

@@ -193,7 +193,7 @@ class PlaybackRun:
             }
         self.scene, self.environment, self.writer = scene, environment, writer
         self.setup = build_robot(scene, derive_seed(config.seed, 1))
-        check_route(environment, waypoints, travelled, self._footprint())
+        check_route(environment, waypoints, travelled, self.setup.footprint)
         sensors = build_sensors(scene, self.setup, config.seed, config.dt)
         self.cameras = [s.device for s in sensors if s.kind == "depth_camera"]
         self.limiter = None
@@ -212,9 +212,6 @@ class PlaybackRun:
         start = waypoints[0]
         self.localizer.initialize((start["x"], start["y"], start["theta"]), config.initial_sd)
         self._begin(waypoints)
-
-    def _footprint(self) -> tuple[float, float]:
-        return (self.setup.length, self.setup.width)
 
     def _begin(self, waypoints: list[dict]) -> None:
         self.waypoints = list(waypoints)
@@ -238,7 +235,7 @@ class PlaybackRun:
         if not self.done:
             raise ValueError("the robot is still on its route: stop it or let it finish first")
         _need_start_and_goal(waypoints)
-        check_route(self.environment, waypoints, self.travelled, self._footprint())
+        check_route(self.environment, waypoints, self.travelled, self.setup.footprint)
         self._begin(waypoints)
 
     @property
