@@ -171,7 +171,20 @@ def _reading(value: Any) -> np.ndarray:
 class MagneticLidarMcl:
     """Chapter 5's localizer. ``grid``: the occupancy grid; ``heading_map``: the taught path's
     map (None, or ``config.magnetic`` False: laser-only MCL); ``laser``: the laser's pose in
-    the robot frame (x, y, yaw); ``start``/``start_sd``: the initial Gaussian cloud."""
+    the robot frame (x, y, yaw); ``start``/``start_sd``: the initial Gaussian cloud.
+    ``model``: a beam model made by :meth:`beam_model` with the same grid, config and laser, to
+    share between filters run one after the other on one map (building it takes about a second
+    on a large map); each step sets its own scan first. None builds one."""
+
+    @staticmethod
+    def beam_model(grid: OccupancyGrid, config: LidarMclConfig, laser: Any) -> _core.BeamModel:
+        """Step 4's beam model (eq. 5.7) on ``grid`` for ``config`` and the laser mount."""
+        mount = np.asarray(laser, dtype=np.float64)
+        if mount.shape != (3,) or not np.isfinite(mount).all():
+            raise ValueError("lidar MCL: laser must be 3 finite numbers (x, y, theta)")
+        return _core.BeamModel(
+            grid, sigma_hit=config.sigma_d, max_beams=config.beams, sensor=Pose2(*mount)
+        )
 
     def __init__(
         self,
@@ -181,6 +194,7 @@ class MagneticLidarMcl:
         start: Any,
         start_sd: tuple[float, float, float] = (0.1, 0.1, math.radians(2.0)),
         laser: Any = (0.0, 0.0, 0.0),
+        model: _core.BeamModel | None = None,
     ) -> None:
         if not isinstance(config, LidarMclConfig):
             raise ValueError(f"lidar MCL: config must be a LidarMclConfig, got {config!r}")
@@ -200,9 +214,9 @@ class MagneticLidarMcl:
         self.heading_map = heading_map if config.magnetic else None
         self.localizer = MonteCarloLocalizer(config.mcl(), derive_seed(config.seed, 1))
         self.localizer.initialize(pose, tuple(sd))
-        self.model = _core.BeamModel(
-            grid, sigma_hit=config.sigma_d, max_beams=config.beams, sensor=Pose2(*mount)
-        )
+        if model is not None and not isinstance(model, _core.BeamModel):
+            raise ValueError(f"lidar MCL: model must be a BeamModel, got {type(model).__name__}")
+        self.model = self.beam_model(grid, config, mount) if model is None else model
         self.rng = np.random.default_rng(derive_seed(config.seed, 2))
         self._odometry: np.ndarray | None = None
 

@@ -13,14 +13,20 @@ localizer is :class:`kiseki.magnetic.lidar_mcl.MagneticLidarMcl`.
   alone), ``laser`` (MCL with the beam model) or ``magnetic`` (the same MCL with the heading
   correction). Every method has the same robot, odometry error model, sensors and seed; the
   laser and the magnetometer read at 10 Hz, one step each 0.1 s.
+
+A process keeps the last scene file it read (and its rasterised grids) and the last beam model
+built on it: the runs of a sweep share them instead of rebuilding them (about 4 s of a 6 s
+trial); a changed scene file is read again.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import time
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -28,7 +34,7 @@ from kiseki.control import PurePursuit
 from kiseki.core import derive_seed
 from kiseki.magnetic.lidar_mcl import LidarMclConfig, MagneticLidarMcl, PathHeadingMap
 from kiseki.magnetic.linear_map import LinearMagneticMap, build_linear_map, path_identity
-from kiseki.sim.scene import load_scene
+from kiseki.sim.scene import Scene, load_scene
 from kiseki.sim.setup import build_robot, build_sensors
 
 __all__ = ["DRIVE_METHODS", "LOOKAHEAD", "DriveResult", "drive", "load", "teach_heading_map"]
@@ -42,9 +48,30 @@ near the last waypoint."""
 DT = 0.1  # s: 10 Hz, the thesis' laser and magnetometer rate (sec. 3.3.2)
 
 
+@functools.lru_cache(maxsize=1)
+def _scene(path: str, stamp: tuple[int, int]) -> Scene:
+    del stamp  # part of the key: the file's modification time and size
+    return load_scene(path)
+
+
+def _scene_key(scene_path: str | os.PathLike) -> tuple[str, tuple[int, int]]:
+    path = Path(scene_path)
+    if not path.is_file():
+        load_scene(path)  # raises its own error for a missing file
+    stat = path.stat()
+    return str(path.resolve()), (stat.st_mtime_ns, stat.st_size)
+
+
+@functools.lru_cache(maxsize=1)
+def _beam_model(key: tuple, z: float, sigma_d: float, beams: int, mount: tuple):
+    """The filters' beam model on the grid of the laser's height ``z`` (as :func:`load`)."""
+    grid = _scene(*key).ground_truth(z - 0.02, z + 0.02)
+    return MagneticLidarMcl.beam_model(grid, LidarMclConfig(sigma_d=sigma_d, beams=beams), mount)
+
+
 def load(scene_path: str | os.PathLike, seed: int):
     """(scene, robot setup, laser, magnetometer, grid at the laser's height) for ``seed``."""
-    scene = load_scene(scene_path)
+    scene = _scene(*_scene_key(scene_path))
     setup = build_robot(scene, seed)
     sensors = build_sensors(scene, setup, seed, DT)
     lasers = [s for s in sensors if s.kind == "laser"]
@@ -133,7 +160,9 @@ def drive(
         )
         hmap = PathHeadingMap(heading_map, mcl_config.reach) if method == "magnetic" else None
         mount = (laser.mount.x, laser.mount.y, math.radians(laser.mount.yaw_deg))
-        mcl = MagneticLidarMcl(grid, hmap, mcl_config, start, laser=mount)
+        key = _scene_key(scene_path)
+        model = _beam_model(key, laser.mount.z, mcl_config.sigma_d, mcl_config.beams, mount)
+        mcl = MagneticLidarMcl(grid, hmap, mcl_config, start, laser=mount, model=model)
     odo0 = _pose(setup.odometry.pose)
     log: dict[str, list] = {k: [] for k in ("t", "truth", "odo", "est", "sd", "reset", "r")}
     log.update(ess=[], resampled=[])
