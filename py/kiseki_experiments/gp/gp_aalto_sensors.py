@@ -63,23 +63,27 @@ def preflight(config: SensorsConfig) -> None:
     DriftCheck(config.window, config.limit)
 
 
-@functools.lru_cache(maxsize=2)
 def maps_and_stream(config: SensorsConfig):
     """(the two field maps, positions (T, 2), readings (T, 2, 3)) of the test run."""
-    aalto = _aalto(config)
+    return _maps_and_stream(config.data_dir, config.test_run)
+
+
+@functools.lru_cache(maxsize=2)  # made once a process for the settings they depend on
+def _maps_and_stream(folder_setting: str, test_run: int):
+    aalto = GpAaltoConfig(data_dir=folder_setting, test_run=test_run)
     folder = data_dir(aalto)
     maps, readings, runs = [], [], {}
     for sensor in SENSORS:
-        runs[sensor] = st.load_runs(folder, sensor, [1, 2, 3, 4, config.test_run])
+        runs[sensor] = st.load_runs(folder, sensor, [1, 2, 3, 4, test_run])
         sm = st.static_map(aalto, folder, sensor)
         lower, upper = bounds({r: runs[sensor][r] for r in aalto.train_runs}, 0.5)
         gps = sm.gp if isinstance(sm.gp, list) else [sm.gp]
         maps.append(MagneticFieldMap.from_gp(gps, lower, upper, aalto.map_resolution, units="uT"))
-        readings.append(sm.corrected(config.test_run, runs[sensor][config.test_run]))
-    lead = runs[SENSORS[0]][config.test_run]
+        readings.append(sm.corrected(test_run, runs[sensor][test_run]))
+    lead = runs[SENSORS[0]][test_run]
     keep = travel_subsample(lead.positions, aalto.mcl_step)
     t = lead.times[keep]
-    other = runs[SENSORS[1]][config.test_run]
+    other = runs[SENSORS[1]][test_run]
     second = np.column_stack([np.interp(t, other.times, readings[1][:, c]) for c in range(3)])
     return maps, lead.positions[keep], np.stack([readings[0][keep], second], axis=1)
 
