@@ -273,8 +273,10 @@ def _draw_layouts(
     at 0.4 m among them; grey: higher, up to 2.0 m, table tops and shelves) with the route."""
     cols = min(4, len(layouts))
     nrows = math.ceil(len(layouts) / cols)
-    fig = new_figure(figsize=(4.4 * cols, 3.0 * nrows + 0.6), dpi=100)
-    axes = np.atleast_1d(fig.subplots(nrows, cols, squeeze=False)).ravel()
+    height = 3.0 * nrows + 0.6  # inches; the title's 0.5 in above the rows, however many
+    fig = new_figure(figsize=(4.4 * cols, height), dpi=100)
+    margins = {"top": 1 - 0.5 / height, "bottom": 0.3 / height}
+    axes = np.atleast_1d(fig.subplots(nrows, cols, squeeze=False, gridspec_kw=margins)).ravel()
     for ax, index in zip(axes, layouts, strict=False):
         shade, extent, route, p = pictures[index]
         ax.imshow(shade, origin="lower", extent=extent, cmap=SHADES, vmin=0, vmax=2)
@@ -288,7 +290,7 @@ def _draw_layouts(
         ax.tick_params(labelsize=6)
     for ax in axes[len(layouts) :]:
         ax.set_visible(False)
-    fig.suptitle(title, fontsize=10)
+    fig.suptitle(title, fontsize=10, y=1 - 0.1 / height, va="top")
     fig.savefig(path, bbox_inches="tight")
     return path
 
