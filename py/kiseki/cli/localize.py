@@ -192,6 +192,12 @@ def localize_command(
         help="With --global: particles kept once the cloud has converged (default "
         f"{GlobalConfig.tracking_particles:,}).",
     ),
+    tracking_method: str | None = typer.Option(
+        None,
+        help="With --global: the model once the cloud has converged (likelihood-field, "
+        "space-observation or ray-space-observation), e.g. the field to find the place and "
+        "kiseki's ray model to track it among unmapped objects; default: --method.",
+    ),
     plot: Path | None = typer.Option(
         None, help="With --global: draw the map, the estimates and where they converged (PNG)."
     ),
@@ -222,7 +228,11 @@ def localize_command(
 
     check_suffix("--plot", plot, FIGURE_SUFFIXES)
     if not global_start:
-        for name, value in (("--tracking-particles", tracking_particles), ("--plot", plot)):
+        for name, value in (
+            ("--tracking-particles", tracking_particles),
+            ("--tracking-method", tracking_method),
+            ("--plot", plot),
+        ):
             if value is not None:
                 raise ValueError(f"{name} applies only with --global")
         if one_scan:
@@ -241,7 +251,12 @@ def localize_command(
     if global_start:
         start = "one-scan" if one_scan else None  # else GlobalConfig's default
         gconfig = GlobalConfig(
-            **_given(**shared, tracking_particles=tracking_particles, start=start)
+            **_given(
+                **shared,
+                tracking_particles=tracking_particles,
+                start=start,
+                tracking_method=tracking_method,
+            )
         )
         saved_config = {"command": "localize --global", **asdict(gconfig)}
         result = global_localize(scans, grid, gconfig, progress=True)

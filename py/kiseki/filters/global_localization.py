@@ -23,7 +23,10 @@
   holds 90 % of the weight below ``shrink_radius``) for ``shrink_after`` updates, it is
   resampled down to ``tracking_particles``: a converged cloud needs far fewer particles than the
   uniform start. With ``kld`` the engine instead adapts the count at every resampling
-  (KLD sampling, Fox 2003), between ``tracking_particles`` and ``particles``.
+  (KLD sampling, Fox 2003), between ``tracking_particles`` and ``particles``. From the cut
+  on, ``tracking_method`` (when given) replaces ``method``: the likelihood field finds the place
+  from the uniform start, where kiseki's ray model converges on look-alike places, and the ray
+  model then tracks it among objects the map does not hold.
 * Recovery (``recovery``, ``none`` by default) while tracking: ``augmented`` (Augmented MCL,
   Probabilistic Robotics Table 8.3, nav2's alpha_slow 0.001 and alpha_fast 0.1) or
   ``resetting`` (expansion, then sensor resetting); see :mod:`kiseki.filters`. Without it,
@@ -104,6 +107,9 @@ class GlobalConfig:
       few decimetres wide.
     * ``start`` uniform (see the module's docstring for ``one-scan``); ``hypotheses`` 5, the
       first scan's hypotheses of a one-scan start (RelocalizeConfig's default).
+    * ``tracking_method`` None: ``method`` throughout. Another of GLOBAL_METHODS is the model
+      after the cut (see the module's docstring): the model that finds the place from a uniform
+      start need not be the one that tracks it afterwards.
     """
 
     method: str = "likelihood-field"
@@ -125,13 +131,16 @@ class GlobalConfig:
     start: str = "uniform"  # or one-scan
     hypotheses: int = RelocalizeConfig.hypotheses  # of a one-scan start
     threads: int = 0
+    tracking_method: str | None = None  # after the cut; None: method
 
     def __post_init__(self) -> None:
-        if self.method not in GLOBAL_METHODS:
-            raise ValueError(
-                f"global localization: method must be one of {', '.join(GLOBAL_METHODS)}, "
-                f"got {self.method!r}"
-            )
+        for name in ("method", "tracking_method"):
+            value = getattr(self, name)
+            if value not in GLOBAL_METHODS and not (name == "tracking_method" and value is None):
+                raise ValueError(
+                    f"global localization: {name} must be one of {', '.join(GLOBAL_METHODS)}, "
+                    f"got {value!r}"
+                )
         check_seed(self.seed)
         if self.start not in START_MODES:
             raise ValueError(
@@ -207,12 +216,7 @@ def global_localize(
         localizer.initialize_particles(one_scan_start(scans, grid, config))
     else:
         localizer.initialize_global()
-    model = scan_model(
-        config.method,
-        grid,
-        LocalizeConfig(method=config.method, beams=config.beams, sigma_hit=config.sigma_hit),
-    )
-    prepare = scan_preparer(model, scans)
+    prepare = _preparer(config.method, scans, grid, config)
     odom = np.asarray(scans.odometry, dtype=float)
     n = len(scans)
     estimates = np.empty((n, 3))
@@ -224,7 +228,7 @@ def global_localize(
     injected = 0
 
     for k in tqdm(range(n), desc="global " + config.method, unit="scan", disable=not progress):
-        report = localizer.step(odom[k], lambda k=k: prepare(k))
+        report = localizer.step(odom[k], lambda k=k, prepare=prepare: prepare(k))
         estimates[k] = localizer.estimate
         reliability[k] = localizer.reliability
         if report is None:  # no update: the cloud stays, the estimate follows the odometry
@@ -241,6 +245,8 @@ def global_localize(
                 localizer.engine.resample_to(config.tracking_particles)
             localizer.engine.set_likelihood_power(1.0)
             localizer.engine.set_recovery(config.recovery)
+            if config.tracking_method not in (None, config.method):
+                prepare = _preparer(config.tracking_method, scans, grid, config)
             shrunk_at = k
     seconds = time.perf_counter() - start
     report = convergence_report(
@@ -255,6 +261,13 @@ def global_localize(
     )
     report = dataclasses.replace(report, injected=injected)
     return GlobalResult(estimates, spread, counts, report, reliability, config)
+
+
+def _preparer(method: str, scans: LaserScans, grid: OccupancyGrid, config: GlobalConfig):
+    """The scan model of `method` with the config's beams and sigma_hit, as the engine's
+    prepare callback: scan k -> the model holding scan k."""
+    settings = LocalizeConfig(method=method, beams=config.beams, sigma_hit=config.sigma_hit)
+    return scan_preparer(scan_model(method, grid, settings), scans)
 
 
 def one_scan_start(scans: LaserScans, grid: OccupancyGrid, config: GlobalConfig) -> np.ndarray:

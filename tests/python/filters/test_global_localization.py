@@ -207,3 +207,47 @@ def test_wean_recovery_injects_and_stays_deterministic(wean: tuple[Path, Path]) 
     np.testing.assert_array_equal(first.estimates, again.estimates)
     with pytest.raises(ValueError, match="recovery"):
         GlobalConfig(recovery="pray")
+
+
+def test_tracking_method_takes_over_at_the_cut(shared_data) -> None:
+    """The likelihood field from a uniform start, kiseki's ray model from the cut on (Intel,
+    first 400 scans, odometry as logged): up to the cut the run is the field's own, bit for bit;
+    after it the estimates differ and the ray model tracks the reference poses."""
+    from kiseki.datasets import read_carmen_log
+    from kiseki.mapping import MapBuildConfig, map_of_log
+
+    scans = read_carmen_log(shared_data / "carmen" / "intel-corrected.log.gz").scans.first(400)
+    grid = map_of_log(scans, MapBuildConfig(0.05))
+    config = GlobalConfig(seed=3, particles=20_000, threads=1)
+    field = global_localize(scans, grid, config)
+    same = global_localize(
+        scans, grid, GlobalConfig(**{**config.__dict__, "tracking_method": "likelihood-field"})
+    )
+    np.testing.assert_array_equal(same.estimates, field.estimates)  # the same model: no change
+    ray = global_localize(
+        scans, grid, GlobalConfig(**{**config.__dict__, "tracking_method": "ray-space-observation"})
+    )
+    cut = ray.report.shrunk_at
+    assert cut is not None and cut == field.report.shrunk_at and cut < 100
+    np.testing.assert_array_equal(ray.estimates[: cut + 1], field.estimates[: cut + 1])
+    assert not np.array_equal(ray.estimates[cut + 1 :], field.estimates[cut + 1 :])
+    error = np.hypot(*(ray.estimates[cut:, :2] - scans.poses[cut:, :2]).T)
+    assert np.sqrt(np.mean(error**2)) < 0.15 and error.max() < 0.5  # m
+    with pytest.raises(ValueError, match="tracking_method must be one of"):
+        GlobalConfig(tracking_method="beam")
+
+
+def test_cli_tracking_method_only_with_global(wean: tuple[Path, Path], tmp_path: Path) -> None:
+    log, map_file = wean
+    out = str(tmp_path / "t.csv")
+    done = run_cli(
+        "localize", str(log), "--map", str(map_file), "--tracking-method", "likelihood-field",
+        "-o", out,
+    )  # fmt: skip
+    assert done.returncode == 1 and "--tracking-method applies only with --global" in done.stderr
+    done = run_cli(
+        "localize", str(log), "--map", str(map_file), "--global", "--tracking-method", "beam",
+        "-o", out,
+    )  # fmt: skip
+    assert done.returncode == 1 and "tracking_method must be one of" in done.stderr
+    assert "Traceback" not in done.stderr and not Path(out).exists()
