@@ -152,7 +152,11 @@ def _dask_client(workers: int | None, scheduler: str | None):
         threads_per_worker=1,
         processes=True,
         dashboard_address=None,
-        silence_logs=logging.ERROR,
+        # CRITICAL, not ERROR: a worker's heartbeat that meets the scheduler already closed
+        # while the cluster shuts down is logged as an ERROR with two tracebacks (once in a
+        # 976-trial run, after its results were written); a trial's error and a lost worker
+        # reach the run through their futures and are reported by kiseki itself
+        silence_logs=logging.CRITICAL,
     )
     with cluster, Client(cluster) as client:
         yield client
