@@ -62,3 +62,21 @@ def test_one_small_run_reports_what_its_trial_measured(tmp_path):
     for name in ("trajectories", "gates", "sd"):
         (png,) = (run.run_dir / "figures").glob(f"*{name}.png")
         assert png.stat().st_size > 20_000
+
+
+def test_a_sweep_keeps_its_scene_until_the_file_changes(tmp_path):
+    # the runs of a sweep share the scene read once (magnav_lidar_drive); a scene file changed
+    # since (here its route speed, one byte longer) is read again, not served from the cache
+    from kiseki_experiments.magnav.magnav_lidar_drive import load
+
+    scene = tmp_path / "path.yaml"
+    text = (WORLDS / "magnetic_lidar_path.yaml").read_text()
+    scene.write_text(text)
+    first = load(scene, 0)[0]
+    assert load(scene, 1)[0] is first
+    assert float(first.route["speed"]) == 0.6
+    scene.write_text(text.replace("speed: 0.6", "speed: 0.55"))
+    again = load(scene, 0)[0]
+    assert again is not first and float(again.route["speed"]) == 0.55
+    with pytest.raises(FileNotFoundError, match="scene file not found"):
+        load(tmp_path / "gone.yaml", 0)
