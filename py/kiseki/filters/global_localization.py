@@ -134,9 +134,10 @@ class GlobalConfig:
     tracking_method: str | None = None  # after the cut; None: method
 
     def __post_init__(self) -> None:
-        for name in ("method", "tracking_method"):
-            value = getattr(self, name)
-            if value not in GLOBAL_METHODS and not (name == "tracking_method" and value is None):
+        tracking = self.method if self.tracking_method is None else self.tracking_method
+        methods = {"method": self.method, "tracking_method": tracking}
+        for name, value in methods.items():
+            if value not in GLOBAL_METHODS:
                 raise ValueError(
                     f"global localization: {name} must be one of {', '.join(GLOBAL_METHODS)}, "
                     f"got {value!r}"

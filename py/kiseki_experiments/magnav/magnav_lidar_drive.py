@@ -71,7 +71,11 @@ def _beam_model(key: tuple, z: float, sigma_d: float, beams: int, mount: tuple):
 
 def load(scene_path: str | os.PathLike, seed: int):
     """(scene, robot setup, laser, magnetometer, grid at the laser's height) for ``seed``."""
-    scene = _scene(*_scene_key(scene_path))
+    return _load(scene_path, _scene_key(scene_path), seed)
+
+
+def _load(scene_path: str | os.PathLike, key: tuple, seed: int):
+    scene = _scene(*key)
     setup = build_robot(scene, seed)
     sensors = build_sensors(scene, setup, seed, DT)
     lasers = [s for s in sensors if s.kind == "laser"]
@@ -148,7 +152,8 @@ def drive(
     and sensor noise of ``seed``; ``max_distance`` m of travel ends it early (tests)."""
     if method not in DRIVE_METHODS:
         raise ValueError(f"drive: method must be one of {', '.join(DRIVE_METHODS)}, got {method!r}")
-    scene, setup, laser, mag, grid = load(scene_path, seed)
+    key = _scene_key(scene_path)
+    scene, setup, laser, mag, grid = _load(scene_path, key, seed)
     pursuit = _pursuit(scene, setup)
     angles = laser.device.params.angles
     max_range = float(laser.device.params.max_range)
@@ -160,7 +165,6 @@ def drive(
         )
         hmap = PathHeadingMap(heading_map, mcl_config.reach) if method == "magnetic" else None
         mount = (laser.mount.x, laser.mount.y, math.radians(laser.mount.yaw_deg))
-        key = _scene_key(scene_path)
         model = _beam_model(key, laser.mount.z, mcl_config.sigma_d, mcl_config.beams, mount)
         mcl = MagneticLidarMcl(grid, hmap, mcl_config, start, laser=mount, model=model)
     odo0 = _pose(setup.odometry.pose)
