@@ -8,7 +8,8 @@
 #   3. kiseki installed editable into .venv, again only when C++/CMake sources changed or a
 #      Python module was added, moved or removed.
 # A second run does no download and no compilation when nothing changed. C++ builds go through
-# ccache (its cache in build/ccache).
+# ccache, in ccache's own cache (~/.cache/ccache unless CCACHE_DIR or ccache's settings say
+# otherwise), so that a fresh clone in the same folder compiles only what changed.
 set -euo pipefail
 
 KISEKI_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -88,11 +89,14 @@ PY
 }
 
 install_debian_packages
-# Every C++ build goes through a compiler cache kept in build/ccache: scripts/test.sh's colcon
-# build compiles the library's sources with the same compiler, flags and paths as the editable
-# install and takes them from the cache, and a rebuild compiles only what changed.
-export CCACHE_DIR="${CCACHE_DIR:-$KISEKI_ROOT/build/ccache}"
-export CCACHE_MAXSIZE="${CCACHE_MAXSIZE:-2G}"
+# Every C++ build goes through the user's compiler cache (ccache's default folder, as pip's wheels
+# sit in pip's), with paths inside the repository hashed relative to the build folder (base_dir;
+# every build folder is two levels down: build/editable, build/kiseki of the colcon test,
+# build/asan, build/anchors) and without the build folder itself (hash_dir off): the colcon build
+# takes the library's objects from the editable install's compiles, and a rebuild or a fresh
+# clone anywhere compiles only what changed.
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$KISEKI_ROOT}"
+export CCACHE_NOHASHDIR="${CCACHE_NOHASHDIR:-true}"
 export CMAKE_CXX_COMPILER_LAUNCHER="${CMAKE_CXX_COMPILER_LAUNCHER:-ccache}"
 export CXX="${CXX:-g++}"
 setup_venv
