@@ -113,20 +113,24 @@ def field_targets(y: Any, n: int, name: str = "Y") -> np.ndarray:
     return a
 
 
-def _blocks(a: np.ndarray, b: np.ndarray, k: CurlFreeKernel, gradient: bool = False):
-    """(K (3 n_a, 3 n_b), dK / dlog l or None) of the field, without noise (module text); built
-    one component pair at a time (memory: the result and a few n_a x n_b arrays)."""
+def _blocks(
+    a: np.ndarray, b: np.ndarray, k: CurlFreeKernel, gradient: bool = False, linear: bool = True
+):
+    """(K (3 n_a, 3 n_b), dK / dlog l or None) of the field, without noise (module text), with
+    the linear term sigma_lin^2 I in every block unless ``linear`` is False; built one
+    component pair at a time (memory: the result and a few n_a x n_b arrays)."""
     r = [a[:, None, c] - b[None, :, c] for c in range(3)]  # r_c (n_a, n_b)
     s = r[0] ** 2 + r[1] ** 2 + r[2] ** 2
     l2 = k.length_scale**2
     e = k.sigma_f**2 * np.exp(-0.5 * s / l2)  # sigma_f^2 exp(-|r|^2 / (2 l^2))
+    lin = k.sigma_lin**2 if linear else 0.0
     kmat = np.empty((len(a), 3, len(b), 3))
     d = np.empty_like(kmat) if gradient else None
     for i in range(3):
         for j in range(i, 3):
             rr = r[i] * r[j] / l2**2  # (r r^T)_ij / l^4
             inner = (1.0 / l2 if i == j else 0.0) - rr  # (I / l^2 - r r^T / l^4)_ij
-            kmat[:, i, :, j] = e * inner + (k.sigma_lin**2 if i == j else 0.0)
+            kmat[:, i, :, j] = e * inner + (lin if i == j else 0.0)
             kmat[:, j, :, i] = kmat[:, i, :, j]
             if d is not None:
                 # d/dlog l of e (I/l^2 - r r^T/l^4) = e [(s/l^2) inner - 2 I/l^2 + 4 r r^T/l^4]
@@ -149,10 +153,13 @@ def curl_free_log_marginal_likelihood(
 
 
 def _lml(x: np.ndarray, y: np.ndarray, k: CurlFreeKernel, gradient: bool):
-    kmat, dl = _blocks(x, x, k, gradient)
+    se, dl = _blocks(x, x, k, gradient, linear=False)  # the squared-exponential part
+    kmat = se.copy()
+    for c in range(3):  # + sigma_lin^2 between the same components of any two readings
+        kmat[c::3, c::3] += k.sigma_lin**2
     kmat[np.diag_indices_from(kmat)] += k.sigma_n**2
     try:
-        chol = scipy.linalg.cho_factor(kmat, lower=True, check_finite=False)
+        chol = scipy.linalg.cho_factor(kmat, lower=True, check_finite=False, overwrite_a=True)
     except np.linalg.LinAlgError:
         return -math.inf, None
     alpha = scipy.linalg.cho_solve(chol, y, check_finite=False)
@@ -160,19 +167,24 @@ def _lml(x: np.ndarray, y: np.ndarray, k: CurlFreeKernel, gradient: bool):
     value = -0.5 * (y @ alpha) - 0.5 * logdet - 0.5 * len(y) * math.log(2 * math.pi)
     if not gradient:
         return float(value), None
-    # dL/dtheta = 1/2 tr((alpha alpha^T - K^-1) dK/dtheta)
-    inverse, info = scipy.linalg.lapack.dpotri(chol[0], lower=1)  # K^-1 from its factor
+    # dL/dtheta = 1/2 tr((alpha alpha^T - K^-1) dK/dtheta) = 1/2 (alpha^T D alpha - <K^-1, D>)
+    # for each symmetric D = dK/dtheta, without forming alpha alpha^T or the whole K^-1
+    inverse, info = scipy.linalg.lapack.dpotri(chol[0], lower=1, overwrite_c=1)
     if info != 0:
         return -math.inf, None
-    w = np.outer(alpha, alpha) - (np.tril(inverse) + np.tril(inverse, -1).T)
-    lin = np.kron(np.ones((len(x), len(x))), np.eye(3))  # dK / d(sigma_lin^2)
-    se = kmat - k.sigma_lin**2 * lin
-    se[np.diag_indices_from(se)] -= k.sigma_n**2
+    lower = np.tril(inverse)  # K^-1's lower half (dpotri leaves the upper half as it was)
+    diagonal = np.diag(lower).copy()
+
+    def with_inverse(d: np.ndarray) -> float:  # <K^-1, D> = sum_ij (K^-1)_ij D_ij
+        return 2.0 * np.vdot(lower, d) - diagonal @ np.diag(d)
+
+    sums = np.array([alpha[c::3].sum() for c in range(3)])
+    lin_inverse = sum(2.0 * lower[c::3, c::3].sum() - diagonal[c::3].sum() for c in range(3))
     grads = [
-        np.sum(w * se),  # dK/dlog sigma_f = 2 K_SE, halved by the 1/2
-        0.5 * np.sum(w * dl),
-        k.sigma_lin**2 * np.sum(w * lin),
-        k.sigma_n**2 * np.trace(w),
+        alpha @ (se @ alpha) - with_inverse(se),  # dK/dlog sigma_f = 2 K_SE, halved by the 1/2
+        0.5 * (alpha @ (dl @ alpha) - with_inverse(dl)),
+        k.sigma_lin**2 * (sums @ sums - lin_inverse),  # dK/dlog sigma_lin = 2 sigma_lin^2 L
+        k.sigma_n**2 * (alpha @ alpha - diagonal.sum()),  # dK/dlog sigma_n = 2 sigma_n^2 I
     ]
     return float(value), np.array(grads)
 
