@@ -25,6 +25,7 @@ class LayoutsConfig:
     )
     particles: Particles = 1000
     boxes: Boxes = 3
+    without_boxes: bool = True  # exp3-boxes' runs again without the boxes (Exp3Config)
     merge: str = "thesis"
     plays: str = ""  # negative controls: exp2-turn's methods played as others (Exp2Config)
 
@@ -35,5 +36,5 @@ def experiment_configs(config: LayoutsConfig, scene: Path, method: str | None = 
     methods = list(config.methods) if method is None else [method]
     return {
         "exp2": Exp2Config(methods=methods, plays=config.plays, **common),
-        "exp3": Exp3Config(boxes=config.boxes, **common),
+        "exp3": Exp3Config(boxes=config.boxes, without_boxes=config.without_boxes, **common),
     }

@@ -213,7 +213,8 @@ def _stops(config: LayoutsConfig, ok: pd.DataFrame) -> pd.DataFrame:
             ("boxes", "proposal2_stop_error"),
             ("noboxes", "proposal2_nobox_stop_error"),
         ):
-            out[f"exp3_{key}_stop_m"] = exp3[col].mean() if col in exp3 else np.inf
+            # a column never played (no boxes, or without_boxes=false) is not a refusal: NaN
+            out[f"exp3_{key}_stop_m"] = exp3[col].mean() if col in exp3 else np.nan
         best = min(config.methods, key=lambda m: out[f"{m}_stop_m"])
         out["best_method"] = best if np.isfinite(out[f"{best}_stop_m"]) else "none (refused)"
         rows.append(out)

@@ -170,7 +170,7 @@ def _play(
     if model == RAY_MODEL:
         return identity, out
     out.update(goal_profile(scene, maps[band], goal, method))
-    if config.boxes:  # the control: the same run without the boxes
+    if config.boxes and getattr(config, "without_boxes", True):  # the same run without them
         plain = load_scene(Path(config.scene), "playback")
         control = playback(
             plain, maps[band], taught.marks, play, taught_scene=taught.scene, travelled=travelled
@@ -278,7 +278,7 @@ def analyze_exp3(config, trials, timings, figures) -> Analysis:
     diag = diagnostics_table(config, ok)
     m = config.methods[0]
     cols = ["final_leg_boxes_left", "final_leg_boxes_right", f"{m}_stop_dx", f"{m}_stop_dy"]
-    cols += [f"{m}_nobox_stop_dx", f"{m}_nobox_stop_dy"]
+    cols += [c for c in (f"{m}_nobox_stop_dx", f"{m}_nobox_stop_dy") if c in ok]
     boxes = ok[["trial", *cols]] if "final_leg_boxes_left" in ok else pd.DataFrame()
     size = " x ".join(f"{v:g}" for v in BOX_SIZE_M)
     shift = [

@@ -46,6 +46,8 @@ class Exp3Config:
     methods: list[str] = field(default_factory=lambda: ["proposal2"])
     particles: Particles = 1000
     boxes: Boxes = 3
+    # each run played again without the boxes (same teaching and seeds): table boxes_final_leg
+    without_boxes: bool = True
     merge: str = "thesis"
     plays: str = ""  # negative controls, as in Exp1Config
     # also play each method with kiseki's ray space observation model (PlaybackConfig.model)
