@@ -5,21 +5,23 @@
 Figures are :class:`matplotlib.figure.Figure` objects drawn by the Agg canvas and made without
 pyplot (:func:`new_figure`): importing kiseki or drawing with it never selects a matplotlib
 backend, so a user's backend choice stands, and the figures are not kept by pyplot (there is
-nothing to close)."""
+nothing to close). matplotlib itself is imported by the first figure, not by importing this
+module: a command that draws nothing does not pay for it."""
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from matplotlib.axes import Axes
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from kiseki._support.atomic import atomic_write
 from kiseki.grid import OccupancyGrid
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 __all__ = [
     "draw_map",
@@ -39,6 +41,9 @@ def new_figure(**kwargs: Any) -> Figure:
     without pyplot: no backend is selected and pyplot does not keep it. Add axes with
     ``fig.subplots(...)``; ``fig.savefig`` picks the canvas of the file's format (Agg for
     PNG)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
     fig = Figure(**kwargs)
     FigureCanvasAgg(fig)
     return fig

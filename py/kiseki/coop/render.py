@@ -7,12 +7,15 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.patches import Ellipse
 
 from kiseki.coop.positioning import CoopRun
 from kiseki.plots import new_figure, save_figure
+
+if TYPE_CHECKING:
+    from matplotlib.patches import Ellipse
 
 COLOURS = ("tab:blue", "tab:orange", "tab:green")
 
@@ -25,6 +28,8 @@ def _ellipse(points: np.ndarray, scale: float, colour: str) -> Ellipse | None:
     values = np.clip(values, 0.0, None)
     angle = np.degrees(np.arctan2(vectors[1, 1], vectors[0, 1]))
     width, height = 2 * 2 * scale * np.sqrt(values[::-1])  # 2 SD each side, magnified
+    from matplotlib.patches import Ellipse
+
     return Ellipse(points.mean(axis=0), width, height, angle=angle, fill=False, color=colour, lw=1)
 
 

@@ -9,8 +9,6 @@ import os
 from pathlib import Path
 
 import numpy as np
-from matplotlib.animation import FuncAnimation, PillowWriter
-from matplotlib.colors import ListedColormap
 
 from kiseki._support.atomic import atomic_write
 from kiseki.plots import new_figure
@@ -59,12 +57,18 @@ def _scene_axes(scene: Scene, title: str):
         layers,
         origin="lower",
         extent=_extent(grid),
-        cmap=ListedColormap(COLOURS),
+        cmap=_colours(),
         vmin=0,
         vmax=3,
         interpolation="nearest",
     )
     return fig, ax
+
+
+def _colours():
+    from matplotlib.colors import ListedColormap  # imported when a picture is drawn
+
+    return ListedColormap(COLOURS)
 
 
 def _extent(grid) -> list[float]:
@@ -191,6 +195,8 @@ def render_run(
             xy = _scan_points(scans[min(len(scans) - 1, int(i * len(scans) / n))][1])
             points.set_data(xy[:, 0], xy[:, 1])
         return (*lines, points)
+
+    from matplotlib.animation import FuncAnimation, PillowWriter
 
     anim = FuncAnimation(fig, draw, frames=picks, blit=True)
     return atomic_write(Path(path), lambda tmp: anim.save(tmp, writer=PillowWriter(fps=10)))

@@ -14,7 +14,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from matplotlib.colors import ListedColormap
 
 from kiseki.metrics import wilson_interval
 from kiseki.plots import new_figure
@@ -28,7 +27,7 @@ from kiseki_experiments.teach.layouts_config import LayoutsConfig, experiment_co
 __all__ = ["GENERAL", "HIGH_BAND_M", "LAYOUT_COLUMNS", "LOW_BAND_M", "Point", "analyze"]
 
 GENERAL = 0.8  # a claim generalises when it holds in at least this share of layouts
-SHADES = ListedColormap(["white", "#a0a0a0", "black"])
+SHADES = ("white", "#a0a0a0", "black")  # the layout pictures' colours of shades 0, 1 and 2
 LOW_BAND_M, HIGH_BAND_M = (0.05, 0.6), (0.6, 2.0)  # the layout pictures' two height bands
 # the layout parameters in the report's per-layout table (all of them are in trials.parquet)
 LAYOUT_COLUMNS = [
@@ -267,6 +266,12 @@ def _layout_picture(seed: int) -> tuple[np.ndarray, list[float], np.ndarray, dic
     return shade, extent, np.asarray(scene.route["waypoints"], dtype=float), layout.params
 
 
+def _shades():
+    from matplotlib.colors import ListedColormap  # imported when a picture is drawn
+
+    return ListedColormap(SHADES)
+
+
 def _draw_layouts(
     pictures: dict, layouts: list[int], title: str, path: Path, measured: dict | None = None
 ) -> Path:
@@ -280,7 +285,7 @@ def _draw_layouts(
     axes = np.atleast_1d(fig.subplots(nrows, cols, squeeze=False, gridspec_kw=margins)).ravel()
     for ax, index in zip(axes, layouts, strict=False):
         shade, extent, route, p = pictures[index]
-        ax.imshow(shade, origin="lower", extent=extent, cmap=SHADES, vmin=0, vmax=2)
+        ax.imshow(shade, origin="lower", extent=extent, cmap=_shades(), vmin=0, vmax=2)
         ax.plot(route[:, 0], route[:, 1], "-o", color="tab:blue", lw=1.2, ms=3)
         value = f"\nmeasured {measured[index]}" if measured else ""
         ax.set_title(

@@ -11,7 +11,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from matplotlib.patches import Circle
 
 from kiseki.metrics import wilson_interval
 from kiseki.plots import new_figure
@@ -196,6 +195,8 @@ def stop_figure(config, trials: pd.DataFrame, figures: Path) -> Path:
     ax = fig.subplots()
     for method in config.methods:
         ax.plot(trials[f"{method}_stop_dx"], trials[f"{method}_stop_dy"], "o", label=method)
+    from matplotlib.patches import Circle  # imported when the picture is drawn
+
     circle = Circle((0, 0), 0.1, fill=False, linestyle="--", color="grey")
     ax.add_patch(circle)
     ax.set_aspect("equal")
