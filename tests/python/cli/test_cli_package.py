@@ -112,6 +112,11 @@ def test_help_imports_no_command_module_and_a_command_only_its_own():
     assert {"kiseki.cli.map", "kiseki.cli.map_info"} <= info_loads
     assert not {"kiseki.cli.map_from_log", "kiseki.cli.map_render"} & info_loads
     assert not any(m.startswith("matplotlib") for m in info_loads)
+    # listing the experiments imports every experiment, and still no matplotlib: a figure
+    # imports it when it is drawn
+    listed = loaded_modules("experiment", "list")
+    assert "kiseki_experiments.teach.layouts_report" in listed
+    assert not any(m.startswith("matplotlib") for m in listed)
 
 
 def test_an_unknown_command_is_a_usage_error():
