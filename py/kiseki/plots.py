@@ -41,6 +41,7 @@ def new_figure(**kwargs: Any) -> Figure:
     without pyplot: no backend is selected and pyplot does not keep it. Add axes with
     ``fig.subplots(...)``; ``fig.savefig`` picks the canvas of the file's format (Agg for
     PNG)."""
+    # matplotlib on the first figure: importing kiseki.plots (every experiment does) stays fast
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 

@@ -28,7 +28,7 @@ def _ellipse(points: np.ndarray, scale: float, colour: str) -> Ellipse | None:
     values = np.clip(values, 0.0, None)
     angle = np.degrees(np.arctan2(vectors[1, 1], vectors[0, 1]))
     width, height = 2 * 2 * scale * np.sqrt(values[::-1])  # 2 SD each side, magnified
-    from matplotlib.patches import Ellipse
+    from matplotlib.patches import Ellipse  # imported when a picture is drawn
 
     return Ellipse(points.mean(axis=0), width, height, angle=angle, fill=False, color=colour, lw=1)
 

@@ -196,7 +196,7 @@ def render_run(
             points.set_data(xy[:, 0], xy[:, 1])
         return (*lines, points)
 
-    from matplotlib.animation import FuncAnimation, PillowWriter
+    from matplotlib.animation import FuncAnimation, PillowWriter  # when an animation is drawn
 
     anim = FuncAnimation(fig, draw, frames=picks, blit=True)
     return atomic_write(Path(path), lambda tmp: anim.save(tmp, writer=PillowWriter(fps=10)))
