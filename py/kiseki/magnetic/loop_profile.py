@@ -8,9 +8,11 @@ channel, fitted to a mapping lap's readings (kiseki's loop filter,
   reading. The loop closes, so each reading is also placed at s - L and s + L before the fit:
   the map is continuous across the lap's seam, and the GP at either end sees the other.
 * Hyperparameters sigma_f, l, sigma_n by maximum marginal likelihood (:func:`kiseki.gp.
-  fit_hyperparameters`, the thesis' eqs. 6.11-6.15) on these readings alone: sigma_n is then
-  what the mapping lap says about its own noise, and l its own length scale; nothing is set
-  by hand.
+  fit_hyperparameters`, the thesis' eqs. 6.11-6.15) on the lap's readings alone, each once:
+  sigma_n is then what the mapping lap says about its own noise, and l its own length scale;
+  nothing is set by hand. The copies at s - L and s + L are for the map's continuity, not more
+  data: in the likelihood they would count each reading three times and cost 27 times as much
+  (n^3; a lap of MAX_READINGS would need 12,000-point factorisations).
 * The mean and the variance of the noise-free field (eqs. 6.8-6.9) are tabulated every
   ``resolution`` m over one period and read linearly between table points, the distance taken
   modulo L.
@@ -91,13 +93,12 @@ def fit_loop_profile(
         raise ValueError("loop profile: s and values must be finite")
     if s.min() < -1e-9 or s.max() > length + 1e-9:
         raise ValueError(f"loop profile: s must lie in [0, {length}] m")
-    x = np.concatenate([s - length, s, s + length])[:, None]
-    y = np.tile(v, 3)[:, None]
-    fit = fit_hyperparameters(x, y, seed=seed, max_points=len(x))
+    fit = fit_hyperparameters(s[:, None], v[:, None], seed=seed, max_points=len(s))
     k = fit.kernel
     if k.sigma_n < noise_floor:
         k = SquaredExponential(max(k.sigma_f, noise_floor), k.length_scale, noise_floor)
-    gp = ExactGP.fit(x, y, kernel=k)
+    x = np.concatenate([s - length, s, s + length])[:, None]
+    gp = ExactGP.fit(x, np.tile(v, 3)[:, None], kernel=k)
     grid = np.arange(0.0, length, resolution)
     mean, var = gp.predict(grid[:, None])
     return LoopProfile(

@@ -169,24 +169,29 @@ def test_bad_inputs_are_refused_with_one_line():
         fit_loop_profile([0.0, 1.0, 2.0, 40.0], [0.0, 1.0, 2.0, 3.0], LOOP)
 
 
-@pytest.mark.parametrize("seed", [0, 2])
-def test_reentry_finds_a_walker_carried_11_m_without_odometry(seed, mapped_loop):
+def test_reentry_finds_a_walker_carried_11_m_without_odometry(mapped_loop):
     """The walker is carried 11 m along the loop while the odometry says 0.1 m (a kidnapping,
-    or a stretch off the loop): with re-entry the filter is back within 3 m of travel; without
-    it (the control) it is still lost 30 m later."""
+    or a stretch off the loop): with re-entry the filter is back within 3 m of travel in every
+    one of 10 seeds; without it (the control) it is still lost 30 m later in most of them.
+    Without re-entry a filter sometimes finds its way back by chance (4 of seeds 0-19), so the
+    control is a share over seeds, not one seed's outcome."""
     steps = 900
     true_s = 0.1 * np.arange(steps)
     true_s[300:] += 11.0
-    readings = field(true_s) + 0.003 * np.random.default_rng(100 + seed).standard_normal((steps, 2))
     odo = np.concatenate([[0.0], np.full(steps - 1, 0.1)])
-    errors = {}
-    for reentry in (True, False):
-        config = LoopTravelConfig(seed=seed, particles=500, reentry=reentry)
-        loc = LoopTravelDistanceLocalizer(mapped_loop, config, 0.0)
-        est, _ = loc.run(odo, readings)
-        errors[reentry] = (est - np.mod(true_s, LOOP) + LOOP / 2) % LOOP - LOOP / 2
-        assert (loc.injected > 0) is reentry
-    back = int(np.argmax(np.abs(errors[True][300:]) < 0.3))
-    assert back < 30 and np.sqrt(np.mean(errors[True][330:] ** 2)) < 0.1
-    assert np.sqrt(np.mean(errors[True][100:300] ** 2)) < 0.05  # no harm before
-    assert np.sqrt(np.mean(errors[False][600:] ** 2)) > 1.0
+    still_lost = 0
+    for seed in range(10):
+        noise = 0.003 * np.random.default_rng(100 + seed).standard_normal((steps, 2))
+        readings = field(true_s) + noise
+        errors = {}
+        for reentry in (True, False):
+            config = LoopTravelConfig(seed=seed, particles=500, reentry=reentry)
+            loc = LoopTravelDistanceLocalizer(mapped_loop, config, 0.0)
+            est, _ = loc.run(odo, readings)
+            errors[reentry] = (est - np.mod(true_s, LOOP) + LOOP / 2) % LOOP - LOOP / 2
+            assert (loc.injected > 0) is reentry
+        back = int(np.argmax(np.abs(errors[True][300:]) < 0.3))
+        assert back < 30 and np.sqrt(np.mean(errors[True][330:] ** 2)) < 0.1, seed
+        assert np.sqrt(np.mean(errors[True][100:300] ** 2)) < 0.05, seed  # no harm before
+        still_lost += bool(np.sqrt(np.mean(errors[False][600:] ** 2)) > 1.0)
+    assert still_lost >= 5
