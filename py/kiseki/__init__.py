@@ -21,7 +21,15 @@ import os
 # value set by the user (OMP_WAIT_POLICY=active, or empty for libgomp's default) is kept.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
-from kiseki._support import moved  # noqa: E402  (after the policy: it loads the core)
+# numpy first: its own OpenBLAS picks its kernels itself, before the variable below is set.
+import numpy  # noqa: E402, F401
+
+from kiseki._support.openblas_kernels import kernels_while_loading  # noqa: E402
+
+with kernels_while_loading():  # the core's OpenBLAS kernels named from the processor
+    from kiseki import _core  # noqa: E402, F401  (loads the core, its OpenMP and its OpenBLAS)
+
+from kiseki._support import moved  # noqa: E402
 from kiseki.core import Pose2, Pose3, Random, derive_seed, library_versions, normalize_angle
 from kiseki.errors import KisekiError, LogFormatError, MapFormatError
 from kiseki.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid

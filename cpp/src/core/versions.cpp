@@ -2,12 +2,29 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/core/versions.hpp"
 
+#include <cblas.h>
+
 #include <Eigen/Core>
 #include <octomap/OcTree.h>
 #include <opencv2/core/version.hpp>
 #include <pcl/pcl_config.h>
 
+#include <sstream>
+
 namespace kiseki {
+
+namespace {
+
+/// OpenBLAS' version and the kernels it runs on, e.g. "0.3.21, SkylakeX kernels": the last bits
+/// of the Gaussian processes' results depend on the kernels.
+std::string openblas() {
+  std::istringstream config(openblas_get_config());  // "OpenBLAS 0.3.21 DYNAMIC_ARCH ..."
+  std::string name, version;
+  config >> name >> version;
+  return version + ", " + openblas_get_corename() + " kernels";
+}
+
+}  // namespace
 
 std::map<std::string, std::string> library_versions() {
   octomap::OcTree probe(0.1);  // links liboctomap: proves the library is usable, not only its headers
@@ -19,6 +36,7 @@ std::map<std::string, std::string> library_versions() {
       {"opencv", CV_VERSION},
       {"pcl", PCL_VERSION_PRETTY},
       {"octomap", octomap_version},
+      {"openblas", openblas()},
   };
 }
 

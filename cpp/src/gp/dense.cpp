@@ -12,6 +12,10 @@
 
 namespace kiseki::gp_detail {
 
+// LAPACKE's *_work entry points: the plain ones first scan the whole matrix for NaN (an O(n^2)
+// pass per call, 2 % of a hyperparameter fit); kiseki's matrices are built from inputs checked
+// to be finite, and a NaN reaching dpotrf still fails its positive-definiteness test.
+
 namespace {
 lapack_int checked_size(Eigen::Index n) {
   if (n > std::numeric_limits<lapack_int>::max()) throw std::length_error("matrix too large for LAPACK");
@@ -22,7 +26,7 @@ lapack_int checked_size(Eigen::Index n) {
 bool cholesky(Eigen::MatrixXd& a) {
   const lapack_int n = checked_size(a.rows());
   if (n == 0) return true;
-  const lapack_int info = LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', n, a.data(), n);
+  const lapack_int info = LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', n, a.data(), n);
   if (info != 0) return false;
   a.triangularView<Eigen::StrictlyUpper>().setZero();
   return true;
@@ -32,7 +36,7 @@ Eigen::MatrixXd inverse_from_cholesky(const Eigen::MatrixXd& l) {
   Eigen::MatrixXd inv = l;
   const lapack_int n = checked_size(l.rows());
   if (n == 0) return inv;
-  if (LAPACKE_dpotri(LAPACK_COL_MAJOR, 'L', n, inv.data(), n) != 0) {
+  if (LAPACKE_dpotri_work(LAPACK_COL_MAJOR, 'L', n, inv.data(), n) != 0) {
     throw std::runtime_error("Gaussian process: the covariance matrix could not be inverted");
   }
   inv.triangularView<Eigen::StrictlyUpper>() = inv.transpose();
@@ -42,7 +46,7 @@ Eigen::MatrixXd inverse_from_cholesky(const Eigen::MatrixXd& l) {
 void invert_from_cholesky_lower(Eigen::MatrixXd& l) {
   const lapack_int n = checked_size(l.rows());
   if (n == 0) return;
-  if (LAPACKE_dpotri(LAPACK_COL_MAJOR, 'L', n, l.data(), n) != 0) {
+  if (LAPACKE_dpotri_work(LAPACK_COL_MAJOR, 'L', n, l.data(), n) != 0) {
     throw std::runtime_error("Gaussian process: the covariance matrix could not be inverted");
   }
 }
@@ -50,7 +54,7 @@ void invert_from_cholesky_lower(Eigen::MatrixXd& l) {
 void cholesky_solve(const Eigen::MatrixXd& l, Eigen::MatrixXd& b) {
   const lapack_int n = checked_size(l.rows());
   if (n == 0 || b.cols() == 0) return;
-  LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'L', n, checked_size(b.cols()), l.data(), n, b.data(), n);
+  LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', n, checked_size(b.cols()), l.data(), n, b.data(), n);
 }
 
 void lower_solve(const Eigen::MatrixXd& l, Eigen::MatrixXd& b) {

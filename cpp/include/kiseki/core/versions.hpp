@@ -7,8 +7,9 @@
 
 namespace kiseki {
 
-/// kiseki's version and the versions of the C++ libraries it was built against
-/// (keys: kiseki, eigen, opencv, pcl, octomap).
+/// kiseki's version and the versions of the C++ libraries it was built against (keys: kiseki,
+/// eigen, opencv, pcl, octomap), and of the OpenBLAS it runs on with the kernels OpenBLAS chose
+/// when it was loaded (key openblas, e.g. "0.3.21, SkylakeX kernels").
 std::map<std::string, std::string> library_versions();
 
 }  // namespace kiseki

@@ -1,0 +1,69 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The OpenBLAS kernels kiseki's core runs on, named from the processor's instruction sets.
+
+An OpenBLAS built for many processors (``DYNAMIC_ARCH``, as Debian's) picks its kernels when it
+is loaded, from the processor's model number. A processor newer than the library falls back to
+its SSE3 kernels ("Prescott"): Debian 12's OpenBLAS 0.3.21 does so on a 5th-generation Xeon
+(family 6, model 207), where the Gaussian processes' factorisations then ran about 1.5x slower.
+``OPENBLAS_CORETYPE`` names the kernels instead. kiseki sets it from the instruction sets that
+Linux reports in ``/proc/cpuinfo``, only when the user has not set it, and only while its core
+is loaded (`kernels_while_loading`), so that numpy's own OpenBLAS and child processes choose
+for themselves. ``kiseki.library_versions()["openblas"]`` names the kernels in use.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
+from pathlib import Path
+
+VARIABLE = "OPENBLAS_CORETYPE"
+# The instruction sets each kernel family needs (OpenBLAS' SkylakeX and Haswell double-precision
+# kernels; later families, e.g. Cooperlake, add only reduced-precision kernels).
+_KERNELS = (
+    ("SkylakeX", frozenset({"avx512f", "avx512cd", "avx512bw", "avx512dq", "avx512vl"})),
+    ("Haswell", frozenset({"avx2", "fma"})),
+)
+_CPUINFO_LIMIT = 1 << 20  # bytes: one processor's block is a few kB, 256 of them fit
+
+
+def kernels_for(flags: set[str] | frozenset[str]) -> str | None:
+    """The widest kernel family whose instruction sets are all in ``flags``; None for none."""
+    for name, needed in _KERNELS:
+        if needed <= flags:
+            return name
+    return None
+
+
+def cpu_flags(cpuinfo: Path = Path("/proc/cpuinfo")) -> frozenset[str]:
+    """The first processor's ``flags`` in ``cpuinfo``; empty if the file is absent or has none."""
+    try:
+        with cpuinfo.open(encoding="ascii", errors="replace") as f:
+            text = f.read(_CPUINFO_LIMIT)
+    except OSError:
+        return frozenset()
+    for line in text.splitlines():
+        key, _, value = line.partition(":")
+        if key.strip() == "flags":
+            return frozenset(value.split())
+    return frozenset()
+
+
+@contextlib.contextmanager
+def kernels_while_loading(cpuinfo: Path = Path("/proc/cpuinfo")) -> Iterator[str | None]:
+    """Within the block, ``OPENBLAS_CORETYPE`` names the kernels for this processor unless the
+    user set it (then it is left alone and None is yielded); afterwards it is unset again."""
+    if VARIABLE in os.environ:
+        yield None
+        return
+    name = kernels_for(cpu_flags(cpuinfo))
+    if name is None:
+        yield None
+        return
+    os.environ[VARIABLE] = name
+    try:
+        yield name
+    finally:
+        os.environ.pop(VARIABLE, None)
