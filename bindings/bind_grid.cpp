@@ -54,24 +54,6 @@ py::array mat_view(cv::Mat& mat, py::handle owner) {
                         mat.ptr<T>(0), owner);
 }
 
-cv::Mat numpy_to_image(const py::array& image) {
-  const auto kind = image.dtype().kind();
-  const auto size = image.itemsize();
-  if (kind != 'u' || (size != 1 && size != 2)) {
-    throw std::invalid_argument("image: expected dtype uint8 or uint16, got " +
-                                std::string(py::str(image.dtype())));
-  }
-  if (image.ndim() != 2 && !(image.ndim() == 3 && image.shape(2) >= 1 && image.shape(2) <= 4)) {
-    throw std::invalid_argument("image: expected shape (h, w) or (h, w, 1..4), got " +
-                                shape_string(image));
-  }
-  const int channels = image.ndim() == 3 ? static_cast<int>(image.shape(2)) : 1;
-  const auto c = py::array::ensure(image, py::array::c_style);
-  cv::Mat view(static_cast<int>(c.shape(0)), static_cast<int>(c.shape(1)),
-               CV_MAKETYPE(size == 1 ? CV_8U : CV_16U, channels), const_cast<void*>(c.data()));
-  return view.clone();
-}
-
 MapImageParams make_params(const std::string& mode, bool negate, double occ, double free) {
   MapImageParams p;
   if (mode == "trinary") p.mode = MapMode::Trinary;
@@ -221,13 +203,6 @@ void bind_map_image(py::module_& m) {
         },
         "grid"_a, "mode"_a = "trinary", "negate"_a = false, "occupied_thresh"_a = 0.65,
         "free_thresh"_a = 0.196);
-  m.def("read_image", [](const std::string& path) { return mat_to_numpy(read_image(path)); },
-        "path"_a, "Reads an image file as stored (OpenCV, channels in B, G, R, A order).");
-  m.def("write_image",
-        [](const std::string& path, const py::array& image) {
-          write_image(path, numpy_to_image(image));
-        },
-        "path"_a, "image"_a);
 }
 
 // Seconds of CPU time this thread has used (POSIX): a benchmark's measure on a shared machine,

@@ -107,4 +107,24 @@ inline py::array mat_to_numpy(cv::Mat mat) {
   return py::array(dt, shape, strides, owned->data, keep);
 }
 
+/// A numpy image (uint8 or uint16; (h, w) or (h, w, 1..4), channels in OpenCV's order) copied
+/// into a cv::Mat; ValueError naming what is wrong otherwise.
+inline cv::Mat numpy_to_image(const py::array& image) {
+  const auto kind = image.dtype().kind();
+  const auto size = image.itemsize();
+  if (kind != 'u' || (size != 1 && size != 2)) {
+    throw std::invalid_argument("image: expected dtype uint8 or uint16, got " +
+                                std::string(py::str(image.dtype())));
+  }
+  if (image.ndim() != 2 && !(image.ndim() == 3 && image.shape(2) >= 1 && image.shape(2) <= 4)) {
+    throw std::invalid_argument("image: expected shape (h, w) or (h, w, 1..4), got " +
+                                shape_string(image));
+  }
+  const int channels = image.ndim() == 3 ? static_cast<int>(image.shape(2)) : 1;
+  const auto c = py::array::ensure(image, py::array::c_style);
+  cv::Mat view(static_cast<int>(c.shape(0)), static_cast<int>(c.shape(1)),
+               CV_MAKETYPE(size == 1 ? CV_8U : CV_16U, channels), const_cast<void*>(c.data()));
+  return view.clone();
+}
+
 }  // namespace kiseki::bindings

@@ -12,6 +12,7 @@
 #include "kiseki/grid/distance_field.hpp"
 #include "kiseki/grid/local_window.hpp"
 #include "kiseki/grid/map_image.hpp"
+#include "kiseki/io/image_file.hpp"
 #include "kiseki/grid/ray_casting.hpp"
 
 using namespace kiseki;

@@ -14,6 +14,7 @@
 #include "kiseki/grid/map_image.hpp"
 #include "kiseki/grid/range_caster.hpp"
 #include "kiseki/grid/sector_caster.hpp"
+#include "kiseki/io/image_file.hpp"
 
 using namespace kiseki;
 using kiseki::test::room;

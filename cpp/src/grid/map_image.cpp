@@ -2,15 +2,9 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/grid/map_image.hpp"
 
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <cstring>
-#include <fstream>
-#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
-#include <vector>
 
 namespace kiseki {
 namespace {
@@ -115,44 +109,6 @@ cv::Mat image_from_occupancy(const OccupancyGrid& grid, const MapImageParams& pa
     }
   }
   return image;
-}
-
-cv::Mat read_image(const std::string& path) {
-  if (!std::ifstream(path).good()) throw std::runtime_error(path + ": cannot open image file");
-  cv::Mat image;
-  try {
-    image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path + ": cannot decode image (" + e.what() + ")");
-  }
-  if (image.empty()) throw std::runtime_error(path + ": cannot decode image");
-  return image;
-}
-
-void write_image(const std::string& path, const cv::Mat& image) {
-  // Encoded in memory, then written with every step checked: cv::imwrite reports success for a
-  // file that a full disk has cut short. The error ends with the system's reason.
-  const auto dot = path.find_last_of('.');
-  const auto slash = path.find_last_of('/');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) {
-    throw std::runtime_error(path + ": cannot write image (no file extension to choose a format by)");
-  }
-  std::vector<std::uint8_t> bytes;
-  bool ok = false;
-  try {
-    ok = cv::imencode(path.substr(dot), image, bytes);
-  } catch (const cv::Exception& e) {
-    throw std::runtime_error(path + ": cannot write image (" + e.what() + ")");
-  }
-  if (!ok) throw std::runtime_error(path + ": cannot write image (encoding failed)");
-  errno = 0;
-  std::FILE* out = std::fopen(path.c_str(), "wb");
-  if (out == nullptr) throw std::runtime_error(path + ": cannot write image: " + std::strerror(errno));
-  const std::size_t written = std::fwrite(bytes.data(), 1, bytes.size(), out);
-  int error = written == bytes.size() ? 0 : errno;
-  if (std::fclose(out) != 0 && error == 0) error = errno;  // a full disk shows at the flush
-  if (written != bytes.size() && error == 0) error = EIO;
-  if (error != 0) throw std::runtime_error(path + ": cannot write image: " + std::strerror(error));
 }
 
 }  // namespace kiseki

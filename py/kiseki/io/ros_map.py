@@ -38,6 +38,7 @@ __all__ = [
     "MapMetadata",
     "load_map",
     "map_files",
+    "read_image",
     "read_map_metadata",
     "save_map",
     "write_image",
@@ -162,7 +163,7 @@ def _load_ros_map(path: Path) -> OccupancyGrid:
         raise FileNotFoundError(f"{path}: image file {meta.image} not found")
     _check_binary_pgm(path, meta.image)
     try:
-        image = _core.read_image(str(meta.image))
+        image = read_image(meta.image)
     except RuntimeError as err:
         raise MapFormatError(f"{path}: {err}") from err
     return _core.occupancy_from_image(
@@ -192,13 +193,26 @@ def load_map(path: str | os.PathLike) -> OccupancyGrid:
     return _load_ros_map(path)
 
 
+def read_image(path: str | os.PathLike) -> np.ndarray:
+    """Reads an image file as stored (OpenCV's decoders: channels in B, G, R, A order, 8 or 16
+    bits). Raises RuntimeError naming `path` when it cannot be opened or decoded."""
+    # here, not at the top: OpenCV's codecs load GDAL and about 140 more libraries (0.1 s),
+    # which `import kiseki` and every command that reads no image should not pay for
+    from kiseki import _image_io
+
+    return _image_io.read_image(str(path))
+
+
 def write_image(path: str | os.PathLike, image: np.ndarray) -> None:
     """Writes an image file (OpenCV's encoders; the format by the extension). Raises OSError
     naming `path` when the file cannot be written whole, with the system's reason (a full disk:
     ENOSPC): the C++ writer checks every step, since cv::imwrite reports success for a PGM that
     a full disk has cut short, which an atomic rename would then put over a good map."""
+    # here, not at the top: as in read_image
+    from kiseki import _image_io
+
     try:
-        _core.write_image(str(path), image)
+        _image_io.write_image(str(path), image)
     except RuntimeError as err:
         text = str(err)
         text = text.removeprefix(f"{path}: ")

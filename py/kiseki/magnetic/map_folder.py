@@ -44,12 +44,11 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from kiseki import _core
 from kiseki._support.atomic import record_written
 from kiseki._support.inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
 from kiseki._support.yaml import read_yaml_file, safe_load_12
 from kiseki.errors import MapFormatError
-from kiseki.io.ros_map import write_image
+from kiseki.io.ros_map import read_image, write_image
 from kiseki.magnetic.map_doc import (
     COMPONENTS,
     KIND,
@@ -244,7 +243,7 @@ def _read_2d(folder: Path, doc: MagneticMapDoc, meta: Path, origin, resolution, 
         image = _file(folder, entry, "image", meta)
         _check_png_size(image, shape)
         try:
-            pixels = _core.read_image(str(image))
+            pixels = read_image(image)
         except RuntimeError as err:
             raise _fail(image, f"unreadable layer image ({err})") from None
         if pixels.shape != shape:

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "kiseki/grid/map_image.hpp"
+#include "kiseki/io/image_file.hpp"
 #include "temp_input.hpp"
 
 namespace {

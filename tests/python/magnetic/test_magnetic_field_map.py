@@ -12,6 +12,7 @@ import yaml
 from kiseki import _core
 from kiseki.errors import MapFormatError
 from kiseki.gp import ExactGP, SquaredExponential
+from kiseki.io.ros_map import read_image
 from kiseki.magnetic import map_gp as map_gp_module
 from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
 from kiseki.magnetic.map_folder import MAP_FILE
@@ -92,7 +93,7 @@ def test_layer_images_are_16_bit_pngs_with_the_top_row_at_the_highest_y(tmp_path
     for k, component in enumerate(("mx", "my", "mz")):
         for quantity in ("mean", "variance"):
             entry = doc["files"]["layers"][f"{component}_{quantity}"]
-            image = _core.read_image(str(tmp_path / "map" / entry["image"]))
+            image = read_image(tmp_path / "map" / entry["image"])
             assert image.dtype == np.uint16 and image.shape == (5, 7)
             decoded = entry["offset"] + entry["scale"] * image.astype(float)
             layer = getattr(fmap, quantity)[..., k]

@@ -39,10 +39,4 @@ OccupancyGrid occupancy_from_image(const cv::Mat& image, double resolution, cons
 /// raw writes the value itself and 255 for unknown. negate inverts trinary and scale shades.
 cv::Mat image_from_occupancy(const OccupancyGrid& grid, const MapImageParams& params);
 
-/// Reads an image file as stored (cv::IMREAD_UNCHANGED). Throws std::runtime_error naming the
-/// file when it does not exist or cannot be decoded.
-cv::Mat read_image(const std::string& path);
-/// Writes an image (PGM, PNG, ... by extension). Throws std::runtime_error on failure.
-void write_image(const std::string& path, const cv::Mat& image);
-
 }  // namespace kiseki
