@@ -9,10 +9,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "kiseki/core/angle.hpp"
+
 namespace kiseki {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 std::string degrees(double rad) {
   char buf[32];

@@ -8,11 +8,11 @@
 #include <vector>
 
 #include "dense.hpp"
+#include "kiseki/core/angle.hpp"
 
 namespace kiseki {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 constexpr Eigen::Index kChunk = 4096;  // rows of Phi built at once
 }  // namespace
 

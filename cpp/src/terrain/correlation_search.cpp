@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "kiseki/core/angle.hpp"
 #include "kiseki/core/parallel.hpp"
 #include "kiseki/terrain/virtual_sdem.hpp"
 
@@ -18,7 +19,6 @@ namespace kiseki {
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr double kMaxCandidates = 1e8;
 
@@ -126,7 +126,7 @@ CorrelationSearch::Level CorrelationSearch::make_level(int factor) const {
       const std::size_t block = static_cast<std::size_t>(row / factor) * level.cols + col / factor;
       current[block] = std::min(current[block], static_cast<float>(r));
       const double centre = grid_.phi_min_deg + ((col / factor) * factor + 0.5 * (factor - 1)) * grid_.step_deg;
-      weight[block] = static_cast<float>(std::cos(std::min(90.0, std::abs(centre)) * kDeg));
+      weight[block] = static_cast<float>(std::cos(std::min(90.0, std::abs(centre)) * kDegree));
       if (weight[block] <= 0) weight[block] = 1e-6f;  // a block on the pole keeps its data
     }
   }

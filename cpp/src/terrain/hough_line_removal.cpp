@@ -9,13 +9,13 @@
 #include <stdexcept>
 #include <string>
 
+#include "kiseki/core/angle.hpp"
 #include "kiseki/core/parallel.hpp"
 
 namespace kiseki {
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 void require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument("Hough line removal: " + message);
@@ -34,8 +34,8 @@ int remove_lines_in_scan(std::vector<ScanPoint>& points, const HoughLineParams& 
   const int rho_offset = rhos / 2;
   std::vector<double> cosines(static_cast<std::size_t>(angles)), sines(static_cast<std::size_t>(angles));
   for (int a = 0; a < angles; ++a) {
-    cosines[static_cast<std::size_t>(a)] = std::cos(a * p.angle_step_deg * kDeg);
-    sines[static_cast<std::size_t>(a)] = std::sin(a * p.angle_step_deg * kDeg);
+    cosines[static_cast<std::size_t>(a)] = std::cos(a * p.angle_step_deg * kDegree);
+    sines[static_cast<std::size_t>(a)] = std::sin(a * p.angle_step_deg * kDegree);
   }
   std::vector<int> votes(static_cast<std::size_t>(angles) * rhos);
   const auto bin_of = [&](const ScanPoint& q, int a) {

@@ -8,11 +8,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "kiseki/core/angle.hpp"
+
 namespace kiseki {
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::size_t kMaxCells = 10'000'000;
 
@@ -46,13 +47,13 @@ void SphereGrid::validate() const {
 
 int SphereGrid::rows() const { return count(theta_min_deg, theta_max_deg, step_deg); }
 int SphereGrid::cols() const { return count(phi_min_deg, phi_max_deg, step_deg); }
-double SphereGrid::theta(int row) const { return (theta_min_deg + row * step_deg) * kDeg; }
-double SphereGrid::phi(int col) const { return (phi_min_deg + col * step_deg) * kDeg; }
+double SphereGrid::theta(int row) const { return (theta_min_deg + row * step_deg) * kDegree; }
+double SphereGrid::phi(int col) const { return (phi_min_deg + col * step_deg) * kDegree; }
 
 long SphereGrid::cell_of(double theta, double phi) const {
-  const double step = step_deg * kDeg;
-  const double r = std::floor((theta - theta_min_deg * kDeg) / step + 0.5);
-  const double c = std::floor((phi - phi_min_deg * kDeg) / step + 0.5);
+  const double step = step_deg * kDegree;
+  const double r = std::floor((theta - theta_min_deg * kDegree) / step + 0.5);
+  const double c = std::floor((phi - phi_min_deg * kDegree) / step + 0.5);
   if (!(r >= 0 && r < rows() && c >= 0 && c < cols())) return -1;
   return static_cast<long>(r) * cols() + static_cast<long>(c);
 }

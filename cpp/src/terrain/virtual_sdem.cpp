@@ -7,11 +7,12 @@
 #include <cstring>
 #include <limits>
 
+#include "kiseki/core/angle.hpp"
+
 namespace kiseki {
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 /// Eight doubles, floats and ints: GCC's and Clang's vector types, so that eq. 4's sums are
@@ -54,7 +55,7 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void widened_cells(
     const float* px, const float* py, const float* pz, std::size_t n, float cx, float cy, float cz, float rho,
     CellProjection g, float max_range, int* __restrict row_lo, int* __restrict row_hi, int* __restrict col_lo,
     int* __restrict col_hi) {
-  constexpr float kMargin = 1e-4f, kPi = static_cast<float>(M_PI);
+  constexpr float kMargin = 1e-4f, kPiF = static_cast<float>(kPi);
   for (std::size_t i = 0; i < n; ++i) {
     const float x = px[i] - cx, y = py[i] - cy, z = pz[i] - cz;
     const float h2 = x * x + z * z, r = std::sqrt(h2 + y * y), h = std::sqrt(h2);
@@ -63,7 +64,7 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void widened_cells(
     const float d_ph = asin_bound(std::min(s_r, 0.5f)) + kMargin;
     const float d_th = asin_bound(std::min(s_h, 0.5f)) + kMargin;
     const bool any_ph = s_r >= 0.5f;  // too near: any direction
-    const bool any_th = (s_h >= 0.5f) | (th - d_th < -kPi) | (th + d_th > kPi);
+    const bool any_th = (s_h >= 0.5f) | (th - d_th < -kPiF) | (th + d_th > kPiF);
     const bool far = r - rho >= max_range;
     const float r_lo = any_th ? 0.0f : (th - d_th - g.th_edge) * g.inv;
     const float r_hi = any_th ? g.rows : (th + d_th - g.th_edge) * g.inv;
@@ -82,9 +83,9 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void widened_cells(
 CellProjection::CellProjection(const SphereGrid& grid, int factor, int level_rows, int level_cols_)
     : level_cols(level_cols_) {
   const double half = 0.5 * grid.step_deg;
-  th_edge = static_cast<float>((grid.theta_min_deg - half) * kDeg);
-  ph_edge = static_cast<float>((grid.phi_min_deg - half) * kDeg);
-  inv = static_cast<float>(1.0 / (grid.step_deg * kDeg));
+  th_edge = static_cast<float>((grid.theta_min_deg - half) * kDegree);
+  ph_edge = static_cast<float>((grid.phi_min_deg - half) * kDegree);
+  inv = static_cast<float>(1.0 / (grid.step_deg * kDegree));
   rows = static_cast<float>(grid.rows());
   cols = static_cast<float>(grid.cols());
   inv_factor = 1.0f / static_cast<float>(factor);

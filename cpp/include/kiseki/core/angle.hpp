@@ -5,6 +5,8 @@
 namespace kiseki {
 
 constexpr double kPi = 3.14159265358979323846;
+/// One degree in radians.
+constexpr double kDegree = kPi / 180.0;
 
 /// Wraps an angle to [-pi, pi).
 double normalize_angle(double angle);
