@@ -5,7 +5,8 @@
 An OpenBLAS built for many processors (``DYNAMIC_ARCH``, as Debian's) picks its kernels when it
 is loaded, from the processor's model number. A processor newer than the library falls back to
 its SSE3 kernels ("Prescott"): Debian 12's OpenBLAS 0.3.21 does so on a 5th-generation Xeon
-(family 6, model 207), where the Gaussian processes' factorisations then ran about 1.5x slower.
+(family 6, model 207), where the Gaussian processes then ran 1.5x (a hyperparameter fit on 870
+points) to 4x (a factorisation of 5,000) slower.
 ``OPENBLAS_CORETYPE`` names the kernels instead. kiseki sets it from the instruction sets that
 Linux reports in ``/proc/cpuinfo``, only when the user has not set it, and only while its core
 is loaded (`kernels_while_loading`), so that numpy's own OpenBLAS and child processes choose
