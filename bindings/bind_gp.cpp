@@ -44,15 +44,16 @@ void bind_gp(py::module_& m) {
   py::class_<ExactGaussianProcess>(m, "ExactGaussianProcess",
                                    "Exact GP regression with a squared-exponential kernel (see kiseki.gp.ExactGP).")
       .def(py::init([](const py::handle& inputs, const py::handle& targets, double sigma_f, double length_scale,
-                       double sigma_n, bool constant_mean) {
+                       double sigma_n, bool constant_mean, bool truncated_prediction) {
              const Rows x(inputs, "inputs");
              const Rows y(targets, "targets");
              const SquaredExponential k = kernel_of(sigma_f, length_scale, sigma_n);
              py::gil_scoped_release release;
-             return std::make_unique<ExactGaussianProcess>(x.map(), y.map(), k,
-                                                           constant_mean ? GpMean::constant : GpMean::zero);
+             return std::make_unique<ExactGaussianProcess>(
+                 x.map(), y.map(), k, constant_mean ? GpMean::constant : GpMean::zero, truncated_prediction);
            }),
-           "inputs"_a, "targets"_a, "sigma_f"_a, "length_scale"_a, "sigma_n"_a, "constant_mean"_a = true)
+           "inputs"_a, "targets"_a, "sigma_f"_a, "length_scale"_a, "sigma_n"_a, "constant_mean"_a = true,
+           "truncated_prediction"_a = true)
       .def(
           "predict",
           [](const ExactGaussianProcess& gp, const py::handle& points, double truncation) {

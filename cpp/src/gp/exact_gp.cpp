@@ -49,8 +49,9 @@ void check_training_data(const Eigen::Ref<const RowMatrix>& inputs, const Eigen:
 
 ExactGaussianProcess::ExactGaussianProcess(const Eigen::Ref<const RowMatrix>& inputs,
                                            const Eigen::Ref<const RowMatrix>& targets,
-                                           const SquaredExponential& kernel, GpMean mean)
-    : kernel_(kernel) {
+                                           const SquaredExponential& kernel, GpMean mean,
+                                           bool truncated_prediction)
+    : kernel_(kernel), truncated_(truncated_prediction) {
   kernel_.validate();
   check_training_data(inputs, targets);
   const Eigen::Index n = inputs.rows();
@@ -70,7 +71,7 @@ ExactGaussianProcess::ExactGaussianProcess(const Eigen::Ref<const RowMatrix>& in
   alpha_ = y;
   gp_detail::cholesky_solve(l, alpha_);
   // Blocks of prediction points far apart use parts of the inverse (see predict()).
-  if (n > kDenseBelow) inverse_ = gp_detail::inverse_from_cholesky(l);
+  if (truncated_ && n > kDenseBelow) inverse_ = gp_detail::inverse_from_cholesky(l);
   // Eq. 6.11 per column, summed: -1/2 y^T alpha - 1/2 log|K + sn^2 I| - n/2 log 2 pi.
   log_marginal_likelihood_ = -0.5 * (y.array() * alpha_.array()).sum() -
                              0.5 * static_cast<double>(k) * gp_detail::log_determinant(l) -
@@ -101,7 +102,7 @@ void ExactGaussianProcess::predict(const Eigen::Ref<const RowMatrix>& points, Ro
   // only the training points within the cutoff radius of its bounding box.
   std::vector<Eigen::Index> order(static_cast<std::size_t>(m));
   std::iota(order.begin(), order.end(), Eigen::Index{0});
-  const bool dense = truncation == 0.0 || n <= kDenseBelow;
+  const bool dense = !truncated_ || truncation == 0.0 || n <= kDenseBelow;
   // Block boundaries: every kMaxBlock points; without `dense`, also wherever the tile changes.
   std::vector<Eigen::Index> starts;
   if (dense) {

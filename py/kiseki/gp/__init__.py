@@ -7,6 +7,7 @@
   :func:`refine_hyperparameters` carries a subsample's maximum to every reading;
 * :class:`ExactGP`: exact regression (eqs. 6.7-6.9), one factorisation for all field components;
 * :class:`HilbertGP`: the reduced-rank approximation for maps of tens of thousands of readings;
+* :class:`TiledGP`: a grid of overlapping exact or reduced-rank GPs, for a whole floor;
 * :class:`CurlFreeGP`, :class:`ReducedRankCurlFreeGP`: the field as the gradient of a scalar
   potential plus a constant (Solin et al., IEEE T-RO 2018), exact and reduced-rank, in numpy;
   :func:`fit_curl_free_hyperparameters` their :class:`CurlFreeKernel`'s hyperparameters.
@@ -23,13 +24,14 @@ from kiseki.gp.curl_free import (
 )
 from kiseki.gp.curl_free_basis import ReducedRankCurlFreeGP
 from kiseki.gp.exact import ExactGP
-from kiseki.gp.hilbert import HilbertGP
+from kiseki.gp.hilbert import HilbertGP, hilbert_basis_size
 from kiseki.gp.kernel import (
     HyperparameterFit,
     SquaredExponential,
     fit_hyperparameters,
     refine_hyperparameters,
 )
+from kiseki.gp.tiled import TiledGP
 
 __all__ = [
     "CurlFreeFit",
@@ -40,7 +42,9 @@ __all__ = [
     "HyperparameterFit",
     "ReducedRankCurlFreeGP",
     "SquaredExponential",
+    "TiledGP",
     "fit_curl_free_hyperparameters",
     "fit_hyperparameters",
+    "hilbert_basis_size",
     "refine_hyperparameters",
 ]

@@ -13,7 +13,7 @@ from kiseki import _core
 from kiseki.gp._data import check_mean, inputs_array, targets_array
 from kiseki.gp.kernel import SquaredExponential
 
-__all__ = ["HilbertGP"]
+__all__ = ["HilbertGP", "hilbert_basis_size"]
 
 
 class HilbertGP:
@@ -111,3 +111,17 @@ class HilbertGP:
     def prior_variance(self) -> np.ndarray:
         """sigma_f^2 per column."""
         return np.full(self.outputs, self.kernel.sigma_f**2)
+
+
+def hilbert_basis_size(sides: Any, length_scale: float, tolerance: float = 1e-4) -> int:
+    """The basis size m of :class:`HilbertGP` on a box with these side lengths, by its rule: the
+    Laplacian's eigenfunctions sin(pi j_d (x_d - lower_d) / side_d), j_d = 1, 2, ..., whose
+    frequency sqrt(sum_d (pi j_d / side_d)^2) is at most w_max, S(w_max) = tolerance S(0) (at
+    least one function)."""
+    w_max = math.sqrt(-2.0 * math.log(tolerance)) / length_scale
+    axes = [
+        np.pi * np.arange(1, max(1, math.floor(w_max * side / math.pi)) + 1) / side
+        for side in np.atleast_1d(np.asarray(sides, dtype=float))
+    ]
+    w2 = sum(a**2 for a in np.meshgrid(*axes, indexing="ij", sparse=True))
+    return max(1, int((w2 <= w_max**2).sum()))
