@@ -18,21 +18,23 @@ from kiseki._support.options import CELL_LIMITS, Count, Metres, Seed, refuse_giv
 from kiseki.datasets.magnetic import concatenate_samples, read_magnetic_data
 from kiseki.gp import (
     CurlFreeKernel,
+    HilbertGP,
     SquaredExponential,
     fit_curl_free_hyperparameters,
     fit_hyperparameters,
+    hilbert_basis_size,
 )
 from kiseki.gp.kernel import subsample
 from kiseki.magnetic.binning import bin_readings
 from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
 from kiseki.magnetic.map_folder import check_map_destination
-from kiseki.magnetic.map_gp import MODELS, fit_component_gps, predictor_state
+from kiseki.magnetic.map_gp import METHODS, MODELS, fit_component_gps, predictor_state
 
 __all__ = ["KERNEL_LIMITS", "fit"]
 
 console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
 EXACT_LIMIT = 10_000  # beyond this many measurements the default is the reduced-rank GP
-METHODS = ("exact", "hilbert")
+HILBERT_LIMIT = 20_000  # and beyond this many basis functions (HilbertGP's cap) the tiled GP
 # The curl-free model's defaults are gp-aalto-defaults' pick (leave-one-run-out on both Aalto
 # sensors: the lowest mean held-out RMSE among the methods that use every reading given): the
 # exact curl-free GP on readings averaged per 0.1 m cell, its hyperparameters by marginal
@@ -93,7 +95,11 @@ def _check_fit_options(ctx: typer.Context, kernel, max_points, method, units, mo
         if max_points is None:  # no search and no subsample: nothing random
             refuse_given(ctx, ["seed"], "with --kernel and without --max-points (nothing random)")
     if method is not None and method not in METHODS:
-        raise ValueError(f"--method must be exact or hilbert, got {method!r}")
+        raise ValueError(f"--method must be exact, hilbert or tiled, got {method!r}")
+    if method == "tiled" and model == "curl-free":
+        raise ValueError(
+            "--method tiled is for --model independent (the curl-free GP is not tiled)"
+        )
     if units is not None and units not in ("uT", "G"):
         raise ValueError(f"--units must be uT or G, got {units!r}")
 
@@ -113,17 +119,19 @@ def _read_data(data: list[Path], units: str | None, dimension: int | None):
     return x, np.asarray(samples.field), height, units or samples.units
 
 
-def _fit_gps(x, y, kernel, per_component: bool, method: str, seed: int, model: str):
-    """(GPs, kernels, seconds for the hyperparameters, seconds for the fit)."""
+def _fit_gps(x, y, kernel, per_component: bool, method: str | None, seed: int, model: str):
+    """(GPs, kernels, method, seconds for the hyperparameters, seconds for the fit); method None
+    is the default for the model, the readings and (independent) the fitted length scale."""
     if model == "curl-free":
         start = time.perf_counter()
         if kernel is None:  # the log marginal likelihood's maximum on a seeded subsample
             found = fit_curl_free_hyperparameters(x, y, max_points=CURL_FREE_FIT_POINTS, seed=seed)
             kernel = found.kernel
         hyper = time.perf_counter() - start
+        method = method or _default_method(model, len(x))
         start = time.perf_counter()
         gps = fit_component_gps(x, y, kernel, method)
-        return gps, [kernel], hyper, time.perf_counter() - start
+        return gps, [kernel], method, hyper, time.perf_counter() - start
     columns = [slice(k, k + 1) for k in range(3)] if per_component else [slice(0, 3)]
     start = time.perf_counter()
     if kernel is not None:
@@ -131,9 +139,13 @@ def _fit_gps(x, y, kernel, per_component: bool, method: str, seed: int, model: s
     else:  # maximise the log marginal likelihood (eqs. 6.11-6.15)
         kernels = [fit_hyperparameters(x, y[:, c], seed=seed).kernel for c in columns]
     hyper = time.perf_counter() - start
+    if method is None:
+        method = _default_method(model, len(x))
+        if method == "hilbert" and _one_box_basis(x, kernels) > HILBERT_LIMIT:
+            method = "tiled"
     start = time.perf_counter()
     gps = fit_component_gps(x, y, kernels, method)
-    return gps, kernels, hyper, time.perf_counter() - start
+    return gps, kernels, method, hyper, time.perf_counter() - start
 
 
 def _default_method(model: str, points: int) -> str:
@@ -141,9 +153,16 @@ def _default_method(model: str, points: int) -> str:
     return "exact" if points <= limit else "hilbert"
 
 
+def _one_box_basis(x: np.ndarray, kernels) -> int:
+    """The basis size of one HilbertGP on the data's default box (4 length scales around it),
+    for the shortest length scale fitted."""
+    ell = min(k.length_scale for k in kernels)
+    return hilbert_basis_size(np.ptp(x, axis=0) + 8 * ell, ell)
+
+
 def _hilbert_settings(gp) -> dict | None:
     """The reduced-rank GP's box, so that predictions rebuild the same GP."""
-    if not hasattr(gp, "lower"):
+    if not isinstance(gp, HilbertGP):
         return None
     return {"domain": [np.asarray(gp.lower).tolist(), np.asarray(gp.upper).tolist()]}
 
@@ -200,8 +219,10 @@ def fit(
     ),
     method: str | None = typer.Option(
         None,
-        help=f"exact or hilbert (reduced rank); default: exact up to {EXACT_LIMIT:,} "
-        f"measurements ({CURL_FREE_EXACT_LIMIT:,} for the curl-free model).",
+        help="exact, hilbert (reduced rank) or tiled (a grid of overlapping GPs, --model "
+        f"independent); default: exact up to {EXACT_LIMIT:,} measurements "
+        f"({CURL_FREE_EXACT_LIMIT:,} for the curl-free model), then hilbert, and tiled where one "
+        f"reduced-rank GP would need over {HILBERT_LIMIT:,} basis functions.",
     ),
     units: str | None = typer.Option(None, help="uT or G: the units of CSV data."),
     bin_size: float | None = typer.Option(
@@ -230,14 +251,17 @@ def fit(
     if max_points is not None and len(x) > max_points:  # after --bin: of the cells' readings
         keep = subsample(len(x), max_points, seed)
         x, y = x[keep], y[keep]
-    method = method or _default_method(model, len(x))
-    if model == "curl-free" and method == "exact" and len(x) > CURL_FREE_EXACT_MAX:
+    if (
+        model == "curl-free"
+        and (method or _default_method(model, len(x))) == "exact"
+        and len(x) > CURL_FREE_EXACT_MAX
+    ):
         raise ValueError(
             f"--method exact: {len(x):,} readings need a {72 * len(x) ** 2 / 1e9:.1f} GB "
             f"curl-free factor (at most {CURL_FREE_EXACT_MAX:,}); use --method hilbert or a "
             "larger --bin"
         )
-    gps, kernels, t_hyper, t_fit = _fit_gps(x, y, fixed, per_component, method, seed, model)
+    gps, kernels, method, t_hyper, t_fit = _fit_gps(x, y, fixed, per_component, method, seed, model)
     lml = [float(g.log_marginal_likelihood()) for g in gps if hasattr(g, "log_marginal_likelihood")]
     start = time.perf_counter()
     lower, upper = x.min(axis=0) - margin, x.max(axis=0) + margin

@@ -35,6 +35,7 @@ from kiseki.errors import MapFormatError
 from kiseki.gp import CurlFreeKernel, SquaredExponential
 from kiseki.magnetic.map_folder import COMPONENTS, read_map_folder, write_map_folder
 from kiseki.magnetic.map_gp import (
+    METHODS,
     as_gp_list,
     column_kernels,
     evaluate_on_cells,
@@ -70,8 +71,9 @@ class TrainingData:
     """The measurements a map was fitted from, kept so that predictions can re-evaluate the
     GP exactly (eqs. 6.8-6.9) at any point instead of interpolating the grid.
 
-    inputs (n, d) metres; outputs (n, 3) field in the map's units; method "exact" or
-    "hilbert" (reduced rank); mean "constant" or "zero" (the independent GPs' prior mean);
+    inputs (n, d) metres; outputs (n, 3) field in the map's units; method "exact", "hilbert"
+    (reduced rank) or "tiled" (a grid of GPs, :class:`~kiseki.gp.TiledGP`); mean "constant" or
+    "zero" (the independent GPs' prior mean);
     hilbert: the reduced-rank GP's box ``{"domain": [lower, upper]}``, or None; predictor: the
     fitted GP's arrays (:func:`kiseki.magnetic.map_gp.predictor_state`) for predictions with no
     refit, or None."""
@@ -89,8 +91,8 @@ class TrainingData:
             raise ValueError(f"training inputs must have shape (n, 2) or (n, 3), got {x.shape}")
         object.__setattr__(self, "inputs", _finite("training inputs", x))
         object.__setattr__(self, "outputs", _finite("training outputs", self.outputs, (len(x), 3)))
-        if self.method not in ("exact", "hilbert"):
-            raise ValueError(f"training method must be exact or hilbert, got {self.method!r}")
+        if self.method not in METHODS:
+            raise ValueError(f"training method must be one of {METHODS}, got {self.method!r}")
         if self.mean not in ("constant", "zero"):
             raise ValueError(f"training mean must be constant or zero, got {self.mean!r}")
         if self.predictor is not None:

@@ -7,8 +7,9 @@ that predictions at any point need no refit.
 Two field models:
 
 * ``independent``: mx, my and mz as GPs with squared-exponential kernels (thesis ch. 6, eqs.
-  6.7-6.9), one kernel shared or one per component, exact (:class:`~kiseki.gp.ExactGP`) or
-  reduced-rank (:class:`~kiseki.gp.HilbertGP`); a map keeps its readings and rebuilds the GP
+  6.7-6.9), one kernel shared or one per component, exact (:class:`~kiseki.gp.ExactGP`),
+  reduced-rank (:class:`~kiseki.gp.HilbertGP`) or a grid of either for a whole floor
+  (:class:`~kiseki.gp.TiledGP`); a map keeps its readings and rebuilds the GP
   (no optimisation) the first time it predicts;
 * ``curl-free``: the field as the gradient of a scalar potential plus a constant (Solin et al.,
   IEEE T-RO 2018; :class:`~kiseki.gp.CurlFreeGP`, :class:`~kiseki.gp.ReducedRankCurlFreeGP`);
@@ -32,10 +33,12 @@ from kiseki.gp import (
     ExactGP,
     HilbertGP,
     ReducedRankCurlFreeGP,
+    TiledGP,
 )
 
 __all__ = [
     "CURL_FREE_BASIS",
+    "METHODS",
     "MODELS",
     "as_gp_list",
     "column_kernels",
@@ -47,6 +50,7 @@ __all__ = [
 ]
 
 MODELS = ("curl-free", "independent")
+METHODS = ("exact", "hilbert", "tiled")  # "tiled": the independent model's only
 CURL_FREE_BASIS = 1024
 """Eigenfunctions of the reduced-rank curl-free GP (the most that gp-aalto-defaults measured:
 4.45 uT mean held-out RMSE against 3.68 for the exact GP on binned readings)."""
@@ -134,9 +138,14 @@ def evaluate_on_cells(gps: list, centres, total: int, progress: bool):
 
 def fit_component_gps(x, y, kernels, method: str, *, mean: str = "constant", domain=None) -> list:
     """GPs of the field's three columns: one GP of all three with one kernel, or one GP per
-    column with three; exact or reduced-rank ("hilbert", on `domain` or its default box). With
-    a :class:`~kiseki.gp.CurlFreeKernel`, the curl-free GP (reduced-rank: 1,024 functions)."""
+    column with three; exact, reduced-rank ("hilbert", on `domain` or its default box) or
+    "tiled". With a :class:`~kiseki.gp.CurlFreeKernel`, the curl-free GP (reduced-rank: 1,024
+    functions; not tiled)."""
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if isinstance(kernels, CurlFreeKernel):
+        if method == "tiled":
+            raise ValueError("the curl-free model is not tiled: use exact or hilbert")
         if method == "exact":
             return [CurlFreeGP.fit(x, y, kernels)]
         gp = ReducedRankCurlFreeGP.fit(x, y, kernels, basis=CURL_FREE_BASIS, domain=domain)
@@ -146,6 +155,8 @@ def fit_component_gps(x, y, kernels, method: str, *, mean: str = "constant", dom
     pairs = zip(kernels, columns, strict=True)
     if method == "exact":
         return [ExactGP.fit(x, y[:, c], k, mean=mean) for k, c in pairs]
+    if method == "tiled":
+        return [TiledGP.fit(x, y[:, c], k, mean=mean) for k, c in pairs]
     return [HilbertGP.fit(x, y[:, c], k, domain=domain, mean=mean) for k, c in pairs]
 
 

@@ -13,6 +13,9 @@ import pytest
 import yaml
 from PIL import Image
 
+from kiseki.cli.magnetic_fit import HILBERT_LIMIT, _fit_gps, _one_box_basis
+from kiseki.gp import SquaredExponential, TiledGP
+
 
 def run(*args, cwd=None) -> subprocess.CompletedProcess:
     return subprocess.run(
@@ -141,6 +144,48 @@ def test_render_draws_six_panels_of_the_stated_size(synthetic):
     assert pixels.std() > 30  # colour panels, not a blank page
 
 
+def test_a_tiled_map_predicts_what_the_exact_map_predicts(tmp_path):
+    """A 24 x 4 m corridor, 2,400 readings, the same given kernel (signal-to-noise ratio 60):
+    --method tiled (a grid of GPs, more than one tile here) predicts held-out points within 0.1
+    of the readings' noise RMS (0.5 at worst) of --method exact, and its map keeps the method,
+    so that predict rebuilds the same tiles."""
+    rng = np.random.default_rng(2)
+    p = rng.uniform([0.0, 0.0], [24.0, 4.0], (2400, 2))
+    field = smooth_field(p) + rng.normal(0.0, 0.05, (len(p), 3))
+    write_csv(tmp_path / "long.csv", "x,y,mx,my,mz", np.column_stack([p, field]))
+    at = rng.uniform([0.5, 0.5], [23.5, 3.5], (80, 2))
+    write_csv(tmp_path / "at.csv", "x,y", at)
+    predicted = {}
+    for method in ("exact", "tiled"):
+        args = ("fit", "long.csv", "-o", method, "--kernel", "3,0.5,0.05", "--resolution", 0.25)
+        done = run(*args, "--model", "independent", "--method", method, cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        assert f"({method} GP)" in done.stdout
+        doc = yaml.safe_load((tmp_path / method / "magnetic_map.yaml").read_text())
+        assert doc["training"]["method"] == method
+        done = run("predict", method, "--at", "at.csv", "-o", f"{method}.csv", cwd=tmp_path)
+        assert done.returncode == 0, done.stderr
+        predicted[method] = read_csv(tmp_path / f"{method}.csv")[1][:, 2:5]
+    gap = predicted["tiled"] - predicted["exact"]
+    assert np.sqrt(np.mean(gap**2)) < 0.1 * 0.05 and np.abs(gap).max() < 0.5 * 0.05
+    tiles = TiledGP.fit(p, field, SquaredExponential(3.0, 0.5, 0.05))
+    assert tiles.tiles > 1
+
+
+def test_beyond_one_reduced_rank_gps_reach_the_default_is_tiled():
+    """10,001 readings over 100 x 100 m at l = 0.5 m: one HilbertGP would need about 58,000
+    basis functions (over its cap), so the default method after the exact GP's 10,000 readings
+    is the tiled GP; on a 10 x 10 m floor it stays the reduced-rank GP."""
+    rng = np.random.default_rng(4)
+    kernel = SquaredExponential(3.0, 0.5, 0.05)
+    wide = rng.uniform(0.0, 100.0, (10_001, 2))
+    assert _one_box_basis(wide, [kernel]) > HILBERT_LIMIT
+    gps, _, method, _, _ = _fit_gps(wide, smooth_field(wide), kernel, False, None, 0, "independent")
+    assert method == "tiled" and isinstance(gps[0], TiledGP)
+    small = wide / 10.0
+    assert _one_box_basis(small, [kernel]) <= HILBERT_LIMIT
+
+
 def test_a_3d_map_from_3d_data(tmp_path):
     rng = np.random.default_rng(2)
     p = rng.uniform([0, 0, 0], [2, 2, 1], (150, 3))
@@ -225,6 +270,7 @@ def inputs(tmp_path_factory):
         (["fit", "d.csv", "-o", "x", "--resolution", "0"], "--resolution"),
         (["fit", "d.csv", "-o", "x", "--kernel", "1,-2,0.1"], "--kernel"),
         (["fit", "d.csv", "-o", "x", "--method", "sparse"], "--method"),
+        (["fit", "d.csv", "-o", "x", "--method", "tiled"], "--method tiled is for --model"),
         (["fit", "d.csv", "-o", "x", "--dimension", "3"], "2-D positions"),
         (["fit", "d.csv", "-o", "x", "--margin", "-1"], "--margin"),
         (["fit", "d.csv", "-o", "x", "--bin", "0"], "--bin"),
