@@ -51,7 +51,7 @@ from pathlib import Path
 import numpy as np
 from sklearn.gaussian_process import GaussianProcessRegressor
 
-from gp_cases_3d import case_hilbert, case_volume, rmse  # beside this file
+from gp_cases_3d import case_hilbert, case_tiled, case_volume, rmse  # beside this file
 from gp_reference import run_sklearn_limited, sklearn_kernel, start_kernel
 from kiseki.datasets import read_aalto_run
 from kiseki.gp import ExactGP
@@ -229,7 +229,7 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=2, help="best of, for times")
     parser.add_argument("--hilbert-points", type=int, default=1000, help="hyperparameter subsample")
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--cases", default="aalto,floor,volume,hilbert")
+    parser.add_argument("--cases", default="aalto,floor,volume,hilbert,tiled")
     args = parser.parse_args()
     if args.quick:
         args.restarts, args.restarts_large, args.repeats = min(args.restarts, 1), 0, 1
@@ -255,6 +255,8 @@ def main() -> None:
         case_volume(args, rows)
     if "hilbert" in cases:
         case_hilbert(args, rows)
+    if "tiled" in cases:
+        case_tiled(args, rows)
     print(f"\nload average {os.getloadavg()[0]:.1f} at the end\n")
     print("| case | kiseki | scikit-learn (or paper) | ratio |\n|---|---|---|---|")
     for row in rows:
