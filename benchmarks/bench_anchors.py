@@ -79,6 +79,7 @@ from anchors_harness import (  # beside this file
 )
 from kiseki.core import derive_seed
 from kiseki.metrics import ape
+from timing import machine_line  # beside this file
 
 LOG = "intel"
 # (library, its harness, beam combination); the rows of one particle and thread count
@@ -299,6 +300,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
+    print(machine_line(), flush=True)
     if not anchors_present(args.anchors):
         print(f"bench_anchors: the anchors' sources are not at {args.anchors}: skipped")
         return 0

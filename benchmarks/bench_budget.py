@@ -27,6 +27,7 @@ from kiseki.datasets import read_carmen_log
 from kiseki.filters import LocalizeConfig, calibrate, localize, motion_alphas
 from kiseki.mapping import MapBuildConfig, map_of_log
 from kiseki.metrics import ape
+from timing import machine_line  # beside this file
 
 LOG = (
     Path(__file__).resolve().parents[2]
@@ -69,6 +70,7 @@ def main() -> None:
     parser.add_argument("--beams", type=int, default=360)
     parser.add_argument("--log", type=Path, default=LOG, help="the Freiburg-079 corrected log")
     args = parser.parse_args()
+    print(machine_line(), flush=True)
     if not args.log.is_file():
         raise SystemExit(f"the Freiburg-079 log is not at {args.log}")
     full = read_carmen_log(args.log).scans

@@ -13,8 +13,6 @@ Needs ../shared/data (the recorded datasets). Run: python benchmarks/bench_found
 
 from __future__ import annotations
 
-import os
-import platform
 import sys
 import time
 from pathlib import Path
@@ -24,7 +22,7 @@ import numpy as np
 from kiseki.datasets import read_carmen_log
 from kiseki.grid import OccupancyGrid, beam_angles
 from kiseki.mapping import build_map, endpoint_agreement
-from timing import best_of  # beside this file
+from timing import best_of, machine_line  # beside this file
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 
@@ -47,21 +45,11 @@ def numpy_cast(grid: OccupancyGrid, poses: np.ndarray, angles: np.ndarray, max_r
     return out
 
 
-def cpu_name() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.machine()
-
-
 def main() -> int:
     if not DATA.is_dir():
         print(f"recorded datasets not found at {DATA}: nothing to benchmark")
         return 1
-    print(f"machine: {cpu_name()}, {os.cpu_count()} cores, Python {platform.python_version()}")
+    print(machine_line())
     start = time.perf_counter()
     log = read_carmen_log(DATA / "carmen" / "intel-corrected.log.gz")
     read_s = time.perf_counter() - start

@@ -63,7 +63,7 @@ from kiseki_experiments.gp.gp_common import (
     magnetic_world,
     survey_2d,
 )
-from timing import best_of
+from timing import best_of, machine_line
 
 ROOT = Path(__file__).resolve().parents[1]
 AALTO = ROOT.parent / "shared" / "data" / "magnetic" / "aalto" / "invensense"
@@ -231,10 +231,10 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--cases", default="aalto,floor,volume,hilbert,tiled")
     args = parser.parse_args()
+    print(machine_line(), flush=True)
     if args.quick:
         args.restarts, args.restarts_large, args.repeats = min(args.restarts, 1), 0, 1
     cases = set(args.cases.split(","))
-    print(f"{os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at the start")
     rows: list[tuple[str, str, str, str]] = []
     if "aalto" in cases:
         if AALTO.is_dir():

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from kiseki.magnetic.lidar_mcl import LidarMclConfig
 from kiseki_experiments.magnav.magnav_lidar_drive import drive, teach_heading_map
+from timing import machine_line  # beside this file
 
 WORLDS = Path(__file__).resolve().parents[1] / "data" / "worlds"
 GOAL = 20.0  # x real time
@@ -33,6 +34,7 @@ def main() -> None:
     parser.add_argument("--beams", type=int, default=60)
     parser.add_argument("--threads", type=int, default=1, help="the engine's (0: every core)")
     args = parser.parse_args()
+    print(machine_line(), flush=True)
     config = LidarMclConfig(particles=args.particles, beams=args.beams, threads=args.threads)
     for scene in ("magnetic_path.yaml", "magnetic_lidar_path.yaml"):
         path = WORLDS / scene

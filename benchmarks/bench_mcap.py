@@ -33,6 +33,7 @@ import numpy as np
 from mcap.writer import CompressionType, Writer
 
 from kiseki.io.runlog import RunWriter, read_run
+from timing import machine_line  # beside this file
 
 SCANS, BEAMS, IMAGES, HEIGHT, WIDTH = 2000, 1081, 100, 120, 160
 MAX_RANGE = 30.0
@@ -154,6 +155,7 @@ def median_of(fn: Callable[[], tuple[float, float]]) -> tuple[float, float]:
 
 
 def main() -> None:
+    print(machine_line(), flush=True)
     poses, ranges, depth = make_data()
     rows = []
     with tempfile.TemporaryDirectory() as folder:

@@ -24,6 +24,7 @@ import numpy as np
 from kiseki.datasets import read_carmen_log
 from kiseki.filters import LocalizeConfig, MclConfig, MonteCarloLocalizer, scan_model
 from kiseki.mapping import MapBuildConfig, map_of_log
+from timing import machine_line  # beside this file
 
 LOG = (
     Path(__file__).resolve().parents[2]
@@ -66,6 +67,7 @@ def main() -> None:
         default=["likelihood-field", "beam"],
     )
     args = parser.parse_args()
+    print(machine_line(), flush=True)
     if args.scans < 1 or min(args.particles) < 1:
         parser.error("scans and particles must be >= 1")
     if not LOG.is_file():

@@ -58,6 +58,7 @@ from amcl_inputs import (  # beside this file
 from kiseki.filters import LOCALIZATION_METHODS, LocalizeConfig
 from kiseki.grid import FREE, OCCUPIED
 from kiseki.metrics import ape
+from timing import machine_line  # beside this file
 
 try:
     import amcl  # GPL-3.0, the benchmark extra only
@@ -284,6 +285,7 @@ def main(argv: list[str] | None = None) -> int:
         print("bench_nav2_amcl: needs the GPL-3.0 nav2 AMCL bindings: pip install amcl")
         return 1
     args = parse_args(argv)
+    print(machine_line(), flush=True)
     if not DATA.is_dir():
         print(f"recorded datasets not found at {DATA}: nothing to benchmark")
         return 1

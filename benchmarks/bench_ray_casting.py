@@ -49,6 +49,7 @@ from kiseki.filters import (
 )
 from kiseki.grid import FREE, RangeCaster, SectorCaster
 from kiseki.mapping import MapBuildConfig, map_of_log
+from timing import machine_line  # beside this file
 
 BUILD_THREADS = os.environ.get("OMP_NUM_THREADS", os.cpu_count())
 GOAL = 25e6  # rays/s on one core: a beam model 5x nav2's
@@ -214,6 +215,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--quick", action="store_true", help="500 poses, 30 scans, 1000 particles")
     args = parser.parse_args(argv)
+    print(machine_line(), flush=True)
     if args.quick:
         args.poses, args.scans, args.particles = 500, 30, [1000]
     if min(args.poses, args.repeats, args.scans, *args.particles) < 1:

@@ -27,6 +27,7 @@ from kiseki.datasets import read_carmen_log, read_wean_log
 from kiseki.filters import RelocalizeConfig, Relocalizer
 from kiseki.io.ros_map import load_map
 from kiseki.mapping import MapBuildConfig, map_of_log
+from timing import machine_line  # beside this file
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 
@@ -68,6 +69,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--scans", type=int, default=10, help="scans timed per map")
     args = parser.parse_args()
+    print(machine_line(), flush=True)
     intel = DATA / "carmen" / "intel-corrected.log.gz"
     wean_map, wean_log = DATA / "cmu_wean" / "wean.dat.gz", DATA / "cmu_wean" / "robotdata1.log.gz"
     for path in (intel, wean_map, wean_log):

@@ -24,6 +24,7 @@ import uvicorn
 from websockets.sync.client import connect
 
 from kiseki.serve import build_server
+from timing import machine_line  # beside this file
 
 
 def _free_port() -> int:
@@ -67,6 +68,7 @@ def main() -> None:
     parser.add_argument("--trials", type=int, default=10)
     parser.add_argument("--continued", type=int, default=3, help="routes going on (~15 s each)")
     args = parser.parse_args()
+    print(machine_line(), flush=True)
     server = build_server(args.taught, method=args.method, particles=args.particles)
     names = [w["name"] for w in server.taught.waypoints]
     route = {"start": names[0], "via": names[1:-1], "goal": names[-1]}

@@ -22,12 +22,13 @@ from kiseki import _core
 from kiseki.sim.run import SimConfig, simulate
 from kiseki.sim.scene import load_scene
 from kiseki.sim.sensors import LASER_PRESETS, DepthCamera, DepthCameraParams, Mount
-from timing import best_of  # beside this file
+from timing import best_of, machine_line  # beside this file
 
 WORLDS = Path(__file__).resolve().parents[1] / "data" / "worlds"
 
 
 def main() -> None:
+    print(machine_line(), flush=True)
     factory = load_scene(WORLDS / "factory_corridor.yaml")
     with tempfile.TemporaryDirectory() as tmp:
         runs = [

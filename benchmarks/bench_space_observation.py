@@ -21,11 +21,13 @@ from kiseki.filters import MclConfig, MonteCarloLocalizer
 from kiseki.grid import beam_angles
 from kiseki.models import LocalMapBuilder, SpaceObservationModel, likelihood_reference
 from kiseki.sim.scene import load_scene
+from timing import machine_line  # beside this file
 
 WORLDS = Path(__file__).resolve().parents[1] / "data" / "worlds"
 
 
 def main() -> None:
+    print(machine_line(), flush=True)
     scene = load_scene(WORLDS / "factory_corridor.yaml")
     scene.grid_resolution = 0.1  # the thesis' map resolution
     grid = scene.ground_truth(0.35, 0.45)

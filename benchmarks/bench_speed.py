@@ -25,6 +25,7 @@ from kiseki.speed import (
     SpeedLimiter,
     occlusion_ratio,
 )
+from timing import machine_line  # beside this file
 
 WORLDS = Path(__file__).resolve().parents[1] / "data" / "worlds"
 
@@ -41,6 +42,7 @@ def per_call(fn, calls: list, repeats: int = 5) -> float:
 
 
 def main() -> None:
+    print(machine_line(), flush=True)
     scene = load_scene(WORLDS / "speed_crossroad.yaml", "playback")
     prior = load_scene(WORLDS / "speed_crossroad.yaml").ground_truth(0.28, 0.32)
     world = scene.ground_truth(0.28, 0.32)

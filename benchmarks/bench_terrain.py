@@ -38,6 +38,7 @@ from kiseki.terrain import (
     sdem_from_points,
     sdem_from_ranges,
 )
+from timing import machine_line  # beside this file
 
 ROOT = Path(__file__).resolve().parents[1]
 DEG = math.pi / 180
@@ -66,6 +67,7 @@ def numpy_eq4(prev_points, current_ranges, rot, t):
 
 
 def main() -> None:
+    print(machine_line(), flush=True)
     stops = terrain_stops(ROOT / "data" / "worlds" / "rubble_a.yaml", 1, seed=0)
     (a, raw_a), (b, _) = levelled(stops[0]), levelled(stops[1])
     kept_a, kept_b = remove_planes(a, "hough").kept, remove_planes(b, "hough").kept

@@ -22,8 +22,8 @@ Run: python benchmarks/bench_terrain_baselines.py [SEED]
 
 from __future__ import annotations
 
+import argparse
 import math
-import sys
 import time
 from pathlib import Path
 
@@ -32,6 +32,7 @@ import numpy as np
 from kiseki.sim.pose6 import PAPER_MOVES, Pose6
 from kiseki.terrain import correlation_search, remove_planes
 from kiseki_experiments.terrain.terrain_common import local_maps
+from timing import machine_line  # beside this file
 
 ROOT = Path(__file__).resolve().parents[1]
 WORLDS = ROOT / "data" / "worlds"
@@ -89,6 +90,7 @@ def kiss_icp_row(prev_points, cur_points):
 
 
 def main(seed: int) -> None:
+    print(machine_line(), flush=True)
     print(f"seed {seed}; translation (cm), error |t - truth| (cm), rotation (deg), time (s)")
     for name, (scene, move) in PAIRS.items():
         maps = local_maps(str(scene), move, seed, 10.0)
@@ -117,4 +119,6 @@ def main(seed: int) -> None:
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 0)
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("seed", nargs="?", type=int, default=0, help="the scenes' seed")
+    main(parser.parse_args().seed)

@@ -25,6 +25,8 @@ import sys
 import time
 from pathlib import Path
 
+from timing import machine_line  # beside this file
+
 # workers that spin between parallel regions (as libgomp's default does for its first 300,000
 # spins; ACTIVE keeps spinning) and kiseki's default (PASSIVE, set when kiseki is imported)
 POLICIES = {"spinning": "ACTIVE", "kiseki": None}
@@ -87,6 +89,7 @@ def main() -> None:
     parser.add_argument("--child", type=int, nargs=3, help=argparse.SUPPRESS)
     parser.add_argument("--forever", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    print(machine_line(), flush=True)
     if args.child:
         child(*args.child, args.forever)
         return

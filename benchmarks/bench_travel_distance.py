@@ -18,6 +18,7 @@ import numpy as np
 
 from kiseki.magnetic.linear_map import build_linear_map
 from kiseki.magnetic.travel_distance import TravelDistanceConfig, TravelDistanceLocalizer
+from timing import machine_line  # beside this file
 
 RATE = 10.0  # Hz
 SPEED = 0.6  # m/s
@@ -75,6 +76,7 @@ def timed(step, increments, readings) -> tuple[np.ndarray, float]:
 
 
 def main() -> None:
+    print(machine_line(), flush=True)
     s = np.arange(0.0, LENGTH + 10.0, SPEED / RATE)
     readings = np.column_stack([np.zeros_like(s), np.zeros_like(s), field(s)])
     linear_map = build_linear_map(s, readings, np.zeros_like(s), path_id="0" * 40)
