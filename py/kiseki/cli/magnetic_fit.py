@@ -119,16 +119,16 @@ def _read_data(data: list[Path], units: str | None, dimension: int | None):
     return x, np.asarray(samples.field), height, units or samples.units
 
 
-def _fit_gps(x, y, kernel, per_component: bool, method: str | None, seed: int, model: str):
-    """(GPs, kernels, method, seconds for the hyperparameters, seconds for the fit); method None
-    is the default for the model, the readings and (independent) the fitted length scale."""
+def _fit_gps(x, y, kernel, per_component: bool, method: str, seed: int, model: str, default: bool):
+    """(GPs, kernels, method, seconds for the hyperparameters, seconds for the fit); with
+    `default` (no --method given) the independent model's reduced-rank GP becomes the tiled GP
+    where one box would need too many basis functions at the fitted length scale."""
     if model == "curl-free":
         start = time.perf_counter()
         if kernel is None:  # the log marginal likelihood's maximum on a seeded subsample
             found = fit_curl_free_hyperparameters(x, y, max_points=CURL_FREE_FIT_POINTS, seed=seed)
             kernel = found.kernel
         hyper = time.perf_counter() - start
-        method = method or _default_method(model, len(x))
         start = time.perf_counter()
         gps = fit_component_gps(x, y, kernel, method)
         return gps, [kernel], method, hyper, time.perf_counter() - start
@@ -139,10 +139,8 @@ def _fit_gps(x, y, kernel, per_component: bool, method: str | None, seed: int, m
     else:  # maximise the log marginal likelihood (eqs. 6.11-6.15)
         kernels = [fit_hyperparameters(x, y[:, c], seed=seed).kernel for c in columns]
     hyper = time.perf_counter() - start
-    if method is None:
-        method = _default_method(model, len(x))
-        if method == "hilbert" and _one_box_basis(x, kernels) > HILBERT_LIMIT:
-            method = "tiled"
+    if default and method == "hilbert" and _one_box_basis(x, kernels) > HILBERT_LIMIT:
+        method = "tiled"
     start = time.perf_counter()
     gps = fit_component_gps(x, y, kernels, method)
     return gps, kernels, method, hyper, time.perf_counter() - start
@@ -251,17 +249,17 @@ def fit(
     if max_points is not None and len(x) > max_points:  # after --bin: of the cells' readings
         keep = subsample(len(x), max_points, seed)
         x, y = x[keep], y[keep]
-    if (
-        model == "curl-free"
-        and (method or _default_method(model, len(x))) == "exact"
-        and len(x) > CURL_FREE_EXACT_MAX
-    ):
+    default = method is None
+    method = method or _default_method(model, len(x))
+    if model == "curl-free" and method == "exact" and len(x) > CURL_FREE_EXACT_MAX:
         raise ValueError(
             f"--method exact: {len(x):,} readings need a {72 * len(x) ** 2 / 1e9:.1f} GB "
             f"curl-free factor (at most {CURL_FREE_EXACT_MAX:,}); use --method hilbert or a "
             "larger --bin"
         )
-    gps, kernels, method, t_hyper, t_fit = _fit_gps(x, y, fixed, per_component, method, seed, model)
+    gps, kernels, method, t_hyper, t_fit = _fit_gps(
+        x, y, fixed, per_component, method, seed, model, default
+    )
     lml = [float(g.log_marginal_likelihood()) for g in gps if hasattr(g, "log_marginal_likelihood")]
     start = time.perf_counter()
     lower, upper = x.min(axis=0) - margin, x.max(axis=0) + margin

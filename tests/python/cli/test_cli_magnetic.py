@@ -175,13 +175,17 @@ def test_a_tiled_map_predicts_what_the_exact_map_predicts(tmp_path):
 def test_beyond_one_reduced_rank_gps_reach_the_default_is_tiled():
     """10,001 readings over 100 x 100 m at l = 0.5 m: one HilbertGP would need about 58,000
     basis functions (over its cap), so the default method after the exact GP's 10,000 readings
-    is the tiled GP; on a 10 x 10 m floor it stays the reduced-rank GP."""
+    is the tiled GP (--method hilbert, asked for, is refused with the reason); on a 10 x 10 m
+    floor it stays the reduced-rank GP."""
     rng = np.random.default_rng(4)
     kernel = SquaredExponential(3.0, 0.5, 0.05)
     wide = rng.uniform(0.0, 100.0, (10_001, 2))
     assert _one_box_basis(wide, [kernel]) > HILBERT_LIMIT
-    gps, _, method, _, _ = _fit_gps(wide, smooth_field(wide), kernel, False, None, 0, "independent")
+    field = smooth_field(wide)
+    gps, _, method, _, _ = _fit_gps(wide, field, kernel, False, "hilbert", 0, "independent", True)
     assert method == "tiled" and isinstance(gps[0], TiledGP)
+    with pytest.raises(ValueError, match="more than 20000 basis functions"):  # asked for
+        _fit_gps(wide, field, kernel, False, "hilbert", 0, "independent", False)
     small = wide / 10.0
     assert _one_box_basis(small, [kernel]) <= HILBERT_LIMIT
 
