@@ -300,7 +300,6 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
-    print(machine_line(), flush=True)
     if not anchors_present(args.anchors):
         print(f"bench_anchors: the anchors' sources are not at {args.anchors}: skipped")
         return 0
@@ -312,6 +311,7 @@ def main(argv: list[str] | None = None) -> int:
     except HarnessError as e:
         print(f"bench_anchors: {e}")
         return 1
+    print(machine_line(), flush=True)  # after the skips: a skip is one line
     inputs = load_log(LOG)
     n_scans = len(inputs.scans) if args.scans is None else min(args.scans, len(inputs.scans))
     print_settings(
