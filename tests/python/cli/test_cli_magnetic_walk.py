@@ -131,8 +131,10 @@ def test_bad_options(tmp_path):
 @pytest.mark.parametrize("start", ["known", "global"])
 def test_loop_filter_on_a_synthetic_walk_is_told_no_laps(tmp_path, start):
     """Three laps of a circle after the mapping lap, with 8 % long odometry: the arc is the
-    truth; the loop filter's file and printout agree, it beats the odometry continued around
-    the loop, and its scale approaches 1 / 1.08."""
+    truth; the loop filter's file and printout agree and it beats the odometry continued around
+    the loop (that its scale approaches 1 / 1.08 is tested over seeds in
+    tests/python/magnetic/test_loop_walk_scale.py: one seed's estimate moves with the machine's
+    floating-point kernels)."""
     write_walk(tmp_path / "loop.mat", laps=4.0)
     out = tmp_path / "out"
     args = ("--seed", "2", "--scale-error", "0.08", "--start", start)
@@ -153,7 +155,7 @@ def test_loop_filter_on_a_synthetic_walk_is_told_no_laps(tmp_path, start):
     # first of the three localized laps
     settled = slice(len(t) // 3 if start == "global" else 0, None)
     assert np.sqrt(np.mean(wrap(s_est - s_true)[settled] ** 2)) < 0.25 * err_odom
-    assert np.mean(scale[len(scale) // 2 :]) == pytest.approx(1 / 1.08, abs=0.03)
+    assert np.all((scale > 0.8) & (scale < 1.2))  # the scale column: the filter's, near 1
 
 
 @pytest.mark.parametrize("name", ["eight", "square"])
