@@ -229,6 +229,9 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=2, help="best of, for times")
     parser.add_argument("--hilbert-points", type=int, default=1000, help="hyperparameter subsample")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--floor-csv", type=Path, help="write the tiled case's readings here (x,y,z,mx,my,mz, G)"
+    )
     parser.add_argument("--cases", default="aalto,floor,volume,hilbert,tiled")
     args = parser.parse_args()
     print(machine_line(), flush=True)

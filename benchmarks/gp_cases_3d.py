@@ -175,6 +175,9 @@ def case_tiled(args, rows) -> None:
     a part of the floor that one exact GP can hold, both against the field."""
     n = 6000 if args.quick else 40000
     x, y, world, grid = floor_readings(n, args.seed)
+    if args.floor_csv is not None:  # for kiseki magnetic fit on the same readings
+        table = np.column_stack([x, y])
+        np.savetxt(args.floor_csv, table, delimiter=",", header="x,y,z,mx,my,mz", comments="")
     if args.quick:
         grid = grid[::10]
     truth = world.static_field_at(grid)
