@@ -271,6 +271,9 @@ def _hilbert_cost(n: int, m: int) -> float:
 
 
 def _cheaper(n: int, m: int) -> str:
+    """The solver of fewer operations; the exact GP where the reduced rank exceeds its cap."""
+    if m > _MAX_BASIS:
+        return "exact"
     return "exact" if _exact_cost(n) <= _hilbert_cost(n, m) else "hilbert"
 
 
@@ -288,6 +291,8 @@ def _cheapest_grid(x, lower, extent, overlap, margin, ell, tolerance, solver) ->
         cost = 0.0
         for n in _tile_counts(x, lower, counts, width, overlap):
             exact, reduced = _exact_cost(n), _hilbert_cost(n, m)
+            if m > _MAX_BASIS:  # no reduced-rank tile of this size
+                reduced = math.inf
             cost += {"exact": exact, "hilbert": reduced}.get(solver, min(exact, reduced))
         if cost < best_cost:
             best, best_cost = counts, cost

@@ -12,7 +12,7 @@ import pytest
 
 from kiseki import _core
 from kiseki.gp import ExactGP, HilbertGP, SquaredExponential, TiledGP, hilbert_basis_size
-from kiseki.gp.tiled import _tile_counts
+from kiseki.gp.tiled import _cheaper, _tile_counts
 
 KERNEL = SquaredExponential(1.0, 0.5, 0.1)
 
@@ -156,3 +156,12 @@ def test_a_core_without_truncated_prediction_predicts_as_the_dense_path():
     np.testing.assert_allclose(tile[1], dense[1], rtol=1e-10, atol=1e-12)
     truncated = _core.ExactGaussianProcess(*args).predict(q, 1e-3)
     assert np.abs(truncated[0] - dense[0]).max() > 1e-9  # the truncation the tile does not do
+
+
+def test_a_tile_s_solver_is_the_one_of_fewer_operations_within_the_reduced_rank_cap():
+    """By the operation counts: 20,000 readings, 3,000 basis functions: 2 n m^2 + m^3 / 3 =
+    3.7e11 against 4 n^3 / 3 = 1.1e13, the reduced rank; 500 readings: 1.7e8 exact against
+    1.8e10; beyond HilbertGP's 20,000 functions the exact GP, however costly."""
+    assert _cheaper(20_000, 3_000) == "hilbert"
+    assert _cheaper(500, 3_000) == "exact"
+    assert _cheaper(20_000, 20_001) == "exact"
