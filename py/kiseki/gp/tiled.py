@@ -41,30 +41,28 @@ class TiledGP:
     The prior mean is the training mean of every reading (``mean="constant"``) or zero, the
     same in every tile, so that tiles far from data agree. Points are predicted by the tile
     whose core holds them (points outside the box by the nearest core); beyond a tile's reach
-    the prediction is the prior."""
+    the prediction is the prior. Built with ``build=False``, a tile is factorised the first
+    time a point of its core is predicted: a few predictions then cost a few tiles."""
 
     def __init__(
         self,
         kernel: SquaredExponential,
         mean: str,
-        prior_mean: np.ndarray,
         lower: np.ndarray,
-        counts: np.ndarray,
         width: np.ndarray,
-        tiles: list[Any],
-        solvers: list[str],
-        size: int,
+        plans: list[_TilePlan],
+        data: _TileData,
     ) -> None:
         self.kernel = kernel
         self.kernels = (kernel,)
         self.mean = mean
         self.lower = lower
-        self.counts = counts  # tiles per axis
+        self.counts = data.counts  # tiles per axis
         self.width = width  # a core's side per axis, m
-        self._tiles = tiles  # a core GP per tile, or None where no reading is within reach
-        self.solvers = tuple(solvers)  # "exact", "hilbert" or "none" per tile
-        self._prior_mean = prior_mean
-        self._size = size
+        self.solvers = tuple(plan.kind for plan in plans)  # "exact", "hilbert" or "none"
+        self._plans = plans
+        self._data = data
+        self._cores: list[Any] = [None] * len(plans)  # each tile's GP once built
 
     @classmethod
     def fit(
@@ -79,6 +77,7 @@ class TiledGP:
         tiles_per_axis: Any = None,
         tolerance: float | None = None,
         mean: str = "constant",
+        build: bool = True,
         progress: bool = False,
     ) -> TiledGP:
         """Fits readings y (n,) or (n, k) at positions x (n, d), d <= 3, with a fixed kernel.
@@ -87,7 +86,8 @@ class TiledGP:
         margin: the reduced-rank tiles' box beyond that (default 1 length scale, so the box
         is at least 4 length scales from the core, as :class:`~kiseki.gp.HilbertGP`'s default);
         solver: "auto", "exact" or "hilbert" for every tile; tiles_per_axis: the grid (d
-        integers) instead of the cost rule; tolerance: the reduced-rank basis' spectral cut
+        integers) instead of the cost rule; build: factorise every tile now (else on first
+        use); tolerance: the reduced-rank basis' spectral cut
         (default HilbertGP's 1e-4 times sigma_n^2 / sigma_f^2 where that is smaller: the
         approximation's error in the mean grows with sigma_f^2 / sigma_n^2, 0.64 against 0.12
         at 1e-4 for ratios of 3,600 and 100 on the same 2,400 readings, 0.004 and 0.0002 at
@@ -126,17 +126,18 @@ class TiledGP:
             counts = _grid_argument(tiles_per_axis, x.shape[1])
         width = extent / counts
         prior_mean = y.mean(axis=0) if constant else np.zeros(y.shape[1])
-        residual = np.ascontiguousarray(y - prior_mean)
+        data = _TileData(x, np.ascontiguousarray(y - prior_mean), prior_mean, counts, tolerance)
         reach = _Reach(overlap, margin, tolerance, solver)
-        tiles, solvers = [], []
-        for index in tqdm(
-            np.ndindex(*counts), total=int(np.prod(counts)), desc="tiles", disable=not progress
-        ):
-            core_lo = lower + width * np.array(index)
-            core, kind = _fit_tile(x, residual, kernel, core_lo, core_lo + width, reach)
-            tiles.append(core)
-            solvers.append(kind)
-        return cls(kernel, mean, prior_mean, lower, counts, width, tiles, solvers, x.shape[0])
+        plans = [
+            _plan_tile(x, lower + width * np.array(index), width, ell, reach)
+            for index in np.ndindex(*counts)
+        ]
+        gp = cls(kernel, mean, lower, width, plans, data)
+        if build:
+            for t in tqdm(range(gp.tiles), desc="tiles", disable=not progress):
+                if plans[t].kind != "none":
+                    gp._core(t)
+        return gp
 
     def predict(self, points: Any) -> tuple[np.ndarray, np.ndarray]:
         """(mean (m, k), variance (m, k)) of the noise-free field, each point from the tile
@@ -148,19 +149,25 @@ class TiledGP:
             )
         if not np.isfinite(p).all():
             raise ValueError("points: contains NaN or infinite values")
-        mean = np.repeat(self._prior_mean[None, :], len(p), axis=0)
+        mean = np.repeat(self._data.prior_mean[None, :], len(p), axis=0)
         var = np.full(len(p), self.kernel.sigma_f**2)
         owner = self._owner(p)
         order = np.argsort(owner, kind="stable")
-        bounds = np.searchsorted(owner[order], np.arange(len(self._tiles) + 1))
-        for t, core in enumerate(self._tiles):
+        bounds = np.searchsorted(owner[order], np.arange(self.tiles + 1))
+        for t in range(self.tiles):
             rows = order[bounds[t] : bounds[t + 1]]
-            if core is None or len(rows) == 0:
+            if len(rows) == 0 or self._plans[t].kind == "none":
                 continue
-            mu, v = core.predict(np.ascontiguousarray(p[rows]))
+            mu, v = self._core(t).predict(np.ascontiguousarray(p[rows]))
             mean[rows] += mu
             var[rows] = v
         return mean, np.repeat(var[:, None], mean.shape[1], axis=1)
+
+    def _core(self, t: int) -> Any:
+        """Tile t's GP, factorised on first use."""
+        if self._cores[t] is None:
+            self._cores[t] = _build_tile(self._plans[t], self._data, self.kernel)
+        return self._cores[t]
 
     def _owner(self, p: np.ndarray) -> np.ndarray:
         """The flat index of the tile whose core holds each point (the nearest core outside)."""
@@ -171,16 +178,24 @@ class TiledGP:
 
     @property
     def tiles(self) -> int:
-        return len(self._tiles)
+        return len(self._plans)
+
+    @property
+    def built(self) -> int:
+        """How many tiles have been factorised."""
+        return sum(core is not None for core in self._cores)
 
     @property
     def basis_size(self) -> int:
         """The largest tile's size (readings for an exact tile, basis functions for a
         reduced-rank one): what one predicted point costs at most."""
+        ell, tolerance = self.kernel.length_scale, self._data.tolerance
         sizes = [
-            int(c.size if s == "exact" else c.basis_size)
-            for c, s in zip(self._tiles, self.solvers, strict=True)
-            if c is not None
+            len(plan.rows)
+            if plan.kind == "exact"
+            else hilbert_basis_size(plan.box_hi - plan.box_lo, ell, tolerance)
+            for plan in self._plans
+            if plan.kind != "none"
         ]
         return max(sizes, default=1)
 
@@ -190,15 +205,15 @@ class TiledGP:
 
     @property
     def outputs(self) -> int:
-        return len(self._prior_mean)
+        return len(self._data.prior_mean)
 
     @property
     def size(self) -> int:
-        return self._size
+        return len(self._data.x)
 
     @property
     def prior_mean(self) -> np.ndarray:
-        return self._prior_mean.copy()
+        return self._data.prior_mean.copy()
 
     @property
     def prior_variance(self) -> np.ndarray:
@@ -217,30 +232,57 @@ class _Reach:
     solver: str
 
 
-def _fit_tile(x, residual, kernel, core_lo, core_hi, reach: _Reach) -> tuple[Any, str]:
-    """(the core GP, its solver) of one tile, or (None, "none") with no reading in reach."""
+@dataclass(frozen=True, eq=False)
+class _TileData:
+    """What every tile is fitted from: the readings, their residuals from the prior mean, the
+    grid and the reduced-rank tiles' spectral tolerance."""
+
+    x: np.ndarray
+    residual: np.ndarray
+    prior_mean: np.ndarray
+    counts: np.ndarray
+    tolerance: float
+
+
+@dataclass(frozen=True, eq=False)
+class _TilePlan:
+    """One tile: the rows of the readings it is fitted on, its solver ("none" without
+    readings) and its reduced-rank box."""
+
+    rows: np.ndarray
+    kind: str
+    box_lo: np.ndarray
+    box_hi: np.ndarray
+
+
+def _plan_tile(x, core_lo, width, ell: float, reach: _Reach) -> _TilePlan:
+    """The readings within reach of the core [core_lo, core_lo + width] (at least d + 1 of
+    them, the nearest joining, when there are any) and the solver of fewer operations."""
+    core_hi = core_lo + width
+    box_lo = core_lo - reach.overlap - reach.margin
+    box_hi = core_hi + reach.overlap + reach.margin
     inside = np.all((x >= core_lo - reach.overlap) & (x <= core_hi + reach.overlap), axis=1)
-    n = int(inside.sum())
-    if n == 0:
-        return None, "none"
-    if n <= x.shape[1]:  # a GP needs d + 1 readings: the nearest to the core join
+    if not inside.any():
+        return _TilePlan(np.zeros(0, dtype=np.int64), "none", box_lo, box_hi)
+    if inside.sum() <= x.shape[1]:  # a GP needs d + 1 readings: the nearest to the core join
         gap = np.linalg.norm(x - (core_lo + core_hi) / 2, axis=1)
         gap[inside] = -1.0
         inside[np.argsort(gap, kind="stable")[: x.shape[1] + 1]] = True
-    box_lo = core_lo - reach.overlap - reach.margin
-    box_hi = core_hi + reach.overlap + reach.margin
-    ell = kernel.length_scale
+    rows = np.flatnonzero(inside)
     basis = hilbert_basis_size(box_hi - box_lo, ell, reach.tolerance)
-    kind = reach.solver if reach.solver != "auto" else _cheaper(n, basis)
-    xt, yt = np.ascontiguousarray(x[inside]), np.ascontiguousarray(residual[inside])
-    f, sn = kernel.sigma_f, kernel.sigma_n
-    if kind == "exact":  # its predictions lie near its data: every reading, by the factor
-        core = _core.ExactGaussianProcess(xt, yt, f, ell, sn, False, truncated_prediction=False)
-    else:
-        core = _core.HilbertGaussianProcess(
-            xt, yt, f, ell, sn, box_lo, box_hi, reach.tolerance, _MAX_BASIS, False
-        )
-    return core, kind
+    kind = reach.solver if reach.solver != "auto" else _cheaper(len(rows), basis)
+    return _TilePlan(rows, kind, box_lo, box_hi)
+
+
+def _build_tile(plan: _TilePlan, data: _TileData, kernel: SquaredExponential) -> Any:
+    """The core GP of a planned tile, on its readings' residuals (zero prior mean)."""
+    xt, yt = data.x[plan.rows], data.residual[plan.rows]  # fancy indexing: contiguous copies
+    f, ell, sn = kernel.sigma_f, kernel.length_scale, kernel.sigma_n
+    if plan.kind == "exact":  # its predictions lie near its data: every reading, by the factor
+        return _core.ExactGaussianProcess(xt, yt, f, ell, sn, False, truncated_prediction=False)
+    return _core.HilbertGaussianProcess(
+        xt, yt, f, ell, sn, plan.box_lo, plan.box_hi, data.tolerance, _MAX_BASIS, False
+    )
 
 
 def _distance(name: str, value: Any) -> float:

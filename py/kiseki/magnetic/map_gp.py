@@ -136,11 +136,14 @@ def evaluate_on_cells(gps: list, centres, total: int, progress: bool):
     return mean, var
 
 
-def fit_component_gps(x, y, kernels, method: str, *, mean: str = "constant", domain=None) -> list:
+def fit_component_gps(
+    x, y, kernels, method: str, *, mean: str = "constant", domain=None, build: bool = True
+) -> list:
     """GPs of the field's three columns: one GP of all three with one kernel, or one GP per
     column with three; exact, reduced-rank ("hilbert", on `domain` or its default box) or
-    "tiled". With a :class:`~kiseki.gp.CurlFreeKernel`, the curl-free GP (reduced-rank: 1,024
-    functions; not tiled)."""
+    "tiled" (its tiles factorised on first use without `build`). With a
+    :class:`~kiseki.gp.CurlFreeKernel`, the curl-free GP (reduced-rank: 1,024 functions; not
+    tiled)."""
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     if isinstance(kernels, CurlFreeKernel):
@@ -156,7 +159,7 @@ def fit_component_gps(x, y, kernels, method: str, *, mean: str = "constant", dom
     if method == "exact":
         return [ExactGP.fit(x, y[:, c], k, mean=mean) for k, c in pairs]
     if method == "tiled":
-        return [TiledGP.fit(x, y[:, c], k, mean=mean) for k, c in pairs]
+        return [TiledGP.fit(x, y[:, c], k, mean=mean, build=build) for k, c in pairs]
     return [HilbertGP.fit(x, y[:, c], k, domain=domain, mean=mean) for k, c in pairs]
 
 
@@ -200,6 +203,8 @@ def rebuild(training, kernel) -> list:
             return [_CurlFreeField(CurlFreeGP.from_state(x, y, kernel, state["factor"]))]
         return [_CurlFreeField(ReducedRankCurlFreeGP.from_state(x, y, kernel, **state))]
     domain = (training.hilbert or {}).get("domain")
-    return as_gp_list(
-        fit_component_gps(x, y, kernel, training.method, mean=training.mean, domain=domain)
+    # a tiled map factorises only the tiles its predictions reach
+    gps = fit_component_gps(
+        x, y, kernel, training.method, mean=training.mean, domain=domain, build=False
     )
+    return as_gp_list(gps)

@@ -165,3 +165,19 @@ def test_a_tile_s_solver_is_the_one_of_fewer_operations_within_the_reduced_rank_
     assert _cheaper(20_000, 3_000) == "hilbert"
     assert _cheaper(500, 3_000) == "exact"
     assert _cheaper(20_000, 20_001) == "exact"
+
+
+def test_unbuilt_tiles_are_factorised_on_first_use_to_the_same_predictions(strip):
+    """build=False: no tile factorised at first; points in one core factorise that tile alone,
+    with the same means and variances, bit for bit, as the tiles built at once."""
+    x, y, q, _ = strip
+    eager = TiledGP.fit(x, y, KERNEL, tiles_per_axis=[4, 2])
+    lazy = TiledGP.fit(x, y, KERNEL, tiles_per_axis=[4, 2], build=False)
+    assert eager.built == 8 and lazy.built == 0
+    corner = q[(q[:, 0] < 2.9) & (q[:, 1] < 2.4)]  # inside the first core (3 x 2.5 m)
+    mine = lazy.predict(corner)
+    assert lazy.built == 1
+    assert all(np.array_equal(a, b) for a, b in zip(mine, eager.predict(corner), strict=True))
+    whole = lazy.predict(q)
+    assert lazy.built == 8
+    assert all(np.array_equal(a, b) for a, b in zip(whole, eager.predict(q), strict=True))
