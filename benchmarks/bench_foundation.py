@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from arguments import no_options  # beside this file
 from kiseki.datasets import read_carmen_log
 from kiseki.grid import OccupancyGrid, beam_angles
 from kiseki.mapping import build_map, endpoint_agreement
@@ -85,4 +86,5 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    no_options(__doc__)
     sys.exit(main())

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 from mcap.writer import CompressionType, Writer
 
+from arguments import no_options  # beside this file
 from kiseki.io.runlog import RunWriter, read_run
 from timing import machine_line  # beside this file
 
@@ -178,4 +179,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    no_options(__doc__)
     main()

@@ -281,10 +281,10 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 
 
 def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)  # first: --help and a bad option need no bindings
     if amcl is None:
         print("bench_nav2_amcl: needs the GPL-3.0 nav2 AMCL bindings: pip install amcl")
         return 1
-    args = parse_args(argv)
     print(machine_line(), flush=True)
     if not DATA.is_dir():
         print(f"recorded datasets not found at {DATA}: nothing to benchmark")

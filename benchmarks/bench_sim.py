@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from arguments import no_options  # beside this file
 from kiseki import _core
 from kiseki.sim.run import SimConfig, simulate
 from kiseki.sim.scene import load_scene
@@ -67,4 +68,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    no_options(__doc__)
     main()

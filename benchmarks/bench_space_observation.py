@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from arguments import no_options  # beside this file
 from kiseki import Pose2
 from kiseki.filters import MclConfig, MonteCarloLocalizer
 from kiseki.grid import beam_angles
@@ -116,4 +117,5 @@ def filter_step() -> None:
 
 
 if __name__ == "__main__":
+    no_options(__doc__)
     main()

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from arguments import no_options  # beside this file
 from kiseki.sim.scene import load_scene
 from kiseki.sim.sensors import LASER_PRESETS
 from kiseki.speed import (
@@ -72,4 +73,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    no_options(__doc__)
     main()

@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from arguments import no_options  # beside this file
 from kiseki import _core
 from kiseki.core import rotation_zyx
 from kiseki.sim.terrain_moves import terrain_stops
@@ -145,4 +146,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    no_options(__doc__)
     main()

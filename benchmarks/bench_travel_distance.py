@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 
+from arguments import no_options  # beside this file
 from kiseki.magnetic.linear_map import build_linear_map
 from kiseki.magnetic.travel_distance import TravelDistanceConfig, TravelDistanceLocalizer
 from timing import machine_line  # beside this file
@@ -111,4 +112,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    no_options(__doc__)
     main()
