@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 import kiseki
+from kiseki._support.openblas_kernels import processor_fields
 
 
 def best_of(fn, repeats: int = 3) -> tuple[float, object]:
@@ -27,15 +28,7 @@ def best_of(fn, repeats: int = 3) -> tuple[float, object]:
 def processor(cpuinfo: Path = Path("/proc/cpuinfo")) -> str:
     """The first processor's model name with its family and model numbers ("AMD EPYC (family
     25, model 1)"), which tell processors of one name apart; the machine type without the file."""
-    fields: dict[str, str] = {}
-    try:
-        for line in cpuinfo.read_text(encoding="ascii", errors="replace").splitlines():
-            if not line.strip():
-                break  # the first processor's block ends here
-            key, _, value = line.partition(":")
-            fields.setdefault(key.strip(), value.strip())
-    except OSError:
-        return platform.machine()
+    fields = processor_fields(cpuinfo)
     name = fields.get("model name", platform.machine())
     if "cpu family" in fields and "model" in fields:
         return f"{name} (family {fields['cpu family']}, model {fields['model']})"

@@ -44,9 +44,9 @@ def kernels_for(flags: set[str] | frozenset[str], vendor: str = "") -> str | Non
     return None
 
 
-def _first_processor(cpuinfo: Path) -> dict[str, str]:
-    """Each key's first value in ``cpuinfo`` (key: value), the first processor's where it has
-    the key; empty without the file."""
+def processor_fields(cpuinfo: Path = Path("/proc/cpuinfo")) -> dict[str, str]:
+    """The first processor's block of ``cpuinfo`` as key: value ("model name", "cpu family",
+    "flags", ...); empty without the file."""
     try:
         with cpuinfo.open(encoding="ascii", errors="replace") as f:
             text = f.read(_CPUINFO_LIMIT)
@@ -54,6 +54,10 @@ def _first_processor(cpuinfo: Path) -> dict[str, str]:
         return {}
     fields: dict[str, str] = {}
     for line in text.splitlines():
+        if not line.strip():
+            if fields:
+                break  # the first processor's block ends here
+            continue
         key, _, value = line.partition(":")
         fields.setdefault(key.strip(), value.strip())
     return fields
@@ -61,12 +65,16 @@ def _first_processor(cpuinfo: Path) -> dict[str, str]:
 
 def cpu_flags(cpuinfo: Path = Path("/proc/cpuinfo")) -> frozenset[str]:
     """The first processor's ``flags`` in ``cpuinfo``; empty if the file is absent or has none."""
-    return frozenset(_first_processor(cpuinfo).get("flags", "").split())
+    return _flags(processor_fields(cpuinfo))
 
 
 def cpu_vendor(cpuinfo: Path = Path("/proc/cpuinfo")) -> str:
     """The first processor's ``vendor_id`` ("GenuineIntel", "AuthenticAMD"); "" without it."""
-    return _first_processor(cpuinfo).get("vendor_id", "")
+    return processor_fields(cpuinfo).get("vendor_id", "")
+
+
+def _flags(fields: dict[str, str]) -> frozenset[str]:
+    return frozenset(fields.get("flags", "").split())
 
 
 @contextlib.contextmanager
@@ -76,7 +84,8 @@ def kernels_while_loading(cpuinfo: Path = Path("/proc/cpuinfo")) -> Iterator[str
     if VARIABLE in os.environ:
         yield None
         return
-    name = kernels_for(cpu_flags(cpuinfo), cpu_vendor(cpuinfo))
+    fields = processor_fields(cpuinfo)  # read once
+    name = kernels_for(_flags(fields), fields.get("vendor_id", ""))
     if name is None:
         yield None
         return
