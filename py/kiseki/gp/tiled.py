@@ -128,8 +128,10 @@ class TiledGP:
         prior_mean = y.mean(axis=0) if constant else np.zeros(y.shape[1])
         data = _TileData(x, np.ascontiguousarray(y - prior_mean), prior_mean, counts, tolerance)
         reach = _Reach(overlap, margin, tolerance, solver)
+        # every tile's reduced-rank box has the same sides, so the same basis size
+        basis = hilbert_basis_size(width + 2 * (overlap + margin), ell, tolerance)
         plans = [
-            _plan_tile(x, lower + width * np.array(index), width, ell, reach)
+            _plan_tile(x, lower + width * np.array(index), width, basis, reach)
             for index in np.ndindex(*counts)
         ]
         gp = cls(kernel, mean, lower, width, plans, data)
@@ -189,11 +191,8 @@ class TiledGP:
     def basis_size(self) -> int:
         """The largest tile's size (readings for an exact tile, basis functions for a
         reduced-rank one): what one predicted point costs at most."""
-        ell, tolerance = self.kernel.length_scale, self._data.tolerance
         sizes = [
-            len(plan.rows)
-            if plan.kind == "exact"
-            else hilbert_basis_size(plan.box_hi - plan.box_lo, ell, tolerance)
+            len(plan.rows) if plan.kind == "exact" else plan.basis
             for plan in self._plans
             if plan.kind != "none"
         ]
@@ -247,15 +246,16 @@ class _TileData:
 @dataclass(frozen=True, eq=False)
 class _TilePlan:
     """One tile: the rows of the readings it is fitted on, its solver ("none" without
-    readings) and its reduced-rank box."""
+    readings), its reduced-rank box and that box's basis size."""
 
     rows: np.ndarray
     kind: str
     box_lo: np.ndarray
     box_hi: np.ndarray
+    basis: int
 
 
-def _plan_tile(x, core_lo, width, ell: float, reach: _Reach) -> _TilePlan:
+def _plan_tile(x, core_lo, width, basis: int, reach: _Reach) -> _TilePlan:
     """The readings within reach of the core [core_lo, core_lo + width] (at least d + 1 of
     them, the nearest joining, when there are any) and the solver of fewer operations."""
     core_hi = core_lo + width
@@ -263,15 +263,14 @@ def _plan_tile(x, core_lo, width, ell: float, reach: _Reach) -> _TilePlan:
     box_hi = core_hi + reach.overlap + reach.margin
     inside = np.all((x >= core_lo - reach.overlap) & (x <= core_hi + reach.overlap), axis=1)
     if not inside.any():
-        return _TilePlan(np.zeros(0, dtype=np.int64), "none", box_lo, box_hi)
+        return _TilePlan(np.zeros(0, dtype=np.int64), "none", box_lo, box_hi, basis)
     if inside.sum() <= x.shape[1]:  # a GP needs d + 1 readings: the nearest to the core join
         gap = np.linalg.norm(x - (core_lo + core_hi) / 2, axis=1)
         gap[inside] = -1.0
         inside[np.argsort(gap, kind="stable")[: x.shape[1] + 1]] = True
     rows = np.flatnonzero(inside)
-    basis = hilbert_basis_size(box_hi - box_lo, ell, reach.tolerance)
     kind = reach.solver if reach.solver != "auto" else _cheaper(len(rows), basis)
-    return _TilePlan(rows, kind, box_lo, box_hi)
+    return _TilePlan(rows, kind, box_lo, box_hi, basis)
 
 
 def _build_tile(plan: _TilePlan, data: _TileData, kernel: SquaredExponential) -> Any:
