@@ -39,6 +39,7 @@ import time
 import numpy as np
 
 import bench_nav2_amcl as nav2_bench  # the side-by-side settings, shared
+from amcl_inputs import nav2_beam_indices  # beside this file
 from kiseki.datasets import read_carmen_log
 from kiseki.filters import (
     LocalizeConfig,
@@ -129,7 +130,7 @@ def ray_table(grid, max_range: float, poses: int, repeats: int, seed: int) -> No
 def weighing_table(scans, grid, particle_counts, n_scans: int, seed: int) -> None:
     """The beam model alone (kiseki's log_likelihoods, one thread): ms to weigh the particles
     against one scan, each caster, particles spread around each scan's reference pose."""
-    idx = nav2_bench.nav2_beam_indices(scans.ranges.shape[1], FILTER_BEAMS)
+    idx = nav2_beam_indices(scans.ranges.shape[1], FILTER_BEAMS)
     angles = scans.angles[idx]
     steps = range(0, len(scans), max(1, len(scans) // n_scans))
     print(f"\nbeam model alone, {len(idx)} beams, {len(steps)} scans of the Intel log, 1 thread")
@@ -157,7 +158,7 @@ def weighing_table(scans, grid, particle_counts, n_scans: int, seed: int) -> Non
 def update_table(scans, grid, particle_counts, n_scans: int, seed: int) -> None:
     alphas = motion_alphas(LocalizeConfig(odometry_noise=nav2_bench.ODOMETRY_NOISE), scans)
     odom = noisy_odometry(scans.odometry, nav2_bench.ODOMETRY_NOISE, seed)
-    idx = nav2_bench.nav2_beam_indices(scans.ranges.shape[1], FILTER_BEAMS)
+    idx = nav2_beam_indices(scans.ranges.shape[1], FILTER_BEAMS)
     m = min(n_scans, len(scans))
     part = dataclasses.replace(
         scans,
