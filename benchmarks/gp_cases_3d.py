@@ -18,6 +18,7 @@ from kiseki.gp import (
     fit_hyperparameters,
     hilbert_basis_size,
     refine_hyperparameters,
+    spectral_tolerance,
 )
 from kiseki.sim.scene import load_scene
 from kiseki_experiments.gp.gp_common import (
@@ -143,7 +144,9 @@ def case_hilbert(args, rows) -> None:
         f"{rmse(exact_mean, truth[probe]):.4f} G, Hilbert {rmse(approx_mean, truth[probe]):.4f} G",
         flush=True,
     )
-    floor = hilbert_basis_size(np.array([30.0, 15.0, 2.2]) + 8 * k.length_scale, k.length_scale)
+    floor = hilbert_basis_size(
+        FLOOR_SIDES + 8 * k.length_scale, k.length_scale, spectral_tolerance(k)
+    )
     print(f"  (the 30 x 15 x 2.2 m floor, this length scale: {floor:,} basis functions)")
     name = f"HilbertGP, {n:,} 3-D readings -> {len(grid):,} voxels, m = {hg.basis_size:,}"
     ratio = f"{MENZEN_S / total:.1f}x"
@@ -196,7 +199,9 @@ def case_tiled(args, rows) -> None:
         predict_s, (mean, _) = best_of(lambda tg=tg: tg.predict(grid), args.repeats)
         total = extra_s + fit_s + predict_s
         solvers = {s: tg.solvers.count(s) for s in sorted(set(tg.solvers))}
-        one_box = hilbert_basis_size(FLOOR_SIDES + 8 * k.length_scale, k.length_scale)
+        one_box = hilbert_basis_size(
+            FLOOR_SIDES + 8 * k.length_scale, k.length_scale, spectral_tolerance(k)
+        )
         exact_mean, _ = ExactGP.fit(x[held], y[held], k).predict(grid[inner])
         exact_rmse = rmse(exact_mean, truth[inner])
         tiled_rmse = rmse(mean[inner], truth[inner])

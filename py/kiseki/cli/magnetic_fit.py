@@ -23,6 +23,7 @@ from kiseki.gp import (
     fit_curl_free_hyperparameters,
     fit_hyperparameters,
     hilbert_basis_size,
+    spectral_tolerance,
 )
 from kiseki.gp.kernel import subsample
 from kiseki.magnetic.binning import bin_readings
@@ -152,17 +153,25 @@ def _default_method(model: str, points: int) -> str:
 
 
 def _one_box_basis(x: np.ndarray, kernels) -> int:
-    """The basis size of one HilbertGP on the data's default box (4 length scales around it),
-    for the shortest length scale fitted."""
-    ell = min(k.length_scale for k in kernels)
-    return hilbert_basis_size(np.ptp(x, axis=0) + 8 * ell, ell)
+    """The largest basis size of the HilbertGPs of these kernels on the data's default box (4
+    length scales around it), each at its default spectral tolerance."""
+    sides = np.ptp(x, axis=0)
+    return max(
+        hilbert_basis_size(sides + 8 * k.length_scale, k.length_scale, spectral_tolerance(k))
+        for k in kernels
+    )
 
 
-def _hilbert_settings(gp) -> dict | None:
-    """The reduced-rank GP's box, so that predictions rebuild the same GP."""
-    if not isinstance(gp, HilbertGP):
+def _hilbert_settings(gps) -> dict | None:
+    """The reduced-rank GPs' box and spectral tolerances (one a GP), so that predictions
+    rebuild the same GPs."""
+    if not isinstance(gps[0], HilbertGP):
         return None
-    return {"domain": [np.asarray(gp.lower).tolist(), np.asarray(gp.upper).tolist()]}
+    gp = gps[0]
+    return {
+        "domain": [np.asarray(gp.lower).tolist(), np.asarray(gp.upper).tolist()],
+        "tolerance": [float(g.tolerance) for g in gps],
+    }
 
 
 @guarded(inputs=("data",), output_folders=("output",))  # replaced whole
@@ -264,7 +273,7 @@ def fit(
     start = time.perf_counter()
     lower, upper = x.min(axis=0) - margin, x.max(axis=0) + margin
     mean = "zero" if model == "curl-free" else "constant"  # curl-free: the constant is a term
-    hilbert = _hilbert_settings(gps[0])
+    hilbert = _hilbert_settings(gps)
     training = TrainingData(x, y, method, mean, hilbert, predictor_state(gps[0]))
     provenance = {
         "data": {

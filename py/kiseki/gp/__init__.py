@@ -24,7 +24,7 @@ from kiseki.gp.curl_free import (
 )
 from kiseki.gp.curl_free_basis import ReducedRankCurlFreeGP
 from kiseki.gp.exact import ExactGP
-from kiseki.gp.hilbert import HilbertGP, hilbert_basis_size
+from kiseki.gp.hilbert import HilbertGP, hilbert_basis_size, spectral_tolerance
 from kiseki.gp.kernel import (
     HyperparameterFit,
     SquaredExponential,
@@ -47,4 +47,5 @@ __all__ = [
     "fit_hyperparameters",
     "hilbert_basis_size",
     "refine_hyperparameters",
+    "spectral_tolerance",
 ]

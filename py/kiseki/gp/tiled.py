@@ -13,7 +13,7 @@ from tqdm import tqdm
 
 from kiseki import _core
 from kiseki.gp._data import check_mean, inputs_array, targets_array
-from kiseki.gp.hilbert import hilbert_basis_size
+from kiseki.gp.hilbert import hilbert_basis_size, spectral_tolerance
 from kiseki.gp.kernel import SquaredExponential
 
 __all__ = ["SOLVERS", "TiledGP"]
@@ -88,10 +88,9 @@ class TiledGP:
         solver: "auto", "exact" or "hilbert" for every tile; tiles_per_axis: the grid (d
         integers) instead of the cost rule; build: factorise every tile now (else on first
         use); tolerance: the reduced-rank basis' spectral cut
-        (default HilbertGP's 1e-4 times sigma_n^2 / sigma_f^2 where that is smaller: the
-        approximation's error in the mean grows with sigma_f^2 / sigma_n^2, 0.64 against 0.12
-        at 1e-4 for ratios of 3,600 and 100 on the same 2,400 readings, 0.004 and 0.0002 at
-        1e-7)."""
+        (default HilbertGP's, :func:`~kiseki.gp.spectral_tolerance`: the approximation's error
+        in the mean grows with sigma_f^2 / sigma_n^2, 0.64 against 0.12 at 1e-4 for ratios of
+        3,600 and 100 on the same 2,400 readings, 0.004 and 0.0002 at 1e-7)."""
         x = inputs_array(x)
         y, _ = targets_array(y, x.shape[0])
         constant = check_mean(mean)
@@ -115,7 +114,7 @@ class TiledGP:
         overlap = _distance("overlap", overlap)
         margin = _distance("margin", 1.0 * ell if margin is None else margin)
         if tolerance is None:
-            tolerance = 1e-4 * min(1.0, 1.0 / snr2)
+            tolerance = spectral_tolerance(kernel)
         if not (isinstance(tolerance, (int, float)) and 0 < tolerance < 1):
             raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
         lower, upper = x.min(axis=0), x.max(axis=0)

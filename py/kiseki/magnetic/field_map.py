@@ -74,15 +74,16 @@ class TrainingData:
     inputs (n, d) metres; outputs (n, 3) field in the map's units; method "exact", "hilbert"
     (reduced rank) or "tiled" (a grid of GPs, :class:`~kiseki.gp.TiledGP`); mean "constant" or
     "zero" (the independent GPs' prior mean);
-    hilbert: the reduced-rank GP's box ``{"domain": [lower, upper]}``, or None; predictor: the
-    fitted GP's arrays (:func:`kiseki.magnetic.map_gp.predictor_state`) for predictions with no
-    refit, or None."""
+    hilbert: the reduced-rank GPs' box and spectral tolerances ``{"domain": [lower, upper],
+    "tolerance": [one a GP]}`` (no tolerance: 1e-4, a map from before the kernel's rule), or
+    None; predictor: the fitted GP's arrays (:func:`kiseki.magnetic.map_gp.predictor_state`)
+    for predictions with no refit, or None."""
 
     inputs: np.ndarray
     outputs: np.ndarray
     method: str = "exact"
     mean: str = "constant"
-    hilbert: Mapping | None = None  # {"domain": [lower, upper]} of the reduced-rank GP
+    hilbert: Mapping | None = None  # the reduced-rank GPs' {"domain": ..., "tolerance": ...}
     predictor: Mapping[str, np.ndarray] | None = None
 
     def __post_init__(self) -> None:

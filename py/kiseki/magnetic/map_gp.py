@@ -137,11 +137,20 @@ def evaluate_on_cells(gps: list, centres, total: int, progress: bool):
 
 
 def fit_component_gps(
-    x, y, kernels, method: str, *, mean: str = "constant", domain=None, build: bool = True
+    x,
+    y,
+    kernels,
+    method: str,
+    *,
+    mean: str = "constant",
+    domain=None,
+    tolerances=None,
+    build: bool = True,
 ) -> list:
     """GPs of the field's three columns: one GP of all three with one kernel, or one GP per
-    column with three; exact, reduced-rank ("hilbert", on `domain` or its default box) or
-    "tiled" (its tiles factorised on first use without `build`). With a
+    column with three; exact, reduced-rank ("hilbert", on `domain` or its default box, with
+    one spectral tolerance a kernel or each kernel's default) or "tiled" (its tiles
+    factorised on first use without `build`). With a
     :class:`~kiseki.gp.CurlFreeKernel`, the curl-free GP (reduced-rank: 1,024 functions; not
     tiled)."""
     if method not in METHODS:
@@ -160,7 +169,13 @@ def fit_component_gps(
         return [ExactGP.fit(x, y[:, c], k, mean=mean) for k, c in pairs]
     if method == "tiled":
         return [TiledGP.fit(x, y[:, c], k, mean=mean, build=build) for k, c in pairs]
-    return [HilbertGP.fit(x, y[:, c], k, domain=domain, mean=mean) for k, c in pairs]
+    tolerances = [None] * len(kernels) if tolerances is None else list(tolerances)
+    if len(tolerances) != len(kernels):
+        raise ValueError(f"{len(tolerances)} spectral tolerances for {len(kernels)} kernels")
+    return [
+        HilbertGP.fit(x, y[:, c], k, domain=domain, tolerance=t, mean=mean)
+        for (k, c), t in zip(pairs, tolerances, strict=True)
+    ]
 
 
 def predictor_state(gp) -> dict[str, np.ndarray] | None:
@@ -202,9 +217,21 @@ def rebuild(training, kernel) -> list:
         if training.method == "exact":
             return [_CurlFreeField(CurlFreeGP.from_state(x, y, kernel, state["factor"]))]
         return [_CurlFreeField(ReducedRankCurlFreeGP.from_state(x, y, kernel, **state))]
-    domain = (training.hilbert or {}).get("domain")
+    hilbert = training.hilbert or {}
+    tolerances = hilbert.get("tolerance")
+    if training.method == "hilbert" and tolerances is None:
+        # a map written before the default followed the kernel (spectral_tolerance): it was
+        # fitted at 1e-4, HilbertGP's default then
+        tolerances = [1e-4] * (len(kernel) if isinstance(kernel, (list, tuple)) else 1)
     # a tiled map factorises only the tiles its predictions reach
     gps = fit_component_gps(
-        x, y, kernel, training.method, mean=training.mean, domain=domain, build=False
+        x,
+        y,
+        kernel,
+        training.method,
+        mean=training.mean,
+        domain=hilbert.get("domain"),
+        tolerances=tolerances,
+        build=False,
     )
     return as_gp_list(gps)

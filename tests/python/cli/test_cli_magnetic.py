@@ -5,6 +5,7 @@ field known in closed form, on the Aalto robot's recorded runs, and on bad input
 
 from __future__ import annotations
 
+import dataclasses
 import subprocess
 import sys
 
@@ -15,6 +16,8 @@ from PIL import Image
 
 from kiseki.cli.magnetic_fit import HILBERT_LIMIT, _fit_gps, _one_box_basis
 from kiseki.gp import SquaredExponential, TiledGP
+from kiseki.magnetic.field_map import MagneticFieldMap
+from kiseki.magnetic.map_gp import rebuild
 
 
 def run(*args, cwd=None) -> subprocess.CompletedProcess:
@@ -144,11 +147,13 @@ def test_render_draws_six_panels_of_the_stated_size(synthetic):
     assert pixels.std() > 30  # colour panels, not a blank page
 
 
-def test_a_tiled_map_predicts_what_the_exact_map_predicts(tmp_path):
+def test_tiled_and_reduced_rank_maps_predict_what_the_exact_map_predicts(tmp_path):
     """A 24 x 4 m corridor, 2,400 readings, the same given kernel (signal-to-noise ratio 60):
-    --method tiled (a grid of GPs, more than one tile here) predicts held-out points within 0.1
-    of the readings' noise RMS (0.5 at worst) of --method exact, and its map keeps the method,
-    so that predict rebuilds the same tiles."""
+    --method tiled (a grid of GPs, more than one tile here) and --method hilbert (at its
+    default spectral cut, which the map keeps) predict held-out points within 0.1 of the
+    readings' noise RMS (0.5 at worst) of --method exact, and each map keeps its method, so
+    that predict rebuilds the same GPs. Control: a reduced-rank map read as one written before
+    the cut followed the kernel (no tolerance kept: 1e-4) misses the worst-case bound."""
     rng = np.random.default_rng(2)
     p = rng.uniform([0.0, 0.0], [24.0, 4.0], (2400, 2))
     field = smooth_field(p) + rng.normal(0.0, 0.05, (len(p), 3))
@@ -156,7 +161,7 @@ def test_a_tiled_map_predicts_what_the_exact_map_predicts(tmp_path):
     at = rng.uniform([0.5, 0.5], [23.5, 3.5], (80, 2))
     write_csv(tmp_path / "at.csv", "x,y", at)
     predicted = {}
-    for method in ("exact", "tiled"):
+    for method in ("exact", "tiled", "hilbert"):
         args = ("fit", "long.csv", "-o", method, "--kernel", "3,0.5,0.05", "--resolution", 0.25)
         done = run(*args, "--model", "independent", "--method", method, cwd=tmp_path)
         assert done.returncode == 0, done.stderr
@@ -166,10 +171,17 @@ def test_a_tiled_map_predicts_what_the_exact_map_predicts(tmp_path):
         done = run("predict", method, "--at", "at.csv", "-o", f"{method}.csv", cwd=tmp_path)
         assert done.returncode == 0, done.stderr
         predicted[method] = read_csv(tmp_path / f"{method}.csv")[1][:, 2:5]
-    gap = predicted["tiled"] - predicted["exact"]
-    assert np.sqrt(np.mean(gap**2)) < 0.1 * 0.05 and np.abs(gap).max() < 0.5 * 0.05
-    tiles = TiledGP.fit(p, field, SquaredExponential(3.0, 0.5, 0.05))
-    assert tiles.tiles > 1
+    for method in ("tiled", "hilbert"):
+        gap = predicted[method] - predicted["exact"]
+        assert np.sqrt(np.mean(gap**2)) < 0.1 * 0.05 and np.abs(gap).max() < 0.5 * 0.05
+    kernel = SquaredExponential(3.0, 0.5, 0.05)
+    assert TiledGP.fit(p, field, kernel).tiles > 1
+    kept = MagneticFieldMap.load(tmp_path / "hilbert").training
+    assert kept.hilbert["tolerance"] == [pytest.approx(1e-4 / 60**2)]
+    older = dataclasses.replace(kept, hilbert={"domain": kept.hilbert["domain"]})
+    (gp,) = rebuild(older, kernel)
+    assert gp.tolerance == 1e-4
+    assert np.abs(gp.predict(at)[0] - predicted["exact"]).max() > 0.5 * 0.05
 
 
 def test_beyond_one_reduced_rank_gps_reach_the_default_is_tiled():

@@ -11,7 +11,14 @@ import numpy as np
 import pytest
 
 from kiseki import _core
-from kiseki.gp import ExactGP, HilbertGP, SquaredExponential, TiledGP, hilbert_basis_size
+from kiseki.gp import (
+    ExactGP,
+    HilbertGP,
+    SquaredExponential,
+    TiledGP,
+    hilbert_basis_size,
+    spectral_tolerance,
+)
 from kiseki.gp.tiled import _cheaper, _tile_counts
 
 KERNEL = SquaredExponential(1.0, 0.5, 0.1)
@@ -99,13 +106,9 @@ def test_tile_counts_equal_a_brute_force_count():
 def test_basis_size_rule_equals_hilbert_gps(sides, length_scale):
     d = len(sides)
     x = 0.5 + 0.1 * np.r_[np.zeros((1, d)), np.eye(d)]
-    gp = HilbertGP.fit(
-        x,
-        np.arange(d + 1.0),
-        SquaredExponential(1.0, length_scale, 0.1),
-        domain=(np.zeros(d), sides),
-    )
-    assert hilbert_basis_size(sides, length_scale) == gp.basis_size
+    kernel = SquaredExponential(1.0, length_scale, 0.1)
+    gp = HilbertGP.fit(x, np.arange(d + 1.0), kernel, domain=(np.zeros(d), sides))
+    assert hilbert_basis_size(sides, length_scale, spectral_tolerance(kernel)) == gp.basis_size
 
 
 def test_what_it_is_given_is_checked(strip):
