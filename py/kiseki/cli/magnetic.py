@@ -63,7 +63,8 @@ def predict(
     points, dropped = read_points(at, fmap.dimension)
     exact = fmap.training is not None and not interpolate
     start = time.perf_counter()
-    mean, var = fmap.predict(points) if exact else fmap.value_at(points)
+    # asked once: a tiled map's tiles are freed as their points are done
+    mean, var = fmap.predict(points, release=True) if exact else fmap.value_at(points)
     seconds = time.perf_counter() - start
     header = ",".join([*"xyz"[: fmap.dimension], "mx", "my", "mz", "var_mx", "var_my", "var_mz"])
     rows = np.column_stack([points, mean, var])

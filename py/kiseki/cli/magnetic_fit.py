@@ -143,7 +143,9 @@ def _fit_gps(x, y, kernel, per_component: bool, method: str, seed: int, model: s
     if default and method == "hilbert" and _one_box_basis(x, kernels) > HILBERT_LIMIT:
         method = "tiled"
     start = time.perf_counter()
-    gps = fit_component_gps(x, y, kernels, method)
+    # a tiled GP's tiles are factorised as the map's cells reach them, each freed after its
+    # cells (kiseki.magnetic.map_gp.evaluate_on_cells): one tile's factor in memory at a time
+    gps = fit_component_gps(x, y, kernels, method, build=method != "tiled")
     return gps, kernels, method, hyper, time.perf_counter() - start
 
 

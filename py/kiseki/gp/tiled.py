@@ -140,9 +140,14 @@ class TiledGP:
                     gp._core(t)
         return gp
 
-    def predict(self, points: Any) -> tuple[np.ndarray, np.ndarray]:
+    def predict(
+        self, points: Any, *, release: bool = False, progress: bool = False
+    ) -> tuple[np.ndarray, np.ndarray]:
         """(mean (m, k), variance (m, k)) of the noise-free field, each point from the tile
-        whose core holds it (the prior beyond every tile's reach)."""
+        whose core holds it (the prior beyond every tile's reach). release: free each tile's
+        factor once its points are predicted, so that one tile's factor is in memory at a
+        time (for points asked once, as a map's cells; a later call factorises them again);
+        progress: a bar over the tiles."""
         p = inputs_array(points, "points")
         if p.shape[1] != self.dimension:
             raise ValueError(
@@ -155,13 +160,15 @@ class TiledGP:
         owner = self._owner(p)
         order = np.argsort(owner, kind="stable")
         bounds = np.searchsorted(owner[order], np.arange(self.tiles + 1))
-        for t in range(self.tiles):
+        for t in tqdm(range(self.tiles), desc="tiles", disable=not progress):
             rows = order[bounds[t] : bounds[t + 1]]
             if len(rows) == 0 or self._plans[t].kind == "none":
                 continue
             mu, v = self._core(t).predict(np.ascontiguousarray(p[rows]))
             mean[rows] += mu
             var[rows] = v
+            if release:
+                self._cores[t] = None
         return mean, np.repeat(var[:, None], mean.shape[1], axis=1)
 
     def _core(self, t: int) -> Any:

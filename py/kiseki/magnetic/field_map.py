@@ -242,12 +242,14 @@ class MagneticFieldMap:
         mean[inside], var[inside] = m_in, v_in
         return mean, var
 
-    def predict(self, points) -> tuple[np.ndarray, np.ndarray]:
+    def predict(self, points, *, release: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """(mean (m, 3), variance (m, 3)) of the GP itself at world points (m, d) (eqs. 6.8,
         6.9): a curl-free map's GP comes from its stored factor (no refit); the independent
         GPs are rebuilt once from the stored training data with the stored hyperparameters
-        (no optimisation). A 2-D map made from a 3-D GP predicts at its
-        height. Raises ValueError when the map keeps no training data."""
+        (no optimisation). A 2-D map made from a 3-D GP predicts at its height. release: a
+        tiled map frees each tile's factor once its points are done (points asked once: one
+        tile in memory; later calls factorise the tiles again). Raises ValueError when the
+        map keeps no training data."""
         p = _points(points, self.dimension)
         if self.training is None:
             raise ValueError("the map keeps no training data: use value_at (interpolation)")
@@ -255,7 +257,7 @@ class MagneticFieldMap:
             p = np.column_stack([p, np.full(len(p), self.height)])
         if self._regressors is None:
             object.__setattr__(self, "_regressors", rebuild(self.training, self.kernel))
-        return predict_all(self._regressors, p)
+        return predict_all(self._regressors, p, release=release)
 
     @classmethod
     def from_gp(

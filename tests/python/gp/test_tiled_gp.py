@@ -184,3 +184,17 @@ def test_unbuilt_tiles_are_factorised_on_first_use_to_the_same_predictions(strip
     whole = lazy.predict(q)
     assert lazy.built == 8
     assert all(np.array_equal(a, b) for a, b in zip(whole, eager.predict(q), strict=True))
+
+
+def test_released_tiles_predict_the_same_and_leave_none_factorised(strip):
+    """predict(release=True), as a map's cells are computed: every tile factorised for its
+    points and freed after them, the same means and variances bit for bit as tiles kept; a
+    later call factorises them again, to the same values."""
+    x, y, q, _ = strip
+    kept = TiledGP.fit(x, y, KERNEL, tiles_per_axis=[4, 2])
+    released = TiledGP.fit(x, y, KERNEL, tiles_per_axis=[4, 2], build=False)
+    for _ in range(2):
+        once = released.predict(q, release=True)
+        assert released.built == 0
+        assert all(np.array_equal(a, b) for a, b in zip(once, kept.predict(q), strict=True))
+    assert kept.built == 8
