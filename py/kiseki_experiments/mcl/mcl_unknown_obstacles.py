@@ -88,6 +88,8 @@ class UnknownObstaclesConfig:
     # the resets' agreement check and confirmation (false: the resets before them)
     reset_needs_agreement: bool = LocalizeConfig.reset_needs_agreement
     sensor_reset_confirm: bool = LocalizeConfig.sensor_reset_confirm
+    # where a sensor reset's candidates come from: uniform or matcher
+    sensor_reset_proposal: str = LocalizeConfig.sensor_reset_proposal
 
 
 def preflight(config: UnknownObstaclesConfig) -> None:
@@ -198,6 +200,7 @@ def trial(config: UnknownObstaclesConfig, index: int, seed: int) -> TrialOutput:
                 threads=config.threads,
                 reset_needs_agreement=config.reset_needs_agreement,
                 sensor_reset_confirm=config.sensor_reset_confirm,
+                sensor_reset_proposal=config.sensor_reset_proposal,
             )
             grid = teaching if method == TEACHING_MAP else log_odds
             result = localize(seen, grid, lc)
