@@ -18,7 +18,6 @@ from kiseki._support.options import CELL_LIMITS, Count, Metres, Seed, refuse_giv
 from kiseki.datasets.magnetic import concatenate_samples, read_magnetic_data
 from kiseki.gp import (
     CurlFreeKernel,
-    HilbertGP,
     SquaredExponential,
     fit_curl_free_hyperparameters,
     fit_hyperparameters,
@@ -29,7 +28,13 @@ from kiseki.gp.kernel import subsample
 from kiseki.magnetic.binning import bin_readings
 from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
 from kiseki.magnetic.map_folder import check_map_destination
-from kiseki.magnetic.map_gp import METHODS, MODELS, fit_component_gps, predictor_state
+from kiseki.magnetic.map_gp import (
+    METHODS,
+    MODELS,
+    fit_component_gps,
+    hilbert_settings,
+    predictor_state,
+)
 
 __all__ = ["KERNEL_LIMITS", "fit"]
 
@@ -164,18 +169,6 @@ def _one_box_basis(x: np.ndarray, kernels) -> int:
     )
 
 
-def _hilbert_settings(gps) -> dict | None:
-    """The reduced-rank GPs' box and spectral tolerances (one a GP), so that predictions
-    rebuild the same GPs."""
-    if not isinstance(gps[0], HilbertGP):
-        return None
-    gp = gps[0]
-    return {
-        "domain": [np.asarray(gp.lower).tolist(), np.asarray(gp.upper).tolist()],
-        "tolerance": [float(g.tolerance) for g in gps],
-    }
-
-
 @guarded(inputs=("data",), output_folders=("output",))  # replaced whole
 @interruptible()
 def fit(
@@ -275,7 +268,7 @@ def fit(
     start = time.perf_counter()
     lower, upper = x.min(axis=0) - margin, x.max(axis=0) + margin
     mean = "zero" if model == "curl-free" else "constant"  # curl-free: the constant is a term
-    hilbert = _hilbert_settings(gps)
+    hilbert = hilbert_settings(gps)
     training = TrainingData(x, y, method, mean, hilbert, predictor_state(gps[0]))
     provenance = {
         "data": {

@@ -74,16 +74,16 @@ class TrainingData:
     inputs (n, d) metres; outputs (n, 3) field in the map's units; method "exact", "hilbert"
     (reduced rank) or "tiled" (a grid of GPs, :class:`~kiseki.gp.TiledGP`); mean "constant" or
     "zero" (the independent GPs' prior mean);
-    hilbert: the reduced-rank GPs' box and spectral tolerances ``{"domain": [lower, upper],
-    "tolerance": [one a GP]}`` (no tolerance: 1e-4, a map from before the kernel's rule), or
-    None; predictor: the fitted GP's arrays (:func:`kiseki.magnetic.map_gp.predictor_state`)
-    for predictions with no refit, or None."""
+    hilbert: the reduced-rank GPs' boxes and spectral tolerances, one a GP
+    (:func:`kiseki.magnetic.map_gp.hilbert_settings`; an older map's one ``"domain"`` for
+    every GP and no tolerance, 1e-4), or None; predictor: the fitted GP's arrays
+    (:func:`kiseki.magnetic.map_gp.predictor_state`) for predictions with no refit, or None."""
 
     inputs: np.ndarray
     outputs: np.ndarray
     method: str = "exact"
     mean: str = "constant"
-    hilbert: Mapping | None = None  # the reduced-rank GPs' {"domain": ..., "tolerance": ...}
+    hilbert: Mapping | None = None  # the reduced-rank GPs' {"domains": ..., "tolerance": ...}
     predictor: Mapping[str, np.ndarray] | None = None
 
     def __post_init__(self) -> None:

@@ -44,6 +44,7 @@ __all__ = [
     "column_kernels",
     "evaluate_on_cells",
     "fit_component_gps",
+    "hilbert_settings",
     "predict_all",
     "predictor_state",
     "rebuild",
@@ -151,14 +152,14 @@ def fit_component_gps(
     method: str,
     *,
     mean: str = "constant",
-    domain=None,
+    domains=None,
     tolerances=None,
     build: bool = True,
 ) -> list:
     """GPs of the field's three columns: one GP of all three with one kernel, or one GP per
-    column with three; exact, reduced-rank ("hilbert", on `domain` or its default box, with
-    one spectral tolerance a kernel or each kernel's default) or "tiled" (its tiles
-    factorised on first use without `build`). With a
+    column with three; exact, reduced-rank ("hilbert": one box (lower, upper) and one
+    spectral tolerance a kernel, or each kernel's defaults) or "tiled" (its tiles factorised
+    on first use without `build`). With a
     :class:`~kiseki.gp.CurlFreeKernel`, the curl-free GP (reduced-rank: 1,024 functions; not
     tiled)."""
     if method not in METHODS:
@@ -168,6 +169,7 @@ def fit_component_gps(
             raise ValueError("the curl-free model is not tiled: use exact or hilbert")
         if method == "exact":
             return [CurlFreeGP.fit(x, y, kernels)]
+        domain = None if domains is None else domains[0]
         gp = ReducedRankCurlFreeGP.fit(x, y, kernels, basis=CURL_FREE_BASIS, domain=domain)
         return [gp]
     kernels = [kernels] if not isinstance(kernels, (list, tuple)) else list(kernels)
@@ -177,13 +179,29 @@ def fit_component_gps(
         return [ExactGP.fit(x, y[:, c], k, mean=mean) for k, c in pairs]
     if method == "tiled":
         return [TiledGP.fit(x, y[:, c], k, mean=mean, build=build) for k, c in pairs]
+    domains = [None] * len(kernels) if domains is None else list(domains)
     tolerances = [None] * len(kernels) if tolerances is None else list(tolerances)
-    if len(tolerances) != len(kernels):
-        raise ValueError(f"{len(tolerances)} spectral tolerances for {len(kernels)} kernels")
+    if not len(domains) == len(tolerances) == len(kernels):
+        raise ValueError(
+            f"{len(domains)} boxes and {len(tolerances)} spectral tolerances for "
+            f"{len(kernels)} kernels"
+        )
     return [
-        HilbertGP.fit(x, y[:, c], k, domain=domain, tolerance=t, mean=mean)
-        for (k, c), t in zip(pairs, tolerances, strict=True)
+        HilbertGP.fit(x, y[:, c], k, domain=d, tolerance=t, mean=mean)
+        for (k, c), d, t in zip(pairs, domains, tolerances, strict=True)
     ]
+
+
+def hilbert_settings(gps: list) -> dict | None:
+    """What a map keeps of its reduced-rank GPs so that :func:`rebuild` makes the same ones:
+    each GP's box and spectral tolerance (a GP per kernel, each on the box its own length
+    scale set); None for other GPs."""
+    if not all(isinstance(g, HilbertGP) for g in gps):
+        return None
+    return {
+        "domains": [[np.asarray(g.lower).tolist(), np.asarray(g.upper).tolist()] for g in gps],
+        "tolerance": [float(g.tolerance) for g in gps],
+    }
 
 
 def predictor_state(gp) -> dict[str, np.ndarray] | None:
@@ -226,11 +244,14 @@ def rebuild(training, kernel) -> list:
             return [_CurlFreeField(CurlFreeGP.from_state(x, y, kernel, state["factor"]))]
         return [_CurlFreeField(ReducedRankCurlFreeGP.from_state(x, y, kernel, **state))]
     hilbert = training.hilbert or {}
-    tolerances = hilbert.get("tolerance")
+    count = len(kernel) if isinstance(kernel, (list, tuple)) else 1
+    domains, tolerances = hilbert.get("domains"), hilbert.get("tolerance")
+    if domains is None and "domain" in hilbert:  # one box for every GP, as older maps kept
+        domains = [hilbert["domain"]] * count
     if training.method == "hilbert" and tolerances is None:
         # a map written before the default followed the kernel (spectral_tolerance): it was
         # fitted at 1e-4, HilbertGP's default then
-        tolerances = [1e-4] * (len(kernel) if isinstance(kernel, (list, tuple)) else 1)
+        tolerances = [1e-4] * count
     # a tiled map factorises only the tiles its predictions reach
     gps = fit_component_gps(
         x,
@@ -238,7 +259,7 @@ def rebuild(training, kernel) -> list:
         kernel,
         training.method,
         mean=training.mean,
-        domain=hilbert.get("domain"),
+        domains=domains,
         tolerances=tolerances,
         build=False,
     )

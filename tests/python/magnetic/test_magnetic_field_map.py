@@ -350,3 +350,27 @@ def test_saving_replaces_a_map_but_never_another_folder(tmp_path):
     with pytest.raises(FileNotFoundError, match="no such magnetic field map folder"):
         MagneticFieldMap.load(tmp_path / "absent")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["map", "photos"]
+
+
+def test_a_reduced_rank_map_rebuilds_each_component_s_gp_on_its_own_box():
+    """Three kernels of different length scales, one reduced-rank GP each, each on the default
+    box its length scale sets: what a map keeps of them (hilbert_settings) rebuilds the same
+    GPs, bit for bit. Control: one box for every GP (the first's, as maps kept before) moves
+    the third component by more than 1e-3 (its noise SD is 0.05)."""
+    rng = np.random.default_rng(0)
+    x = rng.uniform(0.0, 6.0, (600, 2))
+    y = np.c_[np.sin(x[:, 0]), np.cos(x[:, 1]), np.sin(x[:, 0] + x[:, 1])]
+    y = y + rng.normal(0.0, 0.05, y.shape)
+    kernels = [SquaredExponential(1.0, ell, 0.05) for ell in (0.4, 0.8, 1.5)]
+    gps = map_gp_module.fit_component_gps(x, y, kernels, "hilbert")
+    assert len({tuple(g.lower) for g in gps}) == 3  # three boxes
+    q = rng.uniform(0.0, 6.0, (50, 2))
+    fitted = map_gp_module.predict_all(gps, q)
+    kept = TrainingData(x, y, "hilbert", "constant", map_gp_module.hilbert_settings(gps))
+    rebuilt = map_gp_module.predict_all(map_gp_module.rebuild(kept, kernels), q)
+    assert all(np.array_equal(a, b) for a, b in zip(rebuilt, fitted, strict=True))
+    box = [gps[0].lower.tolist(), gps[0].upper.tolist()]
+    one_box = {"domain": box, "tolerance": [g.tolerance for g in gps]}
+    older = TrainingData(x, y, "hilbert", "constant", one_box)
+    moved = map_gp_module.predict_all(map_gp_module.rebuild(older, kernels), q)[0] - fitted[0]
+    assert np.abs(moved[:, 2]).max() > 1e-3
