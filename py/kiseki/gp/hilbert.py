@@ -130,8 +130,9 @@ def spectral_tolerance(kernel: SquaredExponential) -> float:
     return 1e-4 * min(1.0, (kernel.sigma_n / kernel.sigma_f) ** 2)
 
 
-def hilbert_basis_size(sides: Any, length_scale: float, tolerance: float = 1e-4) -> int:
-    """The basis size m of :class:`HilbertGP` on a box with these side lengths, by its rule: the
+def hilbert_basis_size(sides: Any, length_scale: float, tolerance: float) -> int:
+    """The basis size m of :class:`HilbertGP` on a box with these side lengths at a spectral
+    `tolerance` (its default for a kernel: :func:`spectral_tolerance`), by its rule: the
     Laplacian's eigenfunctions sin(pi j_d (x_d - lower_d) / side_d), j_d = 1, 2, ..., whose
     frequency sqrt(sum_d (pi j_d / side_d)^2) is at most w_max, S(w_max) = tolerance S(0) (at
     least one function)."""
