@@ -114,6 +114,7 @@ void bind_filters(py::module_& m) {
       .def_property("sensor_reset_proposal",
                     [](const MclParams& p) { return std::string(reset_proposal_name(p.sensor_reset_proposal)); },
                     [](MclParams& p, const std::string& v) { p.sensor_reset_proposal = reset_proposal_from_name(v); })
+      .def_readwrite("matcher_search_every", &MclParams::matcher_search_every)
       .def_readwrite("reset_look_elsewhere", &MclParams::reset_look_elsewhere)
       .def_readwrite("reliability_rate", &MclParams::reliability_rate)
       .def_readwrite("threads", &MclParams::threads)
@@ -127,6 +128,7 @@ void bind_filters(py::module_& m) {
       .def_readonly("resampled", &UpdateReport::resampled)
       .def_readonly("injected", &UpdateReport::injected)
       .def_readonly("reset", &UpdateReport::reset)
+      .def_readonly("searched", &UpdateReport::searched)
       .def_readonly("particles", &UpdateReport::particles);
 
   py::class_<MonteCarloLocalization>(m, "MonteCarloLocalization")
@@ -179,6 +181,12 @@ void bind_filters(py::module_& m) {
       .def_property_readonly("reliability", &MonteCarloLocalization::reliability)
       .def_property_readonly("effective_sample_size", &MonteCarloLocalization::effective_sample_size)
       .def_property_readonly("poses", [](const MonteCarloLocalization& f) { return poses_array(f.particles()); })
+      .def_property_readonly("matcher_hypotheses",
+                             [](const MonteCarloLocalization& f) {
+                               std::vector<Pose2> poses;
+                               for (const PoseHypothesis& h : f.matcher_hypotheses()) poses.push_back(h.pose);
+                               return poses_array(poses);
+                             })
       .def_property_readonly("weights", [](const MonteCarloLocalization& f) { return array_of(f.weights()); })
       .def_property_readonly("size", [](const MonteCarloLocalization& f) { return f.particles().size(); });
   m.attr("MAX_ODOMETRY_JUMP") = kMaxOdometryJump;

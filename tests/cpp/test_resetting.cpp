@@ -279,6 +279,10 @@ TEST(SensorResetProposal, PosesAroundHypothesesTakeTheirSharesByTemperedScoreAnd
   TargetModel model;
   EXPECT_THROW(mcl.update(model), std::logic_error);
   EXPECT_THROW(mcl.update(model, ScanView{}), std::logic_error);
+  for (const int every : {0, 1001}) {
+    p.matcher_search_every = every;
+    EXPECT_THROW(p.validate(), std::invalid_argument);
+  }
 }
 
 }  // namespace

@@ -91,12 +91,19 @@ std::vector<Pose2> MonteCarloLocalization::reset_candidates(const ScanView* scan
     return uniform_poses(count);
   }
   // The matcher's k best distinct lattice poses; the candidates spread around them by one
-  // lattice step (a cell per axis, a heading step), as the one-scan start's cloud is.
-  const std::vector<PoseHypothesis> found = matcher_->match(scan->angles, scan->ranges, scan->n);
-  if (found.empty()) return {};  // no beam returned: nothing proposes a place
-  const int headings = matcher_->headings(scan->angles, scan->ranges, scan->n);
-  searched = static_cast<double>(matcher_->lattice_cells()) * headings;
-  return poses_around_hypotheses(found, count, matcher_->resolution(), 2.0 * kPi / headings,
+  // lattice step (a cell per axis, a heading step), as the one-scan start's cloud is. The
+  // search is made anew on every matcher_search_every-th reset of a lost spell (predict moves
+  // the hypotheses between).
+  if (matcher_found_.empty() || matcher_uses_ >= params_.matcher_search_every) {
+    matcher_found_ = matcher_->match(scan->angles, scan->ranges, scan->n);
+    matcher_headings_ = matcher_->headings(scan->angles, scan->ranges, scan->n);
+    matcher_uses_ = 0;
+    searched_ = true;
+    if (matcher_found_.empty()) return {};  // no beam returned: nothing proposes a place
+  }
+  ++matcher_uses_;
+  searched = static_cast<double>(matcher_->lattice_cells()) * matcher_headings_;
+  return poses_around_hypotheses(matcher_found_, count, matcher_->resolution(), 2.0 * kPi / matcher_headings_,
                                  params_.likelihood_power, rng_);
 }
 

@@ -51,6 +51,9 @@ void MclParams::validate() const {
   if (sensor_reset_candidates < 1 || sensor_reset_candidates > 10'000'000) {
     throw std::invalid_argument("MCL: sensor_reset_candidates must be in 1..10,000,000");
   }
+  if (matcher_search_every < 1 || matcher_search_every > 1000) {
+    throw std::invalid_argument("MCL: matcher_search_every must be in 1..1000");
+  }
   if (!(reliability_rate > 0.0 && reliability_rate <= 1.0)) throw std::invalid_argument("MCL: reliability_rate must lie in (0, 1]");
   if (threads < 0) throw std::invalid_argument("MCL: threads must be >= 0 (0 = every core)");
 }
@@ -119,6 +122,7 @@ void MonteCarloLocalization::set_particles(const std::vector<Pose2>& poses, cons
   }
   particles_ = poses;
   challenger_.clear();  // a new cloud: a sensor reset held for the old one is void
+  matcher_found_.clear();
   if (weights.empty()) {
     weights_.assign(particles_.size(), 1.0 / static_cast<double>(particles_.size()));
   } else {
@@ -158,6 +162,8 @@ void MonteCarloLocalization::predict(const Pose2& a, const Pose2& b) {
     sample_motion(params_.motion, a, b, challenger_.data(), challenger_.size(), rng_.below(~std::uint64_t{0}),
                   params_.threads);
   }
+  const Pose2 step_taken = a.between(b);  // places, not particles: moved without noise
+  for (PoseHypothesis& h : matcher_found_) h.pose = h.pose.compose(step_taken);
 }
 
 std::vector<double> MonteCarloLocalization::evaluate(const SensorModel& model, const std::vector<Pose2>& poses) const {
@@ -218,6 +224,7 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
                                                  const ScanView* scan) {
   if (log_l.size() != particles_.size()) throw std::invalid_argument("MCL: one log-likelihood per particle is needed");
   UpdateReport report;
+  searched_ = false;
   // Augmented MCL's average likelihood: the weighted mean of the per-reading (geometric mean)
   // likelihood, so that scans with more or fewer returns compare.
   const double r = static_cast<double>(std::max<std::size_t>(readings, 1));
@@ -270,8 +277,12 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
     if (!sensed && model != nullptr && has_free_space() && lost_updates_ >= params_.sensor_reset_after) {
       sensed = sensor_reset(*model, {best, agreement}, scan);
     }
-    if (sensed) lost_updates_ = 0;
+    if (sensed) {
+      lost_updates_ = 0;
+      matcher_found_.clear();  // a lost spell ended: the next one searches anew
+    }
     const bool expanded = !sensed && expansion_reset(model, {best, agreement});
+    report.searched = searched_;
     if (sensed || expanded) {
       report.reset = sensed ? "sensor" : "expansion";
       posterior_ = estimate();
@@ -283,6 +294,7 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
   if (!lost && !dropped) {
     lost_updates_ = 0;
     challenger_.clear();  // the cloud agrees again: nothing to confirm
+    matcher_found_.clear();
   }
   posterior_ = weighed;  // before resampling: injected poses have no weight in it
   double inject = 0.0;

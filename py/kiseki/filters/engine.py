@@ -73,6 +73,11 @@ class MclConfig:
     * ``sensor_reset_proposal`` uniform (the candidates uniform over the free cells, as before
       the matcher existed) or matcher (around the correlative scan matcher's hypotheses for the
       current scan: :meth:`MonteCarloLocalizer.set_matcher` and the scan in :meth:`step`);
+      ``matcher_search_every`` 5: while the cloud stays lost the matcher searches the map on
+      every fifth sensor reset only, the resets between drawing around its last hypotheses
+      moved with the odometry (a search costs up to a second on a building's map; a newer
+      scan's place waits at most 4 updates, a fifth of the 20 scans an excursion may last;
+      1: a search on every reset, as before the option);
       ``reset_look_elsewhere`` False: with True a sensor reset's margin grows by ln N for a
       best of N poses searched (the engine's look_elsewhere_term: even prior odds of "here" and
       "elsewhere", the second spread over the N poses). ``reset_needs_agreement`` True: a
@@ -111,6 +116,7 @@ class MclConfig:
     sensor_reset_share: float = 0.5
     sensor_reset_candidates: int = 20_000
     sensor_reset_proposal: str = "uniform"
+    matcher_search_every: int = 5
     reset_look_elsewhere: bool = False
     reset_needs_agreement: bool = True
     sensor_reset_confirm: bool = True
@@ -157,6 +163,11 @@ class MclConfig:
             f"sensor_reset_proposal must be one of {', '.join(RESET_PROPOSALS)}, "
             f"got {self.sensor_reset_proposal!r}",
         )
+        _check(
+            isinstance(self.matcher_search_every, int) and 1 <= self.matcher_search_every <= 1000,
+            "matcher_search_every must be an integer in 1..1000, "
+            f"got {self.matcher_search_every!r}",
+        )
         for name in ("reset_look_elsewhere", "reset_needs_agreement", "sensor_reset_confirm"):
             value = getattr(self, name)
             _check(isinstance(value, bool), f"{name} must be True or False, got {value!r}")
@@ -196,6 +207,7 @@ class MclConfig:
         p.sensor_reset_share = self.sensor_reset_share
         p.sensor_reset_candidates = self.sensor_reset_candidates
         p.sensor_reset_proposal = self.sensor_reset_proposal
+        p.matcher_search_every = self.matcher_search_every
         p.reset_look_elsewhere = self.reset_look_elsewhere
         p.reset_needs_agreement = self.reset_needs_agreement
         p.sensor_reset_confirm = self.sensor_reset_confirm
@@ -337,6 +349,12 @@ class MonteCarloLocalizer:
     @property
     def weights(self) -> np.ndarray:
         return self.engine.weights
+
+    @property
+    def matcher_hypotheses(self) -> np.ndarray:
+        """(k, 3): the matcher's places of the current lost spell, moved with the odometry
+        since its last search (none when not lost or with the uniform proposal)."""
+        return self.engine.matcher_hypotheses
 
     @property
     def reliability(self) -> float:

@@ -89,6 +89,7 @@ class LocalizeConfig:
     resetting_injects: bool = MclConfig.resetting_injects  # Augmented MCL's injection
     # the sensor reset's candidates: uniform or around the matcher's hypotheses (MclConfig)
     sensor_reset_proposal: str = MclConfig.sensor_reset_proposal
+    matcher_search_every: int = MclConfig.matcher_search_every  # searches while lost (MclConfig)
     reset_look_elsewhere: bool = MclConfig.reset_look_elsewhere
     # a reset must also agree with the map from the place it proposes (MclConfig)
     reset_needs_agreement: bool = MclConfig.reset_needs_agreement
@@ -188,6 +189,7 @@ class LocalizeConfig:
             recovery=self.recovery,
             resetting_injects=self.resetting_injects,
             sensor_reset_proposal=self.sensor_reset_proposal,
+            matcher_search_every=self.matcher_search_every,
             reset_look_elsewhere=self.reset_look_elsewhere,
             reset_needs_agreement=self.reset_needs_agreement,
             sensor_reset_confirm=self.sensor_reset_confirm,

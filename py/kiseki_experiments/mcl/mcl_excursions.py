@@ -40,6 +40,7 @@ from kiseki.plots import new_figure
 from kiseki.teach.environment_map import build_teaching_map
 from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
+    Count,
     NonNegativeReal,
     Particles,
     PositiveReal,
@@ -71,6 +72,8 @@ class ExcursionsConfig:
     max_scans: Scans = 0  # 0 = whole logs
     # the sensor reset's candidates (uniform or matcher) and its look-elsewhere term
     sensor_reset_proposal: str = LocalizeConfig.sensor_reset_proposal
+    # with the matcher: a search on every this-many-th sensor reset of a lost spell
+    matcher_search_every: Count = LocalizeConfig.matcher_search_every
     reset_look_elsewhere: bool = LocalizeConfig.reset_look_elsewhere
     # the resets' agreement check and confirmation (false: the resets before them)
     reset_needs_agreement: bool = LocalizeConfig.reset_needs_agreement
@@ -153,6 +156,7 @@ def trial(config: ExcursionsConfig, index: int, seed: int) -> TrialOutput:
                 threads=config.threads,
                 z_intrusion=config.z_intrusion,
                 sensor_reset_proposal=config.sensor_reset_proposal,
+                matcher_search_every=config.matcher_search_every,
                 reset_look_elsewhere=config.reset_look_elsewhere,
                 reset_needs_agreement=config.reset_needs_agreement,
                 sensor_reset_confirm=config.sensor_reset_confirm,

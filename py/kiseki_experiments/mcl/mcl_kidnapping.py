@@ -135,6 +135,7 @@ def _trial(scans: LaserScans, grid, config: KidnapConfig, seed: int, name: str) 
             recovery=recovery.split("+")[0],
             resetting_injects=recovery == "resetting+injection",
             sensor_reset_proposal=config.sensor_reset_proposal,
+            matcher_search_every=config.matcher_search_every,
             reset_look_elsewhere=config.reset_look_elsewhere,
             reset_needs_agreement=config.reset_needs_agreement,
             sensor_reset_confirm=config.sensor_reset_confirm,

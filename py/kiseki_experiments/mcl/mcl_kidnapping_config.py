@@ -54,6 +54,8 @@ class KidnapConfig:
     threads: Threads = 1  # per trial (trials run in parallel)
     # the sensor reset's candidates (uniform or matcher) and its look-elsewhere term
     sensor_reset_proposal: str = LocalizeConfig.sensor_reset_proposal
+    # with the matcher: a search on every this-many-th sensor reset of a lost spell
+    matcher_search_every: Count = LocalizeConfig.matcher_search_every
     reset_look_elsewhere: bool = LocalizeConfig.reset_look_elsewhere
     # the resets' agreement check and confirmation (false: the resets before them)
     reset_needs_agreement: bool = LocalizeConfig.reset_needs_agreement

@@ -48,6 +48,7 @@ from kiseki.plots import new_figure
 from kiseki.teach.environment_map import build_teaching_map
 from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
+    Count,
     NonNegativeReal,
     Particles,
     PositiveReal,
@@ -90,6 +91,8 @@ class UnknownObstaclesConfig:
     sensor_reset_confirm: bool = LocalizeConfig.sensor_reset_confirm
     # where a sensor reset's candidates come from: uniform or matcher
     sensor_reset_proposal: str = LocalizeConfig.sensor_reset_proposal
+    # with the matcher: a search on every this-many-th sensor reset of a lost spell
+    matcher_search_every: Count = LocalizeConfig.matcher_search_every
 
 
 def preflight(config: UnknownObstaclesConfig) -> None:
@@ -201,6 +204,7 @@ def trial(config: UnknownObstaclesConfig, index: int, seed: int) -> TrialOutput:
                 reset_needs_agreement=config.reset_needs_agreement,
                 sensor_reset_confirm=config.sensor_reset_confirm,
                 sensor_reset_proposal=config.sensor_reset_proposal,
+                matcher_search_every=config.matcher_search_every,
             )
             grid = teaching if method == TEACHING_MAP else log_odds
             result = localize(seen, grid, lc)

@@ -3,7 +3,8 @@
 """The sensor reset's matcher proposal: in a synthetic room without symmetry, a cloud tracking
 the wrong place is reset around the correlative matcher's hypotheses for the scan (every
 candidate drawn within a few lattice steps of one), where the uniform proposal's candidates,
-the reference, spread over the room; both end at the truth; the same particles for one and two
+the reference, spread over the room; both end at the truth; a lost filter searches on every
+k-th reset and moves the places between with the odometry; the same particles for one and two
 threads; bad settings refused in one line."""
 
 from __future__ import annotations
@@ -97,6 +98,54 @@ def test_the_matcher_proposal_resets_around_the_hypotheses_and_ends_at_the_truth
     assert math.hypot(*(estimate_many[:2] - TRUTH[:2])) < 0.5
 
 
+def _lost_walk(every: int, updates: int = 7):
+    """The robot drives 0.15 m per update from TRUTH along its heading (the odometry exact);
+    the cloud starts at WRONG and every reset is refused (an evidence no place can give), so
+    the lost spell lasts. Returns the reports' search flags, the matcher's places after each
+    update, and the true poses."""
+    grid = room()
+    relocalizer = Relocalizer(grid, 20.0, RelocalizeConfig(threads=1))
+    localizer = MonteCarloLocalizer(
+        _config("matcher", matcher_search_every=every, reset_evidence=1e6),
+        seed=3,
+        free_space=grid,
+    )
+    localizer.set_matcher(relocalizer)
+    localizer.initialize(WRONG, (0.1, 0.1, 0.05))
+    model = _core.LikelihoodFieldModel(grid, sigma_hit=0.2, z_hit=0.95, z_rand=0.05, max_beams=90)
+    searched, places, truths = [], [], []
+    for k in range(updates):
+        pose = TRUTH + 0.15 * k * np.array([math.cos(TRUTH[2]), math.sin(TRUTH[2]), 0.0])
+        ranges = grid.cast_scans(pose[None, :], ANGLES, max_range=20.0)[0]
+        model.set_scan(ANGLES, np.asarray(ranges, np.float32), 20.0)
+        report = localizer.step(pose, lambda: model, (ANGLES, ranges))
+        assert report.reset == "none"  # every reset refused: one lost spell
+        searched.append(report.searched)
+        places.append(localizer.matcher_hypotheses.copy())
+        truths.append(pose)
+    return searched, places, truths
+
+
+def test_a_lost_filter_searches_on_every_kth_reset_and_moves_the_places_with_the_odometry():
+    # the closed form: a search on the spell's resets 1, k + 1, 2k + 1, ...
+    for every in (1, 3, 1000):
+        searched, _, _ = _lost_walk(every)
+        assert searched == [k % every == 0 for k in range(7)], every
+    # between searches the places move with the odometry: after 0.9 m the best of the first
+    # search's places is where a search of the new scan puts it (the reference), within the
+    # proposal's spread of a cell and a heading step; the control, the first search's place
+    # unmoved, is 0.9 m off
+    _, places, truths = _lost_walk(1000)
+    reference = Relocalizer(room(), 20.0)
+    ranges = room().cast_scans(truths[-1][None, :], ANGLES, max_range=20.0)[0]
+    best = reference.match(ANGLES, ranges)[0]
+    step = 2 * math.pi / reference.headings(ANGLES, ranges)
+    moved = places[-1][0]
+    assert math.hypot(moved[0] - best.x, moved[1] - best.y) < 2 * RES
+    assert abs(math.remainder(moved[2] - best.theta, 2 * math.pi)) < 1.5 * step
+    assert math.hypot(*(places[0][0][:2] - truths[-1][:2])) > 0.85
+
+
 def test_the_matcher_proposal_gives_the_same_particles_for_one_and_two_threads():
     one, reports_one, _, _ = _run("matcher", threads=1, updates=3)
     two, reports_two, _, _ = _run("matcher", threads=2, updates=3)
@@ -110,6 +159,7 @@ def test_bad_settings_are_refused_in_one_line(tmp_path):
         (dict(reset_look_elsewhere=1), "reset_look_elsewhere must be True or False"),
         (dict(reset_needs_agreement="yes"), "reset_needs_agreement must be True or False"),
         (dict(sensor_reset_confirm=0), "sensor_reset_confirm must be True or False"),
+        (dict(matcher_search_every=0), "matcher_search_every must be an integer in 1..1000"),
     ):
         with pytest.raises(ValueError, match=word) as caught:
             LocalizeConfig(**bad)
@@ -130,6 +180,8 @@ def test_bad_settings_are_refused_in_one_line(tmp_path):
         (["--reset-proposal", "grid"], "sensor_reset_proposal must be one of"),
         (["--global", "--reset-proposal", "matcher"], "does not apply with --global"),
         (["--global", "--reset-unchecked"], "does not apply with --global"),
+        (["--matcher-search-every", "3"], "does not apply without --reset-proposal matcher"),
+        (["--reset-proposal", "matcher", "--matcher-search-every", "0"], "in 1..1000"),
     ):
         done = subprocess.run(
             [sys.executable, "-m", "kiseki.cli", "localize", "log.mcap", "--map", "room.yaml",

@@ -90,6 +90,14 @@ struct MclParams {
   std::size_t sensor_reset_candidates = 20000;
   /// Where the sensor reset's candidates come from (the matcher needs set_matcher and the scan).
   ResetProposal sensor_reset_proposal = ResetProposal::uniform;
+  /// With the matcher proposal, while the cloud stays lost the map is searched on every
+  /// matcher_search_every-th sensor reset only; the resets between take their candidates around
+  /// the last search's hypotheses, moved with the odometry. A search costs a fraction of a
+  /// second to a second on a building's map, so a filter lost for good paid that on every
+  /// update. The rule for 5: a place that a newer scan would propose waits at most 4 updates,
+  /// a fifth of the 20 scans within which an excursion is to end. 1: a search on every sensor
+  /// reset (kiseki before this option).
+  int matcher_search_every = 5;
   /// Add ln N to reset_evidence for a sensor reset that took its best of N poses: N =
   /// sensor_reset_candidates (uniform) or the matcher's lattice poses (matcher). See
   /// look_elsewhere_term. Off: the acceptance of kiseki before the matcher proposal.
@@ -113,6 +121,7 @@ struct UpdateReport {
   bool resampled = false;
   std::size_t injected = 0;         ///< uniform poses added (Augmented MCL)
   std::string reset = "none";       ///< none, expansion or sensor
+  bool searched = false;            ///< the matcher searched the map (matcher_search_every)
   std::size_t particles = 0;        ///< after the update
 };
 
@@ -184,6 +193,9 @@ class MonteCarloLocalization {
   double reliability() const { return reliability_; }
   double effective_sample_size() const;
   const std::vector<Pose2>& particles() const { return particles_; }
+  /// The matcher's hypotheses of the current lost spell, moved with the odometry since its
+  /// last search (empty when not lost or with the uniform proposal).
+  const std::vector<PoseHypothesis>& matcher_hypotheses() const { return matcher_found_; }
   const std::vector<double>& weights() const { return weights_; }
   const MclParams& params() const { return params_; }
 
@@ -226,6 +238,11 @@ class MonteCarloLocalization {
   double w_slow_ = 0.0, w_fast_ = 0.0;
   int lost_updates_ = 0;
   std::vector<Pose2> challenger_;  // a sensor reset held for confirmation (sensor_reset_confirm)
+  // the matcher's last hypotheses (moved with the odometry), its headings, and the sensor
+  // resets that have drawn around them (matcher_search_every)
+  std::vector<PoseHypothesis> matcher_found_;
+  int matcher_headings_ = 0, matcher_uses_ = 0;
+  bool searched_ = false;  // on this update
   double reliability_ = 1.0;
   Pose2 posterior_;
   const CorrelativeScanMatcher* matcher_ = nullptr;
