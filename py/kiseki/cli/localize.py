@@ -125,12 +125,12 @@ def localize_command(
         "cells or around the correlative scan matcher's best poses for the scan (matcher); "
         f"default {LocalizeConfig.sensor_reset_proposal}; not with --global.",
     ),
-    matcher_search_every: int | None = typer.Option(
+    search_every: int | None = typer.Option(
         None,
-        help="With --reset-proposal matcher: while the filter stays lost, the map is searched "
-        "on every N-th sensor reset only, the resets between drawing around the last search's "
-        "places moved with the odometry (1: a search on every reset; default "
-        f"{LocalizeConfig.matcher_search_every}).",
+        "--matcher-search-every",
+        parser=Count("--matcher-search-every", 1, 1000),
+        help="With --reset-proposal matcher: a lost filter searches the map on every N-th "
+        f"sensor reset only (1: on every one; default {LocalizeConfig.matcher_search_every}).",
     ),
     reset_look_elsewhere: bool = typer.Option(
         False,
@@ -231,7 +231,7 @@ def localize_command(
     Example: kiseki localize run.mcap --map data/maps/factory_corridor.yaml -o track.csv --json"""
     _refuse_unused_by_localize(ctx, method, global_start)
     if (reset_proposal or LocalizeConfig.sensor_reset_proposal) != "matcher":
-        refuse_given(ctx, ["matcher_search_every"], "without --reset-proposal matcher")
+        refuse_given(ctx, ["search_every"], "without --reset-proposal matcher")
     if cost_model is not None and budget_ms is None:
         raise ValueError("--cost-model applies only with --budget-ms")
 
@@ -271,11 +271,8 @@ def localize_command(
         result = global_localize(scans, grid, gconfig, progress=True)
         trajectory, reliability = result.estimates, result.reliability
     else:
-        resets = dict(
-            sensor_reset_proposal=reset_proposal, matcher_search_every=matcher_search_every
-        )
-        if reset_look_elsewhere:
-            resets.update(reset_look_elsewhere=True)
+        resets = dict(sensor_reset_proposal=reset_proposal, matcher_search_every=search_every)
+        resets.update(reset_look_elsewhere=reset_look_elsewhere or None)  # None: the default
         if reset_unchecked:
             resets.update(reset_needs_agreement=False, sensor_reset_confirm=False)
         budget = dict(budget_ms=budget_ms, beam_skip=beam_skip or None, caster=caster)
@@ -347,7 +344,7 @@ def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bo
         refuse_given(
             ctx,
             ["particles", "kld", "beams", "recovery", "threads", "global_start"]
-            + ["reset_proposal", "matcher_search_every", "reset_look_elsewhere", "reset_unchecked"],
+            + ["reset_proposal", "search_every", "reset_look_elsewhere", "reset_unchecked"],
             "to --method odometry (the odometry alone: no particle filter)",
         )
     elif method == "space-observation":  # a local map of the whole scan: no beam selection
@@ -360,7 +357,7 @@ def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bo
         refuse_given(ctx, ["odometry_noise"], "with --global (it is for logs with reference poses)")
         refuse_given(
             ctx,
-            ["reset_proposal", "matcher_search_every", "reset_look_elsewhere", "reset_unchecked"],
+            ["reset_proposal", "search_every", "reset_look_elsewhere", "reset_unchecked"],
             "with --global (its start is --one-scan; its resets are the uniform ones)",
         )
         refuse_given(
