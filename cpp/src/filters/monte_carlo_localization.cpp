@@ -277,10 +277,7 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
     if (!sensed && model != nullptr && has_free_space() && lost_updates_ >= params_.sensor_reset_after) {
       sensed = sensor_reset(*model, {best, agreement}, scan);
     }
-    if (sensed) {
-      lost_updates_ = 0;
-      matcher_found_.clear();  // a lost spell ended: the next one searches anew
-    }
+    if (sensed) end_lost_spell();
     const bool expanded = !sensed && expansion_reset(model, {best, agreement});
     report.searched = searched_;
     if (sensed || expanded) {
@@ -292,9 +289,7 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
     }
   }
   if (!lost && !dropped) {
-    lost_updates_ = 0;
-    challenger_.clear();  // the cloud agrees again: nothing to confirm
-    matcher_found_.clear();
+    end_lost_spell();  // the cloud agrees again
   }
   posterior_ = weighed;  // before resampling: injected poses have no weight in it
   double inject = 0.0;
@@ -341,8 +336,13 @@ void MonteCarloLocalization::set_likelihood_power(double power) {
 void MonteCarloLocalization::set_recovery(Recovery recovery) {
   params_.recovery = recovery;
   w_slow_ = w_fast_ = 0.0;  // the averages start again from the next update
+  end_lost_spell();
+}
+
+void MonteCarloLocalization::end_lost_spell() {
   lost_updates_ = 0;
-  challenger_.clear();
+  challenger_.clear();     // nothing held to confirm
+  matcher_found_.clear();  // the next spell searches anew
 }
 
 void MonteCarloLocalization::resample_to(std::size_t n) {

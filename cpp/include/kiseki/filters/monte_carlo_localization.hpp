@@ -223,6 +223,9 @@ class MonteCarloLocalization {
   void mix_in(const SensorModel& model, const std::vector<Pose2>& proposed, const std::vector<double>& log_l);
   std::vector<Pose2> reset_candidates(const ScanView* scan, double& searched);
   void check_ready() const;
+  /// A lost spell ends (the cloud agrees again, a sensor reset is made, the recovery changes):
+  /// its count, its held sensor reset and the matcher's places are dropped.
+  void end_lost_spell();
 
   MclParams params_;
   Random rng_;
