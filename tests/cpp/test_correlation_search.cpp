@@ -179,6 +179,36 @@ TEST(VirtualSdem, PointsLeftOutCannotLandInACellWithData) {
   EXPECT_GT(left_out, 20 * n / 4);  // the bound leaves out a real share of the points
 }
 
+TEST(VirtualSdem, Eq4SumsAddSlotJToLaneJMod8BitForBit) {
+  // The reference: eight scalar double sums, slot j into sum j % 8 in slot order, the eight
+  // added last in lane order; the vectorised pass must give the same bits on every CPU.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> range(0.2f, 5.0f), weight(1e-6f, 1.0f), coin(0.0f, 1.0f);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (const std::size_t slots : {8u, 64u, 3136u}) {
+    std::vector<float> zbuffer(slots), current(slots), w(slots);
+    double lane_sum[8] = {}, lane_weight[8] = {};
+    std::size_t hits = 0;
+    for (std::size_t j = 0; j < slots; ++j) {
+      zbuffer[j] = coin(rng) < 0.4f ? inf : range(rng);
+      current[j] = range(rng);
+      w[j] = coin(rng) < 0.05f ? 0.0f : weight(rng);  // padding slots carry weight 0
+      if (std::isinf(zbuffer[j])) continue;
+      const double d = static_cast<double>(zbuffer[j]) - static_cast<double>(current[j]);
+      lane_sum[j % 8] += d * d * static_cast<double>(w[j]);
+      lane_weight[j % 8] += static_cast<double>(w[j]);
+      ++hits;
+    }
+    double want_sum = 0, want_weight = 0;
+    for (int l = 0; l < 8; ++l) want_sum += lane_sum[l], want_weight += lane_weight[l];
+    const Eq4Sums got = eq4_sums(zbuffer.data(), current.data(), w.data(), slots);
+    EXPECT_EQ(got.sum, want_sum) << slots;
+    EXPECT_EQ(got.weights, want_weight) << slots;
+    EXPECT_EQ(got.shared, hits) << slots;
+    for (std::size_t j = 0; j < slots; ++j) ASSERT_TRUE(std::isinf(zbuffer[j]) && zbuffer[j] > 0) << j;  // reset
+  }
+}
+
 TEST(CorrelationSearch, ExhaustiveEqualsThePreviousImplementationAtEveryCandidate) {
   const SparseScene s;
   TranslationGrid grid;  // 7 x 11 x 7: whole and partial blocks of 4

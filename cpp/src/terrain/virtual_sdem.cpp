@@ -15,11 +15,36 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-/// Eight doubles, floats and ints: GCC's and Clang's vector types, so that eq. 4's sums are
-/// vectorised in a fixed order (slot j adds to lane j % 8, the lanes are added last).
-using Double8 = double __attribute__((vector_size(64)));
-using Float8 = float __attribute__((vector_size(32)));
-using Int8 = int __attribute__((vector_size(32)));
+/// Four doubles, floats and ints: GCC's and Clang's vector types, so that eq. 4's sums are
+/// vectorised in a fixed order (slot j adds to lane j % 8 of two such halves, the lanes are added
+/// last). Four, not eight, in a type: eight doubles are wider than an AVX2 register, and GCC then
+/// kept the sums on the stack, reloading them every step.
+using Double4 = double __attribute__((vector_size(32)));
+using Float4 = float __attribute__((vector_size(16)));
+using Int4 = int __attribute__((vector_size(16)));
+
+/// Lanes 0..3 or 4..7 of eq. 4's sums: four slots' terms added to them, the slots reset to +inf.
+struct Eq4Lanes {
+  Double4 sum = {}, weights = {};
+  Int4 shared = {};
+  inline void add(float* __restrict zbuffer, const float* __restrict current, const float* __restrict weight) {
+    const Float4 empty = {kInf, kInf, kInf, kInf};
+    const Float4 far = {1e30f, 1e30f, 1e30f, 1e30f};
+    const Float4 none = {};
+    Float4 nearest, c, v;
+    std::memcpy(&nearest, zbuffer, sizeof nearest);
+    std::memcpy(&c, current, sizeof c);
+    std::memcpy(&v, weight, sizeof v);
+    std::memcpy(zbuffer, &empty, sizeof empty);
+    const Int4 hit = nearest < empty;  // all ones where a point landed
+    const Float4 range = far < nearest ? far : nearest;
+    const Double4 w = __builtin_convertvector(hit ? v : none, Double4);
+    const Double4 d = __builtin_convertvector(range, Double4) - __builtin_convertvector(c, Double4);
+    sum += d * d * w;
+    weights += w;
+    shared -= hit;
+  }
+};
 
 /// atan(t) for |t| <= 1: an odd polynomial of degree 15 fitted for the least maximum error
 /// (4e-8 rad; in float arithmetic 1.4e-7 rad, the rounding of the result itself).
@@ -142,30 +167,18 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) Eq4Sums eq4_sums(fl
                                                                                 std::size_t slots) {
   // One pass over the slots, eight at a time: slot j adds to lane j % 8 of the sums. An empty
   // slot (+inf) has weight 0 and a finite stand-in range, so its term (finite)^2 * 0 is 0.
-  const Float8 empty = {kInf, kInf, kInf, kInf, kInf, kInf, kInf, kInf};
-  const Float8 far = {1e30f, 1e30f, 1e30f, 1e30f, 1e30f, 1e30f, 1e30f, 1e30f};
-  const Float8 none = {};
-  Double8 sum = {}, weights = {};
-  Int8 shared = {};
+  Eq4Lanes low, high;
   for (std::size_t j = 0; j < slots; j += 8) {
-    Float8 nearest, c, v;
-    std::memcpy(&nearest, zbuffer + j, sizeof nearest);
-    std::memcpy(&c, current + j, sizeof c);
-    std::memcpy(&v, weight + j, sizeof v);
-    std::memcpy(zbuffer + j, &empty, sizeof empty);
-    const Int8 hit = nearest < empty;  // all ones where a point landed
-    const Float8 range = far < nearest ? far : nearest;
-    const Double8 w = __builtin_convertvector(hit ? v : none, Double8);
-    const Double8 d = __builtin_convertvector(range, Double8) - __builtin_convertvector(c, Double8);
-    sum += d * d * w;
-    weights += w;
-    shared -= hit;
+    low.add(zbuffer + j, current + j, weight + j);
+    high.add(zbuffer + j + 4, current + j + 4, weight + j + 4);
   }
   Eq4Sums t;
-  for (int l = 0; l < 8; ++l) {
-    t.sum += sum[l];
-    t.weights += weights[l];
-    t.shared += static_cast<std::size_t>(shared[l]);
+  for (const Eq4Lanes* half : {&low, &high}) {
+    for (int l = 0; l < 4; ++l) {
+      t.sum += half->sum[l];
+      t.weights += half->weights[l];
+      t.shared += static_cast<std::size_t>(half->shared[l]);
+    }
   }
   return t;
 }
