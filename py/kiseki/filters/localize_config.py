@@ -44,6 +44,11 @@ class LocalizeConfig:
       z_hit: equal prior odds that a beam's end is a mapped wall or an unmapped object) times
       the beam model's ``lambda_short`` density for a beam stopped short in free space.
     * ``combination`` product (beams independent) or nav2 (1 + sum pz^3).
+    * ``sensor_reset_proposal`` matcher (with recovery resetting): a sensor reset draws its
+      candidates around the branch-and-bound scan matcher's five best poses for the scan
+      (:class:`~kiseki.filters.relocalize.Relocalizer`, built once per run) instead of
+      uniformly over the free cells (uniform, :class:`MclConfig`'s); chosen by the rule the
+      README states before its runs (mcl-excursions and mcl-unknown-obstacles with either).
     * ``caster``: how the beam model casts z* (:mod:`kiseki.grid.casters`: both exact, the same
       weights); the C++ model's default.
     * ``alphas`` None: :func:`motion_alphas` (the noise the odometry has).
@@ -87,8 +92,9 @@ class LocalizeConfig:
     threads: int = MclConfig.threads
     global_start: bool = False  # start uniformly over the map (no initial pose)
     resetting_injects: bool = MclConfig.resetting_injects  # Augmented MCL's injection
-    # the sensor reset's candidates: uniform or around the matcher's hypotheses (MclConfig)
-    sensor_reset_proposal: str = MclConfig.sensor_reset_proposal
+    # the sensor reset's candidates: around the correlative scan matcher's hypotheses for the
+    # scan, or uniform over the free cells (MclConfig's, the engine's own default)
+    sensor_reset_proposal: str = "matcher"
     matcher_search_every: int = MclConfig.matcher_search_every  # searches while lost (MclConfig)
     reset_look_elsewhere: bool = MclConfig.reset_look_elsewhere
     # a reset must also agree with the map from the place it proposes (MclConfig)

@@ -87,6 +87,9 @@ def _labelled_arms(spliced, grid, config: KidnapConfig, seed: int, noise: float,
             particles=config.particles,
             beams=config.beams,
             recovery=arm,
+            # the proposal the stored coefficients were fitted with (LocalizeConfig's default
+            # then); their held-out checks draw their updates the same way
+            sensor_reset_proposal="uniform",
             threads=1,
             reliability="learned",
         )

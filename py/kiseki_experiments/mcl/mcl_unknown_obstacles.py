@@ -89,8 +89,10 @@ class UnknownObstaclesConfig:
     # the resets' agreement check and confirmation (false: the resets before them)
     reset_needs_agreement: bool = LocalizeConfig.reset_needs_agreement
     sensor_reset_confirm: bool = LocalizeConfig.sensor_reset_confirm
-    # where a sensor reset's candidates come from: uniform or matcher
-    sensor_reset_proposal: str = LocalizeConfig.sensor_reset_proposal
+    # where a sensor reset's candidates come from: uniform or matcher. Uniform here, not
+    # LocalizeConfig's matcher: the committed sweep was made with it (the matcher's sweep of the
+    # resetting arms is beside it in the README) and has not been made again in whole
+    sensor_reset_proposal: str = "uniform"
     # with the matcher: a search on every this-many-th sensor reset of a lost spell
     matcher_search_every: Count = LocalizeConfig.matcher_search_every
 

@@ -168,6 +168,7 @@ def test_unknown_obstacles_on_a_real_log_cut_more_beams_as_they_grow_denser(
         particles=200,
         odometry_noise=0.1,
         recovery="resetting",
+        sensor_reset_proposal=UnknownObstaclesConfig.sensor_reset_proposal,
         threads=1,
     )
     plain = localize(scans, map_of_log(scans, MapBuildConfig(0.05)), config)
