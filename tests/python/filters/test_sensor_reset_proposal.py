@@ -179,7 +179,10 @@ def test_bad_settings_are_refused_in_one_line(tmp_path):
         (["--reset-proposal", "grid"], "sensor_reset_proposal must be one of"),
         (["--global", "--reset-proposal", "matcher"], "does not apply with --global"),
         (["--global", "--reset-unchecked"], "does not apply with --global"),
-        (["--matcher-search-every", "3"], "does not apply without --reset-proposal matcher"),
+        (
+            ["--reset-proposal", "uniform", "--matcher-search-every", "3"],
+            "does not apply without --reset-proposal matcher",
+        ),
         (
             ["--reset-proposal", "matcher", "--matcher-search-every", "0"],
             "--matcher-search-every must be",
