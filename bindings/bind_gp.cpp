@@ -152,12 +152,15 @@ void bind_gp(py::module_& m) {
           py::gil_scoped_release release;
           fit = fit_hyperparameters(x.map(), y.map(), initial, o);
         }
+        py::list optima;
+        for (const auto& [k, lml] : fit.optima) optima.append(py::make_tuple(k.sigma_f, k.length_scale, k.sigma_n, lml));
         return py::make_tuple(fit.kernel.sigma_f, fit.kernel.length_scale, fit.kernel.sigma_n,
-                              fit.log_marginal_likelihood, fit.evaluations, fit.gradients, fit.start_values);
+                              fit.log_marginal_likelihood, fit.evaluations, fit.gradients, fit.start_values, optima);
       },
       "inputs"_a, "targets"_a, "sigma_f"_a, "length_scale"_a, "sigma_n"_a, "restarts"_a = 3, "seed"_a = 0,
       "max_iterations"_a = 100, "tolerance"_a = 1e-6, "scan"_a = true, "stop_at_repeat"_a = true,
-      "(sigma_f, l, sigma_n, LML, likelihood values, gradients, best LML per start made); targets used as given.");
+      "(sigma_f, l, sigma_n, LML, likelihood values, gradients, best LML per start made, the distinct optima as "
+      "(sigma_f, l, sigma_n, LML)); targets used as given.");
 }
 
 }  // namespace kiseki::bindings

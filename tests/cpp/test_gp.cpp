@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "kiseki/core/random.hpp"
@@ -114,6 +116,28 @@ TEST(ExactGp, HyperparametersOfASampledFieldAreFound) {
   // The same seed gives the same answer.
   const HyperparameterFit again = fit_hyperparameters(x, y, initial_kernel(x, y));
   EXPECT_EQ(fit.kernel.length_scale, again.kernel.length_scale);
+  // Every start made (no stop at a repeat): the optima list each distinct end once (no two
+  // within the repeat tolerances of each other), the best among them.
+  HyperparameterOptions all;
+  all.stop_at_repeat = false;
+  const HyperparameterFit every = fit_hyperparameters(x, y, initial_kernel(x, y), all);
+  ASSERT_FALSE(every.optima.empty());
+  EXPECT_LE(every.optima.size(), every.start_values.size());
+  double best = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < every.optima.size(); ++i) {
+    best = std::max(best, every.optima[i].second);
+    for (std::size_t j = 0; j < i; ++j) {
+      const auto& [a, va] = every.optima[i];
+      const auto& [b, vb] = every.optima[j];
+      const bool same_value = std::abs(va - vb) <= all.repeat_tolerance * std::max(std::abs(vb), 1.0);
+      const bool same_place = std::abs(std::log(a.sigma_f / b.sigma_f)) <= all.repeat_parameter_tolerance &&
+                              std::abs(std::log(a.length_scale / b.length_scale)) <= all.repeat_parameter_tolerance &&
+                              std::abs(std::log(a.sigma_n / b.sigma_n)) <= all.repeat_parameter_tolerance;
+      EXPECT_FALSE(same_value && same_place) << "optima " << j << " and " << i;
+    }
+  }
+  // a repeated end may be the best by less than the repeat tolerance
+  EXPECT_NEAR(best, every.log_marginal_likelihood, all.repeat_tolerance * std::abs(best));
   HyperparameterOptions bad;
   bad.repeat_tolerance = -1e-6;
   EXPECT_THROW(fit_hyperparameters(x, y, initial_kernel(x, y), bad), std::invalid_argument);

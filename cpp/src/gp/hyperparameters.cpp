@@ -310,8 +310,10 @@ HyperparameterFit fit_hyperparameters(const Eigen::Ref<const RowMatrix>& inputs,
       fit.log_marginal_likelihood = lml;
       fit.kernel = from_log(p);
     }
-    if (options.stop_at_repeat && repeats_an_earlier_end(p, lml)) break;
+    const bool repeated = repeats_an_earlier_end(p, lml);
+    if (options.stop_at_repeat && repeated) break;
     ends.emplace_back(p, lml);
+    if (!repeated) fit.optima.emplace_back(from_log(p), lml);
   }
   if (!std::isfinite(fit.log_marginal_likelihood)) {
     throw std::runtime_error("fit_hyperparameters: no start gave a covariance matrix that could be factorised");

@@ -51,10 +51,11 @@ class ExactGP:
         max_points: int = 2000,
         per_component: bool = False,
         refine: bool = False,
+        search_points: int | None = None,
     ) -> ExactGP:
         """Fits to readings y (n,) or (n, k) at positions x (n, d). Without a kernel the
-        hyperparameters are chosen by :func:`fit_hyperparameters` (restarts, seed, max_points
-        as there). mean: "constant" (the training mean of each column) or "zero" (as
+        hyperparameters are chosen by :func:`fit_hyperparameters` (restarts, seed, max_points,
+        search_points as there). mean: "constant" (the training mean of each column) or "zero" (as
         scikit-learn's GaussianProcessRegressor with normalize_y=False). per_component: one
         kernel per column, as the thesis fits mx, my and mz (three factorisations). refine: with
         more readings than max_points, the subsample's hyperparameters are then refined on every
@@ -71,7 +72,13 @@ class ExactGP:
             k = kernel
             if k is None:
                 hyper = fit_hyperparameters(
-                    x, part, restarts=restarts, seed=seed, max_points=max_points, mean=mean
+                    x,
+                    part,
+                    restarts=restarts,
+                    seed=seed,
+                    max_points=max_points,
+                    mean=mean,
+                    search_points=search_points,
                 )
                 if refine and hyper.points_used < len(x):
                     hyper = refine_hyperparameters(x, part, hyper, mean=mean)

@@ -5,7 +5,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -72,7 +72,8 @@ class HyperparameterFit:
     gradients: int  # of which also with the gradient (two more n^3 / 3 each)
     start_values: tuple[float, ...]  # the best likelihood reached from each start made
     points_used: int
-    # a refinement's (refine_hyperparameters): the subsample's fit it started from
+    # a refinement's (refine_hyperparameters) or a two-stage fit's: the subsample's fit it
+    # started from
     refined_from: HyperparameterFit | None = None
 
 
@@ -86,6 +87,18 @@ def subsample(n: int, max_points: int, seed: int) -> np.ndarray | None:
     return np.sort(rng.choice(n, size=max_points, replace=False))
 
 
+# The starts are searched on a subsample of a quarter of the points used, at least this many:
+# an evaluation costs n^3 / 3, so the search's costs 1/64 of one on every point, and the climbs
+# on every point decide between the optima it found. 256 readings still cover the field's
+# length scales; at most 4 x 256 points, the search is made on all of them (one stage).
+SEARCH_POINTS_MIN = 256
+
+
+def search_points_for(points: int) -> int:
+    """The default subsample size of the start search for ``points`` readings used."""
+    return max(points // 4, SEARCH_POINTS_MIN)
+
+
 def fit_hyperparameters(
     x: Any,
     y: Any,
@@ -97,6 +110,7 @@ def fit_hyperparameters(
     max_iterations: int = 100,
     mean: str = "constant",
     stop_at_repeat: bool = True,
+    search_points: int | None = None,
 ) -> HyperparameterFit:
     """Hyperparameters that maximise the log marginal likelihood (eq. 6.11) summed over Y's
     columns (one kernel shared by the field's components), by projected L-BFGS in
@@ -104,9 +118,15 @@ def fit_hyperparameters(
     the data's spread), from the best of a coarse scan of l and sigma_n, and from up to
     `restarts` seeded random starts: with `stop_at_repeat` they stop once a start ends at an
     optimum an earlier start reached (the same log marginal likelihood to 1e-6 of its size and
-    every hyperparameter within 1 %), so ``len(start_values)`` says how many were made. Above
-    `max_points` readings the likelihood is that of a seeded random subsample of that size
-    (its cost grows as n^3)."""
+    every hyperparameter within 1 %). Above `max_points` readings the likelihood is that of a
+    seeded random subsample of that size (its cost grows as n^3).
+
+    Two stages when the points used outnumber `search_points` (default
+    :func:`search_points_for`: a quarter of them, at least 256): the starts above are searched
+    on a seeded subsample of that size (``refined_from``), then each distinct optimum it found
+    is climbed by the same L-BFGS on every point used, and the best climb wins; its
+    ``start_values`` are the climbs'. With `search_points` at least the points used, one stage
+    (the search on all of them)."""
     x = inputs_array(x)
     y, _ = targets_array(y, x.shape[0])
     constant = check_mean(mean)
@@ -115,15 +135,23 @@ def fit_hyperparameters(
     if not isinstance(stop_at_repeat, bool):
         raise ValueError(f"stop_at_repeat must be True or False, got {stop_at_repeat!r}")
     check_iterations(max_iterations)
+    if search_points is not None and (
+        isinstance(search_points, bool) or not isinstance(search_points, int) or search_points < 2
+    ):
+        raise ValueError(f"search_points must be an integer >= 2, got {search_points!r}")
     chosen = subsample(x.shape[0], max_points, seed)
     if chosen is not None:
         x, y = x[chosen], y[chosen]
     y = remove_mean(y, constant)
+    if search_points is None:
+        search_points = search_points_for(len(x))
+    searched = subsample(len(x), search_points, seed)
+    xs, ys = (x, y) if searched is None else (x[searched], y[searched])
     if initial is None:
-        initial = SquaredExponential(*_core.gp_initial_kernel(x, y))
-    sf, ls, sn, lml, evaluations, gradients, starts = _core.gp_fit_hyperparameters(
-        x,
-        y,
+        initial = SquaredExponential(*_core.gp_initial_kernel(xs, ys))
+    *found, optima = _core.gp_fit_hyperparameters(
+        xs,
+        ys,
         initial.sigma_f,
         initial.length_scale,
         initial.sigma_n,
@@ -132,13 +160,39 @@ def fit_hyperparameters(
         max_iterations,
         stop_at_repeat=stop_at_repeat,
     )
+    search = _fit_of(found, len(xs))
+    if searched is None:
+        return search
+    # Each distinct optimum of the subsample climbed on every point used, best first.
+    climbs = [
+        _fit_of(
+            _core.gp_fit_hyperparameters(x, y, sf, ls, sn, 0, 0, max_iterations, scan=False),
+            len(x),
+        )
+        for sf, ls, sn, _ in sorted(optima, key=lambda o: -o[3])
+    ]
+    best = max(climbs, key=lambda c: c.log_marginal_likelihood)
+    return HyperparameterFit(
+        best.kernel,
+        best.log_marginal_likelihood,
+        sum(c.evaluations for c in climbs),
+        sum(c.gradients for c in climbs),
+        tuple(c.log_marginal_likelihood for c in climbs),
+        len(x),
+        search,
+    )
+
+
+def _fit_of(found: Any, points: int) -> HyperparameterFit:
+    """A HyperparameterFit from gp_fit_hyperparameters' values (the optima left out)."""
+    sf, ls, sn, lml, evaluations, gradients, starts = found[:7]
     return HyperparameterFit(
         SquaredExponential(sf, ls, sn),
         float(lml),
         int(evaluations),
         int(gradients),
         tuple(starts),
-        len(x),
+        points,
     )
 
 
@@ -160,13 +214,10 @@ def refine_hyperparameters(
     y = remove_mean(y, check_mean(mean))
     check_iterations(max_iterations)
     k = start.kernel
-    sf, ls, sn, lml, evaluations, gradients, starts = _core.gp_fit_hyperparameters(
+    found = _core.gp_fit_hyperparameters(
         x, y, k.sigma_f, k.length_scale, k.sigma_n, 0, 0, max_iterations, scan=False
     )
-    kernel = SquaredExponential(sf, ls, sn)
-    return HyperparameterFit(
-        kernel, float(lml), int(evaluations), int(gradients), tuple(starts), len(x), start
-    )
+    return replace(_fit_of(found, len(x)), refined_from=start)
 
 
 def log_marginal_likelihood(x: Any, y: Any, kernel: SquaredExponential, *, mean: str = "constant"):

@@ -218,5 +218,8 @@ def test_bad_kernels_and_options_are_refused(data):
         HilbertGP.fit(x, y, SquaredExponential(1.0, 0.5, 0.1), domain=([0.5, 0.5], [2.0, 2.0]))
     with pytest.raises(ValueError, match="stop_at_repeat must be True or False"):
         fit_hyperparameters(x, y, stop_at_repeat=1)
+    for bad in (1, 2.5, True):
+        with pytest.raises(ValueError, match="search_points must be an integer >= 2"):
+            fit_hyperparameters(x, y, search_points=bad)
     with pytest.raises(ValueError, match="more than 10 basis functions"):
         HilbertGP.fit(x, y, SquaredExponential(1.0, 0.1, 0.1), max_basis=10)

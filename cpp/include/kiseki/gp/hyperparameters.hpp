@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "kiseki/gp/exact_gp.hpp"
@@ -54,6 +55,9 @@ struct HyperparameterFit {
   int evaluations = 0;                  ///< likelihood values (one Cholesky factorisation each), all starts
   int gradients = 0;                    ///< of which also with the gradient (the inverse as well)
   std::vector<double> start_values;     ///< the best LML reached from each start made
+  /// Where the starts ended that did not end at an earlier start's optimum, in the order
+  /// reached, with their LML: the distinct optima found (a coarse search's candidates).
+  std::vector<std::pair<SquaredExponential, double>> optima;
 };
 
 /// Maximises eq. 6.11 over (sigma_f, l, sigma_n) by projected BFGS in log-parameters with a
