@@ -59,6 +59,12 @@ def hall(n: int, seed: int, voxel: float = 0.05):
 # --- the 3-D cases ----------------------------------------------------------------------------
 
 
+def search_note(fit) -> str:
+    """What the first stage of a two-stage hyperparameter search spent ("" for one stage)."""
+    first = fit.refined_from
+    return "" if first is None else f" after {first.evaluations} on {first.points_used:,}"
+
+
 def case_volume(args, rows) -> None:
     scene = load_scene(FLOOR)
     survey, world = survey_3d(scene, args.seed), magnetic_world(scene)
@@ -76,7 +82,7 @@ def case_volume(args, rows) -> None:
     total = hyper_s + factor_s + predict_s
     print(
         f"  hyperparameters ({hyper.points_used:,}-point subsample, {hyper.evaluations} "
-        f"evaluations, {hyper.gradients} with the gradient, "
+        f"evaluations{search_note(hyper)}, {hyper.gradients} with the gradient, "
         f"{hyper_s / hyper.evaluations:.2f} s each): {hyper_s:.1f} s; "
         f"factorisation of {len(x):,}: {factor_s:.2f} s; prediction with variance: "
         f"{predict_s:.1f} s\n  {gp.kernel}; RMSE against the field at the {near.sum():,} "
@@ -100,7 +106,7 @@ def case_volume(args, rows) -> None:
     total = all_s + factor_s + predict_s
     print(
         f"  hyperparameters on all {len(x):,} readings ({start.evaluations} evaluations on "
-        f"{start.points_used:,}, then {refined.evaluations} on all; LML on all "
+        f"{start.points_used:,}{search_note(start)}, then {refined.evaluations} on all; LML on all "
         f"{refined.log_marginal_likelihood:.2f}): {all_s:.1f} s; factorisation {factor_s:.2f} s; "
         f"prediction with variance {predict_s:.1f} s\n  {refined.kernel}; RMSE near data: "
         f"{rmse(mean[near], world.static_field_at(grid[near])):.4f} G",
@@ -126,7 +132,8 @@ def case_hilbert(args, rows) -> None:
     total = hyper_s + fit_s + predict_s
     truth = world.static_field_at(grid)
     print(
-        f"  hyperparameters ({hyper.points_used:,} points, {hyper.evaluations} evaluations): "
+        f"  hyperparameters ({hyper.points_used:,} points, {hyper.evaluations} evaluations"
+        f"{search_note(hyper)}): "
         f"{hyper_s:.1f} s; fit, {hg.basis_size:,} basis functions: {fit_s:.2f} s; prediction "
         f"with variance: {predict_s:.1f} s; total {total:.1f} s\n  {k}; RMSE against the "
         f"field: {rmse(mean, truth):.4f} G (field SD {truth.std(axis=0).mean():.4f} G)",
