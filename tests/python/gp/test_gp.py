@@ -164,6 +164,23 @@ def test_spectral_tolerance_is_1e_4_until_the_field_stands_above_its_noise():
     assert spectral_tolerance(SquaredExponential(3.0, 0.5, 1.0)) == pytest.approx(1e-4 / 9)
 
 
+def test_two_stages_reach_the_one_stage_optimum(data):
+    """ExactGP.fit's search in two stages (starts on 100 of the 250 points, each distinct
+    optimum climbed on all 250) against the one stage on all of them (250 is under the default
+    two-stage size, so the default is one stage): the same optimum of every point's likelihood."""
+    x, y, _ = data
+    one = ExactGP.fit(x, y, restarts=2, seed=1)
+    assert one.hyperparameter_fit.refined_from is None and one.hyperparameter_fit.points_used == 250
+    two = ExactGP.fit(x, y, restarts=2, seed=1, search_points=100)
+    fit = two.hyperparameter_fit
+    assert fit.points_used == 250 and fit.refined_from.points_used == 100
+    assert len(fit.start_values) >= 1
+    assert fit.log_marginal_likelihood == pytest.approx(two.log_marginal_likelihood(), rel=1e-9)
+    assert two.log_marginal_likelihood() == pytest.approx(one.log_marginal_likelihood(), rel=1e-6)
+    for name in ("sigma_f", "length_scale", "sigma_n"):
+        assert getattr(two.kernel, name) == pytest.approx(getattr(one.kernel, name), rel=1e-3)
+
+
 def test_restarts_stop_once_a_start_ends_at_an_earlier_optimum(data):
     """The stop at a repeated optimum against the full search with the same seed: the starts it
     makes are the full search's first ones, to the same values; the last of them repeats an
