@@ -88,9 +88,9 @@ def subsample(n: int, max_points: int, seed: int) -> np.ndarray | None:
 
 
 # The starts are searched on a subsample of a quarter of the points used, at least this many:
-# an evaluation costs n^3 / 3, so the search's costs 1/64 of one on every point, and the climbs
-# on every point decide between the optima it found. 256 readings still cover the field's
-# length scales; at most 4 x 256 points, the search is made on all of them (one stage).
+# an evaluation costs n^3 / 3, so each of the search's costs 1/64 of one on every point, and
+# the climbs on every point decide between the optima it found. Up to this many points the
+# search is made on all of them (one stage); from 257 to 1,023 points it is made on 256.
 SEARCH_POINTS_MIN = 256
 
 
@@ -165,10 +165,7 @@ def fit_hyperparameters(
         return search
     # Each distinct optimum of the subsample climbed on every point used, best first.
     climbs = [
-        _fit_of(
-            _core.gp_fit_hyperparameters(x, y, sf, ls, sn, 0, 0, max_iterations, scan=False),
-            len(x),
-        )
+        _climb(x, y, SquaredExponential(sf, ls, sn), max_iterations)
         for sf, ls, sn, _ in sorted(optima, key=lambda o: -o[3])
     ]
     best = max(climbs, key=lambda c: c.log_marginal_likelihood)
@@ -181,6 +178,14 @@ def fit_hyperparameters(
         len(x),
         search,
     )
+
+
+def _climb(x: np.ndarray, y: np.ndarray, k: SquaredExponential, max_iterations: int):
+    """The L-BFGS from kernel k alone (no scan, no restarts) on the checked, centred x, y."""
+    found = _core.gp_fit_hyperparameters(
+        x, y, k.sigma_f, k.length_scale, k.sigma_n, 0, 0, max_iterations, scan=False
+    )
+    return _fit_of(found, len(x))
 
 
 def _fit_of(found: Any, points: int) -> HyperparameterFit:
@@ -213,11 +218,7 @@ def refine_hyperparameters(
     y, _ = targets_array(y, x.shape[0])
     y = remove_mean(y, check_mean(mean))
     check_iterations(max_iterations)
-    k = start.kernel
-    found = _core.gp_fit_hyperparameters(
-        x, y, k.sigma_f, k.length_scale, k.sigma_n, 0, 0, max_iterations, scan=False
-    )
-    return replace(_fit_of(found, len(x)), refined_from=start)
+    return replace(_climb(x, y, start.kernel, max_iterations), refined_from=start)
 
 
 def log_marginal_likelihood(x: Any, y: Any, kernel: SquaredExponential, *, mean: str = "constant"):
