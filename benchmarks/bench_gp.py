@@ -53,7 +53,7 @@ from pathlib import Path
 import numpy as np
 from sklearn.gaussian_process import GaussianProcessRegressor
 
-from gp_cases_3d import case_hilbert, case_tiled, case_volume, rmse  # beside this file
+from gp_cases_3d import case_hilbert, case_tiled, case_volume, rmse, search_note  # beside this file
 from gp_reference import run_sklearn_limited, sklearn_kernel, start_kernel
 from kiseki.datasets import read_aalto_run
 from kiseki.gp import ExactGP
@@ -110,30 +110,25 @@ def run_kiseki(x, y, xs, restarts, per_component, max_points, repeats, search_po
     return {
         "fit": fit_s,
         "factor": factor_s,
+        "hyper": fit_s - factor_s,  # the hyperparameter search
         "predict": predict_s,
         "mean": mean,
         "std": std,
         "lml": gp.log_marginal_likelihood(),
         "evaluations": sum(f.evaluations for f in gp.hyperparameter_fits),
         "gradients": sum(f.gradients for f in gp.hyperparameter_fits),
-        # the two-stage search's first stage (on a subsample): evaluations and points
-        "search": [
-            (f.refined_from.evaluations, f.refined_from.points_used)
-            for f in gp.hyperparameter_fits
-            if f.refined_from is not None
-        ],
+        # what the two-stage search's first stage (on a subsample) spent, as text
+        "search": "".join(search_note(f) for f in gp.hyperparameter_fits),
         "kernels": [str(k) for k in gp.kernels],
     }
 
 
 def show_kiseki(label: str, k: dict, truth) -> None:
-    """One kiseki fit's line: times, evaluations (on every point; the search's first stage on a
-    subsample, when made, in brackets), RMSE, LML and kernels."""
-    k["hyper"] = k["fit"] - k["factor"]
-    search = "".join(f" after {e} on {p:,} points" for e, p in k["search"])
+    """One kiseki fit's line: times, evaluations (on every point, then what the search's first
+    stage on a subsample spent, when made), RMSE, LML and kernels."""
     print(
         f"  {label}: fit {k['fit']:.2f} s (hyperparameters {k['hyper']:.2f} s, {k['evaluations']}"
-        f" evaluations on every point{search}, {k['gradients']} of them with the gradient, "
+        f" evaluations on every point{k['search']}, {k['gradients']} of them with the gradient, "
         f"{k['hyper'] / k['evaluations']:.3f} s each; factorisation "
         f"{k['factor']:.2f} s), predict {k['predict']:.3f} s, RMSE {rmse(k['mean'], truth):.5g}, "
         f"LML {k['lml']:.2f}\n           {'; '.join(k['kernels'])}",
@@ -199,8 +194,7 @@ def compare(name, x, y, xs, truth, args, sklearn: bool, r: int, rows) -> None:
         ),
         (
             f"{name}: likelihood evaluations (s each)",
-            f"{k['evaluations']}, {k['gradients']} with gradient ({k_each:.3f} s)"
-            + "".join(f", after {e} on {p:,} points" for e, p in k["search"]),
+            f"{k['evaluations']}, {k['gradients']} with gradient ({k_each:.3f} s)" + k["search"],
             f"{s['evaluations']} ({s_each:.3f} s)",
             f"{s_each / k_each:.1f}x each",
         ),

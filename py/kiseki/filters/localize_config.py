@@ -46,7 +46,7 @@ class LocalizeConfig:
     * ``combination`` product (beams independent) or nav2 (1 + sum pz^3).
     * ``sensor_reset_proposal`` matcher (with recovery resetting): a sensor reset draws its
       candidates around the branch-and-bound scan matcher's five best poses for the scan
-      (:class:`~kiseki.filters.relocalize.Relocalizer`, built once per run) instead of
+      (:class:`~kiseki.filters.relocalization.Relocalizer`, built once per run) instead of
       uniformly over the free cells (uniform, :class:`MclConfig`'s); chosen by the rule the
       README states before its runs (mcl-excursions and mcl-unknown-obstacles with either).
     * ``caster``: how the beam model casts z* (:mod:`kiseki.grid.casters`: both exact, the same
