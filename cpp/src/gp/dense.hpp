@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Copyright (c) 2026 the kiseki authors
 // Private to kiseki/gp: the dense factorisations and products of the Gaussian processes, done by
-// LAPACK and BLAS (OpenBLAS on Debian: multithreaded, vectorised for the CPU it runs on), on
+// LAPACK and BLAS (OpenBLAS on Debian, vectorised for the CPU it runs on; tiled over OpenMP's
+// threads so that the result does not depend on their number, see dense.cpp), on
 // column-major Eigen matrices.
 #pragma once
 
