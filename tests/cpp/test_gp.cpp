@@ -1,12 +1,15 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Copyright (c) 2026 the kiseki authors
+#include <cblas.h>
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
 
 #include "kiseki/core/random.hpp"
 #include "kiseki/gp/hilbert_gp.hpp"
@@ -141,6 +144,38 @@ TEST(ExactGp, HyperparametersOfASampledFieldAreFound) {
   HyperparameterOptions bad;
   bad.repeat_tolerance = -1e-6;
   EXPECT_THROW(fit_hyperparameters(x, y, initial_kernel(x, y), bad), std::invalid_argument);
+}
+
+TEST(ExactGp, SameBitsOnAnyThreadCount) {
+  // 700 points: three tiles of the dense algebra, so the factorisation, the inverse of the
+  // gradient and the products are spread over the threads; OpenBLAS is asked for as many
+  // threads of its own, which the GP must not use (its splits change the last bits).
+  const RowMatrix x = uniform_points(700, 2, 6.0, 21);
+  const RowMatrix y = smooth_field(x, 0.05, 22);
+  const RowMatrix q = uniform_points(400, 2, 6.0, 23);
+  auto run = [&](int threads) {
+    omp_set_num_threads(threads);
+    openblas_set_num_threads(threads);
+    const HyperparameterFit fit = fit_hyperparameters(x, y, initial_kernel(x, y));
+    const ExactGaussianProcess gp(x, y, fit.kernel);
+    RowMatrix mean;
+    Eigen::VectorXd var;
+    gp.predict(q, mean, &var);
+    return std::make_tuple(fit.kernel.sigma_f, fit.kernel.length_scale, fit.kernel.sigma_n,
+                           fit.log_marginal_likelihood, Eigen::MatrixXd(mean), Eigen::VectorXd(var));
+  };
+  const int saved = omp_get_max_threads();
+  const auto one = run(1);
+  for (int threads : {2, 3}) {
+    const auto other = run(threads);
+    EXPECT_EQ(std::get<0>(one), std::get<0>(other)) << threads;
+    EXPECT_EQ(std::get<1>(one), std::get<1>(other)) << threads;
+    EXPECT_EQ(std::get<2>(one), std::get<2>(other)) << threads;
+    EXPECT_EQ(std::get<3>(one), std::get<3>(other)) << threads;
+    EXPECT_TRUE((std::get<4>(one).array() == std::get<4>(other).array()).all()) << threads;
+    EXPECT_TRUE((std::get<5>(one).array() == std::get<5>(other).array()).all()) << threads;
+  }
+  omp_set_num_threads(saved);
 }
 
 TEST(HilbertGp, ApproachesTheExactGp) {
