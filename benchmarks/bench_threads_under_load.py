@@ -10,7 +10,8 @@ The load: ``--busy`` processes that each run the same engine on two threads in a
 OpenMP program, as a second localizer or a planner on the robot would be): with the default
 policy their workers spin between parallel regions and take the cores' time slices. Goal: two
 threads never slower than one under the load, and at least 1.7x one with the machine free at
-50,000 particles.
+50,000 particles. Beside them the engine's default, threads 0: every core, or one thread while
+one is measured faster (its ThreadChooser times the updates with each).
 
 Run: python benchmarks/bench_threads_under_load.py [--scans 15] [--busy 2]
 """
@@ -101,7 +102,7 @@ def main() -> None:
         return
     print(f"cores: {os.cpu_count()}; load: {args.busy} processes running the engine on 2 threads")
     print(f"{'machine':<8}{'policy':<9}{'particles':>10}{'1 thread ms':>13}{'2 threads ms':>14}"
-          f"{'1 / 2':>7}")  # fmt: skip
+          f"{'1 / 2':>7}{'chosen ms':>11}{'1 / chosen':>12}")  # fmt: skip
     for machine in ("free", "busy"):
         procs = start_load(args.busy, 10_000) if machine == "busy" else []
         try:
@@ -109,8 +110,10 @@ def main() -> None:
                 for n in args.particles:
                     one = measure(policy, n, 1, args.scans)
                     two = measure(policy, n, 2, args.scans)
+                    chosen = measure(policy, n, 0, args.scans)
                     print(f"{machine:<8}{policy:<9}{n:>10}{one:>13.2f}{two:>14.2f}"
-                          f"{one / two:>7.2f}", flush=True)  # fmt: skip
+                          f"{one / two:>7.2f}{chosen:>11.2f}{one / chosen:>12.2f}",
+                          flush=True)  # fmt: skip
         finally:
             for p in procs:
                 p.kill()

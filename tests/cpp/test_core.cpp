@@ -4,11 +4,13 @@
 
 #include <cmath>
 #include <set>
+#include <stdexcept>
 #include <vector>
 
 #include "kiseki/core/angle.hpp"
 #include "kiseki/core/pose.hpp"
 #include "kiseki/core/random.hpp"
+#include "kiseki/core/thread_chooser.hpp"
 
 using namespace kiseki;
 
@@ -119,4 +121,53 @@ TEST(Random, DerivedStreamsAreDistinctAndReproducible) {
   for (std::uint64_t s = 0; s < 100; ++s) seeds.insert(derive_seed(123, s));
   EXPECT_EQ(seeds.size(), 100u);
   EXPECT_EQ(Random(9).split(3).uniform(), Random(derive_seed(9, 3)).uniform());
+}
+
+namespace {
+
+// A step costs `one` seconds per item on one thread and `most` on every core.
+int steps_on_most(ThreadChooser& chooser, int steps, double one, double most) {
+  int count = 0;
+  for (int s = 0; s < steps; ++s) {
+    const bool all = chooser.threads() > 1;
+    count += all ? 1 : 0;
+    chooser.record((all ? most : one) * 1000.0, 1000);
+  }
+  return count;
+}
+
+}  // namespace
+
+TEST(ThreadChooser, TakesTheFasterChoiceAndFollowsTheLoad) {
+  ThreadChooser chooser(2, 10);
+  EXPECT_EQ(chooser.threads(), 2);  // every core until measured
+  // The cores busy: two threads 4x slower. After the two warm-ups and one measured step of
+  // each choice, one thread, with every 10th step a probe of two.
+  const int busy = steps_on_most(chooser, 104, 1e-6, 4e-6);
+  EXPECT_EQ(chooser.cost_one(), 1e-6);
+  EXPECT_EQ(chooser.cost_most(), 4e-6);
+  EXPECT_EQ(busy, 2 + 10);  // the warm-up and measured step of two, then one probe in 10
+  // The machine free again: two threads 2x faster. The first probe after it sees it, and the
+  // chooser stays with two threads, probing one every 10th step.
+  const int free = steps_on_most(chooser, 100, 1e-6, 0.5e-6);
+  EXPECT_GE(free, 100 - 10 - 10);
+  EXPECT_EQ(chooser.threads() > 1, true);
+  // Busy again: the chooser leaves two threads within a few steps (its average rises each step).
+  int until = 0;
+  while (chooser.threads() > 1 && until < 100) {
+    chooser.record(8e-6 * 1000.0, 1000);
+    ++until;
+  }
+  EXPECT_LE(until, 8);
+}
+
+TEST(ThreadChooser, OneCoreOrBadSettings) {
+  ThreadChooser one(1);
+  for (int s = 0; s < 20; ++s) {
+    EXPECT_EQ(one.threads(), 1);
+    one.record(1.0, 10);
+  }
+  EXPECT_THROW(ThreadChooser(0), std::invalid_argument);
+  EXPECT_THROW(ThreadChooser(2, 1), std::invalid_argument);
+  EXPECT_THROW(ThreadChooser(2, 10, 0.0), std::invalid_argument);
 }

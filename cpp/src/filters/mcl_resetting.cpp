@@ -58,7 +58,7 @@ bool MonteCarloLocalization::expansion_reset(const SensorModel* model, const Clo
   std::vector<Pose2> out(n);
   const std::uint64_t seed = rng_.below(~std::uint64_t{0});
   const double rp = params_.expansion_position, ro = params_.expansion_orientation;
-  parallel_for(n, params_.threads, [&](std::size_t b, std::size_t e) {
+  parallel_for(n, threads_now(), [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
       StreamRandom g(seed, i);
       const Pose2& q = particles_[idx[i]];

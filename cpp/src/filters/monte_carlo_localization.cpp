@@ -3,6 +3,7 @@
 #include "kiseki/filters/monte_carlo_localization.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -59,7 +60,10 @@ void MclParams::validate() const {
 }
 
 MonteCarloLocalization::MonteCarloLocalization(const MclParams& params, std::uint64_t seed)
-    : params_((params.validate(), params)), rng_(seed), target_(params.particles) {
+    : params_((params.validate(), params)),
+      rng_(seed),
+      target_(params.particles),
+      chooser_(params.threads > 0 ? params.threads : resolve_threads(0)) {
   params_.kld_params.max_particles = params_.particles;
 }
 
@@ -157,10 +161,10 @@ void MonteCarloLocalization::predict(const Pose2& a, const Pose2& b) {
     throw std::invalid_argument(text);
   }
   const std::uint64_t step_seed = rng_.below(~std::uint64_t{0});
-  sample_motion(params_.motion, a, b, particles_.data(), particles_.size(), step_seed, params_.threads);
+  sample_motion(params_.motion, a, b, particles_.data(), particles_.size(), step_seed, threads_now());
   if (!challenger_.empty()) {
     sample_motion(params_.motion, a, b, challenger_.data(), challenger_.size(), rng_.below(~std::uint64_t{0}),
-                  params_.threads);
+                  threads_now());
   }
   const Pose2 step_taken = a.between(b);  // places, not particles: moved without noise
   for (PoseHypothesis& h : matcher_found_) h.pose = h.pose.compose(step_taken);
@@ -168,7 +172,7 @@ void MonteCarloLocalization::predict(const Pose2& a, const Pose2& b) {
 
 std::vector<double> MonteCarloLocalization::evaluate(const SensorModel& model, const std::vector<Pose2>& poses) const {
   std::vector<double> out(poses.size());
-  parallel_for(poses.size(), params_.threads,
+  parallel_for(poses.size(), threads_now(),
                [&](std::size_t b, std::size_t e) { model.log_likelihoods(poses.data() + b, e - b, out.data() + b); }, 64);
   return out;
 }
@@ -179,36 +183,56 @@ double MonteCarloLocalization::agreement_of(const SensorModel& model, const Pose
   return model.agreement(weighed);
 }
 
+namespace {
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+}  // namespace
+
 UpdateReport MonteCarloLocalization::update(SensorModel& model) {
   check_ready();
-  model.select_readings(particles_.data(), particles_.size(), params_.threads);
-  return update(static_cast<const SensorModel&>(model));
+  const auto start = Clock::now();
+  model.select_readings(particles_.data(), particles_.size(), threads_now());
+  UpdateReport report = weigh(model, nullptr);
+  chooser_.record(seconds_since(start), particles_.size());
+  return report;
 }
 
 UpdateReport MonteCarloLocalization::update(const SensorModel& model) {
   check_ready();
-  if (params_.recovery == Recovery::resetting && params_.sensor_reset_proposal == ResetProposal::matcher) {
-    throw std::logic_error("MCL: the matcher proposal needs the scan: update(model, scan)");
-  }
-  const std::vector<double> log_l = evaluate(model, particles_);
-  return update_impl(log_l, model.readings(), std::numeric_limits<double>::quiet_NaN(), &model, nullptr);
+  const auto start = Clock::now();
+  UpdateReport report = weigh(model, nullptr);
+  chooser_.record(seconds_since(start), particles_.size());
+  return report;
 }
 
 UpdateReport MonteCarloLocalization::update(SensorModel& model, const ScanView& scan) {
   check_ready();
-  model.select_readings(particles_.data(), particles_.size(), params_.threads);
-  return update(static_cast<const SensorModel&>(model), scan);
+  const auto start = Clock::now();
+  model.select_readings(particles_.data(), particles_.size(), threads_now());
+  UpdateReport report = weigh(model, &scan);
+  chooser_.record(seconds_since(start), particles_.size());
+  return report;
 }
 
 UpdateReport MonteCarloLocalization::update(const SensorModel& model, const ScanView& scan) {
   check_ready();
-  if (scan.n > 0 && (scan.angles == nullptr || scan.ranges == nullptr)) throw std::invalid_argument("MCL: a scan without beams");
-  if (params_.recovery == Recovery::resetting && params_.sensor_reset_proposal == ResetProposal::matcher &&
-      matcher_ == nullptr) {
+  const auto start = Clock::now();
+  UpdateReport report = weigh(model, &scan);
+  chooser_.record(seconds_since(start), particles_.size());
+  return report;
+}
+
+UpdateReport MonteCarloLocalization::weigh(const SensorModel& model, const ScanView* scan) {
+  const bool matcher = params_.recovery == Recovery::resetting && params_.sensor_reset_proposal == ResetProposal::matcher;
+  if (scan == nullptr && matcher) throw std::logic_error("MCL: the matcher proposal needs the scan: update(model, scan)");
+  if (scan != nullptr && scan->n > 0 && (scan->angles == nullptr || scan->ranges == nullptr)) {
+    throw std::invalid_argument("MCL: a scan without beams");
+  }
+  if (scan != nullptr && matcher && matcher_ == nullptr) {
     throw std::logic_error("MCL: the matcher proposal needs a correlative scan matcher (set_matcher)");
   }
   const std::vector<double> log_l = evaluate(model, particles_);
-  return update_impl(log_l, model.readings(), std::numeric_limits<double>::quiet_NaN(), &model, &scan);
+  return update_impl(log_l, model.readings(), std::numeric_limits<double>::quiet_NaN(), &model, scan);
 }
 
 UpdateReport MonteCarloLocalization::update(const std::vector<double>& log_l, std::size_t readings, double agreement) {
@@ -216,7 +240,10 @@ UpdateReport MonteCarloLocalization::update(const std::vector<double>& log_l, st
   if (!std::isnan(agreement) && !(agreement >= 0.0 && agreement <= 1.0)) {
     throw std::invalid_argument("MCL: agreement must lie in [0, 1] (or be NaN)");
   }
-  return update_impl(log_l, readings, agreement, nullptr, nullptr);
+  const auto start = Clock::now();
+  UpdateReport report = update_impl(log_l, readings, agreement, nullptr, nullptr);
+  chooser_.record(seconds_since(start), particles_.size());
+  return report;
 }
 
 UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_l, std::size_t readings,
@@ -237,7 +264,7 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
   if (std::isfinite(top)) {
     // The terms on the threads, their sum in particle order: the same for any thread count.
     std::vector<double> terms(log_l.size());
-    parallel_for(terms.size(), params_.threads, [&](std::size_t b, std::size_t e) {
+    parallel_for(terms.size(), threads_now(), [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) terms[i] = weights_[i] * std::exp(log_l[i] / r - top);
     }, kParallelExps);
     for (double t : terms) w_avg += t;
@@ -245,7 +272,7 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
   }
   report.average_likelihood = w_avg;
   report.informative =
-      readings > 0 && apply_log_likelihoods(weights_, log_l, params_.likelihood_power, params_.threads);
+      readings > 0 && apply_log_likelihoods(weights_, log_l, params_.likelihood_power, threads_now());
   report.effective_sample_size = kiseki::effective_sample_size(weights_);
   if (report.informative && std::isfinite(w_avg)) {
     if (w_slow_ == 0.0) w_slow_ = w_fast_ = w_avg;
@@ -310,7 +337,7 @@ void MonteCarloLocalization::resample(double inject, UpdateReport& report) {
   if (params_.kld) {
     out = resample_states(particles_, weights_, n, params_.resampling, true, params_.kld_params, rng_);
   } else {  // resample_states without KLD, with the logarithms of the draws on the threads
-    const std::vector<std::size_t> idx = resample_indices(weights_, n, params_.resampling, rng_, params_.threads);
+    const std::vector<std::size_t> idx = resample_indices(weights_, n, params_.resampling, rng_, threads_now());
     out.resize(idx.size());
     for (std::size_t i = 0; i < idx.size(); ++i) out[i] = particles_[idx[i]];
   }
@@ -360,7 +387,7 @@ Pose2 MonteCarloLocalization::estimate() const {
   check_ready();
   const std::size_t n = particles_.size();
   double x = 0, y = 0, c = 0, s = 0;
-  if (n < 2 * kParallelExps || resolve_threads(params_.threads) < 2) {
+  if (n < 2 * kParallelExps || resolve_threads(threads_now()) < 2) {
     for (std::size_t i = 0; i < n; ++i) {
       const double w = weights_[i];
       x += w * particles_[i].x;
@@ -372,7 +399,7 @@ Pose2 MonteCarloLocalization::estimate() const {
   }
   // The headings' cosines and sines on the threads, the sums in particle order as above.
   std::vector<double> cosines(n), sines(n);
-  parallel_for(n, params_.threads, [&](std::size_t b, std::size_t e) {
+  parallel_for(n, threads_now(), [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) cosines[i] = std::cos(particles_[i].theta), sines[i] = std::sin(particles_[i].theta);
   }, kParallelExps);
   for (std::size_t i = 0; i < n; ++i) {

@@ -147,8 +147,9 @@ def localize_command(
     ),
     threads: int | None = typer.Option(
         None,
-        parser=Count("--threads", 0, THREAD_LIMIT, "0 = every core"),
-        help=f"Threads of the filter (0 = every core; default {LocalizeConfig.threads}).",
+        parser=Count("--threads", 0, THREAD_LIMIT, "0 = chosen by measured time"),
+        help="Threads of the filter (0 = every core, or one while one is measured faster; "
+        f"default {LocalizeConfig.threads}).",
     ),
     reliability_estimate: str | None = typer.Option(
         None,

@@ -90,6 +90,10 @@ class MclConfig:
       odometry, and made only if it passes again on the next scan (one scan that fits a place
       elsewhere better does not move a cloud that is right).
     * ``update_min_d`` / ``update_min_a``: 0 (every scan is an update); nav2 uses 0.25 m / 0.2 rad.
+    * ``threads`` 0: every core, or one thread while one is measured faster (the engine times
+      its updates with each and probes the other every 50th; the results are the same for any
+      thread count, so only the time changes: on a robot whose cores other processes keep
+      busy, waking a second thread can cost more than it gives); n > 0: n threads throughout.
     """
 
     particles: int = 500
@@ -156,7 +160,8 @@ class MclConfig:
         )
         _check(
             isinstance(self.threads, int) and 0 <= self.threads <= 1024,
-            f"threads must be an integer in 0..1024 (0 = every core), got {self.threads!r}",
+            f"threads must be an integer in 0..1024 (0 = chosen by measured time), "
+            f"got {self.threads!r}",
         )
         _check(
             self.sensor_reset_proposal in RESET_PROPOSALS,

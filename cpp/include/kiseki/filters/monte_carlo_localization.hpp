@@ -11,6 +11,7 @@
 
 #include "kiseki/core/pose.hpp"
 #include "kiseki/core/random.hpp"
+#include "kiseki/core/thread_chooser.hpp"
 #include "kiseki/filters/kld_sampling.hpp"
 #include "kiseki/filters/motion_model.hpp"
 #include "kiseki/filters/resampling.hpp"
@@ -108,7 +109,9 @@ struct MclParams {
   /// is right, and two independent scans rarely both favour the same wrong place.
   bool sensor_reset_confirm = true;
   double reliability_rate = 0.1;       ///< smoothing of the reliability estimate per update
-  int threads = 0;                     ///< 0 = every core
+  /// 0 = every core, or one when one is measured faster (ThreadChooser: the results are the
+  /// same for any thread count, so the choice changes only the time); n > 0: n threads.
+  int threads = 0;
   void validate() const;
 };
 
@@ -200,6 +203,10 @@ class MonteCarloLocalization {
   const MclParams& params() const { return params_; }
 
  private:
+  /// The threads of this step: params_.threads, or the chooser's for 0.
+  int threads_now() const { return params_.threads > 0 ? params_.threads : chooser_.threads(); }
+  /// Weighs with the model (the scan for the matcher proposal, or nullptr) and recovers.
+  UpdateReport weigh(const SensorModel& model, const ScanView* scan);
   UpdateReport update_impl(const std::vector<double>& log_l, std::size_t readings, double agreement,
                            const SensorModel* model, const ScanView* scan);
   std::vector<double> evaluate(const SensorModel& model, const std::vector<Pose2>& poses) const;
@@ -249,6 +256,7 @@ class MonteCarloLocalization {
   double reliability_ = 1.0;
   Pose2 posterior_;
   const CorrelativeScanMatcher* matcher_ = nullptr;
+  ThreadChooser chooser_;
 };
 
 }  // namespace kiseki
