@@ -188,41 +188,20 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 }  // namespace
 
-UpdateReport MonteCarloLocalization::update(SensorModel& model) {
-  check_ready();
-  const auto start = Clock::now();
-  model.select_readings(particles_.data(), particles_.size(), threads_now());
-  UpdateReport report = weigh(model, nullptr);
-  chooser_.record(seconds_since(start), particles_.size());
-  return report;
-}
+UpdateReport MonteCarloLocalization::update(SensorModel& model) { return weigh(&model, model, nullptr); }
 
-UpdateReport MonteCarloLocalization::update(const SensorModel& model) {
-  check_ready();
-  const auto start = Clock::now();
-  UpdateReport report = weigh(model, nullptr);
-  chooser_.record(seconds_since(start), particles_.size());
-  return report;
-}
+UpdateReport MonteCarloLocalization::update(const SensorModel& model) { return weigh(nullptr, model, nullptr); }
 
 UpdateReport MonteCarloLocalization::update(SensorModel& model, const ScanView& scan) {
-  check_ready();
-  const auto start = Clock::now();
-  model.select_readings(particles_.data(), particles_.size(), threads_now());
-  UpdateReport report = weigh(model, &scan);
-  chooser_.record(seconds_since(start), particles_.size());
-  return report;
+  return weigh(&model, model, &scan);
 }
 
 UpdateReport MonteCarloLocalization::update(const SensorModel& model, const ScanView& scan) {
-  check_ready();
-  const auto start = Clock::now();
-  UpdateReport report = weigh(model, &scan);
-  chooser_.record(seconds_since(start), particles_.size());
-  return report;
+  return weigh(nullptr, model, &scan);
 }
 
-UpdateReport MonteCarloLocalization::weigh(const SensorModel& model, const ScanView* scan) {
+UpdateReport MonteCarloLocalization::weigh(SensorModel* selects, const SensorModel& model, const ScanView* scan) {
+  check_ready();
   const bool matcher = params_.recovery == Recovery::resetting && params_.sensor_reset_proposal == ResetProposal::matcher;
   if (scan == nullptr && matcher) throw std::logic_error("MCL: the matcher proposal needs the scan: update(model, scan)");
   if (scan != nullptr && scan->n > 0 && (scan->angles == nullptr || scan->ranges == nullptr)) {
@@ -231,8 +210,13 @@ UpdateReport MonteCarloLocalization::weigh(const SensorModel& model, const ScanV
   if (scan != nullptr && matcher && matcher_ == nullptr) {
     throw std::logic_error("MCL: the matcher proposal needs a correlative scan matcher (set_matcher)");
   }
+  const auto start = Clock::now();
+  if (selects != nullptr) selects->select_readings(particles_.data(), particles_.size(), threads_now());
   const std::vector<double> log_l = evaluate(model, particles_);
-  return update_impl(log_l, model.readings(), std::numeric_limits<double>::quiet_NaN(), &model, scan);
+  UpdateReport report =
+      update_impl(log_l, model.readings(), std::numeric_limits<double>::quiet_NaN(), &model, scan);
+  chooser_.record(seconds_since(start), particles_.size());
+  return report;
 }
 
 UpdateReport MonteCarloLocalization::update(const std::vector<double>& log_l, std::size_t readings, double agreement) {

@@ -205,8 +205,10 @@ class MonteCarloLocalization {
  private:
   /// The threads of this step: params_.threads, or the chooser's for 0.
   int threads_now() const { return params_.threads > 0 ? params_.threads : chooser_.threads(); }
-  /// Weighs with the model (the scan for the matcher proposal, or nullptr) and recovers.
-  UpdateReport weigh(const SensorModel& model, const ScanView* scan);
+  /// The updates with a model: `selects` (the model, or nullptr for a const one) chooses its
+  /// readings from the cloud, then the cloud is weighed (the scan for the matcher proposal, or
+  /// nullptr) and recovers; the time taken goes to the thread chooser.
+  UpdateReport weigh(SensorModel* selects, const SensorModel& model, const ScanView* scan);
   UpdateReport update_impl(const std::vector<double>& log_l, std::size_t readings, double agreement,
                            const SensorModel* model, const ScanView* scan);
   std::vector<double> evaluate(const SensorModel& model, const std::vector<Pose2>& poses) const;
