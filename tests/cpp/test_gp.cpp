@@ -148,11 +148,12 @@ TEST(ExactGp, HyperparametersOfASampledFieldAreFound) {
 
 TEST(ExactGp, SameBitsOnAnyThreadCount) {
   // 700 points: three tiles of the dense algebra, so the factorisation, the inverse of the
-  // gradient and the products are spread over the threads; OpenBLAS is asked for as many
+  // gradient and the products are spread over the threads, and 2,500 prediction points in three
+  // blocks, which predict spreads; OpenBLAS is asked for as many
   // threads of its own, which the GP must not use (its splits change the last bits).
   const RowMatrix x = uniform_points(700, 2, 6.0, 21);
   const RowMatrix y = smooth_field(x, 0.05, 22);
-  const RowMatrix q = uniform_points(400, 2, 6.0, 23);
+  const RowMatrix q = uniform_points(2500, 2, 6.0, 23);  // three blocks of prediction points
   auto run = [&](int threads) {
     omp_set_num_threads(threads);
     openblas_set_num_threads(threads);

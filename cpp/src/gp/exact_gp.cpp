@@ -122,7 +122,9 @@ void ExactGaussianProcess::predict(const Eigen::Ref<const RowMatrix>& points, Ro
   const double radius = dense ? 0.0 : kernel_.cutoff_radius(truncation);
   const auto blocks = static_cast<Eigen::Index>(starts.size()) - 1;
 
-  // Blocks one after another: the products inside run on every core through BLAS.
+  // The blocks on OpenMP's threads, each block's products on the thread that takes it: every
+  // block writes its own rows, by the same calls whichever thread takes it.
+#pragma omp parallel for schedule(dynamic, 1) if (blocks > 1)
   for (Eigen::Index b = 0; b < blocks; ++b) {
     const Eigen::Index begin = starts[static_cast<std::size_t>(b)];
     const Eigen::Index count = starts[static_cast<std::size_t>(b + 1)] - begin;
