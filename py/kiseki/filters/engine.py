@@ -91,7 +91,8 @@ class MclConfig:
       elsewhere better does not move a cloud that is right).
     * ``update_min_d`` / ``update_min_a``: 0 (every scan is an update); nav2 uses 0.25 m / 0.2 rad.
     * ``threads`` 0: every core, or one thread while one is measured faster (the engine times
-      its updates with each and probes the other every 50th; the results are the same for any
+      its updates with each, compares the medians of their last five, and tries the other once
+      every 50 x its time ratio updates; see ThreadChooser; the results are the same for any
       thread count, so only the time changes: on a robot whose cores other processes keep
       busy, waking a second thread can cost more than it gives); n > 0: n threads throughout.
     """
