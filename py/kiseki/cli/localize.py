@@ -148,8 +148,7 @@ def localize_command(
     threads: int | None = typer.Option(
         None,
         parser=Count("--threads", 0, THREAD_LIMIT, "0 = chosen by measured time"),
-        help="Threads of the filter (0 = every core, or one while one is measured faster; "
-        f"default {LocalizeConfig.threads}).",
+        help=f"Threads (0: all cores, or one while it is faster; default {LocalizeConfig.threads})",
     ),
     reliability_estimate: str | None = typer.Option(
         None,
