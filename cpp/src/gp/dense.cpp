@@ -154,8 +154,8 @@ void lower_gram_tiles(const Tiles& t) {
   }
 }
 
-/// A column range [begin, end) of a matrix cut into kTile-wide blocks, for operations whose
-/// columns (or rows) are independent.
+/// How many blocks of kTile columns (or rows) an extent makes, for operations whose columns (or
+/// rows) are independent.
 std::size_t blocks_of(Eigen::Index extent) { return static_cast<std::size_t>((extent + kTile - 1) / kTile); }
 
 }  // namespace
