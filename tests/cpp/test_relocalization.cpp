@@ -132,6 +132,40 @@ TEST(CorrelativeScanMatcher, EqualsExhaustiveSearchOnRandomSmallMaps) {
   EXPECT_EQ(disc_searches_with_a_result, 6);  // no disc left its side empty
 }
 
+// Every beam ends off the map from every cell, so every lattice pose scores exactly n times the
+// field's outside value and the selection is the lattice order: a node whose bound equals the
+// threshold must be searched (a search that prunes it, `<=` for `<`, fails here and not on the
+// random maps above, where ties do not occur).
+TEST(CorrelativeScanMatcher, TiedScoresAreTakenInLatticeOrderAsByExhaustiveSearch) {
+  OccupancyGrid map(24, 18, 0.1, Pose2(0.3, -0.2, 0.0), kFree);
+  map.set(5, 5, kOccupied), map.set(17, 9, kOccupied), map.set(20, 3, kUnknown);
+  Random rng(3);
+  for (const int beams : {29, 37, 61}) {
+    std::vector<double> angles(static_cast<std::size_t>(beams));
+    for (auto& a : angles) a = rng.uniform(-kPi, kPi);
+    const std::vector<float> ranges(angles.size(), 30.0f);  // the map is 2.4 x 1.8 m
+    CorrelativeMatcherParams p;
+    p.depth = 3;
+    p.hypotheses = 5;
+    p.min_distance = 0.25;
+    p.min_angle = 0.3;
+    p.angular_step = 0.4;
+    p.likelihood.max_beams = 0;
+    p.likelihood.sigma_hit = 0.137;
+    p.threads = 1;
+    const CorrelativeScanMatcher m(map, 40.0, p);
+    const auto got = m.match(angles.data(), ranges.data(), angles.size());
+    const auto want = exhaustive(map, m, angles, ranges);
+    ASSERT_EQ(got.size(), want.size()) << beams << " beams";
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      EXPECT_EQ(got[i].cell_x, want[i].x) << beams << " beams, hypothesis " << i;
+      EXPECT_EQ(got[i].cell_y, want[i].y) << beams << " beams, hypothesis " << i;
+      EXPECT_EQ(got[i].heading, want[i].k) << beams << " beams, hypothesis " << i;
+      EXPECT_EQ(got[i].score, want[i].score) << beams << " beams, hypothesis " << i;
+    }
+  }
+}
+
 TEST(CorrelativeScanMatcher, RecoversAScanSimulatedAtALatticePoseOfAStructuredMap) {
   const OccupancyGrid map = room();
   const auto angles = scan_angles(361);

@@ -42,52 +42,57 @@ CorrelativeScanMatcher::CorrelativeScanMatcher(const OccupancyGrid& map, double 
   outside_ = field.outside();
   const int w = map.width(), h = map.height();
   const cv::Mat& table = field.table();
-  pooled_.assign(static_cast<std::size_t>(params_.depth) + 1, {});
-  pooled_[0].resize(static_cast<std::size_t>(w) * h);
-  for (int y = 0; y < h; ++y) std::copy_n(table.ptr<float>(y), w, pooled_[0].data() + static_cast<std::size_t>(y) * w);
-  free_.assign(pooled_.size(), {});
-  free_[0].resize(pooled_[0].size());
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) free_[0][static_cast<std::size_t>(y) * w + x] = !params_.free_only || is_free(map.value(x, y));
-  if (std::find(free_[0].begin(), free_[0].end(), 1) == free_[0].end()) {
-    throw std::invalid_argument("correlative matcher: the map has no free cell to search");
-  }
   // P_h(x, y) = max of P_{h-1} over the 2 x 2 blocks of side 2^(h-1) starting at (x, y)
-  // (Hess et al. sec. V.C); stored from x = y = -(2^h - 1), where a window first meets the map.
+  // (Hess et al. sec. V.C). Every level is stored on one padded layout, from x = y = -(2^depth
+  // - 1), where the coarsest window first meets the map: a beam end is then one linear offset
+  // from a node at every level. A window that does not meet the map holds outside_ (no free
+  // cell), as the level below reads it.
+  const int pad = (1 << params_.depth) - 1;
+  pitch_ = w + pad, rows_ = h + pad;
+  const std::size_t cells = static_cast<std::size_t>(pitch_) * rows_;
+  pooled_.assign(static_cast<std::size_t>(params_.depth) + 1, std::vector<float>(cells, outside_));
+  free_.assign(pooled_.size(), std::vector<std::uint8_t>(cells, 0));
+  magnitude_ = std::abs(outside_);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = index(x, y);
+      pooled_[0][i] = table.ptr<float>(y)[x];
+      free_[0][i] = !params_.free_only || is_free(map.value(x, y));
+      magnitude_ = std::max(magnitude_, static_cast<double>(std::abs(pooled_[0][i])));
+    }
+  }
+  if (lattice_cells() == 0) throw std::invalid_argument("correlative matcher: the map has no free cell to search");
   for (int level = 1; level <= params_.depth; ++level) {
-    const int pad = (1 << level) - 1, half = 1 << (level - 1);
-    const int pw = w + pad, ph = h + pad;
+    const int half = 1 << (level - 1);
     auto& out = pooled_[static_cast<std::size_t>(level)];
-    out.resize(static_cast<std::size_t>(pw) * ph);
     auto& any = free_[static_cast<std::size_t>(level)];
-    any.resize(out.size());
-    for (int yy = 0; yy < ph; ++yy) {
-      const int y = yy - pad;
-      for (int xx = 0; xx < pw; ++xx) {
-        const int x = xx - pad;
-        out[static_cast<std::size_t>(yy) * pw + xx] =
-            std::max(std::max(value(level - 1, x, y), value(level - 1, x + half, y)),
-                     std::max(value(level - 1, x, y + half), value(level - 1, x + half, y + half)));
-        any[static_cast<std::size_t>(yy) * pw + xx] = has_free(level - 1, x, y) || has_free(level - 1, x + half, y) ||
-                                                      has_free(level - 1, x, y + half) ||
-                                                      has_free(level - 1, x + half, y + half);
+    for (int y = -((1 << level) - 1); y < h; ++y) {
+      for (int x = -((1 << level) - 1); x < w; ++x) {
+        const std::size_t i = index(x, y);
+        out[i] = std::max(std::max(value(level - 1, x, y), value(level - 1, x + half, y)),
+                          std::max(value(level - 1, x, y + half), value(level - 1, x + half, y + half)));
+        any[i] = has_free(level - 1, x, y) || has_free(level - 1, x + half, y) || has_free(level - 1, x, y + half) ||
+                 has_free(level - 1, x + half, y + half);
       }
     }
   }
 }
 
+std::size_t CorrelativeScanMatcher::index(int x, int y) const {
+  const int pad = pitch_ - frame_.width();
+  return static_cast<std::size_t>(y + pad) * static_cast<std::size_t>(pitch_) + static_cast<std::size_t>(x + pad);
+}
+
 float CorrelativeScanMatcher::value(int level, int x, int y) const {
-  const int pad = (1 << level) - 1;
-  const int xx = x + pad, yy = y + pad, pw = frame_.width() + pad, ph = frame_.height() + pad;
-  if (xx < 0 || yy < 0 || xx >= pw || yy >= ph) return outside_;
-  return pooled_[static_cast<std::size_t>(level)][static_cast<std::size_t>(yy) * pw + xx];
+  const int pad = pitch_ - frame_.width();
+  if (x < -pad || y < -pad || x >= frame_.width() || y >= frame_.height()) return outside_;
+  return pooled_[static_cast<std::size_t>(level)][index(x, y)];
 }
 
 bool CorrelativeScanMatcher::has_free(int level, int x, int y) const {
-  const int pad = (1 << level) - 1;
-  const int xx = x + pad, yy = y + pad, pw = frame_.width() + pad, ph = frame_.height() + pad;
-  if (xx < 0 || yy < 0 || xx >= pw || yy >= ph) return false;
-  return free_[static_cast<std::size_t>(level)][static_cast<std::size_t>(yy) * pw + xx] != 0;
+  const int pad = pitch_ - frame_.width();
+  if (x < -pad || y < -pad || x >= frame_.width() || y >= frame_.height()) return false;
+  return free_[static_cast<std::size_t>(level)][index(x, y)] != 0;
 }
 
 std::size_t CorrelativeScanMatcher::lattice_cells() const {
@@ -142,7 +147,9 @@ struct CorrelativeScanMatcher::Search {
   explicit Search(const CorrelativeScanMatcher& matcher) : m(matcher) {}
   const CorrelativeScanMatcher& m;
   int headings = 0, beams = 0;
-  std::vector<int> dx, dy;  // [heading * beams + b]
+  std::vector<int> dx, dy;  // [heading * beams + b]: a beam end's cell offset from the laser's cell
+  std::vector<std::ptrdiff_t> off;  // the same as an offset on the padded layout: dy * pitch + dx
+  double margin = 0.0;
   // A disc restriction: per heading, its centre as the laser's cell coordinates (cell i's centre
   // at i; the robot's position is the laser's shifted by the heading's rotated sensor offset),
   // and its radius in cells.
@@ -158,21 +165,54 @@ struct CorrelativeScanMatcher::Search {
   std::mutex far_mutex;
   std::vector<Leaf> far;  // shared by the workers, so the threshold rises as fast as on one
 
-  double bound(int level, int x, int y, int k) const {
-    const int* ox = dx.data() + static_cast<std::size_t>(k) * beams;
-    const int* oy = dy.data() + static_cast<std::size_t>(k) * beams;
-    // m.value() inlined: one unsigned comparison per axis finds the ends off the stored grid
-    const int pad = (1 << level) - 1;
-    const auto pw = static_cast<unsigned>(m.frame_.width() + pad), ph = static_cast<unsigned>(m.frame_.height() + pad);
-    const float* grid = m.pooled_[static_cast<std::size_t>(level)].data();
-    const float outside = m.outside_;
-    const int gx = x + pad, gy = y + pad;
-    double sum = 0.0;
-    for (int b = 0; b < beams; ++b) {
-      const auto xx = static_cast<unsigned>(gx + ox[b]), yy = static_cast<unsigned>(gy + oy[b]);
-      sum += (xx < pw && yy < ph) ? grid[static_cast<std::size_t>(yy) * pw + xx] : outside;
+  /// Beam b's score term at a node: P_level at its end, outside_ off the stored layout. One
+  /// unsigned comparison per axis finds the ends off it; the read is of cell 0 then, not used.
+  struct Terms {
+    const float* grid;
+    const int *ox, *oy;
+    const std::ptrdiff_t* lin;
+    unsigned pitch, rows;
+    int gx, gy;
+    std::ptrdiff_t base;
+    float outside;
+    float operator()(int b) const {
+      const bool in = static_cast<unsigned>(gx + ox[b]) < pitch && static_cast<unsigned>(gy + oy[b]) < rows;
+      const float v = grid[in ? base + lin[b] : 0];
+      return in ? v : outside;
     }
+  };
+
+  Terms terms(int level, int x, int y, int k) const {
+    const int pad = m.pitch_ - m.frame_.width();
+    const std::size_t at = static_cast<std::size_t>(k) * beams;
+    Terms t{m.pooled_[static_cast<std::size_t>(level)].data(), dx.data() + at, dy.data() + at, off.data() + at,
+            static_cast<unsigned>(m.pitch_), static_cast<unsigned>(m.rows_), x + pad, y + pad, 0, m.outside_};
+    t.base = static_cast<std::ptrdiff_t>(t.gy) * m.pitch_ + t.gx;
+    return t;
+  }
+
+  /// A lattice pose's score: the terms summed in beam order, as the likelihood field's
+  /// log_likelihoods sums them, so a hypothesis' score is the model's own.
+  double score(int x, int y, int k) const {
+    const Terms t = terms(0, x, y, k);
+    double sum = 0.0;
+    for (int b = 0; b < beams; ++b) sum += t(b);
     return sum;
+  }
+
+  /// An upper bound of the scores of the lattice poses under a node (eqs. (13)-(15)); at level 0
+  /// the pose's score. Above it, the P_level terms in four running sums, whose rounding differs
+  /// from score()'s beam order; `margin` exceeds both sums' rounding errors together (n^2 u
+  /// max|term| each, u = 2^-53), so a pose whose score equals the threshold is never pruned and
+  /// the result stays the exhaustive search's.
+  double bound(int level, int x, int y, int k) const {
+    if (level == 0) return score(x, y, k);
+    const Terms t = terms(level, x, y, k);
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    int b = 0;
+    for (; b + 4 <= beams; b += 4) s0 += t(b), s1 += t(b + 1), s2 += t(b + 2), s3 += t(b + 3);
+    for (; b < beams; ++b) s0 += t(b);
+    return (s0 + s1) + (s2 + s3) + margin;
   }
 
   /// Can a cell of the side x side block at (x, y) hold a pose on the disc's side? (Exact up to a
@@ -261,7 +301,9 @@ struct CorrelativeScanMatcher::Search {
         kids[n++] = {bound(level - 1, cx, cy, k), cx, cy};
       }
     }
-    std::stable_sort(kids, kids + n, [](const auto& a, const auto& b2) { return std::get<0>(a) > std::get<0>(b2); });
+    for (int i = 1; i < n; ++i) {  // best bound first, equal bounds in their order (a stable sort)
+      for (int j = i; j > 0 && std::get<0>(kids[j]) > std::get<0>(kids[j - 1]); --j) std::swap(kids[j], kids[j - 1]);
+    }
     for (int i = 0; i < n; ++i) descend(w, level - 1, std::get<1>(kids[i]), std::get<2>(kids[i]), k, std::get<0>(kids[i]));
   }
 };
@@ -278,6 +320,7 @@ std::vector<PoseHypothesis> CorrelativeScanMatcher::match(const double* angles, 
   const double inv_res = 1.0 / frame_.resolution();
   s.dx.resize(static_cast<std::size_t>(s.headings) * s.beams);
   s.dy.resize(s.dx.size());
+  s.off.resize(s.dx.size());
   for (int k = 0; k < s.headings; ++k) {
     const double th = normalize_angle(k * (2.0 * kPi / s.headings));
     const double c = std::cos(th), sn = std::sin(th);
@@ -286,8 +329,10 @@ std::vector<PoseHypothesis> CorrelativeScanMatcher::match(const double* angles, 
       const std::size_t i = static_cast<std::size_t>(k) * s.beams + b;
       s.dx[i] = static_cast<int>(std::floor(0.5 + (c * bx - sn * by)));
       s.dy[i] = static_cast<int>(std::floor(0.5 + (sn * bx + c * by)));
+      s.off[i] = static_cast<std::ptrdiff_t>(s.dy[i]) * pitch_ + s.dx[i];
     }
   }
+  s.margin = 2.0 * static_cast<double>(s.beams) * s.beams * std::ldexp(magnitude_, -53);
   if (disc != nullptr) {
     if (!(disc->radius >= 0.0) || !std::isfinite(disc->radius) || !std::isfinite(disc->x) || !std::isfinite(disc->y)) {
       throw std::invalid_argument("correlative matcher: a search disc needs a finite centre and radius >= 0");

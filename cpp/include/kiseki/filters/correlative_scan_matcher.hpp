@@ -96,14 +96,18 @@ class CorrelativeScanMatcher {
 
  private:
   struct Search;
+  std::size_t index(int x, int y) const;  // (x, y) of the map's cells on the padded layout
   float value(int level, int x, int y) const;
   bool has_free(int level, int x, int y) const;
   CorrelativeMatcherParams params_;
   double max_range_;
   OccupancyGrid frame_;
-  std::vector<std::vector<float>> pooled_;  // P_h, padded by 2^h - 1 cells before x and y
-  std::vector<std::vector<std::uint8_t>> free_;  // per level: a free cell in the block (same layout)
+  // Every level on one layout: pitch_ x rows_ cells from x = y = -(2^depth - 1).
+  int pitch_ = 0, rows_ = 0;
+  std::vector<std::vector<float>> pooled_;  // P_h
+  std::vector<std::vector<std::uint8_t>> free_;  // per level: a free cell in the block
   float outside_ = 0.0f;
+  double magnitude_ = 0.0;  // the largest |score term|: the bounds' rounding margin
 };
 
 }  // namespace kiseki
