@@ -8,7 +8,8 @@ A README marks what the report writes with HTML comments, which Markdown does no
   result (the claim, the paper's value, kiseki's with its 95 % interval, the verdict, the
   trials) and the run they come from;
 * ``<!-- reproduction-summary -->`` ... ``<!-- /reproduction-summary -->``: one row per
-  registered experiment (claims by verdict, the share decided, trials, commit) and the totals.
+  registered experiment (claims by verdict, the share decided, trials, the trials' time on one
+  core, commit) and the totals.
 
 :func:`update_readme` replaces the text between each pair and leaves every other line as it
 was, so the prose around a table stays the authors' while the numbers are the run's."""
@@ -23,8 +24,14 @@ from pathlib import Path
 import pandas as pd
 
 from kiseki_experiments.harness.registry import all_experiments
-from kiseki_experiments.harness.report import markdown_table, tally, tally_text
-from kiseki_experiments.harness.run_reader import read_latest
+from kiseki_experiments.harness.report import (
+    duration_text,
+    markdown_table,
+    tally,
+    tally_text,
+    time_text,
+)
+from kiseki_experiments.harness.run_reader import read_latest, read_timings, trial_seconds
 
 __all__ = ["Result", "claims_block", "gather", "summary_block", "update_readme"]
 
@@ -43,6 +50,7 @@ class Result:
     trials: int
     failed: int
     commit: str
+    seconds: float = math.nan  # the trials' time summed (one core); nan without timings
 
 
 def gather(results_root: Path) -> dict[str, Result]:
@@ -54,9 +62,12 @@ def gather(results_root: Path) -> dict[str, Result]:
         found = read_latest(results_root, name)
         if found is None:
             continue
-        _, claims, manifest = found
+        latest, claims, manifest = found
         commit = str(manifest["git"].get("commit") or "unknown")[:7]
-        out[name] = Result(name, claims, manifest["trials"], manifest["trials_failed"], commit)
+        seconds = trial_seconds(read_timings(latest))
+        out[name] = Result(
+            name, claims, manifest["trials"], manifest["trials_failed"], commit, seconds
+        )
     return out
 
 
@@ -107,13 +118,16 @@ def summary_block(results: dict[str, Result]) -> str:
                 "inconclusive": t["inconclusive"],
                 "decided": f"{100 * t['decided'] / t['claims']:.0f} %" if t["claims"] else "",
                 "trials": r.trials,
+                "trial time (1 core)": duration_text(r.seconds),
                 "commit": r.commit,
             }
         )
     table = pd.DataFrame(rows).astype(object).fillna("")
     empty = pd.DataFrame({"verdict": pd.Series([], dtype=str)})
     total = tally(pd.concat(frames, ignore_index=True) if frames else empty)
-    return f"{markdown_table(table)}\n\nAll results: {tally_text(total)}.\n"
+    timed = [r.seconds for r in results.values() if not math.isnan(r.seconds)]
+    spent = time_text(sum(timed), len(results), len(results) - len(timed))
+    return f"{markdown_table(table)}\n\nAll results: {tally_text(total)}; {spent}.\n"
 
 
 def update_readme(text: str, readme: Path, results_root: Path) -> tuple[str, list[str]]:

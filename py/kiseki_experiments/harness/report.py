@@ -21,7 +21,7 @@ from kiseki._support.atomic import atomic_write, atomic_write_all, reworded
 from kiseki._support.table import show
 from kiseki_experiments.harness.base import Analysis, Experiment
 from kiseki_experiments.harness.registry import all_experiments
-from kiseki_experiments.harness.run_reader import read_latest
+from kiseki_experiments.harness.run_reader import read_latest, read_timings, trial_seconds
 from kiseki_experiments.harness.verdict import UNMIGRATED, VERDICT_COLUMNS, judge
 
 __all__ = [
@@ -102,6 +102,25 @@ def _shown(claims: pd.DataFrame) -> pd.DataFrame:
         }
     )
     return frame
+
+
+def duration_text(seconds: float) -> str:
+    """A duration as people read it: hours from one hour on, else minutes, else seconds."""
+    if math.isnan(seconds):
+        return ""
+    if seconds >= 3600:
+        return f"{seconds / 3600:.2f} h"
+    return f"{seconds / 60:.0f} min" if seconds >= 60 else f"{seconds:.0f} s"
+
+
+def time_text(seconds: float, runs: int, untimed: int, cores: int = 2) -> str:
+    """The sentence on how long the runs' trials took: summed (one core) and spread evenly over
+    `cores` (the lower bound of a run's wall time on that many cores)."""
+    text = (
+        f"the trials of these {runs} runs took {duration_text(seconds)} on one core, "
+        f"{duration_text(seconds / cores)} on {cores} cores if spread evenly"
+    )
+    return text + (f" ({untimed} runs without timings not counted)" if untimed else "")
 
 
 def _mean_trial_seconds(timings: pd.DataFrame | None) -> float:
@@ -293,6 +312,7 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[dict[str, int], l
     by_paper: dict[str, list[str]] = {}
     frames: list[pd.DataFrame] = []
     missing: list[str] = []
+    seconds: list[float] = []
     for name, experiment in sorted(all_experiments().items()):
         section = by_paper.setdefault(experiment.paper, [])
         found = read_latest(results_root, name)
@@ -304,8 +324,8 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[dict[str, int], l
         latest, claims, manifest = found
         run_dir = latest.resolve()
         frames.append(claims)
-        timings_path = latest / "timings.parquet"
-        timings = pd.read_parquet(timings_path) if timings_path.is_file() else None
+        timings = read_timings(latest)
+        seconds.append(trial_seconds(timings))
         section += [
             f"Result: `{run_dir.relative_to(results_root.resolve())}`, "
             f"{manifest['trials']} trials, {manifest['trials_failed']} failed, "
@@ -316,7 +336,9 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[dict[str, int], l
         ]
     empty = pd.DataFrame({"verdict": pd.Series([], dtype=str)})
     totals = tally(pd.concat(frames, ignore_index=True) if frames else empty)
-    lines = ["# Reproduction report", "", f"{tally_text(totals)}."]
+    timed = [x for x in seconds if not math.isnan(x)]
+    spent = time_text(sum(timed), len(seconds), len(seconds) - len(timed))
+    lines = ["# Reproduction report", "", f"{tally_text(totals)}; {spent}."]
     if missing:
         lines.append(f"Missing experiments ({len(missing)}): {', '.join(missing)}.")
     for paper, section in by_paper.items():

@@ -15,7 +15,7 @@ import pandas as pd
 from kiseki._support.inputs import CSV_LIMIT, YAML_LIMIT, check_input, read_input_text
 from kiseki_experiments.harness.verdict import UNMIGRATED, VERDICT_COLUMNS
 
-__all__ = ["latest_run", "read_latest", "read_result"]
+__all__ = ["latest_run", "read_latest", "read_result", "read_timings", "trial_seconds"]
 
 
 def latest_run(results_root: Path, name: str) -> Path | None:
@@ -40,6 +40,26 @@ def read_latest(results_root: Path, name: str) -> tuple[Path, pd.DataFrame, dict
         raise ValueError(f"{latest}: the link points outside --results ({run_dir})")
     claims, manifest = read_result(latest)
     return latest, claims, manifest
+
+
+def read_timings(latest: Path) -> pd.DataFrame | None:
+    """A run's timings.parquet (one row a trial), None when the run has none; refused in one
+    line naming the file when unreadable."""
+    path = latest / "timings.parquet"
+    if not path.is_file():
+        return None
+    try:
+        return pd.read_parquet(path)
+    except (OSError, ValueError) as err:
+        raise ValueError(f"{path}: not a timings table ({err})") from None
+
+
+def trial_seconds(timings: pd.DataFrame | None) -> float:
+    """The run's trials' time summed (s, as if run one after another on one core); nan when the
+    run has no timings."""
+    if timings is None or "trial_seconds" not in timings:
+        return math.nan
+    return float(pd.to_numeric(timings["trial_seconds"], errors="coerce").sum())
 
 
 def read_result(latest: Path) -> tuple[pd.DataFrame, dict]:

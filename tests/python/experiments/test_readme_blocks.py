@@ -5,6 +5,7 @@ reads: the numbers are those of claims.csv, the prose around them is kept byte f
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pandas as pd
@@ -13,7 +14,7 @@ import pytest
 from _helpers.cli_main import kiseki
 from kiseki_experiments.harness.readme_blocks import update_readme
 from kiseki_experiments.harness.registry import all_experiments
-from kiseki_experiments.harness.report import write_reproduction
+from kiseki_experiments.harness.report import duration_text, write_reproduction
 from kiseki_experiments.harness.runner import run_experiment
 
 PROSE = "# A project\n\nText before, with a | pipe.\n\n"
@@ -69,6 +70,15 @@ def test_blocks_hold_the_claims_of_the_latest_result_and_the_prose_is_kept(resul
     mine = next(r for r in rows if r.startswith("| corridor-scans |"))
     # claims, hold, fail, inconclusive, decided
     assert mine.split(" | ")[1:6] == ["1", "1", "0", "0", "100 %"]
+    # the trials' time: their seconds in timings.parquet summed, and halved for 2 cores
+    spent = pd.read_parquet(results / "corridor-scans" / "latest" / "timings.parquet")
+    seconds = float(spent["trial_seconds"].sum())
+    assert len(spent) == 5 and seconds > 0
+    assert mine.split(" | ")[7] == duration_text(seconds)
+    assert (
+        f"the trials of these 1 runs took {duration_text(seconds)} on one core, "
+        f"{duration_text(seconds / 2)} on 2 cores if spread evenly." in summary
+    )
     # regenerating what was regenerated changes nothing
     assert update_readme(text, tmp_path / "README.md", results)[0] == text
 
@@ -127,3 +137,25 @@ def test_a_latest_link_leading_outside_the_results_is_refused_by_report_and_read
     with pytest.raises(ValueError, match="the link points outside --results") as err:
         write_reproduction(root, tmp_path / "R.md")
     assert link in str(err.value) and not (tmp_path / "R.md").exists()
+
+
+def test_durations_read_as_people_read_them():
+    assert [duration_text(s) for s in (7200.0, 5400.0, 90.0, 59.4, 0.0)] == [
+        "2.00 h", "1.50 h", "2 min", "59 s", "0 s",
+    ]  # fmt: skip
+    assert duration_text(float("nan")) == ""
+
+
+def test_a_damaged_timings_file_is_refused_by_report_and_readme_naming_it(results, tmp_path):
+    """The trials' time comes from each run's timings.parquet: one that is not a table stops
+    the README's tables and the report in one line naming the file, and writes nothing."""
+    root = tmp_path / "results"
+    shutil.copytree(results / "corridor-scans" / "latest", root / "corridor-scans")
+    bad = root / "corridor-scans" / "timings.parquet"
+    bad.write_bytes(b"not parquet")
+    with pytest.raises(ValueError, match="not a timings table") as err:
+        update_readme(README, tmp_path / "README.md", root)
+    assert str(bad) in str(err.value) and "\n" not in str(err.value)
+    with pytest.raises(ValueError, match="not a timings table") as err:
+        write_reproduction(root, tmp_path / "R.md")
+    assert str(bad) in str(err.value) and not (tmp_path / "R.md").exists()
