@@ -116,8 +116,9 @@ def duration_text(seconds: float) -> str:
 def time_text(seconds: float, runs: int, untimed: int, cores: int = 2) -> str:
     """The sentence on how long the runs' trials took: summed (one core) and spread evenly over
     `cores` (the lower bound of a run's wall time on that many cores)."""
+    which = "this run" if runs == 1 else f"these {runs} runs"
     text = (
-        f"the trials of these {runs} runs took {duration_text(seconds)} on one core, "
+        f"the trials of {which} took {duration_text(seconds)} on one core, "
         f"{duration_text(seconds / cores)} on {cores} cores if spread evenly"
     )
     return text + (f" ({untimed} runs without timings not counted)" if untimed else "")

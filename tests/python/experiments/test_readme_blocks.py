@@ -76,7 +76,7 @@ def test_blocks_hold_the_claims_of_the_latest_result_and_the_prose_is_kept(resul
     assert len(spent) == 5 and seconds > 0
     assert mine.split(" | ")[7] == duration_text(seconds)
     assert (
-        f"the trials of these 1 runs took {duration_text(seconds)} on one core, "
+        f"the trials of this run took {duration_text(seconds)} on one core, "
         f"{duration_text(seconds / 2)} on 2 cores if spread evenly." in summary
     )
     # regenerating what was regenerated changes nothing
