@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "kiseki/core/random.hpp"
@@ -53,18 +55,28 @@ std::int8_t at(const OccupancyGrid& m, double x, double y) {
 
 TEST(EvidenceMap, HitMaskHoldsTheBeamEndsOnly) {
   const Local l = wall_scan(2.0);
-  int hits = 0, occupied = 0;
+  // The cells of the 61 beams' ends, computed as wall_scan lays them: the laser at the origin,
+  // beam a ending at its (float) range along (cos a, sin a).
+  std::set<std::pair<int, int>> ends;
+  for (int i = -30; i <= 30; ++i) {
+    const double a = 0.6 * i / 30.0;
+    const double r = static_cast<float>(2.0 / std::cos(a));
+    const CellIndex c = l.map.world_to_cell({r * std::cos(a), r * std::sin(a)});
+    ends.emplace(c.x, c.y);
+  }
+  std::set<std::pair<int, int>> hits;
+  int occupied = 0;
   for (int y = 0; y < l.map.height(); ++y) {
     for (int x = 0; x < l.map.width(); ++x) {
-      hits += l.hits.at<std::uint8_t>(y, x) != 0;
       occupied += l.map.value(x, y) == kOccupied;
       if (l.hits.at<std::uint8_t>(y, x)) {
+        hits.emplace(x, y);
         EXPECT_EQ(l.map.value(x, y), kOccupied);
       }
     }
   }
-  EXPECT_GT(hits, 5);
-  EXPECT_GT(occupied, 5 * hits);  // most occupied cells are the space behind the wall
+  EXPECT_EQ(hits, ends);  // the ends' cells, every one and no other
+  EXPECT_GT(occupied, 5 * static_cast<int>(hits.size()));  // most occupied cells: the space behind the wall
 }
 
 TEST(EvidenceMap, OneStrayBeamErasesAWallUnderTheThesisRuleButNotByEvidence) {

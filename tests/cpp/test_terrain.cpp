@@ -7,6 +7,7 @@
 #include <pcl/point_types.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include <set>
 
 #include "kiseki/io/pcd_file.hpp"
+#include "kiseki/sim/octree_world.hpp"
 #include "kiseki/terrain/correlation_search.hpp"
 #include "kiseki/terrain/global_map.hpp"
 #include "kiseki/terrain/hough_line_removal.hpp"
@@ -166,24 +168,39 @@ TEST(PclPlaneRemoval, FindsTheCorridorPlanesAndIsSeeded) {
 }
 
 TEST(GlobalVoxelMap, RaysMarkTheirEndsOccupiedAndTheWayFree) {
-  // a wall of points 2 m ahead of a sensor at (1, 0, 0.5), seen once
+  // a wall of points 2.03 m ahead of a sensor at (1, 0, 0.5), seen once; every point lies
+  // 0.025 m or more inside its 0.1 m voxel, so its voxel is unambiguous
   Eigen::Matrix3Xd wall(3, 21 * 21);
   for (int i = 0; i < 21; ++i) {
-    for (int j = 0; j < 21; ++j) wall.col(i * 21 + j) << 2.0, -0.5 + 0.05 * i, -0.5 + 0.05 * j;
+    for (int j = 0; j < 21; ++j) wall.col(i * 21 + j) << 2.03, -0.475 + 0.05 * i, -0.475 + 0.05 * j;
   }
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.translation() << 1.0, 0.0, 0.5;
   GlobalVoxelMap map(0.1, 5.0);
   map.insert(wall, pose);
-  const Eigen::Matrix3Xd occupied = map.occupied_centres();
-  ASSERT_GT(occupied.cols(), 0);
-  for (Eigen::Index k = 0; k < occupied.cols(); ++k) EXPECT_NEAR(occupied(0, k), 3.0, 0.1);  // x = 1 + 2
+  // the occupied voxels are exactly those holding an end (keys: floor(coordinate / 0.1))
+  const auto key = [](const Eigen::Vector3d& p) {
+    return std::array<long, 3>{std::lround(std::floor(p.x() / 0.1)), std::lround(std::floor(p.y() / 0.1)),
+                               std::lround(std::floor(p.z() / 0.1))};
+  };
+  std::set<std::array<long, 3>> ends, occupied;
+  for (Eigen::Index k = 0; k < wall.cols(); ++k) ends.insert(key(pose * Eigen::Vector3d(wall.col(k))));
+  const Eigen::Matrix3Xd centres = map.occupied_centres();
+  for (Eigen::Index k = 0; k < centres.cols(); ++k) occupied.insert(key(centres.col(k)));
+  EXPECT_EQ(occupied, ends);
+  EXPECT_EQ(map.occupied_leaves(), ends.size());
   EXPECT_GT(map.free_leaves(), 0u);
+  // written and read back by OctoMap: the same occupied voxels; a ray along the sensor's axis
+  // passes the way the beams crossed and stops at the wall's voxel face, x = 3.0
   const auto dir = std::filesystem::temp_directory_path() / "kiseki_test_global_map";
   std::filesystem::create_directories(dir);
   map.write_binary((dir / "map.bt").string());
-  EXPECT_GT(std::filesystem::file_size(dir / "map.bt"), 100u);
+  const OctreeWorld back = OctreeWorld::read_binary((dir / "map.bt").string());
   std::filesystem::remove_all(dir);
+  EXPECT_EQ(back.occupied_leaves(), ends.size());
+  EXPECT_EQ(back.resolution(), 0.1);
+  EXPECT_NEAR(back.cast(pose.translation() + Eigen::Vector3d(0, 0.025, 0.025), Eigen::Vector3d::UnitX(), 10.0), 2.0,
+              0.1 + 1e-9);
   EXPECT_THROW(GlobalVoxelMap(0.0, 5.0), std::invalid_argument);
   Eigen::Matrix3Xd nan(3, 1);
   nan << 1.0, std::nan(""), 0.0;

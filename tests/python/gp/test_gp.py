@@ -110,10 +110,19 @@ def test_far_coordinates_lose_no_digits(data):
 
 
 def test_duplicate_inputs_are_fitted(data):
+    # Two readings at each place, y and y + 0.01, with noise variance s^2 are one reading of
+    # their mean, y + 0.005, with noise variance s^2 / 2 (the product of the two Gaussians):
+    # the same posterior mean and variance everywhere.
     x, y, q = data
     xx, yy = np.vstack([x, x]), np.vstack([y, y + 0.01])
-    gp = ExactGP.fit(xx, yy, SquaredExponential(1.0, 0.5, 1e-6))
-    assert np.isfinite(gp.predict(q)[0]).all()
+    twice = ExactGP.fit(xx, yy, SquaredExponential(1.0, 0.5, 0.05)).predict(q)
+    once = ExactGP.fit(x, y + 0.005, SquaredExponential(1.0, 0.5, 0.05 / np.sqrt(2))).predict(q)
+    np.testing.assert_allclose(twice[0], once[0], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(twice[1], once[1], rtol=0, atol=1e-9)
+    # With almost no noise the doubled matrix is singular to rounding (K's own condition number
+    # at this spacing is beyond 1e12, so no value is asserted): the fit must still factorise.
+    tight = ExactGP.fit(xx, yy, SquaredExponential(1.0, 0.5, 1e-6))
+    assert np.isfinite(tight.predict(q)[0]).all()
 
 
 def test_hilbert_gp_approaches_the_exact_gp(data):

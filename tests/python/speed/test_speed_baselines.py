@@ -66,6 +66,23 @@ def test_both_are_speed_limit_sources():
     assert isinstance(PolygonSpeedLimiter(), SpeedLimitSource)
 
 
+def test_polygon_limiter_ramps_to_its_boxes_limits_at_a_max():
+    # Defaults: robot boxes 0.35 m half length; stop box to 0.35 + 0.3 m ahead, slowdown box to
+    # 0.35 + 1.0 m (half the 0.5 m/s there), 4 points needed, a_max 0.5 m/s^2: 0.05 m/s a step of
+    # 0.1 s. A wall 1.0 m ahead is in the slowdown box only; one 0.5 m ahead is in the stop box.
+    limiter = PolygonSpeedLimiter()
+    slow, stop = wall_ahead(1.0), wall_ahead(0.5)
+    assert limiter.target(ORIGIN, ANGLES, slow, MAX_RANGE) == 0.25
+    assert limiter.target(ORIGIN, ANGLES, stop, MAX_RANGE) == 0.0
+    assert limiter.target(ORIGIN, ANGLES, np.full(ANGLES.shape, MAX_RANGE), MAX_RANGE) == 0.5
+    up = [limiter.update(ORIGIN, ANGLES, slow, MAX_RANGE, 0.1) for _ in range(7)]
+    np.testing.assert_allclose(
+        [u.speed_limit for u in up], [0.05, 0.10, 0.15, 0.20, 0.25, 0.25, 0.25], atol=1e-12
+    )
+    down = [limiter.update(ORIGIN, ANGLES, stop, MAX_RANGE, 0.1).speed_limit for _ in range(6)]
+    np.testing.assert_allclose(down, [0.20, 0.15, 0.10, 0.05, 0.0, 0.0], atol=1e-12)
+
+
 def test_distance_limit_without_an_occluded_region_is_v_max():
     # a free field seen to the sensor's reach: nothing within 4 m - 0.35 m is occluded; an empty
     # map has no free cell at all
