@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from _helpers.scene_boxes import near_small_boxes
 from kiseki.sim.pose6 import PAPER_MOVES
 from kiseki.sim.scene import load_scene
 from kiseki.terrain import attitude_matrix
@@ -60,25 +61,13 @@ def test_object_cells_lie_on_the_small_objects():
     world = points @ level @ pose[:3, :3].T + pose[:3, 3]
     on = mask.reshape(-1)[cells]
     assert on.sum() > 200
-    near = _near_small_boxes(scene, world, 0.03)
+    near = near_small_boxes(scene, world, 0.03)
     # brute force: every labelled cell's point lies on a small object's box (3 cm margin: the
     # cell's 1 deg quantisation), and nearly every point on one is labelled
     assert near[on].mean() > 0.98
     assert on[near & (world[:, 2] > 0.02)].mean() > 0.9  # the floor beside them is not
     floor = np.abs(world[:, 2]) < 0.005
     assert floor.sum() > 1000 and on[floor].mean() < 0.02
-
-
-def _near_small_boxes(scene_path, points, margin):
-    """Whether each point lies within ``margin`` of a box standing on the floor below 1 m."""
-    boxes = load_scene(scene_path).boxes
-    near = np.zeros(len(points), dtype=bool)
-    for c, h, r in zip(boxes.centers, boxes.half_sizes, boxes.rotations, strict=True):
-        extent = np.abs(r) @ h
-        if c[2] - extent[2] > -0.02 and c[2] + extent[2] < 1.0:
-            local = (points - c) @ r  # r^T (p - c)
-            near |= (np.abs(local) <= h + margin).all(axis=1)
-    return near
 
 
 def test_env_b_measures_the_removed_object_cells(tmp_path):
