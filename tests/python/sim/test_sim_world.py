@@ -147,6 +147,24 @@ def test_depth_camera_sees_table_tops_sideways():
     # the wall behind it (y = 1.5) is 1.21 m away through the legs' gap.
     valid = depth[depth > 0]
     assert valid.min() >= 0.5 and np.isclose(np.median(valid), 1.21, atol=0.15)
+    # every pixel against one ray cast into the world through its centre from the mounted
+    # camera (pinhole: fx = w / 2 / tan(hfov / 2), centre at (w / 2, h / 2)); z-depth = range /
+    # |ray| with the ray's z at 1, and 0 outside [min_range, max_range)
+    pose = camera.optical_pose((1.8, 0.0, 0.0))
+    # the mount 0.29 m left of the robot, 0.4 m up, turned 90 deg left: the optical axis along
+    # +y, the image's right along +x, its down along -z (by hand)
+    np.testing.assert_allclose(pose[:3, 3], [1.8, 0.29, 0.4], atol=1e-12)
+    np.testing.assert_allclose(pose[:3, :3], [[1, 0, 0], [0, 0, 1], [0, -1, 0]], atol=1e-12)
+    fx, fy, cx, cy = camera.intrinsics()
+    v, u = np.mgrid[0 : depth.shape[0], 0 : depth.shape[1]]
+    rays = np.stack([(u + 0.5 - cx) / fx, (v + 0.5 - cy) / fy, np.ones(u.shape)], -1).reshape(-1, 3)
+    norm = np.linalg.norm(rays, axis=1)
+    directions = (rays / norm[:, None]) @ pose[:3, :3].T
+    origins = np.tile(pose[:3, 3], (len(rays), 1))
+    ranges = np.asarray(scene.world.cast_many(origins, directions, 10.0 * norm.max()))
+    z = np.minimum(ranges, 10.0 * norm) / norm
+    want = np.where((z >= 0.5) & (z < 10.0), z, 0.0).reshape(depth.shape)
+    np.testing.assert_allclose(depth, want, rtol=0, atol=1e-5)
 
 
 def test_tilting_laser_follows_equation_two():
