@@ -47,6 +47,7 @@ import numpy as np
 from scipy.optimize import nnls
 
 from kiseki._support.atomic import atomic_write
+from kiseki._support.inputs import MIB, read_input_text
 from kiseki.filters.engine import MonteCarloLocalizer
 from kiseki.filters.localize_config import LocalizeConfig
 from kiseki.filters.scan_models import scan_model
@@ -63,6 +64,7 @@ __all__ = [
 ]
 
 COST_MODEL_KIND = "kiseki update cost model"
+COST_MODEL_LIMIT = MIB  # a saved model is a few hundred bytes of JSON
 CALIBRATION_PARTICLES = (1 / 16, 1 / 4, 1.0)  # shares of the particles asked for
 CALIBRATION_BEAMS = (1 / 4, 1 / 2, 1.0)  # shares of the beams asked for
 CALIBRATION_WARMUP = 3  # updates not timed (the first tabulates the field)
@@ -105,8 +107,8 @@ class CostModel:
     def load(cls, path: Path) -> CostModel:
         """A saved cost model; ValueError naming the file and the problem otherwise."""
         path = Path(path)
-        try:
-            doc = json.loads(path.read_text(encoding="utf-8"))
+        try:  # a device, FIFO or oversized file is refused unread (read_input_text)
+            doc = json.loads(read_input_text(path, "cost models", COST_MODEL_LIMIT))
         except OSError as err:
             raise ValueError(f"{path}: cannot read the cost model ({err.strerror})") from None
         except (UnicodeDecodeError, json.JSONDecodeError) as err:

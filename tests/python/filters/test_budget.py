@@ -9,12 +9,16 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from kiseki.datasets import read_carmen_log
 from kiseki.filters import CostModel, LocalizeConfig, choose_counts, localize
+from kiseki.filters.budget import COST_MODEL_LIMIT
 from kiseki.mapping import build_map
 
 # Binary fractions, so that the hand computations below are exact.
@@ -107,6 +111,18 @@ def test_cost_model_file_round_trip_and_bad_files(tmp_path):
         message = str(err.value)
         assert message.startswith(str(tmp_path / name)) and problems[name] in message
         assert "\n" not in message
+    # a FIFO is refused unread (opening it would wait for a writer for ever) and so is a file
+    # larger than a cost model can be; /dev/zero would otherwise be read until memory ran out
+    os.mkfifo(tmp_path / "fifo.json")
+    big = tmp_path / "big.json"
+    big.write_bytes(b" " * (COST_MODEL_LIMIT + 1))
+    for path, problem in (
+        (tmp_path / "fifo.json", "a FIFO (named pipe), not a regular file"),
+        (Path("/dev/zero"), "a character device, not a regular file"),
+        (big, "larger than 1 MiB (kiseki's limit for cost models)"),
+    ):
+        with pytest.raises(ValueError, match=re.escape(f"{path}: {problem}")):
+            CostModel.load(path)
 
 
 def test_config_refuses_a_bad_budget():
