@@ -17,6 +17,8 @@ YAML). A folder of the GP magnetic field maps (:mod:`kiseki.magnetic.map_folder`
 
 from __future__ import annotations
 
+import zipfile
+import zlib
 from pathlib import Path
 from typing import Literal
 
@@ -151,7 +153,7 @@ def _read_nodes(path: Path, n: int) -> dict[str, np.ndarray]:
     try:
         with np.load(path, allow_pickle=False) as npz:
             found = {k: npz[k] for k in npz.files}
-    except (OSError, ValueError, EOFError) as err:
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as err:
         raise MapFormatError(f"{path}: not a readable .npz file ({err})") from None
     shapes = {"field": (n, 3), "g": (n, 2), "position": (n, 2)}
     for name in _ARRAYS:

@@ -38,6 +38,8 @@ import os
 import shutil
 import struct
 import tempfile
+import zipfile
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -197,7 +199,7 @@ def _read_npz(path: Path, shapes: dict[str, tuple]) -> dict[str, np.ndarray]:
     try:
         with np.load(path, allow_pickle=False) as npz:
             found = {k: npz[k] for k in npz.files}
-    except (OSError, ValueError, EOFError) as err:
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as err:
         raise _fail(path, f"not a readable .npz file ({err})") from None
     for key, shape in shapes.items():
         if key not in found:

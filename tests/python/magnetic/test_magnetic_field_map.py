@@ -234,6 +234,13 @@ def _nan_layer(folder):
     np.savez(folder / "layers.npz", **arrays)
 
 
+def _cut_in_half(path):
+    """A zip cut short, as a copy or download that stopped: its magic is a zip's."""
+    data = path.read_bytes()
+    assert data[:2] == b"PK" and len(data) > 200
+    path.write_bytes(data[: len(data) // 2])
+
+
 @pytest.mark.parametrize(
     ("spoil", "culprit", "match"),
     [
@@ -249,6 +256,7 @@ def _nan_layer(folder):
         (lambda f: _edit_yaml(f, shape={"x": 7, "y": 6}), "mx_mean.png", "the YAML says"),
         (lambda f: _nan_layer(f), "layers.npz", "NaN"),
         (lambda f: (f / "training.npz").write_text("x"), "training.npz", "not a readable"),
+        (lambda f: _cut_in_half(f / "layers.npz"), "layers.npz", "not a readable"),
         (lambda f: _edit_yaml(f, dimension=4), MAP_FILE, "dimension: must be 2 or 3, got 4"),
     ],
 )

@@ -285,6 +285,18 @@ def test_simulated_teaching_run_matches_the_simulator_field(tmp_path, project_da
     np.testing.assert_allclose(lmap.g[filled][lmap.position[filled, 0] < 15], 3.8, atol=0.1)
 
 
+def test_a_nodes_file_cut_short_is_refused_naming_it(tmp_path):
+    lmap = build_linear_map([0.0, 0.1, 0.2], [[0.1, 0.2, 0.3]] * 3, [0, 0, 0], path_id=PATH)
+    folder = save_linear_map(lmap, tmp_path / "map")
+    nodes = folder / "nodes.npz"
+    data = nodes.read_bytes()
+    assert data[:2] == b"PK" and len(data) > 200
+    nodes.write_bytes(data[: len(data) // 2])  # a copy that stopped half way
+    with pytest.raises(ValueError, match="not a readable .npz file") as caught:
+        load_linear_map(folder)
+    assert str(caught.value).startswith(str(nodes)) and "\n" not in str(caught.value)
+
+
 @pytest.mark.parametrize(
     ("edit", "message"),
     [
