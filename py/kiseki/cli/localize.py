@@ -24,11 +24,11 @@ from kiseki._support.options import (
     Fraction,
     Quantity,
     Seed,
-    refuse_given,
 )
 from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki._support.table import show_fields
 from kiseki.cli._defaults import default_of
+from kiseki.cli._localize_checks import refuse_unused_by_localize
 from kiseki.cli._off_map import warn_if_off_the_map
 from kiseki.datasets import open_scans
 from kiseki.filters import (
@@ -229,9 +229,7 @@ def localize_command(
     output as OUTPUT-STEM.config.yaml.
 
     Example: kiseki localize run.mcap --map data/maps/factory_corridor.yaml -o track.csv --json"""
-    _refuse_unused_by_localize(ctx, method, global_start)
-    if (reset_proposal or LocalizeConfig.sensor_reset_proposal) != "matcher":
-        refuse_given(ctx, ["search_every"], "without --reset-proposal matcher")
+    refuse_unused_by_localize(ctx, method, global_start, recovery, reset_proposal)
     if cost_model is not None and budget_ms is None:
         raise ValueError("--cost-model applies only with --budget-ms")
 
@@ -336,33 +334,6 @@ def _given(**settings) -> dict:
     """The settings the command line gave (not None): the others keep their config's default,
     so that each default lives in one place (LocalizeConfig, GlobalConfig)."""
     return {name: value for name, value in settings.items() if value is not None}
-
-
-def _refuse_unused_by_localize(ctx: typer.Context, method: str, global_start: bool) -> None:
-    """Options the chosen method or start does not use are errors, not silently ignored."""
-    if method == "odometry":  # the odometry alone: no filter, no sensor model, no start
-        refuse_given(
-            ctx,
-            ["particles", "kld", "beams", "recovery", "threads", "global_start"]
-            + ["reset_proposal", "search_every", "reset_look_elsewhere", "reset_unchecked"],
-            "to --method odometry (the odometry alone: no particle filter)",
-        )
-    elif method == "space-observation":  # a local map of the whole scan: no beam selection
-        refuse_given(ctx, ["beams"], "to --method space-observation (it weighs the whole scan)")
-    if method != "likelihood-field":
-        refuse_given(ctx, ["beam_skip"], f"to --method {method} (a likelihood-field option)")
-    if method != "beam":
-        refuse_given(ctx, ["caster"], f"to --method {method} (a beam-model option)")
-    if global_start:
-        refuse_given(ctx, ["odometry_noise"], "with --global (it is for logs with reference poses)")
-        refuse_given(
-            ctx,
-            ["reset_proposal", "search_every", "reset_look_elsewhere", "reset_unchecked"],
-            "with --global (its start is --one-scan; its resets are the uniform ones)",
-        )
-        refuse_given(
-            ctx, ["budget_ms", "cost_model", "beam_skip", "caster"], "with --global (tracking only)"
-        )
 
 
 def _print_report(lines: list[str], summary: dict, as_json: bool) -> None:

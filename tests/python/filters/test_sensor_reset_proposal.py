@@ -176,13 +176,24 @@ def test_bad_settings_are_refused_in_one_line(tmp_path):
         localizer.step(TRUTH, lambda: model)
     write_inputs(tmp_path)  # the helpers' room and a run log through it
     for args, word in (
-        (["--reset-proposal", "grid"], "sensor_reset_proposal must be one of"),
+        (["--recovery", "resetting", "--reset-proposal", "grid"], "sensor_reset_proposal must be"),
         (["--global", "--reset-proposal", "matcher"], "does not apply with --global"),
         (["--global", "--reset-unchecked"], "does not apply with --global"),
         (
-            ["--reset-proposal", "uniform", "--matcher-search-every", "3"],
+            [
+                "--recovery",
+                "resetting",
+                "--reset-proposal",
+                "uniform",
+                "--matcher-search-every",
+                "3",
+            ],
             "does not apply without --reset-proposal matcher",
         ),
+        # the reset options without sensor resets (they were ignored, and saved as if in effect)
+        (["--reset-unchecked"], "does not apply with --recovery none"),
+        (["--recovery", "augmented", "--reset-proposal", "uniform"], "with --recovery augmented"),
+        (["--method", "odometry", "--reliability", "learned"], "to --method odometry"),
         (
             ["--reset-proposal", "matcher", "--matcher-search-every", "0"],
             "--matcher-search-every must be",
