@@ -82,6 +82,8 @@ def _settings(config: CoopFormsConfig) -> list[tuple]:
     r1 = config.form1_readings
     rows = [("sweep", 1, n, None, r) for r in r1 for n in config.form1_moves]
     rows += [("sweep", 2, n, None, "") for n in config.form2_moves]
+    if len(config.angle_moves) != 2:  # the trial count is taken from here before preflight
+        raise ValueError("coop-forms: angle_moves takes 2 counts (form 1, form 2)")
     m1, m2 = config.angle_moves
     rows += [("angle", 1, m1, a, r) for r in r1 for a in config.angles_deg]
     rows += [("angle", 2, m2, a, "") for a in config.angles_deg]
@@ -101,12 +103,11 @@ def preflight(config: CoopFormsConfig) -> None:
     bad = [r for r in config.form1_readings if r not in FORM1_READINGS]
     if not config.form1_readings or bad:
         raise ValueError(f"coop-forms: form1_readings must be some of {', '.join(FORM1_READINGS)}")
-    if len(config.angle_moves) != 2:
-        raise ValueError("coop-forms: angle_moves takes 2 counts (form 1, form 2)")
+    settings = _settings(config)  # refuses angle_moves without 2 counts
     for n in (*config.form1_moves, config.angle_moves[0]):
         if n < 1 or n % 2 == 0:
             raise ValueError(f"coop-forms: form 1 takes odd move counts, got {n}")
-    for kind, form, moves, angle, reading in _settings(config):
+    for kind, form, moves, angle, reading in settings:
         if kind in ("sweep", "angle"):  # raises for a count or angle out of range
             plan(form, moves, None if angle is None else math.radians(angle), reading=reading or
                  FORM1_READINGS[0])  # fmt: skip

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from _helpers.cli_main import kiseki
 from kiseki_experiments.coop.coop_claims import CPS2_DISTANCE, claim_evidence
 from kiseki_experiments.coop.coop_forms import EXPERIMENT, _groups
 from kiseki_experiments.harness.verdict import judge
@@ -90,3 +91,15 @@ def test_the_anchor_evidence_is_the_per_repeat_ratio_computed_by_hand():
     three = ok[ok["kind"] == "3d"].iloc[1]
     want = np.asarray(three["repeat_horizontal_m"]) / np.asarray(three["repeat_planar_m"])
     np.testing.assert_allclose(evidence["three_dform 2"].values, want)
+
+
+@pytest.mark.parametrize("moves", ["2", "2,3,4"])
+def test_angle_moves_without_two_counts_is_refused_naming_the_key(moves, monkeypatch, capsys):
+    """The trial count is taken from the settings before the preflight: a wrong arity was a
+    bare 'not enough values to unpack' there."""
+    status, _, err = kiseki(
+        monkeypatch, capsys, "experiment", "run", "coop-forms", "--runs", "1",
+        "--set", f"angle_moves={moves}",
+    )  # fmt: skip
+    assert status != 0 and len(err.strip().splitlines()) == 1
+    assert "angle_moves takes 2 counts (form 1, form 2)" in err
