@@ -144,9 +144,11 @@ def report(
 
     Example: kiseki experiment report --results results -o REPRODUCTION.md --readme README.md"""
     if readme is not None:  # read and checked before anything is written
-        text, blocks = update_readme(
-            read_input_text(readme, "Markdown files", YAML_LIMIT), readme, results
-        )
+        try:
+            markdown = read_input_text(readme, "Markdown files", YAML_LIMIT)
+        except UnicodeDecodeError as err:
+            raise ValueError(f"{readme}: not UTF-8 text, so not a README ({err.reason})") from None
+        text, blocks = update_readme(markdown, readme, results)
     totals, missing = write_reproduction(results, output)
     if readme is not None:
         atomic_write(readme, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))

@@ -107,6 +107,15 @@ def test_report_command_rewrites_the_readme_in_place(results, tmp_path, monkeypa
     )  # fmt: skip
     assert status != 0 and str(gone) in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "R2.md").exists()
+    # a picture given as the README: one line naming it, nothing written
+    picture = tmp_path / "x.md"
+    picture.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)))
+    status, out, err = kiseki(
+        monkeypatch, capsys, "experiment", "report", "--results", results,
+        "-o", tmp_path / "R3.md", "--readme", picture,
+    )  # fmt: skip
+    assert status != 0 and len(err.strip().splitlines()) == 1
+    assert f"{picture}: not UTF-8 text" in err and not (tmp_path / "R3.md").exists()
 
 
 def test_the_readme_tables_are_the_committed_results():
