@@ -16,7 +16,7 @@
   as a mapping (every key optional).
 
 A problem is one line naming the file, the key and the value
-(``map.yaml: resolution: must be greater than 0, got -0.05``)."""
+(``map.yaml: resolution: must be greater than or equal to 0.0001, got -0.05``)."""
 
 from __future__ import annotations
 
@@ -24,13 +24,22 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BeforeValidator, Field, ValidationInfo, field_validator
 
-from kiseki._support.schema import FileModel, FiniteFloat, NonNegativeFloat, PositiveFloat
+from kiseki._support.schema import (
+    MAGNITUDE_LIMIT,
+    FileModel,
+    FiniteFloat,
+    NonNegativeFloat,
+    PositiveFloat,
+)
 
 __all__ = ["MODES", "MapBuildSettings", "RosMapYaml"]
 
 MODES = ("trinary", "scale", "raw")
 
 Share = Annotated[float, Field(strict=True, ge=0, le=1, allow_inf_nan=False)]
+# m per cell: from 0.1 mm (far finer than any range sensor resolves; 1e-300 was read as a
+# map 3e-298 m across) up to kiseki's limit for any length
+CellSize = Annotated[float, Field(strict=True, ge=1e-4, le=MAGNITUDE_LIMIT, allow_inf_nan=False)]
 Probability = Annotated[float, Field(strict=True, gt=0, lt=1, allow_inf_nan=False)]
 
 
@@ -50,7 +59,7 @@ class RosMapYaml(FileModel):
     """A ROS map YAML file, as nav2's map_server reads it."""
 
     image: Annotated[str, Field(strict=True, min_length=1, max_length=4096)]
-    resolution: PositiveFloat
+    resolution: CellSize
     origin: Annotated[tuple[FiniteFloat, FiniteFloat, FiniteFloat], BeforeValidator(_pose)]
     mode: Literal["trinary", "scale", "raw"] = "trinary"
     negate: Annotated[bool, BeforeValidator(_negate)] = False

@@ -43,7 +43,8 @@ def _write(tmp_path: Path, **fields) -> Path:
 @pytest.mark.parametrize(
     ("fields", "message"),
     [
-        ({"resolution": 0}, "resolution: must be greater than 0, got 0"),
+        ({"resolution": 0}, "resolution: must be greater than or equal to 0.0001, got 0"),
+        ({"resolution": 1e-300}, "resolution: must be greater than or equal to 0.0001, got 1e-300"),
         ({"resolution": True}, "resolution: must be a valid number, got True"),
         ({"origin": [0, 0]}, "origin: must be a list [x, y, yaw], got [0, 0]"),
         ({"origin": [0, float("nan"), 0]}, "origin[1]: must be a finite number, got nan"),

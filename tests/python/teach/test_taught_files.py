@@ -103,7 +103,10 @@ def test_a_map_yaml_is_read_through_its_model(tmp_path):
     for edit, problem in [
         (lambda m: m.pop("image"), "image: missing"),
         (lambda m: m.update(image=3), "image: must be a valid string, got 3"),
-        (lambda m: m.update(resolution=-0.1), "resolution: must be greater than 0, got -0.1"),
+        (
+            lambda m: m.update(resolution=-0.1),
+            "resolution: must be greater than or equal to 0.0001, got -0.1",
+        ),
     ]:
         changed = dict(meta)
         edit(changed)
