@@ -52,9 +52,35 @@ from kiseki.sim.pedestrians import Pedestrian
 from kiseki.sim.primitives import BoxList, boxes_of
 from kiseki.sim.scene_schema import Poses, SceneDoc, Turns, extent_problem
 
-__all__ = ["MAX_OCTOMAP_BYTES", "Scene", "load_scene"]
+__all__ = ["MAX_OCTOMAP_BYTES", "Scene", "load_scene", "read_octree"]
 
 MAX_OCTOMAP_BYTES = 32 * MIB
+OCTOMAP_RESOLUTIONS = (1e-4, 10.0)  # m per voxel: OctoMap's buildings use 0.01-0.2 m
+OCTOMAP_EXTENT = 1e4  # m: the largest building or site an OctoMap world may span
+
+
+def read_octree(bt: Path) -> Any:
+    """An OctoMap ``.bt`` file as a world, its size and header checked first; a voxel size or
+    an extent beyond kiseki's limits (a header edited to 1e9 m voxels asked for terabytes
+    later) is refused naming the file (ValueError)."""
+    check_input(bt, "OctoMap files", MAX_OCTOMAP_BYTES)
+    if not Path(bt).is_file():
+        raise FileNotFoundError(f"{bt}: OctoMap file not found")
+    try:
+        world = _core.OctreeWorld.read_binary(str(bt))
+    except RuntimeError as err:
+        raise ValueError(str(err)) from None
+    lo_res, hi_res = OCTOMAP_RESOLUTIONS
+    if not lo_res <= world.resolution <= hi_res:
+        raise ValueError(
+            f"{bt}: voxels of {world.resolution:g} m: kiseki reads {lo_res:g}-{hi_res:g} m"
+        )
+    lo, hi = (np.asarray(b, dtype=float) for b in world.bounds)
+    if not (np.isfinite(lo).all() and np.isfinite(hi).all()) or (hi - lo).max() > OCTOMAP_EXTENT:
+        raise ValueError(f"{bt}: the occupied voxels span more than {OCTOMAP_EXTENT:g} m")
+    return world
+
+
 """An OctoMap ``.bt`` file holds at most this: reading one takes about 120 times its size in
 memory (``geb079.bt``, a building floor at 5 cm: 0.2 MB, 25 MB), so 32 MiB is about 4 GB."""
 
@@ -152,15 +178,11 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
     if doc.octomap is not None:
         bt = (path.parent / doc.octomap).resolve()
         try:
-            check_input(bt, "OctoMap files", MAX_OCTOMAP_BYTES)
+            world = read_octree(bt)
         except ValueError as err:
             raise ValueError(f"{path}: octomap {err}") from None
-        if not bt.is_file():
-            raise FileNotFoundError(f"{path}: octomap file {bt} not found")
-        try:
-            world = _core.OctreeWorld.read_binary(str(bt))
-        except RuntimeError as err:
-            raise ValueError(f"{path}: {err}") from err
+        except FileNotFoundError:
+            raise FileNotFoundError(f"{path}: octomap file {bt} not found") from None
     else:
         if not boxes.centers:
             raise SchemaError(f"{path}: objects: a scene needs objects or an octomap")

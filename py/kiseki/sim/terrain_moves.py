@@ -24,11 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
-from kiseki import _core
-from kiseki._support.inputs import check_input
 from kiseki.core import check_seed
 from kiseki.sim.pose6 import Pose6, resting_pose
-from kiseki.sim.scene import MAX_OCTOMAP_BYTES, load_scene
+from kiseki.sim.scene import load_scene, read_octree
 from kiseki.sim.sensors import Mount
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.sim.tilting_laser import TiltingLaser, TiltingLaserParams
@@ -76,13 +74,16 @@ def _polyline_points(
 
 def free_start(world, bounds, clearance: float = 0.6) -> tuple[float, float, float]:
     """A free spot near the floor of an octree world: (x, y, floor z). Candidates on a 0.5 m
-    grid over the bounds; at each, the floor is found by casting down from just under the top;
-    a spot needs 1.5 m of free space above the floor and ``clearance`` metres around at 0.5 m
-    above it. The spot nearest the centre of the bounds wins. Raises ValueError when none."""
+    grid over the bounds (coarser on a site over 100 m across: at most 200 a side, so the
+    search stays a few seconds); at each, the floor is found by casting down from just under
+    the top; a spot needs 1.5 m of free space above the floor and ``clearance`` metres around
+    at 0.5 m above it. The spot nearest the centre of the bounds wins. Raises ValueError when
+    none."""
     lo, hi = (np.asarray(b, dtype=float) for b in bounds)
     centre = (lo + hi) / 2
-    xs = np.arange(lo[0] + 0.5, hi[0] - 0.5, 0.5)
-    ys = np.arange(lo[1] + 0.5, hi[1] - 0.5, 0.5)
+    step = max(0.5, float((hi[:2] - lo[:2]).max()) / 200)
+    xs = np.arange(lo[0] + 0.5, hi[0] - 0.5, step)
+    ys = np.arange(lo[1] + 0.5, hi[1] - 0.5, step)
     if len(xs) == 0 or len(ys) == 0:
         raise ValueError("free_start: the world is smaller than 1 m across")
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
@@ -127,8 +128,7 @@ def terrain_stops(
         raise ValueError(f"step must be 0.02..0.6 m (the search reaches 0.7 m), got {step!r}")
     path = Path(world_path)
     if path.suffix == ".bt":
-        check_input(path, "OctoMap files", MAX_OCTOMAP_BYTES)
-        world = _core.OctreeWorld.read_binary(str(path))
+        world = read_octree(path)
         x, y, f = free_start(world, world.bounds)
         o = np.tile([x, y, f + 0.5], (32, 1))
         angles = np.linspace(0, 2 * math.pi, 32, endpoint=False)

@@ -135,6 +135,21 @@ def test_run_in_a_real_building_finds_its_own_start(tmp_path):
     assert world.cast_many(o, d, 0.5).min() >= 0.5
 
 
+@pytest.mark.skipif(not GEB079.exists(), reason="the recorded Freiburg 079 octree is absent")
+def test_an_octree_header_with_absurd_voxels_is_refused_in_one_line(tmp_path):
+    """The header's voxel size scales the whole tree: 1e9 m voxels asked numpy for terabytes
+    (a traceback); kiseki reads 0.1 mm to 10 m voxels and refuses others naming the file."""
+    data = GEB079.read_bytes()
+    assert b"\nres 0.08\n" in data
+    bad = tmp_path / "huge.bt"
+    bad.write_bytes(data.replace(b"\nres 0.08\n", b"\nres 1e9\n", 1))
+    done = run(bad, "--moves", 1, "-o", tmp_path / "out")
+    assert done.returncode == 1, done.stderr
+    assert f"kiseki: error: {bad}: voxels of 1e+09 m: kiseki reads 0.0001-10 m" in done.stderr
+    assert "Traceback" not in done.stderr
+    assert not any((tmp_path / "out").glob("*"))  # nothing written (the folder is made first)
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
