@@ -72,6 +72,9 @@ __all__ = [
     "read_carmen_log",
 ]
 
+# Every number but the range readings within +-1e12: poses in metres and radians, times in
+# seconds since 1970 (about 1.7e9 now); 1e300 passed and made the pose error infinite
+VALUE_LIMIT = 1e12
 MAX_LOG_BYTES = 1 * GIB
 """A log's text (after gunzip) is read up to this size: the largest Radish logs hold a few hundred
 MB, and parsing takes about 16 times the text's size in memory (Freiburg 079: 9.5 MB of text,
@@ -191,6 +194,14 @@ def _to_float(
     if bad.any():
         lineno = rows[int(np.argmax(bad))][0]
         raise LogFormatError(f"{path}:{lineno}: non-finite value (NaN or inf) in {kind}")
+    huge = np.abs(values) > VALUE_LIMIT
+    huge[:, ranges] = False  # a reading beyond the maximum range is a reading without a return
+    if huge.any():
+        row = int(np.argmax(huge.any(axis=1)))
+        value = values[row][huge[row]][0]
+        raise LogFormatError(
+            f"{path}:{rows[row][0]}: value {value:g} in {kind} beyond +-{VALUE_LIMIT:g}"
+        )
     return values
 
 

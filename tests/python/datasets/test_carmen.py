@@ -213,6 +213,8 @@ GOOD_FLASER = flaser(RANGES[1], POSES[1], ODOMS[1], TIMES[1])  # line 10 of samp
         (GOOD_FLASER.replace("7.125", "7.1x5"), "non-numeric value '7.1x5' in FLASER"),
         (GOOD_FLASER.replace("-3.0", "nan"), r"non-finite value \(NaN or inf\) in FLASER"),
         (GOOD_FLASER.replace("10.5 ", "inf ", 1), "non-finite value"),  # odometry x
+        # a pose of 1e300 m made the pose error infinite (exit 0); a reading of 1e300 is none
+        (GOOD_FLASER.replace("10.5 ", "1e300 ", 1), r"value 1e\+300 in FLASER beyond \+-1e\+12"),
         (GOOD_FLASER.replace("FLASER 4 ", "FLASER 4.0 "), "beam count '4.0' is not an integer"),
         (flaser([1.0, 2.0, 3.0], [0] * 3, [0] * 3, 101.0), "FLASER has 3 beams, line 5 has 4"),
     ],
@@ -228,6 +230,7 @@ def test_corrupt_flaser_line(tmp_path: Path, line: str, message: str) -> None:
     [
         ("ODOM 0.5 -0.25 1.5 0.3 -0.2 0 100.6 host", "ODOM has 9 fields, expected 10"),
         ("ODOM 0.5 -0.25 nan 0.3 -0.2 0 100.6 host 100.6", "non-finite value"),
+        ("ODOM 0.5 -0.25 1.5 0.3 -0.2 0 100.6 host 1e13", r"value 1e\+13 in ODOM beyond"),
         ("ODOM 0.5 -0.25 1.5 0.3 -0.2 0 abc host 100.6", "non-numeric value 'abc' in ODOM"),
         ("PARAM lonely", "PARAM needs a name and a value"),
     ],
