@@ -16,7 +16,7 @@ from kiseki._support.guard import Derived, guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import Seed
 from kiseki.apps.teach import PlaybackConfig, playback
-from kiseki.apps.teach.teaching import load_route
+from kiseki.apps.teach.teaching import check_on_the_map, load_route
 from kiseki.cli._defaults import default_of
 from kiseki.io.ros_map import load_map
 from kiseki.sim.scene import load_scene
@@ -99,6 +99,7 @@ def playback_command(
     if log is not None and log.exists():
         raise FileExistsError(f"--log {log} exists; give a new file")
     scene, environment = load_scene(scene_file, "playback"), load_map(map_path)
+    check_on_the_map(waypoints, map_path, environment, marks)
     limiter = _speed_limiter(speed_limit, scene, environment, config.speed)
     travelled = read_travelled(waypoints)  # the teaching log's odometry (None without it)
     result = playback(

@@ -18,7 +18,7 @@ import yaml
 
 from kiseki import _core, load_map
 from kiseki.apps.teach import PlaybackConfig, playback, teach
-from kiseki.apps.teach.teaching import load_route, load_taught, recover
+from kiseki.apps.teach.teaching import check_on_the_map, load_route, load_taught, recover
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
 from kiseki.io.runlog import read_run
@@ -131,6 +131,22 @@ def test_bad_input(tmp_path, project_root):
         load_route(waypoints, "band", ["P0", "P2"], tmp_path / "o" / "map_plane.yaml")
     with pytest.raises(ValueError, match=r"waypoints.yaml: image: missing \(and \d+ more\)"):
         load_route(waypoints, "band", ["P0", "P2"], waypoints)  # checked as a ROS map YAML
+    # a waypoint edited off the taught map (the robot drove out through the walls before)
+    doc = yaml.safe_load(waypoints.read_text())
+    doc["waypoints"][2]["x"] = 700.0
+    off = tmp_path / "o" / "off.yaml"
+    off.write_text(yaml.safe_dump(doc))
+    map_path, marks = load_route(off, "band", ["P0", "P2"], tmp_path / "o" / "map_band.yaml")
+    with pytest.raises(ValueError, match=r"off.yaml: waypoint P2 at \(700, .*\) m lies off"):
+        check_on_the_map(off, map_path, load_map(map_path), marks)
+    check_on_the_map(off, map_path, load_map(map_path), marks[:1])  # P0 is on it
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "playback", str(scene_file), "--waypoints", str(off),
+         "--map", str(map_path), "--route", "P0,P2"],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert done.returncode == 1 and len(done.stderr.strip().splitlines()) == 1
+    assert "waypoint P2 at (700" in done.stderr and "lies off the taught map" in done.stderr
     cli = [sys.executable, "-m", "kiseki.cli", "playback", str(scene_file), "--route", "P0,P2"]
     done = subprocess.run(cli, capture_output=True, text=True)
     assert done.returncode == 1 and "either --taught FOLDER or --waypoints FILE" in done.stderr
