@@ -55,6 +55,8 @@ from kiseki.sim.scene_schema import Poses, SceneDoc, Turns, extent_problem
 __all__ = ["MAX_OCTOMAP_BYTES", "Scene", "load_scene", "read_octree"]
 
 MAX_OCTOMAP_BYTES = 32 * MIB
+"""An OctoMap ``.bt`` file holds at most this: reading one takes about 120 times its size in
+memory (``geb079.bt``, a building floor at 8 cm: 0.2 MB, 25 MB), so 32 MiB is about 4 GB."""
 OCTOMAP_RESOLUTIONS = (1e-4, 10.0)  # m per voxel: OctoMap's buildings use 0.01-0.2 m
 OCTOMAP_EXTENT = 1e4  # m: the largest building or site an OctoMap world may span
 
@@ -80,9 +82,6 @@ def read_octree(bt: Path) -> Any:
         raise ValueError(f"{bt}: the occupied voxels span more than {OCTOMAP_EXTENT:g} m")
     return world
 
-
-"""An OctoMap ``.bt`` file holds at most this: reading one takes about 120 times its size in
-memory (``geb079.bt``, a building floor at 5 cm: 0.2 MB, 25 MB), so 32 MiB is about 4 GB."""
 
 VARIANTS = ("teach", "playback")
 
