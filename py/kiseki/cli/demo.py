@@ -104,8 +104,10 @@ def run_demo(
 ) -> dict:
     config = DemoConfig(scene=str(scene_file), seed=seed, particles=particles, merge=merge)
     PlaybackConfig(particles=particles)  # a bad --particles is refused before the teaching
-    out.mkdir(parents=True, exist_ok=True)
     scene = load_scene(scene_file)
+    if not scene.route.get("waypoints"):  # teach's own check, before anything is written
+        raise ValueError(f"{scene_file}: the demo teaches along the scene's route: it has none")
+    out.mkdir(parents=True, exist_ok=True)
     render_scene(scene, out / "scene.png")
     console.print("teaching: pushing the AGV along the route ...")
     taught = teach(scene, out / "teach", seed=derive_seed(seed, 1), overwrite=True, merge=merge)

@@ -102,3 +102,16 @@ def test_demo_from_the_cli_prints_what_it_saved(tmp_path, project_root):
         printed = rows[band]  # map | obstacle cells | erased | visible free cells | occupied
         assert printed[1] == f"{100 * shares['erased_share']:.1f} %"
         assert printed[3] == f"{100 * shares['false_occupied_share']:.1f} %"
+
+
+def test_a_scene_without_a_route_is_refused_before_anything_is_written(tmp_path, project_root):
+    """The three-robot scene has no route to teach along: one line naming it, and no --out
+    folder (scene.png was written before teaching failed)."""
+    scene = project_root / "data" / "worlds" / "coop_three_robots.yaml"
+    done = subprocess.run(
+        [sys.executable, "-m", "kiseki.cli", "demo", "--scene", str(scene), "--out", "d"],
+        cwd=tmp_path, capture_output=True, text=True,
+    )  # fmt: skip
+    assert done.returncode == 1 and len(done.stderr.strip().splitlines()) == 1
+    assert f"{scene}: the demo teaches along the scene's route: it has none" in done.stderr
+    assert not (tmp_path / "d").exists()
