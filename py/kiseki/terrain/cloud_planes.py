@@ -177,14 +177,20 @@ def _read_text(path: Path) -> np.ndarray:
     return np.asarray(rows, dtype=float).reshape(-1, 3)
 
 
+ORIGIN_LIMIT = 1e6  # m: a sensor 1,000 km from its cloud's frame is a typo
+
+
 def parse_origin(text: str) -> np.ndarray:
-    """``"x,y,z"`` (metres) as a finite 3-vector; ValueError otherwise."""
+    """``"x,y,z"`` (metres) as a finite 3-vector within +-ORIGIN_LIMIT; ValueError otherwise
+    (1e300 overflowed later into a message about the S-DEM's range, naming no option)."""
     try:
         origin = np.array([float(v) for v in str(text).split(",")])
     except ValueError:
         origin = np.zeros(0)
-    if origin.shape != (3,) or not np.all(np.isfinite(origin)):
-        raise ValueError(f"--origin must be three finite numbers x,y,z, got {text!r}")
+    if origin.shape != (3,) or not np.all(np.abs(origin) <= ORIGIN_LIMIT):
+        raise ValueError(
+            f"--origin must be three numbers x,y,z within +-{ORIGIN_LIMIT:g} m, got {text!r}"
+        )
     return origin
 
 
