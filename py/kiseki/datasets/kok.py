@@ -83,6 +83,9 @@ def quaternion_to_matrix(quat: np.ndarray) -> np.ndarray:
     )
 
 
+POSITION_LIMIT = 1e6  # m: a hand-held walk stays within a building, not 1,000 km
+
+
 def read_kok_walk(path: str | os.PathLike) -> MagneticSamples:
     """A walk from a MATLAB v5 ``.mat`` file: 3-D positions ``[0; cumsum(dPos)]``, the field
     turned to the world frame (see the module docstring for the convention), uT, times ``t``."""
@@ -108,7 +111,15 @@ def read_kok_walk(path: str | os.PathLike) -> MagneticSamples:
         raise LogFormatError(
             f"{path}: quat row {row + 1} is not a unit quaternion (norm {norms[row]:.6g})"
         )
-    positions = np.vstack([np.zeros(3), np.cumsum(dpos, axis=0)])
+    with np.errstate(over="ignore", invalid="ignore"):  # a huge increment is refused below
+        positions = np.vstack([np.zeros(3), np.cumsum(dpos, axis=0)])
+    far = ~(np.abs(positions) <= POSITION_LIMIT).all(axis=1)
+    if far.any():
+        row = int(np.argmax(far))
+        raise LogFormatError(
+            f"{path}: dPos takes the walk to {positions[row].tolist()} m at sample {row + 1}: "
+            f"not finite within +-{POSITION_LIMIT:g} m"
+        )
     rotation = quaternion_to_matrix(quat / norms[:, None]) @ SENSOR_TO_BODY
     field = np.einsum("nij,nj->ni", rotation, m)
     return MagneticSamples(positions, field, "uT", str(path), t.reshape(-1))

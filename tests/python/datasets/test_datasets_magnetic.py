@@ -281,6 +281,15 @@ def test_kok_walk_known_values(tmp_path: Path) -> None:
         ({"t": np.zeros((3, 1))}, "t must hold 5 times like m"),
         ({"quat": np.tile([1.0, 0.0, 0.0, 0.1], (5, 1))}, "quat row 1 is not a unit quaternion"),
         ({"m": np.full((5, 3), "a")}, "m is not a numeric array"),
+        # a huge or NaN increment: the path it gives is refused (1e300 made an infinite walk)
+        (
+            {"dPos": np.array([[0.1, 0, 0], [1e300, 0, 0], [0.1, 0, 0], [0.1, 0, 0]])},
+            r"dPos takes the walk to \[1e\+300, 0.0, 0.0\] m at sample 3: not finite within",
+        ),
+        (
+            {"dPos": np.full((4, 3), np.nan)},
+            r"dPos takes the walk to \[nan, nan, nan\] m at sample 2",
+        ),
     ],
 )
 def test_bad_kok_walk_named(tmp_path: Path, overrides, message: str) -> None:
