@@ -261,9 +261,12 @@ def fit(
             f"curl-free factor (at most {CURL_FREE_EXACT_MAX:,}); use --method hilbert or a "
             "larger --bin"
         )
-    gps, kernels, method, t_hyper, t_fit = _fit_gps(
-        x, y, fixed, per_component, method, seed, model, default
-    )
+    try:  # a fit the data cannot give (too few or coincident readings) names the data
+        gps, kernels, method, t_hyper, t_fit = _fit_gps(
+            x, y, fixed, per_component, method, seed, model, default
+        )
+    except (ValueError, RuntimeError) as err:
+        raise ValueError(f"{', '.join(map(str, data))}: {err}") from None
     lml = [float(g.log_marginal_likelihood()) for g in gps if hasattr(g, "log_marginal_likelihood")]
     start = time.perf_counter()
     lower, upper = x.min(axis=0) - margin, x.max(axis=0) + margin

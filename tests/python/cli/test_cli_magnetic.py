@@ -271,6 +271,7 @@ def inputs(tmp_path_factory):
     write_csv(tmp_path / "p.csv", "x,y", p[:3])
     (tmp_path / "noy.csv").write_text("x,z\n1,2\n")
     (tmp_path / "nan.csv").write_text("x,y,mx,my,mz\n0,0,1,2,3\n1,nan,1,2,3\n")
+    (tmp_path / "two.csv").write_text("x,y,mx,my,mz\n0,0,1,2,3\n1,0,1,2,3\n")
     (tmp_path / "stuff").mkdir()
     (tmp_path / "stuff" / "keep.txt").write_text("mine")
     done = run(
@@ -294,6 +295,8 @@ def inputs(tmp_path_factory):
         (["fit", "d.csv", "-o", "stuff"], "not a magnetic field map folder"),
         (["fit", "m/training.npz", "-o", "m"], "holding the input"),
         (["fit", "nan.csv", "-o", "x"], "nan.csv"),
+        # a fit the data cannot give names the data (the GP's message named no file)
+        (["fit", "two.csv", "-o", "x", "--model", "independent"], "two.csv: Gaussian process: 2"),
         (["fit", "runs/9", "-o", "x"], "not an Aalto run"),
         (["fit", "d.csv", "-o", "nodir/x"], "does not exist"),
         (["predict", "m", "--at", "noy.csv", "-o", "o.csv"], "no y column"),
