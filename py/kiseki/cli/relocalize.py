@@ -17,9 +17,11 @@ from kiseki._support.options import BEAM_LIMIT, THREAD_LIMIT, Count
 from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki._support.table import show
 from kiseki.cli._defaults import default_of
+from kiseki.cli._off_map import warn_if_off_the_map
 from kiseki.datasets import open_scans
 from kiseki.filters import RelocalizeConfig, Relocalizer, render_hypotheses
 from kiseki.io.ros_map import load_map
+from kiseki.mapping import endpoint_agreement
 
 __all__ = ["app"]
 
@@ -76,6 +78,11 @@ def relocalize_command(
     found = Relocalizer(grid, scans.max_range, config).match(scans.angles, scans.ranges[scan])
     if not found:
         raise ValueError(f"scan {scan} of {log}: no beam returned, nothing to match")
+    best = np.array([[found[0].x, found[0].y, found[0].theta]])
+    share = endpoint_agreement(
+        grid, best, scans.ranges[scan : scan + 1], scans.angles, scans.max_range
+    )
+    warn_if_off_the_map(grid, best, None, map_file, share)  # another building's map, say
     truth = scans.poses[scan] if scans.has_reference_poses else None
     rows, data = [], []
     for rank, h in enumerate(found, start=1):

@@ -18,6 +18,7 @@ from _helpers.pixels import blobs, rgb
 from _helpers.room_log import STEPS, room, write_inputs
 from kiseki.datasets import open_scans
 from kiseki.filters import RelocalizeConfig, relocalize
+from kiseki.io.ros_map import save_map
 
 
 @pytest.fixture
@@ -77,3 +78,24 @@ def test_the_plot_shows_the_best_hypothesis_where_it_lies_on_the_map(inputs, mon
     x = 2.15 + 6.0 * (dot[0] - pillar[0]) / walls_size[0]
     y = -0.25 - 4.0 * (dot[1] - pillar[1]) / walls_size[1]
     assert math.hypot(x - best["x"], y - best["y"]) < 0.03  # 6 pixels
+
+
+def test_a_map_of_another_place_is_warned_of(inputs, monkeypatch, capsys):
+    """From the best hypothesis the log's own map holds nearly every endpoint on a wall: no
+    warning. A map with the room's walls moved away (a grid of pillars 3 m apart, another
+    building) holds few: one warning line naming it, as kiseki localize gives."""
+    code, _, err = kiseki(
+        monkeypatch, capsys, "relocalize", "room.yaml", "log.mcap", "--scan", "10"
+    )
+    assert code == 0 and "warning" not in err
+    grid = room()
+    other = np.zeros_like(np.asarray(grid.cells))  # free everywhere
+    other[::60, ::60] = 100  # a pillar every 60 cells
+    grid.cells[:] = other
+    save_map(grid, inputs / "other.yaml")
+    code, _, err = kiseki(
+        monkeypatch, capsys, "relocalize", "other.yaml", "log.mcap", "--scan", "10"
+    )
+    assert code == 0
+    warnings = [line for line in err.splitlines() if "warning" in line]
+    assert len(warnings) == 1 and "other.yaml at the estimated poses" in warnings[0]
