@@ -6,14 +6,13 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
-#include <limits>
-#include <mutex>
 #include <stdexcept>
-#include <tuple>
 
 #include "kiseki/core/angle.hpp"
 #include "kiseki/core/parallel.hpp"
 #include "kiseki/models/scan_beams.hpp"
+
+#include "correlative_search.hpp"
 
 namespace kiseki {
 
@@ -125,188 +124,12 @@ int heading_count(const ScanBeams& beams, double resolution, double angular_step
   return std::max(1, static_cast<int>(std::ceil(2.0 * kPi / step - 1e-9)));
 }
 
-struct Leaf {
-  double score;
-  std::int64_t index;  // (heading * height + y) * width + x
-  int x, y, k;
-  Pose2 pose;
-};
-
-bool before(const Leaf& a, const Leaf& b) { return a.score > b.score || (a.score == b.score && a.index < b.index); }
-
 }  // namespace
 
 int CorrelativeScanMatcher::headings(const double* angles, const float* ranges, std::size_t n) const {
   const ScanBeams beams = used_beams(angles, ranges, n, max_range_, params_.likelihood.max_beams);
   return heading_count(beams, frame_.resolution(), params_.angular_step);
 }
-
-/// One search: the rotated scans' cell offsets, the shared threshold and its witnesses (a set of
-/// pairwise far poses found), and per worker the leaves it found.
-struct CorrelativeScanMatcher::Search {
-  explicit Search(const CorrelativeScanMatcher& matcher) : m(matcher) {}
-  const CorrelativeScanMatcher& m;
-  int headings = 0, beams = 0;
-  std::vector<int> dx, dy;  // [heading * beams + b]: a beam end's cell offset from the laser's cell
-  std::vector<std::ptrdiff_t> off;  // the same as an offset on the padded layout: dy * pitch + dx
-  double margin = 0.0;
-  // A disc restriction: per heading, its centre as the laser's cell coordinates (cell i's centre
-  // at i; the robot's position is the laser's shifted by the heading's rotated sensor offset),
-  // and its radius in cells.
-  const SearchDisc* disc = nullptr;
-  std::vector<double> disc_x, disc_y;
-  double disc_radius = 0.0;
-  std::atomic<double> threshold{-std::numeric_limits<double>::infinity()};
-
-  struct Worker {
-    std::vector<Leaf> leaves;
-    std::size_t compacted = 0;
-  };
-  std::mutex far_mutex;
-  std::vector<Leaf> far;  // shared by the workers, so the threshold rises as fast as on one
-
-  /// Beam b's score term at a node: P_level at its end, outside_ off the stored layout. One
-  /// unsigned comparison per axis finds the ends off it; the read is of cell 0 then, not used.
-  struct Terms {
-    const float* grid;
-    const int *ox, *oy;
-    const std::ptrdiff_t* lin;
-    unsigned pitch, rows;
-    int gx, gy;
-    std::ptrdiff_t base;
-    float outside;
-    float operator()(int b) const {
-      const bool in = static_cast<unsigned>(gx + ox[b]) < pitch && static_cast<unsigned>(gy + oy[b]) < rows;
-      const float v = grid[in ? base + lin[b] : 0];
-      return in ? v : outside;
-    }
-  };
-
-  Terms terms(int level, int x, int y, int k) const {
-    const int pad = m.pitch_ - m.frame_.width();
-    const std::size_t at = static_cast<std::size_t>(k) * beams;
-    Terms t{m.pooled_[static_cast<std::size_t>(level)].data(), dx.data() + at, dy.data() + at, off.data() + at,
-            static_cast<unsigned>(m.pitch_), static_cast<unsigned>(m.rows_), x + pad, y + pad, 0, m.outside_};
-    t.base = static_cast<std::ptrdiff_t>(t.gy) * m.pitch_ + t.gx;
-    return t;
-  }
-
-  /// A lattice pose's score: the terms summed in beam order, as the likelihood field's
-  /// log_likelihoods sums them, so a hypothesis' score is the model's own.
-  double score(int x, int y, int k) const {
-    const Terms t = terms(0, x, y, k);
-    double sum = 0.0;
-    for (int b = 0; b < beams; ++b) sum += t(b);
-    return sum;
-  }
-
-  /// An upper bound of the scores of the lattice poses under a node (eqs. (13)-(15)); at level 0
-  /// the pose's score. Above it, the P_level terms in four running sums, whose rounding differs
-  /// from score()'s beam order; `margin` exceeds both sums' rounding errors together (n^2 u
-  /// max|term| each, u = 2^-53), so a pose whose score equals the threshold is never pruned and
-  /// the result stays the exhaustive search's.
-  double bound(int level, int x, int y, int k) const {
-    if (level == 0) return score(x, y, k);
-    const Terms t = terms(level, x, y, k);
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-    int b = 0;
-    for (; b + 4 <= beams; b += 4) s0 += t(b), s1 += t(b + 1), s2 += t(b + 2), s3 += t(b + 3);
-    for (; b < beams; ++b) s0 += t(b);
-    return (s0 + s1) + (s2 + s3) + margin;
-  }
-
-  /// Can a cell of the side x side block at (x, y) hold a pose on the disc's side? (Exact up to a
-  /// margin of 1e-6 cell that keeps a node; the leaves are tested exactly.)
-  bool on_side(int level, int x, int y, int k) const {
-    if (disc == nullptr) return true;
-    const int last = (1 << level) - 1;
-    const double px = disc_x[static_cast<std::size_t>(k)], py = disc_y[static_cast<std::size_t>(k)];
-    if (disc->inside) {
-      const double ex = std::max({x - px, 0.0, px - (x + last)}), ey = std::max({y - py, 0.0, py - (y + last)});
-      return std::hypot(ex, ey) <= disc_radius + 1e-6;
-    }
-    const double fx = std::max(std::abs(px - x), std::abs(px - (x + last)));
-    const double fy = std::max(std::abs(py - y), std::abs(py - (y + last)));
-    return std::hypot(fx, fy) > disc_radius - 1e-6;
-  }
-
-  bool kept(const Pose2& p) const {
-    if (disc == nullptr) return true;
-    const bool in = std::hypot(p.x - disc->x, p.y - disc->y) <= disc->radius;
-    return in == disc->inside;
-  }
-
-  bool close(const Pose2& a, const Pose2& b, double scale) const {
-    return std::hypot(a.x - b.x, a.y - b.y) < scale * m.params_.min_distance &&
-           std::abs(normalize_angle(a.theta - b.theta)) < scale * m.params_.min_angle;
-  }
-
-  void raise(double t) {
-    double cur = threshold.load();
-    while (t > cur && !threshold.compare_exchange_weak(cur, t)) {
-    }
-  }
-
-  void leaf(Worker& w, double score, int x, int y, int k) {
-    if (score < threshold.load()) return;
-    const int width = m.frame_.width(), height = m.frame_.height();
-    Leaf l{score, (static_cast<std::int64_t>(k) * height + y) * width + x, x, y, k, m.lattice_pose(x, y, k, headings)};
-    if (!kept(l.pose)) return;
-    w.leaves.push_back(l);
-    // Keep k found poses pairwise "far" (2 min_distance or 2 min_angle apart), trading a member
-    // for a better pose when that keeps them far; their lowest score bounds the k-th result.
-    const auto kk = static_cast<std::size_t>(m.params_.hypotheses);
-    std::lock_guard<std::mutex> lock(far_mutex);
-    std::size_t near = far.size(), count = 0;
-    for (std::size_t i = 0; i < far.size(); ++i) {
-      if (close(far[i].pose, l.pose, 2.0)) near = i, ++count;
-    }
-    if (count == 0 && far.size() < kk) {
-      far.push_back(l);
-    } else if (count == 0 || count == 1) {
-      if (count == 0) {
-        near = static_cast<std::size_t>(std::min_element(far.begin(), far.end(), [](const Leaf& a, const Leaf& b) {
-                                          return a.score < b.score;
-                                        }) - far.begin());
-      }
-      if (score > far[near].score) far[near] = l;
-    }
-    if (far.size() == kk) {
-      double lowest = far[0].score;
-      for (const auto& f : far) lowest = std::min(lowest, f.score);
-      raise(lowest);
-    }
-    if (w.leaves.size() >= 2 * w.compacted + 4096) {
-      const double t = threshold.load();
-      w.leaves.erase(std::remove_if(w.leaves.begin(), w.leaves.end(), [t](const Leaf& a) { return a.score < t; }),
-                     w.leaves.end());
-      w.compacted = w.leaves.size();
-    }
-  }
-
-  // Hess et al. Algorithm 3: depth first, children in order of their bounds.
-  void descend(Worker& w, int level, int x, int y, int k, double b) {
-    if (b < threshold.load()) return;
-    if (level == 0) return leaf(w, b, x, y, k);
-    const int half = 1 << (level - 1);
-    std::tuple<double, int, int> kids[4];
-    int n = 0;
-    for (int j = 0; j < 2; ++j) {
-      for (int i = 0; i < 2; ++i) {
-        const int cx = x + i * half, cy = y + j * half;
-        if (cx >= m.frame_.width() || cy >= m.frame_.height() || !m.has_free(level - 1, cx, cy) ||
-            !on_side(level - 1, cx, cy, k)) {
-          continue;
-        }
-        kids[n++] = {bound(level - 1, cx, cy, k), cx, cy};
-      }
-    }
-    for (int i = 1; i < n; ++i) {  // best bound first, equal bounds in their order (a stable sort)
-      for (int j = i; j > 0 && std::get<0>(kids[j]) > std::get<0>(kids[j - 1]); --j) std::swap(kids[j], kids[j - 1]);
-    }
-    for (int i = 0; i < n; ++i) descend(w, level - 1, std::get<1>(kids[i]), std::get<2>(kids[i]), k, std::get<0>(kids[i]));
-  }
-};
 
 std::vector<PoseHypothesis> CorrelativeScanMatcher::match(const double* angles, const float* ranges,
                                                           std::size_t n, const SearchDisc* disc) const {
