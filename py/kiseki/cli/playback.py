@@ -16,8 +16,9 @@ from kiseki._support.guard import Derived, guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import Seed
 from kiseki.apps.teach import PlaybackConfig, playback
-from kiseki.apps.teach.teaching import check_on_the_map, load_route
+from kiseki.apps.teach.teaching import load_route
 from kiseki.cli._defaults import default_of
+from kiseki.grid import OccupancyGrid
 from kiseki.io.ros_map import load_map
 from kiseki.sim.scene import load_scene
 from kiseki.speed import SpeedLimiter, SpeedLimiterConfig
@@ -157,3 +158,16 @@ def _speed_limiter(name: str, scene, grid, v_max: float):
         v_max=v_max, use_occlusion=True, use_width=name == "occlusion-width"
     )
     return SpeedLimiter(grid, config)
+
+
+def check_on_the_map(path: Path, map_path: Path, grid: OccupancyGrid, marks: list[dict]) -> None:
+    """Each waypoint of a route lies on the taught map's cells, ``grid`` read from ``map_path``
+    (a waypoint edited to 700 m sent the simulated robot out through the walls, and the run
+    ended without an error)."""
+    for mark in marks:
+        cell = grid.world_to_cell(np.array([[mark["x"], mark["y"]]]))[0]
+        if not (0 <= cell[0] < grid.width and 0 <= cell[1] < grid.height):
+            raise ValueError(
+                f"{path}: waypoint {mark['name']} at ({mark['x']:g}, {mark['y']:g}) m lies off "
+                f"the taught map {map_path}"
+            )

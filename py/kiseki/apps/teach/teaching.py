@@ -491,16 +491,3 @@ def load_route(
     if len(route) < 2 or len(set(route)) != len(route):
         raise ValueError("a route needs at least two different waypoints")
     return map_path, [by_name[n] for n in route]
-
-
-def check_on_the_map(path: Path, map_path: Path, grid: OccupancyGrid, marks: list[dict]) -> None:
-    """Each waypoint of a route lies on the taught map's cells, ``grid`` read from ``map_path``
-    (a waypoint edited to 700 m sent the simulated robot out through the walls, and the run
-    ended without an error)."""
-    for mark in marks:
-        cell = grid.world_to_cell(np.array([[mark["x"], mark["y"]]]))[0]
-        if not (0 <= cell[0] < grid.width and 0 <= cell[1] < grid.height):
-            raise ValueError(
-                f"{path}: waypoint {mark['name']} at ({mark['x']:g}, {mark['y']:g}) m lies off "
-                f"the taught map {map_path}"
-            )
