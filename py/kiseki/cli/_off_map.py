@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""``kiseki localize``'s check that the map is the log's: a warning when most scan endpoints,
-at the estimated poses, miss the map's walls."""
+"""The check that a map is the log's (``kiseki localize``, ``relocalize``, ``speed limits``): a
+warning when most scan endpoints, at the estimated or the log's reference poses, miss the map's
+walls."""
 
 from __future__ import annotations
 
@@ -16,11 +17,17 @@ OFF_MAP_SHARE = 0.5  # below this share of endpoints near a wall the map is not 
 
 
 def warn_if_off_the_map(
-    grid, trajectory: np.ndarray, scans, map_file: Path, share: float | None = None
+    grid,
+    trajectory: np.ndarray,
+    scans,
+    map_file: Path,
+    share: float | None = None,
+    poses: str = "estimated",
 ) -> None:
-    """One warning line when most scan endpoints, at the estimated poses, miss the map's walls
-    (a map of another building, a 1x1 map): the poses alone look fine in such a case.
-    ``share``: the share already measured (global localization's, from convergence on)."""
+    """One warning line when most scan endpoints, at the ``poses`` ("estimated" by a filter, or
+    the log's "reference" poses), miss the map's walls (a map of another building, a 1x1 map):
+    the poses alone look fine in such a case. ``share``: the share already measured (global
+    localization's, from convergence on)."""
     if share is None:
         finite = np.isfinite(trajectory).all(axis=1)
         # endpoint_agreement's endpoints: finite readings in (0, max_range), float32 as the core
@@ -33,9 +40,10 @@ def warn_if_off_the_map(
             grid, trajectory[finite], scans.ranges[finite], scans.angles, scans.max_range
         )
     if share < OFF_MAP_SHARE:
+        lost = ", or the localization is lost" if poses == "estimated" else ""
         typer.echo(
             f"kiseki: warning: only {100 * share:.1f} % of the scan endpoints fall on or next to "
-            f"an occupied cell of {map_file} at the estimated poses: the map is probably not "
-            "the log's building, or the localization is lost",
+            f"an occupied cell of {map_file} at the {poses} poses: the map is probably not "
+            f"the log's building{lost}",
             err=True,
         )

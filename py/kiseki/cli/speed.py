@@ -17,6 +17,7 @@ from kiseki._support.guard import Derived, guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import REACH_LIMIT, Degrees, Metres, Quantity, refuse_given
 from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki.cli._off_map import warn_if_off_the_map
 from kiseki.datasets import open_scans
 from kiseki.io.ros_map import load_map
 from kiseki.speed import SpeedLimiterConfig
@@ -100,6 +101,7 @@ def speed_limits(
     if not scans.has_reference_poses:
         raise ValueError(f"{log}: the log has no reference poses (give --reference-topic)")
     limits = limits_along_log(scans, grid, config, reach, heading)
+    warn_if_off_the_map(grid, scans.poses, scans, map_file, poses="reference")
     columns = limits.columns()
     rows = np.column_stack(list(columns.values()))
     text = ",".join(columns) + "\n" + "\n".join(",".join(f"{v:.6g}" for v in r) for r in rows)

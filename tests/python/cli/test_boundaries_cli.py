@@ -9,6 +9,7 @@ The experiments' settings and run configs are in test_boundaries_experiment_cli.
 from __future__ import annotations
 
 import gzip
+import itertools
 import json
 import subprocess
 import sys
@@ -153,20 +154,29 @@ def test_a_map_that_is_not_the_logs_building_warns(inputs):
     cells[10, :] = 100  # one wall only: not the room
     save_map(OccupancyGrid(cells, 0.05, Pose2(-1.0, -2.0, 0.0)), inputs / "other.yaml")
     before = digests(inputs)
+    commands = {"localize": ["localize"], "speed": ["speed", "limits"]}
     warnings = {}
-    for name in ("room", "one", "other"):
-        done = run("localize", "log.mcap", "--map", f"{name}.yaml", "-o", f"{name}.csv",
-                   cwd=inputs)  # fmt: skip
+    for command, name in itertools.product(commands, ("room", "one", "other")):
+        done = run(*commands[command], "log.mcap", "--map", f"{name}.yaml", "-o",
+                   f"{command}-{name}.csv", cwd=inputs)  # fmt: skip
         assert done.returncode == 0, done.stderr
-        warnings[name] = [x for x in done.stderr.splitlines() if x.startswith("kiseki: warning")]
-    assert warnings["room"] == []
-    for name in ("one", "other"):
-        assert len(warnings[name]) == 1, warnings
-        assert (
-            f"of the scan endpoints fall on or next to an occupied cell of {name}.yaml"
-            in (warnings[name][0])
-        )
-    assert "only 0.0 %" in warnings["one"][0]  # the 1x1 map: every endpoint off the map
+        warnings[command, name] = [
+            x for x in done.stderr.splitlines() if x.startswith("kiseki: warning")
+        ]
+    # the speed limits read the log's reference poses, which cannot be lost: no "lost" there
+    poses = {"localize": "estimated poses", "speed": "reference poses"}
+    for command in commands:
+        assert warnings[command, "room"] == []
+        for name in ("one", "other"):
+            assert len(warnings[command, name]) == 1, warnings
+            line = warnings[command, name][0]
+            assert (
+                f"of the scan endpoints fall on or next to an occupied cell of {name}.yaml "
+                f"at the {poses[command]}: the map is probably not the log's building"
+            ) in line
+            assert ("localization is lost" in line) == (command == "localize")
+        # the 1x1 map: every endpoint off the map
+        assert "only 0.0 %" in warnings[command, "one"][0]
     after = digests(inputs)
     assert {k: after[k] for k in before} == before
 
