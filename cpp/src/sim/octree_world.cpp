@@ -4,14 +4,78 @@
 
 #include <octomap/OcTree.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace kiseki {
+
+namespace {
+
+/// Runs `read` with the process' standard error sent to a temporary file and returns what was
+/// written there: OctoMap reports a damaged file on stderr (fprintf and std::cerr), not to its
+/// caller, so a user saw its lines above kiseki's own one-line error (and one more line on
+/// every read).
+template <class Read>
+std::string with_stderr_captured(Read&& read) {
+  std::fflush(stderr);
+  std::cerr.flush();
+  std::FILE* sink = std::tmpfile();
+  const int saved = sink == nullptr ? -1 : ::dup(STDERR_FILENO);
+  if (saved < 0 || ::dup2(::fileno(sink), STDERR_FILENO) < 0) {  // cannot redirect: read as is
+    if (saved >= 0) ::close(saved);
+    if (sink != nullptr) std::fclose(sink);
+    read();
+    return {};
+  }
+  const auto restore = [&] {
+    std::fflush(stderr);
+    std::cerr.flush();
+    ::dup2(saved, STDERR_FILENO);
+    ::close(saved);
+  };
+  try {
+    read();
+  } catch (...) {
+    restore();
+    std::fclose(sink);
+    throw;
+  }
+  restore();
+  std::string text;
+  std::rewind(sink);
+  char chunk[512];
+  for (std::size_t n = 0; text.size() < 4096 && (n = std::fread(chunk, 1, sizeof chunk, sink)) > 0;) {
+    text.append(chunk, n);
+  }
+  std::fclose(sink);
+  return text;
+}
+
+/// OctoMap's lines that report a problem ("ERROR: ..." or "WARNING: ..."); its other line,
+/// "Reading binary octree type OcTree", is printed on every read.
+std::vector<std::string> problems(const std::string& text) {
+  std::vector<std::string> found;
+  std::size_t at = 0;
+  while (at < text.size()) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::string line = text.substr(at, end - at);
+    if (line.rfind("ERROR: ", 0) == 0 || line.rfind("WARNING: ", 0) == 0) found.push_back(line);
+    at = end + 1;
+  }
+  return found;
+}
+
+}  // namespace
 
 OctreeWorld::OctreeWorld(std::unique_ptr<octomap::OcTree> tree) : tree_(std::move(tree)) {}
 OctreeWorld::OctreeWorld(OctreeWorld&&) noexcept = default;
@@ -28,9 +92,18 @@ OctreeWorld OctreeWorld::read_binary(const std::string& path) {
   }
   in.seekg(0);
   auto tree = std::make_unique<octomap::OcTree>(0.1);
-  if (!tree->readBinary(in) || tree->size() == 0) {
-    throw std::runtime_error(path + ": corrupt or truncated OctoMap binary file");
+  bool read = false;
+  const std::string said = with_stderr_captured([&] { read = tree->readBinary(in); });
+  const std::vector<std::string> reported = problems(said);
+  if (!read || tree->size() == 0) {
+    std::string why;
+    for (const std::string& line : reported) {
+      if (why.empty() && line.rfind("ERROR: ", 0) == 0) why = " (OctoMap: " + line.substr(7) + ")";
+    }
+    throw std::runtime_error(path + ": corrupt or truncated OctoMap binary file" + why);
   }
+  for (const std::string& line : reported) std::cerr << line << '\n';  // read, with warnings
+  std::cerr.flush();
   return OctreeWorld(std::move(tree));
 }
 

@@ -150,6 +150,20 @@ def test_an_octree_header_with_absurd_voxels_is_refused_in_one_line(tmp_path):
     assert not any((tmp_path / "out").glob("*"))  # nothing written (the folder is made first)
 
 
+@pytest.mark.skipif(not GEB079.exists(), reason="the recorded Freiburg 079 octree is absent")
+def test_a_truncated_octree_is_one_line_with_octomaps_reason(tmp_path):
+    """OctoMap reports a damaged tree on stderr, not to its caller: its line came above
+    kiseki's one-line error. Now its reason is part of that line, and nothing else is printed."""
+    cut = tmp_path / "cut.bt"
+    cut.write_bytes(GEB079.read_bytes()[:100_000])
+    done = run(cut, "--moves", 1, "-o", tmp_path / "out")
+    assert done.returncode == 1, done.stderr
+    assert done.stderr.splitlines() == [
+        f"kiseki: error: {cut}: corrupt or truncated OctoMap binary file (OctoMap: Tree size "
+        "mismatch: # read nodes (248160) != # expected nodes (532566))"
+    ]
+
+
 @pytest.mark.parametrize(
     ("args", "message"),
     [
