@@ -7,6 +7,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import numpy as np
 import typer
 from rich.console import Console
 
@@ -82,6 +83,12 @@ def map_from_log(
         if reference_topic is None and is_ros_bag(log):
             hint = " (a bag's reference poses come from --reference-topic, e.g. /ground_truth)"
         raise ValueError(f"{log}: the log has no reference poses to build a map from{hint}")
+    ranges = np.asarray(scans.ranges)
+    if not ((ranges > 0.0) & (ranges < scans.max_range)).any():  # NaN (invalid) compares False
+        raise ValueError(
+            f"{log}: no range reading below the max range of {scans.max_range:g} m (a reading "
+            "at or beyond it is no return): nothing to map"
+        )
     if rules in ("teaching", "evidence"):
         grid = build_teaching_map(
             scans.poses,

@@ -143,3 +143,24 @@ def test_map_from_log_refuses_a_resolution_giving_a_one_cell_map(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["tiny.log"]  # no map written
     done = subprocess.run(args, cwd=tmp_path, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr  # the same log at the default resolution maps
+
+
+def test_map_from_log_without_a_return_names_the_log_and_writes_nothing(tmp_path):
+    """A log whose every reading is at or beyond its max range (here a PARAM of 1 mm) has no
+    endpoint to map: the map was written, then an error named no file ("no scan endpoint below
+    max_range: agreement is undefined")."""
+    rows = [
+        f"FLASER 180 {' '.join(['1.5', '3.0'] * 90)} {0.1 * k} 0 0 {0.1 * k} 0 0 {k} host {k}"
+        for k in range(5)
+    ]
+    (tmp_path / "short.log").write_text(
+        "PARAM robot_front_laser_max 0.001 nohost 0\n" + "\n".join(rows) + "\n"
+    )
+    args = [sys.executable, "-m", "kiseki.cli", "map", "from-log", "short.log", "-o", "m.yaml"]
+    done = subprocess.run(args, cwd=tmp_path, capture_output=True, text=True)
+    assert done.returncode == 1
+    assert done.stderr.strip().splitlines() == [
+        "kiseki: error: short.log: no range reading below the max range of 0.001 m (a reading at "
+        "or beyond it is no return): nothing to map"
+    ]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["short.log"]  # no map written
