@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import shutil
 import subprocess
 import sys
@@ -210,6 +211,61 @@ def test_octree_export_and_the_real_building(shared_data, tmp_path):
     camera = DepthCamera(DepthCameraParams(), Mount(0.0, 0.0, 1.0), seed=0)
     depth = camera.render(building.world, (xy[0], xy[1], 0.0), noise=False)
     assert np.mean(depth > 0) > 0.3  # the camera sees the real building's walls
+
+
+def occupied_leaves_by_octomap(bt: Path) -> tuple[np.ndarray, np.ndarray]:
+    """The centres and sizes of a .bt file's occupied leaves as OctoMap's own bt2vrml lists
+    them (one VRML box each)."""
+    done = subprocess.run(["bt2vrml", str(bt)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    text = bt.with_name(bt.name + ".wrl").read_text()
+    found = re.findall(r"translation (\S+) (\S+) (\S+)\s+children \[ Shape \{ geometry Box "
+                       r"\{ size (\S+) ", text)  # fmt: skip
+    table = np.array(found, dtype=float)
+    return table[:, :3], table[:, 3]
+
+
+def band_against_leaves(grid, centres, sizes, z_min: float, z_max: float) -> tuple[int, int]:
+    """How a band's grid disagrees with a list of occupied leaves: the leaves inside the band
+    whose cell is not occupied, and the occupied cells under no leaf that meets the band."""
+    occupied = grid.cells == 100
+    lo, res = np.array([grid.origin.x, grid.origin.y]), grid.resolution
+
+    def cell(xy: np.ndarray) -> np.ndarray:
+        return np.floor((xy - lo) / res).astype(int)
+
+    half = sizes / 2
+    within = (centres[:, 2] - half >= z_min) & (centres[:, 2] + half <= z_max)
+    under = cell(centres[within, :2])
+    under = under[(under >= 0).all(axis=1) & (under < [grid.width, grid.height]).all(axis=1)]
+    assert len(under) > 10_000
+    meets = (centres[:, 2] + half > z_min) & (centres[:, 2] - half < z_max)
+    allowed = np.zeros_like(occupied)
+    for c, h in zip(centres[meets, :2], half[meets], strict=True):
+        (x0, y0), (x1, y1) = cell(c - h + 1e-6), cell(c + h - 1e-6)
+        allowed[max(y0, 0) : y1 + 1, max(x0, 0) : x1 + 1] = True
+    return int((~occupied[under[:, 1], under[:, 0]]).sum()), int((occupied & ~allowed).sum())
+
+
+@pytest.mark.skipif(shutil.which("bt2vrml") is None, reason="octomap-tools is not installed")
+def test_the_real_buildings_band_is_where_octomap_lists_its_voxels(shared_data, tmp_path):
+    """The 0.3-1.5 m band of the Freiburg 079 floor on a 0.3 m grid, against the occupied leaves
+    OctoMap's bt2vrml lists: the cell under every leaf inside the band is occupied, and every
+    occupied cell lies under a leaf that meets the band. Control: the 2.0-2.6 m band's grid
+    (above the doors) checked against the 0.3-1.5 m leaves fails both ways."""
+    bt = tmp_path / "geb079.bt"
+    bt.write_bytes((shared_data / "octomap" / "geb079.bt").read_bytes())
+    geb = tmp_path / "geb.yaml"
+    geb.write_text(yaml.safe_dump({"name": "geb079", "octomap": str(bt)}))
+    building = load_scene(geb)
+    centres, sizes = occupied_leaves_by_octomap(bt)
+    assert len(centres) == building.world.occupied_leaves > 100_000
+    band = building.ground_truth(0.3, 1.5, 0.3)
+    assert (band.cells == 100).sum() > 1000
+    assert band_against_leaves(band, centres, sizes, 0.3, 1.5) == (0, 0)
+    above = building.ground_truth(2.0, 2.6, 0.3)
+    missed, extra = band_against_leaves(above, centres, sizes, 0.3, 1.5)
+    assert missed > 100 and extra > 100, (missed, extra)
 
 
 @pytest.mark.parametrize(
