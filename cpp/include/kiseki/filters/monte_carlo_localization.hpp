@@ -109,8 +109,9 @@ struct MclParams {
   /// is right, and two independent scans rarely both favour the same wrong place.
   bool sensor_reset_confirm = true;
   double reliability_rate = 0.1;       ///< smoothing of the reliability estimate per update
-  /// 0 = every core, or one when one is measured faster (ThreadChooser: the results are the
-  /// same for any thread count, so the choice changes only the time); n > 0: n threads.
+  /// 0 = every core, or one when one is measured faster over whole steps, motion and weighing
+  /// (ThreadChooser: the results are the same for any thread count, so the choice changes only
+  /// the time); n > 0: n threads.
   int threads = 0;
   void validate() const;
 };
@@ -209,6 +210,9 @@ class MonteCarloLocalization {
   /// readings from the cloud, then the cloud is weighed (the scan for the matcher proposal, or
   /// nullptr) and recovers; the time taken goes to the thread chooser.
   UpdateReport weigh(SensorModel* selects, const SensorModel& model, const ScanView* scan);
+  /// Gives the thread chooser the step's time per particle: the motion updates since the last
+  /// update and this update's `update_seconds`, for the `weighed` particles.
+  void record_step(double update_seconds, std::size_t weighed);
   UpdateReport update_impl(const std::vector<double>& log_l, std::size_t readings, double agreement,
                            const SensorModel* model, const ScanView* scan);
   std::vector<double> evaluate(const SensorModel& model, const std::vector<Pose2>& poses) const;
@@ -259,6 +263,7 @@ class MonteCarloLocalization {
   Pose2 posterior_;
   const CorrelativeScanMatcher* matcher_ = nullptr;
   ThreadChooser chooser_;
+  double predicted_seconds_ = 0.0;  // predict()'s time since the last update (the chooser's)
 };
 
 }  // namespace kiseki
