@@ -28,6 +28,8 @@ def warn_if_off_the_map(
     the log's "reference" poses), miss the map's walls (a map of another building, a 1x1 map):
     the poses alone look fine in such a case. ``share``: the share already measured (global
     localization's, from convergence on)."""
+    if poses not in ("estimated", "reference"):
+        raise ValueError(f"poses must be 'estimated' or 'reference', got {poses!r}")
     if share is None:
         finite = np.isfinite(trajectory).all(axis=1)
         # endpoint_agreement's endpoints: finite readings in (0, max_range), float32 as the core

@@ -201,6 +201,8 @@ def test_the_off_map_check_skips_only_what_it_cannot_measure(capsys):
     assert "only 0.0 % of the scan endpoints" in capsys.readouterr().err
     with pytest.raises(ValueError, match="ranges"):
         warn_if_off_the_map(grid, poses, scans(np.ones((2, ANGLES.size - 1))), Path("room.yaml"))
+    with pytest.raises(ValueError, match="poses must be 'estimated' or 'reference', got 'true'"):
+        warn_if_off_the_map(grid, poses, seen, Path("room.yaml"), poses="true")
 
 
 def test_global_localization_on_another_map_warns_and_prints_no_nan(inputs):
