@@ -212,11 +212,11 @@ std::vector<PoseHypothesis> CorrelativeScanMatcher::match(const double* angles, 
     }
   }, 1);
   // The greedy selection over the leaves kept, which hold every pose it can take.
-  std::vector<Leaf> all;
+  std::vector<Search::Leaf> all;
   for (auto& wk : workers) all.insert(all.end(), wk.leaves.begin(), wk.leaves.end());
-  std::sort(all.begin(), all.end(), before);
+  std::sort(all.begin(), all.end(), Search::before);
   std::vector<PoseHypothesis> out;
-  for (const Leaf& l : all) {
+  for (const Search::Leaf& l : all) {
     if (out.size() == static_cast<std::size_t>(params_.hypotheses)) break;
     const bool taken = std::any_of(out.begin(), out.end(), [&](const PoseHypothesis& o) { return s.close(o.pose, l.pose, 1.0); });
     if (!taken) out.push_back({l.pose, l.score, l.x, l.y, l.k});

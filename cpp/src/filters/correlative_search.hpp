@@ -15,22 +15,21 @@
 
 namespace kiseki {
 
-/// A lattice pose found by the search.
-struct Leaf {
-  double score;
-  std::int64_t index;  // (heading * height + y) * width + x
-  int x, y, k;
-  Pose2 pose;
-};
-
-/// The selection's order: best score first, equal scores in lattice order.
-inline bool before(const Leaf& a, const Leaf& b) {
-  return a.score > b.score || (a.score == b.score && a.index < b.index);
-}
-
 /// One search: the rotated scans' cell offsets, the shared threshold and its witnesses (a set of
 /// pairwise far poses found), and per worker the leaves it found.
 struct CorrelativeScanMatcher::Search {
+  /// A lattice pose found by the search.
+  struct Leaf {
+    double score;
+    std::int64_t index;  // (heading * height + y) * width + x
+    int x, y, k;
+    Pose2 pose;
+  };
+  /// The selection's order: best score first, equal scores in lattice order.
+  static bool before(const Leaf& a, const Leaf& b) {
+    return a.score > b.score || (a.score == b.score && a.index < b.index);
+  }
+
   explicit Search(const CorrelativeScanMatcher& matcher) : m(matcher) {}
   const CorrelativeScanMatcher& m;
   int headings = 0, beams = 0;
