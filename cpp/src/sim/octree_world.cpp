@@ -4,6 +4,7 @@
 
 #include <octomap/OcTree.h>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -24,13 +26,18 @@ namespace {
 /// Runs `read` with the process' standard error sent to a temporary file and returns what was
 /// written there: OctoMap reports a damaged file on stderr (fprintf and std::cerr), not to its
 /// caller, so a user saw its lines above kiseki's own one-line error (and one more line on
-/// every read).
+/// every read). The redirection is the process': one read at a time holds it (a second one
+/// would restore stderr to the first's file), and what another thread writes to stderr during a
+/// read (milliseconds) lands in the file too.
 template <class Read>
 std::string with_stderr_captured(Read&& read) {
+  static std::mutex one_at_a_time;
+  const std::lock_guard<std::mutex> lock(one_at_a_time);
   std::fflush(stderr);
   std::cerr.flush();
   std::FILE* sink = std::tmpfile();
-  const int saved = sink == nullptr ? -1 : ::dup(STDERR_FILENO);
+  // the saved stderr is not inherited by a program the read might start (close on exec)
+  const int saved = sink == nullptr ? -1 : ::fcntl(STDERR_FILENO, F_DUPFD_CLOEXEC, 0);
   if (saved < 0 || ::dup2(::fileno(sink), STDERR_FILENO) < 0) {  // cannot redirect: read as is
     if (saved >= 0) ::close(saved);
     if (sink != nullptr) std::fclose(sink);
