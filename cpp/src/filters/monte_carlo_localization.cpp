@@ -126,6 +126,7 @@ void MonteCarloLocalization::set_particles(const std::vector<Pose2>& poses, cons
   }
   particles_ = poses;
   challenger_.clear();  // a new cloud: a sensor reset held for the old one is void
+  predicted_seconds_ = 0.0;  // and a motion update of the old one is not its step's
   matcher_found_.clear();
   if (weights.empty()) {
     weights_.assign(particles_.size(), 1.0 / static_cast<double>(particles_.size()));
@@ -172,7 +173,10 @@ void MonteCarloLocalization::predict(const Pose2& a, const Pose2& b) {
     sample_motion(params_.motion, a, b, challenger_.data(), challenger_.size(), rng_.below(~std::uint64_t{0}),
                   threads_now());
   }
-  predicted_seconds_ += seconds_since(start);
+  // the cloud's share of the time (a held sensor reset's particles moved too), as the chooser
+  // counts the time per particle weighed
+  const auto moved = static_cast<double>(particles_.size() + challenger_.size());
+  predicted_seconds_ += seconds_since(start) * static_cast<double>(particles_.size()) / moved;
   const Pose2 step_taken = a.between(b);  // places, not particles: moved without noise
   for (PoseHypothesis& h : matcher_found_) h.pose = h.pose.compose(step_taken);
 }
