@@ -7,7 +7,6 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-import numpy as np
 import typer
 from rich.console import Console
 
@@ -16,6 +15,7 @@ from kiseki._support.interrupt import interruptible
 from kiseki._support.options import CELL_LIMITS, REACH_LIMIT, Metres, refuse_given
 from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki.cli._defaults import default_of
+from kiseki.cli._off_map import has_endpoints
 from kiseki.cli.map import MAP_IMAGE
 from kiseki.datasets import open_scans
 from kiseki.datasets.rosbag import is_ros_bag
@@ -83,8 +83,7 @@ def map_from_log(
         if reference_topic is None and is_ros_bag(log):
             hint = " (a bag's reference poses come from --reference-topic, e.g. /ground_truth)"
         raise ValueError(f"{log}: the log has no reference poses to build a map from{hint}")
-    ranges = np.asarray(scans.ranges)
-    if not ((ranges > 0.0) & (ranges < scans.max_range)).any():  # NaN (invalid) compares False
+    if not has_endpoints(scans.poses, scans.ranges, scans.max_range):
         raise ValueError(
             f"{log}: no range reading below the max range of {scans.max_range:g} m (a reading "
             "at or beyond it is no return): nothing to map"

@@ -205,6 +205,17 @@ def test_the_off_map_check_skips_only_what_it_cannot_measure(capsys):
         warn_if_off_the_map(grid, poses, seen, Path("room.yaml"), poses="true")
 
 
+def test_an_endpoint_is_what_the_core_counts():
+    """A reading stored as float32 and compared in double, as the core does: float32(0.7) is
+    below a max range of 0.7 (in float32 they are equal); a scan at a NaN pose has none."""
+    from kiseki.cli._off_map import has_endpoints
+
+    at, nowhere = np.zeros((1, 3)), np.full((1, 3), np.nan)
+    assert has_endpoints(at, np.array([[0.7, np.nan]], np.float32), 0.7)
+    assert not has_endpoints(at, np.array([[0.7000001, 0.0, -1.0]], np.float32), 0.7)
+    assert not has_endpoints(nowhere, np.array([[0.5]], np.float32), 0.7)
+
+
 def test_global_localization_on_another_map_warns_and_prints_no_nan(inputs):
     cells = np.zeros((80, 120), np.int8)
     cells[10, :] = 100
