@@ -18,10 +18,9 @@ import os
 # Its default lets idle workers spin between parallel regions; on a robot whose cores other
 # processes keep busy, the spinning takes the time slices the work needs, and two threads ran
 # slower than one (benchmarks/bench_threads_under_load.py). Passive workers sleep instead. A
-# policy the user set is kept: OMP_WAIT_POLICY, or GOMP_SPINCOUNT (how long workers spin), which
-# a passive policy would override.
-if "GOMP_SPINCOUNT" not in os.environ:
-    os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+# policy the user set is kept (libgomp refuses an empty one); a GOMP_SPINCOUNT the user sets
+# applies under any policy (libgomp's env.c).
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 # numpy first: its own OpenBLAS picks its kernels itself, before the variable below is set.
 import numpy  # noqa: E402, F401
