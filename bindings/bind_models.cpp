@@ -211,16 +211,17 @@ void bind_models(py::module_& m) {
   py::class_<RaySpaceObservationModel, SensorModel>(m, "RaySpaceObservationModel")
       .def(py::init([](const OccupancyGrid& map, double sigma, double z_hit, double z_rand,
                        double z_intrusion, double lambda_short, double max_distance,
-                       int max_beams, const Pose2& sensor, double tolerance) {
+                       int max_beams, const Pose2& sensor, double tolerance, bool skips_intrusion) {
              RaySpaceObservationParams p;
              p.sigma_hit = sigma, p.z_hit = z_hit, p.z_rand = z_rand, p.z_intrusion = z_intrusion;
              p.lambda_short = lambda_short, p.max_distance = max_distance;
              p.max_beams = max_beams, p.sensor = sensor, p.agreement_tolerance = tolerance;
+             p.agreement_skips_intrusion = skips_intrusion;
              return std::make_unique<RaySpaceObservationModel>(map, p);
            }),
            "map"_a, "sigma_hit"_a = 0.2, "z_hit"_a = 0.95, "z_rand"_a = 0.05,
            "z_intrusion"_a = 0.95, "lambda_short"_a = 0.1, "max_distance"_a = 2.0, "max_beams"_a = 0,
-           "sensor"_a = Pose2(), "agreement_tolerance"_a = 0.2)
+           "sensor"_a = Pose2(), "agreement_tolerance"_a = 0.2, "agreement_skips_intrusion"_a = false)
       .def("set_scan",
            [](RaySpaceObservationModel& model, const py::handle& a_in, const py::handle& r_in,
               double max_range) {

@@ -315,3 +315,32 @@ TEST(RaySpaceObservation, OneBeamIsTheMixtureByHand) {
   EXPECT_EQ(out, 0.0);
   EXPECT_EQ(model.readings(), 0u);
 }
+
+// The same wall; three beams along +x: one ends on the wall's face (agrees), one stops 2 m
+// short in the open (an intrusion), one passes through the wall (disagrees). The plain
+// agreement counts the intrusion against the pose (1 of 3); the intrusion-tolerant one leaves
+// it out (1 of 2), and has nothing to go by when every beam is an intrusion.
+TEST(RaySpaceObservation, IntrusionTolerantAgreementLeavesOutBeamsEndingInTheOpen) {
+  OccupancyGrid g(100, 40, 0.1, Pose2(), kFree);
+  for (int y = 0; y < 40; ++y) g.set(50, y, kOccupied);
+  RaySpaceObservationParams tolerant;
+  tolerant.agreement_skips_intrusion = true;
+  RaySpaceObservationModel plain_model(g), tolerant_model(g, tolerant);
+  const double angles[3] = {0.0, 0.0, 0.0}, max_range = 10.0;
+  const float ranges[3] = {3.95f, 2.0f, 4.5f};
+  const Pose2 robot(1.05, 2.05, 0.0);
+  plain_model.set_scan(angles, ranges, 3, max_range);
+  tolerant_model.set_scan(angles, ranges, 3, max_range);
+  EXPECT_DOUBLE_EQ(plain_model.agreement(robot), 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(tolerant_model.agreement(robot), 1.0 / 2.0);
+  // The likelihood is the same model's: the switch changes the agreement only.
+  double a = 0.0, b = 1.0;
+  plain_model.log_likelihoods(&robot, 1, &a);
+  tolerant_model.log_likelihoods(&robot, 1, &b);
+  EXPECT_EQ(a, b);
+  const float open[2] = {1.0f, 2.0f};
+  plain_model.set_scan(angles, open, 2, max_range);
+  tolerant_model.set_scan(angles, open, 2, max_range);
+  EXPECT_EQ(plain_model.agreement(robot), 0.0);
+  EXPECT_TRUE(std::isnan(tolerant_model.agreement(robot)));
+}

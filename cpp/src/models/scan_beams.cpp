@@ -39,7 +39,8 @@ void ScanBeams::set(const double* angles, const float* ranges, std::size_t n, do
   }
 }
 
-double ScanBeams::agreement(const RangeCaster& occupied, const Pose2& sensor, double tolerance) const {
+double ScanBeams::agreement(const RangeCaster& occupied, const Pose2& sensor, double tolerance,
+                            bool skip_intrusion) const {
   // A sensor outside the map, in a wall or in unknown space agrees with nothing: rays from
   // there cross no known wall, and would otherwise all "agree".
   const OccupancyGrid& g = occupied.grid();
@@ -53,11 +54,15 @@ double ScanBeams::agreement(const RangeCaster& occupied, const Pose2& sensor, do
     // moves a 30 m beam's end by half a metre.
     const double tol = tolerance + kHeadingTolerance * range[b];
     const double want = range[b] - tol;
-    ++used;
     const bool through = want > 0.0 && occupied.range(sensor.x, sensor.y, heading, want) < want;
-    if (through) continue;
+    if (through) {
+      ++used;
+      continue;
+    }
     const double ex = sensor.x + range[b] * std::cos(heading), ey = sensor.y + range[b] * std::sin(heading);
-    if (occupied.clearance(ex, ey) <= tol + g.resolution()) ++reached;
+    const bool at_wall = occupied.clearance(ex, ey) <= tol + g.resolution();
+    if (at_wall || !skip_intrusion) ++used;
+    if (at_wall) ++reached;
   }
   return used == 0 ? std::numeric_limits<double>::quiet_NaN() : static_cast<double>(reached) / used;
 }

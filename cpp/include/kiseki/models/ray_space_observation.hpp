@@ -60,6 +60,9 @@ struct RaySpaceObservationParams {
   int max_beams = 0;          ///< nav2's max_beams; 0 = every beam
   Pose2 sensor;               ///< the laser in the robot frame
   double agreement_tolerance = 0.2;
+  /// The agreement (ScanBeams::agreement) leaves out the beams the intrusion term explains:
+  /// a beam ending in the open is then no sign of being lost, as it costs this model little.
+  bool agreement_skips_intrusion = false;
   void validate() const;
 };
 

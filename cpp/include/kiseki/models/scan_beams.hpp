@@ -35,7 +35,12 @@ struct ScanBeams {
   /// catches a pose in a wider space than the real one, whose beams end in the open and
   /// penetrate nothing. 0 when the sensor is not on a free cell (0..19) of the map; NaN when
   /// no beam returned.
-  double agreement(const RangeCaster& occupied, const Pose2& sensor, double tolerance) const;
+  ///
+  /// With `skip_intrusion`, a beam that penetrates nothing and ends in the open (an intrusion:
+  /// what an object the map does not hold reads) neither agrees nor disagrees: the share is
+  /// taken over the beams that end at a wall or pass through one, NaN when there are none.
+  double agreement(const RangeCaster& occupied, const Pose2& sensor, double tolerance,
+                   bool skip_intrusion = false) const;
 };
 
 }  // namespace kiseki
