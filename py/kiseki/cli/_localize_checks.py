@@ -11,7 +11,13 @@ import typer
 from kiseki._support.options import refuse_given
 from kiseki.filters import LocalizeConfig
 
-RESET_OPTIONS = ["reset_proposal", "search_every", "reset_look_elsewhere", "reset_unchecked"]
+RESET_OPTIONS = [
+    "reset_proposal",
+    "search_every",
+    "reset_look_elsewhere",
+    "reset_unchecked",
+    "intrusion_tolerant",
+]
 
 
 def refuse_unused_by_localize(
@@ -31,6 +37,10 @@ def refuse_unused_by_localize(
         refuse_given(ctx, ["beam_skip"], f"to --method {method} (a likelihood-field option)")
     if method != "beam":
         refuse_given(ctx, ["caster"], f"to --method {method} (a beam-model option)")
+    if method != "ray-space-observation":
+        refuse_given(
+            ctx, ["intrusion_tolerant"], f"to --method {method} (a ray-space-observation option)"
+        )
     if global_start:
         refuse_given(ctx, ["odometry_noise"], "with --global (it is for logs with reference poses)")
         refuse_given(

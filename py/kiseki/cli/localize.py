@@ -145,6 +145,13 @@ def localize_command(
         "they propose, and a sensor reset is made at once, without the next scan's "
         "confirmation (kiseki's resets before both checks); not with --global.",
     ),
+    intrusion_tolerant: bool = typer.Option(
+        False,
+        "--intrusion-tolerant-resets",
+        help="With --method ray-space-observation: the cloud counts as lost only where beams "
+        "pass through walls, not where they end short in the open (unmapped people, carts), "
+        "and the likelihood-drop trigger is off; not with --global.",
+    ),
     threads: int | None = typer.Option(
         None,
         parser=Count("--threads", 0, THREAD_LIMIT, "0 = chosen by measured time"),
@@ -271,6 +278,7 @@ def localize_command(
     else:
         resets = dict(sensor_reset_proposal=reset_proposal, matcher_search_every=search_every)
         resets.update(reset_look_elsewhere=reset_look_elsewhere or None)  # None: the default
+        resets.update(intrusion_tolerant_resets=intrusion_tolerant or None)
         if reset_unchecked:
             resets.update(reset_needs_agreement=False, sensor_reset_confirm=False)
         budget = dict(budget_ms=budget_ms, beam_skip=beam_skip or None, caster=caster)

@@ -43,6 +43,13 @@ class LocalizeConfig:
       likelihood field's terms, the thesis' penetration per ray, and ``z_intrusion`` 0.95 (=
       z_hit: equal prior odds that a beam's end is a mapped wall or an unmapped object) times
       the beam model's ``lambda_short`` density for a beam stopped short in free space.
+    * ``intrusion_tolerant_resets`` (ray-space-observation; off): with recovery resetting the
+      cloud counts as lost only by penetration, as the thesis' model judges a scan: the
+      agreement leaves out the beams that end in the open without passing a wall (what an
+      unmapped object reads, which the intrusion term explains), and the likelihood-drop
+      trigger is off (the likelihood falls wherever such objects stand in the view). Without
+      it, unknown objects that hide most of the view make the true cloud look lost, and a
+      reset moves it to a place whose walls happen to meet the short beams.
     * ``combination`` product (beams independent) or nav2 (1 + sum pz^3).
     * ``sensor_reset_proposal`` matcher (with recovery resetting): a sensor reset draws its
       candidates around the branch-and-bound scan matcher's five best poses for the scan
@@ -80,6 +87,9 @@ class LocalizeConfig:
     z_max: float = 0.05
     lambda_short: float = 0.1
     z_intrusion: float = 0.95
+    # ray-space-observation with recovery resetting: only penetration counts as lost (the
+    # class docstring)
+    intrusion_tolerant_resets: bool = False
     combination: str = "product"
     caster: str = DEFAULT_RAY_CASTER
     kld: bool = MclConfig.kld
@@ -151,6 +161,16 @@ class LocalizeConfig:
                 f"alphas must be 4 (or 5) finite numbers >= 0, got {self.alphas}",
             )
         _check(
+            isinstance(self.intrusion_tolerant_resets, bool),
+            "intrusion_tolerant_resets must be true or false, "
+            f"got {self.intrusion_tolerant_resets!r}",
+        )
+        _check(
+            not self.intrusion_tolerant_resets or self.method == "ray-space-observation",
+            "intrusion_tolerant_resets applies only to ray-space-observation, "
+            f"not to {self.method}",
+        )
+        _check(
             self.reliability in RELIABILITY_ESTIMATES,
             f"reliability must be one of {', '.join(RELIABILITY_ESTIMATES)}, "
             f"got {self.reliability!r}",
@@ -199,6 +219,11 @@ class LocalizeConfig:
             reset_look_elsewhere=self.reset_look_elsewhere,
             reset_needs_agreement=self.reset_needs_agreement,
             sensor_reset_confirm=self.sensor_reset_confirm,
+            # the agreement alone decides: a likelihood that drops where unmapped objects
+            # stand in the view is what the intrusion term expects
+            reset_likelihood_drop=(
+                0.0 if self.intrusion_tolerant_resets else MclConfig.reset_likelihood_drop
+            ),
             update_min_d=self.update_min_d,
             update_min_a=self.update_min_a,
             threads=self.threads,

@@ -90,6 +90,7 @@ def scan_model(method: str, grid: OccupancyGrid, config: LocalizeConfig | None =
             z_intrusion=config.z_intrusion,
             lambda_short=config.lambda_short,
             max_beams=config.beams,
+            agreement_skips_intrusion=config.intrusion_tolerant_resets,
         )
     if method == "space-observation":
         return ScanSpaceObservation(grid)
