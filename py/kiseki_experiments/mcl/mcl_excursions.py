@@ -78,6 +78,9 @@ class ExcursionsConfig:
     # the resets' agreement check and confirmation (false: the resets before them)
     reset_needs_agreement: bool = LocalizeConfig.reset_needs_agreement
     sensor_reset_confirm: bool = LocalizeConfig.sensor_reset_confirm
+    # kiseki's ray model's resets judged by penetration only (LocalizeConfig's
+    # intrusion_tolerant_resets); the other methods are run as they are
+    intrusion_tolerant_resets: bool = LocalizeConfig.intrusion_tolerant_resets
     threads: Threads = 1
 
 
@@ -160,6 +163,8 @@ def trial(config: ExcursionsConfig, index: int, seed: int) -> TrialOutput:
                 reset_look_elsewhere=config.reset_look_elsewhere,
                 reset_needs_agreement=config.reset_needs_agreement,
                 sensor_reset_confirm=config.sensor_reset_confirm,
+                intrusion_tolerant_resets=config.intrusion_tolerant_resets
+                and method == "ray-space-observation",
             )
             result = localize(scans, maps[method], lc)
             d = result.estimates - scans.poses

@@ -95,6 +95,9 @@ class UnknownObstaclesConfig:
     sensor_reset_proposal: str = "uniform"
     # with the matcher: a search on every this-many-th sensor reset of a lost spell
     matcher_search_every: Count = LocalizeConfig.matcher_search_every
+    # kiseki's ray model's resets judged by penetration only (LocalizeConfig's
+    # intrusion_tolerant_resets); the other methods are run as they are
+    intrusion_tolerant_resets: bool = LocalizeConfig.intrusion_tolerant_resets
 
 
 def preflight(config: UnknownObstaclesConfig) -> None:
@@ -207,6 +210,8 @@ def trial(config: UnknownObstaclesConfig, index: int, seed: int) -> TrialOutput:
                 sensor_reset_confirm=config.sensor_reset_confirm,
                 sensor_reset_proposal=config.sensor_reset_proposal,
                 matcher_search_every=config.matcher_search_every,
+                intrusion_tolerant_resets=config.intrusion_tolerant_resets
+                and method == "ray-space-observation",
             )
             grid = teaching if method == TEACHING_MAP else log_odds
             result = localize(seen, grid, lc)
