@@ -319,7 +319,8 @@ TEST(RaySpaceObservation, OneBeamIsTheMixtureByHand) {
 // The same wall; three beams along +x: one ends on the wall's face (agrees), one stops 2 m
 // short in the open (an intrusion), one passes through the wall (disagrees). The plain
 // agreement counts the intrusion against the pose (1 of 3); the intrusion-tolerant one leaves
-// it out (1 of 2), and has nothing to go by when every beam is an intrusion.
+// it out (1 of 2), and has nothing to go by when every beam is an intrusion; a place a reset
+// proposes is judged by the plain one in both.
 TEST(RaySpaceObservation, IntrusionTolerantAgreementLeavesOutBeamsEndingInTheOpen) {
   OccupancyGrid g(100, 40, 0.1, Pose2(), kFree);
   for (int y = 0; y < 40; ++y) g.set(50, y, kOccupied);
@@ -333,6 +334,9 @@ TEST(RaySpaceObservation, IntrusionTolerantAgreementLeavesOutBeamsEndingInTheOpe
   tolerant_model.set_scan(angles, ranges, 3, max_range);
   EXPECT_DOUBLE_EQ(plain_model.agreement(robot), 1.0 / 3.0);
   EXPECT_DOUBLE_EQ(tolerant_model.agreement(robot), 1.0 / 2.0);
+  // A reset's proposed place is judged with every beam, whichever measure judges being lost.
+  EXPECT_DOUBLE_EQ(tolerant_model.placement_agreement(robot), 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(plain_model.placement_agreement(robot), 1.0 / 3.0);
   // The likelihood is the same model's: the switch changes the agreement only.
   double a = 0.0, b = 1.0;
   plain_model.log_likelihoods(&robot, 1, &a);

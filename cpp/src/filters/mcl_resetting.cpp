@@ -47,9 +47,10 @@ Pose2 proposed_place(const std::vector<Pose2>& poses, const std::vector<double>&
 bool MonteCarloLocalization::agrees_at(const SensorModel& model, const std::vector<Pose2>& poses,
                                         const std::vector<double>& log_l, const CloudScore& cloud) const {
   if (!params_.reset_needs_agreement) return true;
-  const double a = model.agreement(proposed_place(poses, log_l));
+  const double a = model.placement_agreement(proposed_place(poses, log_l));
   if (std::isnan(a)) return true;  // the model cannot tell
-  return a >= params_.reset_threshold && (std::isnan(cloud.agreement) || a >= cloud.agreement);
+  return a >= params_.reset_threshold &&
+         (std::isnan(cloud.placement_agreement) || a >= cloud.placement_agreement);
 }
 
 bool MonteCarloLocalization::expansion_reset(const SensorModel* model, const CloudScore& cloud) {

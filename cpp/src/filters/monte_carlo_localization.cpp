@@ -299,13 +299,15 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
   if (params_.recovery == Recovery::resetting && lost_updates_ >= params_.reset_after) {
     double best = -std::numeric_limits<double>::infinity();
     for (double l : log_l) best = std::max(best, l);
+    // The cloud's place in the terms a proposed place is judged by, at agreement_of's pose.
+    const CloudScore cloud{best, model != nullptr ? model->placement_agreement(weighed) : agreement};
     bool sensed = false;
-    if (model != nullptr && !challenger_.empty()) sensed = confirm_challenger(*model, {best, agreement});
+    if (model != nullptr && !challenger_.empty()) sensed = confirm_challenger(*model, cloud);
     if (!sensed && model != nullptr && has_free_space() && lost_updates_ >= params_.sensor_reset_after) {
-      sensed = sensor_reset(*model, {best, agreement}, scan);
+      sensed = sensor_reset(*model, cloud, scan);
     }
     if (sensed) end_lost_spell();
-    const bool expanded = !sensed && expansion_reset(model, {best, agreement});
+    const bool expanded = !sensed && expansion_reset(model, cloud);
     report.searched = searched_;
     if (sensed || expanded) {
       report.reset = sensed ? "sensor" : "expansion";

@@ -90,6 +90,10 @@ void RaySpaceObservationModel::log_likelihoods(const Pose2* poses, std::size_t n
   }
 }
 
+double RaySpaceObservationModel::placement_agreement(const Pose2& pose) const {
+  return beams_.agreement(occupied_, pose.compose(params_.sensor), params_.agreement_tolerance);
+}
+
 double RaySpaceObservationModel::agreement(const Pose2& pose) const {
   return beams_.agreement(occupied_, pose.compose(params_.sensor), params_.agreement_tolerance,
                           params_.agreement_skips_intrusion);

@@ -47,9 +47,11 @@ class LocalizeConfig:
       cloud counts as lost only by penetration, as the thesis' model judges a scan: the
       agreement leaves out the beams that end in the open without passing a wall (what an
       unmapped object reads, which the intrusion term explains), and the likelihood-drop
-      trigger is off (the likelihood falls wherever such objects stand in the view). Without
-      it, unknown objects that hide most of the view make the true cloud look lost, and a
-      reset moves it to a place whose walls happen to meet the short beams.
+      trigger is off (the likelihood falls wherever such objects stand in the view); a place a
+      reset proposes is still judged with every beam (a wrong place in a wider space, whose
+      beams end in the open, would pass the laxer measure). Without it, unknown objects that
+      hide most of the view make the true cloud look lost, and a reset moves it to a place
+      whose walls happen to meet the short beams.
     * ``combination`` product (beams independent) or nav2 (1 + sum pz^3).
     * ``sensor_reset_proposal`` matcher (with recovery resetting): a sensor reset draws its
       candidates around the branch-and-bound scan matcher's five best poses for the scan

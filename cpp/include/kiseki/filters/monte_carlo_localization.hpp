@@ -222,7 +222,7 @@ class MonteCarloLocalization {
   /// What a reset must beat: the cloud's best log-likelihood and the agreement at its estimate.
   struct CloudScore {
     double best_log_likelihood;
-    double agreement;  ///< NaN: the model cannot tell
+    double placement_agreement;  ///< the model's, at the cloud's estimate; NaN: it cannot tell
   };
   bool agrees_at(const SensorModel& model, const std::vector<Pose2>& poses, const std::vector<double>& log_l,
                  const CloudScore& cloud) const;

@@ -62,6 +62,7 @@ struct RaySpaceObservationParams {
   double agreement_tolerance = 0.2;
   /// The agreement (ScanBeams::agreement) leaves out the beams the intrusion term explains:
   /// a beam ending in the open is then no sign of being lost, as it costs this model little.
+  /// A reset's proposed place is still judged with every beam (placement_agreement).
   bool agreement_skips_intrusion = false;
   void validate() const;
 };
@@ -73,6 +74,8 @@ class RaySpaceObservationModel : public SensorModel {
   void log_likelihoods(const Pose2* poses, std::size_t n, double* out) const override;
   std::size_t readings() const override { return beams_.size(); }
   double agreement(const Pose2& pose) const override;
+  /// The plain agreement (every returning beam counted), whichever agreement() is.
+  double placement_agreement(const Pose2& pose) const override;
   const RaySpaceObservationParams& params() const { return params_; }
   /// pz of one beam from its penetration depth delta and its end's distance d (capped).
   double beam_probability(double r, double delta, double d) const;

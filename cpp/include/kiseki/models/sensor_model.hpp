@@ -34,6 +34,11 @@ class SensorModel {
   virtual double agreement(const Pose2& /*pose*/) const {
     return std::numeric_limits<double>::quiet_NaN();
   }
+  /// The agreement by which a reset's proposed place is judged, and the cloud's place against
+  /// it: agreement() itself, unless a model judges being lost by a laxer measure than a new
+  /// place (the ray model's intrusion-tolerant agreement, under which a wrong place in a wider
+  /// space, whose beams end in the open, would pass).
+  virtual double placement_agreement(const Pose2& pose) const { return agreement(pose); }
   /// Called by the engine with the whole cloud before it weighs it, once per update (after
   /// the measurement was set): a model that chooses which readings to use from where the
   /// particles are (the likelihood field's beam skipping) does it here, on up to `threads`
