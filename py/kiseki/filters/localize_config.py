@@ -173,6 +173,11 @@ class LocalizeConfig:
             f"not to {self.method}",
         )
         _check(
+            not self.intrusion_tolerant_resets or self.recovery == "resetting",
+            "intrusion_tolerant_resets applies only with recovery resetting, "
+            f"not with {self.recovery}",
+        )
+        _check(
             self.reliability in RELIABILITY_ESTIMATES,
             f"reliability must be one of {', '.join(RELIABILITY_ESTIMATES)}, "
             f"got {self.reliability!r}",

@@ -79,7 +79,7 @@ class ExcursionsConfig:
     reset_needs_agreement: bool = LocalizeConfig.reset_needs_agreement
     sensor_reset_confirm: bool = LocalizeConfig.sensor_reset_confirm
     # kiseki's ray model's resets judged by penetration only (LocalizeConfig's
-    # intrusion_tolerant_resets); the other methods are run as they are
+    # intrusion_tolerant_resets) in its resetting arms; the other arms are run as they are
     intrusion_tolerant_resets: bool = LocalizeConfig.intrusion_tolerant_resets
     threads: Threads = 1
 
@@ -164,7 +164,8 @@ def trial(config: ExcursionsConfig, index: int, seed: int) -> TrialOutput:
                 reset_needs_agreement=config.reset_needs_agreement,
                 sensor_reset_confirm=config.sensor_reset_confirm,
                 intrusion_tolerant_resets=config.intrusion_tolerant_resets
-                and method == "ray-space-observation",
+                and method == "ray-space-observation"
+                and recovery == "resetting",
             )
             result = localize(scans, maps[method], lc)
             d = result.estimates - scans.poses

@@ -139,7 +139,8 @@ def _trial(scans: LaserScans, grid, config: KidnapConfig, seed: int, name: str) 
             reset_look_elsewhere=config.reset_look_elsewhere,
             reset_needs_agreement=config.reset_needs_agreement,
             sensor_reset_confirm=config.sensor_reset_confirm,
-            intrusion_tolerant_resets=config.intrusion_tolerant_resets,
+            intrusion_tolerant_resets=config.intrusion_tolerant_resets
+            and recovery.split("+")[0] == "resetting",
             threads=config.threads,
             reliability=config.reliability,
         )

@@ -60,7 +60,8 @@ class KidnapConfig:
     # the resets' agreement check and confirmation (false: the resets before them)
     reset_needs_agreement: bool = LocalizeConfig.reset_needs_agreement
     sensor_reset_confirm: bool = LocalizeConfig.sensor_reset_confirm
-    # with method ray-space-observation: resets judged by penetration only (LocalizeConfig)
+    # with method ray-space-observation: resets judged by penetration only (LocalizeConfig),
+    # in the resetting arms
     intrusion_tolerant_resets: bool = LocalizeConfig.intrusion_tolerant_resets
     # the claims' controls: the recovery that runs in the arm named "resetting", and whether
     # the robot is carried at all (false: the log goes on from scan k, no jump)
@@ -98,7 +99,11 @@ def _check(config: KidnapConfig) -> None:
     if config.before_scans < 20 or config.after_scans < config.min_after:
         raise ValueError("kidnapping: need before_scans >= 20 and after_scans >= min_after")
     # the method and the switches that apply to it only (ValueError naming the problem)
-    LocalizeConfig(method=config.method, intrusion_tolerant_resets=config.intrusion_tolerant_resets)
+    LocalizeConfig(
+        method=config.method,
+        recovery="resetting",
+        intrusion_tolerant_resets=config.intrusion_tolerant_resets,
+    )
 
 
 def preflight_sim(config: KidnapConfig) -> None:

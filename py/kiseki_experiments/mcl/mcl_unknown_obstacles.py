@@ -96,7 +96,7 @@ class UnknownObstaclesConfig:
     # with the matcher: a search on every this-many-th sensor reset of a lost spell
     matcher_search_every: Count = LocalizeConfig.matcher_search_every
     # kiseki's ray model's resets judged by penetration only (LocalizeConfig's
-    # intrusion_tolerant_resets); the other methods are run as they are
+    # intrusion_tolerant_resets) in its resetting arms; the other arms are run as they are
     intrusion_tolerant_resets: bool = LocalizeConfig.intrusion_tolerant_resets
 
 
@@ -211,7 +211,8 @@ def trial(config: UnknownObstaclesConfig, index: int, seed: int) -> TrialOutput:
                 sensor_reset_proposal=config.sensor_reset_proposal,
                 matcher_search_every=config.matcher_search_every,
                 intrusion_tolerant_resets=config.intrusion_tolerant_resets
-                and method == "ray-space-observation",
+                and method == "ray-space-observation"
+                and recovery == "resetting",
             )
             grid = teaching if method == TEACHING_MAP else log_odds
             result = localize(seen, grid, lc)

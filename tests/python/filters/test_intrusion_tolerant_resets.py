@@ -111,7 +111,9 @@ def _localize(folder, *args):
 
 def test_the_command_refuses_the_switch_where_it_does_nothing_and_saves_it(tmp_path):
     with pytest.raises(ValueError, match="applies only to ray-space-observation"):
-        LocalizeConfig(method="beam", intrusion_tolerant_resets=True)
+        LocalizeConfig(method="beam", recovery="resetting", intrusion_tolerant_resets=True)
+    with pytest.raises(ValueError, match="only with recovery resetting"):
+        LocalizeConfig(method="ray-space-observation", intrusion_tolerant_resets=True)
     write_inputs(tmp_path)
     for args, word in (
         (["--recovery", "resetting"], "to --method likelihood-field"),
