@@ -35,7 +35,8 @@ namespace {
 
 // A measurement seen only through its likelihood: log p = -|pose - target|^2 / (2 0.3^2) (position
 // in m and heading in rad alike) plus `ripple` sin(3x) cos(2y), over 30 readings, with a fixed
-// agreement with the map (agree_near within near_radius of near, agree elsewhere).
+// agreement with the map (agree_near within near_radius of near, agree elsewhere); a proposed
+// place is judged by the same agreement, or by place_near within near_radius when it is set.
 class TargetModel : public SensorModel {
  public:
   Pose2 target;
@@ -45,6 +46,7 @@ class TargetModel : public SensorModel {
   Pose2 near;
   double near_radius = 0.0;  ///< 0: the same agreement everywhere
   double agree_near = 1.0;
+  double place_near = std::numeric_limits<double>::quiet_NaN();
   void log_likelihoods(const Pose2* poses, std::size_t n, double* out) const override {
     for (std::size_t i = 0; i < n; ++i) {
       const Pose2& q = poses[i];
@@ -57,31 +59,41 @@ class TargetModel : public SensorModel {
   double agreement(const Pose2& q) const override {
     return std::hypot(q.x - near.x, q.y - near.y) < near_radius ? agree_near : agree;
   }
+  double placement_agreement(const Pose2& q) const override {
+    if (std::isnan(place_near)) return agreement(q);
+    return std::hypot(q.x - near.x, q.y - near.y) < near_radius ? place_near : agree;
+  }
 };
 
 TEST(MonteCarloLocalization, ALikelihoodDropResetsACloudCarriedToAPlaceThatLooksAlike) {
-  // The scans go on agreeing with the map (agreement 1), but the robot is elsewhere: only the
-  // likelihood has dropped against its long-term average.
-  for (const double drop : {0.0, 0.5}) {
-    MclParams p;
-    p.particles = 1000;
-    p.recovery = Recovery::resetting;
-    p.reset_likelihood_drop = drop;
-    MonteCarloLocalization mcl(p, 11);
-    mcl.set_free_space(room());
-    TargetModel model;
-    model.target = Pose2(1.0, 4.5, 0.0);
-    mcl.initialize_gaussian(model.target, 0.1, 0.1, 0.05);
-    for (int k = 0; k < 20; ++k) mcl.update(model);
-    model.target = Pose2(7.5, 1.0, 2.0);
-    int sensor_resets = 0;
-    for (int k = 0; k < 30; ++k) sensor_resets += mcl.update(model).reset == "sensor";
-    if (drop == 0.0) {
-      EXPECT_EQ(sensor_resets, 0);
-      EXPECT_GT(position_error(mcl.estimate(), model.target), 3.0);  // agreement alone cannot see it
-    } else {
-      EXPECT_GE(sensor_resets, 1);
-      EXPECT_LT(position_error(mcl.estimate(), model.target), 0.3);
+  // The scans go on agreeing with the map (agreement 1), or the model cannot tell (NaN), but
+  // the robot is elsewhere: only the likelihood has dropped against its long-term average. A
+  // drop of 0 turns that trigger off in both.
+  for (const double agree : {1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    for (const double drop : {0.0, 0.5}) {
+      SCOPED_TRACE(agree);
+      SCOPED_TRACE(drop);
+      MclParams p;
+      p.particles = 1000;
+      p.recovery = Recovery::resetting;
+      p.reset_likelihood_drop = drop;
+      MonteCarloLocalization mcl(p, 11);
+      mcl.set_free_space(room());
+      TargetModel model;
+      model.agree = agree;
+      model.target = Pose2(1.0, 4.5, 0.0);
+      mcl.initialize_gaussian(model.target, 0.1, 0.1, 0.05);
+      for (int k = 0; k < 20; ++k) mcl.update(model);
+      model.target = Pose2(7.5, 1.0, 2.0);
+      int sensor_resets = 0;
+      for (int k = 0; k < 30; ++k) sensor_resets += mcl.update(model).reset == "sensor";
+      if (drop == 0.0) {
+        EXPECT_EQ(sensor_resets, 0);
+        EXPECT_GT(position_error(mcl.estimate(), model.target), 3.0);  // agreement alone cannot see it
+      } else {
+        EXPECT_GE(sensor_resets, 1);
+        EXPECT_LT(position_error(mcl.estimate(), model.target), 0.3);
+      }
     }
   }
 }
@@ -183,6 +195,41 @@ TEST(MonteCarloLocalization, AResetNeverMovesTheCloudWhereTheMapAgreesLessThanWh
     SCOPED_TRACE(c.agree_b);
     SCOPED_TRACE(c.check);
     if (c.moves) {
+      EXPECT_GE(sensor_resets, 1);
+      EXPECT_LT(position_error(mcl.estimate(), b), 0.3);
+    } else {
+      EXPECT_EQ(sensor_resets, 0);
+      EXPECT_LT(position_error(mcl.estimate(), a), 0.5);
+    }
+  }
+}
+
+TEST(MonteCarloLocalization, AProposedPlaceIsJudgedByThePlacementAgreement) {
+  // As above, but agreement() calls B 0.9 while the model judges a proposed place by another
+  // measure (the ray model's plain agreement beside its intrusion-tolerant one): 0.3 there
+  // keeps the cloud at A, 0.9 lets the reset move it to B.
+  const Pose2 a(1.0, 4.5, 0.0), b(7.5, 1.0, 2.0);
+  for (const double place_b : {0.3, 0.9}) {
+    MclParams p;
+    p.particles = 1000;
+    p.recovery = Recovery::resetting;
+    p.expansion_position = p.expansion_orientation = 0.0;  // only a sensor reset can move it
+    MonteCarloLocalization mcl(p, 31);
+    mcl.set_free_space(room());
+    TargetModel model;
+    model.target = a;
+    model.agree = 0.8;
+    model.near = b;
+    model.near_radius = 1.0;
+    model.agree_near = 0.9;
+    model.place_near = place_b;
+    mcl.initialize_gaussian(a, 0.1, 0.1, 0.05);
+    for (int k = 0; k < 20; ++k) mcl.update(model);
+    model.target = b;
+    int sensor_resets = 0;
+    for (int k = 0; k < 30; ++k) sensor_resets += mcl.update(model).reset == "sensor";
+    SCOPED_TRACE(place_b);
+    if (place_b > 0.6) {
       EXPECT_GE(sensor_resets, 1);
       EXPECT_LT(position_error(mcl.estimate(), b), 0.3);
     } else {

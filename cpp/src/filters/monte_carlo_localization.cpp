@@ -286,7 +286,8 @@ UpdateReport MonteCarloLocalization::update_impl(const std::vector<double>& log_
   if (model != nullptr) agreement = agreement_of(*model, weighed);
   report.agreement = agreement;
   const bool knows = !std::isnan(agreement);
-  const bool lost = knows ? agreement < params_.reset_threshold : ratio < 0.5;
+  // Where the model cannot tell, the likelihood's drop decides alone (off with a drop of 0).
+  const bool lost = knows ? agreement < params_.reset_threshold : ratio < params_.reset_likelihood_drop;
   const double signal = knows ? (lost ? 0.0 : 1.0) : std::min(1.0, ratio);
   reliability_ += params_.reliability_rate * (signal - reliability_);
   // emcl2's second trigger: the likelihood has dropped against its long-term average. It sees

@@ -148,9 +148,9 @@ def localize_command(
     intrusion_tolerant: bool = typer.Option(
         False,
         "--intrusion-tolerant-resets",
-        help="With --method ray-space-observation: the cloud counts as lost only where beams "
-        "pass through walls, not where they end short in the open (unmapped people, carts), "
-        "and the likelihood-drop trigger is off; not with --global.",
+        help="With --method ray-space-observation --recovery resetting: the cloud counts as "
+        "lost only where beams pass through walls, not where they end short in the open "
+        "(unmapped people, carts), and the likelihood-drop trigger is off; not with --global.",
     ),
     threads: int | None = typer.Option(
         None,

@@ -43,15 +43,16 @@ class LocalizeConfig:
       likelihood field's terms, the thesis' penetration per ray, and ``z_intrusion`` 0.95 (=
       z_hit: equal prior odds that a beam's end is a mapped wall or an unmapped object) times
       the beam model's ``lambda_short`` density for a beam stopped short in free space.
-    * ``intrusion_tolerant_resets`` (ray-space-observation; off): with recovery resetting the
-      cloud counts as lost only by penetration, as the thesis' model judges a scan: the
+    * ``intrusion_tolerant_resets`` (ray-space-observation with recovery resetting; off; kiseki's
+      own trigger): the cloud counts as lost only by penetration, not by intrusion: the
       agreement leaves out the beams that end in the open without passing a wall (what an
       unmapped object reads, which the intrusion term explains), and the likelihood-drop
       trigger is off (the likelihood falls wherever such objects stand in the view); a place a
       reset proposes is still judged with every beam (a wrong place in a wider space, whose
       beams end in the open, would pass the laxer measure). Without it, unknown objects that
       hide most of the view make the true cloud look lost, and a reset moves it to a place
-      whose walls happen to meet the short beams.
+      whose walls happen to meet the short beams. The agreement it reports (and the reliability
+      estimate ``agreement`` built on it) is the tolerant one.
     * ``combination`` product (beams independent) or nav2 (1 + sum pz^3).
     * ``sensor_reset_proposal`` matcher (with recovery resetting): a sensor reset draws its
       candidates around the branch-and-bound scan matcher's five best poses for the scan
@@ -176,6 +177,16 @@ class LocalizeConfig:
             not self.intrusion_tolerant_resets or self.recovery == "resetting",
             "intrusion_tolerant_resets applies only with recovery resetting, "
             f"not with {self.recovery}",
+        )
+        _check(
+            not (self.intrusion_tolerant_resets and self.resetting_injects),
+            "intrusion_tolerant_resets does not go with resetting_injects (the injection answers "
+            "the likelihood's drop, which the switch stops reading as being lost)",
+        )
+        _check(
+            not self.intrusion_tolerant_resets or self.reliability == "agreement",
+            "intrusion_tolerant_resets needs reliability agreement (the learned estimates were "
+            f"fitted on the plain agreement), not {self.reliability}",
         )
         _check(
             self.reliability in RELIABILITY_ESTIMATES,

@@ -91,6 +91,12 @@ def preflight(config: ExcursionsConfig) -> None:
     for r in config.recoveries:
         if r not in RECOVERY_MODES:
             raise ValueError(f"mcl-excursions: unknown recovery {r!r}")
+    ray_resets = "ray-space-observation" in config.methods and "resetting" in config.recoveries
+    if config.intrusion_tolerant_resets and not ray_resets:
+        raise ValueError(
+            "mcl-excursions: intrusion_tolerant_resets needs the ray-space-observation method and "
+            "the resetting recovery among the arms"
+        )
     folder = shared_data("carmen", config.data_dir)
     missing = [n for n in config.logs if not (folder / f"{n}.log.gz").is_file()]
     if missing:

@@ -58,6 +58,7 @@ from kiseki_experiments.mcl.mcl_kidnapping_config import (
     BLIND_RELIABILITY,
     CarmenKidnapConfig,
     KidnapConfig,
+    arm_recovery,
     preflight_carmen,
     preflight_sim,
 )
@@ -132,15 +133,12 @@ def _trial(scans: LaserScans, grid, config: KidnapConfig, seed: int, name: str) 
             odometry_noise=config.odometry_noise if name != "sim" else 0.0,
             particles=config.particles,
             beams=config.beams,
-            recovery=recovery.split("+")[0],
-            resetting_injects=recovery == "resetting+injection",
+            **arm_recovery(config, arm),
             sensor_reset_proposal=config.sensor_reset_proposal,
             matcher_search_every=config.matcher_search_every,
             reset_look_elsewhere=config.reset_look_elsewhere,
             reset_needs_agreement=config.reset_needs_agreement,
             sensor_reset_confirm=config.sensor_reset_confirm,
-            intrusion_tolerant_resets=config.intrusion_tolerant_resets
-            and recovery.split("+")[0] == "resetting",
             threads=config.threads,
             reliability=config.reliability,
         )

@@ -98,12 +98,24 @@ def _check(config: KidnapConfig) -> None:
         raise ValueError("kidnapping: min_jump, recover_distance and recover_hold must be > 0")
     if config.before_scans < 20 or config.after_scans < config.min_after:
         raise ValueError("kidnapping: need before_scans >= 20 and after_scans >= min_after")
-    # the method and the switches that apply to it only (ValueError naming the problem)
-    LocalizeConfig(
-        method=config.method,
-        recovery="resetting",
-        intrusion_tolerant_resets=config.intrusion_tolerant_resets,
-    )
+    # each arm's settings as LocalizeConfig checks them (ValueError naming the problem)
+    arms = [arm_recovery(config, arm) for arm in config.recoveries]
+    for settings in arms:
+        LocalizeConfig(method=config.method, reliability=config.reliability, **settings)
+    if config.intrusion_tolerant_resets and not any(a["intrusion_tolerant_resets"] for a in arms):
+        raise ValueError("kidnapping: intrusion_tolerant_resets applies to no arm (no resetting)")
+
+
+def arm_recovery(config: KidnapConfig, arm: str) -> dict:
+    """LocalizeConfig's recovery settings of one arm (the arm "resetting" runs
+    ``resetting_runs``, its control's switch)."""
+    recovery = config.resetting_runs if arm == "resetting" else arm
+    base = recovery.split("+")[0]
+    return {
+        "recovery": base,
+        "resetting_injects": recovery == "resetting+injection",
+        "intrusion_tolerant_resets": config.intrusion_tolerant_resets and base == "resetting",
+    }
 
 
 def preflight_sim(config: KidnapConfig) -> None:

@@ -120,6 +120,12 @@ def preflight(config: UnknownObstaclesConfig) -> None:
         )
     if config.band <= config.clearance:
         raise ValueError("mcl-unknown-obstacles: band must exceed clearance")
+    ray_resets = "ray-space-observation" in config.methods and "resetting" in config.recoveries
+    if config.intrusion_tolerant_resets and not ray_resets:
+        raise ValueError(
+            "mcl-unknown-obstacles: intrusion_tolerant_resets needs the ray-space-observation "
+            "method and the resetting recovery among the arms"
+        )
     folder = shared_data("carmen", config.data_dir)
     missing = [n for n in config.logs if not (folder / f"{n}.log.gz").is_file()]
     if missing:

@@ -34,8 +34,9 @@ enum class Recovery {
   /// non-penetration share) is below reset_threshold, or, emcl2's other trigger, when the
   /// likelihood has dropped (w_fast / w_slow below reset_likelihood_drop): a cloud carried to a
   /// place that looks alike still mostly agrees with the map, but explains the scans worse than
-  /// it used to. After reset_after lost updates in a row every particle is moved by uniform
-  /// noise (+-expansion_position, +-expansion_orientation) and weighed again; after
+  /// it used to. Where the model cannot tell (agreement NaN) the drop alone decides. After
+  /// reset_after lost updates in a row every particle is moved by uniform noise
+  /// (+-expansion_position, +-expansion_orientation) and weighed again; after
   /// sensor_reset_after, a share sensor_reset_share of the particles is drawn from
   /// sensor_reset_candidates uniform poses over the free cells in proportion to their
   /// likelihood (the measurement proposes where the robot can be) and the set is weighed
@@ -70,16 +71,18 @@ struct MclParams {
   /// pulls the estimate away (ACES, Freiburg 079: RMSE 0.08 -> 2-7 m), so it is off by default.
   bool resetting_injects = false;
   double reset_threshold = 0.6;  ///< agreement below which the cloud counts as lost
-  /// ... or w_fast / w_slow below this (the likelihood has dropped); 0: agreement only
+  /// ... or w_fast / w_slow below this (the likelihood has dropped; the only test where the
+  /// agreement is NaN); 0: agreement only, and never lost where the model cannot tell
   double reset_likelihood_drop = 0.5;
   /// A reset is kept only if its best pose beats the cloud's best by this log-likelihood ratio
   /// (tempered by likelihood_power): ln 10, a Bayes factor of 10 (Jeffreys' "strong").
   double reset_evidence = 2.302585092994046;
   /// ... and only if the map agrees with the measurement from the place it proposes (the
   /// weighted mean of its poses within 0.5 m and 0.3 rad of its best) at least as well as from
-  /// the cloud's estimate, and at least reset_threshold (where the model can tell): a
-  /// reset never moves the cloud to a place where, by the trigger's own measure, it would count
-  /// as lost, or to one that fits the map worse than where it is. Beams cut short by obstacles
+  /// the cloud's estimate, and at least reset_threshold (where the model can tell), both by the
+  /// model's placement_agreement (its agreement but for the ray model's intrusion-tolerant one):
+  /// a reset never moves the cloud to a place where, by that measure, it would count as lost, or
+  /// to one that fits the map worse than where it is. Beams cut short by obstacles
   /// the map does not hold make the likelihood drop and fit a cluttered place elsewhere better
   /// than the truth under the likelihood field, but from there much of the scan passes through
   /// walls or ends in free space.
@@ -219,10 +222,12 @@ class MonteCarloLocalization {
   double agreement_of(const SensorModel& model, const Pose2& weighed) const;
   void resample(double inject_probability, UpdateReport& report);
   bool explains_better(double proposed_best, double cloud_best) const;
-  /// What a reset must beat: the cloud's best log-likelihood and the agreement at its estimate.
+  /// What a reset must beat: the cloud's best log-likelihood and the placement agreement at
+  /// its estimate (the model's placement_agreement, or the agreement given with log-likelihoods
+  /// from elsewhere; NaN: it cannot tell).
   struct CloudScore {
     double best_log_likelihood;
-    double placement_agreement;  ///< the model's, at the cloud's estimate; NaN: it cannot tell
+    double placement_agreement;
   };
   bool agrees_at(const SensorModel& model, const std::vector<Pose2>& poses, const std::vector<double>& log_l,
                  const CloudScore& cloud) const;

@@ -39,6 +39,8 @@ struct ScanBeams {
   /// With `skip_intrusion`, a beam that penetrates nothing and ends in the open (an intrusion:
   /// what an object the map does not hold reads) neither agrees nor disagrees: the share is
   /// taken over the beams that end at a wall or pass through one, NaN when there are none.
+  /// The second test above then no longer catches a pose in a wider space: such a share must
+  /// not judge a new place (SensorModel::placement_agreement).
   double agreement(const RangeCaster& occupied, const Pose2& sensor, double tolerance,
                    bool skip_intrusion = false) const;
 };

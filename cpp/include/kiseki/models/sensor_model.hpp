@@ -29,8 +29,9 @@ class SensorModel {
   virtual std::size_t readings() const { return 1; }
   /// The share, in [0, 1], of the measurement that agrees with the map seen from one pose, or
   /// NaN when the model cannot tell. For scans: the share of beams whose ray does not pass
-  /// through an occupied cell before its end (emcl2's "non-penetration"). The engine's
-  /// resetting trigger and its reliability estimate use it.
+  /// through an occupied cell before its end (emcl2's "non-penetration") and that end at a wall
+  /// (ScanBeams::agreement, whose intrusion-tolerant form leaves out beams ending in the open).
+  /// The engine's resetting trigger and its reliability estimate use it.
   virtual double agreement(const Pose2& /*pose*/) const {
     return std::numeric_limits<double>::quiet_NaN();
   }
