@@ -186,6 +186,14 @@ def test_unknown_obstacles_on_a_real_log_cut_more_beams_as_they_grow_denser(
         ({"recoveries": []}, "recoveries must be among"),
         ({"band": 0.4}, "band must exceed clearance"),
         ({"methods": ["beam"]}, "include likelihood-field"),
+        (
+            {"intrusion_tolerant_resets": True, "recoveries": ["none"]},
+            "intrusion_tolerant_resets needs the ray-space-observation method and the resetting",
+        ),
+        (
+            {"intrusion_tolerant_resets": True, "methods": ["likelihood-field", "beam"]},
+            "intrusion_tolerant_resets needs the ray-space-observation method and the resetting",
+        ),
     ],
 )
 def test_unknown_obstacles_refuses_a_sweep_it_cannot_judge(changes, message) -> None:
