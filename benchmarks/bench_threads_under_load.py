@@ -42,8 +42,7 @@ import numpy as np
 from timing import machine_line  # beside this file
 
 # workers that spin between parallel regions (as libgomp's default does for its first 300,000
-# spins; ACTIVE keeps spinning) and kiseki's default (set when kiseki is imported: PASSIVE,
-# after 30,000 spins)
+# spins; ACTIVE keeps spinning) and kiseki's default (PASSIVE, set when kiseki is imported)
 POLICIES = {"spinning": "ACTIVE", "kiseki": None}
 SCRIPT = Path(__file__).resolve()
 
