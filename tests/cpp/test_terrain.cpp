@@ -250,6 +250,45 @@ TEST(PcdFile, RoundTripAndCorruptFiles) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(PcdFile, RefusesAHeaderThatDoesNotDescribeItsData) {
+  // A header declaring fewer points than the file holds, a POINTS that is not WIDTH x HEIGHT,
+  // or text data declared binary: each once read as a smaller or garbled cloud without a word.
+  const auto dir = std::filesystem::temp_directory_path() / "kiseki_test_pcd_header";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "cloud.pcd").string();
+  const auto read_text = [&](const std::string& width, const std::string& points, const std::string& data,
+                             const std::string& body) {
+    {
+      std::ofstream out(path, std::ios::binary);
+      out << "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " << width
+          << "\nHEIGHT 1\n" << points << "DATA " << data << "\n" << body;
+    }
+    return read_pcd(path);
+  };
+  const auto refused = [&](const std::string& width, const std::string& points, const std::string& data,
+                           const std::string& body, const std::string& why) {
+    try {
+      read_text(width, points, data, body);
+      ADD_FAILURE() << "read: WIDTH " << width << ", " << points << data;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  };
+  const std::string three = "0 0 0\n1 2 3\n4 5 6\n";
+  EXPECT_EQ(read_text("3", "POINTS 3\n", "ascii", three + "\n  \n").points.cols(), 3);  // blank lines after
+  EXPECT_EQ(read_text("3", "", "ascii", three).points.cols(), 3);                        // POINTS may be left out
+  refused("3", "POINTS 5\n", "ascii", three, "POINTS 5 is not WIDTH x HEIGHT, 3");
+  refused("3", "POINTS -5\n", "ascii", three, "POINTS -5");
+  refused("3", "POINTS 0\n", "ascii", three, "POINTS");
+  refused("2", "POINTS 2\n", "ascii", three, "more data lines than its 2 points");
+  refused("2", "", "ascii", three, "more data lines than its 2 points");
+  // 3 points of 12 bytes are 36 bytes; the text holds 18
+  refused("3", "POINTS 3\n", "binary", three, "truncated");
+  refused("1", "POINTS 1\n", "binary", three, "12 bytes of binary data declared, 18 present");
+  std::filesystem::remove_all(dir);
+}
+
 TEST(PcdFile, ReadsTheRecordedCloudsAsPclDoes) {
   int checked = 0;
   for (const char* name : {"office1.pcd", "sac_plane_test.pcd", "table_scene_mug_stereo_textured.pcd"}) {

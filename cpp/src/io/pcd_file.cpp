@@ -29,6 +29,7 @@ struct PcdHeader {
   std::vector<std::string> fields, types;
   std::vector<unsigned long long> sizes, counts;
   unsigned long long width = 0, height = 1;
+  unsigned long long points = 0;  ///< POINTS, 0 when the header has none
   std::string data;            ///< ascii, binary or binary_compressed
   std::streamoff data_start = 0;
   int xyz[3] = {-1, -1, -1};   ///< the fields x, y, z
@@ -74,6 +75,10 @@ PcdHeader read_header(std::ifstream& in, const std::string& path) {
       numbers(one);
       if (one.size() != 1) fail(key);
       (key == "WIDTH" ? h.width : h.height) = one[0];
+    } else if (key == "POINTS") {
+      numbers(one);
+      if (one.size() != 1 || one[0] == 0) fail(key);
+      h.points = one[0];
     } else if (key == "DATA") {
       words >> h.data;
       if (h.data != "ascii" && h.data != "binary" && h.data != "binary_compressed") fail("DATA " + h.data);
@@ -102,6 +107,9 @@ PcdHeader read_header(std::ifstream& in, const std::string& path) {
   if (point > 1'000'000) fail("a point of more than 1 MB");
   if (h.width == 0 || h.height == 0 || h.width > 1'000'000'000ULL || h.height > 1'000'000'000ULL / h.width) {
     fail("WIDTH x HEIGHT");
+  }
+  if (h.points != 0 && h.points != h.width * h.height) {
+    fail("POINTS " + std::to_string(h.points) + " is not WIDTH x HEIGHT, " + std::to_string(h.width * h.height));
   }
   if (h.data_start < 0) fail("no data after the header");
   return h;
@@ -167,10 +175,24 @@ PcdCloud read_pcd(const std::string& path) {
       keep({values[value_index[static_cast<std::size_t>(h.xyz[0])]], values[value_index[static_cast<std::size_t>(h.xyz[1])]],
             values[value_index[static_cast<std::size_t>(h.xyz[2])]]});
     }
+    // What follows the declared points may be blank, never more points: a header that declares
+    // too few would silently drop the rest of the cloud.
+    while (std::getline(in, line)) {
+      if (line.find_first_not_of(" \t\r") != std::string::npos) {
+        throw std::runtime_error(path + ": the PCD file holds more data lines than its " + std::to_string(n) +
+                                 " points (WIDTH x HEIGHT)");
+      }
+    }
   } else {
     std::vector<unsigned char> data;
     if (h.data == "binary") {
       if (bytes > left) throw truncated(std::to_string(bytes) + " bytes of binary data declared, " + std::to_string(left) + " present");
+      // More bytes than the points need: the header does not describe the data (text data
+      // declared binary, or too few points declared).
+      if (bytes < left) {
+        throw std::runtime_error(path + ": not a valid PCD file (" + std::to_string(bytes) +
+                                 " bytes of binary data declared, " + std::to_string(left) + " present)");
+      }
       data.resize(static_cast<std::size_t>(bytes));
       in.read(reinterpret_cast<char*>(data.data()), static_cast<std::streamsize>(bytes));
     } else {
