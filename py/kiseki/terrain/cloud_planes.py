@@ -97,18 +97,20 @@ class CloudPlanes:
 
 
 def _pcd_viewpoint(path: Path) -> np.ndarray:
-    """The VIEWPOINT translation of a PCD header, (0, 0, 0) when absent or unreadable."""
+    """The VIEWPOINT translation of a PCD header, (0, 0, 0) when the header has none. Raises
+    ValueError when it has one that is not seven finite numbers (tx ty tz qw qx qy qz)."""
     with open(path, "rb") as f:
         head = f.read(4096).split(b"\nDATA", 1)[0]
     for line in head.decode("latin-1").splitlines():
         words = line.split()
-        if words and words[0] == "VIEWPOINT" and len(words) >= 4:
+        if words and words[0] == "VIEWPOINT":
             try:
-                origin = np.array([float(w) for w in words[1:4]])
+                values = np.array([float(w) for w in words[1:]])
             except ValueError:
-                break
-            if np.all(np.isfinite(origin)):
-                return origin
+                values = np.array([])
+            if len(values) != 7 or not np.all(np.isfinite(values)):
+                raise ValueError(f"VIEWPOINT {' '.join(words[1:])!r} is not 7 finite numbers")
+            return values[:3]
     return np.zeros(3)
 
 
@@ -216,7 +218,10 @@ def read_cloud(path: str | os.PathLike, origin: str | None = None) -> Cloud:
             points, _, _, dropped = _core.read_pcd(str(path))
         except (RuntimeError, ValueError) as err:
             raise ValueError(f"CLOUD {path}: not a readable PCD file ({err})") from None
-        origin = _pcd_viewpoint(path)
+        try:  # a VIEWPOINT that the given origin replaces is not read
+            origin = _pcd_viewpoint(path) if given is None else given
+        except ValueError as err:
+            raise ValueError(f"CLOUD {path}: {err} (or give the origin)") from None
     else:
         raw = _read_text(path)
         finite = np.all(np.isfinite(raw), axis=1)
