@@ -15,6 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kiseki._support.schema import MAGNITUDE_LIMIT
+
 __all__ = ["UNITS", "MagneticSamples", "concatenate_samples"]
 
 UNITS = ("uT", "G", "unknown")
@@ -53,8 +55,8 @@ class MagneticSamples:
             )
         if len(positions) == 0:
             raise ValueError(f"{source}: no samples")
-        _check_finite(positions, source, "position")
-        _check_finite(field, source, "field reading")
+        _check_finite(positions, source, "position", MAGNITUDE_LIMIT)
+        _check_finite(field, source, "field reading", MAGNITUDE_LIMIT)
         object.__setattr__(self, "positions", positions)
         object.__setattr__(self, "field", field)
         if self.times is not None:
@@ -122,12 +124,16 @@ def _frozen_array(values: object, source: str, name: str) -> np.ndarray:
     return array
 
 
-def _check_finite(array: np.ndarray, source: str, what: str) -> None:
-    bad = ~np.isfinite(array).all(axis=1)
+def _check_finite(array: np.ndarray, source: str, what: str, limit: float = np.inf) -> None:
+    """Every row finite and, with a limit, within +-limit (a position of 1e300 m once overflowed
+    the fit's squared distances)."""
+    with np.errstate(invalid="ignore"):
+        bad = ~(np.isfinite(array) & (np.abs(array) <= limit)).all(axis=1)
     if bad.any():
         row, count = int(np.argmax(bad)), int(bad.sum())
         rows = "1 row" if count == 1 else f"{count} rows"
+        kind = "NaN or infinite" if np.isinf(limit) else f"NaN, infinite or beyond +-{limit:g}"
         raise ValueError(
-            f"{source}: {rows} with a NaN or infinite {what}, the first in data row {row + 1} "
+            f"{source}: {rows} with a {kind} {what}, the first in data row {row + 1} "
             f"(counting from 1): {array[row].tolist()}"
         )

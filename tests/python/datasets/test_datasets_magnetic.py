@@ -68,16 +68,29 @@ def test_samples_nan_refused_naming_the_source_and_first_row() -> None:
     field = np.ones((6, 3))
     field[2, 1] = np.nan
     field[4, 0] = np.inf
-    with pytest.raises(ValueError, match=r"here: 2 rows with a NaN or infinite field reading, "):
+    beyond = r"NaN, infinite or beyond \+-1e\+09"
+    with pytest.raises(ValueError, match=rf"here: 2 rows with a {beyond} field reading, "):
         samples(6, field=field)
     with pytest.raises(ValueError, match=r"first in data row 3 \(counting from 1\)"):
         samples(6, field=field)
     positions = np.zeros((6, 2))
     positions[5, 0] = np.nan
-    with pytest.raises(ValueError, match="NaN or infinite position, the first in data row 6"):
+    with pytest.raises(ValueError, match=f"{beyond} position, the first in data row 6"):
         samples(6, positions=positions)
     with pytest.raises(ValueError, match="NaN or infinite time, the first in data row 1"):
         samples(2, times=[np.nan, 0.0])
+    # a finite position or reading past 1e9 is refused as well (1e300 m overflowed the fit's
+    # squared distances into a traceback); 1e9 itself, and times of the Unix epoch, are read
+    positions[5, 0] = 1e300
+    with pytest.raises(ValueError, match=f"{beyond} position, the first in data row 6"):
+        samples(6, positions=positions)
+    field = np.ones((6, 3))
+    field[1, 2] = -2e9
+    one_row = f"1 row with a {beyond} field reading, the first in data row 2"
+    with pytest.raises(ValueError, match=one_row):
+        samples(6, field=field)
+    positions[5, 0], field[1, 2] = -1e9, 1e9
+    assert len(samples(6, positions=positions, field=field, times=1.7e9 + np.arange(6.0))) == 6
 
 
 def test_take_and_concatenate() -> None:
@@ -142,7 +155,7 @@ def test_bad_csv_refused_naming_the_file(tmp_path: Path, content, message: str) 
 def test_csv_nan_reading_refused_naming_file_and_row(tmp_path: Path) -> None:
     path = write(tmp_path / "f.csv", "x,y,mx,my,mz\n1,2,3,4,5\n1,2,3,nan,5\n")
     with pytest.raises(
-        ValueError, match=f"^{re.escape(str(path))}: 1 row with a NaN .* data row 2"
+        ValueError, match=f"^{re.escape(str(path))}: 1 row with a NaN, infinite .* data row 2"
     ):
         read_field_csv(path)
 
