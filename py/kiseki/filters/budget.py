@@ -48,6 +48,7 @@ from scipy.optimize import nnls
 
 from kiseki._support.atomic import atomic_write
 from kiseki._support.inputs import MIB, read_input_text
+from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki.filters.engine import MonteCarloLocalizer
 from kiseki.filters.localize_config import LocalizeConfig
 from kiseki.filters.scan_models import scan_model
@@ -86,8 +87,11 @@ class CostModel:
     def __post_init__(self) -> None:
         for name in _COEFFICIENTS:
             value = getattr(self, name)
-            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+            number = isinstance(value, int | float) and not isinstance(value, bool)
+            if not (number and math.isfinite(value) and 0 <= value <= MAGNITUDE_LIMIT):
+                raise ValueError(
+                    f"{name} must be a finite number in [0, {MAGNITUDE_LIMIT:g}] ms, got {value!r}"
+                )
         if self.per_particle_ms + self.per_beam_ms <= 0:
             raise ValueError("per_particle_ms and per_beam_ms must not both be 0")
 

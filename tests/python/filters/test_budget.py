@@ -95,13 +95,18 @@ def test_cost_model_file_round_trip_and_bad_files(tmp_path):
         "other.json": json.dumps({"kind": "something else"}),
         "short.json": json.dumps({"kind": "kiseki update cost model", "fixed_ms": 1.0}),
         "negative.json": json.dumps({**model.to_dict(), "per_beam_ms": -1.0}),
+        # a fixed time of 1e300 ms was taken, and a prediction of 300 digits printed
+        "huge.json": json.dumps({**model.to_dict(), "fixed_ms": 1e300}),
+        "bool.json": json.dumps({**model.to_dict(), "per_particle_ms": True}),
     }
     problems = {
         "missing.json": "cannot read",
         "text.json": "not JSON",
         "other.json": "not a cost model",
         "short.json": "no per_particle_ms, per_beam_ms",
-        "negative.json": "per_beam_ms must be a finite number >= 0",
+        "negative.json": "per_beam_ms must be a finite number in [0, 1e+09] ms, got -1.0",
+        "huge.json": "fixed_ms must be a finite number in [0, 1e+09] ms, got 1e+300",
+        "bool.json": "per_particle_ms must be a finite number in [0, 1e+09] ms, got True",
     }
     for name, text in cases.items():
         if text is not None:
