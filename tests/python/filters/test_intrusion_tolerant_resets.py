@@ -2,7 +2,8 @@
 # Copyright (c) 2026 the kiseki authors
 """``LocalizeConfig.intrusion_tolerant_resets``: kiseki's ray model with recovery resetting,
 the cloud judged lost by penetration only. The 6 m x 4 m room with a pillar, the robot on an
-elliptic loop around it (noise-free scans, odometry noise 0.1), one seed.
+elliptic loop around it (noise-free scans; odometry noise 0.1 with people, 0 in the kidnapping
+cases, as test_localize_recovery), one seed.
 
 - With people the map does not hold standing beside the loop (discs of 0.25 m, hiding about
   60 % of the beams), the plain agreement calls the true cloud lost and its resets carry it
