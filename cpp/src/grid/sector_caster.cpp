@@ -217,7 +217,11 @@ bool SectorCaster::start(Ray& r, double px, double py, double dx, double dy, dou
   double t0 = 0.0;
   r.t1 = max_range / grid_.resolution();
   r.reach = max_range;
-  if (!clip(px, py, dx, dy, r.inv, size[0], size[1], t0, r.t1)) {
+  // A start inside the map (a particle's sensor, as a rule) skips the clipping: t0 stays 0, and
+  // a ray that leaves the map ends there by the walk's own test, with the same range (the
+  // reach) as past the clipped t1.
+  const bool inside = px >= 0.0 && py >= 0.0 && px < size[0] && py < size[1];
+  if (!inside && !clip(px, py, dx, dy, r.inv, size[0], size[1], t0, r.t1)) {
     range = max_range;
     return true;
   }
