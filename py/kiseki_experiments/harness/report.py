@@ -19,7 +19,9 @@ from rich.console import Console
 
 from kiseki._support.atomic import atomic_write, atomic_write_all, reworded
 from kiseki._support.table import show
+from kiseki._support.yaml import read_yaml_file
 from kiseki_experiments.harness.base import Analysis, Experiment
+from kiseki_experiments.harness.config import config_from_dict
 from kiseki_experiments.harness.registry import all_experiments
 from kiseki_experiments.harness.run_reader import read_latest, read_timings, trial_seconds
 from kiseki_experiments.harness.verdict import UNMIGRATED, VERDICT_COLUMNS, judge
@@ -130,9 +132,14 @@ def _mean_trial_seconds(timings: pd.DataFrame | None) -> float:
     return float(pd.to_numeric(timings["trial_seconds"], errors="coerce").mean())
 
 
-def _undecided(claims: pd.DataFrame, runs: int, timings: pd.DataFrame | None) -> list[str]:
+def _undecided(
+    claims: pd.DataFrame, runs: int, timings: pd.DataFrame | None, settings: int | None = None
+) -> list[str]:
     """For each inconclusive claim: the trials that would decide it (verdict.trials_to_decide)
-    and their wall time at the run's mean trial time (one core)."""
+    and their wall time at the run's mean trial time (one core). ``settings``: the most trials
+    the run's config has (an experiment whose trials are its settings, as leave-one-out cases);
+    a claim that would need more is said to be beyond them, not given a run that cannot be
+    made."""
     rows = claims[claims["verdict"].astype(str).eq("inconclusive")]
     if rows.empty:
         return []
@@ -150,6 +157,10 @@ def _undecided(claims: pd.DataFrame, runs: int, timings: pd.DataFrame | None) ->
             lines.append(f"| {_cell(row.claim)} | {n} | none (on the threshold) | | |")
             continue
         run_trials = math.ceil(need * runs / n)  # a claim may take k of the run's trials
+        if settings is not None and run_trials > settings:
+            beyond = f"none: more than the {settings} settings of this config (one trial each)"
+            lines.append(f"| {_cell(row.claim)} | {n} | {int(need)} | {beyond} | |")
+            continue
         wall = run_trials * per_trial
         when = (
             "" if math.isnan(wall) else f"{wall / 3600:.2f} h" if wall > 3600 else f"{wall:.0f} s"
@@ -158,7 +169,28 @@ def _undecided(claims: pd.DataFrame, runs: int, timings: pd.DataFrame | None) ->
     return lines
 
 
-def _report(experiment, analysis, manifest, claims: pd.DataFrame, timings=None) -> str:
+def trial_settings(experiment: Experiment, config: Any) -> int | None:
+    """The most trials ``config`` has when the experiment's trials are its settings, else None."""
+    return None if experiment.trial_count is None else int(experiment.trial_count(config))
+
+
+def _saved_settings(experiment: Experiment, run_dir: Path) -> int | None:
+    """trial_settings of the config saved with a run; None when it cannot be read (the report
+    then gives the trials that would decide a claim without that bound)."""
+    if experiment.trial_count is None:
+        return None
+    path = run_dir / "config.yaml"
+    try:
+        saved = read_yaml_file(path, "run's config")
+        config = config_from_dict(experiment.config_type, saved["config"], str(path), ("config",))
+    except (OSError, ValueError, TypeError, KeyError):
+        return None
+    return trial_settings(experiment, config)
+
+
+def _report(
+    experiment, analysis, manifest, claims: pd.DataFrame, timings=None, settings=None
+) -> str:
     lines = [
         f"# {experiment.name}: {experiment.description}",
         "",
@@ -175,7 +207,7 @@ def _report(experiment, analysis, manifest, claims: pd.DataFrame, timings=None) 
         "criterion.",
         "",
         markdown_table(_shown(claims)),
-        *_undecided(claims, int(manifest["trials"]), timings),
+        *_undecided(claims, int(manifest["trials"]), timings, settings),
     ]
     for name, table in analysis.tables.items():
         lines += ["", f"## {name}", "", markdown_table(table)]
@@ -283,7 +315,10 @@ def write_outputs(experiment, config, trials, timings, manifest, run_dir: Path) 
             for n, t in analysis.tables.items()
         }
         texts[run_dir / "claims.csv"] = claims.to_csv(index=False)
-        texts[run_dir / "report.md"] = _report(experiment, analysis, manifest, claims, timings)
+        settings = trial_settings(experiment, config)
+        texts[run_dir / "report.md"] = _report(
+            experiment, analysis, manifest, claims, timings, settings
+        )
         texts[run_dir / "manifest.json"] = json.dumps(manifest, indent=2)
         try:
             atomic_write_all(_frames(trials, timings, run_dir) + _texts(texts))
@@ -333,7 +368,9 @@ def write_reproduction(results_root: Path, out: Path) -> tuple[dict[str, int], l
             f"commit {manifest['git']['commit'] or 'unknown'}; {tally_text(tally(claims))}.",
             "",
             markdown_table(_shown(claims)),
-            *_undecided(claims, int(manifest["trials"]), timings),
+            *_undecided(
+                claims, int(manifest["trials"]), timings, _saved_settings(experiment, run_dir)
+            ),
         ]
     empty = pd.DataFrame({"verdict": pd.Series([], dtype=str)})
     totals = tally(pd.concat(frames, ignore_index=True) if frames else empty)

@@ -11,10 +11,12 @@ from statistics import NormalDist
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
 from kiseki.metrics import wilson_interval
 from kiseki_experiments.harness import base
-from kiseki_experiments.harness.report import _undecided, claims_frame, tally
+from kiseki_experiments.harness.registry import get_experiment
+from kiseki_experiments.harness.report import _saved_settings, _undecided, claims_frame, tally
 from kiseki_experiments.harness.run_reader import _old_claims
 from kiseki_experiments.harness.verdict import (
     UNMIGRATED,
@@ -142,6 +144,30 @@ def test_reports_count_old_point_verdicts_as_undecided_and_price_the_undecided()
     wall = 2 * need
     shown = f"{wall / 3600:.2f} h" if wall > 3600 else f"{wall:.0f} s"
     assert row == f"| a share | 20 | {need} | {need} | {shown} |"
+    # an experiment whose trials are its config's settings (leave-one-out cases) cannot run
+    # more than it has: the claim is beyond them, without a run or a time (it was priced as a
+    # run the runner refuses); within them it is priced as before
+    beyond = _undecided(claims, 20, None, settings=need - 1)
+    row = next(line for line in beyond if line.startswith("| a share |"))
+    want = f"none: more than the {need - 1} settings of this config (one trial each)"
+    assert row == f"| a share | 20 | {need} | {want} | |"
+    within = _undecided(claims, 20, pd.DataFrame({"trial_seconds": [1.0, 3.0]}), settings=need)
+    kept = next(line for line in within if line.startswith("| a share |"))
+    assert kept == f"| a share | 20 | {need} | {need} | {shown} |"
+
+
+def test_the_report_reads_the_settings_of_the_run_it_reports(tmp_path):
+    """write_reproduction bounds the undecided claims by the trial count of the config saved
+    with each run (gp-aalto-defaults: its 10 leave-one-run-out cases)."""
+    experiment = get_experiment("gp-aalto-defaults")
+    run = tmp_path / "run"
+    run.mkdir()
+    config = {"experiment": experiment.name, "runs": 10, "seed": 0, "config": {"runs": [1, 2, 3]}}
+    (run / "config.yaml").write_text(yaml.safe_dump(config))
+    assert _saved_settings(experiment, run) == 2 * 3  # two sensors x three held-out runs
+    (run / "config.yaml").write_text("config: {runs: [1, 2, 3], unknown_key: 1}\n")
+    assert _saved_settings(experiment, run) is None  # unreadable: priced without the bound
+    assert _saved_settings(get_experiment("mcl-kld"), run) is None  # trials are seeds
 
 
 def test_evidence_for_an_undeclared_claim_is_refused():
