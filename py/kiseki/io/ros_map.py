@@ -104,6 +104,8 @@ def read_map_metadata(path: str | os.PathLike) -> MapMetadata:
 
 
 _PNG = b"\x89PNG\r\n\x1a\n"
+_PNG_END = b"\x00\x00\x00\x00IEND\xaeB`\x82"  # the IEND chunk: no data, a fixed CRC
+_IMAGE_HEADER_BYTES = 65536  # a PGM header with its comments fits in this
 
 
 def _check_cells(path: Path, image: Path, width: int, height: int) -> None:
@@ -114,14 +116,26 @@ def _check_cells(path: Path, image: Path, width: int, height: int) -> None:
         )
 
 
-def _check_binary_pgm(path: Path, image: Path) -> None:
-    """A binary PGM (P5) cut short is refused here, naming both files: OpenCV would print its
-    own 'can't read data' line on stderr before failing. A PGM or PNG whose header states more
-    than MAX_MAP_CELLS pixels is refused before it is decoded."""
+def _check_image_header(path: Path, image: Path) -> None:
+    """What OpenCV's decoders would report with lines of their own on stderr (before failing)
+    is refused here, naming both files: a PGM (P5 or P2) whose header is not width, height and
+    maxval, a binary PGM cut short, a text PGM with a word that is not a pixel value or with too
+    few of them, a PNG without its closing IEND chunk (cut short). A PGM or PNG whose header
+    states more than MAX_MAP_CELLS pixels is refused before it is decoded."""
+
+    def refused(why: str) -> MapFormatError:
+        return MapFormatError(f"{path}: cannot decode image {image}: {why}")
+
     with open(image, "rb") as f:
-        head = f.read(512)
-        if head.startswith(_PNG) and head[12:16] == b"IHDR":
-            _check_cells(path, image, *struct.unpack(">II", head[16:24]))
+        head = f.read(_IMAGE_HEADER_BYTES)
+        size = os.fstat(f.fileno()).st_size
+        if head.startswith(_PNG):
+            if head[12:16] == b"IHDR":
+                _check_cells(path, image, *struct.unpack(">II", head[16:24]))
+            f.seek(max(size - 1024, 0))  # the closing chunk, bytes after it tolerated
+            if _PNG_END not in f.read(1024):
+                raise refused("a truncated PNG (it does not end with the IEND chunk)")
+            return
         if not head.startswith((b"P5", b"P2")):
             return  # other formats: the decoder's error
         fields: list[bytes] = []
@@ -139,18 +153,44 @@ def _check_binary_pgm(path: Path, image: Path) -> None:
                 fields.append(head[at:end])
                 at = end
         if len(fields) < 3 or not all(x.isdigit() for x in fields):
-            return  # a malformed header: the decoder's error
+            found = " ".join(x.decode("latin-1") for x in fields[:3]) or "nothing"
+            raise refused(f"a PGM header is width, height and maxval (numbers), found {found!r}")
         width, height, maxval = (int(x) for x in fields)
         _check_cells(path, image, width, height)
-        if head.startswith(b"P2"):
-            return  # a text PGM: its numbers are not counted here
+        if not 1 <= maxval <= 65535:
+            raise refused(f"a PGM's maxval is 1..65535, found {maxval}")
+        if head.startswith(b"P2"):  # text: every word after the header a pixel value
+            f.seek(at)
+            words = _text_pixels(f, refused)
+            if words < width * height:
+                raise refused(f"a truncated PGM ({words} of the {width * height} pixels)")
+            return
         need = width * height * (1 if maxval < 256 else 2)
-        have = os.fstat(f.fileno()).st_size - (at + 1)  # one whitespace byte after maxval
+        have = size - (at + 1)  # one whitespace byte after maxval
     if have < need:
-        raise MapFormatError(
-            f"{path}: cannot decode image {image}: a truncated PGM ({max(have, 0)} of the {need} "
-            f"pixel bytes of {width} x {height})"
+        raise refused(
+            f"a truncated PGM ({max(have, 0)} of the {need} pixel bytes of {width} x {height})"
         )
+
+
+def _text_pixels(f, refused: Callable[[str], MapFormatError]) -> int:
+    """The words of a text PGM's pixels from the file's position on, read 16 MB at a time;
+    refused at a byte that is neither a digit nor white space."""
+    space = np.frombuffer(b" \t\n\r\x0b\x0c", np.uint8)
+    words, after_digit = 0, False
+    while chunk := f.read(16 * 1024 * 1024):
+        body = np.frombuffer(chunk, dtype=np.uint8)
+        digit = (body >= ord("0")) & (body <= ord("9"))
+        other = ~digit & ~np.isin(body, space)
+        if other.any():
+            where = int(np.argmax(other))
+            raise refused(f"a text PGM with {body[where : where + 20].tobytes()!r} in its pixels")
+        starts = digit.copy()
+        starts[1:] &= ~digit[:-1]
+        starts[0] &= not after_digit
+        words += int(starts.sum())
+        after_digit = bool(digit[-1])
+    return words
 
 
 def _load_ros_map(path: Path) -> OccupancyGrid:
@@ -161,7 +201,7 @@ def _load_ros_map(path: Path) -> OccupancyGrid:
         raise MapFormatError(f"{path}: image {err}") from None
     if not meta.image.is_file():
         raise FileNotFoundError(f"{path}: image file {meta.image} not found")
-    _check_binary_pgm(path, meta.image)
+    _check_image_header(path, meta.image)
     try:
         image = read_image(meta.image)
     except RuntimeError as err:
