@@ -84,6 +84,7 @@ def quaternion_to_matrix(quat: np.ndarray) -> np.ndarray:
 
 
 POSITION_LIMIT = 1e6  # m: a hand-held walk stays within a building, not 1,000 km
+TIME_LIMIT = 1e10  # s: clock times of this century (Unix time is about 1.8e9 s)
 
 
 def read_kok_walk(path: str | os.PathLike) -> MagneticSamples:
@@ -104,6 +105,17 @@ def read_kok_walk(path: str | os.PathLike) -> MagneticSamples:
         )
     if t.size != n:
         raise LogFormatError(f"{path}: t must hold {n} times like m, got shape {t.shape}")
+    times = t.reshape(-1).astype(np.float64)
+    with np.errstate(invalid="ignore"):
+        bad = ~(np.abs(times) <= TIME_LIMIT)  # NaN too
+        bad[1:] |= ~(times[1:] > times[:-1])
+    if bad.any():
+        row = int(np.argmax(bad))
+        after = f" after {float(times[row - 1])!r}" if row else ""
+        raise LogFormatError(
+            f"{path}: t must increase from sample to sample, finite within +-{TIME_LIMIT:g} s; "
+            f"sample {row + 1} is {float(times[row])!r}{after}"
+        )
     norms = np.linalg.norm(quat, axis=1)
     bad = ~(np.abs(norms - 1.0) <= _UNIT_TOLERANCE)
     if bad.any():

@@ -78,6 +78,27 @@ def test_kok_walk_known_values(tmp_path: Path) -> None:
             {"dPos": np.full((4, 3), np.nan)},
             r"dPos takes the walk to \[nan, nan, nan\] m at sample 2",
         ),
+        # times going back, standing still or of 1e300 s were written to the trajectory as read
+        (
+            {"t": np.array([[0.4], [0.3], [0.2], [0.1], [0.0]])},
+            r"t must increase .*sample 2 is 0.3 after 0.4",
+        ),
+        (
+            {"t": np.zeros((5, 1))},
+            r"t must increase from sample to sample.*; sample 2 is 0.0 after 0.0",
+        ),
+        (
+            {"t": np.array([[0.0], [0.1], [1e300], [0.3], [0.4]])},
+            r"t must increase.*sample 3 is 1e\+300 after 0.1",
+        ),
+        (
+            {"t": np.array([[0.0], [0.1], [0.2], [0.3], [1e300]])},
+            r"t must .* within \+-1e\+10 s; sample 5 is 1e\+300",
+        ),
+        (
+            {"t": np.array([[np.nan], [0.1], [0.2], [0.3], [0.4]])},
+            r"t must increase.*sample 1 is nan$",
+        ),
     ],
 )
 def test_bad_kok_walk_named(tmp_path: Path, overrides, message: str) -> None:
