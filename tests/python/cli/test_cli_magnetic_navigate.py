@@ -134,6 +134,34 @@ def test_bad_input_is_refused(taught, tmp_path):
     )
 
 
+def test_teach_refuses_a_route_it_cannot_map_and_a_robot_without_a_magnetometer(taught, tmp_path):
+    """A teaching run that hit a wall wrote the map of the part it drove (exit 0, "114 nodes
+    over 11.3 m" of a 19 m route); a 0.05 m route wrote one node that navigate then failed on;
+    a robot without a magnetometer named a deleted temporary run (teach) or drove past the goal
+    with no reading (navigate, exit 0)."""
+    scene, folder = taught
+    text = scene.read_text(encoding="utf-8")
+    turn = tmp_path / "turn.yaml"  # the route turns into the corridor's wall
+    turn.write_text(text.replace(str(SHORT), "[[0.0, 0.0], [7.0, 0.0], [7.0, 5.0], [0.0, 5.0]]"))
+    message = refused("teach", turn, "-o", tmp_path / "t1")
+    assert message.startswith(f"{turn}: the teaching run along the route did not reach its end")
+    assert "hit " in message and message.endswith(": no map")
+    short = tmp_path / "short.yaml"
+    short.write_text(text.replace(str(SHORT), "[[0.0, 0.0], [0.05, 0.0]]"))
+    assert refused("teach", short, "-o", tmp_path / "t2") == (
+        f"{short}: the route gives 1 node of the linear map (one every 0.1 m): too short to "
+        "navigate"
+    )
+    blind = tmp_path / "blind.yaml"
+    lines = text.splitlines(keepends=True)
+    blind.write_text("".join(line for line in lines if "type: magnetometer" not in line))
+    assert len(blind.read_text().splitlines()) == len(lines) - 1
+    want = f"{blind}: the robot has no sensor of type magnetometer"
+    assert refused("teach", blind, "-o", tmp_path / "t3") == want
+    assert refused("navigate", blind, "--map", folder, "-o", tmp_path / "n3") == want
+    assert not any((tmp_path / name).exists() for name in ("t1", "t2", "t3", "n3"))
+
+
 def test_gp_map_folder_is_refused(taught, tmp_path):
     scene, _ = taught
     gp = tmp_path / "gp"

@@ -28,6 +28,7 @@ from kiseki.apps.magnetic.navigate_run import (
     METHODS,
     NavigationResult,
     TaughtMaps,
+    check_magnetometer,
     navigate,
     teach,
 )
@@ -164,9 +165,11 @@ def navigate_folder(
         raise ValueError(f"--gates must be one of {'|'.join(GATES)}, got {gates!r}")
     folder = Path(folder)
     _check_out(folder, "-o")
-    waypoints = load_scene(scene, "playback").route.get("waypoints")
+    played = load_scene(scene, "playback")
+    waypoints = played.route.get("waypoints")
     if waypoints is None:
         raise ValueError(f"{scene}: the scene has no route")
+    check_magnetometer(played, scene)  # before the output folder is made
     maps = load_taught(map_folder, waypoints)
     folder.mkdir(parents=True, exist_ok=True)
     result = navigate(scene, maps, method, folder / "run.mcap", seed, gates=gates)

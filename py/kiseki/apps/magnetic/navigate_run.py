@@ -163,15 +163,48 @@ def teach(
     scene = load_scene(scene_path, "teach")
     if "waypoints" not in scene.route:
         raise ValueError(f"{scene_path}: the scene has no route to teach")
+    check_magnetometer(scene, scene_path)
     waypoints = np.asarray(scene.route["waypoints"], dtype=np.float64)
     path_id = path_identity(waypoints)
     maps = {}
     for k, (name, shift) in enumerate((("center", 0.0), ("left", offset), ("right", -offset))):
         run = out / f"teach_{name}.mcap"
         here = scene if shift == 0.0 else _scene_along(scene, shift)
-        simulate(here, run, SimConfig(seed=derive_seed(seed, k)), overwrite=True, progress=False)
+        summary = simulate(
+            here, run, SimConfig(seed=derive_seed(seed, k)), overwrite=True, progress=False
+        )
+        # a run that did not reach the route's end maps part of it: refused, not a short map
+        _check_taught_run(summary, scene_path, name)
         maps[name] = linear_map_from_run(run, path_id, provenance={"path": name})
+    if len(maps["center"]) < 2:
+        n = len(maps["center"])
+        raise ValueError(
+            f"{scene_path}: the route gives {n} node{'' if n == 1 else 's'} of the linear map "
+            f"(one every {maps['center'].spacing:g} m): too short to navigate"
+        )
     return TaughtMaps(maps["center"], maps["left"], maps["right"], waypoints)
+
+
+def check_magnetometer(scene, scene_path) -> None:
+    """A magnetic teaching or navigation needs the robot's magnetometer: a scene without one is
+    refused naming the scene (its run would have no readings)."""
+    if not any(s.get("type") == "magnetometer" for s in scene.sensors):
+        raise ValueError(f"{scene_path}: the robot has no sensor of type magnetometer")
+
+
+def _check_taught_run(summary, scene_path, name: str) -> None:
+    if summary.reached_goal:
+        return
+    path = "the route" if name == "center" else f"the {name} parallel path"
+    c = summary.collision
+    why = (
+        f"hit {c.hit} at ({c.contact[0]:.2f}, {c.contact[1]:.2f}) at t = {c.t:.1f} s"
+        if c is not None
+        else f"stopped at ({summary.final_pose[0]:.2f}, {summary.final_pose[1]:.2f})"
+    )
+    raise ValueError(
+        f"{scene_path}: the teaching run along {path} did not reach its end ({why}): no map"
+    )
 
 
 def rahok_vectors(maps: TaughtMaps, smooth: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
@@ -333,6 +366,7 @@ def navigate(
             f"navigate: maps must be TaughtMaps (see teach), got {type(maps).__name__}"
         )
     scene = load_scene(scene_path, variant)
+    check_magnetometer(scene, scene_path)
     if path_identity(scene.route["waypoints"]) != maps.center.path_id:
         raise ValueError(f"{scene_path}: the maps were taught on another path")
     config = SimConfig(seed=seed, max_duration=3.0 * maps.center.s[-1] / scene.route["speed"])
