@@ -116,6 +116,16 @@ def _check_cells(path: Path, image: Path, width: int, height: int) -> None:
         )
 
 
+_PNG_CUT = "a truncated PNG (it does not end with the IEND chunk)"
+
+
+def _png_is_whole(f, size: int) -> bool:
+    """Whether an open PNG file ends with its IEND chunk (bytes after it tolerated): libpng
+    prints its own lines on stderr for a file cut short before OpenCV reports the failure."""
+    f.seek(max(size - 1024, 0))
+    return _PNG_END in f.read(1024)
+
+
 def _check_image_header(path: Path, image: Path) -> None:
     """What OpenCV's decoders would report with lines of their own on stderr (before failing)
     is refused here, naming both files: a PGM (P5 or P2) whose header is not width, height and
@@ -132,9 +142,8 @@ def _check_image_header(path: Path, image: Path) -> None:
         if head.startswith(_PNG):
             if head[12:16] == b"IHDR":
                 _check_cells(path, image, *struct.unpack(">II", head[16:24]))
-            f.seek(max(size - 1024, 0))  # the closing chunk, bytes after it tolerated
-            if _PNG_END not in f.read(1024):
-                raise refused("a truncated PNG (it does not end with the IEND chunk)")
+            if not _png_is_whole(f, size):
+                raise refused(_PNG_CUT)
             return
         if not head.startswith((b"P5", b"P2")):
             return  # other formats: the decoder's error
@@ -240,6 +249,13 @@ def read_image(path: str | os.PathLike) -> np.ndarray:
     # which `import kiseki` and every command that reads no image should not pay for
     from kiseki import _image_io
 
+    try:
+        with open(path, "rb") as f:
+            cut = f.read(len(_PNG)) == _PNG and not _png_is_whole(f, os.fstat(f.fileno()).st_size)
+    except OSError:
+        cut = False  # the reader names what keeps the file from being read
+    if cut:
+        raise RuntimeError(f"{path}: cannot decode image ({_PNG_CUT})")
     return _image_io.read_image(str(path))
 
 

@@ -269,6 +269,24 @@ def test_bad_folders_are_refused_naming_the_file(tmp_path, spoil, culprit, match
     assert str(caught.value).startswith(str(folder / culprit))
 
 
+def test_a_cut_layer_image_is_refused_without_the_codecs_own_lines(tmp_path, capfd):
+    """libpng printed "libpng warning: ..." and "libpng error: Read Error" on stderr before
+    the layer's error: kiseki's one line became three."""
+    folder = tmp_path / "map"
+    linear_map(2).save(folder)
+    image = folder / "mx_mean.png"
+    whole = image.read_bytes()
+    capfd.readouterr()
+    for cut in (whole[:60], whole[:-1], whole[:8] + b"x" * 50):
+        image.write_bytes(cut)
+        with pytest.raises(MapFormatError, match="a truncated PNG") as caught:
+            MagneticFieldMap.load(folder)
+        assert str(caught.value).startswith(f"{image}: unreadable layer image")
+        assert capfd.readouterr().err == ""
+    image.write_bytes(whole + b"trailing bytes")  # after IEND: read as before
+    np.testing.assert_array_equal(MagneticFieldMap.load(folder).mean, linear_map(2).mean)
+
+
 @pytest.mark.parametrize(
     ("dimension", "changes", "problem"),
     [
