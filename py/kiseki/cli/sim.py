@@ -103,6 +103,10 @@ def sim_render(
 
     Example: kiseki sim render run.mcap -o run.gif"""
     check_suffix("--output", output, (".gif",))
+    if not run_file.is_file():
+        raise FileNotFoundError(f"{run_file}: no such run file (an MCAP file of kiseki sim run)")
+    if scene_file is not None and not scene_file.is_file():
+        raise FileNotFoundError(f"--scene {scene_file}: no such scene file")
     run = read_run(run_file)
     recorded = run.metadata.get("scene_file", "")
     # a teaching log records its scene from its own folder, a simulated run from the cwd
@@ -110,7 +114,14 @@ def sim_render(
     if not str(path) or not path.is_file():
         raise FileNotFoundError(f"{run_file}: its scene file {path} is not found: give --scene")
     check_outputs({"--output": output}, {"the run's scene": path})  # named inside the run
-    render_run(load_scene(path), run, output)
+    scene = load_scene(path)
+    digest = run.metadata.get("scene_sha1")  # runs recorded before it carry none
+    if digest and digest != scene.sha1:
+        raise ValueError(
+            f"{run_file} was recorded in {recorded or 'another scene'}, not in {path} (the "
+            "scene files differ): give the scene it was recorded in"
+        )
+    render_run(scene, run, output)
     console.print(f"{output}: animation written")
 
 

@@ -178,6 +178,7 @@ def simulate(
     meta = {
         "scene": scene.name,
         "scene_file": str(scene.path),
+        "scene_sha1": scene.sha1,
         "seed": str(config.seed),
         "dt": str(config.dt),
         "robots": ",".join(a.setup.name for a in agents),

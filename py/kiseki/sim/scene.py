@@ -30,6 +30,7 @@ file, the field and the value.
 
 from __future__ import annotations
 
+import hashlib
 import math
 import os
 from dataclasses import dataclass, field
@@ -40,7 +41,7 @@ import numpy as np
 import yaml
 
 from kiseki import _core
-from kiseki._support.inputs import MIB, YAML_LIMIT, check_input, read_input_text
+from kiseki._support.inputs import MIB, YAML_LIMIT, check_input, read_input
 from kiseki._support.schema import SchemaError, parse
 from kiseki._support.yaml import safe_load_12
 from kiseki.core import Pose2
@@ -113,6 +114,7 @@ class Scene:
     point_robots: bool = False
     # the parameters fitted to a paper's number: [{parameter, fitted_to, unit, source}]
     calibrated: list[dict] = field(default_factory=list)
+    sha1: str = ""  # of the scene file's bytes, as read (recorded with every run)
     _bands: dict = field(default_factory=dict, repr=False, compare=False)  # ground_truth's
 
     def ground_truth(
@@ -163,7 +165,8 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
         raise FileNotFoundError(f"{path}: scene file not found")
     try:
         # 5e-2 is a number, as in YAML 1.2
-        raw = safe_load_12(read_input_text(path, "scene files", YAML_LIMIT))
+        data = read_input(path, "scene files", YAML_LIMIT)
+        raw = safe_load_12(data.decode("utf-8"))
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a scene file (not UTF-8 text)") from None
     except yaml.YAMLError as err:
@@ -213,6 +216,7 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
         turns=_turns(doc.turns),
         poses=_poses(doc.poses),
         pedestrians=[Pedestrian(**p.model_dump()) for p in doc.pedestrians or []],
+        sha1=hashlib.sha1(data).hexdigest(),
         point_robots=doc.point_robots,
         calibrated=check_marks(raw, doc.calibrated, str(path)),
     )
