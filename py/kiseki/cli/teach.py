@@ -106,8 +106,10 @@ def teach_command(
             scene, out, seed, overwrite=overwrite, progress=True, merge=merge or "thesis"
         )
     names = ", ".join(m["name"] for m in result.marks)
+    if result.waypoints is None:
+        names = "none (no waypoints.yaml: playback and serve need a waypoint marked with m)"
     console.print(
-        f"{out}: {result.steps} steps, waypoints {names or 'none'}; maps "
+        f"{out}: {result.steps} steps, waypoints {names}; maps "
         + ", ".join(str(p) for p in result.maps.values())
         + f" ({result.merge} merge)"
     )

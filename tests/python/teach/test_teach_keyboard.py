@@ -103,6 +103,26 @@ def test_a_key_script_teaches_like_the_operator(tmp_path, project_root):
         np.testing.assert_array_equal(load_map(path).cells, load_map(result.maps[band]).cells)
 
 
+def test_a_teaching_without_a_mark_writes_its_maps_and_no_waypoint_file(tmp_path, project_root):
+    """An empty waypoint list was written, which playback and serve then refused as invalid;
+    one left by an earlier teaching in the folder belongs to other maps and goes."""
+    scene = load_scene(project_root / "data" / "worlds" / "factory_turn.yaml")
+    keys = tmp_path / "keys.txt"
+    keys.write_text("0.0 w\n1.0 m q\n")
+    with KeyScript(keys) as source:
+        marked = teach_keyboard(scene, tmp_path / "t", source, stream=io.StringIO())
+    assert marked.waypoints == tmp_path / "t" / "waypoints.yaml" and marked.waypoints.is_file()
+    keys.write_text("0.0 w\n1.0 q\n")
+    with KeyScript(keys) as source:
+        bare = teach_keyboard(scene, tmp_path / "t", source, overwrite=True, stream=io.StringIO())
+    assert (bare.marks, bare.waypoints) == ([], None)
+    assert sorted(p.name for p in (tmp_path / "t").iterdir()) == [
+        "map_band.pgm", "map_band.yaml", "map_plane.pgm", "map_plane.yaml", "map_truth.json",
+        "teach.mcap",
+    ]  # fmt: skip
+    assert all(load_map(path).cells.size > 0 for path in bare.maps.values())
+
+
 def test_the_readme_key_script_runs(tmp_path, project_root):
     readme = (project_root / "README.md").read_text(encoding="utf-8")
     section = readme[readme.index("### Teaching from the keyboard") :]

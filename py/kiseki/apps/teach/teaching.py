@@ -72,7 +72,7 @@ MARK_SCHEMA = {
 @dataclass(frozen=True)
 class TeachResult:
     maps: dict[str, Path]  # band -> map YAML
-    waypoints: Path
+    waypoints: Path | None  # None: no waypoint was marked, no waypoint file written
     log: Path
     steps: int
     marks: list[dict]
@@ -169,6 +169,10 @@ def _write_outputs(
         }
         Path(tmp).write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
 
+    if not marks:  # a waypoint file holds at least one (playback and serve refuse an empty one)
+        atomic_write_all(writes)
+        (out / "waypoints.yaml").unlink(missing_ok=True)  # an earlier teaching's, of other maps
+        return TeachResult(paths, None, log, steps, marks, merge, truth, scene)
     atomic_write_all([*writes, (out / "waypoints.yaml", waypoints)])
     return TeachResult(paths, out / "waypoints.yaml", log, steps, marks, merge, truth, scene)
 
