@@ -29,7 +29,14 @@ from pydantic import Field
 from kiseki import __version__
 from kiseki._support.atomic import atomic_write_all
 from kiseki._support.inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
-from kiseki._support.schema import FileModel, FiniteFloat, PositiveFloat, PositiveInt, parse
+from kiseki._support.schema import (
+    MAGNITUDE_LIMIT,
+    FileModel,
+    FiniteFloat,
+    PositiveFloat,
+    PositiveInt,
+    parse,
+)
 from kiseki._support.yaml import read_yaml_file, safe_load_12
 from kiseki.errors import KisekiError, MapFormatError
 from kiseki.magnetic.linear_map import LinearMagneticMap
@@ -165,6 +172,10 @@ def _read_nodes(path: Path, n: int) -> dict[str, np.ndarray]:
         nan_ok = name in ("g", "position")
         if (np.isinf(a) if nan_ok else ~np.isfinite(a)).any():
             raise MapFormatError(f"{path}: '{name}' holds NaN or infinity")
+        if (np.abs(a) > MAGNITUDE_LIMIT).any():
+            raise MapFormatError(
+                f"{path}: '{name}' holds {np.nanmax(np.abs(a)):g}, beyond +-{MAGNITUDE_LIMIT:g}"
+            )
     if (found["count"] < 0).any():
         raise MapFormatError(f"{path}: 'count' holds negative numbers")
     return found

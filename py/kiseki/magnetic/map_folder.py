@@ -34,6 +34,7 @@ them back checked; the map type (:mod:`kiseki.magnetic.field_map`) builds on thi
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import struct
@@ -48,6 +49,7 @@ import yaml
 
 from kiseki._support.atomic import record_written
 from kiseki._support.inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
+from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki._support.yaml import read_yaml_file, safe_load_12
 from kiseki.errors import MapFormatError
 from kiseki.io.ros_map import read_image, write_image
@@ -194,7 +196,9 @@ def _file(folder: Path, files: dict, key: str, meta: Path) -> Path:
     return path
 
 
-def _read_npz(path: Path, shapes: dict[str, tuple]) -> dict[str, np.ndarray]:
+def _read_npz(
+    path: Path, shapes: dict[str, tuple], limit: float = MAGNITUDE_LIMIT
+) -> dict[str, np.ndarray]:
     check_npz(path, "the files of magnetic field maps", MAX_FILE_BYTES, MapFormatError)
     try:
         with np.load(path, allow_pickle=False) as npz:
@@ -211,6 +215,8 @@ def _read_npz(path: Path, shapes: dict[str, tuple]) -> dict[str, np.ndarray]:
             raise _fail(path, f"'{key}' has shape {a.shape}, expected {shape} (see the YAML)")
         if a.dtype.kind not in "fiu" or not np.all(np.isfinite(a)):
             raise _fail(path, f"'{key}' holds NaN, infinity or non-numbers")
+        if a.size and np.abs(a).max() > limit:
+            raise _fail(path, f"'{key}' holds {np.abs(a).max():g}, beyond +-{limit:g}")
     return found
 
 
@@ -294,7 +300,8 @@ def _read_training(
             | {"indices": (None, None)}
         )
         predictor = _file(folder, doc.files, "predictor", meta)
-        training["predictor"] = _read_npz(predictor, shapes)
+        # a factor or weights of a GP: any finite size (a nearly singular kernel makes them large)
+        training["predictor"] = _read_npz(predictor, shapes, math.inf)
         return training, path, predictor
     return training, path, None
 

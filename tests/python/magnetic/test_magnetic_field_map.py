@@ -227,10 +227,10 @@ def _edit_yaml(folder, **changes):
     path.write_text(yaml.safe_dump(doc))
 
 
-def _nan_layer(folder):
+def _nan_layer(folder, value=np.nan):
     with np.load(folder / "layers.npz") as npz:
         arrays = dict(npz)
-    arrays["my_variance"][0, 0] = np.nan
+    arrays["my_variance"][0, 0] = value
     np.savez(folder / "layers.npz", **arrays)
 
 
@@ -255,6 +255,8 @@ def _cut_in_half(path):
         (lambda f: (f / "layers.npz").unlink(), "layers.npz", "missing"),
         (lambda f: _edit_yaml(f, shape={"x": 7, "y": 6}), "mx_mean.png", "the YAML says"),
         (lambda f: _nan_layer(f), "layers.npz", "NaN"),
+        # finite but past the +-1e9 every number in a file keeps to: rendered before
+        (lambda f: _nan_layer(f, 1e300), "layers.npz", "'my_variance' holds 1e\\+300, beyond"),
         (lambda f: (f / "training.npz").write_text("x"), "training.npz", "not a readable"),
         (lambda f: _cut_in_half(f / "layers.npz"), "layers.npz", "not a readable"),
         (lambda f: _edit_yaml(f, dimension=4), MAP_FILE, "dimension: must be 2 or 3, got 4"),
