@@ -138,7 +138,10 @@ def terrain_stops(
         heading = float(angles[int(np.argmax(reach))])
         free = float(np.max(reach)) - 0.6
         end = np.array([x, y]) + max(free, 0.0) * np.array([math.cos(heading), math.sin(heading)])
-        plan = _polyline_points(np.array([[x, y], end]), step, moves + 1)
+        try:
+            plan = _polyline_points(np.array([[x, y], end]), step, moves + 1)
+        except ValueError as err:
+            raise ValueError(f"{path}: the longest free line from the start: {err}") from None
         length, width, height = BT_FOOTPRINT
         mount, laser = BT_MOUNT, TiltingLaser(TiltingLaserParams(), seed)
     else:
@@ -151,7 +154,10 @@ def terrain_stops(
         waypoints = np.asarray(scene.route.get("waypoints", []), dtype=float)
         if waypoints.ndim != 2 or len(waypoints) < 2:
             raise ValueError(f"{path}: the scene's route needs at least two waypoints")
-        plan = _polyline_points(waypoints, step, moves + 1)
+        try:
+            plan = _polyline_points(waypoints, step, moves + 1)
+        except ValueError as err:
+            raise ValueError(f"{path}: {err}") from None
         length, width, height = robot.length, robot.width, robot.height
         mount, laser = lasers[0].mount, lasers[0].device
     stops = []

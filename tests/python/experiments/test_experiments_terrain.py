@@ -176,3 +176,12 @@ def test_global_map_control_places_every_stop_at_the_start(tmp_path):
     true = np.array([s.sensor[:3, 3] for s in stops])
     assert row["final_error_m"] == pytest.approx(np.linalg.norm(true[-1] - true[0]), abs=1e-9)
     assert row["drift_share"] > 0.9  # the route bends a little: far above the 10 % criterion
+    # more moves than the route holds: the message names the scene (it named nothing)
+    legs = np.diff(np.array(load_scene(WORLDS / "rubble_a.yaml").route["waypoints"]), axis=0)
+    route = float(np.hypot(legs[:, 0], legs[:, 1]).sum())
+    with pytest.raises(ValueError) as caught:
+        terrain_stops(WORLDS / "rubble_a.yaml", 200, 0, 0.35)
+    assert str(caught.value) == (
+        f"{WORLDS / 'rubble_a.yaml'}: the route is {route:.2f} m long: at most "
+        f"{int(route / 0.35 + 1e-9)} moves of 0.35 m"
+    )
