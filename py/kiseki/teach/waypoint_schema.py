@@ -8,7 +8,7 @@ and read by ``kiseki playback`` and ``kiseki serve``; it may have been edited by
     scene_file: ../data/worlds/x.yaml  # the scene taught in (from this folder; older files:
     scene_sha1: 0123...                # from the teaching's working directory) and its SHA-1
     maps:                            # band -> the taught map's YAML and its image's SHA-1
-      band: {file: map_band.yaml, image_sha1: 0123...}
+      band: {file: map_band.yaml, image_sha1: 0123..., resolution: 0.1, origin: [x, y, yaw]}
     waypoints:                       # the marks: name, odometry pose, true pose (optional)
       - {id: 0, name: P0, x: 0.0, y: 0.0, theta: 0.0, truth: [0.0, 0.0, 0.0]}
 
@@ -26,7 +26,14 @@ from typing import Annotated, Any
 from pydantic import AfterValidator, Field, field_validator, model_validator
 
 from kiseki._support.inputs import check_input
-from kiseki._support.schema import INT32_MAX, FileModel, FiniteFloat, SchemaError, parse
+from kiseki._support.schema import (
+    INT32_MAX,
+    FileModel,
+    FiniteFloat,
+    PositiveFloat,
+    SchemaError,
+    parse,
+)
 from kiseki._support.yaml import read_yaml_file
 
 __all__ = [
@@ -64,11 +71,15 @@ def _mapping(value: Any, what: str) -> Any:
 
 
 class TaughtMap(FileModel):
-    """One band's taught map: its ROS map YAML (beside the waypoint file) and the SHA-1 of
-    its image, which ties the waypoints to the map they were taught with."""
+    """One band's taught map: its ROS map YAML (beside the waypoint file), the SHA-1 of its
+    image and the resolution and origin its YAML gave the image, which tie the waypoints to the
+    map they were taught with (waypoint files written before the geometry was recorded have
+    none: only their image is checked)."""
 
     file: Annotated[str, Field(strict=True, min_length=1, max_length=4096)]
     image_sha1: Sha1
+    resolution: PositiveFloat | None = None
+    origin: tuple[FiniteFloat, FiniteFloat, FiniteFloat] | None = None
 
     @model_validator(mode="before")
     @classmethod

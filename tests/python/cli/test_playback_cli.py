@@ -82,3 +82,23 @@ def test_playback_from_waypoints_on_a_copy_of_the_map(tmp_path, project_root):
     done = kiseki("playback", *common, "--map", "copy/map_band.yaml", cwd=tmp_path)
     assert done.returncode == 1 and "is not the one" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
+    # teach records each map's resolution and origin with its image's digest: the same image
+    # at another resolution or origin (the YAML edited) puts the waypoints elsewhere and is
+    # refused too (only the image was checked; the robot was played back on it)
+    shutil.copy(tmp_path / "t" / "map_band.pgm", tmp_path / "copy" / "map_band.pgm")
+    taught = yaml.safe_load((tmp_path / "t" / "map_band.yaml").read_text())
+    for band, entry in doc["maps"].items():
+        saved = yaml.safe_load((tmp_path / "t" / f"map_{band}.yaml").read_text())
+        entry.update(resolution=saved["resolution"], origin=saved["origin"])
+    (tmp_path / "t" / "waypoints.yaml").write_text(yaml.safe_dump(doc, sort_keys=False))
+    before = f"resolution {taught['resolution']:g} m and origin {taught['origin']}"
+    for key, value in (("resolution", 2 * taught["resolution"]), ("origin", [0.0, 0.0, 0.0])):
+        edited = {**taught, key: value}
+        (tmp_path / "copy" / "map_band.yaml").write_text(yaml.safe_dump(edited))
+        done = kiseki("playback", *common, "--map", "copy/map_band.yaml", cwd=tmp_path)
+        now = f"resolution {edited['resolution']:g} m and origin {edited['origin']}"
+        assert (done.returncode, done.stderr.strip()) == (
+            1,
+            f"kiseki: error: copy/map_band.yaml: {now}, but t/waypoints.yaml was taught on "
+            f"{before}",
+        )

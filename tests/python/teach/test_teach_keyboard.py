@@ -112,6 +112,14 @@ def test_a_teaching_without_a_mark_writes_its_maps_and_no_waypoint_file(tmp_path
     with KeyScript(keys) as source:
         marked = teach_keyboard(scene, tmp_path / "t", source, stream=io.StringIO())
     assert marked.waypoints == tmp_path / "t" / "waypoints.yaml" and marked.waypoints.is_file()
+    # each map's entry ties the waypoints to its image and to the geometry its YAML gives it
+    entries = yaml.safe_load(marked.waypoints.read_text())["maps"]
+    for band, path in marked.maps.items():
+        saved = yaml.safe_load(path.read_text())
+        assert (entries[band]["resolution"], entries[band]["origin"]) == (
+            saved["resolution"],
+            saved["origin"],
+        )
     keys.write_text("0.0 w\n1.0 q\n")
     with KeyScript(keys) as source:
         bare = teach_keyboard(scene, tmp_path / "t", source, overwrite=True, stream=io.StringIO())

@@ -156,15 +156,23 @@ def _write_outputs(
             (out / "map_truth.json", lambda tmp: Path(tmp).write_text(truth_text, "utf-8"))
         )
 
+    def taught_map(band: str, p: Path) -> dict:
+        """What ties the waypoints to a map: its file, its image's digest, its geometry."""
+        origin = maps[band].origin
+        return {
+            "file": p.name,
+            "image_sha1": digests[band],
+            "resolution": float(maps[band].resolution),
+            "origin": [float(origin.x), float(origin.y), float(origin.theta)],
+        }
+
     def waypoints(tmp: str) -> None:  # after the images: it records their digests
         doc = {
             "log": log.name,
             "merge": merge,
             "scene_file": scene.file,
             "scene_sha1": scene.sha1,
-            "maps": {
-                band: {"file": p.name, "image_sha1": digests[band]} for band, p in paths.items()
-            },
+            "maps": {band: taught_map(band, p) for band, p in paths.items()},
             "waypoints": marks,
         }
         Path(tmp).write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
@@ -455,6 +463,21 @@ def load_taught(folder: str | os.PathLike, band: str, route: list[str]) -> tuple
     return load_route(Path(folder) / "waypoints.yaml", band, route)
 
 
+def _check_geometry(map_path: Path, taught, waypoints: Path) -> None:
+    """The map's resolution and origin are those it was taught with (the waypoints are poses in
+    its frame): an edited YAML puts the same image elsewhere or at another scale."""
+    if taught.resolution is None and taught.origin is None:
+        return  # a waypoint file from before the geometry was recorded
+    meta = read_map_metadata(map_path)
+    now = (float(meta.resolution), tuple(float(v) for v in meta.origin))
+    then = (taught.resolution, tuple(taught.origin or ()))
+    if now != then:
+        raise ValueError(
+            f"{map_path}: resolution {now[0]:g} m and origin {list(now[1])}, but {waypoints} "
+            f"was taught on resolution {then[0]:g} m and origin {list(then[1])}"
+        )
+
+
 def load_route(
     waypoints: str | os.PathLike,
     band: str,
@@ -486,6 +509,7 @@ def load_route(
                 f"{band!r} map"
             )
         raise ValueError(f"{map_path}: this map is not the one {path} was taught with")
+    _check_geometry(map_path, doc.maps[band], path)
     by_name = doc.by_name()
     unknown = [n for n in route if n not in by_name]
     if unknown:
