@@ -112,6 +112,17 @@ def test_a_killed_teaching_run_is_recovered_losing_under_a_second(tmp_path, proj
 
 def test_bad_input(tmp_path, project_root):
     scene_file = project_root / "data" / "worlds" / "factory_corridor.yaml"
+    # a route point outside the scene: taught before (the robot drove off the world), the
+    # waypoints then refused by playback as lying off the taught map
+    far = tmp_path / "far.yaml"
+    far.write_text(scene_file.read_text().replace("[13.0, 0.0]]", "[50.0, 0.0]]"))
+    assert load_scene(far).route["waypoints"][-1] == [50.0, 0.0]
+    with pytest.raises(ValueError) as caught:
+        teach(load_scene(far), tmp_path / "far")
+    assert str(caught.value) == (
+        f"{far}: route waypoint P2 [50.0, 0.0] lies outside the scene's bounds x -1.5..15, y -2..2"
+    )
+    assert not (tmp_path / "far").exists()
     taught = teach(load_scene(scene_file), tmp_path / "t", seed=1)
     with pytest.raises(ValueError, match="no waypoint named P7"):
         load_taught(tmp_path / "t", "band", ["P0", "P7"])
