@@ -286,6 +286,21 @@ TEST(PcdFile, RefusesAHeaderThatDoesNotDescribeItsData) {
   // 3 points of 12 bytes are 36 bytes; the text holds 18
   refused("3", "POINTS 3\n", "binary", three, "truncated");
   refused("1", "POINTS 1\n", "binary", three, "12 bytes of binary data declared, 18 present");
+  // older PCL writers padded binary files with zeros up to a page: read, as PCL reads them;
+  // bytes that are not zeros are data the header does not declare
+  write_pcd(path, mound_floor(2, 20));
+  const PcdCloud whole = read_pcd(path);
+  {
+    std::ofstream pad(path, std::ios::binary | std::ios::app);
+    pad << std::string(4000, '\0');
+  }
+  const PcdCloud padded = read_pcd(path);
+  EXPECT_EQ(padded.points, whole.points);
+  {
+    std::ofstream more(path, std::ios::binary | std::ios::app);
+    more << "x";
+  }
+  EXPECT_THROW(read_pcd(path), std::runtime_error);
   std::filesystem::remove_all(dir);
 }
 

@@ -115,6 +115,10 @@ PcdHeader read_header(std::ifstream& in, const std::string& path) {
   return h;
 }
 
+// Zero bytes that older PCL releases' binary writer left after the data: it sized the file to
+// a memory page plus the data (the header shorter than a page), 4 kB or 64 kB pages.
+constexpr unsigned long long kPcdPadding = 65536;
+
 double float_at(const unsigned char* p, unsigned long long size) {
   if (size == 8) {
     double v;
@@ -187,14 +191,20 @@ PcdCloud read_pcd(const std::string& path) {
     std::vector<unsigned char> data;
     if (h.data == "binary") {
       if (bytes > left) throw truncated(std::to_string(bytes) + " bytes of binary data declared, " + std::to_string(left) + " present");
-      // More bytes than the points need: the header does not describe the data (text data
-      // declared binary, or too few points declared).
-      if (bytes < left) {
-        throw std::runtime_error(path + ": not a valid PCD file (" + std::to_string(bytes) +
-                                 " bytes of binary data declared, " + std::to_string(left) + " present)");
-      }
       data.resize(static_cast<std::size_t>(bytes));
       in.read(reinterpret_cast<char*>(data.data()), static_cast<std::streamsize>(bytes));
+      // More bytes than the points need: the header does not describe the data (text data
+      // declared binary, or too few points declared), unless they are zeros of older PCL
+      // writers' padding (kPcdPadding).
+      if (bytes < left) {
+        std::vector<char> rest(static_cast<std::size_t>(std::min<unsigned long long>(left - bytes, kPcdPadding + 1)));
+        in.read(rest.data(), static_cast<std::streamsize>(rest.size()));
+        const bool padding = left - bytes <= kPcdPadding && std::all_of(rest.begin(), rest.end(), [](char c) { return c == 0; });
+        if (!padding) {
+          throw std::runtime_error(path + ": not a valid PCD file (" + std::to_string(bytes) +
+                                   " bytes of binary data declared, " + std::to_string(left) + " present)");
+        }
+      }
     } else {
       std::uint32_t sizes[2] = {0, 0};
       in.read(reinterpret_cast<char*>(sizes), sizeof sizes);
