@@ -86,6 +86,12 @@ class TaughtMap(FileModel):
     def _is_mapping(cls, value: Any) -> Any:
         return _mapping(value, "file and image_sha1")
 
+    @model_validator(mode="after")
+    def _geometry_whole(self) -> TaughtMap:
+        if (self.resolution is None) != (self.origin is None):
+            raise ValueError("resolution and origin are recorded together (or neither)")
+        return self
+
 
 class Waypoint(FileModel):
     """A mark: its name, the odometry pose where it was marked (map frame) and, in simulation,

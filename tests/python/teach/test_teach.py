@@ -143,6 +143,19 @@ def test_bad_input(tmp_path, project_root):
         load_route(waypoints, "band", ["P0", "P2"], tmp_path / "o" / "map_plane.yaml")
     with pytest.raises(ValueError, match=r"waypoints.yaml: image: missing \(and \d+ more\)"):
         load_route(waypoints, "band", ["P0", "P2"], waypoints)  # checked as a ROS map YAML
+    # the map's YAML re-saved with its origin's digits rounded is the taught map; moved by
+    # half a cell it is not
+    band_yaml = tmp_path / "o" / "map_band.yaml"
+    taught_yaml = yaml.safe_load(band_yaml.read_text())
+    for shift, same in ((1e-9, True), (0.05, False)):
+        moved = [taught_yaml["origin"][0] + shift, *taught_yaml["origin"][1:]]
+        band_yaml.write_text(yaml.safe_dump({**taught_yaml, "origin": moved}))
+        if same:
+            assert load_route(waypoints, "band", ["P0", "P2"])[0] == band_yaml
+            continue
+        with pytest.raises(ValueError, match=r"map_band.yaml: resolution 0.1 m and origin \["):
+            load_route(waypoints, "band", ["P0", "P2"])
+    band_yaml.write_text(yaml.safe_dump(taught_yaml))
     # a waypoint edited off the taught map (the robot drove out through the walls before)
     doc = yaml.safe_load(waypoints.read_text())
     doc["waypoints"][2]["x"] = 700.0

@@ -130,10 +130,23 @@ def _problem(tmp_path, change) -> str:
             lambda d: d["maps"]["band"].update(image_sha1=None),
             "maps.band.image_sha1: must be a valid string, got None",
         ),
+        (
+            lambda d: d["maps"]["band"].update(resolution=0.1, origin=[0.0, 0.0]),
+            "maps.band.origin[2]: missing",
+        ),
     ],
 )
 def test_a_wrong_value_is_named_by_its_path(tmp_path, change, expected):
     assert _problem(tmp_path, change) == expected
+
+
+def test_a_map_s_geometry_is_recorded_whole_or_not_at_all(tmp_path):
+    """One of resolution and origin alone made playback fail on None (a traceback)."""
+    for field, value in (("origin", [0.0, 0.0, 0.0]), ("resolution", 0.1)):
+        problem = _problem(tmp_path, lambda d, f=field, v=value: d["maps"]["band"].update({f: v}))
+        assert problem.startswith(
+            "maps.band: resolution and origin are recorded together (or neither), got {"
+        )
 
 
 def test_every_problem_is_kept(tmp_path):

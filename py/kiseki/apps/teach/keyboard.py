@@ -9,7 +9,7 @@ Keys (like ``teleop_twist_keyboard``, but each press changes the command by one 
 w / Up and s / Down raise and lower the forward speed by 0.1 m/s, a / Left and d / Right the
 turn rate (counter-clockwise positive) by 0.1 rad/s, both within the robot's limits; space
 stops; m marks a waypoint at the odometry pose, named P0, P1, ...; q finishes and writes the
-maps and the waypoint file.
+maps and the waypoint file (no waypoint file when nothing was marked).
 
 Keys come from the terminal (cbreak mode, no Enter needed; the terminal's mode is restored on
 exit, also on an exception, Ctrl-C or SIGTERM) or from a key script for tests and demos: lines

@@ -321,8 +321,8 @@ class TeachingRun:
             raise self._log_error(err) from err
 
     def finish(self) -> TeachResult:
-        """Closes the log and writes the maps, the waypoint file and the maps measured
-        against the scene's truth (map_truth.json)."""
+        """Closes the log and writes the maps, the waypoint file (when a waypoint was marked)
+        and the maps measured against the scene's truth (map_truth.json)."""
         self.close()
         maps = {b: m.map() for b, m in self.maps.items()}
         truth = measure_taught_maps(self.scene, maps, np.array(self.truths), self.cameras)
@@ -473,15 +473,21 @@ def load_taught(folder: str | os.PathLike, band: str, route: list[str]) -> tuple
 def _check_geometry(map_path: Path, taught, waypoints: Path) -> None:
     """The map's resolution and origin are those it was taught with (the waypoints are poses in
     its frame): an edited YAML puts the same image elsewhere or at another scale."""
-    if taught.resolution is None and taught.origin is None:
-        return  # a waypoint file from before the geometry was recorded
+    if taught.resolution is None:
+        return  # a waypoint file from before the geometry was recorded (the schema: both or none)
     meta = read_map_metadata(map_path)
-    now = (float(meta.resolution), tuple(float(v) for v in meta.origin))
-    then = (taught.resolution, tuple(taught.origin or ()))
-    if now != then:
+    now = (float(meta.resolution), [float(v) for v in meta.origin])
+    then = (taught.resolution, list(taught.origin))
+    # equal but for the digits a hand-saved YAML may round: a millionth of the resolution, a
+    # thousandth of a cell and of a radian
+    same = math.isclose(now[0], then[0], rel_tol=1e-6) and all(
+        abs(a - b) <= 1e-3 * (then[0] if k < 2 else 1.0)
+        for k, (a, b) in enumerate(zip(now[1], then[1], strict=True))
+    )
+    if not same:
         raise ValueError(
-            f"{map_path}: resolution {now[0]:g} m and origin {list(now[1])}, but {waypoints} "
-            f"was taught on resolution {then[0]:g} m and origin {list(then[1])}"
+            f"{map_path}: resolution {now[0]:g} m and origin {now[1]}, but {waypoints} was "
+            f"taught on resolution {then[0]:g} m and origin {then[1]}"
         )
 
 
