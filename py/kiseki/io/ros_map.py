@@ -104,7 +104,7 @@ def read_map_metadata(path: str | os.PathLike) -> MapMetadata:
 
 
 _PNG = b"\x89PNG\r\n\x1a\n"
-_PNG_END = b"\x00\x00\x00\x00IEND\xaeB`\x82"  # the IEND chunk: no data, a fixed CRC
+_PNG_MAX_CHUNKS = 1_000_000  # a PNG of more chunks than this is left to the decoder to judge
 _IMAGE_HEADER_BYTES = 65536  # a PGM header with its comments fits in this
 
 
@@ -120,10 +120,21 @@ _PNG_CUT = "a truncated PNG (it does not end with the IEND chunk)"
 
 
 def _png_is_whole(f, size: int) -> bool:
-    """Whether an open PNG file ends with its IEND chunk (bytes after it tolerated): libpng
-    prints its own lines on stderr for a file cut short before OpenCV reports the failure."""
-    f.seek(max(size - 1024, 0))
-    return _PNG_END in f.read(1024)
+    """Whether an open PNG file holds its IEND chunk, found by walking the chunks' headers
+    (length, type) from the signature; bytes after it are the reader's to ignore, as libpng
+    does. libpng prints its own lines on stderr for a file cut short before OpenCV reports the
+    failure. A file of more than _PNG_MAX_CHUNKS chunks is left to the decoder."""
+    at = len(_PNG)
+    for _ in range(_PNG_MAX_CHUNKS):
+        f.seek(at)
+        head = f.read(8)
+        if len(head) < 8:
+            return False
+        length = struct.unpack(">I", head[:4])[0]
+        if head[4:8] == b"IEND":
+            return at + 12 <= size
+        at += 12 + length  # length, type, data, CRC
+    return True
 
 
 def _check_image_header(path: Path, image: Path) -> None:
@@ -150,9 +161,9 @@ def _check_image_header(path: Path, image: Path) -> None:
         fields: list[bytes] = []
         at = 2
         while len(fields) < 3 and at < len(head):
-            if head[at : at + 1] == b"#":  # a comment runs to the end of its line
-                end = head.find(b"\n", at)
-                at = len(head) if end < 0 else end + 1
+            if head[at : at + 1] == b"#":  # a comment runs to the end of its line (LF or CR)
+                ends = [e for e in (head.find(b"\n", at), head.find(b"\r", at)) if e >= 0]
+                at = min(ends) + 1 if ends else len(head)
             elif head[at : at + 1].isspace():
                 at += 1
             else:
@@ -171,7 +182,7 @@ def _check_image_header(path: Path, image: Path) -> None:
         if head.startswith(b"P2"):  # text: every word after the header a pixel value
             f.seek(at)
             words = _text_pixels(f, refused)
-            if words < width * height:
+            if words is not None and words < width * height:
                 raise refused(f"a truncated PGM ({words} of the {width * height} pixels)")
             return
         need = width * height * (1 if maxval < 256 else 2)
@@ -182,12 +193,15 @@ def _check_image_header(path: Path, image: Path) -> None:
         )
 
 
-def _text_pixels(f, refused: Callable[[str], MapFormatError]) -> int:
+def _text_pixels(f, refused: Callable[[str], MapFormatError]) -> int | None:
     """The words of a text PGM's pixels from the file's position on, read 16 MB at a time;
-    refused at a byte that is neither a digit nor white space."""
+    refused at a byte that is neither a digit nor white space. None when a comment (#) lies
+    among them, which OpenCV's reader skips: the count is then the decoder's to judge."""
     space = np.frombuffer(b" \t\n\r\x0b\x0c", np.uint8)
     words, after_digit = 0, False
     while chunk := f.read(16 * 1024 * 1024):
+        if b"#" in chunk:
+            return None
         body = np.frombuffer(chunk, dtype=np.uint8)
         digit = (body >= ord("0")) & (body <= ord("9"))
         other = ~digit & ~np.isin(body, space)

@@ -335,10 +335,17 @@ def test_a_cut_png_is_one_line_and_whole_text_pgms_still_load(inputs):
             "kiseki: error: cut.yaml: cannot decode image cut.png: a truncated PNG (it does not "
             "end with the IEND chunk)"
         )
-    # the same pixels as a whole PNG and as a text PGM with a comment read as the P5 map does
+    # the same pixels as a whole PNG (also with 2 kB after its IEND chunk, which libpng
+    # ignores), as a text PGM with a comment, and as one with CR line ends and a comment among
+    # its pixels (OpenCV skips both) read as the P5 map does
+    (inputs / "tail.png").write_bytes(png + bytes(range(256)) * 8)
     text = " ".join(str(v) for v in pixels.ravel()).encode()
     (inputs / "text.pgm").write_bytes(b"P2\n# a comment\n120 80\n255\n" + text + b"\n")
-    for name in ("room.png", "text.pgm"):
+    half = len(text) // 2 + text[len(text) // 2 :].index(b" ")
+    (inputs / "cr.pgm").write_bytes(
+        b"P2\r# a comment\r120 80\r255\r" + text[:half] + b"\r# between\r" + text[half:] + b"\r"
+    )
+    for name in ("room.png", "tail.png", "text.pgm", "cr.pgm"):
         (inputs / "same.yaml").write_text(meta.replace("room.pgm", name))
         assert run("map", "info", "same.yaml", cwd=inputs).returncode == 0
         np.testing.assert_array_equal(read_image(inputs / name), pixels)
