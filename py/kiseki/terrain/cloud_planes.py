@@ -98,7 +98,8 @@ class CloudPlanes:
 
 def _pcd_viewpoint(path: Path) -> np.ndarray:
     """The VIEWPOINT translation of a PCD header, (0, 0, 0) when the header has none. Raises
-    ValueError when it has one that is not seven finite numbers (tx ty tz qw qx qy qz)."""
+    ValueError when it has one that is not seven finite numbers (tx ty tz qw qx qy qz), or
+    whose translation lies beyond +-ORIGIN_LIMIT."""
     with open(path, "rb") as f:
         head = f.read(4096).split(b"\nDATA", 1)[0]
     for line in head.decode("latin-1").splitlines():
@@ -110,6 +111,11 @@ def _pcd_viewpoint(path: Path) -> np.ndarray:
                 values = np.array([])
             if len(values) != 7 or not np.all(np.isfinite(values)):
                 raise ValueError(f"VIEWPOINT {' '.join(words[1:])!r} is not 7 finite numbers")
+            if not np.all(np.abs(values[:3]) <= ORIGIN_LIMIT):  # as --origin: 1e300 overflows
+                raise ValueError(
+                    f"VIEWPOINT {' '.join(words[1:4])!r}: the sensor lies beyond "
+                    f"+-{ORIGIN_LIMIT:g} m"
+                )
             return values[:3]
     return np.zeros(3)
 

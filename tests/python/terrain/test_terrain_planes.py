@@ -197,14 +197,18 @@ def test_text_reader_bz2_comments_nan_and_viewpoint(tmp_path):
         with pytest.raises(ValueError, match=wrong):
             read_cloud(pcd, bad)
     np.testing.assert_array_equal(read_cloud(pcd, "1e6,0,-1e6").origin, [1e6, 0, -1e6])
-    # a VIEWPOINT that is not seven finite numbers is refused (it was read as 0, 0, 0), unless
-    # the origin is given
+    # a VIEWPOINT that is not seven finite numbers is refused (it was read as 0, 0, 0, or as
+    # its first three numbers when those were finite), unless the origin is given
     for viewpoint in ("nan 2 3 1 0 0 0", "1 2 3", "1 2 x 1 0 0 0", "1 2 3 1 0 0 inf"):
         pcd.write_text(pcd.read_text().replace("VIEWPOINT 1 2 3 1 0 0 0", f"VIEWPOINT {viewpoint}"))
         with pytest.raises(ValueError, match=rf"v\.pcd: VIEWPOINT '{viewpoint}' is not 7 finite"):
             read_cloud(pcd)
         np.testing.assert_array_equal(read_cloud(pcd, "0,0,1").origin, [0, 0, 1])
         pcd.write_text(pcd.read_text().replace(f"VIEWPOINT {viewpoint}", "VIEWPOINT 1 2 3 1 0 0 0"))
+    # a sensor 1e300 m away is refused as --origin refuses it (it overflowed later)
+    pcd.write_text(pcd.read_text().replace("VIEWPOINT 1 2 3", "VIEWPOINT 1e300 2 3"))
+    with pytest.raises(ValueError, match=r"v\.pcd: VIEWPOINT '1e300 2 3': the sensor lies beyond"):
+        read_cloud(pcd)
 
 
 @pytest.mark.parametrize(
