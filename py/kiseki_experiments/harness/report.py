@@ -138,8 +138,8 @@ def _undecided(
     """For each inconclusive claim: the trials that would decide it (verdict.trials_to_decide)
     and their wall time at the run's mean trial time (one core). ``settings``: the most trials
     the run's config has (an experiment whose trials are its settings, as leave-one-out cases);
-    a claim that would need more is said to be beyond them, not given a run that cannot be
-    made."""
+    a claim that would need more is priced with that said: --runs cannot ask for them, a config
+    with more repeats (or data with more cases) can."""
     rows = claims[claims["verdict"].astype(str).eq("inconclusive")]
     if rows.empty:
         return []
@@ -157,15 +157,17 @@ def _undecided(
             lines.append(f"| {_cell(row.claim)} | {n} | none (on the threshold) | | |")
             continue
         run_trials = math.ceil(need * runs / n)  # a claim may take k of the run's trials
-        if settings is not None and run_trials > settings:
-            beyond = f"none: more than the {settings} settings of this config (one trial each)"
-            lines.append(f"| {_cell(row.claim)} | {n} | {int(need)} | {beyond} | |")
-            continue
+        shown = str(run_trials)
+        if settings is not None and run_trials > settings:  # --runs cannot ask for them
+            shown += (
+                f" (more than the {settings} settings of this config, one trial each: a "
+                "config with more repeats or cases)"
+            )
         wall = run_trials * per_trial
         when = (
             "" if math.isnan(wall) else f"{wall / 3600:.2f} h" if wall > 3600 else f"{wall:.0f} s"
         )
-        lines.append(f"| {_cell(row.claim)} | {n} | {int(need)} | {run_trials} | {when} |")
+        lines.append(f"| {_cell(row.claim)} | {n} | {int(need)} | {shown} | {when} |")
     return lines
 
 

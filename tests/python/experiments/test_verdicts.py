@@ -144,13 +144,16 @@ def test_reports_count_old_point_verdicts_as_undecided_and_price_the_undecided()
     wall = 2 * need
     shown = f"{wall / 3600:.2f} h" if wall > 3600 else f"{wall:.0f} s"
     assert row == f"| a share | 20 | {need} | {need} | {shown} |"
-    # an experiment whose trials are its config's settings (leave-one-out cases) cannot run
-    # more than it has: the claim is beyond them, without a run or a time (it was priced as a
-    # run the runner refuses); within them it is priced as before
-    beyond = _undecided(claims, 20, None, settings=need - 1)
+    # an experiment whose trials are its config's settings (leave-one-out cases, repeats)
+    # cannot run more than it has by --runs: the price says so (it priced a run the runner
+    # refuses without a word); within them it is priced as before
+    beyond = _undecided(claims, 20, pd.DataFrame({"trial_seconds": [1.0, 3.0]}), settings=need - 1)
     row = next(line for line in beyond if line.startswith("| a share |"))
-    want = f"none: more than the {need - 1} settings of this config (one trial each)"
-    assert row == f"| a share | 20 | {need} | {want} | |"
+    said = (
+        f"{need} (more than the {need - 1} settings of this config, one trial each: a config "
+        "with more repeats or cases)"
+    )
+    assert row == f"| a share | 20 | {need} | {said} | {shown} |"
     within = _undecided(claims, 20, pd.DataFrame({"trial_seconds": [1.0, 3.0]}), settings=need)
     kept = next(line for line in within if line.startswith("| a share |"))
     assert kept == f"| a share | 20 | {need} | {need} | {shown} |"
