@@ -67,7 +67,9 @@ class TaughtRun:
         self.band = METHODS[method][0]
         self.path = folder / "waypoints.yaml"
         if not self.path.is_file():
-            raise FileNotFoundError(f"{self.path}: no waypoint file (run kiseki teach first)")
+            raise FileNotFoundError(
+                f"{self.path}: no waypoint file (kiseki teach writes one when a waypoint is marked)"
+            )
         doc = self._read()  # names are unique (the model checks it)
         names = [w["name"] for w in doc["waypoints"]]
         if len(names) < 2:

@@ -172,7 +172,9 @@ def read_waypoint_file(path: str | os.PathLike) -> WaypointFile:
     path = Path(path)
     check_input(path)
     if not path.is_file():
-        raise FileNotFoundError(f"{path}: no waypoint file (run kiseki teach first)")
+        raise FileNotFoundError(
+            f"{path}: no waypoint file (kiseki teach writes one when a waypoint is marked)"
+        )
     doc = read_yaml_file(path, "kiseki waypoint file")
     if not isinstance(doc, dict) or not ({"waypoints", "maps"} & set(doc)):
         raise ValueError(f"{path}: not a kiseki waypoint file")

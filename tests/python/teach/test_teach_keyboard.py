@@ -25,6 +25,7 @@ from kiseki.apps.teach.keyboard import KeyScript, Teleop, decode_keys, teach_key
 from kiseki.apps.teach.teaching import recover
 from kiseki.io.runlog import read_run
 from kiseki.sim.scene import load_scene
+from kiseki.teach.waypoint_schema import read_waypoint_file
 
 termios = pytest.importorskip("termios")
 
@@ -129,6 +130,13 @@ def test_a_teaching_without_a_mark_writes_its_maps_and_no_waypoint_file(tmp_path
         "teach.mcap",
     ]  # fmt: skip
     assert all(load_map(path).cells.size > 0 for path in bare.maps.values())
+    # playback's message says why there is none (it said "run kiseki teach first")
+    with pytest.raises(FileNotFoundError) as caught:
+        read_waypoint_file(tmp_path / "t" / "waypoints.yaml")
+    assert str(caught.value) == (
+        f"{tmp_path / 't' / 'waypoints.yaml'}: no waypoint file (kiseki teach writes one when a "
+        "waypoint is marked)"
+    )
 
 
 def test_the_readme_key_script_runs(tmp_path, project_root):
