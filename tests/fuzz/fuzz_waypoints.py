@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""Fuzz the waypoint-file reader kiseki.apps.teach.teaching.load_route (the file ``kiseki teach``
-writes and ``kiseki playback`` reads), with a taught map beside it; see fuzz_common.py."""
+"""Fuzz the waypoint-file reader kiseki.apps.teach.taught_route.load_route (the file
+``kiseki teach`` writes and ``kiseki playback`` reads), with a taught map beside it; see
+fuzz_common.py."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ from pathlib import Path
 import yaml
 from fuzz_common import PROJECT_DATA, main
 
-from kiseki.apps.teach.teaching import load_route
+from kiseki.apps.teach.taught_route import load_route
 
 CORRIDOR = PROJECT_DATA / "maps" / "factory_corridor"
 

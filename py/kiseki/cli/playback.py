@@ -16,7 +16,7 @@ from kiseki._support.guard import Derived, guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import Seed
 from kiseki.apps.teach import PlaybackConfig, playback
-from kiseki.apps.teach.teaching import load_route
+from kiseki.apps.teach.taught_route import load_route
 from kiseki.cli._defaults import default_of
 from kiseki.grid import OccupancyGrid
 from kiseki.io.ros_map import load_map

@@ -18,7 +18,7 @@ import yaml
 
 from kiseki import _core
 from kiseki._support.atomic import atomic_write
-from kiseki.apps.teach.teaching import load_route
+from kiseki.apps.teach.taught_route import load_route
 from kiseki.grid import OccupancyGrid
 from kiseki.io.ros_map import load_map, write_image
 from kiseki.io.runlog import read_run

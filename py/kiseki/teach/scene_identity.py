@@ -83,7 +83,7 @@ class TaughtScene:
 
 def taught_scene_of(waypoints: str | os.PathLike) -> TaughtScene | None:
     """The taught scene recorded in a waypoint file (one
-    :func:`kiseki.apps.teach.teaching.load_route`
+    :func:`kiseki.apps.teach.taught_route.load_route`
     accepted), else in the metadata of the teaching log it names (waypoint files written before
     the scene was recorded in them); None when neither records it (a hand-made file)."""
 

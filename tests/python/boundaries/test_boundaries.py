@@ -13,7 +13,7 @@ import warnings
 import pytest
 import yaml
 
-from kiseki.apps.teach.teaching import load_route
+from kiseki.apps.teach.taught_route import load_route
 from kiseki.sim.run import read_commands
 
 RANDOM_BYTES = bytes(range(128, 256)) * 4  # not UTF-8

@@ -16,7 +16,7 @@ import pytest
 import yaml
 
 from kiseki.apps.teach.keyboard import KeyScript
-from kiseki.apps.teach.teaching import load_route
+from kiseki.apps.teach.taught_route import load_route
 from kiseki.io.ros_map import load_map
 from kiseki.sim.scene import load_scene
 

@@ -15,7 +15,7 @@ import pytest
 
 from kiseki import load_map
 from kiseki.apps.teach import PlaybackConfig, playback, teach
-from kiseki.apps.teach.teaching import load_taught
+from kiseki.apps.teach.taught_route import load_taught
 from kiseki.control import PurePursuit, SpeedLimit
 from kiseki.io.runlog import read_run
 from kiseki.sim.scene import load_scene

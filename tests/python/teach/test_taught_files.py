@@ -13,7 +13,7 @@ import hashlib
 import pytest
 import yaml
 
-from kiseki.apps.teach.teaching import load_route, waypoints_file_hash
+from kiseki.apps.teach.taught_route import load_route, waypoints_file_hash
 from kiseki.errors import MapFormatError
 from kiseki.grid import OccupancyGrid
 from kiseki.io.ros_map import save_map

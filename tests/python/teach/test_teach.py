@@ -18,7 +18,8 @@ import yaml
 
 from kiseki import _core, load_map
 from kiseki.apps.teach import PlaybackConfig, playback, teach
-from kiseki.apps.teach.teaching import load_route, load_taught, recover
+from kiseki.apps.teach.taught_route import load_route, load_taught
+from kiseki.apps.teach.teaching import recover
 from kiseki.cli.playback import check_on_the_map
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid

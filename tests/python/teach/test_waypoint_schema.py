@@ -13,7 +13,7 @@ import pytest
 import yaml
 
 from kiseki._support.schema import SchemaError, parse
-from kiseki.apps.teach.teaching import load_route
+from kiseki.apps.teach.taught_route import load_route
 from kiseki.grid import OccupancyGrid
 from kiseki.io.ros_map import save_map
 from kiseki.teach.scene_identity import TaughtScene, taught_scene_of
