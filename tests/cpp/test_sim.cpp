@@ -4,11 +4,14 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <sstream>
 #include <string>
 
+#include <octomap/OcTree.h>
 #include <opencv2/core.hpp>
 
 #include "kiseki/core/angle.hpp"
@@ -16,6 +19,7 @@
 #include "kiseki/sim/box_world.hpp"
 #include "kiseki/sim/depth_camera.hpp"
 #include "kiseki/sim/octree_world.hpp"
+#include "kiseki/io/octomap_file.hpp"
 
 using namespace kiseki;
 
@@ -186,6 +190,37 @@ TEST(OctreeWorld, VoxelisedBoxesCastWithinAVoxelAndRoundTripThroughBt) {
   std::fclose(g);
   EXPECT_THROW(OctreeWorld::read_binary(path + ".txt"), std::runtime_error);
   EXPECT_THROW(OctreeWorld::read_binary("/nonexistent/x.bt"), std::runtime_error);
+}
+
+TEST(OctomapFile, WritesOctomapsOwnBytesAndNothingToStderr) {
+  // the reference is OctoMap's own writer (writeBinaryConst), whose " done." on stderr is
+  // swallowed here; kiseki's writer must give the same bytes and print nothing
+  Random r(7);
+  for (const double resolution : {0.05, 0.1, 0.123456789}) {
+    octomap::OcTree tree(resolution);
+    for (int i = 0; i < 400; ++i) {
+      tree.updateNode(octomap::point3d(r.uniform(-3, 3), r.uniform(-3, 3), r.uniform(0, 2)), r.uniform(0, 1) < 0.7);
+    }
+    tree.toMaxLikelihood();
+    tree.prune();
+    std::ostringstream reference;
+    testing::internal::CaptureStderr();
+    ASSERT_TRUE(tree.writeBinaryConst(reference));
+    EXPECT_EQ(testing::internal::GetCapturedStderr(), " done.\n");  // why kiseki writes its own
+    const std::string path = testing::TempDir() + "kiseki_octomap_file.bt";
+    testing::internal::CaptureStderr();
+    write_octomap_binary(tree, path);
+    EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+    std::ifstream in(path, std::ios::binary);
+    const std::string written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(written, reference.str()) << "resolution " << resolution;
+    EXPECT_FALSE(std::filesystem::exists(path + ".partial"));
+    const OctreeWorld back = OctreeWorld::read_binary(path);
+    EXPECT_NEAR(back.resolution(), resolution, 5e-6 * resolution);  // 6 significant digits, as OctoMap
+  }
+  const std::string nowhere = testing::TempDir() + "no_such_folder/map.bt";
+  EXPECT_THROW(write_octomap_binary(octomap::OcTree(0.1), nowhere), std::runtime_error);
+  EXPECT_FALSE(std::filesystem::exists(nowhere + ".partial"));
 }
 
 TEST(DepthCamera, BoxWorldImageEqualsOneCastPerPixel) {

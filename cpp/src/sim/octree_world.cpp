@@ -2,6 +2,8 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/sim/octree_world.hpp"
 
+#include "kiseki/io/octomap_file.hpp"
+
 #include <octomap/OcTree.h>
 
 #include <fcntl.h>
@@ -182,7 +184,9 @@ std::size_t OctreeWorld::occupied_leaves() const {
 }
 
 void OctreeWorld::write_binary(const std::string& path) const {
-  if (!tree_->writeBinary(path)) throw std::runtime_error(path + ": cannot write OctoMap file");
+  tree_->toMaxLikelihood();  // as OctoMap's writeBinary: the world's voxels are free or occupied already
+  tree_->prune();
+  write_octomap_binary(*tree_, path);
 }
 
 void OctreeWorld::rasterize_band(double z_min, double z_max, OccupancyGrid& grid) const {

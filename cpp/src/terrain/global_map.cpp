@@ -2,11 +2,11 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/terrain/global_map.hpp"
 
+#include "kiseki/io/octomap_file.hpp"
+
 #include <octomap/OcTree.h>
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <stdexcept>
 #include <string>
 
@@ -78,27 +78,12 @@ Eigen::Matrix3Xd GlobalVoxelMap::occupied_centres() const {
 }
 
 void GlobalVoxelMap::write_binary(const std::string& path) const {
-  const std::string partial = path + ".partial";
-  // writeBinary prunes (so a copy keeps this map's leaves as they are); its file form also
-  // prints to stdout, the stream form does not.
+  // as OctoMap's writeBinary writes a tree (maximum likelihood, pruned), on a copy so that this
+  // map keeps its leaves as they are
   octomap::OcTree copy(*tree_);
   copy.toMaxLikelihood();
   copy.prune();
-  std::error_code ec;
-  bool ok = false;
-  {
-    std::ofstream out(partial, std::ios::binary);
-    ok = out && copy.writeBinaryConst(out) && out.flush();
-  }
-  if (!ok) {
-    std::filesystem::remove(partial, ec);
-    throw std::runtime_error(path + ": cannot write the OctoMap file");
-  }
-  std::filesystem::rename(partial, path, ec);
-  if (ec) {
-    std::filesystem::remove(partial, ec);
-    throw std::runtime_error(path + ": cannot write the OctoMap file (" + ec.message() + ")");
-  }
+  write_octomap_binary(copy, path);
 }
 
 }  // namespace kiseki

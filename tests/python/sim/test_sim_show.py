@@ -63,6 +63,7 @@ def test_sim_show_draws_each_band_where_it_is_and_exports_the_voxels(tmp_path):
     )
     assert done.returncode == 0, done.stderr
     assert "s.png: scene drawn; s.bt written" in " ".join(done.stdout.split())
+    assert done.stderr == ""  # OctoMap's own writer printed " done." there
     image = rgb(tmp_path / "s.png")
     found = {band: largest_blob(image, colour, tol=4) for band, colour in COLOURS.items()}
     middle = {band: middle_of(box) for band, box in BOXES.items()}
