@@ -136,7 +136,8 @@ def test_bad_input_is_refused(taught, tmp_path):
 
 def test_teach_refuses_a_route_it_cannot_map_and_a_robot_without_a_magnetometer(taught, tmp_path):
     """A teaching run that hit a wall wrote the map of the part it drove (exit 0, "114 nodes
-    over 11.3 m" of a 19 m route); a 0.05 m route wrote one node that navigate then failed on;
+    over 11.3 m" of a 19 m route); a 0.05 m route wrote one node that navigate then failed on (now
+    refused by its length, before the three teaching runs);
     a robot without a magnetometer named a deleted temporary run (teach) or drove past the goal
     with no reading (navigate, exit 0)."""
     scene, folder = taught
@@ -149,8 +150,8 @@ def test_teach_refuses_a_route_it_cannot_map_and_a_robot_without_a_magnetometer(
     short = tmp_path / "short.yaml"
     short.write_text(text.replace(str(SHORT), "[[0.0, 0.0], [0.05, 0.0]]"))
     assert refused("teach", short, "-o", tmp_path / "t2") == (
-        f"{short}: the route gives 1 node of the linear map (one every 0.1 m): too short to "
-        "navigate"
+        f"{short}: the route is 0.05 m long, shorter than the linear map's node spacing "
+        "(0.1 m): too short to navigate"
     )
     blind = tmp_path / "blind.yaml"
     lines = text.splitlines(keepends=True)

@@ -41,7 +41,12 @@ import numpy as np
 from kiseki.control.pd_steering import PdSteering
 from kiseki.core import derive_seed
 from kiseki.magnetic.gates import gate_limits, reading_noise_sd
-from kiseki.magnetic.linear_map import LinearMagneticMap, geometric_features, path_identity
+from kiseki.magnetic.linear_map import (
+    NODE_SPACING,
+    LinearMagneticMap,
+    geometric_features,
+    path_identity,
+)
 from kiseki.magnetic.linear_map_run import linear_map_from_run
 from kiseki.magnetic.navigators import DMZ_MAX, NAVIGATORS, RZ_MIN, MultiNavigator
 from kiseki.magnetic.rahok_navigation import (
@@ -165,6 +170,7 @@ def teach(
         raise ValueError(f"{scene_path}: the scene has no route to teach")
     check_magnetometer(scene, scene_path)
     waypoints = np.asarray(scene.route["waypoints"], dtype=np.float64)
+    _check_route_length(scene, scene_path, waypoints)
     path_id = path_identity(waypoints)
     maps = {}
     for k, (name, shift) in enumerate((("center", 0.0), ("left", offset), ("right", -offset))):
@@ -183,6 +189,19 @@ def teach(
             f"(one every {maps['center'].spacing:g} m): too short to navigate"
         )
     return TaughtMaps(maps["center"], maps["left"], maps["right"], waypoints)
+
+
+def _check_route_length(scene, scene_path, waypoints: np.ndarray) -> None:
+    """A drive (from the robot's start through the waypoints) shorter than the linear map's node
+    spacing cannot give the two nodes navigation needs: refused before the three runs."""
+    start = np.asarray(scene.robot.get("start", [0.0, 0.0, 0.0])[:2], dtype=np.float64)
+    drive = np.vstack([start, waypoints])
+    length = float(np.linalg.norm(np.diff(drive, axis=0), axis=1).sum())
+    if length < NODE_SPACING:
+        raise ValueError(
+            f"{scene_path}: the route is {length:.2f} m long, shorter than the linear map's "
+            f"node spacing ({NODE_SPACING:g} m): too short to navigate"
+        )
 
 
 def check_magnetometer(scene, scene_path) -> None:
