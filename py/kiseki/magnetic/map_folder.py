@@ -238,6 +238,25 @@ def _check_grid(path: Path, arrays: dict, origin: np.ndarray, resolution: float)
         raise _fail(path, "origin or resolution disagrees with the YAML")
 
 
+def _check_picture_scale(meta: Path, name: str, entry: dict) -> None:
+    """A layer's scale and offset say how its picture's pixels read as values (value = pixel x
+    scale + offset, for other tools; kiseki reads the arrays): finite, within the arrays' bound,
+    the scale >= 0, or the folder was edited by hand."""
+    for key in ("scale", "offset"):
+        v = entry.get(key)
+        if (
+            isinstance(v, bool)
+            or not isinstance(v, int | float)
+            or not abs(v) <= 2 * MAGNITUDE_LIMIT
+            or (key == "scale" and v < 0)
+        ):
+            want = "a finite number >= 0" if key == "scale" else "a finite number"
+            raise _fail(
+                meta,
+                f"layer '{name}': {key} must be {want} (value = pixel x scale + offset), got {v!r}",
+            )
+
+
 def _read_2d(folder: Path, doc: MagneticMapDoc, meta: Path, origin, resolution, shape) -> tuple:
 
     files = doc.files
@@ -248,6 +267,7 @@ def _read_2d(folder: Path, doc: MagneticMapDoc, meta: Path, origin, resolution, 
         entry = layers.get(name)
         if not isinstance(entry, dict):
             raise _fail(meta, f"layer '{name}' is not listed under files: layers")
+        _check_picture_scale(meta, name, entry)
         image = _file(folder, entry, "image", meta)
         _check_png_size(image, shape)
         try:
