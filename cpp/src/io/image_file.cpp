@@ -2,7 +2,9 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/io/image_file.hpp"
 
+#include <cctype>
 #include <cerrno>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -14,10 +16,23 @@
 namespace kiseki {
 
 cv::Mat read_image(const std::string& path) {
-  if (!std::ifstream(path).good()) throw std::runtime_error(path + ": cannot open image file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in.good()) throw std::runtime_error(path + ": cannot open image file");
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  in.seekg(0);
+  if (size < 0) throw std::runtime_error(path + ": cannot read image file");
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
+  if (!in.read(reinterpret_cast<char*>(bytes.data()), size)) throw std::runtime_error(path + ": cannot read image file");
+  if (bytes.empty()) throw std::runtime_error(path + ": cannot decode image (an empty file)");
+  // A text Netpbm image (P1, P2, P3) may end with its last value, without a line end after it
+  // (the format separates values by white space); OpenCV's decoder then fails on the missing
+  // delimiter ("Unexpected end of input stream") and prints so. One line end is added here.
+  const bool text_netpbm = bytes.size() > 2 && bytes[0] == 'P' && bytes[1] >= '1' && bytes[1] <= '3';
+  if (text_netpbm && !std::isspace(static_cast<unsigned char>(bytes.back()))) bytes.push_back('\n');
   cv::Mat image;
   try {
-    image = cv::imread(path, cv::IMREAD_UNCHANGED);
+    image = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
     throw std::runtime_error(path + ": cannot decode image (" + e.what() + ")");
   }

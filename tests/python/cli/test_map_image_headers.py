@@ -77,3 +77,25 @@ def test_a_cut_png_is_one_line_and_whole_text_pgms_still_load(inputs):
         (inputs / "same.yaml").write_text(meta.replace("room.pgm", name))
         assert run("map", "info", "same.yaml", cwd=inputs).returncode == 0
         np.testing.assert_array_equal(read_image(inputs / name), pixels)
+
+
+def test_a_text_pgm_ending_at_its_last_value_and_an_empty_image(inputs):
+    """A text PGM without a line end after its last value is a whole image (values are
+    separated by white space): OpenCV's decoder failed on it with its own line; an empty image
+    file said "cannot decode image" with no reason."""
+    from kiseki.io.ros_map import read_image
+
+    pixels = read_image(inputs / "room.pgm")
+    text = " ".join(str(v) for v in pixels.ravel()).encode()
+    (inputs / "end.pgm").write_bytes(b"P2\n120 80\n255\n" + text)  # no line end after the last
+    meta = (inputs / "room.yaml").read_text()
+    (inputs / "end.yaml").write_text(meta.replace("room.pgm", "end.pgm"))
+    done = run("map", "info", "end.yaml", cwd=inputs)
+    assert (done.returncode, done.stderr) == (0, "")
+    assert done.stdout == run("map", "info", "room.yaml", cwd=inputs).stdout
+    np.testing.assert_array_equal(read_image(inputs / "end.pgm"), pixels)
+    (inputs / "empty.pgm").write_bytes(b"")
+    (inputs / "empty.yaml").write_text(meta.replace("room.pgm", "empty.pgm"))
+    assert one_error(run("map", "info", "empty.yaml", cwd=inputs)).endswith(
+        "empty.pgm: cannot decode image (an empty file)"
+    )
