@@ -63,7 +63,7 @@ Eigen::Vector3d TranslationGrid::at(std::size_t k) const {
 }
 
 void CorrelationOptions::validate() const {
-  if (threads < 0) throw std::invalid_argument("correlation search: threads must be >= 0");
+  if (threads < 0 || threads > kMaxThreads) throw std::invalid_argument("correlation search: threads must be in 0..1024 (0 = every core)");
 }
 
 struct CorrelationSearch::Scratch {
@@ -226,7 +226,7 @@ CorrelationResult CorrelationSearch::exhaustive(const TranslationGrid& grid) con
   // points they keep); each writes only its own candidates, so the result is the same.
   const auto blocks = static_cast<long long>(bx) * by * bz;
   std::exception_ptr error;
-#pragma omp parallel num_threads(resolve_threads(options_.threads))
+#pragma omp parallel num_threads(std::min(resolve_threads(options_.threads), kMaxThreads))
   {
     try {
       Scratch s(fine_.current.size(), points());

@@ -13,12 +13,18 @@ namespace kiseki {
 
 namespace {
 
+constexpr double kPclCoordinateLimit = 1e6;  // m
+
 void require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument("PCL registration: " + message);
 }
 
 pcl::PointCloud<pcl::PointXYZ>::Ptr cloud_of(const Eigen::Matrix3Xd& p, const char* name) {
   require(p.allFinite(), std::string(name) + " holds NaN or infinity");
+  // PCL holds points as float: far beyond a sensor's reach its squared distances overflow and
+  // its search aborts the process (an assertion on "NaN, Inf" coordinates, from 1e20 m)
+  require(p.size() == 0 || p.cwiseAbs().maxCoeff() <= kPclCoordinateLimit,
+          std::string(name) + " holds coordinates beyond +-1e6 m");
   require(p.cols() >= 10, std::string(name) + " has fewer than 10 points");
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   cloud->resize(static_cast<std::size_t>(p.cols()));
@@ -60,6 +66,13 @@ PclRegistrationResult register_pcl(const Eigen::Matrix3Xd& source, const Eigen::
                                    const Eigen::Isometry3d& initial, const PclRegistrationParams& params) {
   params.validate();
   require(initial.matrix().allFinite(), "the initial guess holds NaN");
+  // a rigid motion: PCL aligns from any 4 x 4, a scaled or sheared guess gives a result no
+  // rotation explains
+  const Eigen::Matrix3d r = initial.linear();
+  require((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-6 && r.determinant() > 0,
+          "the initial guess is not a rigid motion (its 3 x 3 part is not a rotation)");
+  require(initial.translation().cwiseAbs().maxCoeff() <= kPclCoordinateLimit,
+          "the initial guess moves beyond +-1e6 m");
   if (params.method == "icp") {
     pcl::IterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> icp;
     return align(icp, source, target, initial, params);

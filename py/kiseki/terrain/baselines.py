@@ -34,9 +34,20 @@ def register_pcl(
     max_correspondence: float = 0.5,
     max_iterations: int = 50,
 ) -> Registration:
-    """Aligns source (n, 3) to target (m, 3) from ``initial`` (4x4; None: identity). Raises
-    ValueError for NaN points, fewer than 10 points or bad parameters."""
+    """Aligns source (n, 3) to target (m, 3) from ``initial`` (4x4 rigid motion; None:
+    identity). Raises ValueError for NaN points, points beyond +-1e6 m, fewer than 10 points, a
+    guess that is not a rigid motion or bad parameters."""
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, int | np.integer):
+        raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+    if max_iterations > 100_000:
+        raise ValueError(f"max_iterations must be at most 100000, got {max_iterations}")
     guess = np.eye(4) if initial is None else np.asarray(initial, dtype=float)
+    if (
+        guess.shape == (4, 4)
+        and np.isfinite(guess).all()
+        and not np.array_equal(guess[3], [0, 0, 0, 1])
+    ):
+        raise ValueError(f"initial: a rigid motion's last row is 0 0 0 1, got {guess[3].tolist()}")
     m, ok, fit = _core.register_pcl(
         source, target, guess, method, float(max_correspondence), int(max_iterations)
     )

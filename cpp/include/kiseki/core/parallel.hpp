@@ -13,6 +13,10 @@
 
 namespace kiseki {
 
+/// The most threads a request may ask for (each starts a thread of OpenMP's pool; the Python
+/// configs bound theirs alike).
+inline constexpr int kMaxThreads = 1024;
+
 /// The number of threads a request for `threads` means: 0 = every hardware thread.
 inline int resolve_threads(int threads) {
   if (threads > 0) return threads;
@@ -30,7 +34,8 @@ template <typename Body>
 void parallel_for(std::size_t n, int threads, Body&& body, std::size_t min_chunk = 256) {
   if (n == 0) return;
   const std::size_t by_size = std::max<std::size_t>(1, n / std::max<std::size_t>(1, min_chunk));
-  const std::size_t t = std::min<std::size_t>(static_cast<std::size_t>(resolve_threads(threads)), by_size);
+  const std::size_t asked = static_cast<std::size_t>(std::min(resolve_threads(threads), kMaxThreads));
+  const std::size_t t = std::min<std::size_t>(asked, by_size);
   if (t <= 1) {
     body(std::size_t{0}, n);
     return;
