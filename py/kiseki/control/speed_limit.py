@@ -39,6 +39,12 @@ class SpeedLimit:
     max_speed: float = 0.5
 
     def __post_init__(self) -> None:
+        if not isinstance(self.percentage, bool | np.bool_):  # "no" read as True
+            raise ValueError(f"percentage must be True or False, got {self.percentage!r}")
+        for name in ("speed_limit", "max_speed"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
+                raise ValueError(f"{name} must be a number (m/s, or percent), got {v!r}")
         if not (math.isfinite(self.speed_limit) and self.speed_limit >= 0):
             raise ValueError(f"speed_limit must be a finite number >= 0, got {self.speed_limit}")
         if not (math.isfinite(self.max_speed) and self.max_speed > 0):

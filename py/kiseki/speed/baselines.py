@@ -96,10 +96,25 @@ class AccelerationLimit:
 def _check_config(config, non_negative=()) -> None:
     for f in fields(config):
         value = getattr(config, f.name)
-        low_ok = value >= 0 if f.name in non_negative else value > 0
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and low_ok):
+        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        low_ok = number and (value >= 0 if f.name in non_negative else value > 0)
+        if not (number and math.isfinite(value) and low_ok):
             kind = ">= 0" if f.name in non_negative else "positive"
             raise ValueError(f"{type(config).__name__}.{f.name} must be {kind}, got {value!r}")
+    check_initial_speed(
+        type(config).__name__ + ".initial_speed", config.initial_speed, config.v_max
+    )
+
+
+def check_initial_speed(name: str, initial, v_max: float) -> None:
+    """A limiter's starting speed lies in [0, v_max]: above it, the first limits exceeded the
+    robot's maximum speed (they fall from there at a_max)."""
+    if (
+        isinstance(initial, bool)
+        or not isinstance(initial, (int, float))
+        or not 0 <= initial <= v_max
+    ):
+        raise ValueError(f"{name} must be a speed in [0, v_max = {v_max:g}] m/s, got {initial!r}")
 
 
 def points_in_motion_frame(sensor_pose, angles, ranges, max_range, heading, sensor_offset):

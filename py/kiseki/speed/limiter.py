@@ -37,7 +37,7 @@ import numpy as np
 from kiseki import _core
 from kiseki.control.speed_limit import SpeedLimit
 from kiseki.grid import OccupancyGrid
-from kiseki.speed.baselines import AccelerationLimit
+from kiseki.speed.baselines import AccelerationLimit, check_initial_speed
 
 __all__ = [
     "LimitTerms",
@@ -205,6 +205,7 @@ class SpeedLimiter:
             raise TypeError(f"grid must be a kiseki OccupancyGrid, got {type(grid).__name__}")
         self.grid = grid
         self.config = config or SpeedLimiterConfig()
+        check_initial_speed("initial", initial, self.config.v_max)
         self._rate = AccelerationLimit(self.config.a_max, initial)
         self.last: LimitTerms | None = None
 

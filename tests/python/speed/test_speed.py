@@ -178,6 +178,10 @@ def test_limiter_combines_the_terms_and_limits_acceleration():
         SpeedLimit(0.0).to_message()["stop"]
         and not SpeedLimit(0.0, True).as_percentage().to_message()["speed_limit"]
     )
+    # 'no' was read as a percentage (truthy): 50 "percent" became 0.25 m/s
+    for bad in ({"percentage": "no"}, {"speed_limit": True}, {"max_speed": "0.5"}):
+        with pytest.raises(ValueError, match="must be"):
+            SpeedLimit(**{"speed_limit": 50, **bad})
     only_width = SpeedLimiter(grid, SpeedLimiterConfig(use_occlusion=False))
     assert only_width.reference(pose, ANGLES, ranges, MAX_RANGE)["v_ref"] == pytest.approx(
         0.5 * width_factor(w)

@@ -250,8 +250,26 @@ def test_polygon_counts_match_a_brute_force_point_in_polygon(seed):
         (PolygonLimiterConfig, "slowdown_ratio", 1.5),
         (PolygonLimiterConfig, "min_points", 0),
         (PolygonLimiterConfig, "stop_ahead", -0.1),
+        # a starting speed above v_max made the first limits exceed the robot's maximum
+        (DistanceLimiterConfig, "initial_speed", 5.0),
+        (PolygonLimiterConfig, "initial_speed", 0.51),
+        (PolygonLimiterConfig, "a_max", True),
     ],
 )
 def test_bad_config_names_the_field(cls, field, value):
     with pytest.raises(ValueError, match=f"{cls.__name__}.{field}"):
         cls(**{field: value})
+
+
+def test_no_limiter_starts_above_the_robots_maximum_speed():
+    """SpeedLimiter(grid, initial=5.0) gave 4.95 m/s on a 0.5 m/s robot (the limit falls from
+    the starting speed at a_max); a start at v_max is the most it takes."""
+    from kiseki.speed import SpeedLimiter, SpeedLimiterConfig
+
+    grid = OccupancyGrid(40, 40, 0.1, Pose2(0.0, 0.0, 0.0), FREE)
+    for initial in (5.0, 0.5000001, -0.1, math.nan, True, "0.3"):
+        with pytest.raises(ValueError, match="initial must be a speed in \\[0, v_max = 0.5\\]"):
+            SpeedLimiter(grid, initial=initial)
+    limiter = SpeedLimiter(grid, SpeedLimiterConfig(), initial=0.5)
+    limit = limiter.update((2.0, 2.0, 0.0), ANGLES, wall_ahead(MAX_RANGE), MAX_RANGE, 0.1)
+    assert limit.speed_limit <= 0.5
