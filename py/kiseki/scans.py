@@ -28,6 +28,7 @@ the odometry is raw, how ``max_range`` was found). What every reader does alike:
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -63,6 +64,28 @@ class LaserScans:
     ranges: np.ndarray  # (N, B) float32 metres, C-contiguous; NaN: invalid (skipped)
     angles: np.ndarray  # (B,) float64 beam angles in the laser frame, radians
     max_range: float  # readings >= max_range mean no return
+
+    def __post_init__(self) -> None:
+        # the fields must describe the same scans: with times or odometry shorter than the
+        # ranges, localize returned an estimate for only the shorter one's scans, without a word
+        for name in ("times", "angles"):
+            if np.ndim(getattr(self, name)) != 1:
+                raise ValueError(
+                    f"LaserScans: {name} has shape {np.shape(getattr(self, name))}, expected one "
+                    "value per " + ("scan" if name == "times" else "beam")
+                )
+        n, b = len(self.times), len(self.angles)
+        for name, shape in (("poses", (n, 3)), ("odometry", (n, 3)), ("ranges", (n, b))):
+            if np.shape(getattr(self, name)) != shape:
+                raise ValueError(
+                    f"LaserScans: {name} has shape {np.shape(getattr(self, name))}, expected "
+                    f"{shape} ({n} scans in times, {b} beams in angles)"
+                )
+        m = self.max_range
+        if isinstance(m, bool) or not isinstance(m, int | float | np.number) or not m > 0:
+            raise ValueError(f"LaserScans: max_range must be a number > 0, got {m!r}")
+        if not math.isfinite(m):
+            raise ValueError(f"LaserScans: max_range must be finite, got {m!r}")
 
     def __len__(self) -> int:
         return int(self.times.shape[0])
