@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.field_types import check_field_types
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
 from kiseki.scans import MAX_ODOMETRY_JUMP
@@ -130,6 +131,7 @@ class MclConfig:
     threads: int = 0
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         _check(
             isinstance(self.particles, int) and 1 <= self.particles <= 10_000_000,
             f"particles must be an integer in 1..10,000,000, got {self.particles!r}",

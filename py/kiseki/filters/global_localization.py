@@ -50,6 +50,7 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki._support.atomic import atomic_write
+from kiseki._support.field_types import check_field_types
 from kiseki.core import check_seed, derive_seed
 from kiseki.filters.convergence import ConvergenceReport, convergence_report, spread_radius
 from kiseki.filters.engine import (
@@ -134,6 +135,7 @@ class GlobalConfig:
     tracking_method: str | None = None  # after the cut; None: method
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         tracking = self.method if self.tracking_method is None else self.tracking_method
         methods = {"method": self.method, "tracking_method": tracking}
         for name, value in methods.items():

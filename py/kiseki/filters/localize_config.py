@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+from kiseki._support.field_types import check_field_types
 from kiseki.core import check_seed
 from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS, MclConfig
 from kiseki.filters.reliability import RELIABILITY_ESTIMATES
@@ -128,6 +129,7 @@ class LocalizeConfig:
     budget_min_beams: int = 30
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         _check(
             self.method in LOCALIZATION_METHODS,
             f"method must be one of {', '.join(LOCALIZATION_METHODS)}, got {self.method!r}",

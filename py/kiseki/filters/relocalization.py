@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.field_types import check_field_types
 from kiseki.errors import RelocalizationError
 from kiseki.grid import OccupancyGrid
 
@@ -71,6 +72,7 @@ class RelocalizeConfig:
     threads: int = 0
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         bounds = {
             "beams": (0, 100_000),
             "depth": (0, 16),

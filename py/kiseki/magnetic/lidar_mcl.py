@@ -46,6 +46,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.field_types import check_field_types
 from kiseki.core import Pose2, check_seed, derive_seed
 from kiseki.filters import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
 from kiseki.grid import OccupancyGrid
@@ -91,6 +92,7 @@ class LidarMclConfig:
     threads: int = 1  # the engine's threads (0: every core); one seed gives one run for any
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         for name in ("particles", "beams"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:

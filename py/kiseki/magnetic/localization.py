@@ -20,6 +20,7 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki import _core
+from kiseki._support.field_types import check_field_types
 from kiseki.core import check_seed
 from kiseki.filters import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
 
@@ -114,6 +115,7 @@ class MagneticMclConfig:
     threads: int = 0
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         if self.noise_sd is not None and not (math.isfinite(self.noise_sd) and self.noise_sd >= 0):
             raise ValueError(f"noise_sd must be >= 0 or None, got {self.noise_sd!r}")
         if len(self.initial_sd) != 3 or not all(

@@ -50,6 +50,7 @@ from typing import Any
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.field_types import check_field_types
 from kiseki.magnetic.loop_profile import LoopProfile
 
 __all__ = ["LoopTravelConfig", "LoopTravelDistanceLocalizer", "loop_log_likelihood"]
@@ -76,6 +77,7 @@ class LoopTravelConfig:
     alpha_fast: float = 0.1
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         if isinstance(self.particles, bool) or not isinstance(self.particles, int):
             raise ValueError(f"loop filter: particles must be an integer, got {self.particles!r}")
         if not 1 <= self.particles <= 10_000_000:

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from kiseki._support.field_types import check_field_types
 from kiseki.control import PurePursuit
 from kiseki.core import check_seed
 from kiseki.io.runlog import TWIST_SCHEMA, TWIST_SCHEMA_NAME, RunWriter, read_run
@@ -49,6 +50,7 @@ class SimConfig:
     stop_on_collision: bool = True
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         if not (self.dt > 0 and math.isfinite(self.dt)):
             raise ValueError(f"dt must be positive, got {self.dt}")
         for name in ("duration", "max_duration"):

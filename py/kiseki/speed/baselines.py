@@ -59,6 +59,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.field_types import check_field_types
 from kiseki.control.speed_limit import SpeedLimit
 from kiseki.grid import OccupancyGrid
 
@@ -151,6 +152,7 @@ class DistanceLimiterConfig:
     initial_speed: float = 0.0
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         _check_config(
             self,
             non_negative=("reaction_time", "half_length", "free_threshold", "sensor_offset",
@@ -227,6 +229,7 @@ class PolygonLimiterConfig:
     initial_speed: float = 0.0
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         _check_config(self, non_negative=("stop_ahead", "sensor_offset", "initial_speed"))
         if not self.slowdown_ratio <= 1:
             raise ValueError(

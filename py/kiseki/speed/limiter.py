@@ -35,6 +35,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.field_types import check_field_types
 from kiseki.control.speed_limit import SpeedLimit
 from kiseki.grid import OccupancyGrid
 from kiseki.speed.baselines import AccelerationLimit, check_initial_speed
@@ -159,6 +160,7 @@ class SpeedLimiterConfig:
     use_width: bool = True
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         for name in ("v_max", "a_max", "w1", "w2", "a", "half_band"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int | float):

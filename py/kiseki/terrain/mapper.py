@@ -23,6 +23,7 @@ from typing import Any, Literal
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.field_types import check_field_types
 from kiseki.core import check_seed, derive_seed, rotation_zyx
 from kiseki.terrain.correlation import SearchResult, correlation_search, search_grid
 from kiseki.terrain.plane_removal import HoughParams, PclParams, remove_planes
@@ -54,6 +55,7 @@ class MapperConfig:
     seed: int = 0
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         if self.removal not in ("hough", "pcl", "none"):
             raise ValueError(f"removal must be hough, pcl or none, got {self.removal!r}")
         if self.search not in ("exhaustive", "coarse-to-fine"):

@@ -150,7 +150,7 @@ def test_bad_inputs_are_refused_with_one_line():
         LoopTravelConfig(scale_sd=0.7)
     with pytest.raises(ValueError, match="alpha_slow < alpha_fast"):
         LoopTravelConfig(alpha_slow=0.2, alpha_fast=0.1)
-    with pytest.raises(ValueError, match="reentry must be true or false"):
+    with pytest.raises(ValueError, match="reentry must be True or False"):
         LoopTravelConfig(reentry="yes")
     with pytest.raises(ValueError, match="length must be given"):
         LoopTravelDistanceLocalizer([])
@@ -167,6 +167,12 @@ def test_bad_inputs_are_refused_with_one_line():
         fit_loop_profile([0.0, 1.0], [0.0, 1.0], LOOP)
     with pytest.raises(ValueError, match=r"s must lie in \[0"):
         fit_loop_profile([0.0, 1.0, 2.0, 40.0], [0.0, 1.0, 2.0, 3.0], LOOP)
+    # a 1e-9 m grid asked for 149 GiB
+    for resolution in (1e-9, LOOP, True):
+        with pytest.raises(ValueError, match=r"resolution must be in \[length / 100000"):
+            fit_loop_profile(
+                [0.0, 1.0, 2.0, 3.0], [0.0, 1.0, 2.0, 3.0], LOOP, resolution=resolution
+            )
 
 
 def test_reentry_finds_a_walker_carried_11_m_without_odometry(mapped_loop):

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.field_types import check_field_types
 from kiseki.control import PurePursuit, SpeedLimit, SpeedLimitSource
 from kiseki.core import derive_seed
 from kiseki.filters import MclConfig, MonteCarloLocalizer
@@ -68,6 +69,7 @@ class PlaybackConfig:
     scan_range_scale: float = 1.0  # the ray model's readings times this (a range calibration)
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         if self.method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, got {self.method!r}")
         if not (isinstance(self.particles, int) and 1 <= self.particles <= 10_000_000):
