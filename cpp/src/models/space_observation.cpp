@@ -79,6 +79,10 @@ void SpaceObservationParams::validate() const {
         "space observation: sigmas and heading step must be positive (step <= 45 deg), "
         "0 <= free_max < occupied_threshold");
   }
+  // one pre-rotated local map per heading bin: 3,600 bins at most (1e-9 deg asked for 3.6e11)
+  if (heading_step_deg < 0.1) {
+    throw std::invalid_argument("space observation: heading_step_deg must be >= 0.1 (3,600 pre-rotated local maps)");
+  }
 }
 
 struct SpaceObservationModel::Impl {

@@ -104,6 +104,11 @@ HoughRemovalResult remove_lines_hough(const SphereElevationMap& map, const Hough
   params.validate();
   const SphereGrid& g = map.grid();
   require(params.rho_step >= g.max_range * 1e-5, "rho_step is too small for the map's range");
+  // the vote table of every row at once (one per thread): at most 50 M cells (200 MB) each
+  const double table = std::ceil(180.0 / params.angle_step_deg) * (2.0 * std::ceil(g.max_range / params.rho_step) + 1);
+  require(table <= 5e7, "the vote table (180 / angle_step_deg x 2 max_range / rho_step) would hold " +
+                            std::to_string(static_cast<long long>(std::min(table, 9e18))) +
+                            " cells, more than 50,000,000: a coarser angle_step_deg or rho_step");
   HoughRemovalResult result{map, std::vector<std::uint8_t>(g.cells(), 0), 0};
   const int rows = g.rows(), cols = g.cols();
   std::vector<int> lines(static_cast<std::size_t>(rows), 0);

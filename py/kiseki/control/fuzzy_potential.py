@@ -72,6 +72,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kiseki._support.field_types import check_field_types
+
 __all__ = ["FuzzyPotentialConfig", "FuzzyPotentialMethod"]
 
 _TIE = 1e-9
@@ -90,6 +92,7 @@ class FuzzyPotentialConfig:
     step: float = math.radians(1.0)
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         for name in ("v_max", "robot_radius", "stop_distance", "influence_distance", "step"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
@@ -108,8 +111,11 @@ class FuzzyPotentialConfig:
                 "FuzzyPotentialConfig.goal_half_width must be in (0, pi], got "
                 f"{self.goal_half_width!r}"
             )
-        if self.step > math.pi / 4:
-            raise ValueError(f"FuzzyPotentialConfig.step must be at most pi/4, got {self.step!r}")
+        if not math.radians(0.01) <= self.step <= math.pi / 4:  # 36,000 directions at most
+            raise ValueError(
+                "FuzzyPotentialConfig.step must be in [0.01 deg, pi/4] (rad), "
+                f"got {self.step!r}"
+            )
 
 
 def _wrap(a):

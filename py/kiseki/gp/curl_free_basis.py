@@ -33,7 +33,9 @@ import scipy.linalg
 from kiseki.gp._data import inputs_array
 from kiseki.gp.curl_free import CurlFreeKernel, field_targets
 
-__all__ = ["ReducedRankCurlFreeGP", "laplacian_basis"]
+__all__ = ["MAX_BASIS", "ReducedRankCurlFreeGP", "laplacian_basis"]
+
+MAX_BASIS = 10_000  # eigenfunctions of a reduced-rank curl-free GP
 
 
 def laplacian_basis(half_widths: Any, count: int) -> np.ndarray:
@@ -42,11 +44,18 @@ def laplacian_basis(half_widths: Any, count: int) -> np.ndarray:
     half = np.asarray(half_widths, dtype=float).reshape(-1)
     if half.size not in (2, 3) or not (np.isfinite(half).all() and (half > 0).all()):
         raise ValueError(f"half_widths: 2 or 3 finite lengths > 0, got {half_widths!r}")
-    if isinstance(count, bool) or not isinstance(count, int) or count < 1:
-        raise ValueError(f"count must be an integer >= 1, got {count!r}")
+    if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= MAX_BASIS:
+        # the fit keeps a (count + 3)^2 factor: 10,000 functions are 800 MB
+        raise ValueError(f"count must be an integer in 1..{MAX_BASIS:,}, got {count!r}")
     d = half.size
     # enough candidates per axis that the `count` smallest eigenvalues are among them
-    per_axis = np.ceil(2.0 * count ** (1.0 / d) * half / half.min()).astype(int) + 1
+    per_axis = np.ceil(2.0 * count ** (1.0 / d) * half / half.min()) + 1
+    if np.prod(per_axis) > 5e7:
+        raise ValueError(
+            f"half_widths {half.tolist()}: sides too unequal to pick {count} functions from "
+            "(more than 50,000,000 candidates)"
+        )
+    per_axis = per_axis.astype(int)
     grids = np.meshgrid(*[np.arange(1, n + 1) for n in per_axis], indexing="ij")
     j = np.column_stack([g.ravel() for g in grids])
     lam = (((math.pi / 2) * j / half) ** 2).sum(axis=1)

@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 from typing import Any
 
 import numpy as np
@@ -14,6 +15,13 @@ from kiseki.gp._data import check_mean, inputs_array, targets_array
 from kiseki.gp.kernel import SquaredExponential
 
 __all__ = ["HilbertGP", "hilbert_basis_size", "spectral_tolerance"]
+
+# hilbert_basis_size's counting: every combination of the sides' eigenfunctions at once up to
+# _DENSE_COUNT (as always), above that by a search per value of the first sides, up to
+# _SEARCHED_COUNT such values; no side beyond _MAX_PER_SIDE functions
+_DENSE_COUNT = 20_000_000
+_SEARCHED_COUNT = 20_000_000
+_MAX_PER_SIDE = 10_000_000
 
 
 class HilbertGP:
@@ -136,10 +144,37 @@ def hilbert_basis_size(sides: Any, length_scale: float, tolerance: float) -> int
     Laplacian's eigenfunctions sin(pi j_d (x_d - lower_d) / side_d), j_d = 1, 2, ..., whose
     frequency sqrt(sum_d (pi j_d / side_d)^2) is at most w_max, S(w_max) = tolerance S(0) (at
     least one function)."""
+    for name, value in (("length_scale", length_scale), ("tolerance", tolerance)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise ValueError(f"hilbert_basis_size: {name} must be a number, got {value!r}")
+    if not (math.isfinite(length_scale) and length_scale > 0):
+        raise ValueError(f"hilbert_basis_size: length_scale must be > 0, got {length_scale!r}")
+    if not 0 < tolerance < 1:
+        raise ValueError(f"hilbert_basis_size: tolerance must be in (0, 1), got {tolerance!r}")
+    box = np.atleast_1d(np.asarray(sides, dtype=float))
+    if box.ndim != 1 or not 1 <= len(box) <= 3 or not (np.isfinite(box) & (box > 0)).all():
+        raise ValueError(f"hilbert_basis_size: sides must be 1-3 lengths > 0, got {sides!r}")
     w_max = math.sqrt(-2.0 * math.log(tolerance)) / length_scale
-    axes = [
-        np.pi * np.arange(1, max(1, math.floor(w_max * side / math.pi)) + 1) / side
-        for side in np.atleast_1d(np.asarray(sides, dtype=float))
-    ]
-    w2 = sum(a**2 for a in np.meshgrid(*axes, indexing="ij", sparse=True))
-    return max(1, int((w2 <= w_max**2).sum()))
+    counts = [max(1, math.floor(min(w_max * side / math.pi, 1e18))) for side in box]
+    if max(counts) > _MAX_PER_SIDE:
+        raise ValueError(
+            f"hilbert_basis_size: a side of {box[int(np.argmax(counts))]:g} at length scale "
+            f"{length_scale:g} holds {max(counts):.3g} eigenfunctions, more than "
+            f"{_MAX_PER_SIDE:,} (a length scale this short for so large a box)"
+        )
+    axes = [np.pi * np.arange(1, c + 1) / side for c, side in zip(counts, box, strict=True)]
+    if math.prod(counts) <= _DENSE_COUNT:  # every combination at once, as always
+        w2 = sum(a**2 for a in np.meshgrid(*axes, indexing="ij", sparse=True))
+        return max(1, int((w2 <= w_max**2).sum()))
+    # too many combinations to hold: for each value of the first axes, the last axis' count by
+    # a search (the same count)
+    if math.prod(counts[:-1]) > _SEARCHED_COUNT:
+        raise ValueError(
+            f"hilbert_basis_size: sides {box.tolist()} at length scale {length_scale:g} would "
+            f"need about {math.prod(counts):.3g} eigenfunctions to count (a length scale this "
+            "short for so large a box)"
+        )
+    squares = [a**2 for a in axes]
+    rows = [squares[0]] if len(squares) == 2 else [a + squares[1] for a in squares[0]]
+    inside = sum(int(np.searchsorted(squares[-1], w_max**2 - r, side="right").sum()) for r in rows)
+    return max(1, inside)

@@ -21,6 +21,7 @@ channel, fitted to a mapping lap's readings (kiseki's loop filter,
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any
 
@@ -77,8 +78,12 @@ def fit_loop_profile(
         raise ValueError(f"loop profile: the loop's length must be a number, got {length!r}")
     if not (math.isfinite(length) and length > 0):
         raise ValueError(f"loop profile: the loop's length must be > 0, got {length}")
-    if not (isinstance(resolution, int | float) and 0 < resolution <= length / 4):
-        raise ValueError(f"loop profile: resolution must be in (0, length / 4], got {resolution}")
+    if isinstance(resolution, bool) or not (
+        isinstance(resolution, numbers.Real) and length / 100_000 <= resolution <= length / 4
+    ):  # the profile's grid: 4 to 100,000 points (1e-9 m asked for 149 GiB)
+        raise ValueError(
+            f"loop profile: resolution must be in [length / 100000, length / 4], got {resolution!r}"
+        )
     s = np.asarray(s, dtype=np.float64)
     v = np.asarray(values, dtype=np.float64)
     if s.ndim != 1 or v.shape != s.shape:

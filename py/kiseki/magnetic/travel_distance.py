@@ -49,6 +49,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.field_types import check_field_types
 from kiseki.magnetic.linear_map import LinearMagneticMap
 
 __all__ = [
@@ -103,6 +104,7 @@ class TravelDistanceConfig:
     seed: int = 0
 
     def __post_init__(self) -> None:
+        check_field_types(self)
         _number(self.particles, "particles", 0, strict=True, integer=True)
         if self.particles > 10_000_000:
             raise ValueError(
@@ -197,6 +199,14 @@ class TravelDistanceLocalizer:
             raise ValueError(
                 f"travel distance: window l {self.config.window} m is shorter than the map's "
                 f"{self._spacing} m node spacing"
+            )
+        # beyond the map the window compares the padding only; each step gathers particles x
+        # bins values (15 GiB at l = 1e6 m): at most twice the map's length, or 100 m
+        longest = max(2.0 * len(self._mz) * self._spacing, 100.0)
+        if self.config.window > longest:
+            raise ValueError(
+                f"travel distance: window l {self.config.window:g} m is longer than twice the "
+                f"map ({len(self._mz)} nodes, {len(self._mz) * self._spacing:g} m) or 100 m"
             )
         self._windows = MapWindows(float(self._s[0]), self._spacing, self._mz, self._bins)
         self._odometry = 0.0

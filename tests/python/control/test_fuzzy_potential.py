@@ -168,7 +168,14 @@ def test_bad_input_is_refused(goal, angles, ranges, match):
 
 @pytest.mark.parametrize(
     ("field", "value"),
-    [("v_max", 0.0), ("robot_radius", -1.0), ("margin", math.nan), ("stop_distance", 3.0)],
+    [
+        ("v_max", 0.0),
+        ("robot_radius", -1.0),
+        ("margin", math.nan),
+        ("stop_distance", 3.0),
+        ("step", 1e-9),  # asked for 46.8 GiB of candidate directions
+        ("step", math.radians(46.0)),
+    ],
 )
 def test_bad_config_names_the_field(field, value):
     with pytest.raises(

@@ -104,3 +104,19 @@ def test_bad_input_is_one_line_naming_the_problem():
         SearchDisc(0.0, 0.0, -1.0)
     with pytest.raises(RelocalizationError, match="disc must be a SearchDisc"):
         Relocalizer(grid, MAX_RANGE).match(angles, ranges, (0.0, 0.0, 1.0))
+
+
+def test_a_depth_past_the_map_finds_the_same_hypotheses():
+    """Depth 16 (in its documented range) laid out 17 levels of (w + 65,535) x (h + 65,535)
+    cells on a small map, 366 GB on 80 x 80: the levels stop at the first whose node covers the
+    map, with the same hypotheses."""
+    grid, angles, ranges = random_case(2)
+    covering = math.ceil(math.log2(max(grid.width, grid.height)))
+    config = RelocalizeConfig(beams=15, angular_step=0.3, hypotheses=3, threads=1)
+    want = relocalize(
+        grid, angles, ranges, MAX_RANGE, RelocalizeConfig(**{**config.__dict__, "depth": covering})
+    )
+    got = relocalize(
+        grid, angles, ranges, MAX_RANGE, RelocalizeConfig(**{**config.__dict__, "depth": 16})
+    )
+    assert got == want and len(got) == 3

@@ -182,6 +182,15 @@ def test_laplacian_basis_takes_the_smallest_eigenvalues() -> None:
     np.testing.assert_allclose(lam, brute[:10])
 
 
+def test_laplacian_basis_bounds_what_it_is_asked_for() -> None:
+    """basis=10**7 ran for minutes building its candidates (and a factor of 800 TB)."""
+    with pytest.raises(ValueError, match="count must be an integer in 1..10,000, got 10000000"):
+        laplacian_basis([2.0, 1.0], 10**7)
+    with pytest.raises(ValueError, match="sides too unequal"):
+        laplacian_basis([1e9, 1e-9], 100)
+    assert len(laplacian_basis([2.0, 1.0], 10_000)) == 10_000
+
+
 def test_hyperparameters_reach_at_least_the_truths_likelihood() -> None:
     rng = np.random.default_rng(6)
     k = CurlFreeKernel(sigma_f=0.4, length_scale=0.4, sigma_lin=5.0, sigma_n=0.1)

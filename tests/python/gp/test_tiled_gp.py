@@ -111,6 +111,41 @@ def test_basis_size_rule_equals_hilbert_gps(sides, length_scale):
     assert hilbert_basis_size(sides, length_scale, spectral_tolerance(kernel)) == gp.basis_size
 
 
+@pytest.mark.parametrize(
+    "sides, length_scale", [([30.0, 12.0], 0.05), ([10.0, 7.0, 3.0], 0.08), ([400.0, 300.0], 0.2)]
+)
+def test_basis_size_counted_by_search_equals_every_combination(monkeypatch, sides, length_scale):
+    """Above 20 M combinations the count is taken by a search per value of the first sides (a
+    dense grid of every combination asked for 20 GiB at sides [1e9, 3]); here both ways."""
+    import kiseki.gp.hilbert as hilbert
+
+    dense = hilbert_basis_size(sides, length_scale, 1e-4)
+    monkeypatch.setattr(hilbert, "_DENSE_COUNT", 0)
+    assert hilbert_basis_size(sides, length_scale, 1e-4) == dense > 200_000
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (([1e9, 3.0], 0.5, 1e-4), "a side of 1e\\+09 at length scale 0.5 holds 2.73e\\+09"),
+        (([3.0, 3.0], 0.0, 1e-4), "length_scale must be > 0, got 0"),
+        (([3.0, 3.0], 0.5, 0.0), "tolerance must be in \\(0, 1\\), got 0"),
+        (([3.0, 3.0], 0.5, True), "tolerance must be a number"),
+        (([-1.0, 3.0], 0.5, 1e-4), "sides must be 1-3 lengths > 0"),
+    ],
+)
+def test_basis_size_refuses_what_it_cannot_count(args, message):
+    with pytest.raises(ValueError, match=message):
+        hilbert_basis_size(*args)
+
+
+def test_a_length_scale_far_below_the_box_is_refused_in_one_line(strip):
+    """A micrometre length scale over a 10 m strip asked for 176 TiB."""
+    x, y, _, _ = strip
+    with pytest.raises(ValueError, match="eigenfunctions, more than 10,000,000"):
+        TiledGP.fit(x, y, SquaredExponential(1.0, 1e-6, 0.1))
+
+
 def test_what_it_is_given_is_checked(strip):
     x, y, _, _ = strip
     with pytest.raises(ValueError, match="solver must be one of"):

@@ -190,6 +190,12 @@ def test_bad_input():
         TravelDistanceLocalizer({"s": [0, 1]})
     with pytest.raises(ValueError, match="shorter than the map's"):
         TravelDistanceLocalizer(m, TravelDistanceConfig(window=0.01))
+    # its padding took 15 GiB at l = 1e6 m
+    with pytest.raises(
+        ValueError,
+        match="window l 1e\\+06 m is longer than twice the map \\(51 nodes, 5.1 m\\) or 100 m",
+    ):
+        TravelDistanceLocalizer(m, TravelDistanceConfig(window=1e6))
     loc = TravelDistanceLocalizer(m, TravelDistanceConfig(particles=10))
     with pytest.raises(ValueError, match="mz reading"):
         loc.step(0.1, float("nan"))

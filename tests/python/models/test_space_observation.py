@@ -167,6 +167,12 @@ def test_bad_input(corridor):
         model.likelihoods(np.array([[np.nan, 0.0, 0.0]]))
     with pytest.raises(ValueError):
         SpaceObservationModel(grid, sigma_penetration=-1.0)
+    # one pre-rotated local map per heading bin: 1e-9 deg asked for 3.6e11 of them
+    with pytest.raises(ValueError, match="heading_step_deg must be >= 0.1"):
+        SpaceObservationModel(grid, heading_step_deg=1e-9)
+    for span in (10**5, 0, True):
+        with pytest.raises(ValueError, match="span must be an integer in 1..1001"):
+            visibility_reference(grid, (5, 5), span)
     with pytest.raises(RuntimeError, match="local map first"):
         SpaceObservationModel(grid).counts(Pose2())
     with pytest.raises(ValueError, match="float32 of the camera"):

@@ -18,7 +18,8 @@ struct CorrelativeMatcherParams {
   /// max_beams is the beam subsampling rule, nav2's: every step-th beam from the first).
   LikelihoodFieldParams likelihood;
   /// Levels of the multi-resolution search above the finest lattice: a node at depth h covers
-  /// 2^h x 2^h cells (Hess et al. 2016, sec. V.C, the "branch-and-bound depth").
+  /// 2^h x 2^h cells (Hess et al. 2016, sec. V.C, the "branch-and-bound depth"); capped at the
+  /// first level whose node covers the whole map (deeper ones find the same poses).
   int depth = 7;
   /// rad between headings; 0 = Hess et al. 2016 eq. (7): acos(1 - r^2 / (2 d_max^2)), r the
   /// map resolution and d_max the longest range used, rounded so that the headings divide 2 pi.
