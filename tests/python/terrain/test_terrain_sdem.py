@@ -281,3 +281,15 @@ def test_search_refuses_an_empty_map_and_a_non_rotation():
             correlation_search(m, m, threads=threads)
     with pytest.raises(ValueError, match="threads must be in 0..1024"):
         _core.CorrelationSearch(m.to_points()[0], m, None, "sum", 50, 10**6)
+
+
+def test_hough_removal_refuses_a_vote_table_beyond_memory():
+    """angle_step_deg 1e-6 asked for std::bad_alloc (60 G cells); the default's table is
+    180 x 135 cells."""
+    from kiseki.terrain import HoughParams, remove_planes
+
+    m = sdem_from_points(rubble_points(3, 500))
+    with pytest.raises(ValueError, match="would hold 60300000000 cells, more than 50,000,000"):
+        remove_planes(m, "hough", hough=HoughParams(angle_step_deg=1e-6))
+    done = remove_planes(m, "hough")  # the default still runs: kept and removed add up
+    assert done.kept.valid_cells + int(done.removed.sum()) == m.valid_cells
