@@ -236,6 +236,13 @@ def read_cloud(path: str | os.PathLike, origin: str | None = None) -> Cloud:
     if len(points) == 0:
         what = f"all {dropped} points are NaN or infinite" if dropped else "it holds no point"
         raise ValueError(f"CLOUD {path}: empty cloud ({what})")
+    far = np.abs(points).max(axis=1) > ORIGIN_LIMIT
+    if far.any():  # PCL holds points as float: its search aborted the process from 1e39 m
+        k = int(np.argmax(far))
+        raise ValueError(
+            f"CLOUD {path}: point {k + 1} of the finite ones, {points[k].tolist()}, lies beyond "
+            f"+-{ORIGIN_LIMIT:g} m"
+        )
     return Cloud(points, origin if given is None else given, int(dropped), str(path))
 
 

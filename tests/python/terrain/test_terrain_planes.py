@@ -221,6 +221,9 @@ def test_text_reader_bz2_comments_nan_and_viewpoint(tmp_path):
         (b"1 2 3\n4 5 6 7\n", "line 2"),
         (b"\x89PNG\r\n\x1a\n\x00\xff\xfe", "not a point cloud"),
         (b"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nDATA ascii\n", "PCD"),
+        # beyond float, PCL's search aborted the process (SIGABRT) on these
+        (b"1 2 3\n1e39 1 2\n4 5 6\n", "point 2 of the finite ones, .* lies beyond \\+-1e\\+06 m"),
+        (b"1 2 3\n4 5 1e300\n", "point 2 of the finite ones"),
     ],
 )
 def test_bad_clouds_name_the_file_and_problem(tmp_path, content, message):
