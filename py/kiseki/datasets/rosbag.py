@@ -106,6 +106,7 @@ ODOM_FRAME = "odom"
 BASE_FRAME = "base_link"
 MAP_FRAME = "map"
 
+UNIT_QUATERNION_TOLERANCE = 1e-3  # |q| - 1: float32 quaternions and more
 _NS_PER_S = 1_000_000_000
 _ROS1_MAGIC = b"#ROSBAG V2.0\n"
 _SQLITE_MAGIC = b"SQLite format 3\x00"
@@ -258,14 +259,17 @@ def read_bag_scans(
     if not scans:
         raise LogFormatError(f"{path}: no messages on the scan topic {scan_topic!r}")
     laser, ns, ranges, angles, max_range = _scan_arrays(path, scan_topic, scans)
-    static = _static_transforms(messages.get(TF_STATIC_TOPIC, []))
-    if use_tf:
-        odom = _tf_odometry(path, messages[TF_TOPIC], static, laser, odom_topic)
-    else:
-        odom = _odometry_track(path, odom_topic, messages[odom_topic])
-    tracks = [odom]
-    if reference_topic is not None:
-        tracks.append(_odometry_track(path, reference_topic, messages[reference_topic]))
+    try:
+        static = _static_transforms(messages.get(TF_STATIC_TOPIC, []))
+        if use_tf:
+            odom = _tf_odometry(path, messages[TF_TOPIC], static, laser, odom_topic)
+        else:
+            odom = _odometry_track(path, odom_topic, messages[odom_topic])
+        tracks = [odom]
+        if reference_topic is not None:
+            tracks.append(_odometry_track(path, reference_topic, messages[reference_topic]))
+    except _NotARotationError as err:
+        raise LogFormatError(f"{path}: {err}") from None
     keep = np.ones(len(ns), dtype=bool)
     for track in tracks:
         keep &= (ns >= track.ns[0]) & (ns <= track.ns[-1])
@@ -314,6 +318,7 @@ def _check_chunks(path: Path) -> None:
         try:
             info = safe_load_12(text)["rosbag2_bagfile_information"]
             compressed_files = str(info.get("compression_mode", "")).lower() == "file"
+            compressed_files &= str(info.get("compression_format", "")).lower() == "zstd"
         except (yaml.YAMLError, KeyError, TypeError, AttributeError):
             pass  # rosbags says what is wrong with it
         files = sorted(entry for entry in path.iterdir() if entry.is_file() and entry != meta)
@@ -322,8 +327,13 @@ def _check_chunks(path: Path) -> None:
             try:
                 with open(file, "rb") as raw:
                     size = decompressed_size(raw, "zstd", MAX_BAG_FILE_BYTES)
-            except Exception:  # noqa: BLE001 (not zstd, or corrupt: rosbags reports it)
-                continue
+            except Exception as err:  # noqa: BLE001 (zstandard's errors have no common base)
+                # the reader failed on these with a bare EOFError ("Aborted.") or a traceback
+                why = str(err) or type(err).__name__
+                raise LogFormatError(
+                    f"{file}: not a whole zstd file, as the bag's metadata.yaml says its files "
+                    f"are (compression_mode: file): {why}"
+                ) from None
             if size > MAX_BAG_FILE_BYTES:
                 raise LogFormatError(
                     f"{file}: decompresses to more than {describe_bytes(MAX_BAG_FILE_BYTES)} "
@@ -349,8 +359,12 @@ def _open_bag(path: Path) -> Iterator[Any]:
         reader.open()
     except AnyReaderError as exc:
         raise LogFormatError(f"{path}: unreadable ROS bag ({exc})") from exc
+    except EOFError as exc:  # a compressed file cut short: the command line printed "Aborted."
+        raise LogFormatError(f"{path}: a compressed file of the bag is cut short ({exc})") from exc
     try:
         yield reader
+    except EOFError as exc:
+        raise LogFormatError(f"{path}: a compressed file of the bag is cut short ({exc})") from exc
     finally:
         reader.close()
 
@@ -376,8 +390,21 @@ def _stamp_ns(header: Any) -> int:
     return int(header.stamp.sec) * _NS_PER_S + int(header.stamp.nanosec)
 
 
+class _NotARotationError(ValueError):
+    """A quaternion of a pose that is not a unit quaternion (read_bag_scans names the bag)."""
+
+
 def _yaw(q: Any) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+    # a pose's quaternion is a unit one (to float32 rounding and some): a scaled or zero one gave
+    # other headings without a word (a zero one, yaw 0)
+    norm = math.sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w)
+    if not abs(norm - 1.0) <= UNIT_QUATERNION_TOLERANCE:
+        raise _NotARotationError(
+            f"an orientation ({q.x:g}, {q.y:g}, {q.z:g}, {q.w:g}) of norm {norm:.6g} is not a "
+            "unit quaternion"
+        )
+    x, y, z, w = (v / norm for v in (q.x, q.y, q.z, q.w)) if norm != 1.0 else (q.x, q.y, q.z, q.w)
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
 def _scan_arrays(
@@ -389,6 +416,17 @@ def _scan_arrays(
     if beams < 1:
         raise LogFormatError(f"{path}: the first scan on {topic!r} has no beams")
     laser = _frame(first.header.frame_id)
+    start, step = float(first.angle_min), float(first.angle_increment)
+    span = abs(step) * (beams - 1)
+    if not (
+        math.isfinite(start) and abs(start) <= 2 * math.pi and step != 0 and span <= 2.01 * math.pi
+    ):
+        # an increment of 0 put every beam on one ray, 1000 rad or NaN read as given
+        raise LogFormatError(
+            f"{path}: the first scan on {topic!r} has angle_min {first.angle_min} and "
+            f"angle_increment {first.angle_increment} rad for {beams} beams: not beams of one "
+            "turn at most (angle_min within +-2 pi, a non-zero increment)"
+        )
     for index, scan in enumerate(scans):
         if (
             len(scan.ranges) != beams

@@ -1,0 +1,72 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""A ROS 2 bag compressed file by file (metadata.yaml: compression_mode file, zstd): read as
+the same bag uncompressed; cut short, or not compressed as its metadata says, one line naming
+the bag or the file (the command printed "Aborted." for the first, a traceback for the
+second)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+import zstandard
+
+from _helpers.room_log import ANGLES, room
+from kiseki.datasets import read_bag_scans, write_bag
+from kiseki.errors import LogFormatError
+from kiseki.scans import LaserScans
+
+
+def _scans(n: int = 12) -> LaserScans:
+    poses = np.column_stack([np.linspace(0.0, 1.0, n), np.full(n, -1.0), np.zeros(n)])
+    ranges = room().cast_scans(poses, ANGLES, max_range=8.0)
+    return LaserScans(0.1 * np.arange(1, n + 1), poses, poses.copy(), ranges, ANGLES, 8.0)
+
+
+def _compress_files(bag: Path, cut: bool = False, plain: bool = False) -> Path:
+    """The bag with its storage file zstd-compressed (or only declared so: ``plain``), as
+    rosbag2 writes with compression_mode file; ``cut``: the compressed file's second half lost."""
+    meta = bag / "metadata.yaml"
+    doc = yaml.safe_load(meta.read_text())
+    info = doc["rosbag2_bagfile_information"]
+    (storage,) = info["relative_file_paths"]
+    data = (bag / storage).read_bytes()
+    packed = data if plain else zstandard.ZstdCompressor().compress(data)
+    (bag / storage).unlink()
+    (bag / f"{storage}.zstd").write_bytes(packed[: len(packed) // 2] if cut else packed)
+    info["compression_mode"], info["compression_format"] = "file", "zstd"
+    info["relative_file_paths"] = [f"{storage}.zstd"]
+    for entry in info.get("files", []):
+        entry["path"] = f"{entry['path']}.zstd"
+    meta.write_text(yaml.safe_dump(doc))
+    return bag
+
+
+@pytest.fixture
+def bag(tmp_path: Path) -> Path:
+    return write_bag(_scans(), tmp_path / "bag", "ros2-mcap")
+
+
+def test_a_file_compressed_bag_reads_as_the_bag_itself(bag: Path) -> None:
+    want = read_bag_scans(bag)
+    got = read_bag_scans(_compress_files(bag))
+    assert len(got) == len(want) == 12
+    np.testing.assert_array_equal(got.ranges, want.ranges)
+    np.testing.assert_array_equal(got.odometry, want.odometry)
+
+
+def test_a_cut_compressed_file_is_one_line_naming_the_bag(bag: Path) -> None:
+    _compress_files(bag, cut=True)
+    with pytest.raises(LogFormatError) as caught:
+        read_bag_scans(bag)
+    assert str(caught.value).startswith(f"{bag}: a compressed file of the bag is cut short")
+
+
+def test_a_file_the_metadata_calls_zstd_but_is_not_is_named(bag: Path) -> None:
+    _compress_files(bag, plain=True)
+    with pytest.raises(LogFormatError) as caught:
+        read_bag_scans(bag)
+    assert str(caught.value).startswith(f"{bag}/bag.mcap.zstd: not a whole zstd file")
