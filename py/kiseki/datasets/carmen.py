@@ -52,6 +52,7 @@ Radish "-corrected" logs (Intel, ACES, CSAIL, Freiburg 079) that users should kn
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -308,6 +309,13 @@ def _parse_robotlaser(path: Path, rows: list[_Row]) -> LaserScans:
     start, _, step, max_range = config[0]
     if n == 0 or max_range <= 0:
         raise LogFormatError(f"{path}:{rows[0][0]}: ROBOTLASER1 with no beams or max range <= 0")
+    if not (abs(start) <= 2 * math.pi and step != 0 and abs(step) * (n - 1) <= 2.01 * math.pi):
+        # a resolution of 0 put every beam on one ray; 100 rad or a start of 1e9 read as given
+        raise LogFormatError(
+            f"{path}:{rows[0][0]}: ROBOTLASER1 start_angle {start:g} and angular_resolution "
+            f"{step:g} rad for {n} beams: not beams of one turn at most (start within +-2 pi, "
+            "a non-zero resolution)"
+        )
     angles = start + step * np.arange(n, dtype=np.float64)
     limit = float(np.float32(max_range))
     return _laser_scans(path, rows, values, (4, n + 4, n + 10), angles, limit, "ROBOTLASER1")

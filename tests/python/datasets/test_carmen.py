@@ -253,6 +253,15 @@ def test_corrupt_robotlaser1_line(tmp_path: Path) -> None:
             read_carmen_log(path)
 
 
+@pytest.mark.parametrize(("start", "res"), [(-1.5, 0.0), (-1.5, 100.0), (1e9, 1.0), (-1.5, -7.0)])
+def test_robotlaser1_beams_beyond_one_turn_are_refused(tmp_path: Path, start, res) -> None:
+    """A resolution of 0 put every beam on one ray; 100 rad, or a start of 1e9, read as given."""
+    line = robotlaser([1.0, 2.0], [0.5], [0, 0, 0], [0, 0, 0], 5.0, start=start, res=res)
+    path = write(tmp_path / "rl.log", line + "\n")
+    with pytest.raises(LogFormatError, match=r"rl\.log:1: ROBOTLASER1 start_angle .* not beams of"):
+        read_carmen_log(path)
+
+
 def test_bad_max_range_param(tmp_path: Path) -> None:
     text = "PARAM robot_front_laser_max fifty\n" + GOOD_FLASER
     with pytest.raises(LogFormatError, match=r"p\.log: PARAM robot_front_laser_max 'fifty'"):
