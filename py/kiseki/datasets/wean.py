@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from kiseki._support.inputs import MIB
+from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki.datasets._files import read_maybe_gzipped
 from kiseki.errors import MapFormatError
 
@@ -118,6 +119,11 @@ def _header_resolution(path: Path, specs: dict[str, str], size_y: int, size_x: i
     resolution = _spec_number(path, specs, "resolution")
     if resolution is None or resolution <= 0:
         raise MapFormatError(f"{path}: missing or non-positive robot_specifications->resolution")
+    if not 1e-2 <= resolution <= 100 * MAGNITUDE_LIMIT:  # cm: a ROS map's 1e-4 .. 1e9 m per cell
+        raise MapFormatError(
+            f"{path}: robot_specifications->resolution {resolution:g} cm is outside "
+            "0.01 .. 1e11 cm (a ROS map's 1e-4 .. 1e9 m per cell)"
+        )
     for axis, cells in (("x", size_x), ("y", size_y)):
         extent = _spec_number(path, specs, f"global_mapsize_{axis}")
         if extent is not None and extent != cells * resolution:

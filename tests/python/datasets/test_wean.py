@@ -76,6 +76,9 @@ def test_missing_file(tmp_path: Path) -> None:
         (HEADER.replace("resolution 5", "resolution five") + BODY, "resolution 'five' is bad"),
         (HEADER.replace("resolution 5", "resolution 0") + BODY, "non-positive .*resolution"),
         (HEADER.replace("robot_specifications->resolution 5\n", "") + BODY, "missing"),
+        # read as 1e298 m per cell (hypotheses with 300-digit coordinates), or 1e-302 m
+        (HEADER.replace("resolution 5", "resolution 1e300") + BODY, "1e\\+300 cm is outside"),
+        (HEADER.replace("resolution 5", "resolution 1e-300") + BODY, "1e-300 cm is outside"),
         (HEADER.replace("global_mapsize_x  10", "global_mapsize_x 20") + BODY, "global_mapsize_x"),
         (HEADER.replace("robot_specifications->", "robot_spec->") + BODY, ":1: unexpected"),
         (HEADER + BODY.replace(" 0.900", ""), "5 map values, the header promises 6"),
