@@ -82,6 +82,7 @@ def read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
         )
     for column in ("ci_low", "ci_high", "trials_to_decide"):
         claims[column] = pd.to_numeric(claims[column], errors="coerce")
+    _check_claims(claims_path, claims)
     try:
         manifest = json.loads(read_input_text(manifest_path, "JSON manifests", YAML_LIMIT))
     except (ValueError, UnicodeDecodeError) as err:
@@ -89,7 +90,54 @@ def read_result(latest: Path) -> tuple[pd.DataFrame, dict]:
     needed = ("trials", "trials_failed", "git")
     if not isinstance(manifest, dict) or any(k not in manifest for k in needed):
         raise ValueError(f"{manifest_path}: a manifest needs the fields {', '.join(needed)}")
+    _check_manifest(manifest_path, manifest)
     return claims, manifest
+
+
+def _count(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and 0 <= value <= 10**9
+
+
+def _check_manifest(path: Path, manifest: dict) -> None:
+    """The fields the report prints, of their kinds: a hand-edited ``git: null`` or
+    ``trials: "many"`` gave a traceback, ``trials: -5`` was printed."""
+    trials, failed, git = manifest["trials"], manifest["trials_failed"], manifest["git"]
+    if not _count(trials) or not _count(failed) or failed > trials:
+        raise ValueError(
+            f"{path}: trials and trials_failed must be counts with trials_failed <= trials, "
+            f"got {trials!r} and {failed!r}"
+        )
+    if (
+        not isinstance(git, dict)
+        or not isinstance(git.get("commit"), str | None)
+        or not isinstance(git.get("dirty", False), bool)
+    ):
+        raise ValueError(
+            f"{path}: git must hold commit (text or null) and dirty (true or false), got {git!r}"
+        )
+
+
+def _check_claims(path: Path, claims: pd.DataFrame) -> None:
+    """Each claim's verdict is one the report counts, its trials a count and its interval, when
+    it has one, finite: a verdict of "maybe" was counted as nothing at all."""
+    known = {"holds", "fails", "inconclusive", UNMIGRATED}
+    for row, verdict in enumerate(claims["verdict"], start=2):
+        if verdict not in known:
+            raise ValueError(
+                f"{path} row {row}: verdict must be one of {', '.join(sorted(known))}, "
+                f"got {verdict!r}"
+            )
+    trials = pd.to_numeric(claims["trials"], errors="coerce")
+    bad = ~((trials >= 0) & (trials == trials.round()))
+    for column in ("ci_low", "ci_high"):
+        bad |= claims[column].isin([math.inf, -math.inf])
+    if bad.any():
+        row = int(bad.to_numpy().argmax())
+        raise ValueError(
+            f"{path} row {row + 2}: trials must be a count and the interval finite (or empty), "
+            f"got trials {claims['trials'].iloc[row]!r}, interval "
+            f"[{claims['ci_low'].iloc[row]}, {claims['ci_high'].iloc[row]}]"
+        )
 
 
 def _old_claims(claims: pd.DataFrame) -> pd.DataFrame:

@@ -198,6 +198,22 @@ def test_bad_input_is_one_line_and_non_zero(tmp_path, args, needle):
         (b"\xff\xfe\x00garbage\x81", "{}", "corridor-scans/latest/claims.csv: not a claims"),
         ("claim,holds\nx,True\n", "[1,", "corridor-scans/latest/manifest.json: not a JSON"),
         ("claim,holds\nx,True\n", "{}", "corridor-scans/latest/manifest.json: a manifest needs"),
+        # hand-edited: a traceback ('NoneType' object is not subscriptable), or printed as read
+        (
+            "claim,holds\nx,True\n",
+            '{"trials": 1, "trials_failed": 0, "git": null}',
+            "manifest.json: git must hold commit (text or null) and dirty",
+        ),
+        (
+            "claim,holds\nx,True\n",
+            '{"trials": -5, "trials_failed": 100, "git": {"commit": null}}',
+            "manifest.json: trials and trials_failed must be counts",
+        ),
+        (
+            "claim,holds\nx,True\n",
+            '{"trials": "many", "trials_failed": 0, "git": {"commit": null}}',
+            "manifest.json: trials and trials_failed must be counts",
+        ),
     ],
 )
 def test_report_refuses_a_missing_folder_and_broken_results_in_one_line(
@@ -328,3 +344,32 @@ def test_the_manifest_names_the_checkout_the_trials_ran_from(tmp_path, monkeypat
     run_experiment("corridor-scans", runs=2, out=tmp_path / "still", progress=False)
     git = json.loads((tmp_path / "still" / "manifest.json").read_text())["git"]
     assert git == start
+
+
+@pytest.mark.parametrize(
+    ("change", "needle"),
+    [
+        ({"verdict": "maybe"}, "claims.csv row 2: verdict must be one of"),
+        ({"trials": "abc"}, "claims.csv row 2: trials must be a count"),
+        ({"ci_high": "inf"}, "claims.csv row 2: trials must be a count and the interval finite"),
+    ],
+)
+def test_report_refuses_claims_it_cannot_count_in_one_line(tmp_path, change, needle):
+    """A verdict of "maybe" was tallied as nothing ("2 claims: 0 hold, 0 fail, 0
+    inconclusive"); trials "abc" said "invalid literal for int()" without naming the file."""
+    from kiseki_experiments.harness.verdict import VERDICT_COLUMNS
+
+    row = {c: "" for c in VERDICT_COLUMNS} | {"claim": "x", "verdict": "holds", "trials": "5"}
+    row |= {"ci_low": "0.1", "ci_high": "0.2"} | change
+    latest = tmp_path / "results" / "corridor-scans" / "latest"
+    latest.mkdir(parents=True)
+    latest.joinpath("claims.csv").write_text(
+        ",".join(VERDICT_COLUMNS) + "\n" + ",".join(row[c] for c in VERDICT_COLUMNS) + "\n"
+    )
+    latest.joinpath("manifest.json").write_text(
+        '{"trials": 5, "trials_failed": 0, "git": {"commit": null}}'
+    )
+    done = cli("experiment", "report", "--results", "results", "-o", "R.md", cwd=tmp_path)
+    assert done.returncode == 1, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], done.stderr
