@@ -113,8 +113,7 @@ class FuzzyPotentialConfig:
             )
         if not math.radians(0.01) <= self.step <= math.pi / 4:  # 36,000 directions at most
             raise ValueError(
-                "FuzzyPotentialConfig.step must be in [0.01 deg, pi/4] (rad), "
-                f"got {self.step!r}"
+                f"FuzzyPotentialConfig.step must be in [0.01 deg, pi/4] (rad), got {self.step!r}"
             )
 
 
