@@ -36,6 +36,7 @@ of the last waypoint with less than 0.5 m of the path left to go.
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -55,8 +56,16 @@ class PurePursuit:
         pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
         if len(pts) < 2 or not np.isfinite(pts).all():
             raise ValueError("a route needs at least two finite waypoints")
-        if not speed > 0:
-            raise ValueError("route speed must be positive")
+        for name, value in (
+            ("route speed", speed),
+            ("lookahead", lookahead),
+            ("tolerance", tolerance),
+            ("max_accel", max_accel),
+        ):  # a NaN lookahead gave NaN yaw rates, a negative max_accel "math domain error"
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
+                raise ValueError(f"{name} must be a number, got {value!r}")
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
         seg = np.diff(pts, axis=0)
         self.lengths = np.hypot(seg[:, 0], seg[:, 1])
         if (self.lengths <= 0).any():
@@ -94,6 +103,8 @@ class PurePursuit:
         if max_speed is not None and not (math.isfinite(max_speed) and max_speed >= 0):
             raise ValueError(f"max_speed must be a finite number >= 0 m/s, got {max_speed}")
         x, y, th = (float(v) for v in pose)
+        if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(th)):
+            raise ValueError(f"pose must be three finite numbers (x, y, theta), got {tuple(pose)}")
         xy = np.array([x, y])
         goal = self.points[-1]
         dist_goal = float(np.hypot(*(goal - xy)))
