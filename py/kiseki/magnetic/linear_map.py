@@ -154,8 +154,9 @@ class LinearMagneticMap:
     def index(self, s: Any) -> np.ndarray | int:
         """The nearest node's index for travel distance(s) s, clamped to the map's ends."""
         q = self._distances(s)
-        k = np.floor((q - self.s[0]) / self.spacing + 0.5).astype(np.int64)
-        k = np.clip(k, 0, len(self) - 1)
+        # clamped before the cast: 1e20 m cast to int64 wrapped to a negative index, node 0
+        u = np.clip((q - self.s[0]) / self.spacing + 0.5, 0.0, len(self) - 1.0)
+        k = np.floor(u).astype(np.int64)
         return int(k) if k.ndim == 0 else k
 
     def at(self, s: Any) -> NodeValues:

@@ -167,6 +167,8 @@ def test_lookup_nearest_and_interpolated():
     heading = np.radians([179.0, -179.0, -170.0])
     lmap = build_linear_map(s, readings, heading, path_id=PATH)
     assert lmap.index(0.149) == 1 and lmap.index(0.151) == 2 and lmap.index(-5.0) == 0
+    # far beyond the ends: the end nodes (1e20 m wrapped through int64 to node 0)
+    assert lmap.index(1e20) == 2 and lmap.index(-1e300) == 0 and lmap.index(1e300) == 2
     values = lmap.at([0.05, 0.15, 9.0])
     np.testing.assert_allclose(values.field[:, 2], [0.2, 0.4, 0.5], atol=1e-12)
     assert abs(np.angle(np.exp(1j * (values.heading[0] - math.pi)))) < 1e-12  # across +-pi
