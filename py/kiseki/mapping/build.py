@@ -118,6 +118,9 @@ def build_map(
     config = config or MapBuildConfig()
     if not np.isfinite(config.margin) or config.margin < 0:
         raise ValueError(f"margin must be >= 0, got {config.margin}")
+    if isinstance(chunk, bool) or not isinstance(chunk, int | np.integer) or chunk < 1:
+        # -1 gave a map of unknown cells only, 0 Python's "range() arg 3 must not be zero"
+        raise ValueError(f"chunk must be an integer >= 1 (scans per pass), got {chunk!r}")
     params = config.core_params(max_range)
     poses = np.ascontiguousarray(poses, dtype=np.float64)
     ranges = np.ascontiguousarray(ranges, dtype=np.float32)

@@ -100,6 +100,14 @@ def test_build_map_rejects_bad_parameters():
         build_map(poses, ranges, np.zeros(4), 10.0, MapBuildConfig(prob_hit=0.3))
     with pytest.raises(ValueError, match="unknown"):
         MapBuildConfig.from_dict({"resolutoin": 0.1})
+    # -1 scans per pass gave a map of unknown cells only; one per pass, the same map as 100
+    for chunk in (-1, 0, 2.5, True):
+        with pytest.raises(ValueError, match="chunk must be an integer >= 1"):
+            build_map(poses, ranges, np.zeros(4), 10.0, chunk=chunk)
+    np.testing.assert_array_equal(
+        build_map(poses, ranges, np.zeros(4), 10.0, chunk=1).cells,
+        build_map(poses, ranges, np.zeros(4), 10.0).cells,
+    )
 
 
 def test_build_map_refuses_negative_ranges_and_skips_nan_readings():
