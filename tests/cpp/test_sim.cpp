@@ -218,6 +218,35 @@ TEST(OctomapFile, WritesOctomapsOwnBytesAndNothingToStderr) {
     const OctreeWorld back = OctreeWorld::read_binary(path);
     EXPECT_NEAR(back.resolution(), resolution, 5e-6 * resolution);  // 6 significant digits, as OctoMap
   }
+  // another kind of tree, or bytes after the tree: OctoMap read both as this tree
+  const std::string path = testing::TempDir() + "kiseki_octomap_kind.bt";
+  octomap::OcTree small(0.1);
+  small.updateNode(octomap::point3d(0.05f, 0.05f, 0.05f), true);
+  write_octomap_binary(small, path);
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const auto rewrite = [&](const std::string& content) {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(content.data(), static_cast<std::streamsize>(content.size()));
+  };
+  const auto message = [&]() -> std::string {
+    try {
+      (void)OctreeWorld::read_binary(path);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "read";
+  };
+  EXPECT_EQ(message(), "read");
+  std::string colour = bytes;
+  colour.replace(colour.find("id OcTree"), 9, "id ColorOcTree");
+  rewrite(colour);
+  EXPECT_EQ(message(), path + ": an OctoMap tree of kind 'ColorOcTree', not OcTree (occupancy only)");
+  rewrite(bytes + std::string(700, 'x'));
+  EXPECT_EQ(message(), path + ": 700 bytes after the OctoMap tree (a damaged or concatenated file)");
   const std::string nowhere = testing::TempDir() + "no_such_folder/map.bt";
   EXPECT_THROW(write_octomap_binary(octomap::OcTree(0.1), nowhere), std::runtime_error);
   EXPECT_FALSE(std::filesystem::exists(nowhere + ".partial"));

@@ -99,6 +99,15 @@ OctreeWorld OctreeWorld::read_binary(const std::string& path) {
   if (header.rfind("# Octomap OcTree binary file", 0) != 0) {
     throw std::runtime_error(path + ": not an OctoMap binary tree (.bt) file");
   }
+  // the tree's kind: OctoMap reads another kind's nodes (a ColorOcTree's colours) as OcTree
+  // nodes, or a made-up id, without a word
+  for (std::string line; std::getline(in, line) && line != "data";) {
+    if (line.rfind("id ", 0) == 0 && line != "id OcTree") {
+      throw std::runtime_error(path + ": an OctoMap tree of kind '" + line.substr(3) +
+                               "', not OcTree (occupancy only)");
+    }
+  }
+  in.clear();
   in.seekg(0);
   auto tree = std::make_unique<octomap::OcTree>(0.1);
   bool read = false;
@@ -110,6 +119,13 @@ OctreeWorld OctreeWorld::read_binary(const std::string& path) {
       if (why.empty() && line.rfind("ERROR: ", 0) == 0) why = " (OctoMap: " + line.substr(7) + ")";
     }
     throw std::runtime_error(path + ": corrupt or truncated OctoMap binary file" + why);
+  }
+  if (in.peek() != std::ifstream::traits_type::eof()) {  // OctoMap stops after the tree
+    in.clear();
+    const std::streamoff at = in.tellg();
+    in.seekg(0, std::ios::end);
+    throw std::runtime_error(path + ": " + std::to_string(static_cast<long long>(in.tellg() - at)) +
+                             " bytes after the OctoMap tree (a damaged or concatenated file)");
   }
   for (const std::string& line : reported) std::cerr << line << '\n';  // read, with warnings
   std::cerr.flush();
