@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
 import pandas as pd
@@ -42,6 +43,7 @@ from kiseki_experiments.coop.coop_optimum import analytic_optimum
 from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
     Count,
+    NonEmpty,
     NonNegativeReal,
     PositiveReal,
     Real,
@@ -56,14 +58,18 @@ class CoopFormsConfig:
     angle_sigma_deg: NonNegativeReal = 0.1  # the paper's
     # the 3-D case's elevation angles: as noisy as the horizontal ones (the paper gives none)
     elevation_sigma_deg: NonNegativeReal = 0.1
-    form1_moves: list[Count] = field(default_factory=lambda: list(range(1, 40, 2)))
+    form1_moves: Annotated[list[Count], NonEmpty] = field(
+        default_factory=lambda: list(range(1, 40, 2))
+    )
     form2_moves: list[Count] = field(default_factory=lambda: list(range(1, 31)))
     form1_readings: list[str] = field(default_factory=lambda: list(FORM1_READINGS))
     # Figs. 7-8: the representative angle swept at a fixed number of moves per form (form 1,
     # form 2): the middles of the paper's best ranges (10-20 and 5-10 moves); from 30 deg, as
     # below it form 2's second move (from the start's width to the formation's) has lines of
     # sight that nearly meet head on (0.01 deg at 25 deg, 7 moves) and cannot be triangulated
-    angles_deg: list[Real] = field(default_factory=lambda: [float(a) for a in range(30, 85, 5)])
+    angles_deg: Annotated[list[Real], NonEmpty] = field(
+        default_factory=lambda: [float(a) for a in range(30, 85, 5)]
+    )
     angle_moves: list[Count] = field(default_factory=lambda: [15, 7])
     # each sweep setting is simulated this many times (runs each, seeds derived from the
     # trial's): the claims' intervals are over these repeats of the whole sweep

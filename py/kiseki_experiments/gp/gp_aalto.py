@@ -41,6 +41,7 @@ import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated
 
 from kiseki_experiments.gp import gp_aalto_tasks as work
 from kiseki_experiments.gp.gp_aalto_change import change_task
@@ -59,6 +60,7 @@ from kiseki_experiments.harness.config import (
     FitPoints,
     Index,
     Lag,
+    NonEmpty,
     NonNegativeReal,
     Particles,
     PositiveReal,
@@ -92,7 +94,7 @@ class GpAaltoConfig:
     restarts: Restarts = 2  # seeded restarts of the hyperparameter search
     gp_seed: Seed = 0  # seed of the hyperparameter search (shared by every task)
     offset_calibration: bool = True  # remove a residual hard-iron offset fixed to the robot
-    sweep: list[Count] = field(default_factory=lambda: [1, 5, 10, 25, 50, 100])
+    sweep: Annotated[list[Count], NonEmpty] = field(default_factory=lambda: [1, 5, 10, 25, 50, 100])
     sweep_raw: bool = True  # the sweep also on the readings as recorded
     hilbert: bool = True  # the reduced-rank GP on all readings of the training runs
     hilbert_tolerance: Share = 1e-4  # its basis' spectral tolerance (HilbertGP.fit's)

@@ -36,6 +36,7 @@ from kiseki._support.yaml import safe_load_12
 __all__ = [
     "Lag",
     "LIST_LIMIT",
+    "NonEmpty",
     "PARTICLE_LIMIT",
     "RUN_LIMIT",
     "Boxes",
@@ -65,6 +66,11 @@ __all__ = [
     "config_from_dict",
     "config_to_dict",
 ]
+
+NonEmpty = Field(min_length=1)
+"""Marks a list field that needs at least one item (``methods: Annotated[list[str], NonEmpty]``):
+``--set methods=`` ran a trial and failed with "list index out of range", leaving a half-written
+results folder."""
 
 PARTICLE_LIMIT = 10_000_000
 """The most particles an experiment's filter may take (as ``kiseki.filters.MclConfig``)."""

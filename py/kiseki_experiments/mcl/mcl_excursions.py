@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
 import pandas as pd
@@ -41,6 +42,7 @@ from kiseki.teach.environment_map import build_teaching_map
 from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
     Count,
+    NonEmpty,
     NonNegativeReal,
     Particles,
     PositiveReal,
@@ -60,7 +62,7 @@ SETTLING_SHARE = 0.1
 class ExcursionsConfig:
     data_dir: str = ""  # folder of the .log.gz files; "" = ../shared/data/carmen
     logs: list[str] = field(default_factory=lambda: list(CARMEN_LOGS))
-    methods: list[str] = field(default_factory=lambda: list(METHODS))
+    methods: Annotated[list[str], NonEmpty] = field(default_factory=lambda: list(METHODS))
     recoveries: list[str] = field(default_factory=lambda: ["resetting"])
     particles: Particles = 500
     odometry_noise: NonNegativeReal = 0.1

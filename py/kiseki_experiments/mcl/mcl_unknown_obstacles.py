@@ -33,6 +33,7 @@ from __future__ import annotations
 import itertools
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
 import pandas as pd
@@ -49,6 +50,7 @@ from kiseki.teach.environment_map import build_teaching_map
 from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
 from kiseki_experiments.harness.config import (
     Count,
+    NonEmpty,
     NonNegativeReal,
     Particles,
     PositiveReal,
@@ -75,7 +77,7 @@ FREE_MAX = 19  # map cells 0..19 are free (the ROS map convention kiseki's reade
 class UnknownObstaclesConfig:
     data_dir: str = ""  # folder of the .log.gz files; "" = ../shared/data/carmen
     logs: list[str] = field(default_factory=lambda: list(CARMEN_LOGS))
-    methods: list[str] = field(default_factory=lambda: list(METHODS))
+    methods: Annotated[list[str], NonEmpty] = field(default_factory=lambda: list(METHODS))
     # obstacles per 10 m of route; the first is the reference without obstacles
     densities: list[NonNegativeReal] = field(default_factory=lambda: [0.0, 1.0, 2.0, 4.0])
     # the engine's default (none) and the recovery kiseki offers for real logs (resetting)

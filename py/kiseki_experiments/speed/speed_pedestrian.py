@@ -29,6 +29,7 @@ import functools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
 import pandas as pd
@@ -39,7 +40,14 @@ from kiseki.plots import new_figure
 from kiseki.sim.pedestrians import Pedestrian
 from kiseki.sim.scene import load_scene
 from kiseki_experiments.harness.base import Analysis, Experiment, TrialOutput
-from kiseki_experiments.harness.config import NonNegativeReal, PositiveReal, Real, Seconds, Speed
+from kiseki_experiments.harness.config import (
+    NonEmpty,
+    NonNegativeReal,
+    PositiveReal,
+    Real,
+    Seconds,
+    Speed,
+)
 from kiseki_experiments.harness.verdict import ClaimSpec, Control, Criterion, Evidence
 from kiseki_experiments.speed.speed_common import (
     METHODS,
@@ -59,12 +67,14 @@ STOPPED = 0.05  # m/s: below this the robot counts as standing
 class PedestrianConfig:
     scene: str = str(WORLDS / "speed_crossroad.yaml")
     goal: list[Real] = field(default_factory=lambda: [0.0, 8.0])  # past the crossing
-    methods: list[str] = field(
+    methods: Annotated[list[str], NonEmpty] = field(
         default_factory=lambda: ["none", "distance", "polygon", "occlusion", "occlusion-width"]
     )
     walking_speed: Speed = 1.4  # m/s
     radius: PositiveReal = 0.25  # m, a person's half shoulder width
-    crossing: list[Real] = field(default_factory=lambda: [3.85, 6.15])  # y of the arm's faces
+    crossing: Annotated[list[Real], NonEmpty] = field(
+        default_factory=lambda: [3.85, 6.15]
+    )  # y of the arm's faces
     # m from the robot's corridor axis, out of the laser's sight
     start_distance: NonNegativeReal = 4.0
     max_duration: Seconds = 90.0  # s

@@ -7,8 +7,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated
 
-from kiseki_experiments.harness.config import Boxes, Particles, Runs
+from kiseki_experiments.harness.config import Boxes, NonEmpty, Particles, Runs
 from kiseki_experiments.teach.teach_playback_config import Exp2Config, Exp3Config
 
 __all__ = ["LayoutsConfig", "experiment_configs"]
@@ -20,7 +21,7 @@ class LayoutsConfig:
     # 2 is the fewest with a mean over runs and an SD (Exp. 3). 150 layouts x 2 runs took
     # 50 min on two workers (1000 particles); 3 runs per layout would take a third longer.
     runs_per_layout: Runs = 2
-    methods: list[str] = field(
+    methods: Annotated[list[str], NonEmpty] = field(
         default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
     )
     particles: Particles = 1000

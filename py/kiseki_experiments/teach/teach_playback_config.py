@@ -7,10 +7,11 @@ played under another's name."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Annotated
 
 from kiseki.apps.teach import PlaybackConfig
 from kiseki.teach.local_maps import METHODS
-from kiseki_experiments.harness.config import Boxes, Count, Factor, Particles
+from kiseki_experiments.harness.config import Boxes, Count, Factor, NonEmpty, Particles
 from kiseki_experiments.harness.paths import WORLDS
 
 __all__ = ["RAY_MODEL", "Exp1Config", "Exp2Config", "Exp3Config", "stand_ins"]
@@ -19,7 +20,7 @@ __all__ = ["RAY_MODEL", "Exp1Config", "Exp2Config", "Exp3Config", "stand_ins"]
 @dataclass(frozen=True)
 class Exp1Config:
     scene: str = str(WORLDS / "factory_corridor.yaml")
-    methods: list[str] = field(default_factory=lambda: ["proposal2"])
+    methods: Annotated[list[str], NonEmpty] = field(default_factory=lambda: ["proposal2"])
     particles: Particles = 1000
     boxes: Boxes = 0  # unknown boxes placed at random for playback (Exp. 3)
     merge: str = "thesis"  # the taught maps' merge rule: thesis or evidence
@@ -31,7 +32,7 @@ class Exp1Config:
 @dataclass(frozen=True)
 class Exp2Config:
     scene: str = str(WORLDS / "factory_turn.yaml")
-    methods: list[str] = field(
+    methods: Annotated[list[str], NonEmpty] = field(
         default_factory=lambda: ["conventional", "proposal1", "proposal2", "both"]
     )
     particles: Particles = 1000
@@ -43,7 +44,7 @@ class Exp2Config:
 @dataclass(frozen=True)
 class Exp3Config:
     scene: str = str(WORLDS / "factory_turn.yaml")
-    methods: list[str] = field(default_factory=lambda: ["proposal2"])
+    methods: Annotated[list[str], NonEmpty] = field(default_factory=lambda: ["proposal2"])
     particles: Particles = 1000
     boxes: Boxes = 3
     # each run played again without the boxes (same teaching and seeds): table boxes_final_leg

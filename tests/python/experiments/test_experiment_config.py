@@ -19,6 +19,7 @@ from kiseki_experiments.harness.config import (
     PARTICLE_LIMIT,
     RUN_LIMIT,
     ConfigError,
+    NonEmpty,
     apply_overrides,
     config_from_dict,
     config_to_dict,
@@ -196,3 +197,30 @@ def test_every_registered_config_builds_its_model_and_a_bare_number_is_refused()
     )
     with pytest.raises(TypeError, match=r"UnboundedItems\.sizes\): a bare float has no range"):
         config_from_dict(UnboundedItems, {})
+
+
+def _non_empty_lists() -> list:
+    import typing
+
+    found = []
+    for name, experiment in sorted(all_experiments().items()):
+        hints = typing.get_type_hints(experiment.config_type, include_extras=True)
+        for key, kind in hints.items():
+            if typing.get_origin(kind) is typing.Annotated and NonEmpty in typing.get_args(kind):
+                found.append(pytest.param(name, key, id=f"{name}.{key}"))
+    return found
+
+
+@pytest.mark.parametrize(("experiment", "key"), _non_empty_lists())
+def test_a_list_that_needs_an_item_refuses_none(experiment, key):
+    """--set methods= ran a trial of exp1-corridor that failed with "list index out of range"
+    and left a half-written results folder; each such list now refuses to be empty."""
+    config = all_experiments()[experiment].config_type()
+    with pytest.raises(ConfigError, match=f"--set: {key}: list should have at least 1 item"):
+        apply_overrides(config, [f"{key}="], experiment)
+
+
+def test_lists_that_may_be_empty_still_may():
+    """gp-aalto's walks= leaves out the walks (its negative control does so)."""
+    assert len(_non_empty_lists()) >= 9
+    assert apply_overrides(GpAaltoConfig(), ["walks="]).walks == []
