@@ -206,6 +206,8 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
         except (TypeError, ValueError) as err:  # the model's message names the file already
             text = str(err) if str(err).startswith(f"{path}: ") else f"{path}: {err}"
             raise ConfigError(text) from None
+        if experiment.preflight is not None:
+            experiment.preflight(config)
         if runs is not None and runs != saved.runs:
             _extend(experiment, config, saved, _option(Runs, runs, "--runs"), path)
             return experiment, run_dir, config, runs, saved.seed
@@ -226,6 +228,8 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
     if (run_dir / "trials.jsonl").exists():
         raise KisekiError(f"{run_dir}: already holds trials: use --resume or another --out")
     check_writable_folder(run_dir, "results")
+    if experiment.preflight is not None:  # before the folder: a refused run leaves none
+        experiment.preflight(config)
     run_dir.mkdir(parents=True, exist_ok=True)
     saved = {"experiment": name, "runs": runs, "seed": seed, "config": config_to_dict(config)}
     text = yaml.safe_dump(saved, sort_keys=False)
@@ -257,8 +261,6 @@ def run_experiment(
         experiment, run_dir, config, runs, seed = _prepare(
             name, runs, seed, overrides, out, resume, Path(results_root)
         )
-        if experiment.preflight is not None:
-            experiment.preflight(config)
         git_at_start = git_state()  # the checkout the trials run from, not the one at the end
         log = TrialLog(run_dir / "trials.jsonl")
         done = log.read()

@@ -29,6 +29,7 @@ import pandas as pd
 from kiseki.datasets import read_carmen_log
 from kiseki.filters import (
     RECOVERY_MODES,
+    RESET_PROPOSALS,
     LocalizeConfig,
     MclConfig,
     localize,
@@ -93,6 +94,11 @@ def preflight(config: ExcursionsConfig) -> None:
     for r in config.recoveries:
         if r not in RECOVERY_MODES:
             raise ValueError(f"mcl-excursions: unknown recovery {r!r}")
+    if config.sensor_reset_proposal not in RESET_PROPOSALS:  # failed in every trial
+        raise ValueError(
+            f"mcl-excursions: sensor_reset_proposal must be one of {', '.join(RESET_PROPOSALS)}, "
+            f"got {config.sensor_reset_proposal!r}"
+        )
     ray_resets = "ray-space-observation" in config.methods and "resetting" in config.recoveries
     if config.intrusion_tolerant_resets and not ray_resets:
         raise ValueError(

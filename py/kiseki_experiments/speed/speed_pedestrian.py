@@ -89,6 +89,9 @@ def preflight(config: PedestrianConfig) -> None:
         raise ValueError(f"speed-pedestrian: unknown methods {unknown} (known: {METHODS})")
     if not (config.walking_speed > 0 and config.radius > 0 and config.start_distance > 1):
         raise ValueError("speed-pedestrian: walking_speed, radius > 0, start_distance > 1 m")
+    if len(config.goal) != 2 or not all(abs(v) <= 1e4 for v in config.goal):
+        # goal=1 failed in every trial ("goal_xy must be two finite numbers")
+        raise ValueError(f"speed-pedestrian: goal must be two numbers x,y (m), got {config.goal}")
     if not Path(config.scene).is_file():
         raise FileNotFoundError(f"speed-pedestrian: {config.scene} not found")
 

@@ -373,3 +373,24 @@ def test_report_refuses_claims_it_cannot_count_in_one_line(tmp_path, change, nee
     assert done.returncode == 1, done.stdout + done.stderr
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], done.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (
+            ["mcl-excursions", "--set", "sensor_reset_proposal=foo"],
+            "sensor_reset_proposal must be one of uniform, matcher, got 'foo'",
+        ),
+        (["speed-pedestrian", "--set", "goal=1"], "goal must be two numbers x,y (m), got [1.0]"),
+        (["exp1-corridor", "--set", "methods="], "--set: methods: list should have at least 1"),
+    ],
+)
+def test_a_refused_run_leaves_no_results_folder(tmp_path, args, needle):
+    """Each failed in every trial (or after one), leaving a results folder with a config.yaml
+    and no result; the preflight now runs before the folder is made."""
+    done = cli("experiment", "run", *args, "--runs", "1", "--out", "r", cwd=tmp_path)
+    assert done.returncode == 1, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], done.stderr
+    assert not (tmp_path / "r").exists()
