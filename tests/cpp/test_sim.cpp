@@ -2,6 +2,7 @@
 // Copyright (c) 2026 the kiseki authors
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -206,7 +207,8 @@ TEST(OctomapFile, WritesOctomapsOwnBytesAndNothingToStderr) {
     std::ostringstream reference;
     testing::internal::CaptureStderr();
     ASSERT_TRUE(tree.writeBinaryConst(reference));
-    EXPECT_EQ(testing::internal::GetCapturedStderr(), " done.\n");  // why kiseki writes its own
+    const std::string said = testing::internal::GetCapturedStderr();  // why kiseki writes its own
+    EXPECT_EQ(said.substr(said.size() - std::min<std::size_t>(said.size(), 7)), " done.\n");
     const std::string path = testing::TempDir() + "kiseki_octomap_file.bt";
     testing::internal::CaptureStderr();
     write_octomap_binary(tree, path);
