@@ -14,6 +14,7 @@ them; this module knows only names, priorities and opaque commands.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Mapping
 from typing import Any
 
@@ -38,7 +39,7 @@ class PriorityArbiter:
         for name, value in priorities.items():
             if not isinstance(name, str) or not name:
                 raise ValueError(f"PriorityArbiter: a navigator name must be text, got {name!r}")
-            ok = isinstance(value, int | float) and not isinstance(value, bool)
+            ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
             if not (ok and math.isfinite(value) and value > 0):
                 raise ValueError(
                     f"PriorityArbiter: priority of {name!r} must be a finite number > 0,"

@@ -68,6 +68,7 @@ they say.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,7 +96,7 @@ class FuzzyPotentialConfig:
         check_field_types(self)
         for name in ("v_max", "robot_radius", "stop_distance", "influence_distance", "step"):
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            if not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
                 raise ValueError(
                     f"FuzzyPotentialConfig.{name} must be a positive number, got {value!r}"
                 )

@@ -11,12 +11,13 @@ Convention: a positive error means "turn left" (counter-clockwise, the world's z
 from __future__ import annotations
 
 import math
+import numbers
 
 __all__ = ["PdSteering"]
 
 
 def _positive(value: float, name: str, allow_zero: bool = False) -> float:
-    ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
     if not ok or value < 0 or (value == 0 and not allow_zero):
         need = ">= 0" if allow_zero else "> 0"
         raise ValueError(f"PdSteering: {name} must be a finite number {need}, got {value!r}")

@@ -39,6 +39,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import numbers
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -87,7 +88,7 @@ class CostModel:
     def __post_init__(self) -> None:
         for name in _COEFFICIENTS:
             value = getattr(self, name)
-            number = isinstance(value, int | float) and not isinstance(value, bool)
+            number = isinstance(value, numbers.Real) and not isinstance(value, bool)
             if not (number and math.isfinite(value) and 0 <= value <= MAGNITUDE_LIMIT):
                 raise ValueError(
                     f"{name} must be a finite number in [0, {MAGNITUDE_LIMIT:g}] ms, got {value!r}"

@@ -23,6 +23,7 @@ the reduced-rank version.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -63,7 +64,7 @@ class CurlFreeKernel:
             v = getattr(self, name)
             if (
                 isinstance(v, bool)
-                or not isinstance(v, (int, float))
+                or not isinstance(v, numbers.Real)
                 or not math.isfinite(v)
                 or v <= 0
             ):

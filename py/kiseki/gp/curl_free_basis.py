@@ -25,6 +25,7 @@ weights on the same basis with density S_2(w) / l^2.
 from __future__ import annotations
 
 import math
+import numbers
 from typing import Any
 
 import numpy as np
@@ -97,7 +98,7 @@ class ReducedRankCurlFreeGP:
         if x.shape[1] not in (2, 3) or not np.isfinite(x).all():
             raise ValueError(f"X: finite positions with 2 or 3 coordinates, got shape {x.shape}")
         y = field_targets(y, len(x))
-        if not (isinstance(margin, (int, float)) and math.isfinite(margin) and margin >= 0):
+        if not (isinstance(margin, numbers.Real) and math.isfinite(margin) and margin >= 0):
             raise ValueError(f"margin must be a finite number >= 0, got {margin!r}")
         if isinstance(block, bool) or not isinstance(block, int) or block < 1:
             raise ValueError(f"block must be an integer >= 1, got {block!r}")

@@ -74,7 +74,7 @@ class HilbertGP:
         if tolerance is None:
             tolerance = spectral_tolerance(kernel)
         if not (
-            isinstance(tolerance, (int, float)) and 0 < tolerance < 1 and math.isfinite(tolerance)
+            isinstance(tolerance, numbers.Real) and 0 < tolerance < 1 and math.isfinite(tolerance)
         ):
             raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
         core = _core.HilbertGaussianProcess(

@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
@@ -43,7 +44,7 @@ class SquaredExponential:
             v = getattr(self, name)
             if (
                 isinstance(v, bool)
-                or not isinstance(v, (int, float))
+                or not isinstance(v, numbers.Real)
                 or not math.isfinite(v)
                 or v <= 0
             ):

@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any
 
@@ -115,7 +116,7 @@ class TiledGP:
         margin = _distance("margin", 1.0 * ell if margin is None else margin)
         if tolerance is None:
             tolerance = spectral_tolerance(kernel)
-        if not (isinstance(tolerance, (int, float)) and 0 < tolerance < 1):
+        if not (isinstance(tolerance, numbers.Real) and 0 < tolerance < 1):
             raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
         lower, upper = x.min(axis=0), x.max(axis=0)
         extent = upper - lower
@@ -291,7 +292,7 @@ def _build_tile(plan: _TilePlan, data: _TileData, kernel: SquaredExponential) ->
 
 
 def _distance(name: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value >= 0:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not value >= 0:
         raise ValueError(f"{name} must be a distance >= 0 in metres, got {value!r}")
     if not math.isfinite(value):
         raise ValueError(f"{name} must be finite, got {value!r}")

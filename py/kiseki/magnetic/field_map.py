@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -290,7 +291,7 @@ class MagneticFieldMap:
         if gd != d and not (d == 2 and gd == 3 and height is not None):
             hint = " (give height for a 2-D slice of a 3-D GP)" if (d, gd) == (2, 3) else ""
             raise ValueError(f"the GP is {gd}-D but the box is {d}-D{hint}")
-        if not (isinstance(resolution, (int, float)) and math.isfinite(resolution)):
+        if not (isinstance(resolution, numbers.Real) and math.isfinite(resolution)):
             raise ValueError(f"resolution must be a positive number of metres, got {resolution!r}")
         if resolution <= 0:
             raise ValueError(f"resolution must be a positive number of metres, got {resolution!r}")

@@ -22,6 +22,7 @@ noise).
 from __future__ import annotations
 
 import math
+import numbers
 from typing import Any
 
 import numpy as np
@@ -66,7 +67,7 @@ def gate_limits(noise_sd: float, counts: Any, z: float = GATE_Z) -> np.ndarray:
     """Per node: the largest |m_z,n - m_z,t| the gate passes, ``z sigma sqrt(1 + 1/c_n)``
     (an interpolated node, c = 0, counts as one reading)."""
     for name, value in (("noise_sd", noise_sd), ("z", z)):
-        if isinstance(value, bool) or not isinstance(value, int | float):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise ValueError(f"gates: {name} must be a number, got {value!r}")
         if not (math.isfinite(value) and value > 0):
             raise ValueError(f"gates: {name} must be > 0, got {value}")

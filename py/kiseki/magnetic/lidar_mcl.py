@@ -40,6 +40,7 @@ One map kind serves chapters 3-5 this way, and the nodes need positions (the map
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -66,7 +67,7 @@ SIGMA_THETA = math.radians(1.0)
 
 
 def _number(value: Any, name: str, low: float, high: float = math.inf) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ValueError(f"lidar MCL: {name} must be a number, got {value!r}")
     if not (math.isfinite(value) and low <= value <= high):
         raise ValueError(f"lidar MCL: {name} must be in [{low}, {high}], got {value}")

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
@@ -99,9 +100,9 @@ def geometric_features(
     if not np.all(np.isfinite(a)):
         raise ValueError("geometric_features: the beam angles hold NaN or infinity")
     for name, value in (("max_range", max_range), ("window_range", window_range)):
-        if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+        if not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
             raise ValueError(f"geometric_features: {name} must be a positive number, got {value}")
-    if not (isinstance(window_angle, int | float) and 0 < window_angle <= math.pi):
+    if not (isinstance(window_angle, numbers.Real) and 0 < window_angle <= math.pi):
         raise ValueError(f"geometric_features: window_angle must be in (0, pi], got {window_angle}")
     wrapped = np.angle(np.exp(1j * a))
     half = window_angle / 2
@@ -225,11 +226,11 @@ def build_linear_map(
     the sensor frame, odometry ``heading`` (n,) rad, optional geometric features ``g`` (n, 2)
     (NaN: no obstacle) and reference ``position`` (n, 2). ``path_id``: 40 hex digits
     (:func:`path_identity`). ValueError names the first bad sample."""
-    if not (isinstance(spacing, int | float) and not isinstance(spacing, bool)):
+    if not (isinstance(spacing, numbers.Real) and not isinstance(spacing, bool)):
         raise ValueError(f"linear magnetic map: spacing must be a number, got {spacing!r}")
     if not (math.isfinite(spacing) and spacing > 0):
         raise ValueError(f"linear magnetic map: spacing must be positive, got {spacing} m")
-    if not (isinstance(tolerance, int | float) and math.isfinite(tolerance) and tolerance >= 0):
+    if not (isinstance(tolerance, numbers.Real) and math.isfinite(tolerance) and tolerance >= 0):
         raise ValueError(f"linear magnetic map: tolerance must be >= 0, got {tolerance!r}")
     if not (isinstance(path_id, str) and len(path_id) == _SHA1_HEX):
         raise ValueError(f"linear magnetic map: path_id must be 40 hex digits, got {path_id!r}")

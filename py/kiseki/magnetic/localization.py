@@ -12,6 +12,7 @@ The thesis' settings: 1000 particles, resampling when the ESS falls below n/2.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
@@ -63,7 +64,7 @@ class MagneticMapModel:
             raise ValueError("magnetic-map localization needs a 2-D field map (dimension 2)")
         if frame not in FRAMES:
             raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
-        if not (isinstance(noise_sd, (int, float)) and math.isfinite(noise_sd) and noise_sd >= 0):
+        if not (isinstance(noise_sd, numbers.Real) and math.isfinite(noise_sd) and noise_sd >= 0):
             raise ValueError(f"noise_sd must be a finite number >= 0, got {noise_sd!r}")
         self.offsets = sensor_offsets(offsets)
         self.frame = frame

@@ -74,7 +74,7 @@ def fit_loop_profile(
     """The profile of one channel (module text). ``s`` (n,) m in [0, length], ``values`` (n,);
     ``noise_floor``: the least sigma_n (the channel's units) the profile keeps, for a lap whose
     readings carry no noise (a synthetic one): without it the likelihood's width is zero."""
-    if isinstance(length, bool) or not isinstance(length, int | float):
+    if isinstance(length, bool) or not isinstance(length, numbers.Real):
         raise ValueError(f"loop profile: the loop's length must be a number, got {length!r}")
     if not (math.isfinite(length) and length > 0):
         raise ValueError(f"loop profile: the loop's length must be > 0, got {length}")
@@ -88,7 +88,7 @@ def fit_loop_profile(
     v = np.asarray(values, dtype=np.float64)
     if s.ndim != 1 or v.shape != s.shape:
         raise ValueError(f"loop profile: s {s.shape} and values {v.shape} must be (n,) alike")
-    if not (isinstance(noise_floor, int | float) and 0 <= noise_floor < math.inf):
+    if not (isinstance(noise_floor, numbers.Real) and 0 <= noise_floor < math.inf):
         raise ValueError(f"loop profile: noise_floor must be a number >= 0, got {noise_floor!r}")
     if len(s) < 4:
         raise ValueError(f"loop profile: {len(s)} readings; at least 4 are needed")

@@ -43,6 +43,7 @@ changes, each for a reason measured on real walks:
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -86,21 +87,21 @@ class LoopTravelConfig:
             )
         for name in ("odometry_noise", "scale_sd", "scale_walk", "initial_sd"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
                 raise ValueError(f"loop filter: {name} must be a finite number, got {v!r}")
             if v < 0:
                 raise ValueError(f"loop filter: {name} must be >= 0, got {v}")
         if self.scale_sd >= 0.5:
             raise ValueError(f"loop filter: scale_sd must be < 0.5, got {self.scale_sd}")
         r = self.resample_threshold
-        if isinstance(r, bool) or not isinstance(r, int | float) or not 0 <= r <= 1:
+        if isinstance(r, bool) or not isinstance(r, numbers.Real) or not 0 <= r <= 1:
             raise ValueError(f"loop filter: resample_threshold must be in [0, 1], got {r!r}")
         if self.start not in STARTS:
             raise ValueError(f"loop filter: start must be one of {STARTS}, got {self.start!r}")
         if not isinstance(self.reentry, bool):
             raise ValueError(f"loop filter: reentry must be true or false, got {self.reentry!r}")
         a, b = self.alpha_slow, self.alpha_fast
-        if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in (a, b)) or not (
+        if not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in (a, b)) or not (
             0 < a < b <= 1
         ):
             raise ValueError(
@@ -162,7 +163,7 @@ class LoopTravelDistanceLocalizer:
         loop = lengths.pop()
         if not (math.isfinite(loop) and loop > 0):
             raise ValueError(f"loop filter: the loop's length must be > 0, got {loop}")
-        if isinstance(start, bool) or not isinstance(start, int | float):
+        if isinstance(start, bool) or not isinstance(start, numbers.Real):
             raise ValueError(f"loop filter: start must be a number, got {start!r}")
         if not math.isfinite(start):
             raise ValueError(f"loop filter: start must be finite, got {start}")
@@ -208,7 +209,7 @@ class LoopTravelDistanceLocalizer:
     def step(self, distance: float, reading: Any) -> float:
         """One reading: the odometry's travel since the last one (m) and one value per channel.
         Returns the estimate in [0, L)."""
-        if isinstance(distance, bool) or not isinstance(distance, int | float):
+        if isinstance(distance, bool) or not isinstance(distance, numbers.Real):
             raise ValueError(
                 f"loop filter: the odometry increment must be a number, got {distance!r}"
             )

@@ -35,6 +35,7 @@ them back checked; the map type (:mod:`kiseki.magnetic.field_map`) builds on thi
 from __future__ import annotations
 
 import math
+import numbers
 import os
 import shutil
 import struct
@@ -246,7 +247,7 @@ def _check_picture_scale(meta: Path, name: str, entry: dict) -> None:
         v = entry.get(key)
         if (
             isinstance(v, bool)
-            or not isinstance(v, int | float)
+            or not isinstance(v, numbers.Real)
             or not abs(v) <= 2 * MAGNITUDE_LIMIT
             or (key == "scale" and v < 0)
         ):

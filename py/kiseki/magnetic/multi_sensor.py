@@ -20,6 +20,7 @@ readings drift away from its map.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -50,7 +51,7 @@ class DriftCheck:
     def __post_init__(self) -> None:
         if isinstance(self.window, bool) or not isinstance(self.window, int) or self.window < 2:
             raise ValueError(f"drift check: window must be an integer >= 2, got {self.window!r}")
-        ok = isinstance(self.limit, int | float) and not isinstance(self.limit, bool)
+        ok = isinstance(self.limit, numbers.Real) and not isinstance(self.limit, bool)
         if not (ok and math.isfinite(self.limit) and self.limit > 0):
             raise ValueError(f"drift check: limit must be a number > 0, got {self.limit!r}")
 

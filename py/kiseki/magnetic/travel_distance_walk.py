@@ -28,6 +28,7 @@ positions from the visual-inertial odometry, the field turned to the world frame
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -71,12 +72,12 @@ class WalkOdometry:
     def __post_init__(self) -> None:
         for name in ("scale_sd", "noise", "radius", "min_travel", "max_offset", "truth_window"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float):
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
                 raise ValueError(f"walk: {name} must be a number, got {value!r}")
             if not (math.isfinite(value) and value >= 0):
                 raise ValueError(f"walk: {name} must be a number >= 0, got {value}")
         e = self.scale_error
-        if e is not None and not (isinstance(e, int | float) and math.isfinite(e) and e > -1):
+        if e is not None and not (isinstance(e, numbers.Real) and math.isfinite(e) and e > -1):
             raise ValueError(f"walk: scale_error must be a number > -1, got {e!r}")
 
 

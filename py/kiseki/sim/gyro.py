@@ -26,6 +26,7 @@ the worst case, and setting bias_sd and N to 0 models the compensated unit.
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -35,7 +36,7 @@ __all__ = ["Gyro", "error_sd"]
 
 
 def _non_negative(name: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not 0 <= value < math.inf:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 <= value < math.inf:
         raise ValueError(f"gyro: {name} must be a finite number >= 0, got {value!r}")
     return float(value)
 

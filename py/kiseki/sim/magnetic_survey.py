@@ -18,6 +18,7 @@ regular grid of points, and stops every 0.1 m of a robot's travel.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -48,7 +49,7 @@ def _triple(value: Any, name: str, where: str) -> tuple[float, float, float]:
     if (
         not isinstance(value, list | tuple)
         or len(value) != 3
-        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+        or not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in value)
         or not all(math.isfinite(v) for v in value)
     ):
         raise ValueError(f"{where}: {name} must be [x, y, z], three finite numbers, got {value!r}")
@@ -71,7 +72,7 @@ class MeasurementGrid:
         w = self.where
         lo, hi = _triple(self.lower, "lower", w), _triple(self.upper, "upper", w)
         s = self.spacing
-        if isinstance(s, bool) or not isinstance(s, int | float) or not math.isfinite(s) or s <= 0:
+        if isinstance(s, bool) or not isinstance(s, numbers.Real) or not math.isfinite(s) or s <= 0:
             raise ValueError(f"{w}: spacing must be a positive number of metres, got {s!r}")
         counts = []
         for axis, a, b in zip("xyz", lo, hi, strict=True):
@@ -161,7 +162,7 @@ def hand_survey(
     row order). Default noise: the 3DM-DH's 0.01 G (thesis sec. 6.3.2)."""
     if not isinstance(world, MagneticWorld):
         raise ValueError(f"world: expected a MagneticWorld, got {type(world).__name__}")
-    if isinstance(noise_sd, bool) or not isinstance(noise_sd, int | float) or not noise_sd >= 0:
+    if isinstance(noise_sd, bool) or not isinstance(noise_sd, numbers.Real) or not noise_sd >= 0:
         raise ValueError(f"noise_sd: must be a number >= 0, got {noise_sd!r}")
     seed = check_seed(seed)
     truth = np.reshape(world.field_at(points, times), (-1, 3))
@@ -203,7 +204,7 @@ def route_stops(waypoints: Any, step: float = 0.1) -> tuple[np.ndarray, np.ndarr
     """The robot's poses (n, 3) every ``step`` m of travel along the route from its first
     waypoint (the thesis records a reading every 0.1 m, sec. 6.5.1), and their travel distances
     (n,): ``floor(length / step) + 1`` stops."""
-    if isinstance(step, bool) or not isinstance(step, int | float) or not step > 0:
+    if isinstance(step, bool) or not isinstance(step, numbers.Real) or not step > 0:
         raise ValueError(f"step: must be a positive number of metres, got {step!r}")
     total = float(_legs(waypoints)[1].sum())
     s = step * np.arange(int(math.floor(total / step + 1e-9)) + 1)

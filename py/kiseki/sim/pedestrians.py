@@ -13,6 +13,7 @@ kiseki.sim.run counts them, and a run logs their positions on ``/pedestrians``.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,7 +35,7 @@ def _finite(value, what: str, n: int = 1) -> tuple[float, ...]:
     if (
         not isinstance(items, list | tuple)
         or len(items) != n
-        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in items)
+        or not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in items)
         or not all(math.isfinite(v) for v in items)
     ):
         raise ValueError(f"{what} must be {n} finite number(s), got {value!r}")

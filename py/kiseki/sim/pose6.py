@@ -27,6 +27,7 @@ onto an object, raises the nose.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,7 +40,7 @@ __all__ = ["PAPER_MOVES", "Pose6", "attitude", "pose_matrix", "resting_pose", "t
 def pose_matrix(x: float, y: float, z: float, roll: float, pitch: float, yaw: float) -> np.ndarray:
     """The 4x4 pose (world from body) of a 6-DOF pose; angles in radians."""
     values = (x, y, z, roll, pitch, yaw)
-    if not all(isinstance(v, int | float) and math.isfinite(v) for v in values):
+    if not all(isinstance(v, numbers.Real) and math.isfinite(v) for v in values):
         raise ValueError(f"pose: expected finite x, y, z, roll, pitch, yaw, got {values}")
     m = np.eye(4)
     m[:3, :3] = rotation(yaw, pitch, roll)
@@ -79,7 +80,7 @@ class Pose6:
     @classmethod
     def from_degrees(cls, x, y, z, roll_deg, pitch_deg, yaw_deg) -> Pose6:
         angles = (roll_deg, pitch_deg, yaw_deg)
-        if not all(isinstance(v, int | float) and math.isfinite(v) for v in angles):
+        if not all(isinstance(v, numbers.Real) and math.isfinite(v) for v in angles):
             raise ValueError(f"pose: attitude must be 3 finite numbers (deg), got {angles}")
         return cls(x, y, z, *(math.radians(a) for a in angles))
 
@@ -106,7 +107,7 @@ def terrain_pose(world, x: float, y: float, yaw: float, length: float, width: fl
     ``cast_many(origins, directions, max_range)``): rays are cast down from height ``from_z``
     (below any ceiling, above the ground) at the footprint's corners."""
     values = (x, y, yaw, length, width, from_z)
-    if not all(isinstance(v, int | float) and math.isfinite(v) for v in values):
+    if not all(isinstance(v, numbers.Real) and math.isfinite(v) for v in values):
         raise ValueError(f"terrain_pose: expected finite numbers, got {values}")
     if length <= 0 or width <= 0:
         raise ValueError(f"terrain_pose: footprint must be > 0 m, got {length} x {width}")

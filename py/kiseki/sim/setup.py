@@ -18,6 +18,7 @@ through their models here to build them."""
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any
 
@@ -159,7 +160,7 @@ def build_sensors(
 ) -> list[SensorSetup]:
     """The sensors of robot `index`; each gets its own seeded stream."""
     seed = check_seed(seed)
-    if isinstance(dt, bool) or not isinstance(dt, int | float) or not 0 < dt < math.inf:
+    if isinstance(dt, bool) or not isinstance(dt, numbers.Real) or not 0 < dt < math.inf:
         raise ValueError(f"{scene.path}: dt must be a finite number of seconds > 0, got {dt!r}")
     robot_at = _robot_at(scene, index)
     out: list[SensorSetup] = []

@@ -18,6 +18,7 @@ grows along the run as it would on a robot.
 from __future__ import annotations
 
 import math
+import numbers
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -124,7 +125,7 @@ def terrain_stops(
     seed = check_seed(seed)
     if isinstance(moves, bool) or not isinstance(moves, int) or not 1 <= moves <= 200:
         raise ValueError(f"moves must be an integer in 1..200, got {moves!r}")
-    if not (isinstance(step, (int, float)) and 0.02 <= step <= 0.6):
+    if not (isinstance(step, numbers.Real) and 0.02 <= step <= 0.6):
         raise ValueError(f"step must be 0.02..0.6 m (the search reaches 0.7 m), got {step!r}")
     path = Path(world_path)
     if path.suffix == ".bt":

@@ -54,6 +54,7 @@ no-return reading sees up to the range, a NaN one sees nothing).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -97,7 +98,7 @@ class AccelerationLimit:
 def _check_config(config, non_negative=()) -> None:
     for f in fields(config):
         value = getattr(config, f.name)
-        number = isinstance(value, (int, float)) and not isinstance(value, bool)
+        number = isinstance(value, numbers.Real) and not isinstance(value, bool)
         low_ok = number and (value >= 0 if f.name in non_negative else value > 0)
         if not (number and math.isfinite(value) and low_ok):
             kind = ">= 0" if f.name in non_negative else "positive"
@@ -112,7 +113,7 @@ def check_initial_speed(name: str, initial, v_max: float) -> None:
     robot's maximum speed (they fall from there at a_max)."""
     if (
         isinstance(initial, bool)
-        or not isinstance(initial, (int, float))
+        or not isinstance(initial, numbers.Real)
         or not 0 <= initial <= v_max
     ):
         raise ValueError(f"{name} must be a speed in [0, v_max = {v_max:g}] m/s, got {initial!r}")

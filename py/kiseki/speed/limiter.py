@@ -30,6 +30,7 @@ cells 0..25 are free, nav2 map_server's free_thresh 0.25).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -163,7 +164,7 @@ class SpeedLimiterConfig:
         check_field_types(self)
         for name in ("v_max", "a_max", "w1", "w2", "a", "half_band"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float):
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
                 raise ValueError(f"SpeedLimiterConfig.{name} must be a number, got {value!r}")
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"SpeedLimiterConfig.{name} must be positive, got {value!r}")

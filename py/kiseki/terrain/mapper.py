@@ -17,6 +17,7 @@ pose. Nothing here uses the simulator: sweeps are ranges and attitudes, from a l
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import asdict, dataclass, field
 from typing import Any, Literal
 
@@ -62,7 +63,7 @@ class MapperConfig:
             raise ValueError(f"search must be exhaustive or coarse-to-fine, got {self.search!r}")
         if self.cost not in ("sum", "mean"):
             raise ValueError(f"cost must be sum (eq. 4) or mean, got {self.cost!r}")
-        if not (isinstance(self.voxel, (int, float)) and 0.005 <= self.voxel <= 10):
+        if not (isinstance(self.voxel, numbers.Real) and 0.005 <= self.voxel <= 10):
             raise ValueError(f"voxel must be in 0.005..10 m, got {self.voxel!r}")
         check_seed(self.seed)
         search_grid(self.x, self.y, self.z, self.step)  # raises for a bad box

@@ -13,6 +13,7 @@ by eq. 3. The C++ core does the work (``kiseki/terrain/sphere_elevation_map.hpp`
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from typing import Any
 
@@ -64,7 +65,9 @@ def attitude_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
     """R = Rz(yaw) Ry(pitch) Rx(roll), angles in rad (the gyro's attitude: from the sensor
     frame to the level frame). Raises ValueError for a non-finite angle (a failed gyro)."""
     values = (roll, pitch, yaw)
-    if not all(isinstance(v, (int, float, np.floating)) and math.isfinite(v) for v in values):
+    if not all(
+        isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v) for v in values
+    ):
         raise ValueError(f"attitude: roll, pitch, yaw must be finite numbers, got {values}")
     return rotation_zyx(float(yaw), float(pitch), float(roll))
 

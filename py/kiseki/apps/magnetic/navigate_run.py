@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -161,7 +162,7 @@ def teach(
     """Three teaching runs (taught path, left and right parallel paths) written to
     ``out_dir/teach_{center,left,right}.mcap``; returns their linear maps."""
 
-    if not (isinstance(offset, int | float) and math.isfinite(offset) and offset > 0):
+    if not (isinstance(offset, numbers.Real) and math.isfinite(offset) and offset > 0):
         raise ValueError(f"teach: offset must be a positive number of metres, got {offset!r}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -368,7 +369,7 @@ def navigate(
         raise ValueError(
             f"navigate: navigators must be some of {', '.join(NAVIGATORS)}, got {navigators!r}"
         )
-    if not (isinstance(gate_scale, (int, float)) and 0 < gate_scale < math.inf):
+    if not (isinstance(gate_scale, numbers.Real) and 0 < gate_scale < math.inf):
         raise ValueError(f"navigate: gate_scale must be a number > 0, got {gate_scale!r}")
 
     if method not in METHODS:

@@ -1,0 +1,55 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""A numpy scalar (float32 from a float32 array, int64 from an index) is taken wherever the
+Python number is, with the same result: float32 values were refused with "must be a positive
+number, got 5.0", which named a value that looked right."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kiseki.control import PriorityArbiter
+from kiseki.gp import CurlFreeKernel, SquaredExponential
+from kiseki.magnetic import build_linear_map, geometric_features
+from kiseki.terrain import attitude_matrix
+
+F32 = np.float32
+
+
+def _same(a, b) -> None:
+    if isinstance(a, np.ndarray):
+        np.testing.assert_array_equal(a, b)
+    else:
+        assert a == b
+
+
+@pytest.mark.parametrize(
+    ("call", "numpy_args", "python_args"),
+    [
+        (SquaredExponential, (F32(1.5), F32(0.5), F32(0.25)), (1.5, 0.5, 0.25)),
+        (CurlFreeKernel, (F32(1.5), F32(0.5), F32(40.0), F32(0.25)), (1.5, 0.5, 40.0, 0.25)),
+        (attitude_matrix, (np.int64(0), F32(0.5), np.float64(1.0)), (0, 0.5, 1.0)),
+        (
+            lambda m: geometric_features(np.full(9, 2.0), np.linspace(-1.5, 1.5, 9), m),
+            (F32(5.0),),
+            (5.0,),
+        ),
+        (
+            lambda s: (
+                build_linear_map(
+                    np.arange(0.0, 2.0, 0.05),
+                    np.ones((40, 3)),
+                    np.zeros(40),
+                    spacing=s,
+                    path_id="0" * 40,
+                ).s
+            ),
+            (F32(0.25),),
+            (0.25,),
+        ),
+        (lambda p: PriorityArbiter({"a": p, "b": 1.0}).priorities["a"], (np.int64(3),), (3,)),
+    ],
+)
+def test_numpy_scalars_are_taken_as_their_numbers(call, numpy_args, python_args):
+    _same(call(*numpy_args), call(*python_args))
