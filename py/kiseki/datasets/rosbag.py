@@ -49,6 +49,7 @@ from __future__ import annotations
 import math
 import os
 import shutil
+import sqlite3
 import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
@@ -357,7 +358,7 @@ def _open_bag(path: Path) -> Iterator[Any]:
     try:
         reader = AnyReader([path], default_typestore=store)
         reader.open()
-    except AnyReaderError as exc:
+    except (AnyReaderError, UnicodeDecodeError, sqlite3.Error) as exc:  # a damaged .db3 file
         raise LogFormatError(f"{path}: unreadable ROS bag ({exc})") from exc
     except EOFError as exc:  # a compressed file cut short: the command line printed "Aborted."
         raise LogFormatError(f"{path}: a compressed file of the bag is cut short ({exc})") from exc

@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""A ROS 2 bag compressed file by file (metadata.yaml: compression_mode file, zstd): read as
-the same bag uncompressed; cut short, or not compressed as its metadata says, one line naming
-the bag or the file (the command printed "Aborted." for the first, a traceback for the
-second)."""
+"""Damaged ROS 2 bags, each one line naming the bag or its file: a bag compressed file by file
+(metadata.yaml: compression_mode file, zstd) reads as the same bag uncompressed; cut short, or
+not compressed as its metadata says, it printed "Aborted." or a traceback; a .db3 bag with a
+damaged topics table named no file."""
 
 from __future__ import annotations
 
@@ -70,3 +70,17 @@ def test_a_file_the_metadata_calls_zstd_but_is_not_is_named(bag: Path) -> None:
     with pytest.raises(LogFormatError) as caught:
         read_bag_scans(bag)
     assert str(caught.value).startswith(f"{bag}/bag.mcap.zstd: not a whole zstd file")
+
+
+def test_a_damaged_sqlite_bag_is_one_line_naming_the_bag(tmp_path: Path) -> None:
+    """A topic type that is not UTF-8 in a .db3 bag said only "'utf-8' codec can't decode
+    byte 0xff in position 0", naming no file."""
+    import sqlite3
+
+    bag = write_bag(_scans(), tmp_path / "bag", "ros2-sqlite3")
+    (db,) = bag.glob("*.db3")
+    with sqlite3.connect(db) as connection:
+        connection.execute("update topics set type = CAST(X'ff6f6f' AS TEXT) where name = '/scan'")
+    with pytest.raises(LogFormatError) as caught:
+        read_bag_scans(bag)
+    assert str(caught.value).startswith(f"{bag}: unreadable ROS bag ('utf-8' codec")
