@@ -160,6 +160,11 @@ def _load_mat(path: Path) -> dict[str, np.ndarray]:
         )
     arrays = {}
     for name in ("t", "dPos", "quat", "m"):
+        # a complex array lost its imaginary part with a numpy warning
+        if np.asarray(contents[name]).dtype.kind in "cb":
+            raise LogFormatError(
+                f"{path}: {name} is a {np.asarray(contents[name]).dtype} array, not real numbers"
+            )
         try:
             arrays[name] = np.asarray(contents[name], dtype=np.float64)
         except (TypeError, ValueError) as exc:

@@ -69,6 +69,8 @@ def test_kok_walk_known_values(tmp_path: Path) -> None:
         ({"t": np.zeros((3, 1))}, "t must hold 5 times like m"),
         ({"quat": np.tile([1.0, 0.0, 0.0, 0.1], (5, 1))}, "quat row 1 is not a unit quaternion"),
         ({"m": np.full((5, 3), "a")}, "m is not a numeric array"),
+        # taken with a numpy warning (the imaginary part dropped)
+        ({"m": np.ones((5, 3)) + 1j}, "m is a complex128 array, not real numbers"),
         # a huge or NaN increment: the path it gives is refused (1e300 made an infinite walk)
         (
             {"dPos": np.array([[0.1, 0, 0], [1e300, 0, 0], [0.1, 0, 0], [0.1, 0, 0]])},
