@@ -32,7 +32,28 @@ _FLOAT_12 = re.compile(
 
 
 class _Loader12(yaml.SafeLoader):
-    """SafeLoader whose plain scalars are typed as YAML 1.2's core schema types them."""
+    """SafeLoader whose plain scalars are typed as YAML 1.2's core schema types them, and whose
+    mappings refuse a key given twice (YAML 1.2.2, 3.2.1.1: keys are unique): PyYAML kept the
+    last one, so a scene's ``floor: true`` then ``floor: false`` read as false without a word.
+    Keys that a merge (``<<``) brings in may be overridden, as YAML's merge key allows."""
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            seen = set()
+            for key_node, _ in node.value:
+                if not isinstance(key_node, yaml.ScalarNode) or key_node.tag.endswith(":merge"):
+                    continue
+                key = (key_node.tag, key_node.value)
+                if key in seen:
+                    raise yaml.constructor.ConstructorError(
+                        None,
+                        None,
+                        f"found the key {key_node.value!r} twice in one mapping (line "
+                        f"{key_node.start_mark.line + 1})",
+                        key_node.start_mark,
+                    )
+                seen.add(key)
+        return super().construct_mapping(node, deep)
 
 
 _Loader12.yaml_implicit_resolvers = {

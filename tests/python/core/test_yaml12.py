@@ -47,3 +47,16 @@ def test_where_the_specs_agree_it_reads_as_pyyaml(text):
 def test_quoted_scalars_stay_strings_and_structure_is_pyyamls():
     doc = "a: '5e-2'\nb: \"010\"\nc: [1, {d: yes}]\n"
     assert safe_load_12(doc) == {"a": "5e-2", "b": "010", "c": [1, {"d": "yes"}]}
+
+
+def test_a_key_given_twice_is_refused_and_a_merge_may_override():
+    """PyYAML kept the last of two equal keys: a scene's floor: true then floor: false read as
+    false without a word (YAML 1.2 requires unique keys)."""
+    with pytest.raises(yaml.YAMLError) as caught:
+        safe_load_12("floor: true\nobjects: []\nfloor: false\n")
+    assert str(caught.value).splitlines()[0] == "found the key 'floor' twice in one mapping (line 3)"
+    with pytest.raises(yaml.YAMLError, match="found the key 'x' twice"):
+        safe_load_12("a:\n  - {x: 1, x: 2}\n")
+    merged = safe_load_12("base: &b {x: 1, y: 2}\nuse:\n  <<: *b\n  x: 3\n")
+    assert merged["use"] == {"x": 3, "y": 2}  # as PyYAML's merge: the explicit key wins
+    assert yaml.safe_load("floor: true\nfloor: false\n") == {"floor": False}  # PyYAML's way
