@@ -17,7 +17,7 @@ import yaml
 
 from kiseki._support.inputs import YAML_LIMIT, read_input_text
 
-__all__ = ["read_yaml_file", "safe_load_12"]
+__all__ = ["read_yaml_file", "safe_load_12", "yaml_problem"]
 
 _BOOL, _INT, _FLOAT, _TIMESTAMP = (
     f"tag:yaml.org,2002:{t}" for t in ("bool", "int", "float", "timestamp")
@@ -97,5 +97,10 @@ def read_yaml_file(path, what: str):
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a {what} (not UTF-8 text)") from None
     except yaml.YAMLError as err:
-        first = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-        raise ValueError(f"{path}: not a {what} (invalid YAML: {first})") from None
+        raise ValueError(f"{path}: not a {what} (invalid YAML: {yaml_problem(err)})") from None
+
+
+def yaml_problem(err: yaml.YAMLError) -> str:
+    """A YAML error's first line (PyYAML's text runs over several: the problem, then where),
+    for a message of one line."""
+    return str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__

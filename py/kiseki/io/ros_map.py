@@ -26,7 +26,7 @@ from kiseki import _core
 from kiseki._support.atomic import atomic_write_all
 from kiseki._support.inputs import GIB, YAML_LIMIT, check_input, read_input_text
 from kiseki._support.schema import SchemaError, parse
-from kiseki._support.yaml import safe_load_12
+from kiseki._support.yaml import safe_load_12, yaml_problem
 from kiseki.core import Pose2
 from kiseki.errors import MapFormatError
 from kiseki.grid import OCCUPIED, UNKNOWN, OccupancyGrid
@@ -74,7 +74,7 @@ def _parse_yaml(path: Path) -> RosMapYaml:
     try:
         doc = safe_load_12(text)  # resolution: 5e-2 is a number, as nav2 reads it
     except yaml.YAMLError as err:
-        raise MapFormatError(f"{path}: invalid YAML ({err})") from err
+        raise MapFormatError(f"{path}: invalid YAML ({yaml_problem(err)})") from err
     if not isinstance(doc, dict):
         raise MapFormatError(f"{path}: expected a YAML mapping with image, resolution and origin")
     try:

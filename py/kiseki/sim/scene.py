@@ -43,7 +43,7 @@ import yaml
 from kiseki import _core
 from kiseki._support.inputs import MIB, YAML_LIMIT, check_input, read_input
 from kiseki._support.schema import SchemaError, parse
-from kiseki._support.yaml import safe_load_12
+from kiseki._support.yaml import safe_load_12, yaml_problem
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
 from kiseki.sim.calibration import check_marks
@@ -170,7 +170,7 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a scene file (not UTF-8 text)") from None
     except yaml.YAMLError as err:
-        raise ValueError(f"{path}: invalid YAML ({err})") from err
+        raise ValueError(f"{path}: invalid YAML ({yaml_problem(err)})") from err
     if not isinstance(raw, dict):
         raise ValueError(f"{path}: a scene file must be a YAML mapping")
     doc = parse(SceneDoc, raw, path)

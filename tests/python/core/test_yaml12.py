@@ -60,3 +60,22 @@ def test_a_key_given_twice_is_refused_and_a_merge_may_override():
     merged = safe_load_12("base: &b {x: 1, y: 2}\nuse:\n  <<: *b\n  x: 3\n")
     assert merged["use"] == {"x": 3, "y": 2}  # as PyYAML's merge: the explicit key wins
     assert yaml.safe_load("floor: true\nfloor: false\n") == {"floor": False}  # PyYAML's way
+
+
+def test_a_scene_or_map_with_a_key_twice_is_one_whole_line(tmp_path):
+    """The readers put PyYAML's whole text in their message, and the command line showed its
+    first line only: "... (line 3)" without the closing parenthesis."""
+    from kiseki.io.ros_map import load_map
+    from kiseki.sim.scene import load_scene
+
+    (tmp_path / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\nresolution: 0.1\n")
+    with pytest.raises(ValueError) as caught:
+        load_map(tmp_path / "m.yaml")
+    assert str(caught.value) == (
+        f"{tmp_path / 'm.yaml'}: invalid YAML (found the key 'resolution' twice in one mapping "
+        "(line 3))"
+    )
+    (tmp_path / "s.yaml").write_text("floor: true\nfloor: false\n")
+    with pytest.raises(ValueError) as caught:
+        load_scene(tmp_path / "s.yaml")
+    assert "\n" not in str(caught.value) and str(caught.value).endswith("(line 2))")
