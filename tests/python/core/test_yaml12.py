@@ -54,7 +54,8 @@ def test_a_key_given_twice_is_refused_and_a_merge_may_override():
     false without a word (YAML 1.2 requires unique keys)."""
     with pytest.raises(yaml.YAMLError) as caught:
         safe_load_12("floor: true\nobjects: []\nfloor: false\n")
-    assert str(caught.value).splitlines()[0] == "found the key 'floor' twice in one mapping (line 3)"
+    first = str(caught.value).splitlines()[0]
+    assert first == "found the key 'floor' twice in one mapping (line 3)"
     with pytest.raises(yaml.YAMLError, match="found the key 'x' twice"):
         safe_load_12("a:\n  - {x: 1, x: 2}\n")
     merged = safe_load_12("base: &b {x: 1, y: 2}\nuse:\n  <<: *b\n  x: 3\n")
