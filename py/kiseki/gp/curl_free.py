@@ -33,7 +33,7 @@ import scipy.linalg.lapack
 import scipy.optimize
 
 from kiseki.gp._data import check_iterations, inputs_array, targets_array
-from kiseki.gp.kernel import subsample
+from kiseki.gp.kernel import KERNEL_HIGH, KERNEL_LOW, subsample
 
 __all__ = [
     "CurlFreeFit",
@@ -65,10 +65,12 @@ class CurlFreeKernel:
             if (
                 isinstance(v, bool)
                 or not isinstance(v, numbers.Real)
-                or not math.isfinite(v)
-                or v <= 0
+                or not (KERNEL_LOW if name == "length_scale" else 0.0) < v <= KERNEL_HIGH
             ):
-                raise ValueError(f"CurlFreeKernel: {name} must be a finite number > 0, got {v!r}")
+                raise ValueError(
+                    f"CurlFreeKernel: {name} must be a finite number > 0 (at most 1e50, "
+                    f"a length at least 1e-50), got {v!r}"
+                )
             object.__setattr__(self, name, float(v))
 
     def to_dict(self) -> dict[str, float]:

@@ -4,7 +4,6 @@
 
 from __future__ import annotations
 
-import math
 import numbers
 from dataclasses import asdict, dataclass, replace
 from typing import Any
@@ -20,6 +19,12 @@ from kiseki.gp._data import (
     remove_mean,
     targets_array,
 )
+
+# Hyperparameters beyond these overflow in the GP's algebra (sigma_f = 1e300 squared is inf, and
+# a length scale of 1e-300 divides to inf: the predictions NaN); no field, length or noise is
+# within 50 orders of magnitude of them. Tiny amplitudes (sigma_lin = 1e-300: no constant term)
+# stay allowed.
+KERNEL_LOW, KERNEL_HIGH = 1e-50, 1e50
 
 __all__ = [
     "HyperparameterFit",
@@ -45,11 +50,11 @@ class SquaredExponential:
             if (
                 isinstance(v, bool)
                 or not isinstance(v, numbers.Real)
-                or not math.isfinite(v)
-                or v <= 0
+                or not (KERNEL_LOW if name == "length_scale" else 0.0) < v <= KERNEL_HIGH
             ):
                 raise ValueError(
-                    f"SquaredExponential: {name} must be a finite number > 0, got {v!r}"
+                    f"SquaredExponential: {name} must be a finite number > 0 (at most 1e50, "
+                    f"a length at least 1e-50), got {v!r}"
                 )
             object.__setattr__(self, name, float(v))
 

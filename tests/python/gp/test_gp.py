@@ -11,6 +11,7 @@ from sklearn.gaussian_process.kernels import RBF, WhiteKernel
 from sklearn.gaussian_process.kernels import ConstantKernel as Constant
 
 from kiseki.gp import (
+    CurlFreeKernel,
     ExactGP,
     HilbertGP,
     SquaredExponential,
@@ -236,6 +237,14 @@ def test_bad_kernels_and_options_are_refused(data):
     x, y, _ = data
     with pytest.raises(ValueError, match="length_scale must be a finite number > 0"):
         SquaredExponential(1.0, 0.0, 0.1)
+    # beyond, the algebra overflowed: NaN means and variances, or an OverflowError
+    for bad in ((1e300, 0.5, 0.1), (1.0, 1e-300, 0.1), (1.0, 0.5, 1e51)):
+        with pytest.raises(ValueError, match="must be a finite number > 0 \\(at most 1e50"):
+            SquaredExponential(*bad)
+    with pytest.raises(ValueError, match="sigma_f must be a finite number > 0 \\(at most"):
+        CurlFreeKernel(1e300, 0.5, 40.0, 0.1)
+    mean, var = ExactGP.fit(x, y, SquaredExponential(1e50, 0.5, 0.1)).predict(x)
+    assert np.isfinite(mean).all() and np.isfinite(var).all()
     with pytest.raises(ValueError, match="mean must be one of"):
         ExactGP.fit(x, y, SquaredExponential(1.0, 0.5, 0.1), mean="linear")
     with pytest.raises(ValueError, match="points have 3 coordinates"):
