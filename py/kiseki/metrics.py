@@ -76,6 +76,13 @@ def as_se3(poses: np.ndarray) -> np.ndarray:
         raise ValueError(f"poses must have shape (n, 3) or (n, 4, 4), got {p.shape}")
     if not np.isfinite(p).all():
         raise ValueError("poses contain NaN or infinite values")
+    # matrices must be rigid motions: all ones gave a rotation error of 180 deg
+    r = p[:, :3, :3]
+    off = np.abs(np.einsum("nji,njk->nik", r, r) - np.eye(3)).max(axis=(1, 2))
+    bad = (off > 1e-6) | (np.linalg.det(r) <= 0) | (np.abs(p[:, 3] - [0, 0, 0, 1]).max(axis=1) > 0)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise ValueError(f"pose {k} is not a rigid motion (a rotation, and a last row 0 0 0 1)")
     return p
 
 
@@ -99,8 +106,11 @@ def _inv(t: np.ndarray) -> np.ndarray:
 
 def umeyama_alignment(src: np.ndarray, dst: np.ndarray, with_scale: bool = False):
     """Least-squares (R, t, s) with dst ~ s R src + t (Umeyama 1991); src, dst are (n, d)."""
-    if src.shape != dst.shape or src.ndim != 2 or len(src) < 2:
+    src, dst = np.asarray(src, dtype=float), np.asarray(dst, dtype=float)  # lists were refused
+    if src.shape != dst.shape or src.ndim != 2 or len(src) < 2:  # with an AttributeError
         raise ValueError("alignment needs two (n, d) point sets of the same shape, n >= 2")
+    if not (np.isfinite(src).all() and np.isfinite(dst).all()):
+        raise ValueError("alignment needs finite points")
     mu_s, mu_d = src.mean(axis=0), dst.mean(axis=0)
     xs, xd = src - mu_s, dst - mu_d
     cov = xd.T @ xs / len(src)
@@ -169,8 +179,8 @@ def rpe(
     (est_i^-1 est_j). Without all_pairs the pairs do not overlap (evo's default)."""
     if relation not in RELATIONS:
         raise ValueError(f"relation must be one of {', '.join(RELATIONS)}, got {relation!r}")
-    if delta < 1:
-        raise ValueError(f"delta must be >= 1 frame, got {delta}")
+    if isinstance(delta, bool) or not isinstance(delta, int | np.integer) or delta < 1:
+        raise ValueError(f"delta must be an integer >= 1 (frames), got {delta!r}")
     e, r = _pair(est, ref)
     n = len(e)
     if all_pairs:
@@ -352,6 +362,13 @@ def taught_map_truth(
 def wilson_interval(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
     """The Wilson score interval of a share k/n (95 % with z = 1.96; E. B. Wilson, JASA 22,
     1927); (NaN, NaN) when n is 0."""
+    for name, v in (("k", k), ("n", n)):
+        if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < 0:
+            raise ValueError(f"wilson_interval: {name} must be a count >= 0, got {v!r}")
+    if k > n:  # 5 of 3 was "math domain error"
+        raise ValueError(f"wilson_interval: k = {k} successes of n = {n} trials")
+    if not (isinstance(z, int | float | np.floating) and math.isfinite(z) and z > 0):
+        raise ValueError(f"wilson_interval: z must be a finite number > 0, got {z!r}")
     if n == 0:
         return (math.nan, math.nan)
     p = k / n
@@ -364,7 +381,15 @@ def area_under_roc(score, positive) -> float:
     """Area under the ROC curve of ``score`` for the boolean ``positive``: the probability that
     a positive scores above a negative, ties counted half (the Mann-Whitney U statistic over
     n_pos n_neg). NaN when either class is empty."""
-    score, positive = np.asarray(score, dtype=float), np.asarray(positive, dtype=bool)
+    labels = np.asarray(positive)
+    if labels.dtype.kind not in "bi" or (
+        labels.dtype.kind == "i" and not np.isin(labels, (0, 1)).all()
+    ):
+        # 'no' and 'yes' were both read as True
+        raise ValueError(
+            f"area_under_roc: labels must be booleans (or 0 and 1), got {labels.dtype}"
+        )
+    score, positive = np.asarray(score, dtype=float), labels.astype(bool)
     if score.shape != positive.shape or not np.isfinite(score).all():
         raise ValueError("area_under_roc: need finite scores, one per label")
     pos, neg = np.sort(score[positive]), np.sort(score[~positive])

@@ -37,6 +37,9 @@ MIN_MAP_SIDE = 2  # cells: a map of one cell across says nothing
 def check_map_size(width_m: float, height_m: float, resolution: float) -> tuple[int, int]:
     """The (width, height) in cells of a map of this extent, refused in one line when it has
     fewer than MIN_MAP_SIDE cells across or more than MAX_MAP_CELLS cells (limits stated)."""
+    for name, v in (("width", width_m), ("height", height_m), ("resolution", resolution)):
+        if not (math.isfinite(v) and v > 0):  # 0 was a ZeroDivisionError, inf an OverflowError
+            raise ValueError(f"check_map_size: {name} must be a finite number > 0 m, got {v!r}")
     width, height = (math.ceil(side / resolution) for side in (width_m, height_m))
     if min(width, height) < MIN_MAP_SIDE:
         raise ValueError(

@@ -131,6 +131,11 @@ def test_stop_error_in_goal_frame():
         (lambda: rpe(np.zeros((3, 3)), np.zeros((3, 3)), delta=0), "delta"),
         (lambda: rpe(np.zeros((3, 3)), np.zeros((3, 3)), delta=5), "no pose pairs"),
         (lambda: stop_error([0, 0], [0, 0, 0]), "triples"),
+        # each found by an audit: a number where there was none, or an internal error
+        (lambda: ape(np.ones((3, 4, 4)), np.ones((3, 4, 4)), "rotation_deg"), "not a rigid"),
+        (lambda: rpe(np.zeros((3, 3)), np.zeros((3, 3)), delta=1.5), "delta must be an integer"),
+        (lambda: umeyama_alignment([[0, 0], [1, 1]], [[0, 0]]), "same shape"),
+        (lambda: umeyama_alignment([[0, 0], [np.nan, 1]], [[0, 0], [1, 1]]), "finite"),
     ],
 )
 def test_bad_input(call, match):
@@ -147,3 +152,19 @@ def test_wilson_interval_against_its_closed_form_values():
     lo, hi = wilson_interval(0, 20)
     assert lo == 0.0 and hi == pytest.approx(0.16113, abs=1e-5)
     assert all(np.isnan(v) for v in wilson_interval(0, 0))
+    # 5 of 3 was "math domain error"; n = -3 gave (7.0, -0.06)
+    for k, n in ((5, 3), (1, -3), (True, 3), (1.5, 3)):
+        with pytest.raises(ValueError, match="wilson_interval"):
+            wilson_interval(k, n)
+
+
+def test_area_under_roc_against_counting_and_its_labels_checked():
+    from kiseki.metrics import area_under_roc
+
+    score, positive = np.array([0.1, 0.4, 0.35, 0.8]), np.array([False, False, True, True])
+    pairs = [(p, q) for p in score[positive] for q in score[~positive]]
+    want = np.mean([1.0 if p > q else 0.5 if p == q else 0.0 for p, q in pairs])
+    assert area_under_roc(score, positive) == want == 0.75
+    assert area_under_roc(score, positive.astype(int)) == want
+    with pytest.raises(ValueError, match="labels must be booleans"):  # both read as True
+        area_under_roc([0.1, 0.9], ["no", "yes"])

@@ -172,3 +172,14 @@ def test_map_from_log_without_a_return_names_the_log_and_writes_nothing(tmp_path
         "or beyond it is no return): nothing to map"
     ]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["short.log"]  # no map written
+
+
+def test_check_map_size_refuses_what_it_cannot_divide():
+    """resolution 0 was a ZeroDivisionError, NaN "cannot convert float NaN to integer", inf an
+    OverflowError; a good extent gives the ceiling of each side over the resolution."""
+    from kiseki.mapping.build import check_map_size
+
+    assert check_map_size(10.0, 4.01, 0.5) == (20, 9)
+    for bad in (0.0, float("nan"), float("inf"), -0.1):
+        with pytest.raises(ValueError, match="check_map_size: resolution must be a finite number"):
+            check_map_size(10.0, 10.0, bad)
