@@ -129,6 +129,11 @@ def largest_reading(ranges: np.ndarray) -> float | None:
 def apply_range_rule(ranges: np.ndarray, max_range: float) -> np.ndarray:
     """Readings as kiseki keeps them (float32, C-contiguous, a new array): invalid readings
     (NaN, -inf, negative, zero) as NaN, +inf (no return) as ``max_range``."""
+    if not (isinstance(max_range, int | float | np.floating) and 0 < max_range < math.inf):
+        # -1 was stored for every no return
+        raise ValueError(
+            f"apply_range_rule: max_range must be a finite number > 0, got {max_range!r}"
+        )
     with np.errstate(over="ignore", invalid="ignore"):  # beyond float32: +inf, a no return
         out = np.array(ranges, dtype=np.float32, order="C", copy=True)
         out[~(out > 0)] = np.nan

@@ -52,6 +52,10 @@ def triangulate(
     ``min_intersection_angle`` (nearly parallel: theta1 + theta2 near 0 or pi), a bearing
     pointing away from where the others meet, or a non-finite value.
     """
+    for name, value in (("bearing_sigma", bearing_sigma), ("elevation_sigma", elevation_sigma)):
+        # an SD of 1e300 rad gave a NaN and infinite covariance; beyond pi a bearing says nothing
+        if value is not None and not (isinstance(value, int | float) and 0 <= value <= math.pi):
+            raise ValueError(f"{name} must be a number in [0, pi] rad, got {value!r}")
     sigma = 0.0 if bearing_sigma is None else float(bearing_sigma)
     try:
         points = np.asarray(standing_positions, dtype=float)

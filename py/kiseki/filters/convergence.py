@@ -70,7 +70,17 @@ class ConvergenceReport:
 
 def spread_radius(poses: np.ndarray, weights: np.ndarray, share: float = 0.9) -> float:
     """Radius around the weighted mean position that holds ``share`` of the weight."""
+    poses = np.asarray(poses, dtype=float)
     w = np.asarray(weights, dtype=float)
+    if poses.ndim != 2 or poses.shape[1] < 2 or len(poses) == 0 or w.shape != (len(poses),):
+        raise ValueError(
+            f"spread_radius: need (n, 3) poses and n weights, got {poses.shape}, {w.shape}"
+        )
+    if not (np.isfinite(w).all() and (w >= 0).all() and w.sum() > 0):
+        # all zero gave NaN with a numpy warning
+        raise ValueError("spread_radius: weights must be finite, >= 0 and not all 0")
+    if not (isinstance(share, int | float) and 0 < share <= 1):
+        raise ValueError(f"spread_radius: share must lie in (0, 1], got {share!r}")
     w = w / w.sum()
     centre = w @ poses[:, :2]
     d = np.hypot(poses[:, 0] - centre[0], poses[:, 1] - centre[1])

@@ -261,7 +261,12 @@ class MonteCarloLocalizer:
         self.updates = 0
 
     def initialize(self, pose, sd: tuple[float, float, float]) -> None:
-        self.engine.initialize_gaussian(Pose2(*np.asarray(pose, dtype=float)), *sd)
+        p, s = np.asarray(pose, dtype=float), np.asarray(sd, dtype=float)
+        if p.shape != (3,) or s.shape != (3,):  # (x, y) was taken with theta = 0
+            raise ValueError(
+                f"initialize: pose and sd must be (x, y, theta) triples, got {p.shape}, {s.shape}"
+            )
+        self.engine.initialize_gaussian(Pose2(*p), *s)
         self.estimate = self.engine.estimate().to_array()
 
     def initialize_particles(self, poses: np.ndarray, weights: np.ndarray | None = None) -> None:

@@ -107,6 +107,11 @@ def test_bad_geometry_and_input_are_named(standing, bearings, message: str) -> N
 def test_bad_sigma_and_paper_angles() -> None:
     with pytest.raises(ValueError, match="bearing_sigma"):
         triangulate([[-1.0, 0.0], [1.0, 0.0]], [0.8, 2.3], bearing_sigma=-1.0)
+    # an SD of 1e300 rad gave a NaN and infinite covariance
+    with pytest.raises(ValueError, match=r"bearing_sigma must be a number in \[0, pi\] rad"):
+        triangulate([[-1.0, 0.0], [1.0, 0.0]], [0.8, 2.3], bearing_sigma=1e300)
+    with pytest.raises(ValueError, match=r"elevation_sigma must be a number in \[0, pi\]"):
+        triangulate([[-1.0, 0.0], [1.0, 0.0]], [0.8, 2.3], bearing_sigma=0.01, elevation_sigma=9)
     with pytest.raises(ValueError, match="elevation 0"):
         triangulate([[0.0, 0, 0], [1.0, 0, 0]], [0.5, 2.0], [math.pi / 2, 0.0])
     with pytest.raises(ValueError, match="interior angles"):

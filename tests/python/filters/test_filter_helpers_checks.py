@@ -1,0 +1,49 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""The filters' helpers against their definitions, and what they are given checked: zero
+weights gave a NaN spread with a numpy warning, a fraction of -0.5 or NaN added no odometry
+noise without a word, and an (x, y) start was taken with theta = 0."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from kiseki.filters import MclConfig, MonteCarloLocalizer
+from kiseki.filters.convergence import spread_radius
+from kiseki.filters.odometry_noise import noisy_odometry
+
+
+def test_spread_radius_is_the_smallest_radius_holding_the_share():
+    rng = np.random.default_rng(4)
+    poses = np.column_stack([rng.normal(size=(200, 2)), np.zeros(200)])
+    weights = rng.uniform(0.1, 1.0, 200)
+    radius = spread_radius(poses, weights, 0.9)
+    w = weights / weights.sum()
+    d = np.hypot(*(poses[:, :2] - w @ poses[:, :2]).T)
+    assert w[d <= radius].sum() >= 0.9 > w[d < radius].sum()  # by brute force
+    for bad in (np.zeros(200), np.full(200, np.nan), -weights):
+        with pytest.raises(ValueError, match="spread_radius: weights must be finite"):
+            spread_radius(poses, bad)
+    with pytest.raises(ValueError, match="share must lie in"):
+        spread_radius(poses, weights, 1.5)
+
+
+def test_noisy_odometry_without_noise_is_the_path_and_bad_fractions_are_refused():
+    path = np.column_stack([np.linspace(0, 3, 20), np.sin(np.linspace(0, 3, 20)), np.zeros(20)])
+    path[:, 2] = np.arctan2(np.gradient(path[:, 1]), np.gradient(path[:, 0]))
+    np.testing.assert_allclose(noisy_odometry(path, 0.0, 1), path, atol=1e-12)
+    assert not np.allclose(noisy_odometry(path, 0.1, 1), path)
+    for bad in (-0.5, math.nan, True, 10.0):
+        with pytest.raises(ValueError, match="noisy_odometry: fraction must be a number"):
+            noisy_odometry(path, bad, 1)
+
+
+def test_a_start_without_a_heading_is_refused():
+    loc = MonteCarloLocalizer(MclConfig(particles=10), 1)
+    with pytest.raises(ValueError, match=r"pose and sd must be \(x, y, theta\) triples"):
+        loc.initialize((1.0, 1.0), (0.1, 0.1, 0.1))
+    loc.initialize((1.0, 1.0, 0.5), (0.0, 0.0, 0.0))
+    np.testing.assert_allclose(loc.estimate, [1.0, 1.0, 0.5])
