@@ -146,13 +146,11 @@ def check_odometry_jumps(
     times: np.ndarray,
     odometry: np.ndarray,
     lines: Sequence[int] | None = None,
-    what: str = "odometry",
 ) -> None:
     """Raises LogFormatError (naming ``source``, the two scans, their times and, with ``lines``,
     their line numbers) at the first pair of consecutive scans whose odometry positions lie more
     than :data:`MAX_ODOMETRY_JUMP` apart. Scans without odometry (NaN) are not compared. Scan
-    numbers count from 0 in the order of the LaserScans. ``what`` names the poses (``reference
-    poses``: the readers check those too; a jump of 500 m made a map 10,381 cells wide)."""
+    numbers count from 0 in the order of the LaserScans."""
     odometry = np.asarray(odometry, dtype=np.float64)
     if len(odometry) < 2:
         return
@@ -167,11 +165,8 @@ def check_odometry_jumps(
         line = f"line {lines[i]}, " if lines is not None else ""
         return f"scan {i} ({line}t = {float(times[i]):.3f} s)"
 
-    verb, fault = (
-        ("jumps", "an odometry reset") if what == "odometry" else ("jump", "a corrupt pose")
-    )
     raise LogFormatError(
-        f"{source}: {what} {verb} {steps[k]:.4g} m between {scan(k)} and {scan(k + 1)}: more "
+        f"{source}: odometry jumps {steps[k]:.4g} m between {scan(k)} and {scan(k + 1)}: more "
         f"than kiseki's limit of {MAX_ODOMETRY_JUMP:g} m between two scans (a fault of the log, "
-        f"such as {fault}, not a motion)"
+        "such as an odometry reset, not a motion)"
     )

@@ -246,7 +246,6 @@ def _laser_scans(
     )
     lines = [lineno for lineno, _ in rows]
     check_odometry_jumps(path, scans.times, scans.odometry, lines)
-    check_odometry_jumps(path, scans.times, scans.poses, lines, "reference poses")
     return scans
 
 

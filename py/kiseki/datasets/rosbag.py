@@ -303,7 +303,6 @@ def read_bag_scans(
         max_range=max_range,
     )
     check_odometry_jumps(path, scans.times, scans.odometry)
-    check_odometry_jumps(path, scans.times, scans.poses, what="reference poses")
     return scans
 
 

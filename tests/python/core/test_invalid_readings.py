@@ -282,33 +282,6 @@ def test_an_odometry_jump_over_the_limit_fails_naming_the_scans(tmp_path, reader
     ), message
 
 
-@pytest.mark.parametrize("reader", ["carmen", "ros1"])
-def test_a_jump_of_the_reference_poses_alone_fails_naming_them(tmp_path, reader):
-    """Reference poses 500 m off on some scans made a map 10,381 cells wide (exit 0): the
-    readers check them as the odometry."""
-    path = log_path(tmp_path, reader, "reference")
-    smooth, jumping = odometry(), odometry(12.5)
-    if reader == "carmen":
-        lines = [f"PARAM robot_front_laser_max {MAX_RANGE} nohost 0"]
-        for k, t in enumerate(times()):
-            nums = [*clean_ranges()[k], *jumping[k], *smooth[k], t]
-            lines.append(f"FLASER {BEAMS} " + " ".join(map(number, nums)) + f" host {t}")
-        path.write_text("\n".join(lines) + "\n")
-        read = lambda: read_carmen_log(path)  # noqa: E731
-    else:
-        ranges = clean_ranges().astype(np.float32)
-        write_bag(
-            LaserScans(times(), jumping, smooth, ranges, flaser_angles(BEAMS), MAX_RANGE),
-            path,
-            "ros1",
-        )
-        read = lambda: read_bag_scans(path, reference_topic="/ground_truth")  # noqa: E731
-    with pytest.raises(LogFormatError) as caught:
-        read()
-    assert str(caught.value).startswith(f"{path}: reference poses jump 12.5 m between scan 3 (")
-    assert str(caught.value).endswith("(a fault of the log, such as a corrupt pose, not a motion)")
-
-
 def test_the_command_line_refuses_a_jump_in_one_line(tmp_path):
     log = tmp_path / "jump.log"
     with pytest.raises(LogFormatError):
