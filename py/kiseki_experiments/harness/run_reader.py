@@ -110,10 +110,11 @@ def _check_manifest(path: Path, manifest: dict) -> None:
     if (
         not isinstance(git, dict)
         or not isinstance(git.get("commit"), str | None)
-        or not isinstance(git.get("dirty", False), bool)
-    ):
+        or not isinstance(git.get("dirty"), bool | None)
+    ):  # both null: the run had no git checkout (manifest.git_state)
         raise ValueError(
-            f"{path}: git must hold commit (text or null) and dirty (true or false), got {git!r}"
+            f"{path}: git must hold commit (text or null) and dirty (true, false or null), "
+            f"got {git!r}"
         )
 
 

@@ -206,6 +206,11 @@ def test_bad_input_is_one_line_and_non_zero(tmp_path, args, needle):
         ),
         (
             "claim,holds\nx,True\n",
+            '{"trials": 1, "trials_failed": 0, "git": {"commit": null, "dirty": "no"}}',
+            "manifest.json: git must hold commit (text or null) and dirty",
+        ),
+        (
+            "claim,holds\nx,True\n",
             '{"trials": -5, "trials_failed": 100, "git": {"commit": null}}',
             "manifest.json: trials and trials_failed must be counts",
         ),
@@ -394,3 +399,17 @@ def test_a_refused_run_leaves_no_results_folder(tmp_path, args, needle):
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], done.stderr
     assert not (tmp_path / "r").exists()
+
+
+def test_report_reads_a_run_made_without_a_git_checkout(tmp_path):
+    """manifest.git_state writes commit and dirty null without a checkout (a tarball, an image
+    without .git): the report reads such a run."""
+    latest = tmp_path / "results" / "corridor-scans" / "latest"
+    latest.mkdir(parents=True)
+    latest.joinpath("claims.csv").write_text("claim,holds\nx,True\n")
+    latest.joinpath("manifest.json").write_text(
+        '{"trials": 1, "trials_failed": 0, "git": {"commit": null, "dirty": null}}'
+    )
+    done = cli("experiment", "report", "--results", "results", "-o", "R.md", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert "commit unknown" in (tmp_path / "R.md").read_text()
