@@ -29,6 +29,7 @@ the odometry is raw, how ``max_range`` was found). What every reader does alike:
 from __future__ import annotations
 
 import math
+import numbers
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -42,6 +43,7 @@ __all__ = [
     "MAX_ODOMETRY_JUMP",
     "LaserScans",
     "apply_range_rule",
+    "beams_of_one_turn",
     "check_odometry_jumps",
     "largest_reading",
 ]
@@ -126,10 +128,19 @@ def largest_reading(ranges: np.ndarray) -> float | None:
     return float(valid.max()) if valid.size else None
 
 
+def beams_of_one_turn(start: float, step: float, beams: int) -> bool:
+    """Whether ``beams`` beams from ``start`` every ``step`` rad are a scanner's: a finite start
+    within +-2 pi, a finite non-zero step, and one turn at most (a sliver over it for rounding).
+    A log's step of 0 put every beam on one ray; 1000 rad, or a start of 1e30, were read as
+    given."""
+    span = abs(step) * (beams - 1)
+    return bool(abs(start) <= 2 * math.pi and step != 0 and span <= 2.01 * math.pi)
+
+
 def apply_range_rule(ranges: np.ndarray, max_range: float) -> np.ndarray:
     """Readings as kiseki keeps them (float32, C-contiguous, a new array): invalid readings
     (NaN, -inf, negative, zero) as NaN, +inf (no return) as ``max_range``."""
-    if not (isinstance(max_range, int | float | np.floating) and 0 < max_range < math.inf):
+    if not (isinstance(max_range, numbers.Real) and 0 < max_range < math.inf):
         # -1 was stored for every no return
         raise ValueError(
             f"apply_range_rule: max_range must be a finite number > 0, got {max_range!r}"

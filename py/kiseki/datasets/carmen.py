@@ -52,7 +52,6 @@ Radish "-corrected" logs (Intel, ACES, CSAIL, Freiburg 079) that users should kn
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -63,7 +62,13 @@ import numpy as np
 from kiseki._support.inputs import GIB
 from kiseki.datasets._files import read_maybe_gzipped
 from kiseki.errors import LogFormatError
-from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps, largest_reading
+from kiseki.scans import (
+    LaserScans,
+    apply_range_rule,
+    beams_of_one_turn,
+    check_odometry_jumps,
+    largest_reading,
+)
 
 __all__ = [
     "MAX_LOG_BYTES",
@@ -309,8 +314,7 @@ def _parse_robotlaser(path: Path, rows: list[_Row]) -> LaserScans:
     start, _, step, max_range = config[0]
     if n == 0 or max_range <= 0:
         raise LogFormatError(f"{path}:{rows[0][0]}: ROBOTLASER1 with no beams or max range <= 0")
-    if not (abs(start) <= 2 * math.pi and step != 0 and abs(step) * (n - 1) <= 2.01 * math.pi):
-        # a resolution of 0 put every beam on one ray; 100 rad or a start of 1e9 read as given
+    if not beams_of_one_turn(start, step, n):
         raise LogFormatError(
             f"{path}:{rows[0][0]}: ROBOTLASER1 start_angle {start:g} and angular_resolution "
             f"{step:g} rad for {n} beams: not beams of one turn at most (start within +-2 pi, "

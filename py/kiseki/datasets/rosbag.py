@@ -72,8 +72,14 @@ from kiseki._support.inputs import (
     read_input_text,
 )
 from kiseki._support.yaml import safe_load_12
+from kiseki.datasets.ros_orientation import NotARotationError, yaw, yaw_or_nan
 from kiseki.errors import LogFormatError
-from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps
+from kiseki.scans import (
+    LaserScans,
+    apply_range_rule,
+    beams_of_one_turn,
+    check_odometry_jumps,
+)
 
 __all__ = [
     "BAG_KINDS",
@@ -107,7 +113,6 @@ ODOM_FRAME = "odom"
 BASE_FRAME = "base_link"
 MAP_FRAME = "map"
 
-UNIT_QUATERNION_TOLERANCE = 1e-3  # |q| - 1: float32 quaternions and more
 _NS_PER_S = 1_000_000_000
 _ROS1_MAGIC = b"#ROSBAG V2.0\n"
 _SQLITE_MAGIC = b"SQLite format 3\x00"
@@ -269,7 +274,7 @@ def read_bag_scans(
         tracks = [odom]
         if reference_topic is not None:
             tracks.append(_odometry_track(path, reference_topic, messages[reference_topic]))
-    except _NotARotationError as err:
+    except NotARotationError as err:
         raise LogFormatError(f"{path}: {err}") from None
     keep = np.ones(len(ns), dtype=bool)
     for track in tracks:
@@ -291,7 +296,7 @@ def read_bag_scans(
             k = int(np.argmax(bad))
             raise LogFormatError(
                 f"{path}: the pose from {source!r} at scan {k} (t = {times[k]:.3f} s) is NaN "
-                "or infinite"
+                "or infinite (or a transform on its way has no unit quaternion)"
             )
     poses = laser_poses[1] if reference_topic is not None else np.full((len(ns), 3), np.nan)
     scans = LaserScans(
@@ -312,19 +317,21 @@ _NO_LIMIT = 1 << 62
 def _check_chunks(path: Path) -> None:
     """Measures, within MAX_BAG_CHUNK_BYTES and MAX_BAG_FILE_BYTES, what the bag's compressed
     chunks and files decompress to, before rosbags decompresses each of them whole."""
-    files, compressed_files = [path], False
+    files, compressed, listed = [path], False, set()
     if path.is_dir():
         meta = path / "metadata.yaml"
         text = read_input_text(meta, "ROS 2 bag metadata files", YAML_LIMIT, LogFormatError)
         try:
             info = safe_load_12(text)["rosbag2_bagfile_information"]
-            compressed_files = str(info.get("compression_mode", "")).lower() == "file"
-            compressed_files &= str(info.get("compression_format", "")).lower() == "zstd"
+            compressed = str(info.get("compression_mode", "")).lower() == "file"
+            compressed &= str(info.get("compression_format", "")).lower() == "zstd"
+            listed = {str(name) for name in info.get("relative_file_paths") or []}
         except (yaml.YAMLError, KeyError, TypeError, AttributeError):
             pass  # rosbags says what is wrong with it
         files = sorted(entry for entry in path.iterdir() if entry.is_file() and entry != meta)
     for file in files:
-        if compressed_files:
+        # the storage files the metadata lists are compressed (rosbags opens those only)
+        if compressed and file.name in listed:
             try:
                 with open(file, "rb") as raw:
                     size = decompressed_size(raw, "zstd", MAX_BAG_FILE_BYTES)
@@ -391,23 +398,6 @@ def _stamp_ns(header: Any) -> int:
     return int(header.stamp.sec) * _NS_PER_S + int(header.stamp.nanosec)
 
 
-class _NotARotationError(ValueError):
-    """A quaternion of a pose that is not a unit quaternion (read_bag_scans names the bag)."""
-
-
-def _yaw(q: Any) -> float:
-    # a pose's quaternion is a unit one (to float32 rounding and some): a scaled or zero one gave
-    # other headings without a word (a zero one, yaw 0)
-    norm = math.sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w)
-    if not abs(norm - 1.0) <= UNIT_QUATERNION_TOLERANCE:
-        raise _NotARotationError(
-            f"an orientation ({q.x:g}, {q.y:g}, {q.z:g}, {q.w:g}) of norm {norm:.6g} is not a "
-            "unit quaternion"
-        )
-    x, y, z, w = (v / norm for v in (q.x, q.y, q.z, q.w)) if norm != 1.0 else (q.x, q.y, q.z, q.w)
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 def _scan_arrays(
     path: Path, topic: str, scans: list[Any]
 ) -> tuple[str, np.ndarray, np.ndarray, np.ndarray, float]:
@@ -417,12 +407,7 @@ def _scan_arrays(
     if beams < 1:
         raise LogFormatError(f"{path}: the first scan on {topic!r} has no beams")
     laser = _frame(first.header.frame_id)
-    start, step = float(first.angle_min), float(first.angle_increment)
-    span = abs(step) * (beams - 1)
-    if not (
-        math.isfinite(start) and abs(start) <= 2 * math.pi and step != 0 and span <= 2.01 * math.pi
-    ):
-        # an increment of 0 put every beam on one ray, 1000 rad or NaN read as given
+    if not beams_of_one_turn(float(first.angle_min), float(first.angle_increment), beams):
         raise LogFormatError(
             f"{path}: the first scan on {topic!r} has angle_min {first.angle_min} and "
             f"angle_increment {first.angle_increment} rad for {beams} beams: not beams of one "
@@ -474,7 +459,7 @@ def _odometry_track(path: Path, topic: str, messages: list[Any]) -> _Track:
             )
         pose = msg.pose.pose
         track.ns.append(_stamp_ns(msg.header))
-        track.poses.append((float(pose.position.x), float(pose.position.y), _yaw(pose.orientation)))
+        track.poses.append((float(pose.position.x), float(pose.position.y), yaw(pose.orientation)))
     return _sorted(track)
 
 
@@ -490,7 +475,7 @@ def _sorted(track: _Track) -> _Track:
 
 def _transform_pose(transform: Any) -> tuple[float, float, float]:
     t = transform.transform
-    return (float(t.translation.x), float(t.translation.y), _yaw(t.rotation))
+    return (float(t.translation.x), float(t.translation.y), yaw_or_nan(t.rotation))
 
 
 def _static_transforms(messages: list[Any]) -> dict[str, tuple[str, tuple[float, float, float]]]:

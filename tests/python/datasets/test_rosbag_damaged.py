@@ -84,3 +84,11 @@ def test_a_damaged_sqlite_bag_is_one_line_naming_the_bag(tmp_path: Path) -> None
     with pytest.raises(LogFormatError) as caught:
         read_bag_scans(bag)
     assert str(caught.value).startswith(f"{bag}: unreadable ROS bag ('utf-8' codec")
+
+
+def test_other_files_in_a_compressed_bags_folder_are_left_alone(bag: Path) -> None:
+    """Only the storage files metadata.yaml lists are compressed: a notes file beside them was
+    refused as "not a whole zstd file"."""
+    _compress_files(bag)
+    (bag / "notes.txt").write_text("recorded on the second floor\n")
+    assert len(read_bag_scans(bag)) == 12

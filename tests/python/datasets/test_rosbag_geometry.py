@@ -65,3 +65,33 @@ def test_beams_beyond_one_turn_are_refused(tmp_path: Path, angles) -> None:
     assert str(caught.value).endswith(
         "not beams of one turn at most (angle_min within +-2 pi, a non-zero increment)"
     )
+
+
+def test_a_frame_the_scans_do_not_use_may_hold_any_quaternion() -> None:
+    """tf2 warns about a zero quaternion on, say, an arm's frame and goes on; so does kiseki,
+    refusing it only where the laser's mount or the odometry goes through it."""
+    from types import SimpleNamespace as Ns
+
+    def transform(parent, child, q):
+        header = Ns(frame_id=parent, stamp=Ns(sec=0, nanosec=0))
+        translation, rotation = Ns(x=0.1, y=0.0, z=0.0), Ns(x=0.0, y=0.0, z=q[0], w=q[1])
+        return Ns(
+            header=header,
+            child_frame_id=child,
+            transform=Ns(translation=translation, rotation=rotation),
+        )
+
+    messages = [
+        Ns(
+            transforms=[
+                transform("base_link", "laser", (0.0, 1.0)),
+                transform("base_link", "arm", (0.0, 0.0)),
+            ]
+        )
+    ]
+    static = rosbag._static_transforms(messages)
+    np.testing.assert_allclose(
+        rosbag._mount(Path("b"), static, "base_link", "laser"), [0.1, 0.0, 0.0]
+    )
+    assert np.isnan(static["arm"][1][2])
+    assert np.isnan(rosbag._mount(Path("b"), static, "base_link", "arm")[2])
