@@ -69,7 +69,8 @@ PclRegistrationResult register_pcl(const Eigen::Matrix3Xd& source, const Eigen::
   // a rigid motion: PCL aligns from any 4 x 4, a scaled or sheared guess gives a result no
   // rotation explains
   const Eigen::Matrix3d r = initial.linear();
-  require((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-6 && r.determinant() > 0,
+  // to 1e-2: a guess chained in float32 (PCL's Matrix4f) or written with 4 decimals is one
+  require((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-2 && r.determinant() > 0,
           "the initial guess is not a rigid motion (its 3 x 3 part is not a rotation)");
   require(initial.translation().cwiseAbs().maxCoeff() <= kPclCoordinateLimit,
           "the initial guess moves beyond +-1e6 m");

@@ -158,6 +158,17 @@ def test_wilson_interval_against_its_closed_form_values():
             wilson_interval(k, n)
 
 
+def test_poses_written_with_four_decimals_are_rigid_enough():
+    """The rigid-motion check takes rotations rounded to 4 decimals (or chained in float32)."""
+    c, s = np.cos(0.3), np.sin(0.3)
+    poses = np.tile(np.eye(4), (5, 1, 1))
+    poses[:, :2, :2] = [[c, -s], [s, c]]
+    poses[:, 0, 3] = np.arange(5.0)
+    rounded = np.round(poses, 4)
+    assert ape(rounded, rounded, "rotation_deg").max == 0.0
+    assert ape(rounded, poses).max < 1e-4
+
+
 def test_area_under_roc_against_counting_and_its_labels_checked():
     from kiseki.metrics import area_under_roc
 
