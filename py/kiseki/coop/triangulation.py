@@ -22,6 +22,7 @@ found by testing the formulas against each other:
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -54,7 +55,7 @@ def triangulate(
     """
     for name, value in (("bearing_sigma", bearing_sigma), ("elevation_sigma", elevation_sigma)):
         # an SD of 1e300 rad gave a NaN and infinite covariance; beyond pi a bearing says nothing
-        if value is not None and not (isinstance(value, int | float) and 0 <= value <= math.pi):
+        if value is not None and not (isinstance(value, numbers.Real) and 0 <= value <= math.pi):
             raise ValueError(f"{name} must be a number in [0, pi] rad, got {value!r}")
     sigma = 0.0 if bearing_sigma is None else float(bearing_sigma)
     try:

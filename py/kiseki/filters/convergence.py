@@ -14,6 +14,7 @@ endpoints inside the map to the nearest occupied cell. The same figures for the 
 from __future__ import annotations
 
 import contextlib
+import numbers
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -74,12 +75,13 @@ def spread_radius(poses: np.ndarray, weights: np.ndarray, share: float = 0.9) ->
     w = np.asarray(weights, dtype=float)
     if poses.ndim != 2 or poses.shape[1] < 2 or len(poses) == 0 or w.shape != (len(poses),):
         raise ValueError(
-            f"spread_radius: need (n, 3) poses and n weights, got {poses.shape}, {w.shape}"
+            "spread_radius: need (n, 2) or (n, 3) poses and n weights, got "
+            f"{poses.shape}, {w.shape}"
         )
     if not (np.isfinite(w).all() and (w >= 0).all() and w.sum() > 0):
         # all zero gave NaN with a numpy warning
         raise ValueError("spread_radius: weights must be finite, >= 0 and not all 0")
-    if not (isinstance(share, int | float) and 0 < share <= 1):
+    if not (isinstance(share, numbers.Real) and 0 < share <= 1):
         raise ValueError(f"spread_radius: share must lie in (0, 1], got {share!r}")
     w = w / w.sum()
     centre = w @ poses[:, :2]

@@ -6,6 +6,7 @@ increments with added noise) and the motion noise the filter assumes for it
 
 from __future__ import annotations
 
+import numbers
 from typing import Protocol
 
 import numpy as np
@@ -51,11 +52,15 @@ def noisy_odometry(poses: np.ndarray, fraction: float, seed: int) -> np.ndarray:
     """Odometry rebuilt from the increments of `poses` (in each previous pose's frame), each
     component perturbed by zero-mean Gaussian noise with SD = fraction x |component|."""
     poses = np.asarray(poses, dtype=float)
-    if isinstance(fraction, bool) or not (isinstance(fraction, int | float) and 0 <= fraction < 10):
+    if isinstance(fraction, bool) or not (
+        isinstance(fraction, numbers.Real) and 0 <= fraction < 10
+    ):
         # -0.5 or NaN added no noise without a word
         raise ValueError(f"noisy_odometry: fraction must be a number in [0, 10), got {fraction!r}")
     if poses.ndim != 2 or poses.shape[1] != 3 or not np.isfinite(poses).all():
-        raise ValueError(f"noisy_odometry: poses must be finite (n, 3), got shape {poses.shape}")
+        raise ValueError(
+            f"noisy_odometry: poses must be an (n, 3) array of finite numbers, got {poses.shape}"
+        )
     rng = Random(seed)
     out = np.empty_like(poses)
     out[0] = poses[0]

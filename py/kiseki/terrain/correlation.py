@@ -20,6 +20,7 @@ work on every core (``kiseki/terrain/correlation_search.hpp``).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -97,7 +98,11 @@ def correlation_search(
         raise ValueError(f"method must be 'exhaustive' or 'coarse-to-fine', got {method!r}")
     if isinstance(min_overlap, bool) or not isinstance(min_overlap, int) or min_overlap < 1:
         raise ValueError(f"min_overlap must be an integer >= 1, got {min_overlap!r}")
-    if isinstance(threads, bool) or not isinstance(threads, int) or not 0 <= threads <= 1024:
+    if (
+        isinstance(threads, bool)
+        or not isinstance(threads, numbers.Integral)
+        or not 0 <= threads <= 1024
+    ):
         raise ValueError(f"threads must be an integer in 0..1024 (0 = every core), got {threads!r}")
     grid = PAPER_SEARCH if grid is None else grid
     if not isinstance(grid, _core.TranslationGrid):
