@@ -136,8 +136,8 @@ class LocalizeConfig:
         )
         check_seed(self.seed)
         _check(
-            self.odometry_noise >= 0 and math.isfinite(self.odometry_noise),
-            f"odometry noise must be >= 0, got {self.odometry_noise}",
+            0 <= self.odometry_noise < 10,  # as noisy_odometry: the SD as a multiple of each step
+            f"odometry noise must be >= 0 and below 10, got {self.odometry_noise}",
         )
         _check(
             len(self.initial_sd) == 3 and all(s >= 0 and math.isfinite(s) for s in self.initial_sd),

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from kiseki.datasets.magnetic import read_aalto_run
+from kiseki.gp.curl_free_basis import MAX_BASIS
 from kiseki_experiments.gp.gp_aalto_defaults_methods import BASELINE, method_names, run_method
 from kiseki_experiments.gp.gp_aalto_defaults_report import analyze
 from kiseki_experiments.harness.base import Experiment, TrialOutput
@@ -97,6 +98,8 @@ def preflight(config: GpAaltoDefaultsConfig) -> None:
         raise ValueError("gp-aalto-defaults: need >= 3 distinct runs (each held out in turn)")
     if any(not 0 < t < 1 for t in config.hilbert_tolerances):
         raise ValueError("gp-aalto-defaults: hilbert_tolerances must lie in (0, 1)")
+    if any(m > MAX_BASIS for m in config.curl_free_basis):  # else every trial failed on it
+        raise ValueError(f"gp-aalto-defaults: curl_free_basis must be at most {MAX_BASIS:,}")
     missing = [
         f"{s}/{r}-{part}.csv"
         for s in config.sensors
