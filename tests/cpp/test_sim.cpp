@@ -247,6 +247,10 @@ TEST(OctomapFile, WritesOctomapsOwnBytesAndNothingToStderr) {
   colour.replace(colour.find("id OcTree"), 9, "id ColorOcTree");
   rewrite(colour);
   EXPECT_EQ(message(), path + ": an OctoMap tree of kind 'ColorOcTree', not OcTree (occupancy only)");
+  std::string crlf = bytes;  // OctoMap reads its header word by word: a CR line end is read
+  crlf.replace(crlf.find("id OcTree\n"), 10, "id  OcTree\r\n");
+  rewrite(crlf + "\n");  // and a line end after the tree is no data
+  EXPECT_EQ(message(), "read");
   rewrite(bytes + std::string(700, 'x'));
   EXPECT_EQ(message(), path + ": 700 bytes after the OctoMap tree (a damaged or concatenated file)");
   const std::string nowhere = testing::TempDir() + "no_such_folder/map.bt";

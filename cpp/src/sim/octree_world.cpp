@@ -10,12 +10,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <limits>
 #include <mutex>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -101,10 +103,13 @@ OctreeWorld OctreeWorld::read_binary(const std::string& path) {
   }
   // the tree's kind: OctoMap reads another kind's nodes (a ColorOcTree's colours) as OcTree
   // nodes, or a made-up id, without a word
-  for (std::string line; std::getline(in, line) && line != "data";) {
-    if (line.rfind("id ", 0) == 0 && line != "id OcTree") {
-      throw std::runtime_error(path + ": an OctoMap tree of kind '" + line.substr(3) +
-                               "', not OcTree (occupancy only)");
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);  // token by token, as OctoMap reads its header
+    std::string key, value;
+    words >> key >> value;
+    if (key == "data") break;
+    if (key == "id" && value != "OcTree") {
+      throw std::runtime_error(path + ": an OctoMap tree of kind '" + value + "', not OcTree (occupancy only)");
     }
   }
   in.clear();
@@ -120,11 +125,15 @@ OctreeWorld OctreeWorld::read_binary(const std::string& path) {
     }
     throw std::runtime_error(path + ": corrupt or truncated OctoMap binary file" + why);
   }
-  if (in.peek() != std::ifstream::traits_type::eof()) {  // OctoMap stops after the tree
-    in.clear();
-    const std::streamoff at = in.tellg();
-    in.seekg(0, std::ios::end);
-    throw std::runtime_error(path + ": " + std::to_string(static_cast<long long>(in.tellg() - at)) +
+  // OctoMap stops after the tree: white space may follow (a line end added by an editor), not
+  // data (a damaged or concatenated file)
+  std::size_t after = 0, data_after = 0;
+  for (int c = in.get(); c != std::ifstream::traits_type::eof(); c = in.get()) {
+    ++after;
+    data_after += !std::isspace(c);
+  }
+  if (data_after > 0) {
+    throw std::runtime_error(path + ": " + std::to_string(after) +
                              " bytes after the OctoMap tree (a damaged or concatenated file)");
   }
   for (const std::string& line : reported) std::cerr << line << '\n';  // read, with warnings
