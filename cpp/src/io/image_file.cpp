@@ -8,14 +8,20 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
+#include <system_error>
 #include <vector>
 
 namespace kiseki {
 
 cv::Mat read_image(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {  // a folder opens, and tellg says 2^63
+    throw std::runtime_error(path + ": cannot open image file (not a regular file)");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in.good()) throw std::runtime_error(path + ": cannot open image file");
   in.seekg(0, std::ios::end);

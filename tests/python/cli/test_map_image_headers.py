@@ -99,3 +99,6 @@ def test_a_text_pgm_ending_at_its_last_value_and_an_empty_image(inputs):
     assert one_error(run("map", "info", "empty.yaml", cwd=inputs)).endswith(
         "empty.pgm: cannot decode image (an empty file)"
     )
+    (inputs / "folder.pgm").mkdir()  # a folder opened, and its size read as 2^63: bad_alloc
+    with pytest.raises(RuntimeError, match="folder.pgm: cannot open image file .not a regular"):
+        read_image(inputs / "folder.pgm")
