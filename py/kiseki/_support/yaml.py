@@ -43,7 +43,7 @@ class _Loader12(yaml.SafeLoader):
             for key_node, _ in node.value:
                 if not isinstance(key_node, yaml.ScalarNode) or key_node.tag.endswith(":merge"):
                     continue
-                key = (key_node.tag, key_node.value)
+                key = self.construct_object(key_node)  # the value: 1 and 0x1 are one key
                 if key in seen:
                     raise yaml.constructor.ConstructorError(
                         None,

@@ -58,6 +58,8 @@ def test_a_key_given_twice_is_refused_and_a_merge_may_override():
     assert first == "found the key 'floor' twice in one mapping (line 3)"
     with pytest.raises(yaml.YAMLError, match="found the key 'x' twice"):
         safe_load_12("a:\n  - {x: 1, x: 2}\n")
+    with pytest.raises(yaml.YAMLError, match="found the key '0x1' twice"):  # both the integer 1
+        safe_load_12("1: a\n0x1: b\n")
     merged = safe_load_12("base: &b {x: 1, y: 2}\nuse:\n  <<: *b\n  x: 3\n")
     assert merged["use"] == {"x": 3, "y": 2}  # as PyYAML's merge: the explicit key wins
     assert yaml.safe_load("floor: true\nfloor: false\n") == {"floor": False}  # PyYAML's way
