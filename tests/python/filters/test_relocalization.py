@@ -106,17 +106,14 @@ def test_bad_input_is_one_line_naming_the_problem():
         Relocalizer(grid, MAX_RANGE).match(angles, ranges, (0.0, 0.0, 1.0))
 
 
-def test_a_depth_past_the_map_finds_the_same_hypotheses():
+def test_a_depth_past_the_map_finds_the_brute_force_selection():
     """Depth 16 (in its documented range) laid out 17 levels of (w + 65,535) x (h + 65,535)
     cells on a small map, 366 GB on 80 x 80: the levels stop at the first whose node covers the
-    map, with the same hypotheses."""
+    map, and the hypotheses are still the brute force's selection."""
     grid, angles, ranges = random_case(2)
-    covering = math.ceil(math.log2(max(grid.width, grid.height)))
-    config = RelocalizeConfig(beams=15, angular_step=0.3, hypotheses=3, threads=1)
-    want = relocalize(
-        grid, angles, ranges, MAX_RANGE, RelocalizeConfig(**{**config.__dict__, "depth": covering})
-    )
-    got = relocalize(
-        grid, angles, ranges, MAX_RANGE, RelocalizeConfig(**{**config.__dict__, "depth": 16})
-    )
-    assert got == want and len(got) == 3
+    config = RelocalizeConfig(beams=15, depth=16, angular_step=0.3, hypotheses=3, threads=1)
+    matcher = Relocalizer(grid, MAX_RANGE, config)
+    got = matcher.match(angles, ranges)
+    _, want = brute_force(grid, angles, ranges, config, matcher.headings(angles, ranges))
+    assert len(got) == len(want) == 3
+    np.testing.assert_allclose([g.score for g in got], [t[0] for t in want], rtol=0, atol=1e-6)
