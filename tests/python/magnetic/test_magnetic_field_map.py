@@ -196,13 +196,6 @@ def _edit_yaml(folder, **changes):
     path.write_text(yaml.safe_dump(doc))
 
 
-def _edit_picture_scale(folder, key, value):
-    path = folder / MAP_FILE
-    doc = yaml.safe_load(path.read_text())
-    doc["files"]["layers"]["mz_mean"][key] = value
-    path.write_text(yaml.safe_dump(doc))
-
-
 def _nan_layer(folder, value=np.nan):
     with np.load(folder / "layers.npz") as npz:
         arrays = dict(npz)
@@ -236,27 +229,6 @@ def _cut_in_half(path):
         (lambda f: (f / "training.npz").write_text("x"), "training.npz", "not a readable"),
         (lambda f: _cut_in_half(f / "layers.npz"), "layers.npz", "not a readable"),
         (lambda f: _edit_yaml(f, dimension=4), MAP_FILE, "dimension: must be 2 or 3, got 4"),
-        # the pictures' scale and offset (for other tools) were read without a look
-        (
-            lambda f: _edit_picture_scale(f, "scale", float("nan")),
-            MAP_FILE,
-            "layer 'mz_mean': scale must be a finite number >= 0 .*, got nan",
-        ),
-        (
-            lambda f: _edit_picture_scale(f, "scale", -0.5),
-            MAP_FILE,
-            "layer 'mz_mean': scale must be a finite number >= 0",
-        ),
-        (
-            lambda f: _edit_picture_scale(f, "offset", 1e300),
-            MAP_FILE,
-            "layer 'mz_mean': offset must be a finite number .*, got 1e\\+300",
-        ),
-        (
-            lambda f: _edit_picture_scale(f, "offset", "low"),
-            MAP_FILE,
-            "layer 'mz_mean': offset must be a finite number .*, got 'low'",
-        ),
     ],
 )
 def test_bad_folders_are_refused_naming_the_file(tmp_path, spoil, culprit, match):

@@ -28,10 +28,10 @@ from kiseki.apps.magnetic.navigate_run import (
     METHODS,
     NavigationResult,
     TaughtMaps,
-    check_magnetometer,
     navigate,
     teach,
 )
+from kiseki.apps.magnetic.teach_checks import check_magnetometer
 from kiseki.magnetic.linear_map import path_identity
 from kiseki.magnetic.linear_map_folder import MAP_FILE, load_linear_map, save_linear_map
 from kiseki.plots import new_figure, save_figure

@@ -39,11 +39,15 @@ from pathlib import Path
 
 import numpy as np
 
+from kiseki.apps.magnetic.teach_checks import (
+    check_magnetometer,
+    check_route_length,
+    check_taught_run,
+)
 from kiseki.control.pd_steering import PdSteering
 from kiseki.core import derive_seed
 from kiseki.magnetic.gates import gate_limits, reading_noise_sd
 from kiseki.magnetic.linear_map import (
-    NODE_SPACING,
     LinearMagneticMap,
     geometric_features,
     path_identity,
@@ -171,7 +175,7 @@ def teach(
         raise ValueError(f"{scene_path}: the scene has no route to teach")
     check_magnetometer(scene, scene_path)
     waypoints = np.asarray(scene.route["waypoints"], dtype=np.float64)
-    _check_route_length(scene, scene_path, waypoints)
+    check_route_length(scene, scene_path, waypoints)
     path_id = path_identity(waypoints)
     maps = {}
     for k, (name, shift) in enumerate((("center", 0.0), ("left", offset), ("right", -offset))):
@@ -181,7 +185,7 @@ def teach(
             here, run, SimConfig(seed=derive_seed(seed, k)), overwrite=True, progress=False
         )
         # a run that did not reach the route's end maps part of it: refused, not a short map
-        _check_taught_run(summary, scene_path, name)
+        check_taught_run(summary, scene_path, name)
         maps[name] = linear_map_from_run(run, path_id, provenance={"path": name})
     if len(maps["center"]) < 2:
         n = len(maps["center"])
@@ -190,41 +194,6 @@ def teach(
             f"(one every {maps['center'].spacing:g} m): too short to navigate"
         )
     return TaughtMaps(maps["center"], maps["left"], maps["right"], waypoints)
-
-
-def _check_route_length(scene, scene_path, waypoints: np.ndarray) -> None:
-    """A drive (from the robot's start through the waypoints) shorter than the linear map's node
-    spacing cannot give the two nodes navigation needs: refused before the three runs."""
-    start = np.asarray(scene.robot.get("start", [0.0, 0.0, 0.0])[:2], dtype=np.float64)
-    drive = np.vstack([start, waypoints])
-    length = float(np.linalg.norm(np.diff(drive, axis=0), axis=1).sum())
-    if length < NODE_SPACING:
-        raise ValueError(
-            f"{scene_path}: the route is {length:.2f} m long, shorter than the linear map's "
-            f"node spacing ({NODE_SPACING:g} m): too short to navigate"
-        )
-
-
-def check_magnetometer(scene, scene_path) -> None:
-    """A magnetic teaching or navigation needs the robot's magnetometer: a scene without one is
-    refused naming the scene (its run would have no readings)."""
-    if not any(s.get("type") == "magnetometer" for s in scene.sensors):
-        raise ValueError(f"{scene_path}: the robot has no sensor of type magnetometer")
-
-
-def _check_taught_run(summary, scene_path, name: str) -> None:
-    if summary.reached_goal:
-        return
-    path = "the route" if name == "center" else f"the {name} parallel path"
-    c = summary.collision
-    why = (
-        f"hit {c.hit} at ({c.contact[0]:.2f}, {c.contact[1]:.2f}) at t = {c.t:.1f} s"
-        if c is not None
-        else f"stopped at ({summary.final_pose[0]:.2f}, {summary.final_pose[1]:.2f})"
-    )
-    raise ValueError(
-        f"{scene_path}: the teaching run along {path} did not reach its end ({why}): no map"
-    )
 
 
 def rahok_vectors(maps: TaughtMaps, smooth: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
