@@ -2,13 +2,12 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/io/octomap_file.hpp"
 
+#include "replace_file.hpp"
+
 #include <octomap/OcTree.h>
 
-#include <filesystem>
 #include <fstream>
-#include <stdexcept>
 #include <string>
-#include <system_error>
 
 namespace kiseki {
 
@@ -33,16 +32,7 @@ void write_octomap_binary(const octomap::OcTree& tree, const std::string& path) 
       ok = out.flush().good();
     }
   }
-  std::error_code ec;
-  if (!ok) {
-    std::filesystem::remove(partial, ec);
-    throw std::runtime_error(path + ": cannot write the OctoMap file");
-  }
-  std::filesystem::rename(partial, path, ec);
-  if (ec) {
-    std::filesystem::remove(partial, ec);
-    throw std::runtime_error(path + ": cannot write the OctoMap file (" + ec.message() + ")");
-  }
+  io_detail::replace_with_partial(partial, path, ok, "the OctoMap file");
 }
 
 }  // namespace kiseki

@@ -2,6 +2,8 @@
 // Copyright (c) 2026 the kiseki authors
 #include "kiseki/io/pcd_file.hpp"
 
+#include "replace_file.hpp"
+
 #include <pcl/console/print.h>
 #include <pcl/io/lzf.h>
 #include <pcl/io/pcd_io.h>
@@ -255,16 +257,7 @@ void write_pcd(const std::string& path, const Eigen::Matrix3Xd& points) {
     std::remove(partial.c_str());
     throw std::runtime_error(path + ": cannot write the PCD file (" + e.what() + ")");
   }
-  std::error_code ec;
-  if (result < 0) {
-    std::filesystem::remove(partial, ec);
-    throw std::runtime_error(path + ": cannot write the PCD file");
-  }
-  std::filesystem::rename(partial, path, ec);
-  if (ec) {
-    std::filesystem::remove(partial, ec);
-    throw std::runtime_error(path + ": cannot write the PCD file (" + ec.message() + ")");
-  }
+  io_detail::replace_with_partial(partial, path, result >= 0, "the PCD file");
 }
 
 }  // namespace kiseki
