@@ -12,6 +12,7 @@ ddof = 0, min, max, sse).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -76,14 +77,15 @@ def as_se3(poses: np.ndarray) -> np.ndarray:
         raise ValueError(f"poses must have shape (n, 3) or (n, 4, 4), got {p.shape}")
     if not np.isfinite(p).all():
         raise ValueError("poses contain NaN or infinite values")
-    # matrices must be rigid motions: all ones gave a rotation error of 180 deg
+    # rigid motions (all ones gave a rotation error of 180 deg), to 1e-2: poses written with 4
+    # decimals, or chained in float32, are rotations too
     r = p[:, :3, :3]
     off = np.abs(np.einsum("nji,njk->nik", r, r) - np.eye(3)).max(axis=(1, 2))
-    # to 1e-2: poses written with 4 decimals, or chained in float32, are rotations too
     bad = (off > 1e-2) | (np.linalg.det(r) <= 0) | (np.abs(p[:, 3] - [0, 0, 0, 1]).max(axis=1) > 0)
     if bad.any():
-        k = int(np.argmax(bad))
-        raise ValueError(f"pose {k} is not a rigid motion (a rotation, and a last row 0 0 0 1)")
+        raise ValueError(
+            f"pose {int(np.argmax(bad))} is not a rigid motion (a rotation, and a last row 0 0 0 1)"
+        )
     return p
 
 
@@ -108,10 +110,8 @@ def _inv(t: np.ndarray) -> np.ndarray:
 def umeyama_alignment(src: np.ndarray, dst: np.ndarray, with_scale: bool = False):
     """Least-squares (R, t, s) with dst ~ s R src + t (Umeyama 1991); src, dst are (n, d)."""
     src, dst = np.asarray(src, dtype=float), np.asarray(dst, dtype=float)  # lists were refused
-    if src.shape != dst.shape or src.ndim != 2 or len(src) < 2:  # with an AttributeError
-        raise ValueError("alignment needs two (n, d) point sets of the same shape, n >= 2")
-    if not (np.isfinite(src).all() and np.isfinite(dst).all()):
-        raise ValueError("alignment needs finite points")
+    if src.shape != dst.shape or src.ndim != 2 or len(src) < 2 or not np.isfinite(src + dst).all():
+        raise ValueError("alignment needs two finite (n, d) point sets of the same shape, n >= 2")
     mu_s, mu_d = src.mean(axis=0), dst.mean(axis=0)
     xs, xd = src - mu_s, dst - mu_d
     cov = xd.T @ xs / len(src)
@@ -363,13 +363,11 @@ def taught_map_truth(
 def wilson_interval(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
     """The Wilson score interval of a share k/n (95 % with z = 1.96; E. B. Wilson, JASA 22,
     1927); (NaN, NaN) when n is 0."""
-    for name, v in (("k", k), ("n", n)):
-        if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < 0:
-            raise ValueError(f"wilson_interval: {name} must be a count >= 0, got {v!r}")
-    if k > n:  # 5 of 3 was "math domain error"
-        raise ValueError(f"wilson_interval: k = {k} successes of n = {n} trials")
-    if not (isinstance(z, int | float | np.floating) and math.isfinite(z) and z > 0):
-        raise ValueError(f"wilson_interval: z must be a finite number > 0, got {z!r}")
+    counts = all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in (k, n))
+    if not (counts and 0 <= k <= n and isinstance(z, numbers.Real) and 0 < z < math.inf):
+        raise ValueError(  # 5 of 3 was "math domain error", n = -3 an interval
+            f"wilson_interval: need counts 0 <= k <= n and z > 0, got {k!r}, {n!r}, {z!r}"
+        )
     if n == 0:
         return (math.nan, math.nan)
     p = k / n
@@ -382,11 +380,10 @@ def area_under_roc(score, positive) -> float:
     """Area under the ROC curve of ``score`` for the boolean ``positive``: the probability that
     a positive scores above a negative, ties counted half (the Mann-Whitney U statistic over
     n_pos n_neg). NaN when either class is empty."""
-    labels = np.asarray(positive)
-    if labels.dtype.kind not in "bi" or (
-        labels.dtype.kind == "i" and not np.isin(labels, (0, 1)).all()
+    labels = np.asarray(positive)  # 'no' and 'yes' were both read as True
+    if not (
+        labels.dtype.kind == "b" or (labels.dtype.kind == "i" and np.isin(labels, (0, 1)).all())
     ):
-        # 'no' and 'yes' were both read as True
         raise ValueError(
             f"area_under_roc: labels must be booleans (or 0 and 1), got {labels.dtype}"
         )
