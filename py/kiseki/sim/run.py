@@ -27,7 +27,7 @@ from kiseki.sim.collisions import COLLISION_SCHEMA, Collision, CollisionCheck
 from kiseki.sim.command_schema import MAX_COMMAND_SECONDS, read_command_rows
 from kiseki.sim.pedestrians import PEDESTRIANS_SCHEMA
 from kiseki.sim.recorder import Recorder, planar_pose
-from kiseki.sim.scene import Scene
+from kiseki.sim.scene import Scene, check_route_in_bounds
 from kiseki.sim.setup import RobotSetup, SensorSetup, build_robot, build_sensors
 from kiseki.sim.turns import Turns
 
@@ -140,6 +140,16 @@ def _agents(scene: Scene, config: SimConfig, commands, controller) -> list[_Agen
         raise ValueError(f"{scene.path}: no route: give velocity commands instead")
     if commands is not None and len(agents) > 1:
         raise ValueError(f"{scene.path}: command scripts drive one robot; this scene has several")
+    if commands is not None and agents[0].setup.kind == "diff_drive" and commands[:, 2].any():
+        # a differential robot cannot move sideways: the vy column was dropped without a word
+        row = int(np.argmax(commands[:, 2] != 0))
+        raise ValueError(
+            f"{scene.path}: the robot is a differential drive, but the command script's row "
+            f"{row + 1} asks for vy = {commands[row, 2]:g} m/s (give t,v,w)"
+        )
+    for agent, spec in zip(agents, scene.robot_specs, strict=True):
+        if agent.controller is not None:  # the robot would leave the world to reach it
+            check_route_in_bounds(scene, spec["route"]["waypoints"])
     return agents
 
 

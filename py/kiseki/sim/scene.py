@@ -53,7 +53,7 @@ from kiseki.sim.pedestrians import Pedestrian
 from kiseki.sim.primitives import BoxList, boxes_of
 from kiseki.sim.scene_schema import Poses, SceneDoc, Turns, extent_problem
 
-__all__ = ["MAX_OCTOMAP_BYTES", "Scene", "load_scene", "read_octree"]
+__all__ = ["MAX_OCTOMAP_BYTES", "Scene", "check_route_in_bounds", "load_scene", "read_octree"]
 
 MAX_OCTOMAP_BYTES = 32 * MIB
 """An OctoMap ``.bt`` file holds at most this: reading one takes about 120 times its size in
@@ -283,3 +283,16 @@ def _robot_specs(doc: SceneDoc) -> list[dict]:
             }
         )
     return specs
+
+
+def check_route_in_bounds(scene: Scene, waypoints, names=None) -> None:
+    """A ValueError naming the scene and the first route waypoint outside its bounds (x, y):
+    the robot would leave the mapped world to reach it."""
+    lo, hi = (np.asarray(b, dtype=float)[:2] for b in scene.bounds)
+    names = names or [f"W{i}" for i in range(len(waypoints))]
+    for name, point in zip(names, waypoints, strict=True):
+        if not (np.all(np.asarray(point) >= lo) and np.all(np.asarray(point) <= hi)):
+            raise ValueError(
+                f"{scene.path}: route waypoint {name} {list(point)} lies outside the scene's "
+                f"bounds x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g}"
+            )

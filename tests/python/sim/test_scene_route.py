@@ -120,3 +120,26 @@ def test_teaching_a_scenes_names_writes_a_waypoint_file_the_reader_takes(tmp_pat
     teach(load_scene(scene), tmp_path / "t", seed=1)
     marks = read_waypoint_file(tmp_path / "t" / "waypoints.yaml").waypoints
     assert [w.name for w in marks] == names
+
+
+def test_sim_refuses_a_route_out_of_bounds_and_sideways_commands_to_a_differential_robot(tmp_path):
+    """sim run drove a route to a waypoint 1,300 m outside the scene (teach refused it); a
+    t,vx,vy,w script on a differential robot lost its vy column without a word."""
+    import numpy as np
+
+    from kiseki.sim.run import SimConfig, simulate
+
+    text = SCENE.format(key="speed", value=0.5)
+    far = tmp_path / "far.yaml"
+    far.write_text(text.replace("[2, 0]]", "[1300, 0]]"))
+    with pytest.raises(ValueError) as caught:
+        simulate(load_scene(far), tmp_path / "run.mcap", SimConfig(max_duration=1.0))
+    assert str(caught.value) == (
+        f"{far}: route waypoint W2 [1300.0, 0.0] lies outside the scene's bounds x -5..5, y -5..5"
+    )
+    here = tmp_path / "here.yaml"
+    here.write_text(text)
+    sideways = np.array([[0.0, 0.3, 0.0, 0.0], [1.0, 0.0, 0.2, 0.0]])
+    with pytest.raises(ValueError, match="row 2 asks for vy = 0.2 m/s"):
+        simulate(load_scene(here), tmp_path / "run.mcap", SimConfig(max_duration=1.0), sideways)
+    assert not (tmp_path / "run.mcap").exists()

@@ -32,7 +32,7 @@ from kiseki.grid import OccupancyGrid
 from kiseki.io.ros_map import map_files
 from kiseki.io.runlog import RunWriter, read_run
 from kiseki.metrics import taught_map_truth
-from kiseki.sim.scene import Scene
+from kiseki.sim.scene import Scene, check_route_in_bounds
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import MERGE_RULES, EnvironmentMap
 from kiseki.teach.local_maps import BANDS, LocalMapMaker
@@ -343,13 +343,7 @@ def teach(
     if not route.get("waypoints"):
         raise ValueError(f"{scene.path}: scripted teaching needs a route (or use the keyboard)")
     names = route.get("names") or [f"W{i}" for i in range(len(route["waypoints"]))]
-    lo, hi = (np.asarray(b, dtype=float)[:2] for b in scene.bounds)
-    for name, point in zip(names, route["waypoints"], strict=True):
-        if not (np.all(np.asarray(point) >= lo) and np.all(np.asarray(point) <= hi)):
-            raise ValueError(  # the robot would leave the mapped world to reach it
-                f"{scene.path}: route waypoint {name} {list(point)} lies outside the scene's "
-                f"bounds x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g}"
-            )
+    check_route_in_bounds(scene, route["waypoints"], names)
     with TeachingRun(scene, out, seed, dt, overwrite, {"names": ",".join(names)}, merge) as run:
         controller = PurePursuit(
             route["waypoints"],
