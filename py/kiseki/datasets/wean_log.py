@@ -41,7 +41,7 @@ import numpy as np
 
 from kiseki._support.inputs import GIB, check_input
 from kiseki.datasets._files import GZIP_MAGIC, read_maybe_gzipped
-from kiseki.datasets.carmen import flaser_angles
+from kiseki.datasets.carmen import VALUE_LIMIT, flaser_angles
 from kiseki.errors import LogFormatError
 from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps, largest_reading
 
@@ -175,4 +175,10 @@ def _numbers(
     bad = ~finite.all(axis=1)
     if bad.any():
         raise LogFormatError(f"{path}:{linenos[int(np.argmax(bad))]}: non-finite value")
+    huge = np.abs(values) > VALUE_LIMIT  # as CARMEN's: odometry of 1e300 was taken
+    huge[:, ranges] = False  # a reading beyond the maximum range has no return
+    if huge.any():
+        row = int(np.argmax(huge.any(axis=1)))
+        value = values[row][huge[row]][0]
+        raise LogFormatError(f"{path}:{linenos[row]}: value {value:g} beyond +-{VALUE_LIMIT:g}")
     return values

@@ -70,6 +70,8 @@ def test_malformed_lines_name_file_and_line(tmp_path: Path) -> None:
             r"time\.log:2: non-finite",
         ),
         "nan": (["O 1 2 nan 4", good[1]], r"nan\.log:1: non-finite"),
+        # odometry of 1e300 was taken (CARMEN's readers bound it at +-1e12)
+        "huge": (["O 1e300 2 3 4", good[1]], r"huge\.log:1: value 1e\+300 beyond \+-1e\+12"),
     }
     for name, (lines, message) in cases.items():
         path = tmp_path / f"{name}.log"
