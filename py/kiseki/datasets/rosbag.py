@@ -325,9 +325,16 @@ def _check_chunks(path: Path) -> None:
             info = safe_load_12(text)["rosbag2_bagfile_information"]
             compressed = str(info.get("compression_mode", "")).lower() == "file"
             compressed &= str(info.get("compression_format", "")).lower() == "zstd"
-            listed = {str(name) for name in info.get("relative_file_paths") or []}
+            names = [str(name) for name in info.get("relative_file_paths") or []]
+            listed = set(names)
         except (yaml.YAMLError, KeyError, TypeError, AttributeError):
-            pass  # rosbags says what is wrong with it
+            names = []  # rosbags says what is wrong with it
+        twice = sorted({name for name in names if names.count(name) > 1})
+        if twice:  # rosbags read each of its messages twice, without a word
+            raise LogFormatError(
+                f"{meta}: relative_file_paths lists {twice[0]} more than once (its messages "
+                "would be read as many times)"
+            )
         files = sorted(entry for entry in path.iterdir() if entry.is_file() and entry != meta)
     for file in files:
         # the storage files the metadata lists are compressed (rosbags opens those only)

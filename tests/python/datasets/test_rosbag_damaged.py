@@ -92,3 +92,16 @@ def test_other_files_in_a_compressed_bags_folder_are_left_alone(bag: Path) -> No
     _compress_files(bag)
     (bag / "notes.txt").write_text("recorded on the second floor\n")
     assert len(read_bag_scans(bag)) == 12
+
+
+def test_a_storage_file_listed_twice_is_refused(bag: Path) -> None:
+    """rosbags read each message of a file that metadata.yaml lists twice twice over (80 scans
+    from 40)."""
+    meta = bag / "metadata.yaml"
+    doc = yaml.safe_load(meta.read_text())
+    info = doc["rosbag2_bagfile_information"]
+    info["relative_file_paths"] = info["relative_file_paths"] * 2
+    meta.write_text(yaml.safe_dump(doc))
+    with pytest.raises(LogFormatError) as caught:
+        read_bag_scans(bag)
+    assert str(caught.value).startswith(f"{meta}: relative_file_paths lists bag.mcap more than")
