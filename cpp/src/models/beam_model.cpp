@@ -17,6 +17,8 @@ void BeamModelParams::validate() const {
   }
   if (!(z_hit + z_short + z_max + z_rand > 0.0)) throw std::invalid_argument("beam model: the z weights are all 0");
   if (!(sigma_hit > 0.0) || !std::isfinite(sigma_hit)) throw std::invalid_argument("beam model: sigma_hit must be > 0");
+  // a micrometre at least: 1e-300 squared is 0, and the Gaussian 0 / 0 (NaN log-likelihoods)
+  if (sigma_hit < kMinSigmaHit) throw std::invalid_argument("beam model: sigma_hit must be at least 1e-6 m");
   if (!(lambda_short > 0.0) || !std::isfinite(lambda_short)) {
     throw std::invalid_argument("beam model: lambda_short must be > 0");
   }

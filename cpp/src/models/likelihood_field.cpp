@@ -25,6 +25,8 @@ void LikelihoodFieldParams::validate() const {
       !(z_hit + z_rand > 0.0) || !std::isfinite(z_hit + z_rand)) {
     throw std::invalid_argument("likelihood field: need sigma_hit > 0, z_hit, z_rand >= 0 and not both 0");
   }
+  // a micrometre at least: 1e-300 squared is 0, and the Gaussian 0 / 0 (NaN scores)
+  if (sigma_hit < kMinSigmaHit) throw std::invalid_argument("likelihood field: sigma_hit must be at least 1e-6 m");
   if (max_beams < 0) throw std::invalid_argument("likelihood field: max_beams must be >= 0");
   if (!(max_distance > 0.0) || !std::isfinite(max_distance)) {
     throw std::invalid_argument("likelihood field: max_distance must be finite and > 0");

@@ -20,6 +20,7 @@ void RaySpaceObservationParams::validate() const {
   if (!(z_rand > 0.0)) {
     throw std::invalid_argument("ray space observation: z_rand must be > 0 (every reading must be possible)");
   }
+  if (sigma_hit < kMinSigmaHit) throw std::invalid_argument("ray space observation: sigma_hit must be at least 1e-6 m");
   for (double v : {sigma_hit, lambda_short, max_distance}) {
     if (!(v > 0.0) || !std::isfinite(v)) {
       throw std::invalid_argument("ray space observation: sigma_hit, lambda_short, max_distance must be finite and > 0");

@@ -47,3 +47,19 @@ def test_a_start_without_a_heading_is_refused():
         loc.initialize((1.0, 1.0), (0.1, 0.1, 0.1))
     loc.initialize((1.0, 1.0, 0.5), (0.0, 0.0, 0.0))
     np.testing.assert_allclose(loc.estimate, [1.0, 1.0, 0.5])
+
+
+@pytest.mark.parametrize("method", ["likelihood-field", "beam", "ray-space-observation"])
+def test_a_sigma_hit_below_a_micrometre_is_refused(method):
+    """sigma_hit 1e-300 squared is 0: the range models gave NaN log-likelihoods."""
+    from _helpers.room_log import ANGLES, room
+    from kiseki.filters import LocalizeConfig, scan_model
+
+    grid = room()
+    pose = np.array([[1.0, 0.0, 0.0]])
+    ranges = grid.cast_scans(pose, ANGLES, max_range=8.0)[0]
+    with pytest.raises(ValueError, match="sigma_hit must be at least 1e-6 m"):
+        scan_model(method, grid, LocalizeConfig(method=method, sigma_hit=1e-300))
+    model = scan_model(method, grid, LocalizeConfig(method=method, sigma_hit=1e-6))
+    model.set_scan(ANGLES, ranges, 8.0)
+    assert np.isfinite(model.log_likelihoods(pose)).all()

@@ -23,6 +23,10 @@ enum class BeamCombination {
   nav2,
 };
 
+/// The smallest sigma_hit of the range models (m): below it the Gaussian's variance underflows
+/// (1e-300 squared is 0) and a beam's likelihood becomes 0 / 0.
+inline constexpr double kMinSigmaHit = 1e-6;
+
 /// The likelihood-field range-finder model (Thrun, Burgard, Fox, Probabilistic Robotics,
 /// Table 6.3; nav2 AMCL's likelihood_field): a beam ending at distance d from the nearest
 /// occupied cell has pz = z_hit g(d) + z_rand / max_range, with g(d) = exp(-d^2 / 2 sigma^2)
