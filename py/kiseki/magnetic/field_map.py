@@ -295,6 +295,11 @@ class MagneticFieldMap:
             raise ValueError(f"resolution must be a positive number of metres, got {resolution!r}")
         if resolution <= 0:
             raise ValueError(f"resolution must be a positive number of metres, got {resolution!r}")
+        cells = np.concatenate([lo, hi]) / resolution
+        if not np.all(np.abs(cells) < 2.0**62):  # the int64 cast wrapped: a 1 x 1 map at 1e-300
+            raise ValueError(
+                f"the box {lo}..{hi} at {resolution:g} m is beyond any grid's cell indices"
+            )
         first = np.floor(lo / resolution + 1e-9).astype(np.int64)
         last = np.ceil(hi / resolution - 1e-9).astype(np.int64)
         if d == 3 and np.any(np.abs(np.concatenate([first, last])) > OCTOMAP_KEY_OFFSET):

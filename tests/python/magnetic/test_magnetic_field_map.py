@@ -128,6 +128,10 @@ def test_from_gp_evaluates_the_gp_on_octomap_aligned_cells(monkeypatch):
     # cell (i, j, k) centre = origin + ((i, j, k) + 0.5) * resolution, x fastest in memory
     np.testing.assert_allclose(fmap.cell_centres()[8 * 4 + 8 + 1], [-0.25, 0.25, 0.05], atol=1e-12)
     assert list(fmap.octomap_key_origin()) == [32764, 32769, 32767]
+    gp2, _, _ = small_gp(2)  # cell indices past int64 wrapped: a 1 x 1 map at 1e-300 m
+    for lower, upper, resolution in (([0, 0], [1, 1], 1e-300), ([-1e300, 0], [1e300, 1], 0.1)):
+        with pytest.raises(ValueError, match="beyond any grid's cell indices"):
+            MagneticFieldMap.from_gp(gp2, lower, upper, resolution)
 
 
 def test_voxel_centres_are_octomap_key_centres():
