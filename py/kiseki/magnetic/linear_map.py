@@ -71,6 +71,8 @@ def path_identity(points: Any) -> str:
         raise ValueError(f"path_identity: expected (n, 2) points with n >= 1, got {p.shape}")
     if not np.all(np.isfinite(p)):
         raise ValueError("path_identity: the points hold NaN or infinity")
+    if not np.all(np.abs(p) <= 1e9):  # in mm past int64 (1e17 and 2e17 m had one identity)
+        raise ValueError("path_identity: the points lie beyond +-1e9 m")
     mm = np.rint(p * 1000.0).astype("<i8")
     digest = hashlib.sha1(usedforsecurity=False)
     digest.update(np.int64(len(mm)).astype("<i8").tobytes())

@@ -336,3 +336,12 @@ def test_malformed_folder_is_refused(tmp_path, edit, message):
     meta.write_text(text.replace(edit[0], edit[1]))
     with pytest.raises(ValueError, match=message):
         load_linear_map(folder)
+
+
+def test_path_identity_tells_paths_apart_and_refuses_points_beyond_its_millimetres():
+    """Points in whole millimetres as int64: 1e17 and 2e17 m wrapped to one identity."""
+    assert path_identity([[0.0, 0.0], [1.0, 0.0]]) == path_identity([[0.0, 0.0], [1.0004, 0.0]])
+    assert path_identity([[0.0, 0.0], [1.0, 0.0]]) != path_identity([[0.0, 0.0], [1.001, 0.0]])
+    for far in (1e17, 2e17, -1e10):
+        with pytest.raises(ValueError, match="beyond \\+-1e9 m"):
+            path_identity([[far, 0.0]])
