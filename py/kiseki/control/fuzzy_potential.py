@@ -22,10 +22,11 @@ With the default half-width pi, mu_g falls linearly to 0 straight away from the 
 direction keeps some attraction and the robot can go round an obstacle that blocks the goal.
 The peak is 1: slowing down at the goal is the caller's (the navigator's stopping-distance cap).
 
-Obstacle repulsion: every scan point i (a return shorter than ``max_range``; NaN and no-return
-beams are ignored) at distance d_i in direction phi_i spans the collision cone of a robot of
-half-width r = ``robot_radius`` + ``margin``: a robot centre moving along psi passes the point
-closer than r exactly when |wrap(psi - phi_i)| < asin(r / d_i) (pi / 2 once d_i <= r). The
+Obstacle repulsion: every scan point i (a return shorter than ``max_range``; NaN, negative,
+zero and no-return beams are ignored) at distance d_i in direction phi_i spans the collision
+cone of a robot of half-width r = ``robot_radius`` + ``margin``: a robot centre moving along
+psi passes the point closer than r exactly when |wrap(psi - phi_i)| < asin(r / d_i) (pi / 2
+once d_i <= r). The
 point's membership is rectangular over that cone -- every direction inside it leads to a
 collision if held, none outside does, so there is no reason to grade it -- with a depth that
 grows as the point gets closer:
@@ -170,6 +171,9 @@ def _checked(goal_xy, angles, ranges, max_range):
         raise ValueError("the scan's angles must be finite")
     if not (math.isfinite(max_range) and max_range > 0):
         raise ValueError(f"max_range must be a positive number, got {max_range!r}")
+    # kiseki's rule for readings (kiseki.scans): a negative or zero one is invalid, as NaN; it
+    # counted as an obstacle at the robot, blocking half the directions
+    ranges = np.where(ranges > 0, ranges, np.nan)
     return goal, angles, ranges
 
 

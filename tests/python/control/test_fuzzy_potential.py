@@ -182,3 +182,15 @@ def test_bad_config_names_the_field(field, value):
         ValueError, match="influence_distance" if field == "stop_distance" else field
     ):
         FuzzyPotentialConfig(**{field: value})
+
+
+def test_negative_and_zero_readings_are_invalid_as_nan():
+    """kiseki's rule (kiseki.scans): a reading <= 0 says nothing; it counted as an obstacle at
+    the robot, which blocks about half the directions."""
+    angles = np.linspace(-math.pi, math.pi, 73)[:-1]
+    free = np.full(72, MAX_RANGE)
+    want = FuzzyPotentialMethod().direction((5.0, 0.0), angles, free, MAX_RANGE)
+    for bad in (-1.0, 0.0, np.nan):
+        ranges = free.copy()
+        ranges[[10, 40]] = bad
+        assert FuzzyPotentialMethod().direction((5.0, 0.0), angles, ranges, MAX_RANGE) == want
