@@ -346,3 +346,19 @@ def test_global_localization_from_one_scan_is_run_and_saved_as_such(inputs):
     # the saved start ran: the cloud converged where the scans fit the map, better than 1 m off
     assert report["converged"]
     assert report["fit"]["within_1_cell"] > 2 * report["fit_shifted_1m"]["within_1_cell"]
+
+
+@pytest.mark.parametrize(
+    ("x", "needle"), [(1e11, "the reference poses reach 1e+11 m, beyond +-1e+09"), (3e8, "cells")]
+)
+def test_a_map_from_a_log_with_far_poses_names_the_log(tmp_path, x, needle):
+    """A CARMEN pose of 1e11 m said "resolution 0.05 m makes a map of 2000000000545 x 606
+    cells" naming no file; poses past +-1e9 m made a map that the output's YAML then refused,
+    naming the output."""
+    line = "FLASER 3 1.0 1.5 2.0 {x} 0.0 0.0 {odom} 0.0 0.0 {t} host {t}"  # odometry smooth
+    rows = [(0.0, 0.0, 1.0), (0.5, 0.5, 1.1), (x, 1.0, 1.2)]
+    log = tmp_path / "far.log"
+    log.write_text("\n".join(line.format(x=a, odom=b, t=t) for a, b, t in rows) + "\n")
+    message = one_error(run("map", "from-log", "far.log", "-o", "m.yaml", cwd=tmp_path))
+    assert message.startswith("kiseki: error: far.log: ") and needle in message, message
+    assert not (tmp_path / "m.yaml").exists()
