@@ -21,7 +21,8 @@ from kiseki.datasets.magnetic import (
     read_field_csv,
     read_magnetic_data,
 )
-from kiseki.datasets.rosbag import BAG_KINDS, is_ros_bag, read_bag_scans, write_bag
+from kiseki.datasets.rosbag import BAG_KINDS, is_ros_bag, read_bag_scans
+from kiseki.datasets.rosbag_writer import write_bag
 from kiseki.datasets.unknown_obstacles import UnknownObstacles, occlude_scans
 from kiseki.datasets.wean import WeanMap, read_wean_map
 from kiseki.datasets.wean_log import WeanLog, is_wean_log, read_wean_log

@@ -34,27 +34,25 @@ reference poses that are NaN or infinite at a scan, and an odometry jump of more
 (its index among the scans read, from 0, and its stamp). Frame names are
 compared without a leading ``/`` (ROS 1 style ``/base_link`` is ``base_link``).
 
-Writing (:func:`write_bag`) converts a :class:`LaserScans` (e.g. a CARMEN log) into a bag with
-``rosbags``' own writers: LaserScan messages, the odometry of ``base_link`` in ``odom``, the mount
-on ``/tf_static`` and, when the scans have reference poses, ``base_link`` in ``map`` on the
-reference topic. Each message is stamped (and logged) at its scan's time.
+Writing (:func:`kiseki.datasets.rosbag_writer.write_bag`) converts a :class:`LaserScans`
+(e.g. a CARMEN log) into a bag with ``rosbags``' own writers: LaserScan messages, the odometry
+of ``base_link`` in ``odom``, the mount on ``/tf_static`` and, when the scans have reference
+poses, ``base_link`` in ``map`` on the reference topic. Each message is stamped (and logged) at
+its scan's time.
 
-Why one file over 400 lines: ROS 1 and ROS 2 bags share the message layout, the
-checks of a scan and the writer's inverse of the reader; split, each half would import the
-other's private rules.
+Why one file over 400 lines: one reader for ROS 1 and ROS 2 bags (rosbags' three storages),
+with the checks of their files, scans, odometry and /tf that the three share. Writing is
+:mod:`kiseki.datasets.rosbag_writer`; what both share about ROS messages (frames, stamps,
+quaternions, planar poses) is :mod:`kiseki.datasets.ros_messages`.
 """
 
 from __future__ import annotations
 
-import math
 import os
-import shutil
 import sqlite3
-import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
-from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
@@ -72,7 +70,15 @@ from kiseki._support.inputs import (
     read_input_text,
 )
 from kiseki._support.yaml import safe_load_12
-from kiseki.datasets.ros_orientation import NotARotationError, yaw, yaw_or_nan
+from kiseki.datasets.ros_messages import (
+    NS_PER_S,
+    NotARotationError,
+    compose,
+    frame_name,
+    wrap_angle,
+    yaw,
+    yaw_or_nan,
+)
 from kiseki.errors import LogFormatError
 from kiseki.scans import (
     LaserScans,
@@ -88,7 +94,6 @@ __all__ = [
     "MAX_BAG_MESSAGE_BYTES",
     "is_ros_bag",
     "read_bag_scans",
-    "write_bag",
 ]
 
 BAG_KINDS = ("ros1", "ros2-sqlite3", "ros2-mcap")
@@ -113,11 +118,9 @@ ODOM_FRAME = "odom"
 BASE_FRAME = "base_link"
 MAP_FRAME = "map"
 
-_NS_PER_S = 1_000_000_000
 _ROS1_MAGIC = b"#ROSBAG V2.0\n"
 _SQLITE_MAGIC = b"SQLite format 3\x00"
 _MCAP_MAGIC = b"\x89MCAP0\r\n"
-_TF_MESSAGE_MSG = "geometry_msgs/TransformStamped[] transforms\n"
 
 
 # --- recognising bags ---
@@ -285,12 +288,12 @@ def read_bag_scans(
             + (" and the reference poses" if reference_topic is not None else "")
         )
     ns = ns[keep]
-    times = np.array([int(t) / _NS_PER_S for t in ns], dtype=np.float64)
+    times = np.array([int(t) / NS_PER_S for t in ns], dtype=np.float64)
     laser_poses = []
     sources = [TF_TOPIC if use_tf else odom_topic, reference_topic][: len(tracks)]
     for track, source in zip(tracks, sources, strict=True):
         mount = _mount(path, static, track.child, laser)
-        laser_poses.append(_compose(_interpolate(track, ns), mount))
+        laser_poses.append(compose(_interpolate(track, ns), mount))
         bad = ~np.isfinite(laser_poses[-1]).all(axis=1)
         if bad.any():
             k = int(np.argmax(bad))
@@ -397,12 +400,8 @@ def _check_type(
         )
 
 
-def _frame(name: str) -> str:
-    return name.lstrip("/")
-
-
 def _stamp_ns(header: Any) -> int:
-    return int(header.stamp.sec) * _NS_PER_S + int(header.stamp.nanosec)
+    return int(header.stamp.sec) * NS_PER_S + int(header.stamp.nanosec)
 
 
 def _scan_arrays(
@@ -413,7 +412,7 @@ def _scan_arrays(
     beams = len(first.ranges)
     if beams < 1:
         raise LogFormatError(f"{path}: the first scan on {topic!r} has no beams")
-    laser = _frame(first.header.frame_id)
+    laser = frame_name(first.header.frame_id)
     if not beams_of_one_turn(float(first.angle_min), float(first.angle_increment), beams):
         raise LogFormatError(
             f"{path}: the first scan on {topic!r} has angle_min {first.angle_min} and "
@@ -431,7 +430,7 @@ def _scan_arrays(
                 f"({len(scan.ranges)} from {scan.angle_min} step {scan.angle_increment} rad, "
                 f"not {beams} from {first.angle_min} step {first.angle_increment} rad)"
             )
-        if _frame(scan.header.frame_id) != laser:
+        if frame_name(scan.header.frame_id) != laser:
             raise LogFormatError(
                 f"{path}: scan {index} on {topic!r} is in frame {scan.header.frame_id!r}, the "
                 f"first scan in {laser!r}"
@@ -455,11 +454,11 @@ def _scan_arrays(
 def _odometry_track(path: Path, topic: str, messages: list[Any]) -> _Track:
     if not messages:
         raise LogFormatError(f"{path}: no messages on {topic!r}")
-    parent = _frame(messages[0].header.frame_id)
-    child = _frame(messages[0].child_frame_id)
+    parent = frame_name(messages[0].header.frame_id)
+    child = frame_name(messages[0].child_frame_id)
     track = _Track(parent, child, [], [])
     for index, msg in enumerate(messages):
-        if (_frame(msg.header.frame_id), _frame(msg.child_frame_id)) != (parent, child):
+        if (frame_name(msg.header.frame_id), frame_name(msg.child_frame_id)) != (parent, child):
             raise LogFormatError(
                 f"{path}: message {index} on {topic!r} is {msg.child_frame_id!r} in "
                 f"{msg.header.frame_id!r}, the first one {child!r} in {parent!r}"
@@ -490,8 +489,8 @@ def _static_transforms(messages: list[Any]) -> dict[str, tuple[str, tuple[float,
     static: dict[str, tuple[str, tuple[float, float, float]]] = {}
     for msg in messages:
         for transform in msg.transforms:
-            static[_frame(transform.child_frame_id)] = (
-                _frame(transform.header.frame_id),
+            static[frame_name(transform.child_frame_id)] = (
+                frame_name(transform.header.frame_id),
                 _transform_pose(transform),
             )
     return static
@@ -509,7 +508,10 @@ def _tf_odometry(
     tracks: dict[tuple[str, str], _Track] = {}
     for msg in messages:
         for transform in msg.transforms:
-            parent, child = _frame(transform.header.frame_id), _frame(transform.child_frame_id)
+            parent, child = (
+                frame_name(transform.header.frame_id),
+                frame_name(transform.child_frame_id),
+            )
             track = tracks.setdefault((parent, child), _Track(parent, child, [], []))
             track.ns.append(_stamp_ns(transform.header))
             track.poses.append(_transform_pose(transform))
@@ -545,7 +547,7 @@ def _mount(
                 f"{TF_STATIC_TOPIC}"
             )
         parent, pose = static[frame]
-        mount = _compose(np.array([pose]), mount)[0]
+        mount = compose(np.array([pose]), mount)[0]
         frame = parent
     return mount
 
@@ -564,217 +566,5 @@ def _interpolate(track: _Track, ns: np.ndarray) -> np.ndarray:
     p0, p1 = poses[i0], poses[i0 + 1]
     out = np.empty((len(ns), 3))
     out[:, :2] = p0[:, :2] + a[:, None] * (p1[:, :2] - p0[:, :2])
-    out[:, 2] = _wrap(p0[:, 2] + a * _wrap(p1[:, 2] - p0[:, 2]))
+    out[:, 2] = wrap_angle(p0[:, 2] + a * wrap_angle(p1[:, 2] - p0[:, 2]))
     return out
-
-
-def _wrap(theta: np.ndarray) -> np.ndarray:
-    return np.remainder(theta + np.pi, 2 * np.pi) - np.pi
-
-
-def _compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a ∘ b`` for planar poses (rows of x, y, theta; ``b`` may be one pose)."""
-    b = np.broadcast_to(b, a.shape)
-    c, s = np.cos(a[:, 2]), np.sin(a[:, 2])
-    return np.column_stack(
-        [
-            a[:, 0] + c * b[:, 0] - s * b[:, 1],
-            a[:, 1] + s * b[:, 0] + c * b[:, 1],
-            _wrap(a[:, 2] + b[:, 2]),
-        ]
-    )
-
-
-def _inverse(pose: np.ndarray) -> np.ndarray:
-    x, y, theta = pose
-    c, s = math.cos(theta), math.sin(theta)
-    return np.array([-c * x - s * y, s * x - c * y, -theta])
-
-
-# --- writing ---
-
-
-def write_bag(
-    scans: LaserScans,
-    path: str | os.PathLike,
-    kind: str = "ros1",
-    scan_topic: str = "/scan",
-    odom_topic: str = "/odom",
-    reference_topic: str = "/ground_truth",
-    laser_frame: str = "laser",
-    mount: Sequence[float] = (0.0, 0.0, 0.0),
-) -> Path:
-    """Write ``scans`` as a bag: ``kind`` ``ros1`` (a ``.bag`` file), ``ros2-sqlite3`` or
-    ``ros2-mcap`` (a bag folder). ``mount`` is the laser's planar pose (x, y, yaw) in
-    ``base_link``; the odometry (and reference poses) of ``base_link`` are the laser's composed
-    with its inverse. The bag is written beside ``path`` under a temporary name and renamed when
-    complete; an existing ``path`` is refused. Scan times that step back or repeat (some CARMEN
-    logs) are written as they are, but the reader orders scans and poses by stamp."""
-    # here: rosbags loads only for a bag (see _is_ros2_mcap)
-    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
-
-    path = Path(path)
-    if kind not in BAG_KINDS:
-        raise ValueError(f"bag kind must be one of {', '.join(BAG_KINDS)}, got {kind!r}")
-    if path.exists():
-        raise FileExistsError(f"{path}: exists already, not overwriting")
-    if not path.parent.is_dir():
-        raise FileNotFoundError(f"{path}: directory {path.parent} does not exist")
-    mount = np.array(mount, dtype=np.float64)
-    if mount.shape != (3,) or not np.isfinite(mount).all():
-        raise ValueError(f"mount must be three finite numbers x, y, yaw, got {mount.tolist()}")
-    laser_frame = _frame(laser_frame)
-    if laser_frame == BASE_FRAME and mount.any():
-        raise ValueError(f"a laser frame {BASE_FRAME!r} is the base frame: its mount must be 0")
-    if len(scans) == 0:
-        raise ValueError(f"{path}: no scans to write")
-    if not np.isfinite(scans.odometry).all():
-        raise ValueError(f"{path}: the scans' odometry has NaN or inf poses")
-    if not np.isfinite(scans.times).all() or (scans.times < 0).any():
-        raise ValueError(f"{path}: scan times must be finite and >= 0")
-    angle_min, angle_increment = _beam_spacing(path, scans.angles)
-
-    ros1 = kind == "ros1"
-    store = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
-    if TF_MESSAGES[0] not in store.types:  # ROS1_NOETIC in rosbags has no tf2_msgs
-        store.register(get_types_from_msg(_TF_MESSAGE_MSG, TF_MESSAGES[0]))
-    types = store.types
-    ns = [round(Fraction(float(t)) * _NS_PER_S) for t in scans.times]
-    seq = iter(range(1, 2**32))
-
-    def header(stamp: int, frame: str) -> Any:
-        sec, nanosec = divmod(stamp, _NS_PER_S)
-        time = types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec)
-        if ros1:
-            return types["std_msgs/msg/Header"](seq=next(seq), stamp=time, frame_id=frame)
-        return types["std_msgs/msg/Header"](stamp=time, frame_id=frame)
-
-    def odometry(stamp: int, frame: str, pose: np.ndarray) -> Any:
-        geometry = "geometry_msgs/msg/"
-        q = types[geometry + "Quaternion"](*_yaw_quaternion(pose[2]))
-        where = types[geometry + "Pose"](
-            position=types[geometry + "Point"](x=pose[0], y=pose[1], z=0.0), orientation=q
-        )
-        zero = types[geometry + "Vector3"](x=0.0, y=0.0, z=0.0)
-        return types[ODOMETRY](
-            header=header(stamp, frame),
-            child_frame_id=BASE_FRAME,
-            pose=types[geometry + "PoseWithCovariance"](pose=where, covariance=np.zeros(36)),
-            twist=types[geometry + "TwistWithCovariance"](
-                twist=types[geometry + "Twist"](linear=zero, angular=zero),
-                covariance=np.zeros(36),
-            ),
-        )
-
-    def tf_static() -> Any:
-        geometry = "geometry_msgs/msg/"
-        transform = types[geometry + "TransformStamped"](
-            header=header(ns[0], BASE_FRAME),
-            child_frame_id=laser_frame,
-            transform=types[geometry + "Transform"](
-                translation=types[geometry + "Vector3"](x=mount[0], y=mount[1], z=0.0),
-                rotation=types[geometry + "Quaternion"](*_yaw_quaternion(mount[2])),
-            ),
-        )
-        return types[TF_MESSAGES[0]](transforms=[transform])
-
-    back = _inverse(mount)
-    base_odometry = _compose(scans.odometry, back)
-    base_reference = _compose(scans.poses, back) if scans.has_reference_poses else None
-    range_max = float(scans.max_range)
-    empty = np.zeros(0, dtype=np.float32)
-
-    def records() -> Iterator[tuple[str, int, Any]]:
-        if laser_frame != BASE_FRAME:
-            yield TF_STATIC_TOPIC, ns[0], tf_static()
-        for i, stamp in enumerate(ns):
-            yield odom_topic, stamp, odometry(stamp, ODOM_FRAME, base_odometry[i])
-            if base_reference is not None:
-                yield reference_topic, stamp, odometry(stamp, MAP_FRAME, base_reference[i])
-            beams = np.ascontiguousarray(scans.ranges[i], dtype=np.float32)
-            yield (
-                scan_topic,
-                stamp,
-                types[LASER_SCAN](
-                    header=header(stamp, laser_frame),
-                    angle_min=angle_min,
-                    angle_max=angle_min + (len(beams) - 1) * angle_increment,
-                    angle_increment=angle_increment,
-                    time_increment=0.0,
-                    scan_time=0.0,
-                    range_min=0.0,
-                    range_max=range_max,
-                    ranges=beams,
-                    intensities=empty,
-                ),
-            )
-
-    msgtypes = {scan_topic: LASER_SCAN, odom_topic: ODOMETRY, TF_STATIC_TOPIC: TF_MESSAGES[0]}
-    if base_reference is not None:
-        msgtypes[reference_topic] = ODOMETRY
-    if len(msgtypes) != 3 + (base_reference is not None):
-        raise ValueError(f"{path}: the scan, odometry and reference topics must differ")
-    work = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}."))
-    try:
-        staged = work / path.name
-        if ros1:
-            _write_ros1(staged, store, msgtypes, records())
-        else:
-            _write_ros2(staged, store, msgtypes, records(), kind.removeprefix("ros2-"))
-        if path.exists():
-            raise FileExistsError(f"{path}: appeared while the bag was written, not overwriting")
-        os.rename(staged, path)
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
-    return path
-
-
-def _beam_spacing(path: Path, angles: np.ndarray) -> tuple[float, float]:
-    """``angle_min`` and ``angle_increment`` of evenly spaced beam angles."""
-    angles = np.asarray(angles, dtype=np.float64)
-    if angles.ndim != 1 or len(angles) < 1 or not np.isfinite(angles).all():
-        raise ValueError(f"{path}: beam angles must be a non-empty 1-D array of finite numbers")
-    step = float((angles[-1] - angles[0]) / (len(angles) - 1)) if len(angles) > 1 else 0.0
-    spaced = angles[0] + step * np.arange(len(angles))
-    if np.abs(spaced - angles).max() > 1e-9:
-        raise ValueError(f"{path}: a LaserScan needs evenly spaced beam angles")
-    return float(angles[0]), step
-
-
-def _yaw_quaternion(theta: float) -> tuple[float, float, float, float]:
-    return (0.0, 0.0, math.sin(theta / 2), math.cos(theta / 2))
-
-
-def _write_ros1(
-    path: Path, store: Any, msgtypes: dict[str, str], records: Iterator[tuple[str, int, Any]]
-) -> None:
-    from rosbags.rosbag1 import Writer  # here: rosbags loads only for a bag
-
-    with Writer(path) as writer:
-        connections = {
-            topic: writer.add_connection(
-                topic, msgtype, typestore=store, latching=1 if topic == TF_STATIC_TOPIC else None
-            )
-            for topic, msgtype in msgtypes.items()
-        }
-        for topic, stamp, msg in records:
-            writer.write(connections[topic], stamp, store.serialize_ros1(msg, msgtypes[topic]))
-
-
-def _write_ros2(
-    path: Path,
-    store: Any,
-    msgtypes: dict[str, str],
-    records: Iterator[tuple[str, int, Any]],
-    storage: str,
-) -> None:
-    from rosbags.rosbag2 import StoragePlugin, Writer  # here: rosbags only for a bag
-
-    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
-    with Writer(path, version=Writer.VERSION_LATEST, storage_plugin=plugin) as writer:
-        connections = {
-            topic: writer.add_connection(topic, msgtype, typestore=store)
-            for topic, msgtype in msgtypes.items()
-        }
-        for topic, stamp, msg in records:
-            writer.write(connections[topic], stamp, store.serialize_cdr(msg, msgtypes[topic]))

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import kiseki.datasets.rosbag as rosbag
+import kiseki.datasets.rosbag_writer as rosbag_writer
 from _helpers.room_log import ANGLES, room
 from kiseki.datasets import read_bag_scans, write_bag
 from kiseki.errors import LogFormatError
@@ -32,19 +33,21 @@ def test_unit_quaternions_read_back_and_others_are_refused(tmp_path: Path, kind:
         write_bag(scans, tmp_path / f"good{ext}", kind), reference_topic="/ground_truth"
     )
     np.testing.assert_allclose(good.odometry, scans.odometry, atol=1e-6)
-    unit = rosbag._yaw_quaternion
+    unit = rosbag_writer._yaw_quaternion
     for scale in (1000.0, 0.0, 1.01):
         monkeypatch.setattr(
-            rosbag, "_yaw_quaternion", lambda t, s=scale: tuple(s * v for v in unit(t))
+            rosbag_writer, "_yaw_quaternion", lambda t, s=scale: tuple(s * v for v in unit(t))
         )
         bag = write_bag(scans, tmp_path / f"bad-{scale:g}{ext}", kind)
-        monkeypatch.setattr(rosbag, "_yaw_quaternion", unit)
+        monkeypatch.setattr(rosbag_writer, "_yaw_quaternion", unit)
         with pytest.raises(LogFormatError) as caught:
             read_bag_scans(bag)
         assert str(caught.value).startswith(f"{bag}: an orientation (")
         assert f"of norm {scale * 1.0:.6g} is not a unit quaternion" in str(caught.value)
     # within the tolerance (float32 quaternions, rounding): read, normalised
-    monkeypatch.setattr(rosbag, "_yaw_quaternion", lambda t: tuple(1.0004 * v for v in unit(t)))
+    monkeypatch.setattr(
+        rosbag_writer, "_yaw_quaternion", lambda t: tuple(1.0004 * v for v in unit(t))
+    )
     near = read_bag_scans(write_bag(scans, tmp_path / f"near{ext}", kind))
     np.testing.assert_allclose(near.odometry, scans.odometry, atol=1e-6)
 

@@ -1,14 +1,32 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The heading of a ROS pose's orientation (geometry_msgs Quaternion), for the bag reader
-(:mod:`kiseki.datasets.rosbag`): a unit quaternion to tf2's tolerance, or refused."""
+"""What kiseki's ROS bag reader (:mod:`kiseki.datasets.rosbag`) and writer
+(:mod:`kiseki.datasets.rosbag_writer`) share about ROS messages: frame names, stamps, the
+TFMessage layout, the heading of a pose's quaternion (a unit one to tf2's tolerance, or
+refused) and planar poses composed and inverted."""
 
 from __future__ import annotations
 
 import math
 from typing import Any
 
-__all__ = ["UNIT_QUATERNION_TOLERANCE", "NotARotationError", "yaw", "yaw_or_nan"]
+import numpy as np
+
+__all__ = [
+    "NS_PER_S",
+    "TF_MESSAGE_MSG",
+    "UNIT_QUATERNION_TOLERANCE",
+    "NotARotationError",
+    "compose",
+    "frame_name",
+    "inverse",
+    "wrap_angle",
+    "yaw",
+    "yaw_or_nan",
+]
+
+NS_PER_S = 1_000_000_000
+TF_MESSAGE_MSG = "geometry_msgs/TransformStamped[] transforms\n"  # ROS 1's tf/tfMessage
 
 UNIT_QUATERNION_TOLERANCE = 1e-2  # on |q|^2 - 1, tf2's QUATERNION_NORMALIZATION_TOLERANCE
 
@@ -41,3 +59,31 @@ def yaw_or_nan(q: Any) -> float:
         return yaw(q)
     except NotARotationError:
         return math.nan
+
+
+def frame_name(name: str) -> str:
+    """A tf frame id without its leading slash (ROS 1's "/base_link" is "base_link")."""
+    return name.lstrip("/")
+
+
+def wrap_angle(theta: np.ndarray) -> np.ndarray:
+    return np.remainder(theta + np.pi, 2 * np.pi) - np.pi
+
+
+def compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a ∘ b`` for planar poses (rows of x, y, theta; ``b`` may be one pose)."""
+    b = np.broadcast_to(b, a.shape)
+    c, s = np.cos(a[:, 2]), np.sin(a[:, 2])
+    return np.column_stack(
+        [
+            a[:, 0] + c * b[:, 0] - s * b[:, 1],
+            a[:, 1] + s * b[:, 0] + c * b[:, 1],
+            wrap_angle(a[:, 2] + b[:, 2]),
+        ]
+    )
+
+
+def inverse(pose: np.ndarray) -> np.ndarray:
+    x, y, theta = pose
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([-c * x - s * y, s * x - c * y, -theta])
