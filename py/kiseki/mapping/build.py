@@ -164,7 +164,8 @@ def scan_local_builder(
     """The builder of the thesis' local map L (robot frame, sensor at its centre) filled with
     one 2-D scan; readings >= max_range ("no return": glass, black surfaces, open space) are
     left out, as in `build_map`: a missing echo says nothing certain about the space along the
-    beam. Its `build()` is L, its `hits()` the cells a beam ended in."""
+    beam. Readings that are NaN, zero or negative are no reading and add nothing. Its `build()`
+    is L, its `hits()` the cells a beam ended in."""
     ranges = np.array(ranges, dtype=np.float32)  # a copy: the caller's scan stays as it was
     ranges[ranges >= max_range] = np.nan
     builder = _core.LocalMapBuilder(size, resolution)

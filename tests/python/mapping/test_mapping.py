@@ -183,3 +183,19 @@ def test_check_map_size_refuses_what_it_cannot_divide():
     for bad in (0.0, float("nan"), float("inf"), -0.1):
         with pytest.raises(ValueError, match="check_map_size: resolution must be a finite number"):
             check_map_size(10.0, 10.0, bad)
+
+
+def test_scan_local_map_takes_readings_at_or_below_zero_as_no_reading():
+    """A negative or zero reading is no reading, as a NaN one: the local map and its hit cells
+    are those of the scan without those beams."""
+    from kiseki.mapping import scan_local_builder
+
+    angles = np.linspace(-np.pi, np.pi, 180, endpoint=False)
+    ranges = np.full(180, 2.0)
+    bad, none = ranges.copy(), ranges.copy()
+    bad[::3], bad[1::3] = -1.5, 0.0
+    none[::3], none[1::3] = np.nan, np.nan
+    with_bad, without = scan_local_builder(angles, bad, 5.0), scan_local_builder(angles, none, 5.0)
+    np.testing.assert_array_equal(with_bad.build().cells, without.build().cells)
+    np.testing.assert_array_equal(with_bad.hits(), without.hits())
+    assert np.asarray(without.hits()).size > 0  # the remaining beams did map something
