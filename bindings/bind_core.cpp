@@ -6,6 +6,7 @@
 #include "kiseki/core/angle.hpp"
 #include "kiseki/core/pose.hpp"
 #include "kiseki/core/random.hpp"
+#include "kiseki/core/threads.hpp"
 #include "kiseki/core/versions.hpp"
 #include "numpy_helpers.hpp"
 
@@ -105,6 +106,7 @@ void bind_core(py::module_& m) {
   m.def("normalize_angle", py::vectorize(&normalize_angle), "angle"_a,
         "Wraps angles (scalar or array) to [-pi, pi).");
   m.def("library_versions", &library_versions);
+  m.attr("MAX_THREADS") = kMaxThreads;  // the most threads any call may ask for
   bind_poses(m);
   bind_random(m);
 }

@@ -272,6 +272,7 @@ void bind_terrain(py::module_& m) {
       .def("occupied_centres", [](const GlobalVoxelMap& map) { return points_array(map.occupied_centres()); })
       .def("write_binary", &GlobalVoxelMap::write_binary, "path"_a);
 
+  m.attr("PCL_COORDINATE_LIMIT") = kPclCoordinateLimit;
   m.def(
       "register_pcl",
       [](const py::handle& source, const py::handle& target, const py::handle& initial, const std::string& method,

@@ -26,7 +26,7 @@ void CorrelativeMatcherParams::validate() const {
   if (!(min_distance >= 0.0) || !std::isfinite(min_distance) || !(min_angle >= 0.0) || !std::isfinite(min_angle)) {
     throw std::invalid_argument("correlative matcher: min_distance and min_angle must be finite and >= 0");
   }
-  if (threads < 0 || threads > kMaxThreads) throw std::invalid_argument("correlative matcher: threads must be in 0..1024");
+  check_threads(threads, "correlative matcher");
 }
 
 CorrelativeScanMatcher::CorrelativeScanMatcher(const OccupancyGrid& map, double max_range,

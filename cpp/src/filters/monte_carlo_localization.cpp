@@ -56,7 +56,7 @@ void MclParams::validate() const {
     throw std::invalid_argument("MCL: matcher_search_every must be in 1..1000");
   }
   if (!(reliability_rate > 0.0 && reliability_rate <= 1.0)) throw std::invalid_argument("MCL: reliability_rate must lie in (0, 1]");
-  if (threads < 0 || threads > kMaxThreads) throw std::invalid_argument("MCL: threads must be in 0..1024 (0 = every core)");
+  check_threads(threads, "MCL");
 }
 
 MonteCarloLocalization::MonteCarloLocalization(const MclParams& params, std::uint64_t seed)

@@ -23,7 +23,7 @@ void TravelDistanceParams::validate() const {
   if (!(likelihood_power > 0.0) || !std::isfinite(likelihood_power)) {
     throw std::invalid_argument("travel distance filter: likelihood_power must be > 0");
   }
-  if (threads < 0 || threads > kMaxThreads) throw std::invalid_argument("travel distance filter: threads must be in 0..1024");
+  check_threads(threads, "travel distance filter");
 }
 
 TravelDistanceFilter::TravelDistanceFilter(const TravelDistanceParams& params, std::uint64_t seed)

@@ -63,7 +63,7 @@ Eigen::Vector3d TranslationGrid::at(std::size_t k) const {
 }
 
 void CorrelationOptions::validate() const {
-  if (threads < 0 || threads > kMaxThreads) throw std::invalid_argument("correlation search: threads must be in 0..1024 (0 = every core)");
+  check_threads(threads, "correlation search");
 }
 
 struct CorrelationSearch::Scratch {

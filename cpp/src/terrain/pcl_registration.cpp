@@ -13,16 +13,12 @@ namespace kiseki {
 
 namespace {
 
-constexpr double kPclCoordinateLimit = 1e6;  // m
-
 void require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument("PCL registration: " + message);
 }
 
 pcl::PointCloud<pcl::PointXYZ>::Ptr cloud_of(const Eigen::Matrix3Xd& p, const char* name) {
   require(p.allFinite(), std::string(name) + " holds NaN or infinity");
-  // PCL holds points as float: far beyond a sensor's reach its squared distances overflow and
-  // its search aborts the process (an assertion on "NaN, Inf" coordinates, from 1e20 m)
   require(p.size() == 0 || p.cwiseAbs().maxCoeff() <= kPclCoordinateLimit,
           std::string(name) + " holds coordinates beyond +-1e6 m");
   require(p.cols() >= 10, std::string(name) + " has fewer than 10 points");

@@ -22,6 +22,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
+from kiseki import _core
 from kiseki.core import SEED_RULE
 from kiseki.errors import KisekiError
 
@@ -53,8 +54,9 @@ experiments' limit; 10^7 poses are 240 MB of (x, y, theta) before their weights.
 BEAM_LIMIT = 100_000
 """Beams used per scan, nav2's max_beams (C++ int): the densest 2-D lasers give a few thousand
 beams a scan (0.1 deg over 360 deg is 3,600), so this keeps every beam of any real scan."""
-THREAD_LIMIT = 1024
-"""Threads of the filter (C++ int): MclConfig's limit; beyond the cores they only add overhead."""
+THREAD_LIMIT: int = _core.MAX_THREADS
+"""Threads a request may ask for (the C++ core's kMaxThreads, 1024, which its filters, matcher
+and searches check too): beyond the cores they only add overhead."""
 RUN_LIMIT = 100_000
 """Trials of an experiment: the experiment configs' limit (kiseki_experiments.harness.config)."""
 WORKER_LIMIT = 256

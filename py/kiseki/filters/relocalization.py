@@ -24,6 +24,7 @@ import numpy as np
 
 from kiseki import _core
 from kiseki._support.field_types import check_field_types
+from kiseki._support.options import THREAD_LIMIT
 from kiseki.errors import RelocalizationError
 from kiseki.grid import OccupancyGrid
 
@@ -77,7 +78,7 @@ class RelocalizeConfig:
             "beams": (0, 100_000),
             "depth": (0, 16),
             "hypotheses": (1, 1000),
-            "threads": (0, 1024),
+            "threads": (0, THREAD_LIMIT),
         }
         for name, (low, high) in bounds.items():
             value = getattr(self, name)

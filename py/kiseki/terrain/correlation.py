@@ -27,6 +27,7 @@ from typing import Any, Literal
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.options import THREAD_LIMIT
 from kiseki.terrain.sdem import SphereElevationMap
 
 __all__ = ["PAPER_SEARCH", "SearchGrid", "SearchResult", "correlation_search", "search_grid"]
@@ -101,9 +102,11 @@ def correlation_search(
     if (
         isinstance(threads, bool)
         or not isinstance(threads, numbers.Integral)
-        or not 0 <= threads <= 1024
+        or not 0 <= threads <= THREAD_LIMIT
     ):
-        raise ValueError(f"threads must be an integer in 0..1024 (0 = every core), got {threads!r}")
+        raise ValueError(
+            f"threads must be an integer in 0..{THREAD_LIMIT} (0 = every core), got {threads!r}"
+        )
     grid = PAPER_SEARCH if grid is None else grid
     if not isinstance(grid, _core.TranslationGrid):
         raise TypeError("correlation search: grid must be a SearchGrid (search_grid())")

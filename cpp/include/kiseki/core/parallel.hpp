@@ -8,21 +8,12 @@
 #include <thread>
 #include <vector>
 
+#include "kiseki/core/threads.hpp"
+
 // Built with OpenMP (the core's sources are compiled with -fopenmp); without it the loop below
 // runs its chunks one after another on the calling thread, with the same results.
 
 namespace kiseki {
-
-/// The most threads a request may ask for (each starts a thread of OpenMP's pool; the Python
-/// configs bound theirs alike).
-inline constexpr int kMaxThreads = 1024;
-
-/// The number of threads a request for `threads` means: 0 = every hardware thread.
-inline int resolve_threads(int threads) {
-  if (threads > 0) return threads;
-  const unsigned hw = std::thread::hardware_concurrency();
-  return hw == 0 ? 1 : static_cast<int>(hw);
-}
 
 /// Runs body(begin, end) over [0, n) split into contiguous chunks of at least `min_chunk` items,
 /// on up to `threads` threads of OpenMP's pool (started once, so a parallel loop costs

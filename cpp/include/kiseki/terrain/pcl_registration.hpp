@@ -8,6 +8,12 @@
 
 namespace kiseki {
 
+/// m: the largest coordinate a cloud given to PCL may hold. PCL holds points as float: far beyond
+/// a sensor's reach its squared distances overflow and its search aborts the process (an
+/// assertion on "NaN, Inf" coordinates, from 1e20 m). Bound as
+/// `kiseki._core.PCL_COORDINATE_LIMIT`, also the bound of the text clouds' points and origins.
+inline constexpr double kPclCoordinateLimit = 1e6;
+
 /// PCL's scan registration, the baselines the rubble paper's correlation search is compared
 /// with on the same scan pairs: pcl::IterativeClosestPoint (point to point) and
 /// pcl::GeneralizedIterativeClosestPoint (plane to plane, Segal et al. 2009).
