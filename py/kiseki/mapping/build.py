@@ -7,13 +7,14 @@ from logs by the thesis' merge rules is `kiseki.teach.environment_map.build_teac
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass
 
 import numpy as np
 from tqdm import tqdm
 
 from kiseki import _core
-from kiseki._support.schema import parse
+from kiseki._support.schema import MAGNITUDE_LIMIT, parse
 from kiseki.grid import OccupancyGrid
 from kiseki.io.map_schema import MapBuildSettings
 from kiseki.scans import LaserScans
@@ -32,6 +33,22 @@ __all__ = [
 
 MAX_MAP_CELLS = 10**8  # 100 M int8 cells (and as many float log-odds while building)
 MIN_MAP_SIDE = 2  # cells: a map of one cell across says nothing
+
+
+def _check_max_range(where: str, max_range) -> float:
+    """``max_range`` as a float: a number in (0, MAGNITUDE_LIMIT] m (a NaN one compared false
+    with every reading, so that every reading counted as an endpoint; 1e300 overflowed the
+    float32 readings it is compared with)."""
+    if (
+        isinstance(max_range, bool)
+        or not isinstance(max_range, numbers.Real)
+        or not 0 < max_range <= MAGNITUDE_LIMIT
+    ):
+        raise ValueError(
+            f"{where}: max_range must be a number > 0 and at most {MAGNITUDE_LIMIT:g} m, "
+            f"got {max_range!r}"
+        )
+    return float(max_range)
 
 
 def check_map_size(width_m: float, height_m: float, resolution: float) -> tuple[int, int]:
@@ -121,6 +138,7 @@ def build_map(
     config = config or MapBuildConfig()
     if not np.isfinite(config.margin) or config.margin < 0:
         raise ValueError(f"margin must be >= 0, got {config.margin}")
+    max_range = _check_max_range("build_map", max_range)
     if isinstance(chunk, bool) or not isinstance(chunk, int | np.integer) or chunk < 1:
         # -1 gave a map of unknown cells only, 0 Python's "range() arg 3 must not be zero"
         raise ValueError(f"chunk must be an integer >= 1 (scans per pass), got {chunk!r}")
@@ -166,6 +184,7 @@ def scan_local_builder(
     left out, as in `build_map`: a missing echo says nothing certain about the space along the
     beam. Readings that are NaN, zero or negative are no reading and add nothing. Its `build()`
     is L, its `hits()` the cells a beam ended in."""
+    max_range = _check_max_range("local map", max_range)
     ranges = np.array(ranges, dtype=np.float32)  # a copy: the caller's scan stays as it was
     ranges[ranges >= max_range] = np.nan
     builder = _core.LocalMapBuilder(size, resolution)
@@ -192,11 +211,29 @@ def endpoint_agreement(
     max_range: float,
     neighbourhood: int = 1,
 ) -> float:
-    """Share of scan endpoints (readings below max_range) that land on an occupied cell or,
-    with neighbourhood 1, on one of its 8 neighbours."""
+    """Share of scan endpoints (readings > 0 and below max_range; NaN, zero and negative ones
+    are no reading) that land on an occupied cell or, with neighbourhood 1, on one of its 8
+    neighbours."""
+    if not isinstance(grid, OccupancyGrid):
+        raise TypeError(
+            f"endpoint_agreement: grid must be a kiseki OccupancyGrid, got {type(grid).__name__}"
+        )
+    max_range = _check_max_range("endpoint_agreement", max_range)
+    if (
+        isinstance(neighbourhood, bool)
+        or not isinstance(neighbourhood, numbers.Integral)
+        or not 0 <= neighbourhood <= 10
+    ):
+        raise ValueError(
+            f"endpoint_agreement: neighbourhood must be an integer in 0..10 (cells), "
+            f"got {neighbourhood!r}"
+        )
     hits, endpoints = _core.endpoint_agreement(
-        grid, poses, ranges, angles, max_range, neighbourhood=neighbourhood
+        grid, poses, ranges, angles, max_range, neighbourhood=int(neighbourhood)
     )
     if endpoints == 0:
-        raise ValueError("no scan endpoint below max_range: agreement is undefined")
+        raise ValueError(
+            f"endpoint_agreement: no scan endpoint (a reading > 0 and below max_range "
+            f"{max_range:g} m): agreement is undefined"
+        )
     return hits / endpoints

@@ -199,3 +199,40 @@ def test_scan_local_map_takes_readings_at_or_below_zero_as_no_reading():
     np.testing.assert_array_equal(with_bad.build().cells, without.build().cells)
     np.testing.assert_array_equal(with_bad.hits(), without.hits())
     assert np.asarray(without.hits()).size > 0  # the remaining beams did map something
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, 0.0, -5.0, 1e300, True, "5", None])
+def test_a_max_range_that_is_no_length_is_refused(bad):
+    """A NaN max range counted every reading as an endpoint (agreement 1.0); "5" was a numpy
+    ufunc error in the local map, 1e300 an overflow warning; a string was taken by build_map."""
+    from kiseki.mapping import scan_local_map
+
+    angles = np.linspace(-1.0, 1.0, 9)
+    poses, ranges = np.zeros((1, 3)), np.full((1, 9), 2.0)
+    grid = build_map(poses, ranges, angles, 10.0)
+    needle = r"max_range must be a number > 0 and at most 1e\+09 m, got "
+    with pytest.raises(ValueError, match="endpoint_agreement: " + needle):
+        endpoint_agreement(grid, poses, ranges, angles, bad)
+    with pytest.raises(ValueError, match="local map: " + needle):
+        scan_local_map(angles, ranges[0], bad)
+    with pytest.raises(ValueError, match="build_map: " + needle):
+        build_map(poses, ranges, angles, bad)
+    assert endpoint_agreement(grid, poses, ranges, angles, np.float32(10.0)) == 1.0
+
+
+def test_endpoint_agreement_counts_no_reading_at_or_below_zero_and_says_so():
+    """All readings negative said "no scan endpoint below max_range", as if they were too long."""
+    angles = np.linspace(-1.0, 1.0, 9)
+    poses, ranges = np.zeros((1, 3)), np.full((1, 9), 2.0)
+    grid = build_map(poses, ranges, angles, 10.0)
+    some_bad = ranges.copy()
+    some_bad[0, ::2] = -2.0
+    assert endpoint_agreement(grid, poses, some_bad, angles, 10.0) == 1.0  # 4 good endpoints
+    for bad in (-ranges, 0 * ranges):
+        with pytest.raises(ValueError, match=r"no scan endpoint \(a reading > 0 and below max_ra"):
+            endpoint_agreement(grid, poses, bad, angles, 10.0)
+    for neighbourhood in (1.5, True, -1, 11):
+        with pytest.raises(ValueError, match="neighbourhood must be an integer in 0..10"):
+            endpoint_agreement(grid, poses, ranges, angles, 10.0, neighbourhood)
+    with pytest.raises(TypeError, match="grid must be a kiseki OccupancyGrid, got NoneType"):
+        endpoint_agreement(None, poses, ranges, angles, 10.0)
