@@ -6,9 +6,9 @@ simulator."""
 
 from __future__ import annotations
 
+from kiseki.speed.acceleration import AccelerationLimit
 from kiseki.speed.along_log import LimitsAlongLog, limits_along_log, motion_headings
 from kiseki.speed.baselines import (
-    AccelerationLimit,
     DistanceLimiterConfig,
     DistanceSpeedLimiter,
     PolygonLimiterConfig,

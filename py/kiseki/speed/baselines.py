@@ -2,11 +2,7 @@
 # Copyright (c) 2026 the kiseki authors
 """Two baseline speed limiters to compare paper 004's occlusion- and width-aware limit with, on
 the same runs. Both implement ``kiseki.control.SpeedLimitSource`` and pass their output through
-``AccelerationLimit``, the rate limiter the paper's limiter reuses.
-
-``AccelerationLimit``: the output moves towards the wanted limit by at most a_max * dt per
-update, up and down alike (the robot can neither speed up nor brake faster than a_max), starting
-from ``initial`` (0 m/s by default: the robot starts at rest).
+``kiseki.speed.acceleration.AccelerationLimit``, the rate limiter the paper's limiter uses too.
 
 ``DistanceSpeedLimiter``: distance-only slowdown after paper 004's ref. [4] (J. Miura,
 Y. Negishi and Y. Shirai, "Adaptive robot speed control by considering map and motion
@@ -63,36 +59,15 @@ from kiseki import _core
 from kiseki._support.field_types import check_field_types
 from kiseki.control.speed_limit import SpeedLimit
 from kiseki.grid import OccupancyGrid
+from kiseki.speed.acceleration import AccelerationLimit, check_initial_speed
 
 __all__ = [
-    "AccelerationLimit",
     "DistanceLimiterConfig",
     "DistanceSpeedLimiter",
     "PolygonLimiterConfig",
     "PolygonSpeedLimiter",
     "points_in_motion_frame",
 ]
-
-
-class AccelerationLimit:
-    """Rate limiter: each ``step`` moves ``value`` towards ``target`` by at most a_max * dt."""
-
-    def __init__(self, a_max: float, initial: float = 0.0) -> None:
-        if not (math.isfinite(a_max) and a_max > 0):
-            raise ValueError(f"a_max must be positive, got {a_max!r}")
-        if not math.isfinite(initial):
-            raise ValueError(f"initial must be finite, got {initial!r}")
-        self.a_max, self.value = float(a_max), float(initial)
-
-    def step(self, target: float, dt: float) -> float:
-        """The new value after ``dt`` seconds of moving towards ``target`` (m/s)."""
-        if not (math.isfinite(dt) and dt >= 0):
-            raise ValueError(f"dt must be a finite number >= 0, got {dt!r}")
-        if not math.isfinite(target):
-            raise ValueError(f"target must be finite, got {target!r}")
-        reach = self.a_max * dt
-        self.value += min(reach, max(-reach, target - self.value))
-        return self.value
 
 
 def _check_config(config, non_negative=()) -> None:
@@ -106,17 +81,6 @@ def _check_config(config, non_negative=()) -> None:
     check_initial_speed(
         type(config).__name__ + ".initial_speed", config.initial_speed, config.v_max
     )
-
-
-def check_initial_speed(name: str, initial, v_max: float) -> None:
-    """A limiter's starting speed lies in [0, v_max]: above it, the first limits exceeded the
-    robot's maximum speed (they fall from there at a_max)."""
-    if (
-        isinstance(initial, bool)
-        or not isinstance(initial, numbers.Real)
-        or not 0 <= initial <= v_max
-    ):
-        raise ValueError(f"{name} must be a speed in [0, v_max = {v_max:g}] m/s, got {initial!r}")
 
 
 def points_in_motion_frame(sensor_pose, angles, ranges, max_range, heading, sensor_offset):

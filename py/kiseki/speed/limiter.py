@@ -39,7 +39,7 @@ from kiseki import _core
 from kiseki._support.field_types import check_field_types
 from kiseki.control.speed_limit import SpeedLimit
 from kiseki.grid import OccupancyGrid
-from kiseki.speed.baselines import AccelerationLimit, check_initial_speed
+from kiseki.speed.acceleration import AccelerationLimit, check_initial_speed
 
 __all__ = [
     "LimitTerms",

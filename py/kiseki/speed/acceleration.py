@@ -1,0 +1,48 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""What every speed limit of paper 004's comparison does with its output: a rate limit, and the
+speed it starts from.
+
+``AccelerationLimit``: the output moves towards the wanted limit by at most a_max * dt per
+update, up and down alike (the robot can neither speed up nor brake faster than a_max), starting
+from ``initial`` (0 m/s by default: the robot starts at rest). ``check_initial_speed``: that
+start lies in [0, v_max]."""
+
+from __future__ import annotations
+
+import math
+import numbers
+
+__all__ = ["AccelerationLimit", "check_initial_speed"]
+
+
+class AccelerationLimit:
+    """Rate limiter: each ``step`` moves ``value`` towards ``target`` by at most a_max * dt."""
+
+    def __init__(self, a_max: float, initial: float = 0.0) -> None:
+        if not (math.isfinite(a_max) and a_max > 0):
+            raise ValueError(f"a_max must be positive, got {a_max!r}")
+        if not math.isfinite(initial):
+            raise ValueError(f"initial must be finite, got {initial!r}")
+        self.a_max, self.value = float(a_max), float(initial)
+
+    def step(self, target: float, dt: float) -> float:
+        """The new value after ``dt`` seconds of moving towards ``target`` (m/s)."""
+        if not (math.isfinite(dt) and dt >= 0):
+            raise ValueError(f"dt must be a finite number >= 0, got {dt!r}")
+        if not math.isfinite(target):
+            raise ValueError(f"target must be finite, got {target!r}")
+        reach = self.a_max * dt
+        self.value += min(reach, max(-reach, target - self.value))
+        return self.value
+
+
+def check_initial_speed(name: str, initial, v_max: float) -> None:
+    """A limiter's starting speed lies in [0, v_max]: above it, the first limits exceeded the
+    robot's maximum speed (they fall from there at a_max)."""
+    if (
+        isinstance(initial, bool)
+        or not isinstance(initial, numbers.Real)
+        or not 0 <= initial <= v_max
+    ):
+        raise ValueError(f"{name} must be a speed in [0, v_max = {v_max:g}] m/s, got {initial!r}")
