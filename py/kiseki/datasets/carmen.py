@@ -61,6 +61,7 @@ import numpy as np
 
 from kiseki._support.inputs import GIB
 from kiseki.datasets._files import read_maybe_gzipped
+from kiseki.datasets.numbers_text import NumberTextError, float_array, parse_float, parse_int
 from kiseki.errors import LogFormatError
 from kiseki.scans import (
     LaserScans,
@@ -133,9 +134,9 @@ def flaser_angles(num_beams: int) -> np.ndarray:
 def read_carmen_log(path: str | os.PathLike) -> CarmenLog:
     """Read a CARMEN log (gzip if the file starts with the gzip magic bytes)."""
     path = Path(path)
-    rows, params = _split_messages(path, _read_text(path))
+    rows, params, param_lines = _split_messages(path, _read_text(path))
     if rows["FLASER"]:
-        scans = _parse_flaser(path, rows["FLASER"], params)
+        scans = _parse_flaser(path, rows["FLASER"], params, param_lines)
     elif rows["ROBOTLASER1"]:
         scans = _parse_robotlaser(path, rows["ROBOTLASER1"])
     else:
@@ -151,9 +152,13 @@ def _read_text(path: Path) -> str:
     return text
 
 
-def _split_messages(path: Path, text: str) -> tuple[dict[str, list[_Row]], dict[str, str]]:
+def _split_messages(
+    path: Path, text: str
+) -> tuple[dict[str, list[_Row]], dict[str, str], dict[str, int]]:
+    """The rows of each message read, the PARAM values and the line of each PARAM."""
     rows: dict[str, list[_Row]] = {"FLASER": [], "ROBOTLASER1": [], "ODOM": []}
     params: dict[str, str] = {}
+    param_lines: dict[str, int] = {}
     for lineno, line in enumerate(text.split("\n"), start=1):
         tokens = line.split()
         if not tokens or tokens[0].startswith("#"):
@@ -165,12 +170,13 @@ def _split_messages(path: Path, text: str) -> tuple[dict[str, list[_Row]], dict[
             if len(tokens) < 3:
                 raise LogFormatError(f"{path}:{lineno}: PARAM needs a name and a value")
             params[tokens[1]] = tokens[2]
-    return rows, params
+            param_lines[tokens[1]] = lineno
+    return rows, params, param_lines
 
 
 def _int_field(path: Path, lineno: int, token: str, what: str) -> int:
     try:
-        value = int(token)
+        value = parse_int(token)
     except ValueError:
         raise LogFormatError(f"{path}:{lineno}: {what} {token!r} is not an integer") from None
     if value < 0:
@@ -184,15 +190,11 @@ def _to_float(
     """Convert equal-length token lists to a float64 array; errors name the line. Columns
     ``ranges`` (range readings) may be NaN or infinite; any other column may not."""
     try:
-        values = np.array(fields, dtype=np.float64)
+        values = float_array(fields)
+    except NumberTextError as bad:
+        msg = f"{path}:{rows[bad.row][0]}: non-numeric value {bad.token!r} in {kind}"
+        raise LogFormatError(msg) from None
     except ValueError:
-        for (lineno, _), tokens in zip(rows, fields, strict=True):
-            for token in tokens:
-                try:
-                    float(token)
-                except ValueError:
-                    msg = f"{path}:{lineno}: non-numeric value {token!r} in {kind}"
-                    raise LogFormatError(msg) from None
         raise LogFormatError(f"{path}: unreadable numbers in {kind}") from None
     finite = np.isfinite(values)
     finite[:, ranges] = True
@@ -254,7 +256,9 @@ def _laser_scans(
     return scans
 
 
-def _parse_flaser(path: Path, rows: list[_Row], params: dict[str, str]) -> LaserScans:
+def _parse_flaser(
+    path: Path, rows: list[_Row], params: dict[str, str], param_lines: dict[str, int]
+) -> LaserScans:
     first_line, first = rows[0]
     _check_min_count(path, first_line, first, 2, "FLASER")
     n = _int_field(path, first_line, first[1], "FLASER beam count")
@@ -269,20 +273,23 @@ def _parse_flaser(path: Path, rows: list[_Row], params: dict[str, str]) -> Laser
         _check_count(path, lineno, tokens, n + 11, "FLASER")
         fields.append(tokens[2 : n + 9] + tokens[n + 10 :])  # skip count and hostname
     values = _to_float(path, rows, fields, "FLASER", ranges=slice(0, n))
-    max_range = _flaser_max_range(path, params)
+    max_range = _flaser_max_range(path, params, param_lines)
     return _laser_scans(path, rows, values, (0, n, n + 6), flaser_angles(n), max_range, "FLASER")
 
 
-def _flaser_max_range(path: Path, params: dict[str, str]) -> float | None:
+def _flaser_max_range(
+    path: Path, params: dict[str, str], param_lines: dict[str, int]
+) -> float | None:
     text = params.get(_MAX_RANGE_PARAM)
     if text is None:
         return None
+    where = f"{path}:{param_lines[_MAX_RANGE_PARAM]}: PARAM {_MAX_RANGE_PARAM} {text!r}"
     try:
-        value = float(np.float32(text))
+        value = float(np.float32(parse_float(text)))
     except ValueError:
-        raise LogFormatError(f"{path}: PARAM {_MAX_RANGE_PARAM} {text!r} is not a number") from None
+        raise LogFormatError(f"{where} is not a number") from None
     if not np.isfinite(value) or value <= 0:
-        raise LogFormatError(f"{path}: PARAM {_MAX_RANGE_PARAM} {text!r} is not positive")
+        raise LogFormatError(f"{where} is not positive")
     return value
 
 

@@ -211,6 +211,10 @@ GOOD_FLASER = flaser(RANGES[1], POSES[1], ODOMS[1], TIMES[1])  # line 10 of samp
         (GOOD_FLASER + " extra", "FLASER has 16 fields, expected 15"),
         ("FLASER", "FLASER has 1 fields"),
         (GOOD_FLASER.replace("7.125", "7.1x5"), "non-numeric value '7.1x5' in FLASER"),
+        # PEP 515 underscores are not numbers in a log (float() read 7_125 as 7125)
+        (GOOD_FLASER.replace("7.125", "7_125"), "non-numeric value '7_125' in FLASER"),
+        (GOOD_FLASER.replace("10.5 ", "1_0.5 ", 1), "non-numeric value '1_0.5' in FLASER"),
+        (GOOD_FLASER.replace("FLASER 4 ", "FLASER 4_0 "), "beam count '4_0' is not an integer"),
         (GOOD_FLASER.replace("-3.0", "nan"), r"non-finite value \(NaN or inf\) in FLASER"),
         (GOOD_FLASER.replace("10.5 ", "inf ", 1), "non-finite value"),  # odometry x
         # a pose of 1e300 m made the pose error infinite (exit 0); a reading of 1e300 is none
@@ -232,6 +236,7 @@ def test_corrupt_flaser_line(tmp_path: Path, line: str, message: str) -> None:
         ("ODOM 0.5 -0.25 nan 0.3 -0.2 0 100.6 host 100.6", "non-finite value"),
         ("ODOM 0.5 -0.25 1.5 0.3 -0.2 0 100.6 host 1e13", r"value 1e\+13 in ODOM beyond"),
         ("ODOM 0.5 -0.25 1.5 0.3 -0.2 0 abc host 100.6", "non-numeric value 'abc' in ODOM"),
+        ("ODOM 0.5 -0.25 1.5 0.3 -0.2 0 10_0.6 host 1", "non-numeric value '10_0.6' in ODOM"),
         ("PARAM lonely", "PARAM needs a name and a value"),
     ],
 )
@@ -246,6 +251,8 @@ def test_corrupt_robotlaser1_line(tmp_path: Path) -> None:
     for bad, message in [
         (good.rsplit(" ", 2)[0], "ROBOTLASER1 has 25 fields, expected at least 26"),
         (good.replace(" 1 0.5 ", " x 0.5 "), "ROBOTLASER1 remission count 'x' is not"),
+        (good.replace(" 1 0.5 ", " 0_1 0.5 "), "ROBOTLASER1 remission count '0_1' is not"),
+        (good.replace(" 2.0 1 0.5 ", " 2_0 1 0.5 "), "non-numeric value '2_0' in ROBOTLASER1"),
         ("ROBOTLASER1 0 -1.5 3.0", "ROBOTLASER1 has 4 fields, expected at least 24"),
     ]:
         path = write(tmp_path / "rl.log", good + "\n" + bad + "\n")
@@ -262,9 +269,11 @@ def test_robotlaser1_beams_beyond_one_turn_are_refused(tmp_path: Path, start, re
         read_carmen_log(path)
 
 
-def test_bad_max_range_param(tmp_path: Path) -> None:
-    text = "PARAM robot_front_laser_max fifty\n" + GOOD_FLASER
-    with pytest.raises(LogFormatError, match=r"p\.log: PARAM robot_front_laser_max 'fifty'"):
+@pytest.mark.parametrize("value", ["fifty", "8_0"])  # float() read 8_0 as 80
+def test_bad_max_range_param(tmp_path: Path, value: str) -> None:
+    text = f"# a log\nPARAM robot_front_laser_max {value}\n" + GOOD_FLASER
+    message = rf"p\.log:2: PARAM robot_front_laser_max '{value}' is not a number"
+    with pytest.raises(LogFormatError, match=message):
         read_carmen_log(write(tmp_path / "p.log", text))
 
 
