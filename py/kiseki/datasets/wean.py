@@ -36,6 +36,7 @@ import numpy as np
 from kiseki._support.inputs import MIB
 from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki.datasets._files import read_maybe_gzipped
+from kiseki.datasets.numbers_text import NumberTextError, float_array, parse_float
 from kiseki.errors import MapFormatError
 
 __all__ = ["MAX_MAP_BYTES", "WeanMap", "read_wean_map"]
@@ -71,8 +72,8 @@ def read_wean_map(path: str | os.PathLike) -> WeanMap:
     """Read a BeeSoft ``.dat`` map such as ``wean.dat.gz`` (gzip detected by magic bytes)."""
     path = Path(path)
     text = _read_text(path)
-    resolution_cm, size_y, size_x, body = _parse_header(path, text)
-    stored = _parse_values(path, body, size_x * size_y).reshape(size_x, size_y)  # [x, y]
+    resolution_cm, size_y, size_x, body, line = _parse_header(path, text)
+    stored = _parse_values(path, body, line, size_x * size_y).reshape(size_x, size_y)  # [x, y]
     occupancy = np.where(stored < 0, np.nan, 1.0 - stored).T
     return WeanMap(occupancy=np.ascontiguousarray(occupancy), resolution=resolution_cm / 100.0)
 
@@ -81,9 +82,9 @@ def _read_text(path: Path) -> str:
     return read_maybe_gzipped(path, MapFormatError, "BeeSoft .dat maps", MAX_MAP_BYTES)
 
 
-def _parse_header(path: Path, text: str) -> tuple[float, int, int, str]:
-    """Return (resolution in cm, size_y, size_x, text after the size line)."""
-    specs: dict[str, str] = {}
+def _parse_header(path: Path, text: str) -> tuple[float, int, int, str, int]:
+    """Return (resolution in cm, size_y, size_x, text after the size line, its first line)."""
+    specs: dict[str, tuple[str, int]] = {}  # name: (value, line)
     pos = 0
     for lineno, line in enumerate(text.split("\n"), start=1):
         end = pos + len(line) + 1
@@ -93,29 +94,32 @@ def _parse_header(path: Path, text: str) -> tuple[float, int, int, str]:
             if size is None or min(int(size[1]), int(size[2])) == 0:
                 raise MapFormatError(f"{path}:{lineno}: bad map size line {stripped!r}")
             resolution = _header_resolution(path, specs, int(size[1]), int(size[2]))
-            return resolution, int(size[1]), int(size[2]), text[end:]
+            return resolution, int(size[1]), int(size[2]), text[end:], lineno + 1
         spec = _HEADER_LINE.fullmatch(stripped)
         if stripped and spec is None:
             raise MapFormatError(f"{path}:{lineno}: unexpected header line {stripped[:60]!r}")
         if spec is not None:
-            specs[spec[1]] = spec[2]
+            specs[spec[1]] = (spec[2], lineno)
         pos = end
     raise MapFormatError(f"{path}: no 'global_map[0]: size_y size_x' line")
 
 
-def _spec_number(path: Path, specs: dict[str, str], name: str) -> float | None:
+def _spec_number(path: Path, specs: dict[str, tuple[str, int]], name: str) -> float | None:
     if name not in specs:
         return None
+    text, line = specs[name]
     try:
-        value = float(specs[name])
+        value = parse_float(text)
     except ValueError:
         value = float("nan")
     if not np.isfinite(value):
-        raise MapFormatError(f"{path}: robot_specifications->{name} {specs[name]!r} is bad")
+        raise MapFormatError(f"{path}:{line}: robot_specifications->{name} {text!r} is bad")
     return value
 
 
-def _header_resolution(path: Path, specs: dict[str, str], size_y: int, size_x: int) -> float:
+def _header_resolution(
+    path: Path, specs: dict[str, tuple[str, int]], size_y: int, size_x: int
+) -> float:
     resolution = _spec_number(path, specs, "resolution")
     if resolution is None or resolution <= 0:
         raise MapFormatError(f"{path}: missing or non-positive robot_specifications->resolution")
@@ -132,26 +136,30 @@ def _header_resolution(path: Path, specs: dict[str, str], size_y: int, size_x: i
     return resolution
 
 
-def _parse_values(path: Path, body: str, count: int) -> np.ndarray:
+def _parse_values(path: Path, body: str, first_line: int, count: int) -> np.ndarray:
+    """The ``count`` values of the text ``body``, which starts at line ``first_line``."""
     tokens = body.split()
     if len(tokens) != count:
         raise MapFormatError(f"{path}: {len(tokens)} map values, the header promises {count}")
     try:
-        values = np.array(tokens, dtype=np.float64)
-    except ValueError:
-        bad = next(t for t in tokens if not _is_float(t))
-        raise MapFormatError(f"{path}: non-numeric map value {bad!r}") from None
+        values = float_array(tokens)
+    except NumberTextError as bad:
+        line = first_line + _line_of_token(body, bad.row)
+        raise MapFormatError(f"{path}:{line}: non-numeric map value {bad.token!r}") from None
     invalid = ~((values >= -1.0) & (values <= 1.0))  # also catches NaN
     if invalid.any():
         index = int(np.argmax(invalid))
-        msg = f"{path}: map value {tokens[index]!r} (number {index}) is outside [-1, 1]"
+        line = first_line + _line_of_token(body, index)
+        msg = f"{path}:{line}: map value {tokens[index]!r} (number {index}) is outside [-1, 1]"
         raise MapFormatError(msg)
     return values
 
 
-def _is_float(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
+def _line_of_token(body: str, index: int) -> int:
+    """The line (0 for the first) of ``body`` that holds its token number ``index``."""
+    seen = 0
+    for k, line in enumerate(body.split("\n")):
+        seen += len(line.split())
+        if seen > index:
+            return k
+    return body.count("\n")

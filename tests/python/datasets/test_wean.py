@@ -73,7 +73,10 @@ def test_missing_file(tmp_path: Path) -> None:
         (HEADER.replace("global_map[0]: 3 2\n", "") + BODY, r":6: unexpected header line"),
         (HEADER.replace("global_map[0]: 3 2", "global_map[0]: 3") + BODY, ":6: bad map size"),
         (HEADER.replace("3 2", "0 2") + BODY, ":6: bad map size"),
-        (HEADER.replace("resolution 5", "resolution five") + BODY, "resolution 'five' is bad"),
+        (HEADER.replace("resolution 5", "resolution five") + BODY, ":3: .*'five' is bad"),
+        # PEP 515 underscores are not numbers in a .dat map (float() read 1_0 as 10)
+        (HEADER.replace("resolution 5", "resolution 1_0") + BODY, ":3: .*resolution '1_0' is"),
+        (HEADER.replace("x  10", "x  1_0") + BODY, ":1: .*global_mapsize_x '1_0' is bad"),
         (HEADER.replace("resolution 5", "resolution 0") + BODY, "non-positive .*resolution"),
         (HEADER.replace("robot_specifications->resolution 5\n", "") + BODY, "missing"),
         # read as 1e298 m per cell (hypotheses with 300-digit coordinates), or 1e-302 m
@@ -83,10 +86,12 @@ def test_missing_file(tmp_path: Path) -> None:
         (HEADER.replace("robot_specifications->", "robot_spec->") + BODY, ":1: unexpected"),
         (HEADER + BODY.replace(" 0.900", ""), "5 map values, the header promises 6"),
         (HEADER + BODY + "0.5\n", "7 map values, the header promises 6"),
-        (HEADER + BODY.replace("0.900", "0.9O0"), "non-numeric map value '0.9O0'"),
-        (HEADER + BODY.replace("0.900", "1.500"), r"'1\.500' \(number 5\) is outside"),
-        (HEADER + BODY.replace("-1.000", "-2.000"), r"'-2\.000' \(number 2\) is outside"),
-        (HEADER + BODY.replace("0.250", "nan"), r"'nan' \(number 1\) is outside"),
+        (HEADER + BODY.replace("0.900", "0.9O0"), ":8: non-numeric map value '0.9O0'"),
+        (HEADER + BODY.replace("0.900", "0.9_0"), ":8: non-numeric map value '0.9_0'"),
+        (HEADER + BODY.replace("0.000", "0_0"), ":7: non-numeric map value '0_0'"),
+        (HEADER + BODY.replace("0.900", "1.500"), r":8: .*'1\.500' \(number 5\) is outside"),
+        (HEADER + BODY.replace("-1.000", "-2.000"), r":7: .*'-2\.000' \(number 2\) is outside"),
+        (HEADER + BODY.replace("0.250", "nan"), r":7: .*'nan' \(number 1\) is outside"),
     ],
 )
 def test_bad_map(tmp_path: Path, text: str, message: str) -> None:
