@@ -42,6 +42,7 @@ import numpy as np
 from kiseki._support.inputs import GIB, check_input
 from kiseki.datasets._files import GZIP_MAGIC, read_maybe_gzipped
 from kiseki.datasets.carmen import VALUE_LIMIT, flaser_angles
+from kiseki.datasets.numbers_text import NumberTextError, float_array
 from kiseki.errors import LogFormatError
 from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps, largest_reading
 
@@ -86,7 +87,7 @@ def is_wean_log(path: str | os.PathLike) -> bool:
             continue
         if tokens[0] not in ("O", "L") or len(tokens) < 2:
             return False
-        try:
+        try:  # leniently: a number read_wean_log refuses (1_0) is its to name
             float(tokens[1])
         except ValueError:
             return False
@@ -159,16 +160,11 @@ def _numbers(
 ) -> np.ndarray:
     """The lines' numbers; columns ``ranges`` (range readings) may be NaN or infinite."""
     try:
-        values = np.array(rows, dtype=np.float64)
+        values = float_array(rows)
+    except NumberTextError as bad:
+        msg = f"{path}:{linenos[bad.row]}: non-numeric value {bad.token[:20]!r}"
+        raise LogFormatError(msg) from None
     except ValueError:
-        for lineno, tokens in zip(linenos, rows, strict=True):
-            for token in tokens:
-                try:
-                    float(token)
-                except ValueError:
-                    raise LogFormatError(
-                        f"{path}:{lineno}: non-numeric value {token[:20]!r}"
-                    ) from None
         raise LogFormatError(f"{path}: unreadable numbers") from None
     finite = np.isfinite(values)
     finite[:, ranges] = True

@@ -64,6 +64,13 @@ def test_malformed_lines_name_file_and_line(tmp_path: Path) -> None:
             r"short\.log:4: L line has 186 fields, expected 188",
         ),
         "text": (good[:2] + ["O 1 2 x 4"], r"text\.log:3: non-numeric value 'x'"),
+        # PEP 515 underscores are not numbers in a log (float() read 1_0 as 10)
+        "odo_": (good[:2] + ["O 1_0 2 3 4"], r"odo_\.log:3: non-numeric value '1_0'"),
+        "range_": (
+            [good[0], good[1].replace(" 200.000000", " 2_00.000000", 1)],
+            r"range_\.log:2: non-numeric value '2_00\.000000'",
+        ),
+        "first_": (["L 1_0" + good[1][5:]], r"first_\.log:1: non-numeric value '1_0"),
         "kind": (good[:1] + ["Q 1 2 3"], r"kind\.log:2: unknown line type 'Q'"),
         "time": (  # a negative range is an invalid reading (kiseki.scans), a NaN time is not
             [good[0], good[1].replace(" 200.000000", " -200.000000", 1).rsplit(" ", 1)[0] + " nan"],
@@ -78,6 +85,8 @@ def test_malformed_lines_name_file_and_line(tmp_path: Path) -> None:
         path.write_text("\n".join(lines) + "\n")
         with pytest.raises(LogFormatError, match=message):
             read_wean_log(path)
+    with pytest.raises(LogFormatError, match=r"first_\.log:1: non-numeric value '1_0"):
+        open_scans(tmp_path / "first_.log")  # a Wean log still, not a CARMEN log
     (tmp_path / "odo.log").write_text("O 1 2 3 4\n")
     with pytest.raises(LogFormatError, match="no laser"):
         read_wean_log(tmp_path / "odo.log")
