@@ -29,6 +29,7 @@ import numpy as np
 from kiseki._support.inputs import CSV_LIMIT, check_input, read_input
 from kiseki.datasets.kok import read_kok_walk
 from kiseki.datasets.magnetic_samples import UNITS, MagneticSamples, concatenate_samples
+from kiseki.datasets.numbers_text import is_number, parse_float
 from kiseki.errors import LogFormatError
 
 __all__ = [
@@ -149,7 +150,7 @@ def _numbered_lines(path: Path) -> list[tuple[int, str]]:
 
 
 def _header_columns(path: Path, line: int, names: list[str]) -> dict[str, int]:
-    if all(_is_number(name) for name in names):
+    if all(is_number(name) for name in names):
         raise LogFormatError(
             f"{path}: line {line}: no header: the first line must name the columns "
             "x,y[,z],mx,my,mz (an Aalto run is named by its prefix DIR/N, not by one of its files)"
@@ -191,17 +192,9 @@ def _parse_rows(
             )
         for j, k in enumerate(wanted):
             try:
-                table[row, j] = float(fields[k])
+                table[row, j] = parse_float(fields[k])
             except ValueError:
                 raise LogFormatError(
                     f"{path}: line {line}: column {k + 1} is not a number: {fields[k].strip()!r}"
                 ) from None
     return table
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True

@@ -144,6 +144,9 @@ def test_csv_three_dimensional_positions(tmp_path: Path) -> None:
         ("x,y,mx,my,mz,x\n1,2,3,4,5,6\n", "column 'x' given twice"),
         ("x,y,mx,my,mz\n1,2,3,4,5\n1,2,3,4\n", "line 3: 4 columns, expected 5"),
         ("x,y,mx,my,mz\n1,2,3,4,5\n1,2,abc,4,5\n", "line 3: column 3 is not a number: 'abc'"),
+        # PEP 515 underscores are not numbers in a CSV (float() read 3_0 as 30)
+        ("x,y,mx,my,mz\n1,2,3,4,5\n1,2,3_0,4,5\n", "line 3: column 3 is not a number: '3_0'"),
+        ("x,y,mx,my,mz\n1,2,3,4,5\n1,2,3,4,5\n1_0,2,3,4,5\n", "line 4: column 1 .*: '1_0'"),
     ],
 )
 def test_bad_csv_refused_naming_the_file(tmp_path: Path, content, message: str) -> None:
@@ -206,6 +209,8 @@ def test_aalto_mismatched_rows_name_both_files(tmp_path: Path) -> None:
         ("mag", "1,2\n3,4\n5,6\n", "line 1: 2 columns, expected 3 .mx, my, mz."),
         ("loc", bytes(range(256)), "binary data"),
         ("time", "0.0\n0.1\nx\n", "line 3: column 1 is not a number"),
+        ("loc", "0,0\n1,-1\n2_0,-2\n", "line 3: column 1 is not a number: '2_0'"),
+        ("mag", "0,1,2\n1,2,3\n2,3,4_0\n", "line 3: column 3 is not a number: '4_0'"),
         ("time", "", "no rows"),
     ],
 )
