@@ -84,7 +84,7 @@ class LaserScans:
                     f"{shape} ({n} scans in times, {b} beams in angles)"
                 )
         m = self.max_range
-        if isinstance(m, bool) or not isinstance(m, int | float | np.number) or not m > 0:
+        if isinstance(m, bool) or not isinstance(m, numbers.Real) or not m > 0:
             raise ValueError(f"LaserScans: max_range must be a number > 0, got {m!r}")
         if not math.isfinite(m):
             raise ValueError(f"LaserScans: max_range must be finite, got {m!r}")

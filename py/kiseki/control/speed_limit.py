@@ -16,6 +16,7 @@ never imports the limiter's area (kiseki.speed), so playback stays independent o
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
@@ -43,7 +44,7 @@ class SpeedLimit:
             raise ValueError(f"percentage must be True or False, got {self.percentage!r}")
         for name in ("speed_limit", "max_speed"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
+            if isinstance(v, bool) or not isinstance(v, numbers.Real):
                 raise ValueError(f"{name} must be a number (m/s, or percent), got {v!r}")
         if not (math.isfinite(self.speed_limit) and self.speed_limit >= 0):
             raise ValueError(f"speed_limit must be a finite number >= 0, got {self.speed_limit}")

@@ -16,6 +16,7 @@ the same for any thread count; the GIL is released during the search.
 from __future__ import annotations
 
 import math
+import numbers
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -335,7 +336,7 @@ def render_hypotheses(
 
 def _finite(value: object) -> bool:
     return (
-        isinstance(value, (int, float, np.floating, np.integer))
+        isinstance(value, numbers.Real)
         and not isinstance(value, bool)
         and math.isfinite(float(value))
     )

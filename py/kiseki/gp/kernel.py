@@ -50,7 +50,8 @@ class SquaredExponential:
             if (
                 isinstance(v, bool)
                 or not isinstance(v, numbers.Real)
-                or not (KERNEL_LOW if name == "length_scale" else 0.0) < v <= KERNEL_HIGH
+                # as a Python float: a float32 would take the bounds as float32 (1e50: inf)
+                or not (KERNEL_LOW if name == "length_scale" else 0.0) < float(v) <= KERNEL_HIGH
             ):
                 raise ValueError(
                     f"SquaredExponential: {name} must be a finite number > 0 (at most 1e50, "

@@ -159,7 +159,7 @@ class MagneticFieldMap:
             raise ValueError("variance must be >= 0")
         set_(self, "origin", _finite("origin", self.origin, (d,)))
         r = self.resolution
-        if isinstance(r, bool) or not isinstance(r, (int, float, np.floating)) or not r > 0:
+        if isinstance(r, bool) or not isinstance(r, numbers.Real) or not r > 0:
             raise ValueError(f"resolution must be a positive number of metres, got {r!r}")
         if not math.isfinite(r):
             raise ValueError(f"resolution must be finite, got {r!r}")

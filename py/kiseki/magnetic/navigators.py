@@ -30,6 +30,7 @@ runs) drives whatever its validity.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from typing import Any
 
@@ -62,7 +63,7 @@ G_CHANGE_MAX = 1.0
 
 
 def _angle(value: Any, name: str) -> float:
-    ok = isinstance(value, int | float | np.floating) and not isinstance(value, bool)
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
     if not ok or not math.isfinite(value):
         raise ValueError(f"{name} must be a finite number, got {value!r}")
     return float(value)

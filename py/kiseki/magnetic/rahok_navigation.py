@@ -38,6 +38,7 @@ Methods take readings and travel distances; nothing here knows the simulator.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any
 
@@ -66,7 +67,7 @@ S_THRESHOLD = 0.01
 
 
 def _number(value: Any, name: str, positive: bool = True) -> float:
-    ok = isinstance(value, int | float | np.floating) and not isinstance(value, bool)
+    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
     if not ok or not math.isfinite(value) or (positive and value <= 0):
         need = "a finite number > 0" if positive else "a finite number"
         raise ValueError(f"{name} must be {need}, got {value!r}")
@@ -88,7 +89,7 @@ def _finite(value: Any, name: str, ndim: int) -> np.ndarray:
 def moving_average(values: Any, cells: int) -> np.ndarray:
     """Centred moving average over ``cells`` samples along axis 0 (shorter at the ends)."""
     a = np.asarray(values, dtype=np.float64)
-    if not (isinstance(cells, int) and cells >= 1):
+    if isinstance(cells, bool) or not (isinstance(cells, numbers.Integral) and cells >= 1):
         raise ValueError(f"moving_average: cells must be an integer >= 1, got {cells!r}")
     if cells == 1:
         return a.copy()

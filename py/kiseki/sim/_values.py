@@ -6,6 +6,7 @@ kiseki.sim.magnetic, magnetic_arm and magnetic_lattice."""
 from __future__ import annotations
 
 import math
+import numbers
 from typing import Any
 
 import numpy as np
@@ -34,7 +35,7 @@ def finite_array(value: Any, shape: tuple[int | None, ...], name: str) -> np.nda
 def finite_scalar(
     value: Any, name: str, *, minimum: float | None = None, strict: bool = False
 ) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ValueError(f"{name}: expected a number, got {value!r}")
     v = float(value)
     if not math.isfinite(v):

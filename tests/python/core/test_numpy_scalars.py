@@ -12,9 +12,15 @@ import pytest
 from kiseki.control import PriorityArbiter
 from kiseki.gp import CurlFreeKernel, SquaredExponential
 from kiseki.magnetic import build_linear_map, geometric_features
+from kiseki.magnetic.navigators import r_z
+from kiseki.magnetic.rahok_navigation import moving_average, taught_peaks
 from kiseki.terrain import attitude_matrix
 
 F32 = np.float32
+
+# a float32 compared with a Python bound is cast to float32 first (1e50 overflowed to inf with a
+# RuntimeWarning, 1e-50 to 0): the checks compare Python floats, and warn about nothing
+pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")
 
 
 def _same(a, b) -> None:
@@ -49,6 +55,14 @@ def _same(a, b) -> None:
             (0.25,),
         ),
         (lambda p: PriorityArbiter({"a": p, "b": 1.0}).priorities["a"], (np.int64(3),), (3,)),
+        # int64 was refused by checks written as int | float | np.floating
+        (r_z, (np.int64(1), np.int64(0), np.int64(2)), (1, 0, 2)),
+        (lambda c: moving_average(np.arange(7.0), c), (np.int64(3),), (3,)),
+        (
+            lambda w: [p.s for p in taught_peaks(np.arange(9.0), np.cos(np.arange(9.0)), 0.04, w)],
+            (np.int64(2),),
+            (2,),
+        ),
     ],
 )
 def test_numpy_scalars_are_taken_as_their_numbers(call, numpy_args, python_args):
