@@ -100,13 +100,15 @@ def _pcd_viewpoint(path: Path) -> np.ndarray:
     """The VIEWPOINT translation of a PCD header, (0, 0, 0) when the header has none. Raises
     ValueError when it has one that is not seven finite numbers (tx ty tz qw qx qy qz), or
     whose translation lies beyond +-ORIGIN_LIMIT."""
+    from kiseki.datasets.numbers_text import parse_float  # here: see _read_text
+
     with open(path, "rb") as f:
         head = f.read(4096).split(b"\nDATA", 1)[0]
     for line in head.decode("latin-1").splitlines():
         words = line.split()
         if words and words[0] == "VIEWPOINT":
             try:
-                values = np.array([float(w) for w in words[1:]])
+                values = np.array([parse_float(w) for w in words[1:]])
             except ValueError:
                 values = np.array([])
             if len(values) != 7 or not np.all(np.isfinite(values)):
@@ -149,6 +151,10 @@ def _check_pcd_size(path: Path) -> None:
 
 
 def _read_text(path: Path) -> np.ndarray:
+    # the numbers of data files (1_0 is none); here, not at the top, so that the terrain
+    # commands do not load the log readers of kiseki.datasets
+    from kiseki.datasets.numbers_text import is_number
+
     unzip = "bz2" if path.suffix.lower() == ".bz2" else None
     rows: list[list[float]] = []
     try:
@@ -172,16 +178,14 @@ def _read_text(path: Path) -> np.ndarray:
         words = line.split()
         if not words or words[0].startswith("#"):
             continue
-        try:
-            values = [float(w) for w in words]
-        except ValueError:
-            values = []
-        if len(values) != 3:
+        bad = [w for w in words if not is_number(w)]
+        if len(words) != 3 or bad:
+            why = f" ({bad[0][:20]!r} is not a number)" if bad else ""
             raise ValueError(
                 f"CLOUD {path} line {number}: expected three numbers 'x y z', "
-                f"got {line.strip()[:60]!r}"
+                f"got {line.strip()[:60]!r}{why}"
             )
-        rows.append(values)
+        rows.append([float(w) for w in words])
     return np.asarray(rows, dtype=float).reshape(-1, 3)
 
 

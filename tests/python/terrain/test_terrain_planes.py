@@ -198,8 +198,15 @@ def test_text_reader_bz2_comments_nan_and_viewpoint(tmp_path):
             read_cloud(pcd, bad)
     np.testing.assert_array_equal(read_cloud(pcd, "1e6,0,-1e6").origin, [1e6, 0, -1e6])
     # a VIEWPOINT that is not seven finite numbers is refused (it was read as 0, 0, 0, or as
-    # its first three numbers when those were finite), unless the origin is given
-    for viewpoint in ("nan 2 3 1 0 0 0", "1 2 3", "1 2 x 1 0 0 0", "1 2 3 1 0 0 inf"):
+    # its first three numbers when those were finite), unless the origin is given; 3_0 is not
+    # a number (float() read it as 30)
+    for viewpoint in (
+        "nan 2 3 1 0 0 0",
+        "1 2 3",
+        "1 2 x 1 0 0 0",
+        "1 2 3 1 0 0 inf",
+        "1 2 3_0 1 0 0 0",
+    ):
         pcd.write_text(pcd.read_text().replace("VIEWPOINT 1 2 3 1 0 0 0", f"VIEWPOINT {viewpoint}"))
         with pytest.raises(ValueError, match=rf"v\.pcd: VIEWPOINT '{viewpoint}' is not 7 finite"):
             read_cloud(pcd)
@@ -219,6 +226,8 @@ def test_text_reader_bz2_comments_nan_and_viewpoint(tmp_path):
         (b"nan nan nan\nnan 1 nan\n", "all 2 points are NaN"),
         (b"1 2 3\n4 5 6\n7 8 x\n", "line 3"),
         (b"1 2 3\n4 5 6 7\n", "line 2"),
+        # PEP 515 underscores are not numbers (the line-by-line reader's float() read 5_0 as 50)
+        (b"1 2 3\n4 5 6\n4 5_0 6\n", r"line 3: .*'4 5_0 6' \('5_0' is not a number\)"),
         (b"\x89PNG\r\n\x1a\n\x00\xff\xfe", "not a point cloud"),
         (b"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nDATA ascii\n", "PCD"),
         # beyond float, PCL's search aborted the process (SIGABRT) on these
