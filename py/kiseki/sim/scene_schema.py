@@ -3,7 +3,7 @@
 """The model of a scene file's top level (see :mod:`kiseki.sim.scene` for what each key means),
 checked by :mod:`kiseki._support.schema`: name, description, source, bounds, floor, octomap, objects
 (:mod:`kiseki.sim.primitives_schema`), grid_resolution, measurement_grid, robots (their name
-and the sections kiseki.sim.setup and kiseki.sim.robot read), turns, poses, pedestrians and
+and the sections kiseki.sim.setup and kiseki.sim.robot_params read), turns, poses, pedestrians and
 point_robots, ``calibrated`` (:class:`Calibration`: the parameters fitted to a paper's number;
 each path is checked by :mod:`kiseki.sim.calibration`),
 and ``route`` (:class:`Route`, ``route: {}`` is none). ``robot``, ``sensors`` and
@@ -149,7 +149,8 @@ RouteSection = Annotated[Route | None, BeforeValidator(_empty_is_none)]
 
 
 class RobotEntry(FileModel):
-    """One of ``robots``: its name; the rest is read by kiseki.sim.setup and kiseki.sim.robot."""
+    """One of ``robots``: its name; the rest is read by kiseki.sim.setup and
+    kiseki.sim.robot_params."""
 
     name: Name
     type: Any = None

@@ -26,10 +26,11 @@ import numpy as np
 
 from kiseki._support.schema import SchemaError, location_text, parse
 from kiseki.core import check_seed, derive_seed
-from kiseki.sim import robot as robots
 from kiseki.sim.collisions import check_free_start
 from kiseki.sim.magnetic import MagneticWorld, Magnetometer
 from kiseki.sim.magnetic_arm import arm_sensor_from_spec
+from kiseki.sim.odometry import OmniOdometry, WheelOdometry
+from kiseki.sim.robot import DiffDriveRobot, OmniRobot
 from kiseki.sim.scene import Scene
 from kiseki.sim.sensors import BearingSensor, DepthCamera, Laser2D, Mount
 from kiseki.sim.setup_schema import (
@@ -104,8 +105,8 @@ def build_robot(scene: Scene, seed: int, index: int = 0) -> RobotSetup:
         setup = RobotSetup(
             name,
             kind,
-            robots.DiffDriveRobot(params, pose),
-            robots.WheelOdometry(params, errors, odo_seed, pose),
+            DiffDriveRobot(params, pose),
+            WheelOdometry(params, errors, odo_seed, pose),
             params.length,
             params.width,
             params.height,
@@ -115,8 +116,8 @@ def build_robot(scene: Scene, seed: int, index: int = 0) -> RobotSetup:
         setup = RobotSetup(
             name,
             kind,
-            robots.OmniRobot(omni, pose),
-            robots.OmniOdometry(omni_errors, odo_seed, pose),
+            OmniRobot(omni, pose),
+            OmniOdometry(omni_errors, odo_seed, pose),
             omni.length,
             omni.width,
             1.2,

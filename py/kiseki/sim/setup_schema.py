@@ -6,7 +6,7 @@ by kiseki.sim.setup with kiseki._support.schema.parse before the robots and sens
 error names the file, the path (``robots[1].sensors[0].rate_hz``) and the value.
 
 A robot: ``type`` (diff_drive, the default, or omni), ``start`` [x, y, yaw_deg], ``params`` and
-``odometry_errors`` (the parameter classes of kiseki.sim.robot for that type).
+``odometry_errors`` (the parameter classes of kiseki.sim.robot_params for that type).
 
 A sensor: ``type``, ``name``, ``mount`` [x, y, z] or [x, y, z, yaw_deg], ``pitch`` and ``roll``
 (deg, the mount's rotation Rz(yaw) Ry(pitch) Rx(roll)),
@@ -40,7 +40,7 @@ from pydantic import (
 from pydantic_core import PydanticCustomError
 
 from kiseki._support.schema import FileModel, FiniteFloat
-from kiseki.sim.robot import (
+from kiseki.sim.robot_params import (
     DiffDriveParams,
     OdometryErrorParams,
     OmniOdometryErrorParams,

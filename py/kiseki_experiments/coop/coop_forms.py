@@ -32,7 +32,8 @@ from kiseki.coop.planner import plan_moves, predicted_goal_rms
 from kiseki.coop.positioning import FORM1_READINGS
 from kiseki.core import derive_seed
 from kiseki.plots import new_figure
-from kiseki.sim.robot import BodyMotion, OmniOdometry
+from kiseki.sim.motion import BodyMotion
+from kiseki.sim.odometry import OmniOdometry
 from kiseki_experiments.coop.coop_claims import (
     CPS2_DISTANCE,
     N_PAPER,

@@ -2,7 +2,7 @@
 # Copyright (c) 2026 the kiseki authors
 """gp-mcl: the thesis' magnetic-map localization (``002_74cea16d239c028f.txt``, secs. 6.7-6.8,
 Figs. 6.15-6.18) on the simulated floor (data/worlds/magnetic_floor.yaml): mapper_2d drives a
-route by pure pursuit, its wheel odometry (kiseki.sim.robot.WheelOdometry with the scene's
+route by pure pursuit, its wheel odometry (kiseki.sim.odometry.WheelOdometry with the scene's
 error model) drifts, its three magnetometers read the field with their noise, and MCL with the
 measurement model of eqs. 6.17-6.18 (1000 particles, resampling at ESS < n/2) runs on the 2-D
 map built as in gp-floor-mapping (mapper_2d's survey, exact GP, 0.1 m grid).
@@ -28,7 +28,9 @@ from kiseki.control import PurePursuit
 from kiseki.core import derive_seed, normalize_angle
 from kiseki.magnetic import MagneticMclConfig, localize_on_magnetic_map
 from kiseki.plots import new_figure, save_figure
-from kiseki.sim import robot as robots
+from kiseki.sim.odometry import WheelOdometry
+from kiseki.sim.robot import DiffDriveRobot
+from kiseki.sim.robot_params import DiffDriveParams, OdometryErrorParams
 from kiseki.sim.scene import load_scene
 from kiseki_experiments.gp.gp_common import (
     FLOOR,
@@ -109,12 +111,12 @@ def drive(scene, waypoints, speed: float, dt: float, seed: int):
     pursuit, its wheel odometry with the scene's error model (seeded)."""
     spec = next(s for s in scene.robot_specs if s["name"] == ROBOT)["robot"]
     where = f"{scene.path}: {ROBOT}"
-    params = robots.DiffDriveParams.from_dict(spec.get("params") or {}, where)
-    errors = robots.OdometryErrorParams.from_dict(spec.get("odometry_errors") or {}, where)
+    params = DiffDriveParams.from_dict(spec.get("params") or {}, where)
+    errors = OdometryErrorParams.from_dict(spec.get("odometry_errors") or {}, where)
     pts = np.asarray(waypoints, dtype=float)
     start = np.array([*pts[0], np.arctan2(*(pts[1] - pts[0])[::-1])])
-    robot = robots.DiffDriveRobot(params, start)
-    odometry = robots.WheelOdometry(params, errors, derive_seed(seed, 1000), start)
+    robot = DiffDriveRobot(params, start)
+    odometry = WheelOdometry(params, errors, derive_seed(seed, 1000), start)
     pursuit = PurePursuit(pts, speed, 0.6, 0.1, params.max_accel)
     truth, odo = [], []
     limit = int(10 * pursuit.cum[-1] / (speed * dt)) + 100
@@ -299,7 +301,7 @@ def _plot_route(name: str, runs: pd.DataFrame, figures: Path) -> list[Path]:
 NOTES = """
 The map is the one gp-floor-mapping builds (mapper_2d's survey with noise seed map_seed, exact
 GP, 0.1 m grid), built once per process and shared by every trial. The robot drives each route
-by pure pursuit at `speed`; odometry is kiseki.sim.robot.WheelOdometry with the scene's error
+by pure pursuit at `speed`; odometry is kiseki.sim.odometry.WheelOdometry with the scene's error
 model (wheel radii, track width, placement and slip), the same for both methods; readings are
 the scene's three magnetometers (0.01 G noise) at the true poses, in their own frame (x
 forward, y right, z down), one set per 0.1 s step. The filter starts Gaussian about the true

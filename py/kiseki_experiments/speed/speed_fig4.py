@@ -43,7 +43,7 @@ class Fig4Config:
     # "occlusion": method 1 (eq. 1); "distance": the distance-only rule of the paper's ref. [4]
     # as the issue reads it, v_max min(1, d_hidden / d_stop), the claims' control
     limit: str = "occlusion"
-    a_max: PositiveReal = 0.5  # m/s^2, the robot's (kiseki.sim.robot), for d_stop
+    a_max: PositiveReal = 0.5  # m/s^2, the robot's (kiseki.sim.robot_params), for d_stop
 
 
 LIMITS = ("occlusion", "distance")

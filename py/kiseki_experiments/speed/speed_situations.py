@@ -184,7 +184,7 @@ def _evidence(runs: dict, repeats: list[int]) -> list[Evidence]:
     return [Evidence.of(k, v, shown=shown[k]) for k, v in values.items() if v]
 
 
-V_MAX = 0.5  # m/s, the paper's robot (kiseki.sim.robot)
+V_MAX = 0.5  # m/s, the paper's robot (kiseki.sim.robot_params)
 
 
 def analyze(config: SituationsConfig, trials: pd.DataFrame, timings, figures: Path) -> Analysis:

@@ -82,7 +82,6 @@ def test_imports_inside_functions_say_why(folder, at_least):
 LINE_LIMIT = 400
 LONG_FILES = {
     "datasets/rosbag.py": "one reader for ROS 1 and 2 bags, the checks three storages share",
-    "sim/robot.py": "the two simulated platforms share the odometry error model",
     "sim/magnetic.py": "the simulated field and the magnetometer that reads it",
     "apps/teach/teaching.py": "a teaching run, its recovery from the log and its files",
 }

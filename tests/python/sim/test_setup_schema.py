@@ -16,7 +16,7 @@ import pytest
 import yaml
 
 from kiseki.core import Random, derive_seed
-from kiseki.sim.robot import DiffDriveParams, OdometryErrorParams, OmniParams
+from kiseki.sim.robot_params import DiffDriveParams, OdometryErrorParams, OmniParams
 from kiseki.sim.scene import load_scene
 from kiseki.sim.sensors import (
     LASER_PRESETS,

@@ -17,7 +17,7 @@ import yaml
 
 from kiseki.sim.magnetic import Dipole, DipoleLine, MagneticWorld, default_earth_field
 from kiseki.sim.magnetic_lattice import DipoleLattice
-from kiseki.sim.robot import WheelMotion
+from kiseki.sim.motion import WheelMotion
 from kiseki.sim.scene import load_scene
 from kiseki.sim.setup import build_robot, build_sensors
 

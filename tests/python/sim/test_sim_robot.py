@@ -17,17 +17,14 @@ import numpy as np
 import pytest
 
 from kiseki.core import Pose2, Random, derive_seed
-from kiseki.sim.robot import (
-    BodyMotion,
+from kiseki.sim.motion import BodyMotion, WheelMotion
+from kiseki.sim.odometry import OmniOdometry, WheelOdometry
+from kiseki.sim.robot import DiffDriveRobot, OmniRobot
+from kiseki.sim.robot_params import (
     DiffDriveParams,
-    DiffDriveRobot,
     OdometryErrorParams,
-    OmniOdometry,
     OmniOdometryErrorParams,
     OmniParams,
-    OmniRobot,
-    WheelMotion,
-    WheelOdometry,
 )
 
 NONE = OdometryErrorParams.none()
