@@ -29,6 +29,7 @@ __all__ = [
     "ScanFit",
     "convergence_report",
     "describe",
+    "elapsed_time",
     "scan_fit",
     "spread_radius",
 ]
@@ -51,7 +52,7 @@ class ScanFit:
 class ConvergenceReport:
     converged: bool
     converged_scan: int | None  # first scan from which the spread stays below the threshold
-    converged_time: float | None  # seconds after the first scan
+    converged_time: float | None  # seconds after the first scan (elapsed_time)
     threshold: float
     final_spread: float
     fit: ScanFit | None  # at the estimates from the converged scan on
@@ -140,6 +141,15 @@ def _converged_from(spread: np.ndarray, threshold: float) -> int | None:
     return k if k < len(spread) else None
 
 
+def elapsed_time(times: np.ndarray, k: int) -> float:
+    """Seconds of the log's clock from its first scan to scan ``k``, counting only the steps
+    forward: a clock that steps back (the Intel log's does, by up to 0.86 s) never makes the
+    time negative or shorter than what passed. Equals ``times[k] - times[0]`` when the clock
+    only goes forward."""
+    steps = np.diff(np.asarray(times, dtype=np.float64)[: k + 1])
+    return float(steps[steps > 0].sum())
+
+
 def convergence_report(
     scans: LaserScans,
     grid: OccupancyGrid,
@@ -181,7 +191,7 @@ def convergence_report(
     return ConvergenceReport(
         converged=k is not None,
         converged_scan=k,
-        converged_time=None if k is None else float(scans.times[k] - scans.times[0]),
+        converged_time=None if k is None else elapsed_time(scans.times, k),
         threshold=converged_radius,
         final_spread=float(spread[-1]),
         fit=fits[0],

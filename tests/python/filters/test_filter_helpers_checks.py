@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from kiseki.filters import MclConfig, MonteCarloLocalizer
-from kiseki.filters.convergence import spread_radius
+from kiseki.filters.convergence import elapsed_time, spread_radius
 from kiseki.filters.odometry_noise import noisy_odometry
 
 
@@ -63,3 +63,13 @@ def test_a_sigma_hit_below_a_micrometre_is_refused(method):
     model = scan_model(method, grid, LocalizeConfig(method=method, sigma_hit=1e-6))
     model.set_scan(ANGLES, ranges, 8.0)
     assert np.isfinite(model.log_likelihoods(pose)).all()
+
+
+def test_elapsed_time_counts_the_clock_forward_only():
+    """A log whose clock steps back gave a negative convergence time (times[k] - times[0])."""
+    times = np.array([10.0, 11.0, 5.0, 6.0, 7.5])
+    assert elapsed_time(times, 4) == pytest.approx(1.0 + 1.0 + 1.5)
+    assert elapsed_time(times, 0) == 0.0
+    forward = np.cumsum(np.random.default_rng(2).uniform(0.05, 0.2, 50))
+    for k in (1, 17, 49):
+        assert elapsed_time(forward, k) == pytest.approx(forward[k] - forward[0], abs=1e-12)
