@@ -179,6 +179,12 @@ def simulate(
     A collision (a footprint touching an obstacle, another robot or a pedestrian) ends the run
     at the end of the step that made it: /collision, RunSummary.collision, reached_goal False.
     """
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a kiseki Scene (load_scene), got {type(scene).__name__}")
+    if config is not None and not isinstance(config, SimConfig):
+        raise TypeError(f"config must be a SimConfig or None, got {type(config).__name__}")
+    if not isinstance(out, str | os.PathLike):
+        raise TypeError(f"out must be a path (the MCAP file), got {type(out).__name__}")
     config = config or SimConfig()
     agents = _agents(scene, config, commands, controller)
     routed = [a for a in agents if a.controller is not None]
