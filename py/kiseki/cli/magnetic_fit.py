@@ -26,7 +26,7 @@ from kiseki.gp import (
 )
 from kiseki.gp.kernel import subsample
 from kiseki.magnetic.binning import bin_readings
-from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
+from kiseki.magnetic.field_map import MAX_CELLS, MagneticFieldMap, TrainingData
 from kiseki.magnetic.map_folder import check_map_destination
 from kiseki.magnetic.map_gp import (
     METHODS,
@@ -154,6 +154,22 @@ def _fit_gps(x, y, kernel, per_component: bool, method: str, seed: int, model: s
     return gps, kernels, method, hyper, time.perf_counter() - start
 
 
+def _check_map_size(data: list[Path], x: np.ndarray, margin: float, resolution: float) -> None:
+    """The map's cells over the readings' box plus ``margin``, counted as
+    MagneticFieldMap.from_gp counts them, within its MAX_CELLS before the fit; a ValueError
+    naming the data otherwise (a reading 1e8 m from the others was refused after the fit, in a
+    message naming no file)."""
+    lower, upper = x.min(axis=0) - margin, x.max(axis=0) + margin
+    counts = np.maximum(np.ceil(upper / resolution - 1e-9) - np.floor(lower / resolution + 1e-9), 1)
+    if np.prod(counts) > MAX_CELLS:
+        span = " x ".join(f"{s:.6g}" for s in np.ptp(x, axis=0))
+        raise ValueError(
+            f"{', '.join(map(str, data))}: the readings span {span} m: a map of "
+            f"{' x '.join(f'{c:.0f}' for c in counts)} cells of {resolution:g} m is more than "
+            f"{MAX_CELLS:,} cells; choose a coarser --resolution or leave out the far readings"
+        )
+
+
 def _default_method(model: str, points: int) -> str:
     limit = CURL_FREE_EXACT_LIMIT if model == "curl-free" else EXACT_LIMIT
     return "exact" if points <= limit else "hilbert"
@@ -253,6 +269,7 @@ def fit(
     if max_points is not None and len(x) > max_points:  # after --bin: of the cells' readings
         keep = subsample(len(x), max_points, seed)
         x, y = x[keep], y[keep]
+    _check_map_size(data, x, margin, resolution)
     default = method is None
     method = method or _default_method(model, len(x))
     if model == "curl-free" and method == "exact" and len(x) > CURL_FREE_EXACT_MAX:
@@ -292,17 +309,20 @@ def fit(
             "seconds": {"hyperparameters": round(t_hyper, 3), "fit": round(t_fit, 3)},
         },
     }
-    fmap = MagneticFieldMap.from_gp(
-        gps,
-        lower,
-        upper,
-        resolution,
-        height,
-        units=units,
-        provenance=provenance,
-        training=training,
-        progress=True,
-    )
+    try:  # a box the map cannot take (beyond OctoMap's keys in 3-D) names the data
+        fmap = MagneticFieldMap.from_gp(
+            gps,
+            lower,
+            upper,
+            resolution,
+            height,
+            units=units,
+            provenance=provenance,
+            training=training,
+            progress=True,
+        )
+    except ValueError as err:
+        raise ValueError(f"{', '.join(map(str, data))}: {err}") from None
     t_map = time.perf_counter() - start
     fmap.save(output)
     _report_fit(fmap, output, kernels, lml, len(x), n_read, (t_hyper, t_fit, t_map))
