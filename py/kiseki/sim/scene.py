@@ -151,6 +151,25 @@ def _boxes(doc: SceneDoc, variant: str) -> BoxList:
     return boxes
 
 
+def _check_objects_meet_bounds(doc: SceneDoc, path: Path, lo: np.ndarray, hi: np.ndarray) -> None:
+    """A SchemaError naming the first object (of either variant) wholly outside the scene's
+    bounds: no sensor, map or grid of the run would hold it. An object that reaches past the
+    bounds (a wall longer than the room) is kept. Each box is taken as the axis-aligned box
+    around it (|R| times its half sizes), so a turned object is never refused wrongly."""
+    for i, obj in enumerate(doc.objects):
+        centers, halves, rotations = boxes_of(obj).arrays()
+        reach = np.einsum("nij,nj->ni", np.abs(rotations), halves)
+        meets = np.all((centers - reach <= hi) & (centers + reach >= lo), axis=1)
+        if centers.size and not meets.any():
+            box_lo, box_hi = (centers - reach).min(axis=0), (centers + reach).max(axis=0)
+            raise SchemaError(
+                f"{path}: objects[{i}] spans x {box_lo[0]:g}..{box_hi[0]:g}, "
+                f"y {box_lo[1]:g}..{box_hi[1]:g}, z {box_lo[2]:g}..{box_hi[2]:g}: wholly outside "
+                f"the scene's bounds x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g}, "
+                f"z {lo[2]:g}..{hi[2]:g}"
+            )
+
+
 def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
     """Reads a scene file. ``variant`` selects objects marked ``only_in`` (a bicycle park that
     changes between teaching and playback), and magnetic sources so marked (``Scene.variant``:
@@ -196,6 +215,7 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
             raise SchemaError(f"{path}: {problem[0]}: {problem[2]}, got {problem[1]!r}")
     else:
         lo, hi = np.array(doc.bounds.min), np.array(doc.bounds.max)
+        _check_objects_meet_bounds(doc, path, lo, hi)
     specs = _robot_specs(doc)
     return Scene(
         name=doc.name if doc.name is not None else path.stem,
