@@ -50,6 +50,7 @@ formation's width follows from them.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -260,16 +261,24 @@ def _wrap(a: np.ndarray) -> np.ndarray:
     return np.remainder(a + np.pi, 2 * np.pi) - np.pi
 
 
+def _check_runs(the_plan, runs, limit: int, seed, **sigmas) -> None:
+    """A Plan (None was an AttributeError), runs in 1..limit, angle SDs in [0, 10 deg)."""
+    if not isinstance(the_plan, Plan):
+        raise TypeError(f"the_plan must be a Plan (see plan()), got {type(the_plan).__name__}")
+    if isinstance(runs, bool) or not (isinstance(runs, numbers.Integral) and 0 < runs <= limit):
+        raise ValueError(f"runs must be an integer in 1..{limit:,}, got {runs!r}")
+    for name, v in sigmas.items():
+        if isinstance(v, bool) or not (isinstance(v, numbers.Real) and 0 <= v < math.radians(10)):
+            raise ValueError(f"{name} must lie in [0, 10 deg), got {v!r}")
+    check_seed(seed)
+
+
 def simulate(
     the_plan: Plan, runs: int = 100, angle_sigma: float = ANGLE_SIGMA, seed: int = 0
 ) -> CoopRun:
     """``runs`` runs of a plan with Gaussian noise of SD ``angle_sigma`` (rad) on every measured
     angle. Seeded: the same seed gives the same runs."""
-    if not isinstance(runs, int) or isinstance(runs, bool) or not 1 <= runs <= 1_000_000:
-        raise ValueError(f"runs must be an integer in 1..1,000,000, got {runs!r}")
-    if not (math.isfinite(angle_sigma) and 0 <= angle_sigma < math.radians(10)):
-        raise ValueError(f"angle_sigma must lie in [0, 10 deg), got {angle_sigma}")
-    check_seed(seed)
+    _check_runs(the_plan, runs, 1_000_000, seed, angle_sigma=angle_sigma)
     rng = np.random.default_rng(seed)
     truth = the_plan.nominal_positions()
     est = np.empty((runs, len(the_plan.steps) + 1, 3, 2))
@@ -335,15 +344,14 @@ def simulate_3d(
     horizontal; the mover's estimate is the least-squares point of the two lines of sight in
     3-D (kiseki.coop.triangulate with elevations). ``elevation_sigma`` defaults to
     ``angle_sigma``."""
-    if not isinstance(runs, int) or isinstance(runs, bool) or not 1 <= runs <= 100_000:
-        raise ValueError(f"runs must be an integer in 1..100,000, got {runs!r}")
     e_sigma = angle_sigma if elevation_sigma is None else elevation_sigma
-    for name, v in (("angle_sigma", angle_sigma), ("elevation_sigma", e_sigma)):
-        if not (math.isfinite(v) and 0 <= v < math.radians(10)):
-            raise ValueError(f"{name} must lie in [0, 10 deg), got {v}")
-    if not (math.isfinite(marker_height) and 0 <= marker_height < 10):
-        raise ValueError(f"marker_height must lie in [0, 10) m, got {marker_height}")
-    check_seed(seed)
+    _check_runs(the_plan, runs, 100_000, seed, angle_sigma=angle_sigma, elevation_sigma=e_sigma)
+    if isinstance(marker_height, bool) or not (
+        isinstance(marker_height, numbers.Real) and 0 <= marker_height < 10
+    ):
+        raise ValueError(f"marker_height must lie in [0, 10) m, got {marker_height!r}")
+    if not callable(ground):
+        raise TypeError(f"ground must be a function z(x, y), got {type(ground).__name__}")
     flat = the_plan.nominal_positions()
     z = np.asarray(ground(flat[..., 0], flat[..., 1]), dtype=float)
     if z.shape != flat.shape[:-1] or not np.isfinite(z).all():
