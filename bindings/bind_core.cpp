@@ -3,6 +3,9 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
+#include <stdexcept>
+
 #include "kiseki/core/angle.hpp"
 #include "kiseki/core/pose.hpp"
 #include "kiseki/core/random.hpp"
@@ -80,6 +83,11 @@ void bind_random(py::module_& m) {
       .def("uniform",
            [](Random& r, double low, double high, py::ssize_t size) {
              if (size < 0) throw std::invalid_argument("size must be >= 0");
+             // NaN or infinite bounds gave NaN or infinite draws; so did bounds whose span
+             // overflows (-1e308 .. 1e308)
+             if (!std::isfinite(high - low)) {
+               throw std::invalid_argument("uniform: low and high must be finite numbers less than 1e308 apart");
+             }
              py::array_t<double> out(size);
              auto* p = out.mutable_data();
              for (py::ssize_t i = 0; i < size; ++i) p[i] = r.uniform(low, high);
@@ -90,6 +98,9 @@ void bind_random(py::module_& m) {
            [](Random& r, double mean, double stddev, py::ssize_t size) {
              if (size < 0) throw std::invalid_argument("size must be >= 0");
              if (!(stddev >= 0.0)) throw std::invalid_argument("stddev must be >= 0");
+             if (!std::isfinite(mean) || !std::isfinite(stddev)) {  // NaN or infinite draws
+               throw std::invalid_argument("normal: mean and stddev must be finite");
+             }
              py::array_t<double> out(size);
              auto* p = out.mutable_data();
              for (py::ssize_t i = 0; i < size; ++i) p[i] = r.normal(mean, stddev);

@@ -12,9 +12,13 @@ are methods of the grid.
 
 from __future__ import annotations
 
+import math
+import numbers
+
 import numpy as np
 
 from kiseki._core import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from kiseki._support.options import BEAM_LIMIT
 
 __all__ = ["FREE", "OCCUPIED", "UNKNOWN", "OccupancyGrid", "beam_angles", "grid_summary"]
 
@@ -22,10 +26,17 @@ __all__ = ["FREE", "OCCUPIED", "UNKNOWN", "OccupancyGrid", "beam_angles", "grid_
 def beam_angles(count: int, field_of_view: float, start: float | None = None) -> np.ndarray:
     """Evenly spaced beam angles (radians) covering ``field_of_view`` with both ends included,
     starting at ``start`` (default ``-field_of_view / 2``)."""
-    if count < 1:
-        raise ValueError(f"beam count must be >= 1, got {count}")
-    if not np.isfinite(field_of_view) or field_of_view <= 0:
-        raise ValueError(f"field of view must be positive, got {field_of_view}")
+    if isinstance(count, bool) or not isinstance(count, numbers.Integral) or count < 1:
+        raise ValueError(f"beam count must be an integer >= 1, got {count!r}")
+    if count > BEAM_LIMIT:
+        raise ValueError(f"beam count must be at most {BEAM_LIMIT}, got {count}")
+    fov_ok = isinstance(field_of_view, numbers.Real) and not isinstance(field_of_view, bool)
+    # a scanner covers at most one turn (100 rad put every beam on 16 turns)
+    if not fov_ok or not 0 < field_of_view <= 2 * math.pi + 1e-9:
+        raise ValueError(f"field of view must be in (0, 2 pi] rad, got {field_of_view!r}")
+    start_ok = isinstance(start, numbers.Real) and not isinstance(start, bool)
+    if start is not None and not (start_ok and math.isfinite(start)):
+        raise ValueError(f"start must be a finite angle in rad, got {start!r}")
     first = -field_of_view / 2 if start is None else start
     if count == 1:
         return np.array([first])

@@ -15,6 +15,7 @@ width's search; the scan's own ``max_range`` readings are no return as always.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,6 +58,13 @@ def motion_headings(poses: np.ndarray, min_step: float = 0.01) -> np.ndarray:
     """The direction of motion at each pose: toward the next pose at least ``min_step`` metres
     away (m); the pose's own heading where the robot does not move any more."""
     poses = np.asarray(poses, dtype=float)
+    if poses.ndim != 2 or poses.shape[1] != 3:
+        raise ValueError(f"motion_headings: poses must be (n, 3) x, y, theta, got {poses.shape}")
+    step_ok = isinstance(min_step, numbers.Real) and not isinstance(min_step, bool)
+    if not (step_ok and 0 <= min_step < math.inf):  # NaN or -1 took the pose's own heading
+        raise ValueError(
+            f"motion_headings: min_step must be a finite number >= 0 m, got {min_step!r}"
+        )
     headings = poses[:, 2].copy()
     target = None
     for i in range(len(poses) - 1, -1, -1):

@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import math
 import pickle
 
 import numpy as np
@@ -67,6 +68,22 @@ def test_random_is_reproducible_and_seed_sensitive():
         Random(1).normal(0.0, -1.0, 3)
     with pytest.raises(ValueError):
         Random(1).uniform(size=-1)
+
+
+@pytest.mark.parametrize(
+    ("draw", "match"),
+    [
+        (lambda r: r.uniform(math.nan, 1.0, 3), "uniform: low and high must be finite"),
+        (lambda r: r.uniform(0.0, math.inf, 3), "uniform: low and high must be finite"),
+        (lambda r: r.uniform(-1e308, 1e308, 3), "less than 1e308 apart"),
+        (lambda r: r.normal(math.nan, 1.0, 3), "normal: mean and stddev must be finite"),
+        (lambda r: r.normal(0.0, math.inf, 3), "normal: mean and stddev must be finite"),
+    ],
+)
+def test_random_refuses_parameters_that_give_nan_or_infinite_draws(draw, match):
+    """Each of these returned NaN or infinite numbers without a word."""
+    with pytest.raises(ValueError, match=match):
+        draw(Random(1))
 
 
 def test_version_and_linked_libraries():

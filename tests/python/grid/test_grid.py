@@ -4,6 +4,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -105,6 +107,23 @@ def test_extract_window_matches_pointwise_lookup():
     assert 0 < inside.mean() < 1  # part of the window lies outside the map
     # the window's centre is the pose
     np.testing.assert_allclose(win.cell_to_world(np.array([[40, 40]]))[0], [1.0, 2.0], atol=0.08)
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        ((5, 100.0), r"field of view must be in \(0, 2 pi\]"),  # 16 turns of beams
+        ((5, 1.0, math.nan), "start must be a finite angle"),  # NaN angles
+        ((2.5, 1.0), "beam count must be an integer"),
+        ((True, 1.0), "beam count must be an integer"),
+        ((10**9, 1.0), "beam count must be at most"),
+    ],
+)
+def test_beam_angles_refuse_what_no_scanner_has(args, match):
+    with pytest.raises(ValueError, match=match):
+        beam_angles(*args)
+    # a whole turn is a scanner's largest field of view
+    np.testing.assert_allclose(np.diff(beam_angles(5, 2 * math.pi)), math.pi / 2)
 
 
 def test_beam_angles_and_summary():

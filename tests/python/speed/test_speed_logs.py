@@ -29,6 +29,15 @@ def test_motion_headings_follow_the_displacement():
     np.testing.assert_allclose(motion_headings(poses[:1]), [1.0])
 
 
+@pytest.mark.parametrize("min_step", [math.nan, -1.0, math.inf, "0.1", True])
+def test_motion_headings_refuse_a_bad_min_step(min_step):
+    """NaN or -1 gave the poses' own headings without a word."""
+    with pytest.raises(ValueError, match="motion_headings: min_step must be a finite number"):
+        motion_headings(np.zeros((3, 3)), min_step)
+    with pytest.raises(ValueError, match=r"poses must be \(n, 3\)"):
+        motion_headings(np.zeros((3, 2)))
+
+
 @pytest.fixture(scope="module")
 def intel(shared_data):
     scans = read_carmen_log(shared_data / "carmen" / "intel-corrected.log.gz").scans
