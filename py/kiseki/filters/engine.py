@@ -27,7 +27,7 @@ import numpy as np
 
 from kiseki import _core
 from kiseki._support.field_types import check_field_types
-from kiseki.core import Pose2
+from kiseki.core import Pose2, check_seed
 from kiseki.grid import OccupancyGrid
 from kiseki.scans import MAX_ODOMETRY_JUMP
 
@@ -250,8 +250,15 @@ class MonteCarloLocalizer:
     def __init__(
         self, config: MclConfig, seed: int, free_space: OccupancyGrid | None = None
     ) -> None:
+        if not isinstance(config, MclConfig):
+            raise TypeError(f"config must be an MclConfig, got {type(config).__name__}")
+        if free_space is not None and not isinstance(free_space, OccupancyGrid):
+            raise TypeError(
+                "free_space must be a kiseki OccupancyGrid or None, "
+                f"got {type(free_space).__name__}"
+            )
         self.config = config
-        self.engine = _core.MonteCarloLocalization(config.to_core(), seed)
+        self.engine = _core.MonteCarloLocalization(config.to_core(), check_seed(seed))
         if free_space is not None:
             self.engine.set_free_space(free_space)
         self._last_update: np.ndarray | None = None

@@ -59,7 +59,14 @@ class LocalizationResult:
     cost_model: CostModel | None = None
 
 
-def _check_scans(scans: LaserScans, grid: OccupancyGrid) -> None:
+def _check_scans(scans: LaserScans, grid: OccupancyGrid, config: LocalizeConfig) -> None:
+    for name, value, kind, what in (
+        ("scans", scans, LaserScans, "a LaserScans (a log's scans)"),
+        ("grid", grid, OccupancyGrid, "a kiseki OccupancyGrid"),
+        ("config", config, LocalizeConfig, "a LocalizeConfig"),
+    ):
+        if not isinstance(value, kind):  # None was an AttributeError from inside
+            raise TypeError(f"localize: {name} must be {what}, got {type(value).__name__}")
     if len(scans) == 0:
         raise ValueError("the log has no scans")
     if scans.ranges.ndim != 2 or scans.ranges.shape[1] != scans.angles.shape[0]:
@@ -87,7 +94,7 @@ def localize(
     here on this log when none is given (:mod:`kiseki.filters.budget`). The learned reliability
     estimates use ``reliability_model`` when given, else the coefficients their name stands
     for (:func:`kiseki.filters.reliability.learned_model`)."""
-    _check_scans(scans, grid)
+    _check_scans(scans, grid, config)
     odom = noisy_odometry(scans.odometry, config.odometry_noise, derive_seed(config.seed, 1))
     noise = f" with noise {config.odometry_noise:g}" if config.odometry_noise else ""
     check_odometry_jumps(f"the odometry{noise}", scans.times, odom)
