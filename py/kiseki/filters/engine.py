@@ -28,6 +28,7 @@ import numpy as np
 from kiseki import _core
 from kiseki._support.field_types import check_field_types
 from kiseki.core import Pose2, check_seed
+from kiseki.filters.initial_pose import check_particles, check_start
 from kiseki.grid import OccupancyGrid
 from kiseki.scans import MAX_ODOMETRY_JUMP
 
@@ -268,17 +269,15 @@ class MonteCarloLocalizer:
         self.updates = 0
 
     def initialize(self, pose, sd: tuple[float, float, float]) -> None:
-        p, s = np.asarray(pose, dtype=float), np.asarray(sd, dtype=float)
-        if p.shape != (3,) or s.shape != (3,):  # (x, y) was taken with theta = 0
-            raise ValueError(
-                f"initialize: pose and sd must be (x, y, theta) triples, got {p.shape}, {s.shape}"
-            )
+        """Particles drawn around ``pose`` (x, y, theta) with standard deviations ``sd``, each
+        within +-1e9 (:data:`kiseki.filters.initial_pose.POSE_LIMIT`)."""
+        p, s = check_start(pose, sd)
         self.engine.initialize_gaussian(Pose2(*p), *s)
         self.estimate = self.engine.estimate().to_array()
 
     def initialize_particles(self, poses: np.ndarray, weights: np.ndarray | None = None) -> None:
         """Particles at the given poses (n, 3), with weights (normalised) or equal ones."""
-        self.engine.set_particles(np.asarray(poses, dtype=float), weights)
+        self.engine.set_particles(*check_particles(poses, weights))
         self.estimate = self.engine.estimate().to_array()
 
     def initialize_global(self) -> None:
