@@ -20,10 +20,13 @@ Readings are (n, 3) arrays in any one unit; the results are in the same unit.
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares
+
+from kiseki._support.schema import MAGNITUDE_LIMIT
 
 __all__ = [
     "EllipsoidCalibration",
@@ -36,6 +39,15 @@ __all__ = [
 # Readings whose thinnest extent is below this share of their widest lie on a plane (or a line,
 # or a point): no sphere or ellipsoid is determined by them.
 _FLAT = 1e-6
+# Readings (and offsets, radii) beyond MAGNITUDE_LIMIT, kiseki's bound for every number of its
+# files, are refused in any unit (1e9 nT is 1 T, beyond any magnetometer's range): their squares
+# overflowed with numpy warnings and the fits then said no sphere fitted them.
+# Readings that spread less than _MIN_SPREAD about their mean (in any unit: a femtotesla in
+# tesla, below any magnetometer's noise), or less than _SPREAD_SHARE of their largest magnitude
+# (their differences then keep fewer than 7 of a double's 16 digits), determine no sphere: at
+# 1e-300 their squares were 0, LAPACK printed an error line and the fit failed or gave garbage.
+_MIN_SPREAD = 1e-15
+_SPREAD_SHARE = 1e-9
 
 
 @dataclass(frozen=True, eq=False)
@@ -126,8 +138,11 @@ def fit_ellipsoid(readings: np.ndarray, radius: float | None = None) -> Ellipsoi
     geometric mean of the semi-axes (the ellipsoid's volume is kept)."""
     m = _as_readings(readings, 9, "ellipsoid fit")
     _check_spread(m, "ellipsoid fit")
-    if radius is not None and not (np.isfinite(radius) and radius > 0):
-        raise ValueError(f"ellipsoid fit: radius must be a positive number, got {radius}")
+    if radius is not None and not _positive(radius):
+        raise ValueError(
+            f"ellipsoid fit: radius must be a positive number up to {MAGNITUDE_LIMIT:g}, "
+            f"got {radius!r}"
+        )
     mean = m.mean(axis=0)
     scale = np.sqrt(np.mean(np.sum((m - mean) ** 2, axis=1)))
     x, y, z = ((m - mean) / scale).T
@@ -184,11 +199,16 @@ def calibrated_magnitude(
     single = np.ndim(readings) == 1
     m = _as_readings(np.atleast_2d(readings) if single else readings, 1, "eq. 6.16 readings")
     centre = np.asarray(m_ref, dtype=np.float64)
-    if centre.shape != (3,) or not np.all(np.isfinite(centre)):
-        raise ValueError(f"eq. 6.16: m_ref must be 3 finite numbers, got {m_ref!r}")
+    if centre.shape != (3,) or not np.all(np.abs(centre) <= MAGNITUDE_LIMIT):
+        raise ValueError(
+            f"eq. 6.16: m_ref must be 3 finite numbers within +-{MAGNITUDE_LIMIT:g}, got {m_ref!r}"
+        )
     for name, value in (("r_ref", r_ref), ("r_base", r_base)):
-        if not (np.isfinite(value) and value > 0):
-            raise ValueError(f"eq. 6.16: {name} must be a positive number, got {value}")
+        if not _positive(value):
+            raise ValueError(
+                f"eq. 6.16: {name} must be a positive number up to {MAGNITUDE_LIMIT:g}, "
+                f"got {value!r}"
+            )
     magnitude = np.linalg.norm(m - centre, axis=1) - (r_base - r_ref)
     return float(magnitude[0]) if single else magnitude
 
@@ -209,13 +229,39 @@ def _as_readings(readings: np.ndarray, minimum: int, what: str) -> np.ndarray:
             f"{what}: {int(bad.sum())} of {len(m)} readings NaN or infinite, the first in row "
             f"{row} (counting from 0): {m[row].tolist()}"
         )
+    beyond = (np.abs(m) > MAGNITUDE_LIMIT).any(axis=1)
+    if beyond.any():
+        row = int(np.argmax(beyond))
+        raise ValueError(
+            f"{what}: {int(beyond.sum())} of {len(m)} readings beyond +-{MAGNITUDE_LIMIT:g} (in "
+            f"any unit), the first in row {row} (counting from 0): {m[row].tolist()}"
+        )
     return m
 
 
+def _positive(value) -> bool:
+    """A number (not a bool) in (0, MAGNITUDE_LIMIT]."""
+    return (
+        isinstance(value, numbers.Real)
+        and not isinstance(value, bool)
+        and 0 < value <= MAGNITUDE_LIMIT
+    )
+
+
 def _check_spread(m: np.ndarray, what: str) -> None:
-    singular = np.linalg.svd(m - m.mean(axis=0), compute_uv=False)
-    if singular[0] == 0:
+    """Readings that determine a sphere or an ellipsoid, checked before any solver sees them:
+    not identical, spread enough (see _MIN_SPREAD), not on a line or in a plane."""
+    deviations = m - m.mean(axis=0)
+    spread, largest = float(np.abs(deviations).max()), float(np.abs(m).max())
+    if spread == 0:
         raise ValueError(f"{what}: all {len(m)} readings are identical")
+    if spread < max(_MIN_SPREAD, _SPREAD_SHARE * largest):
+        raise ValueError(
+            f"{what}: the readings lie within {spread:.3g} of their mean (the largest is "
+            f"{largest:.3g}): too close together to fit; in any unit they must spread at least "
+            f"{_MIN_SPREAD:g} and {_SPREAD_SHARE:g} of the largest reading"
+        )
+    singular = np.linalg.svd(deviations, compute_uv=False)
     if singular[-1] <= _FLAT * singular[0]:
         shape = "on one line" if singular[1] <= _FLAT * singular[0] else "in one plane"
         raise ValueError(

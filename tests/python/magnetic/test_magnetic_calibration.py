@@ -222,3 +222,51 @@ def test_results_are_read_only() -> None:
     fit = fit_ellipsoid(CENTRE + RADIUS * directions(20, seed=1))
     with pytest.raises(ValueError, match="read-only"):
         fit.offset[0] = 0.0
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("fit", [fit_sphere, fit_ellipsoid])
+@pytest.mark.parametrize("scale", [1e-300, 1e-160, 1e-20])
+def test_readings_too_close_together_are_refused_before_the_solver(fit, scale, capfd) -> None:
+    """Readings of magnitude 1e-300 had squares of 0: a divide-by-zero warning, LAPACK's
+    'On entry to DLASCL parameter number 4 had an illegal value' on stderr, then a LinAlgError;
+    at 1e-160 the ellipsoid fit returned a radius of 0 with NaN warnings."""
+    with pytest.raises(ValueError, match=r"the readings lie within [0-9.e-]+ of their mean .* too"):
+        fit(scale * (CENTRE + RADIUS * directions(30, seed=1)))
+    assert capfd.readouterr().err == ""
+    # the same sphere in a unit that keeps it apart fits: spread enough is unit-free
+    same = fit(1e-6 * (CENTRE + RADIUS * directions(30, seed=1)))
+    assert same.radius == pytest.approx(1e-6 * RADIUS, rel=1e-9)
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("fit", [fit_sphere, fit_ellipsoid])
+def test_readings_that_vary_in_their_last_digits_are_refused(fit) -> None:
+    """A spread of 1e-9 on an offset of 1e6 keeps about one of a double's 16 digits: refused,
+    with the shares it must reach."""
+    readings = 1e6 + 1e-9 * directions(30, seed=1) / np.abs(directions(30, seed=1)).max()
+    with pytest.raises(ValueError, match=r"at least 1e-15 and 1e-09 of the largest reading"):
+        fit(readings)
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize("fit", [fit_sphere, fit_ellipsoid])
+def test_readings_beyond_a_billion_are_refused_naming_the_row(fit) -> None:
+    """1e200 readings overflowed their squares (warnings) and were said to fit no sphere."""
+    readings = CENTRE + RADIUS * directions(30, seed=1)
+    readings[5] *= 1e200
+    with pytest.raises(ValueError, match=r"1 of 30 readings beyond \+-1e\+09 .* in row 5 "):
+        fit(readings)
+
+
+def test_offsets_and_radii_that_are_no_numbers_are_refused() -> None:
+    readings = CENTRE + RADIUS * directions(20, seed=1)
+    for radius in ("48", True, 1e300):
+        with pytest.raises(ValueError, match=r"radius must be a positive number up to 1e\+09"):
+            fit_ellipsoid(readings, radius=radius)
+    with pytest.raises(ValueError, match=r"m_ref must be 3 finite numbers within \+-1e\+09"):
+        calibrated_magnitude(readings, [1e300, 0.0, 0.0], 1.0, 1.0)
+    for bad in ("1", True, 1e300):
+        with pytest.raises(ValueError, match=r"r_base must be a positive number up to 1e\+09"):
+            calibrated_magnitude(readings, CENTRE, RADIUS, bad)
+    assert calibrated_magnitude(readings[0], CENTRE, np.float32(RADIUS), 48) == pytest.approx(48)
