@@ -12,6 +12,7 @@ from typing import Annotated, Any
 
 from pydantic import BeforeValidator, Field
 
+from kiseki._support.numbers_text import parse_float
 from kiseki._support.schema import MAGNITUDE_LIMIT
 
 __all__ = ["CsvNumber", "data_rows", "number_text"]
@@ -22,7 +23,7 @@ def number_text(text: Any) -> Any:
     anything else that is not a number is refused as it was written."""
     if isinstance(text, str):
         try:
-            value = float(text)
+            value = parse_float(text)  # 1_0 is not 10
         except ValueError:
             raise ValueError("must be a number") from None
         if not math.isfinite(value):

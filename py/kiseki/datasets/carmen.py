@@ -60,8 +60,8 @@ from pathlib import Path
 import numpy as np
 
 from kiseki._support.inputs import GIB
+from kiseki._support.numbers_text import NumberTextError, float_array, parse_float, parse_int
 from kiseki.datasets._files import read_maybe_gzipped
-from kiseki.datasets.numbers_text import NumberTextError, float_array, parse_float, parse_int
 from kiseki.errors import LogFormatError
 from kiseki.scans import (
     LaserScans,

@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 
 from kiseki._support.inputs import CSV_LIMIT, check_input, read_input
+from kiseki._support.numbers_text import is_number, parse_float
 from kiseki.datasets.kok import read_kok_walk
 from kiseki.datasets.magnetic_samples import UNITS, MagneticSamples, concatenate_samples
-from kiseki.datasets.numbers_text import is_number, parse_float
 from kiseki.errors import LogFormatError
 
 __all__ = [

@@ -34,9 +34,9 @@ from pathlib import Path
 import numpy as np
 
 from kiseki._support.inputs import MIB
+from kiseki._support.numbers_text import NumberTextError, float_array, parse_float
 from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki.datasets._files import read_maybe_gzipped
-from kiseki.datasets.numbers_text import NumberTextError, float_array, parse_float
 from kiseki.errors import MapFormatError
 
 __all__ = ["MAX_MAP_BYTES", "WeanMap", "read_wean_map"]

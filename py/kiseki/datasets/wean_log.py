@@ -40,9 +40,9 @@ from pathlib import Path
 import numpy as np
 
 from kiseki._support.inputs import GIB, check_input
+from kiseki._support.numbers_text import NumberTextError, float_array
 from kiseki.datasets._files import GZIP_MAGIC, read_maybe_gzipped
 from kiseki.datasets.carmen import VALUE_LIMIT, flaser_angles
-from kiseki.datasets.numbers_text import NumberTextError, float_array
 from kiseki.errors import LogFormatError
 from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps, largest_reading
 

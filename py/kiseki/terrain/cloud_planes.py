@@ -38,6 +38,7 @@ import numpy as np
 
 from kiseki import _core
 from kiseki._support.inputs import GIB, MIB, check_input, describe_bytes, read_input
+from kiseki._support.numbers_text import is_number, parse_float
 from kiseki.core import check_seed
 from kiseki.terrain.plane_removal import HoughParams, PclParams, remove_planes
 from kiseki.terrain.sdem import sdem_from_points, sphere_grid
@@ -100,8 +101,6 @@ def _pcd_viewpoint(path: Path) -> np.ndarray:
     """The VIEWPOINT translation of a PCD header, (0, 0, 0) when the header has none. Raises
     ValueError when it has one that is not seven finite numbers (tx ty tz qw qx qy qz), or
     whose translation lies beyond +-ORIGIN_LIMIT."""
-    from kiseki.datasets.numbers_text import parse_float  # here: see _read_text
-
     with open(path, "rb") as f:
         head = f.read(4096).split(b"\nDATA", 1)[0]
     for line in head.decode("latin-1").splitlines():
@@ -151,10 +150,6 @@ def _check_pcd_size(path: Path) -> None:
 
 
 def _read_text(path: Path) -> np.ndarray:
-    # the numbers of data files (1_0 is none); here, not at the top, so that the terrain
-    # commands do not load the log readers of kiseki.datasets
-    from kiseki.datasets.numbers_text import is_number
-
     unzip = "bz2" if path.suffix.lower() == ".bz2" else None
     rows: list[list[float]] = []
     try:

@@ -31,6 +31,7 @@ def test_a_trajectory_reads_to_what_numpy_reads(tmp_path, text):
     [
         ("x,y\nnan,1\n", ":2: x: must be a finite number, got 'nan'"),
         ("t,x,y\n0,0,0\n1,2,far\n", ":3: y: must be a number, got 'far'"),
+        ("t,x,y\n0,0,0\n1,1_0,2\n", ":3: x: must be a number, got '1_0'"),  # was read as 10
         ("t,x,y\n0,0\n", ":2: a row has 3 values (t,x,y), got '0,0'"),
         ("t,x\n0,0\n", ": a trajectory CSV needs a header with columns x and y"),
         ("x,y,x\n0,0,0\n", ": the header's column names must be unique and not empty"),

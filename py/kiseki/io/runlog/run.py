@@ -17,6 +17,7 @@ from google.protobuf.message import DecodeError
 from mcap.exceptions import McapError
 from mcap_protobuf.decoder import DecoderFactory
 
+from kiseki._support.numbers_text import parse_float
 from kiseki.core import Pose2
 from kiseki.errors import LogFormatError
 from kiseki.grid import OccupancyGrid
@@ -287,7 +288,7 @@ class SimRun:
             self._check_finite(odom_topic, "odometry", times, odometry)
         limit_text = self._topic(scan_topic).metadata.get(_MAX_RANGE_KEY)
         try:
-            limit = float(limit_text) if limit_text is not None else largest_reading(ranges)
+            limit = parse_float(limit_text) if limit_text is not None else largest_reading(ranges)
         except ValueError as exc:
             raise LogFormatError(f"{self.path}: bad max_range {limit_text!r}") from exc
         if limit is None:

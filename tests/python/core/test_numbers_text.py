@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kiseki.datasets.numbers_text import (
+from kiseki._support.numbers_text import (
     NumberTextError,
     float_array,
     is_number,
