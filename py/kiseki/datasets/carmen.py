@@ -25,8 +25,9 @@ PARAMs are not used, just as CARMEN ignores them for FLASER. ROBOTLASER1 message
 ``start_angle + i * angular_resolution``.
 
 Max range (readings >= ``max_range`` mean "no return"): the PARAM ``robot_front_laser_max`` if
-present, else the largest reading in the log, which is the no-return value the logger wrote (a
-log without any no-return reading would lose its single largest return this way). For
+present, else the largest reading that two scans of the log report, which is the no-return value
+the logger wrote (``kiseki.scans.largest_reading``: one corrupt larger reading is a no return
+itself; a log without any no-return reading loses its largest return or returns this way). For
 ROBOTLASER1 it is the message's ``maximum_range`` field. The value is rounded to float32, like the
 ranges, so the comparison gives the same answer in float32 and float64. In the Radish logs:
 Intel has no PARAM and no returns are 81.83; ACES has no PARAM and readings are clipped at 50;
