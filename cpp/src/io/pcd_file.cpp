@@ -172,11 +172,21 @@ PcdCloud read_pcd(const std::string& path) {
     for (unsigned long long j = 0; j < n; ++j) {
       if (!std::getline(in, line)) throw truncated("point " + std::to_string(j) + " of " + std::to_string(n));
       const char* c = line.c_str();
+      const auto space = [](char ch) { return ch == ' ' || ch == '\t' || ch == '\r'; };
       for (auto& v : values) {
         char* end = nullptr;
         v = std::strtod(c, &end);
-        if (end == c) throw std::runtime_error(path + ": not a number in point " + std::to_string(j));
+        // strtod stops at the first character it cannot read: "3_4" or "3.5abc" would be 3 and
+        // 3.5, so a number must end at white space or the line's end
+        if (end == c || (*end != '\0' && !space(*end))) {
+          throw std::runtime_error(path + ": not a number in point " + std::to_string(j));
+        }
         c = end;
+      }
+      while (space(*c)) ++c;
+      if (*c != '\0') {
+        throw std::runtime_error(path + ": point " + std::to_string(j) + " has more values than the header's " +
+                                 std::to_string(values.size()));
       }
       keep({values[value_index[static_cast<std::size_t>(h.xyz[0])]], values[value_index[static_cast<std::size_t>(h.xyz[1])]],
             values[value_index[static_cast<std::size_t>(h.xyz[2])]]});

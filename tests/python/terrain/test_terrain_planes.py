@@ -219,6 +219,29 @@ def test_text_reader_bz2_comments_nan_and_viewpoint(tmp_path):
 
 
 @pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        ("0.5 -1 2\n1 2 3_4\n", "not a number in point 1"),  # read as z = 3
+        ("0.5 -1 2\n1 2 3.5abc\n", "not a number in point 1"),  # read as z = 3.5
+        ("0.5 -1 2 7\n1 2 3\n", "point 0 has more values than the header's 3"),
+    ],
+)
+def test_ascii_pcd_numbers_end_at_white_space(tmp_path, data, message):
+    """The C++ reader's strtod stopped at the first character it could not read and kept the
+    number before it."""
+    pcd = tmp_path / "a.pcd"
+    pcd.write_text(
+        "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\n"
+        "POINTS 2\nDATA ascii\n" + data
+    )
+    with pytest.raises(ValueError, match=message) as err:
+        read_cloud(pcd)
+    assert "a.pcd" in str(err.value)
+    pcd.write_text(pcd.read_text().replace(data, "0.5 -1 2\t\r\n1 2 3 \n"))
+    np.testing.assert_allclose(read_cloud(pcd).points, [[0.5, -1, 2], [1, 2, 3]])
+
+
+@pytest.mark.parametrize(
     ("content", "message"),
     [
         (None, "no such file"),
