@@ -23,6 +23,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from kiseki import _core
+from kiseki._support.numbers_text import parse_float, parse_int
 from kiseki.core import SEED_RULE
 from kiseki.errors import KisekiError
 
@@ -124,7 +125,7 @@ class Count(_Bounded):
             return value
         if isinstance(value, str):
             try:
-                return int(value.strip(), 10)
+                return parse_int(value.strip())  # 1_0 is not 10
             except ValueError:
                 return None
         return None
@@ -167,7 +168,7 @@ class Quantity(_Bounded):
             number = float(value)
         elif isinstance(value, str):
             try:
-                number = float(value.strip())
+                number = parse_float(value.strip())  # 1_0 is not 10
             except ValueError:
                 return None
         else:

@@ -184,14 +184,16 @@ def _read_text(path: Path) -> np.ndarray:
     return np.asarray(rows, dtype=float).reshape(-1, 3)
 
 
-ORIGIN_LIMIT = 1e6  # m: a sensor 1,000 km from its cloud's frame is a typo
+ORIGIN_LIMIT: float = _core.PCL_COORDINATE_LIMIT
+"""m: the largest coordinate of a cloud's points and of its sensor (a sensor 1,000 km from its
+cloud's frame is a typo; beyond it PCL's float search overflows)."""
 
 
 def parse_origin(text: str) -> np.ndarray:
     """``"x,y,z"`` (metres) as a finite 3-vector within +-ORIGIN_LIMIT; ValueError otherwise
     (1e300 overflowed later into a message about the S-DEM's range, naming no option)."""
     try:
-        origin = np.array([float(v) for v in str(text).split(",")])
+        origin = np.array([parse_float(v.strip()) for v in str(text).split(",")])
     except ValueError:
         origin = np.zeros(0)
     if origin.shape != (3,) or not np.all(np.abs(origin) <= ORIGIN_LIMIT):

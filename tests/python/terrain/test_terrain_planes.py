@@ -193,7 +193,7 @@ def test_text_reader_bz2_comments_nan_and_viewpoint(tmp_path):
     np.testing.assert_array_equal(c.origin, [1, 2, 3])
     np.testing.assert_array_equal(read_cloud(pcd, "0,0,0.5").origin, [0, 0, 0.5])
     wrong = r"--origin must be three numbers x,y,z within \+-1e\+06"
-    for bad in ("1,2", "1,2,nan", "a,b,c", "1e300,0,0", "0,-1e7,0"):
+    for bad in ("1,2", "1,2,nan", "a,b,c", "1e300,0,0", "0,-1e7,0", "1_0,0,0"):
         with pytest.raises(ValueError, match=wrong):
             read_cloud(pcd, bad)
     np.testing.assert_array_equal(read_cloud(pcd, "1e6,0,-1e6").origin, [1e6, 0, -1e6])
