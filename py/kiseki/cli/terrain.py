@@ -94,7 +94,10 @@ def terrain_run(
     mapper = SdemMapper(config, start=stops[0].sensor[:3, 3])
     rows = []
     for k, stop in enumerate(tqdm(stops, desc="stops", unit="sweep")):
-        pose = mapper.add(stop.ranges, stop.gyro_rpy)
+        try:
+            pose = mapper.add(stop.ranges, stop.gyro_rpy)
+        except ValueError as err:  # "sweep 3: no candidate shares ...": of this world's run
+            raise ValueError(f"{world}: {err}") from None
         points, _ = mapper.sweeps[-1].kept.to_points()
         atomic_write(output / f"sdem_{k:03d}.pcd", lambda tmp, p=points: _core.write_pcd(tmp, p))
         rows.append([k, *stop.sensor[:3, 3], *pose[:3, 3]])

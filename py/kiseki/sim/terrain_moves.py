@@ -130,7 +130,10 @@ def terrain_stops(
     path = Path(world_path)
     if path.suffix == ".bt":
         world = read_octree(path)
-        x, y, f = free_start(world, world.bounds)
+        try:
+            x, y, f = free_start(world, world.bounds)
+        except ValueError as err:  # the file's voxels, not the call, decide it: name the file
+            raise ValueError(f"{path}: {err}") from None
         o = np.tile([x, y, f + 0.5], (32, 1))
         angles = np.linspace(0, 2 * math.pi, 32, endpoint=False)
         reach = world.cast_many(

@@ -151,6 +151,29 @@ def test_an_octree_header_with_absurd_voxels_is_refused_in_one_line(tmp_path):
 
 
 @pytest.mark.skipif(not GEB079.exists(), reason="the recorded Freiburg 079 octree is absent")
+def test_an_octree_too_small_to_stand_in_names_its_file(tmp_path):
+    """0.2 mm voxels (a header edited within kiseki's limits) shrink the building to 8 cm: the
+    run found no free start and said so naming no file."""
+    small = tmp_path / "small.bt"
+    small.write_bytes(GEB079.read_bytes().replace(b"\nres 0.08\n", b"\nres 0.0002\n", 1))
+    with pytest.raises(ValueError, match=f"^{re.escape(str(small))}: free_start: the world is"):
+        terrain_stops(small, 1, 0)
+
+
+@pytest.mark.skipif(not GEB079.exists(), reason="the recorded Freiburg 079 octree is absent")
+def test_a_run_whose_search_fails_names_its_world(tmp_path):
+    """5 m voxels (within kiseki's limits): the second sweep shares no cells with the first, and
+    the one line named the sweep but not the world."""
+    big = tmp_path / "big.bt"
+    big.write_bytes(GEB079.read_bytes().replace(b"\nres 0.08\n", b"\nres 5\n", 1))
+    done = run(big, "--moves", 1, "-o", tmp_path / "out")
+    assert done.returncode == 1, done.stderr
+    assert done.stderr.strip().splitlines()[-1] == (
+        f"kiseki: error: {big}: sweep 1: no candidate shares enough cells with sweep 0"
+    )
+
+
+@pytest.mark.skipif(not GEB079.exists(), reason="the recorded Freiburg 079 octree is absent")
 def test_a_truncated_octree_is_one_line_with_octomaps_reason(tmp_path):
     """OctoMap reports a damaged tree on stderr, not to its caller: its line came above
     kiseki's one-line error. Now its reason is part of that line, and nothing else is printed."""
