@@ -3,9 +3,11 @@
 """Numbers written as text in the data files kiseki reads (logs, maps, tables, point clouds).
 
 Python's ``int()`` and ``float()``, and numpy's conversion of ``str`` to numbers, also take PEP
-515 underscores between digits (``1_0`` is 10). None of the formats read here allows them, and
-the tools that write and read them (C's ``strtod``, ``strtol``) stop at the underscore, so here
-a token holding one is not a number. The readers name the file, the line and the token.
+515 underscores between digits (``1_0`` is 10) and the digits of other scripts (full-width
+``１０``, Arabic-Indic ``١٠``: 10). None of the formats read here allows either, and the tools
+that write and read them (C's ``strtod``, ``strtol``) stop at them, so here a token holding one
+is not a number: a number is ASCII without an underscore. The readers name the file, the line
+and the token.
 """
 
 from __future__ import annotations
@@ -27,9 +29,14 @@ class NumberTextError(ValueError):
         self.token = token
 
 
+def _plain(text: str) -> bool:
+    """ASCII without an underscore: what a number of these formats may be written with."""
+    return text.isascii() and "_" not in text
+
+
 def parse_int(token: str) -> int:
     """The decimal integer ``token``; ValueError when it is not one (``1_0`` is not)."""
-    if "_" in token:
+    if not _plain(token):
         raise ValueError(f"{token!r} is not an integer")
     return int(token)
 
@@ -37,7 +44,7 @@ def parse_int(token: str) -> int:
 def parse_float(token: str) -> float:
     """The number ``token`` as ``float()`` reads it; ValueError when it is not one (``1_0``
     is not)."""
-    if "_" in token:
+    if not _plain(token):
         raise ValueError(f"{token!r} is not a number")
     return float(token)
 
@@ -58,7 +65,7 @@ def float_array(tokens: Sequence[Sequence[str]] | Sequence[str]) -> np.ndarray:
     whole list's for a flat list), not token by token: a large log stays fast to read."""
     flat = len(tokens) > 0 and isinstance(tokens[0], str)
     rows: Sequence[Sequence[str]] = [tokens] if flat else tokens  # type: ignore[list-item]
-    if not any("_" in "".join(row) for row in rows):
+    if all(_plain("".join(row)) for row in rows):
         try:
             return np.array(tokens, dtype=np.float64)
         except ValueError:

@@ -23,8 +23,11 @@ def test_numbers_read_as_float_and_int_read_them() -> None:
     assert is_number("0.25") and not is_number("abc")
 
 
-@pytest.mark.parametrize("token", ["1_0", "1_000.5", "0.5_0", "1e1_0", "_1", "1_"])
-def test_a_token_with_an_underscore_is_not_a_number(token: str) -> None:
+# full-width and Arabic-Indic digits: float() read both as 10
+@pytest.mark.parametrize(
+    "token", ["1_0", "1_000.5", "0.5_0", "1e1_0", "_1", "1_", "\uff11\uff10", "\u0661\u0660"]
+)
+def test_a_token_with_an_underscore_or_other_scripts_digits_is_not_a_number(token: str) -> None:
     assert not is_number(token)
     with pytest.raises(ValueError, match=f"'{token}' is not a number"):
         parse_float(token)
@@ -33,7 +36,7 @@ def test_a_token_with_an_underscore_is_not_a_number(token: str) -> None:
     assert (bad.value.row, bad.value.token) == (1, token)
 
 
-@pytest.mark.parametrize("token", ["1_0", "4_0", "x", "1.0"])
+@pytest.mark.parametrize("token", ["1_0", "4_0", "x", "1.0", "\u0661\u0660"])
 def test_an_integer_is_decimal_digits(token: str) -> None:
     with pytest.raises(ValueError, match=f"'{token}'"):
         parse_int(token)
