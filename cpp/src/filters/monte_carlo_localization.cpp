@@ -31,22 +31,34 @@ void MclParams::validate() const {
     k.validate();
   }
   motion.validate();
-  const auto finite_nonneg = [](double v) { return v >= 0.0 && std::isfinite(v); };
-  if (!finite_nonneg(resample_threshold)) throw std::invalid_argument("MCL: resample_threshold must be >= 0");
-  if (!(likelihood_power > 0.0) || !std::isfinite(likelihood_power)) throw std::invalid_argument("MCL: likelihood_power must be > 0");
+  // a share of n (1: every update); above it the same as 1
+  if (!(resample_threshold >= 0.0 && resample_threshold <= 1.0)) {
+    throw std::invalid_argument("MCL: resample_threshold must lie in [0, 1]");
+  }
+  // a scan counted as up to 1,000 scans; 1e300 overflowed the log-likelihoods to NaN weights
+  if (!(likelihood_power > 0.0 && likelihood_power <= 1000.0)) {
+    throw std::invalid_argument("MCL: likelihood_power must lie in (0, 1000]");
+  }
   if (!(alpha_slow > 0.0 && alpha_slow <= 1.0 && alpha_fast > 0.0 && alpha_fast <= 1.0)) {
     throw std::invalid_argument("MCL: alpha_slow and alpha_fast must lie in (0, 1]");
   }
   if (!(reset_threshold >= 0.0 && reset_threshold <= 1.0)) throw std::invalid_argument("MCL: reset_threshold must lie in [0, 1]");
-  if (!(reset_evidence >= 0.0 && std::isfinite(reset_evidence))) throw std::invalid_argument("MCL: reset_evidence must be finite and >= 0");
+  // nats: a million is more than a scan of 100,000 beams (kiseki's most) can show, a few nats a
+  // beam: a margin no reset passes; beyond it, the same
+  if (!(reset_evidence >= 0.0 && reset_evidence <= 1e6)) throw std::invalid_argument("MCL: reset_evidence must lie in [0, 1e6]");
   if (!(reset_likelihood_drop >= 0.0 && reset_likelihood_drop < 1.0)) {
     throw std::invalid_argument("MCL: reset_likelihood_drop must lie in [0, 1)");
   }
-  if (!finite_nonneg(expansion_position) || !finite_nonneg(expansion_orientation)) {
-    throw std::invalid_argument("MCL: expansion radii must be finite and >= 0");
+  // wider than the farthest the robot may move between two updates (kMaxOdometryJump), or than a
+  // half turn, an expansion is a global reset, which the sensor reset is for
+  if (!(expansion_position >= 0.0 && expansion_position <= kMaxOdometryJump) ||
+      !(expansion_orientation >= 0.0 && expansion_orientation <= kPi)) {
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g", kMaxOdometryJump);
+    throw std::invalid_argument(std::string("MCL: expansion radii must lie in [0, ") + limit + " m] and [0, pi]");
   }
-  if (reset_after < 1 || sensor_reset_after < reset_after) {
-    throw std::invalid_argument("MCL: need 1 <= reset_after <= sensor_reset_after");
+  if (reset_after < 1 || sensor_reset_after < reset_after || sensor_reset_after > 1'000'000) {
+    throw std::invalid_argument("MCL: need 1 <= reset_after <= sensor_reset_after <= 1,000,000 updates");
   }
   if (!(sensor_reset_share >= 0.0 && sensor_reset_share <= 1.0)) throw std::invalid_argument("MCL: sensor_reset_share must lie in [0, 1]");
   if (sensor_reset_candidates < 1 || sensor_reset_candidates > 10'000'000) {

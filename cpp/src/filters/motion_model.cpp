@@ -19,8 +19,10 @@ MotionModelType motion_model_from_name(const std::string& name) {
 }
 
 void MotionParams::validate() const {
+  // at most 100: a noise SD ten times the motion itself (kiseki's odometry noise fraction F < 10
+  // gives alpha = F^2 < 100); 1e300 put the particles 1e148 m off without a word
   for (double a : {alpha1, alpha2, alpha3, alpha4, alpha5}) {
-    if (!(a >= 0.0) || !std::isfinite(a)) throw std::invalid_argument("motion model: alphas must be finite and >= 0");
+    if (!(a >= 0.0 && a <= 100.0)) throw std::invalid_argument("motion model: alphas must lie in [0, 100]");
   }
 }
 

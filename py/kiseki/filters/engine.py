@@ -21,12 +21,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
 from kiseki import _core
 from kiseki._support.field_types import check_field_types
+from kiseki._support.options import THREAD_LIMIT
 from kiseki.core import Pose2, check_seed
 from kiseki.filters.initial_pose import check_particles, check_start
 from kiseki.grid import OccupancyGrid
@@ -163,8 +164,8 @@ class MclConfig:
             f"recovery must be one of {', '.join(RECOVERY_MODES)}, got {self.recovery!r}",
         )
         _check(
-            isinstance(self.threads, int) and 0 <= self.threads <= 1024,
-            f"threads must be an integer in 0..1024 (0 = chosen by measured time), "
+            isinstance(self.threads, int) and 0 <= self.threads <= THREAD_LIMIT,
+            f"threads must be an integer in 0..{THREAD_LIMIT} (0 = chosen by measured time), "
             f"got {self.threads!r}",
         )
         _check(
@@ -183,6 +184,11 @@ class MclConfig:
         for name in ("update_min_d", "update_min_a"):
             value = getattr(self, name)
             _check(value >= 0 and math.isfinite(value), f"{name} must be >= 0, got {value}")
+        _check(self.update_min_a <= math.pi, f"update_min_a must be <= pi, got {self.update_min_a}")
+        for f in fields(self):  # the core's ints (10**300 was a pybind11 list of signatures)
+            value = getattr(self, f.name)
+            if f.type == "int" and not -(2**31) < value < 2**31:
+                raise ValueError(f"{f.name} must be an integer below 2**31 (C++ int), got {value}")
         _check(
             self.update_min_d < MAX_ODOMETRY_JUMP,
             f"update_min_d must be below kiseki's limit of {MAX_ODOMETRY_JUMP:g} m for the "
