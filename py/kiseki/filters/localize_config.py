@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 from kiseki._support.field_types import check_field_types
 from kiseki.core import check_seed
 from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS, MclConfig
+from kiseki.filters.initial_pose import POSE_LIMIT
 from kiseki.filters.reliability import RELIABILITY_ESTIMATES
 from kiseki.grid import DEFAULT_RAY_CASTER, ray_caster
 
@@ -139,9 +140,9 @@ class LocalizeConfig:
             0 <= self.odometry_noise < 10,  # as noisy_odometry: the SD as a multiple of each step
             f"odometry noise must be >= 0 and below 10, got {self.odometry_noise}",
         )
-        _check(
-            len(self.initial_sd) == 3 and all(s >= 0 and math.isfinite(s) for s in self.initial_sd),
-            f"initial_sd must be three finite numbers >= 0, got {self.initial_sd}",
+        _check(  # within the start's bound (1e300 was taken here and refused by initialize)
+            len(self.initial_sd) == 3 and all(0 <= s <= POSE_LIMIT for s in self.initial_sd),
+            f"initial_sd must be three numbers in [0, {POSE_LIMIT:g}], got {self.initial_sd}",
         )
         _check(
             isinstance(self.beams, int) and self.beams >= 0,

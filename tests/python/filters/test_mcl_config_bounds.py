@@ -10,7 +10,7 @@ import math
 
 import pytest
 
-from kiseki.filters import MclConfig
+from kiseki.filters import LocalizeConfig, MclConfig
 
 ABSURD = [
     ({"alphas": (1e300, 0.0, 0.0, 0.0)}, "alphas must lie in \\[0, 100\\]"),
@@ -50,3 +50,11 @@ def test_the_bounds_themselves_are_taken():
         sensor_reset_after=1_000_000,
     )
     assert config.to_core().likelihood_power == 1000.0
+
+
+@pytest.mark.parametrize("sd", [(1e300, 0.1, 0.05), (0.1, math.nan, 0.05), (0.1, 0.1, -1.0)])
+def test_localize_configs_start_spread_is_bounded_where_it_is_given(sd):
+    """1e300 was taken by LocalizeConfig and refused later by initialize, naming its own
+    argument, not the config's field."""
+    with pytest.raises(ValueError, match="initial_sd must be three numbers in \\[0, 1e\\+09\\]"):
+        LocalizeConfig(initial_sd=sd)
