@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki.errors import LogFormatError
 
 __all__ = [
@@ -44,6 +45,7 @@ __all__ = [
     "LaserScans",
     "apply_range_rule",
     "beams_of_one_turn",
+    "check_max_range",
     "check_odometry_jumps",
     "largest_reading",
 ]
@@ -117,6 +119,22 @@ class LaserScans:
         """The number of invalid readings, which the models skip: NaN after a reader's
         :func:`apply_range_rule` (any NaN, ``-inf``, negative or zero reading)."""
         return int(np.count_nonzero(~(np.asarray(self.ranges) > 0)))
+
+
+def check_max_range(where: str, max_range) -> float:
+    """``max_range`` as a float: a number in (0, MAGNITUDE_LIMIT] m, refused naming ``where``
+    otherwise (a NaN one compared false with every reading, so that every reading counted as an
+    endpoint; 1e300 overflowed the float32 readings it is compared with)."""
+    if (
+        isinstance(max_range, bool)
+        or not isinstance(max_range, numbers.Real)
+        or not 0 < max_range <= MAGNITUDE_LIMIT
+    ):
+        raise ValueError(
+            f"{where}: max_range must be a number > 0 and at most {MAGNITUDE_LIMIT:g} m, "
+            f"got {max_range!r}"
+        )
+    return float(max_range)
 
 
 def largest_reading(ranges: np.ndarray) -> float | None:

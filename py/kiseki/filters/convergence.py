@@ -21,7 +21,7 @@ import numpy as np
 
 from kiseki import _core
 from kiseki.grid import OccupancyGrid
-from kiseki.scans import LaserScans
+from kiseki.scans import LaserScans, check_max_range
 
 __all__ = [
     "FIT_BLOCK",
@@ -102,6 +102,7 @@ def scan_fit(
     distance: np.ndarray | None = None,
 ) -> ScanFit:
     """Fit of scans (n, b) at sensor poses (n, 3) to the grid's occupied cells."""
+    max_range = check_max_range("scan_fit", max_range)
     poses = np.ascontiguousarray(poses, dtype=np.float64)
     ranges = np.ascontiguousarray(ranges, dtype=np.float32)
     hits1, endpoints = _core.endpoint_agreement(
@@ -109,7 +110,10 @@ def scan_fit(
     )
     hits2, _ = _core.endpoint_agreement(grid, poses, ranges, angles, max_range, neighbourhood=2)
     if endpoints == 0:
-        raise ValueError("no scan endpoint below max range: the fit is undefined")
+        raise ValueError(
+            f"scan_fit: no scan endpoint (a reading > 0 and below max_range {max_range:g} m): "
+            "the fit is undefined"
+        )
     if distance is None:
         distance = grid.distance_field()
     valid = np.isfinite(ranges) & (ranges > 0) & (ranges < max_range)

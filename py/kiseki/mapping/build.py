@@ -14,10 +14,10 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki import _core
-from kiseki._support.schema import MAGNITUDE_LIMIT, parse
+from kiseki._support.schema import parse
 from kiseki.grid import OccupancyGrid
 from kiseki.io.map_schema import MapBuildSettings
-from kiseki.scans import LaserScans
+from kiseki.scans import LaserScans, check_max_range
 
 __all__ = [
     "MAX_MAP_CELLS",
@@ -33,22 +33,6 @@ __all__ = [
 
 MAX_MAP_CELLS = 10**8  # 100 M int8 cells (and as many float log-odds while building)
 MIN_MAP_SIDE = 2  # cells: a map of one cell across says nothing
-
-
-def _check_max_range(where: str, max_range) -> float:
-    """``max_range`` as a float: a number in (0, MAGNITUDE_LIMIT] m (a NaN one compared false
-    with every reading, so that every reading counted as an endpoint; 1e300 overflowed the
-    float32 readings it is compared with)."""
-    if (
-        isinstance(max_range, bool)
-        or not isinstance(max_range, numbers.Real)
-        or not 0 < max_range <= MAGNITUDE_LIMIT
-    ):
-        raise ValueError(
-            f"{where}: max_range must be a number > 0 and at most {MAGNITUDE_LIMIT:g} m, "
-            f"got {max_range!r}"
-        )
-    return float(max_range)
 
 
 def check_map_size(width_m: float, height_m: float, resolution: float) -> tuple[int, int]:
@@ -138,7 +122,7 @@ def build_map(
     config = config or MapBuildConfig()
     if not np.isfinite(config.margin) or config.margin < 0:
         raise ValueError(f"margin must be >= 0, got {config.margin}")
-    max_range = _check_max_range("build_map", max_range)
+    max_range = check_max_range("build_map", max_range)
     if isinstance(chunk, bool) or not isinstance(chunk, int | np.integer) or chunk < 1:
         # -1 gave a map of unknown cells only, 0 Python's "range() arg 3 must not be zero"
         raise ValueError(f"chunk must be an integer >= 1 (scans per pass), got {chunk!r}")
@@ -184,7 +168,7 @@ def scan_local_builder(
     left out, as in `build_map`: a missing echo says nothing certain about the space along the
     beam. Readings that are NaN, zero or negative are no reading and add nothing. Its `build()`
     is L, its `hits()` the cells a beam ended in."""
-    max_range = _check_max_range("local map", max_range)
+    max_range = check_max_range("local map", max_range)
     ranges = np.array(ranges, dtype=np.float32)  # a copy: the caller's scan stays as it was
     ranges[ranges >= max_range] = np.nan
     builder = _core.LocalMapBuilder(size, resolution)
@@ -218,7 +202,7 @@ def endpoint_agreement(
         raise TypeError(
             f"endpoint_agreement: grid must be a kiseki OccupancyGrid, got {type(grid).__name__}"
         )
-    max_range = _check_max_range("endpoint_agreement", max_range)
+    max_range = check_max_range("endpoint_agreement", max_range)
     if (
         isinstance(neighbourhood, bool)
         or not isinstance(neighbourhood, numbers.Integral)

@@ -73,3 +73,20 @@ def test_elapsed_time_counts_the_clock_forward_only():
     forward = np.cumsum(np.random.default_rng(2).uniform(0.05, 0.2, 50))
     for k in (1, 17, 49):
         assert elapsed_time(forward, k) == pytest.approx(forward[k] - forward[0], abs=1e-12)
+
+
+def test_scan_fit_refuses_a_max_range_that_is_no_length():
+    """A NaN max range made every reading an endpoint (endpoint_agreement's defect, which
+    scan_fit shared); all readings at or below zero said 'below max range'."""
+    from _helpers.room_log import ANGLES, room
+    from kiseki.filters.convergence import scan_fit
+
+    grid = room()
+    pose = np.array([[1.0, 0.0, 0.0]])
+    ranges = grid.cast_scans(pose, ANGLES, max_range=8.0)
+    assert scan_fit(grid, pose, ranges, ANGLES, 8.0).within_1_cell > 0.9  # a scan of the map
+    for bad in (math.nan, math.inf, 0.0, "8"):
+        with pytest.raises(ValueError, match="scan_fit: max_range must be a number > 0"):
+            scan_fit(grid, pose, ranges, ANGLES, bad)
+    with pytest.raises(ValueError, match=r"scan_fit: no scan endpoint \(a reading > 0"):
+        scan_fit(grid, pose, -np.asarray(ranges), ANGLES, 8.0)
