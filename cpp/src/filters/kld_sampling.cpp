@@ -7,12 +7,18 @@
 
 namespace kiseki {
 
-std::size_t kld_sample_bound(std::size_t bins, double err, double z) {
-  // err: the KL bound epsilon (nav2's pf_err 0.01-0.05; above 1 any cloud passes); z: the upper
-  // standard normal quantile (nav2's pf_z 0.99; 10 is 1 - 1e-23)
+namespace {
+// err: the KL bound epsilon (nav2's pf_err 0.01-0.05; above 1 any cloud passes); z: the upper
+// standard normal quantile (nav2's pf_z 0.99; 10 is 1 - 1e-23)
+void check_err_z(double err, double z) {
   if (!(err > 0.0 && err <= 1.0) || !(z >= 0.0 && z <= 10.0)) {
     throw std::invalid_argument("KLD sampling: err must lie in (0, 1] and z in [0, 10]");
   }
+}
+}  // namespace
+
+std::size_t kld_sample_bound(std::size_t bins, double err, double z) {
+  check_err_z(err, z);
   if (bins <= 1) return 0;
   const double k1 = static_cast<double>(bins - 1);
   const double a = 2.0 / (9.0 * k1);
@@ -21,11 +27,7 @@ std::size_t kld_sample_bound(std::size_t bins, double err, double z) {
 }
 
 void KldParams::validate() const {
-  // err: the KL bound epsilon (nav2's pf_err 0.01-0.05; above 1 any cloud passes); z: the upper
-  // standard normal quantile (nav2's pf_z 0.99; 10 is 1 - 1e-23)
-  if (!(err > 0.0 && err <= 1.0) || !(z >= 0.0 && z <= 10.0)) {
-    throw std::invalid_argument("KLD sampling: err must lie in (0, 1] and z in [0, 10]");
-  }
+  check_err_z(err, z);
   if (!(bin_xy > 0.0) || !(bin_theta > 0.0) || !(bin_distance > 0.0) || !std::isfinite(bin_xy + bin_theta + bin_distance)) {
     throw std::invalid_argument("KLD sampling: bin sizes must be finite and > 0");
   }

@@ -43,14 +43,12 @@ void MclParams::validate() const {
     throw std::invalid_argument("MCL: alpha_slow and alpha_fast must lie in (0, 1]");
   }
   if (!(reset_threshold >= 0.0 && reset_threshold <= 1.0)) throw std::invalid_argument("MCL: reset_threshold must lie in [0, 1]");
-  // nats: a million is more than a scan of 100,000 beams (kiseki's most) can show, a few nats a
-  // beam: a margin no reset passes; beyond it, the same
+  // nats: more than a scan of 100,000 beams (kiseki's most, a few nats each) shows: no reset passes
   if (!(reset_evidence >= 0.0 && reset_evidence <= 1e6)) throw std::invalid_argument("MCL: reset_evidence must lie in [0, 1e6]");
   if (!(reset_likelihood_drop >= 0.0 && reset_likelihood_drop < 1.0)) {
     throw std::invalid_argument("MCL: reset_likelihood_drop must lie in [0, 1)");
   }
-  // wider than the farthest the robot may move between two updates (kMaxOdometryJump), or than a
-  // half turn, an expansion is a global reset, which the sensor reset is for
+  // wider than the robot may move between two updates, or a half turn: a global reset (the sensor reset's)
   if (!(expansion_position >= 0.0 && expansion_position <= kMaxOdometryJump) ||
       !(expansion_orientation >= 0.0 && expansion_orientation <= kPi)) {
     char limit[32];

@@ -19,10 +19,10 @@ MotionModelType motion_model_from_name(const std::string& name) {
 }
 
 void MotionParams::validate() const {
-  // at most 100: a noise SD ten times the motion itself (kiseki's odometry noise fraction F < 10
-  // gives alpha = F^2 < 100); 1e300 put the particles 1e148 m off without a word
+  // at most 1,000: a noise SD about 30 times the motion itself (kiseki's noisy odometry, F < 10,
+  // with a real odometry's alphas gives at most 100.05); 1e300 put the particles 1e148 m off
   for (double a : {alpha1, alpha2, alpha3, alpha4, alpha5}) {
-    if (!(a >= 0.0 && a <= 100.0)) throw std::invalid_argument("motion model: alphas must lie in [0, 100]");
+    if (!(a >= 0.0 && a <= 1000.0)) throw std::invalid_argument("motion model: alphas must lie in [0, 1000]");
   }
 }
 

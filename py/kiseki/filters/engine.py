@@ -151,9 +151,8 @@ class MclConfig:
             self.motion_model in ("differential", "omnidirectional"),
             f"motion_model must be differential or omnidirectional, got {self.motion_model!r}",
         )
-        _check(
-            len(self.alphas) in (4, 5) and all(a >= 0 and math.isfinite(a) for a in self.alphas),
-            f"alphas must be 4 (or 5) finite numbers >= 0, got {self.alphas}",
+        _check(  # their values: the motion model's validate, in [0, 1000]
+            len(self.alphas) in (4, 5), f"alphas must be 4 (or 5) numbers, got {self.alphas}"
         )
         _check(
             self.resampling in RESAMPLING_METHODS,
@@ -184,11 +183,14 @@ class MclConfig:
         for name in ("update_min_d", "update_min_a"):
             value = getattr(self, name)
             _check(value >= 0 and math.isfinite(value), f"{name} must be >= 0, got {value}")
-        _check(self.update_min_a <= math.pi, f"update_min_a must be <= pi, got {self.update_min_a}")
+        _check(  # a turn is wrapped to at most pi: above it means never on rotation alone
+            self.update_min_a <= 2 * math.pi,
+            f"update_min_a must be <= 2 pi, got {self.update_min_a}",
+        )
         for f in fields(self):  # the core's ints (10**300 was a pybind11 list of signatures)
             value = getattr(self, f.name)
-            if f.type == "int" and not -(2**31) < value < 2**31:
-                raise ValueError(f"{f.name} must be an integer below 2**31 (C++ int), got {value}")
+            if f.type == "int" and not -(2**31) <= value < 2**31:
+                raise ValueError(f"{f.name} must be a C++ int (within +-2**31), got {value}")
         _check(
             self.update_min_d < MAX_ODOMETRY_JUMP,
             f"update_min_d must be below kiseki's limit of {MAX_ODOMETRY_JUMP:g} m for the "

@@ -14,7 +14,7 @@ import numpy as np
 
 from kiseki._support.schema import MAGNITUDE_LIMIT
 
-__all__ = ["POSE_LIMIT", "check_particles", "check_start"]
+__all__ = ["POSE_LIMIT", "check_particles", "check_spread", "check_start"]
 
 POSE_LIMIT = MAGNITUDE_LIMIT
 """The largest magnitude of a start's x, y (m) and theta (rad), of its standard deviations and
@@ -39,16 +39,22 @@ def check_start(pose, sd) -> tuple[np.ndarray, np.ndarray]:
     p, s = np.shape(np.asarray(pose, dtype=object)), np.shape(np.asarray(sd, dtype=object))
     if p != (3,) or s != (3,):  # (x, y) was taken with theta = 0
         raise ValueError(f"initialize: pose and sd must be (x, y, theta) triples, got {p}, {s}")
-    start, spread = _numbers(pose), _numbers(sd)
+    start = _numbers(pose)
     if start is None or not np.all(np.abs(start) <= POSE_LIMIT):
         raise ValueError(
             f"initialize: pose must be 3 numbers within +-{POSE_LIMIT:g} (m, m, rad), got {pose!r}"
         )
+    return start, check_spread("initialize: sd", sd)
+
+
+def check_spread(name: str, sd) -> np.ndarray:
+    """A start's (x, y, theta) standard deviations as a float array: 3 numbers in [0,
+    POSE_LIMIT], refused naming ``name`` otherwise (the configs that hold one check it here,
+    where it is given, not when the run starts)."""
+    spread = _numbers(sd) if np.shape(np.asarray(sd, dtype=object)) == (3,) else None
     if spread is None or not np.all((spread >= 0) & (spread <= POSE_LIMIT)):
-        raise ValueError(
-            f"initialize: sd must be 3 numbers in [0, {POSE_LIMIT:g}] (m, m, rad), got {sd!r}"
-        )
-    return start, spread
+        raise ValueError(f"{name} must be 3 numbers in [0, {POSE_LIMIT:g}] (m, m, rad), got {sd!r}")
+    return spread
 
 
 def check_particles(poses, weights) -> tuple[np.ndarray, np.ndarray | None]:

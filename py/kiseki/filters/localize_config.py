@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass
 from kiseki._support.field_types import check_field_types
 from kiseki.core import check_seed
 from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS, MclConfig
-from kiseki.filters.initial_pose import POSE_LIMIT
+from kiseki.filters.initial_pose import check_spread
 from kiseki.filters.reliability import RELIABILITY_ESTIMATES
 from kiseki.grid import DEFAULT_RAY_CASTER, ray_caster
 
@@ -140,10 +140,7 @@ class LocalizeConfig:
             0 <= self.odometry_noise < 10,  # as noisy_odometry: the SD as a multiple of each step
             f"odometry noise must be >= 0 and below 10, got {self.odometry_noise}",
         )
-        _check(  # within the start's bound (1e300 was taken here and refused by initialize)
-            len(self.initial_sd) == 3 and all(0 <= s <= POSE_LIMIT for s in self.initial_sd),
-            f"initial_sd must be three numbers in [0, {POSE_LIMIT:g}], got {self.initial_sd}",
-        )
+        check_spread("initial_sd", self.initial_sd)  # 1e300 was refused only by the run
         _check(
             isinstance(self.beams, int) and self.beams >= 0,
             f"beams must be an integer >= 0 (0 = every beam), got {self.beams!r}",
@@ -160,12 +157,10 @@ class LocalizeConfig:
             value = getattr(self, name)
             _check(value >= 0 and math.isfinite(value), f"{name} must be >= 0, got {value}")
         _check(self.z_hit + self.z_rand > 0, "z_hit and z_rand must not both be 0")
-        if self.alphas is not None:
-            _check(
-                len(self.alphas) in (4, 5)
-                and all(a >= 0 and math.isfinite(a) for a in self.alphas),
-                f"alphas must be 4 (or 5) finite numbers >= 0, got {self.alphas}",
-            )
+        _check(
+            self.alphas is None or len(self.alphas) in (4, 5),
+            f"alphas must be 4 (or 5) numbers, got {self.alphas}",
+        )
         _check(
             isinstance(self.intrusion_tolerant_resets, bool),
             "intrusion_tolerant_resets must be true or false, "
@@ -222,7 +217,9 @@ class LocalizeConfig:
             isinstance(self.budget_min_beams, int) and self.budget_min_beams >= 1,
             f"budget_min_beams must be an integer >= 1, got {self.budget_min_beams!r}",
         )
-        self.mcl(REAL_ODOMETRY_ALPHAS)  # the engine's checks, as ValueError
+        # the engine's checks, as ValueError, of the alphas given (1e300 was taken here and
+        # refused by the run); those derived from odometry_noise stay within them (F < 10)
+        self.mcl(REAL_ODOMETRY_ALPHAS if self.alphas is None else self.alphas)
 
     def mcl(self, alphas: tuple[float, ...]) -> MclConfig:
         return MclConfig(

@@ -50,6 +50,7 @@ from kiseki import _core
 from kiseki._support.field_types import check_field_types
 from kiseki.core import Pose2, check_seed, derive_seed
 from kiseki.filters import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
+from kiseki.filters.initial_pose import check_spread
 from kiseki.grid import OccupancyGrid
 from kiseki.magnetic.linear_map import LinearMagneticMap
 from kiseki.magnetic.travel_distance import R_THETA_GATE, R_Z_GATE, azimuth_heading
@@ -210,9 +211,7 @@ class MagneticLidarMcl:
         for name, v in (("start", pose), ("laser", mount)):
             if v.shape != (3,) or not np.isfinite(v).all():
                 raise ValueError(f"lidar MCL: {name} must be 3 finite numbers (x, y, theta)")
-        sd = [_number(s, "start_sd", 0.0) for s in start_sd]
-        if len(sd) != 3:
-            raise ValueError("lidar MCL: start_sd must be 3 numbers (m, m, rad)")
+        sd = check_spread("lidar MCL: start_sd", start_sd)
         self.config = config
         self.heading_map = heading_map if config.magnetic else None
         self.localizer = MonteCarloLocalizer(config.mcl(), derive_seed(config.seed, 1))

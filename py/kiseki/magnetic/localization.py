@@ -24,6 +24,7 @@ from kiseki import _core
 from kiseki._support.field_types import check_field_types
 from kiseki.core import check_seed
 from kiseki.filters import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
+from kiseki.filters.initial_pose import check_spread
 
 __all__ = [
     "FRAMES",
@@ -119,10 +120,7 @@ class MagneticMclConfig:
         check_field_types(self)
         if self.noise_sd is not None and not (math.isfinite(self.noise_sd) and self.noise_sd >= 0):
             raise ValueError(f"noise_sd must be >= 0 or None, got {self.noise_sd!r}")
-        if len(self.initial_sd) != 3 or not all(
-            math.isfinite(s) and s >= 0 for s in self.initial_sd
-        ):
-            raise ValueError(f"initial_sd must be 3 finite numbers >= 0, got {self.initial_sd!r}")
+        check_spread("initial_sd", self.initial_sd)  # 1e300 was refused only by the run
         self.mcl()  # the engine's own checks
 
     def mcl(self) -> MclConfig:
