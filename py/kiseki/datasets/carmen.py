@@ -25,9 +25,10 @@ PARAMs are not used, just as CARMEN ignores them for FLASER. ROBOTLASER1 message
 ``start_angle + i * angular_resolution``.
 
 Max range (readings >= ``max_range`` mean "no return"): the PARAM ``robot_front_laser_max`` if
-present, else the largest reading that two scans of the log report, which is the no-return value
-the logger wrote (``kiseki.scans.largest_reading``: one corrupt larger reading is a no return
-itself; a log without any no-return reading loses its largest return or returns this way). For
+present, else the largest reading in the log, which is the no-return value the logger wrote
+(``kiseki.scans.largest_reading``: a few corrupt readings above a value the logger wrote many
+times are no returns themselves; a log without any no-return reading would lose its single
+largest return this way). For
 ROBOTLASER1 it is the message's ``maximum_range`` field. The value is rounded to float32, like the
 ranges, so the comparison gives the same answer in float32 and float64. In the Radish logs:
 Intel has no PARAM and no returns are 81.83; ACES has no PARAM and readings are clipped at 50;
@@ -237,7 +238,7 @@ def _laser_scans(
 ) -> LaserScans:
     """The scans of laser messages whose ``values`` hold, from ``columns``, the ranges, then
     the laser pose and odometry (6 values), then the timestamp: the ranges by kiseki's rule
-    (``max_range`` None: the largest finite reading), the odometry checked for jumps."""
+    (``max_range`` None: ``largest_reading``), the odometry checked for jumps."""
     first, pose, time = columns
     readings = values[:, first : first + len(angles)]
     if max_range is None:

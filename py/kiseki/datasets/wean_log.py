@@ -16,9 +16,10 @@ The scans become a :class:`~kiseki.scans.LaserScans` in metres:
   (``LaserScans.has_reference_poses`` is False), so they are for global localization;
 * the 180 beams start at the right and go counter-clockwise, one degree apart, i.e. the angles
   of a CARMEN FLASER with 180 beams (``-pi/2 + i * pi/180``);
-* ``max_range`` is the largest (finite) reading that two scans of the log report: the SICK's
-  no-return code (8183 cm in robotdata1, 8191 cm in robotdata2 and 3), as the CARMEN reader does
-  for logs without a max-range PARAM (``kiseki.scans.largest_reading``);
+* ``max_range`` is the largest (finite) reading of the log: the SICK's no-return code (8183 cm
+  in robotdata1, 8191 cm in robotdata2 and 3), as the CARMEN reader does for logs without a
+  max-range PARAM (``kiseki.scans.largest_reading``, which takes a few corrupt readings above
+  that code as no returns);
 * ranges follow kiseki's rule (``kiseki.scans``): NaN, ``-inf``, negative and zero readings are
   invalid, kept as NaN and counted; ``+inf`` is a no return. Any other field that is NaN or
   infinite is an error naming the line, and so is an odometry jump of more than

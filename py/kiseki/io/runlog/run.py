@@ -245,7 +245,7 @@ class SimRun:
           ``odom_topic`` is None.
         * ``angles``: ``linspace(start_angle, end_angle, B)``, equal for every scan (1e-9 rad).
         * ``max_range``: the channel metadata ``max_range`` written by :class:`RunWriter`, else
-          the largest finite reading (as for CARMEN logs without the PARAM), rounded to float32.
+          ``kiseki.scans.largest_reading`` (as for CARMEN logs without the PARAM), as float32.
         * ``ranges`` follow kiseki's rule (``kiseki.scans``): NaN, ``-inf``, negative and zero
           readings are invalid, kept as NaN and counted; ``+inf`` is a no return. A NaN or
           infinite pose or odometry, and an odometry jump of more than
