@@ -14,6 +14,7 @@ from rich.console import Console
 
 from kiseki._support.guard import guarded
 from kiseki._support.interrupt import interruptible
+from kiseki._support.numbers_text import parse_float
 from kiseki._support.options import CELL_LIMITS, Count, Metres, Seed, refuse_given
 from kiseki.datasets.magnetic import concatenate_samples, read_magnetic_data
 from kiseki.gp import (
@@ -73,7 +74,7 @@ def _parse_kernel(text: str, model: str):
     parts = text.split(",")
     names = _KERNEL_PARTS[model]
     try:
-        values = [float(v) for v in parts]
+        values = [parse_float(v.strip()) for v in parts]  # 1_0 is not 10
     except ValueError:
         values = []
     if len(values) != len(names):

@@ -150,8 +150,11 @@ def elapsed_time(times: np.ndarray, k: int) -> float:
     forward: a clock that steps back (the Intel log's does, by up to 0.86 s) never makes the
     time negative or shorter than what passed. Equals ``times[k] - times[0]`` when the clock
     only goes forward."""
-    steps = np.diff(np.asarray(times, dtype=np.float64)[: k + 1])
-    return float(steps[steps > 0].sum())
+    times = np.asarray(times, dtype=np.float64)
+    if isinstance(k, bool) or not isinstance(k, numbers.Integral) or not 0 <= k < len(times):
+        raise ValueError(f"elapsed_time: k must be a scan index in 0..{len(times) - 1}, got {k!r}")
+    steps = np.diff(times[: k + 1])
+    return float(times[k] - times[0] - steps[steps < 0].sum())  # less the steps back
 
 
 def convergence_report(

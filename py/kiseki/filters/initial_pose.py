@@ -64,7 +64,7 @@ def check_particles(poses, weights) -> tuple[np.ndarray, np.ndarray | None]:
     try:
         p = np.asarray(poses, dtype=float)
     except (TypeError, ValueError):
-        p = np.full((0, 0), np.nan)  # not numbers: refused below by its shape
+        raise ValueError("initialize_particles: poses must be numbers, an (n, 3) array") from None
     if p.ndim != 2 or p.shape[1:] != (3,) or len(p) == 0:
         raise ValueError(
             f"initialize_particles: poses must be an (n, 3) array, n >= 1, got shape {p.shape}"

@@ -25,7 +25,7 @@ import numpy as np
 
 from kiseki import _core
 from kiseki._support.field_types import check_field_types
-from kiseki._support.options import THREAD_LIMIT
+from kiseki._support.options import BEAM_LIMIT, THREAD_LIMIT
 from kiseki.errors import RelocalizationError
 from kiseki.grid import OccupancyGrid
 
@@ -76,7 +76,7 @@ class RelocalizeConfig:
     def __post_init__(self) -> None:
         check_field_types(self)
         bounds = {
-            "beams": (0, 100_000),
+            "beams": (0, BEAM_LIMIT),
             "depth": (0, 16),
             "hypotheses": (1, 1000),
             "threads": (0, THREAD_LIMIT),

@@ -15,6 +15,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from kiseki.core import Pose2, normalize_angle
 
 __all__ = ["BodyMotion", "WheelMotion"]
@@ -70,7 +72,11 @@ class BodyMotion:
 
 
 def finite_number(value: Any, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+    """``value`` as a float: a finite real number (a 0-d array too); a bool or a string is none
+    (True drove at 1 m/s, "1_0" at 10)."""
+    if isinstance(value, bool | np.bool_ | str | bytes):
+        raise ValueError(f"{name} must be a finite number, got {value!r}")
+    if not isinstance(value, numbers.Real):
         try:
             number = float(value)
         except (TypeError, ValueError):

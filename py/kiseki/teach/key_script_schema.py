@@ -23,6 +23,7 @@ from typing import Annotated, Any
 from pydantic import BeforeValidator, Field, field_validator
 
 from kiseki._support.inputs import MIB, check_input, read_input_text
+from kiseki._support.numbers_text import parse_float
 from kiseki._support.schema import FileModel, parse
 
 __all__ = [
@@ -44,7 +45,7 @@ def _seconds(text: Any) -> Any:
     """A time as written in the script (``5``, ``0.5``, ``1e1``) as a number."""
     if isinstance(text, str):
         try:
-            text = float(text)
+            text = parse_float(text.strip())  # 1_0 is not 10
         except ValueError:
             raise ValueError("must be a number of seconds (a line is TIME KEY [KEY ...])") from None
         if not math.isfinite(text):

@@ -22,6 +22,7 @@ from typing import Annotated, Any
 import yaml
 from pydantic import Field, create_model
 
+from kiseki._support.numbers_text import parse_float
 from kiseki._support.schema import (
     FileModel,
     FiniteFloat,
@@ -226,8 +227,8 @@ def _value(text: str, kind: Any) -> Any:
         value = text
     if isinstance(value, int | float | bool):
         return value
-    try:  # "nan", "inf": numbers the model refuses as not finite
-        return float(text)
+    try:  # "nan", "inf": numbers the model refuses as not finite; "1_0" is not 10
+        return parse_float(text)
     except ValueError:
         return text
 

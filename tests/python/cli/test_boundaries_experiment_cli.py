@@ -21,6 +21,7 @@ def test_fig_3_14_refuses_settings_that_make_its_claims_meaningless(tmp_path):
         ("beams=1", "beams must be >= 2, got 1"),
         ("offsets=1", "offsets must be >= 3"),
         ("max_offset=nan", "--set: max_offset: must be a finite number, got nan"),
+        ("max_offset=1_0", "--set: max_offset: must be a valid number, got '1_0'"),  # was 10
         ("flat_ratio=2", "flat_ratio must be in (0, 1]"),
     ):
         with pytest.raises(ConfigError) as err:

@@ -15,10 +15,6 @@ from kiseki.filters import MclConfig, RelocalizeConfig
 from kiseki.terrain import correlation_search, sdem_from_points
 
 
-def test_the_python_limit_is_the_cores():
-    assert THREAD_LIMIT == _core.MAX_THREADS == 1024
-
-
 @pytest.mark.parametrize("config", [MclConfig, RelocalizeConfig])
 def test_configs_take_the_limit_and_refuse_one_more(config):
     assert config(threads=THREAD_LIMIT).threads == THREAD_LIMIT

@@ -73,7 +73,7 @@ def test_missing_file(tmp_path: Path) -> None:
         (HEADER.replace("global_map[0]: 3 2\n", "") + BODY, r":6: unexpected header line"),
         (HEADER.replace("global_map[0]: 3 2", "global_map[0]: 3") + BODY, ":6: bad map size"),
         (HEADER.replace("3 2", "0 2") + BODY, ":6: bad map size"),
-        (HEADER.replace("resolution 5", "resolution five") + BODY, ":3: .*'five' is bad"),
+        (HEADER.replace("resolution 5", "resolution five") + BODY, ":3: .*resolution 'five' is"),
         # PEP 515 underscores are not numbers in a .dat map (float() read 1_0 as 10)
         (HEADER.replace("resolution 5", "resolution 1_0") + BODY, ":3: .*resolution '1_0' is"),
         (HEADER.replace("x  10", "x  1_0") + BODY, ":1: .*global_mapsize_x '1_0' is bad"),

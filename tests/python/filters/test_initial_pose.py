@@ -60,6 +60,8 @@ def test_particles_beyond_a_billion_or_weights_of_no_share_are_refused():
     far[3] = (0.0, 1e300, 0.0)
     with pytest.raises(ValueError, match=r"poses must be finite and within \+-1e\+09 .* row 3 "):
         loc.initialize_particles(far)
+    with pytest.raises(ValueError, match=r"poses must be numbers, an \(n, 3\) array$"):
+        loc.initialize_particles([["a", "b", "c"]])  # was "got shape (0, 0)"
     for weights in (np.zeros(5), np.full(5, np.nan), -np.ones(5), np.ones(4), ["a"] * 5):
         with pytest.raises(ValueError, match="weights must be 5 finite numbers >= 0 .*not all 0"):
             loc.initialize_particles(np.zeros((5, 3)), weights)

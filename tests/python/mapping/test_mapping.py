@@ -13,7 +13,14 @@ import pytest
 from kiseki import OccupancyGrid, Pose2, load_map
 from kiseki.datasets import read_carmen_log
 from kiseki.grid import beam_angles
-from kiseki.mapping import MapBuildConfig, build_map, endpoint_agreement
+from kiseki.mapping import (
+    MapBuildConfig,
+    build_map,
+    endpoint_agreement,
+    scan_local_builder,
+    scan_local_map,
+)
+from kiseki.mapping.build import check_map_size
 
 
 def test_intel_map_from_the_cli_holds_ninety_percent_of_endpoints(shared_data, tmp_path):
@@ -177,8 +184,6 @@ def test_map_from_log_without_a_return_names_the_log_and_writes_nothing(tmp_path
 def test_check_map_size_refuses_what_it_cannot_divide():
     """resolution 0 was a ZeroDivisionError, NaN "cannot convert float NaN to integer", inf an
     OverflowError; a good extent gives the ceiling of each side over the resolution."""
-    from kiseki.mapping.build import check_map_size
-
     assert check_map_size(10.0, 4.01, 0.5) == (20, 9)
     for bad in (0.0, float("nan"), float("inf"), -0.1):
         with pytest.raises(ValueError, match="check_map_size: resolution must be a finite number"):
@@ -188,8 +193,6 @@ def test_check_map_size_refuses_what_it_cannot_divide():
 def test_scan_local_map_takes_readings_at_or_below_zero_as_no_reading():
     """A negative or zero reading is no reading, as a NaN one: the local map and its hit cells
     are those of the scan without those beams."""
-    from kiseki.mapping import scan_local_builder
-
     angles = np.linspace(-np.pi, np.pi, 180, endpoint=False)
     ranges = np.full(180, 2.0)
     bad, none = ranges.copy(), ranges.copy()
@@ -205,8 +208,6 @@ def test_scan_local_map_takes_readings_at_or_below_zero_as_no_reading():
 def test_a_max_range_that_is_no_length_is_refused(bad):
     """A NaN max range counted every reading as an endpoint (agreement 1.0); "5" was a numpy
     ufunc error in the local map, 1e300 an overflow warning; a string was taken by build_map."""
-    from kiseki.mapping import scan_local_map
-
     angles = np.linspace(-1.0, 1.0, 9)
     poses, ranges = np.zeros((1, 3)), np.full((1, 9), 2.0)
     grid = build_map(poses, ranges, angles, 10.0)

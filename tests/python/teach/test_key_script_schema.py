@@ -37,6 +37,7 @@ def test_the_limits_themselves_are_accepted(tmp_path):
          f":2: a key script holds at most {MAX_KEYS:,} keys"),
         (f"0 w\n{MAX_SCRIPT_SECONDS + 0.1} q\n",
          f":2: time: must be less than or equal to {MAX_SCRIPT_SECONDS:g}, got"),
+        ("0 w\n1_0 q\n", ":2: time: must be a number of seconds"),  # read as 10 s
     ],
 )  # fmt: skip
 def test_limits_are_enforced_with_the_limit_in_the_message(tmp_path, text, expected):

@@ -49,7 +49,7 @@ class PlaybackConfig:
     goal_tolerance: float = 0.1  # m, the thesis' stop rule
     initial_sd: tuple[float, float, float] = (0.05, 0.05, math.radians(1.0))
     # Odometry motion model noise (Probabilistic Robotics Table 5.6), the same for every method,
-    # set so that its 1-sigma spread covers the simulated AGV's odometry error (sim.robot's
+    # set so that its 1-sigma spread covers the simulated AGV's odometry error (sim.robot_params'
     # OdometryErrorParams) at 10 Hz and 0.5 m/s (0.05 m, up to about 0.05 rad per step):
     #   alpha1 (rot -> rot): track width +0.5 % over a 90 deg turn of about 30 steps needs
     #     0.005^2 * 30 = 7.5e-4, turning slip 5e-5 rad/rad adds 5e-5 / 0.05 = 1e-3 -> 0.002;
