@@ -27,7 +27,8 @@ from kiseki.gp import (
 )
 from kiseki.gp.kernel import subsample
 from kiseki.magnetic.binning import bin_readings
-from kiseki.magnetic.field_map import MAX_CELLS, MagneticFieldMap, TrainingData
+from kiseki.magnetic.field_map import MagneticFieldMap, TrainingData
+from kiseki.magnetic.map_cells import MAX_CELLS, cell_span
 from kiseki.magnetic.map_folder import check_map_destination
 from kiseki.magnetic.map_gp import (
     METHODS,
@@ -160,9 +161,11 @@ def _check_map_size(data: list[Path], x: np.ndarray, margin: float, resolution: 
     MagneticFieldMap.from_gp counts them, within its MAX_CELLS before the fit; a ValueError
     naming the data otherwise (a reading 1e8 m from the others was refused after the fit, in a
     message naming no file)."""
-    lower, upper = x.min(axis=0) - margin, x.max(axis=0) + margin
-    counts = np.maximum(np.ceil(upper / resolution - 1e-9) - np.floor(lower / resolution + 1e-9), 1)
-    if np.prod(counts) > MAX_CELLS:
+    try:
+        counts = cell_span(x.min(axis=0) - margin, x.max(axis=0) + margin, resolution)[2]
+    except ValueError as err:
+        raise ValueError(f"{', '.join(map(str, data))}: {err}") from None
+    if np.prod(counts.astype(float)) > MAX_CELLS:
         span = " x ".join(f"{s:.6g}" for s in np.ptp(x, axis=0))
         raise ValueError(
             f"{', '.join(map(str, data))}: the readings span {span} m: a map of "

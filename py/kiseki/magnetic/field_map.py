@@ -34,6 +34,7 @@ import numpy as np
 
 from kiseki.errors import MapFormatError
 from kiseki.gp import CurlFreeKernel, SquaredExponential
+from kiseki.magnetic.map_cells import MAX_CELLS, cell_span
 from kiseki.magnetic.map_folder import COMPONENTS, read_map_folder, write_map_folder
 from kiseki.magnetic.map_gp import (
     METHODS,
@@ -53,7 +54,6 @@ __all__ = [
     "save_map_folder",
 ]
 
-MAX_CELLS = 20_000_000  # 6 float64 layers: about 1 GB in memory
 OCTOMAP_KEY_OFFSET = 32768  # tree_max_val of OctoMap's default 16-level tree
 
 
@@ -295,16 +295,9 @@ class MagneticFieldMap:
             raise ValueError(f"resolution must be a positive number of metres, got {resolution!r}")
         if resolution <= 0:
             raise ValueError(f"resolution must be a positive number of metres, got {resolution!r}")
-        cells = np.concatenate([lo, hi]) / resolution
-        if not np.all(np.abs(cells) < 2.0**62):  # the int64 cast wrapped: a 1 x 1 map at 1e-300
-            raise ValueError(
-                f"the box {lo}..{hi} at {resolution:g} m is beyond any grid's cell indices"
-            )
-        first = np.floor(lo / resolution + 1e-9).astype(np.int64)
-        last = np.ceil(hi / resolution - 1e-9).astype(np.int64)
+        first, last, counts = cell_span(lo, hi, resolution)
         if d == 3 and np.any(np.abs(np.concatenate([first, last])) > OCTOMAP_KEY_OFFSET):
             raise ValueError(f"the box {lo}..{hi} lies beyond OctoMap's keys at {resolution} m")
-        counts = np.maximum(last - first, 1)
         total = int(np.prod(counts))
         if total > MAX_CELLS:
             raise ValueError(
