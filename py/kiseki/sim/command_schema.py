@@ -24,12 +24,13 @@ from pydantic import Field
 
 from kiseki._support.csv import CsvNumber, data_rows
 from kiseki._support.inputs import CSV_LIMIT, check_input, read_input_text
-from kiseki._support.schema import FileModel, parse
+from kiseki._support.schema import MAGNITUDE_LIMIT, FileModel, parse
 
 __all__ = [
     "HEADERS",
     "MAX_COMMANDS",
     "MAX_COMMAND_SECONDS",
+    "check_command_array",
     "DiffDriveCommand",
     "OmniCommand",
     "read_command_rows",
@@ -98,3 +99,35 @@ def read_command_rows(path: str | os.PathLike) -> np.ndarray:
     if not rows:
         raise ValueError(f"{path}: no commands below the header")
     return np.array(rows, dtype=np.float64)
+
+
+def check_command_array(commands) -> np.ndarray | None:
+    """Commands given as an array (the API's ``simulate(commands=...)``), checked by the rules
+    of a command script: (n, 4) rows t, vx, vy, w (as :func:`kiseki.sim.run.read_commands` gives
+    them) of numbers within +-MAGNITUDE_LIMIT, 1 to MAX_COMMANDS rows, t in [0,
+    MAX_COMMAND_SECONDS] and not decreasing; None stays None. A list was a TypeError, an (n, 3)
+    array an IndexError, and rows out of time order were followed in the wrong order."""
+    if commands is None:
+        return None
+    try:
+        c = np.asarray(commands, dtype=float)
+    except (TypeError, ValueError):
+        c = np.empty((0, 0))
+    if (
+        c.ndim != 2
+        or c.shape[1:] != (4,)
+        or not 0 < len(c) <= MAX_COMMANDS
+        or not np.all(np.abs(c) <= MAGNITUDE_LIMIT)
+    ):
+        raise ValueError(
+            f"commands must be an (n, 4) array of 1 to {MAX_COMMANDS:,} rows t, vx, vy, w (see "
+            f"read_commands), finite numbers within +-{MAGNITUDE_LIMIT:g}, got "
+            f"{np.array2string(c, threshold=8)}"
+        )
+    t = c[:, 0]
+    if not (t[0] >= 0 and t[-1] <= MAX_COMMAND_SECONDS and np.all(np.diff(t) >= 0)):
+        raise ValueError(
+            f"commands: the times (column 0) must lie in [0, {MAX_COMMAND_SECONDS:,.0f}] s and "
+            f"not decrease, got {np.array2string(t, threshold=8)}"
+        )
+    return c

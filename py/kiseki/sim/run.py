@@ -20,12 +20,11 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki._support.field_types import check_field_types
-from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki.control import PurePursuit
 from kiseki.core import check_seed
 from kiseki.io.runlog import TWIST_SCHEMA, TWIST_SCHEMA_NAME, RunWriter, read_run
 from kiseki.sim.collisions import COLLISION_SCHEMA, Collision, CollisionCheck
-from kiseki.sim.command_schema import MAX_COMMAND_SECONDS, read_command_rows
+from kiseki.sim.command_schema import MAX_COMMAND_SECONDS, check_command_array, read_command_rows
 from kiseki.sim.pedestrians import PEDESTRIANS_SCHEMA
 from kiseki.sim.recorder import Recorder, planar_pose
 from kiseki.sim.scene import Scene, check_route_in_bounds
@@ -86,30 +85,6 @@ def read_commands(path: str | os.PathLike) -> np.ndarray:
     if data.shape[1] == 3:
         data = np.column_stack([data[:, :2], np.zeros(len(data)), data[:, 2]])
     return data
-
-
-def _checked_commands(commands) -> np.ndarray | None:
-    """Commands as :func:`read_commands` gives them: (n, 4) rows t, vx, vy, w of numbers within
-    +-MAGNITUDE_LIMIT, t in [0, MAX_SIM_SECONDS] and not decreasing (a list was a TypeError, an
-    (n, 3) array an IndexError, rows out of time order were followed in the wrong order)."""
-    if commands is None:
-        return None
-    try:
-        c = np.asarray(commands, dtype=float)
-    except (TypeError, ValueError):
-        c = np.empty((0, 0))
-    if c.ndim != 2 or c.shape[1:] != (4,) or not len(c) or not np.all(np.abs(c) <= MAGNITUDE_LIMIT):
-        raise ValueError(
-            "commands must be an (n, 4) array of rows t, vx, vy, w (see read_commands), finite "
-            f"numbers within +-{MAGNITUDE_LIMIT:g}, got {np.array2string(c, threshold=8)}"
-        )
-    t = c[:, 0]
-    if not (t[0] >= 0 and t[-1] <= MAX_SIM_SECONDS and np.all(np.diff(t) >= 0)):
-        raise ValueError(
-            f"commands: the times (column 0) must lie in [0, {MAX_SIM_SECONDS:,.0f}] s and not "
-            f"decrease, got {np.array2string(t, threshold=8)}"
-        )
-    return c
 
 
 def _step(setup: RobotSetup, command, dt: float) -> None:
@@ -211,7 +186,7 @@ def simulate(
     if not isinstance(out, str | os.PathLike):
         raise TypeError(f"out must be a path (the MCAP file), got {type(out).__name__}")
     config = config or SimConfig()
-    commands = _checked_commands(commands)
+    commands = check_command_array(commands)
     agents = _agents(scene, config, commands, controller)
     routed = [a for a in agents if a.controller is not None]
     turns = Turns(scene, agents, config) if scene.turns is not None else None

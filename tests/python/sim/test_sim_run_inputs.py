@@ -56,7 +56,9 @@ def test_a_scene_config_or_output_of_another_kind_is_refused_naming_it(
 @pytest.mark.parametrize(
     ("commands", "needle"),
     [
-        (np.array([[0.0, 0.5, 0.0]]), r"commands must be an \(n, 4\) array of rows t, vx, vy, w"),
+        (np.array([[0.0, 0.5, 0.0]]), r"must be an \(n, 4\) array of 1 to 1,000,000 rows t, vx,"),
+        # more rows than a command script may hold (the file's limit, MAX_COMMANDS)
+        (np.zeros((1_000_001, 4)), r"commands must be an \(n, 4\) array of 1 to 1,000,000 rows"),
         (np.array([[0.0, np.nan, 0.0, 0.0]]), r"finite numbers within \+-1e\+09, got \[\[ 0\. nan"),
         (np.array([[0.0, 1e300, 0.0, 0.0]]), r"finite numbers within \+-1e\+09"),
         (np.zeros((0, 4)), r"commands must be an \(n, 4\) array"),
