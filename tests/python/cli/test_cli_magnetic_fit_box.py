@@ -53,3 +53,17 @@ def test_a_3d_box_beyond_octomaps_keys_names_the_file(tmp_path, monkeypatch, cap
     assert lines[0].startswith("kiseki: error: far.csv: the box [")
     assert lines[0].endswith("lies beyond OctoMap's keys at 0.1 m")
     assert not (tmp_path / "m").exists()
+
+
+def test_a_kernel_written_with_an_underscore_is_refused(tmp_path, monkeypatch, capsys) -> None:
+    """--kernel 1_0,1,1 fitted with sigma_f = 10 (float() reads PEP 515 underscores)."""
+    write_aalto(tmp_path / "1", np.random.default_rng(2).uniform(0, 3, (40, 2)))
+    monkeypatch.chdir(tmp_path)
+    args = ("magnetic", "fit", "1", "-o", "m", "--model", "independent", "--kernel", "1_0,1,1")
+    status, _, err = kiseki(monkeypatch, capsys, *args)
+    assert (status, err.strip()) == (
+        1,
+        "kiseki: error: --kernel must be 3 numbers "
+        "sigma_f,l,sigma_n (--model independent), got 1_0,1,1",
+    )
+    assert not (tmp_path / "m").exists()

@@ -262,8 +262,6 @@ MAGNETIC_POINTS = "x,y,mx,my,mz\n0,0,1,2,3\n1,0,1.5,2,3\n0,1,1,2.5,3\n1,1,1,2,3.
         ("1,1", "--kernel must be 3 numbers sigma_f,l,sigma_n (--model independent), got 1,1"),
         ("1,x,1", "--kernel must be 3 numbers sigma_f,l,sigma_n (--model independent), got "
          "1,x,1"),
-        ("1_0,1,1", "--kernel must be 3 numbers sigma_f,l,sigma_n (--model independent), got "
-         "1_0,1,1"),  # sigma_f 10 before
     ],
 )  # fmt: skip
 def test_the_kernels_numbers_have_limits(tmp_path, monkeypatch, capsys, kernel, line):

@@ -11,13 +11,11 @@ the runs are seeded, so they are reproducible anyway.
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import math
 
 import numpy as np
 import pytest
 
-import kiseki.sim.robot as robot_module
 from kiseki.core import Pose2, Random, derive_seed
 from kiseki.sim.motion import BodyMotion, WheelMotion
 from kiseki.sim.odometry import OmniOdometry, WheelOdometry
@@ -279,26 +277,6 @@ def test_diff_drive_rejects_bad_commands(args, needle):
     with pytest.raises(ValueError, match=needle):
         robot.step(*args)
     assert robot.velocity == (0.0, 0.0)  # state untouched
-
-
-@pytest.mark.parametrize("bad", [True, "0.5", "1_0"])
-def test_a_command_that_is_no_number_is_refused(bad):
-    """True drove at 1 m/s and the text "1_0" at 10 m/s (float() of anything not a number)."""
-    with pytest.raises(ValueError, match="v_cmd must be a finite number"):
-        DiffDriveRobot().step(bad, 0.0, 0.1)
-
-
-@pytest.mark.parametrize(
-    ("name", "module"),
-    [("WheelOdometry", "odometry"), ("OmniOdometry", "odometry"),
-     ("OdometryErrorParams", "robot_params"), ("OmniOdometryErrorParams", "robot_params")],
-)  # fmt: skip
-def test_names_moved_out_of_the_robot_module_import_with_a_warning(name, module):
-    with pytest.warns(DeprecationWarning, match=f"moved to kiseki.sim.{module}.{name}"):
-        moved = getattr(robot_module, name)
-    assert moved is getattr(importlib.import_module(f"kiseki.sim.{module}"), name)
-    with pytest.raises(AttributeError):
-        robot_module.NoSuchName  # noqa: B018
 
 
 def test_bad_poses_and_velocities_are_rejected():
