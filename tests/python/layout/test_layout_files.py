@@ -83,7 +83,6 @@ LINE_LIMIT = 400
 LONG_FILES = {
     "datasets/rosbag.py": "one reader for ROS 1 and 2 bags, the checks three storages share",
     "sim/magnetic.py": "the simulated field and the magnetometer that reads it",
-    "apps/teach/teaching.py": "a teaching run, its recovery from the log and its files",
 }
 
 

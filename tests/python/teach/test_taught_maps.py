@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 from kiseki import _core
-from kiseki.apps.teach.teaching import _environment, measure_taught_maps
+from kiseki.apps.teach.teaching_files import environment_grid, measure_taught_maps
 from kiseki.control import PurePursuit
 from kiseki.core import Pose2
 from kiseki.metrics import taught_map_truth
@@ -34,7 +34,7 @@ def perfect_teaching(project_data):
     cameras = [s for s in build_sensors(scene, setup, 0, 0.1) if s.kind == "depth_camera"]
     makers = {b: LocalMapMaker([c.device for c in cameras], b) for b in BANDS}
     maps = {
-        (rule, b): EnvironmentMap(_environment(scene), rule)
+        (rule, b): EnvironmentMap(environment_grid(scene), rule)
         for rule in ("thesis", "evidence")
         for b in BANDS
     }

@@ -8,6 +8,7 @@ playback run (`playback`) follows a taught route with the localization engine. T
 from __future__ import annotations
 
 from kiseki.apps.teach.playback import PlaybackConfig, PlaybackResult, playback
-from kiseki.apps.teach.teaching import TeachResult, teach
+from kiseki.apps.teach.teaching import teach
+from kiseki.apps.teach.teaching_files import TeachResult
 
 __all__ = ["PlaybackConfig", "PlaybackResult", "TeachResult", "playback", "teach"]

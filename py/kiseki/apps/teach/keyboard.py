@@ -28,7 +28,8 @@ import sys
 import time
 from typing import TextIO
 
-from kiseki.apps.teach.teaching import TeachingRun, TeachResult
+from kiseki.apps.teach.teaching import TeachingRun
+from kiseki.apps.teach.teaching_files import TeachResult
 from kiseki.sim.scene import Scene
 from kiseki.teach.key_script_schema import KEYS, read_key_script
 

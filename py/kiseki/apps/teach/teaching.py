@@ -7,31 +7,29 @@ to MCAP as it goes (odometry, depth images, waypoint marks), so that `recover` r
 and the waypoints from the log after a crash, losing at most the last unwritten chunk (well
 under a second at 10 Hz).
 
-Why one file over 400 lines: a teaching run, its recovery from the log and the files it
-writes are one run's life; the maps and waypoints it builds are kiseki.teach's.
+The files a run writes (its maps, their truth, the waypoint file) are `teaching_files`'.
 """
 
 from __future__ import annotations
 
 import contextlib
-import hashlib
-import json
 import math
 import os
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 from tqdm import tqdm
 
-from kiseki._support.atomic import atomic_write_all, check_writable_folder, reworded
+from kiseki._support.atomic import check_writable_folder, reworded
+from kiseki.apps.teach.teaching_files import (
+    TeachResult,
+    environment_grid,
+    measure_taught_maps,
+    write_teaching_files,
+)
 from kiseki.control import PurePursuit
 from kiseki.core import Pose2
-from kiseki.grid import OccupancyGrid
-from kiseki.io.ros_map import map_files
 from kiseki.io.runlog import RunWriter, read_run
-from kiseki.metrics import taught_map_truth
 from kiseki.sim.scene import Scene, check_route_in_bounds
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import MERGE_RULES, EnvironmentMap
@@ -43,12 +41,7 @@ from kiseki.teach.scene_identity import (
     scene_digest,
 )
 
-__all__ = [
-    "TeachResult",
-    "TeachingRun",
-    "recover",
-    "teach",
-]
+__all__ = ["TeachingRun", "recover", "teach"]
 
 MARK_SCHEMA = {
     "type": "object",
@@ -62,114 +55,6 @@ MARK_SCHEMA = {
         "truth": {"type": "array"},
     },
 }
-
-
-@dataclass(frozen=True)
-class TeachResult:
-    maps: dict[str, Path]  # band -> map YAML
-    waypoints: Path | None  # None: no waypoint was marked, no waypoint file written
-    log: Path
-    steps: int
-    marks: list[dict]
-    merge: str = "thesis"  # the merge rule the maps were built with
-    truth: dict | None = None  # band -> the map against the scene's truth (map_truth.json)
-    scene: TaughtScene | None = None  # the scene file taught in and its SHA-1
-
-
-def _environment(scene: Scene, resolution: float = 0.1, margin: float = 4.0) -> OccupancyGrid:
-    lo, hi = scene.bounds
-    width = int(math.ceil((hi[0] - lo[0] + 2 * margin) / resolution))
-    height = int(math.ceil((hi[1] - lo[1] + 2 * margin) / resolution))
-    return OccupancyGrid(width, height, resolution, Pose2(lo[0] - margin, lo[1] - margin, 0.0))
-
-
-def measure_taught_maps(
-    scene: Scene,
-    maps: dict[str, OccupancyGrid],
-    truths: np.ndarray,
-    cameras: list,
-    local_size: float = 8.0,
-) -> dict:
-    """Each taught map against the scene's ground truth at its own band's heights (and its
-    resolution), over what the cameras could reach from the true poses of the run: see
-    `kiseki.metrics.taught_map_truth` (every camera's poses together: a cell that several
-    reach counts once). A camera's reach is half the local map's size less the mount's offset
-    from the robot's centre (so every cell in reach lies inside L), within its max range, and
-    no nearer than its minimum depth (a bench under it is invisible)."""
-    truths = np.asarray(truths, dtype=np.float64).reshape(-1, 3)
-    poses, hfov, reach, min_range = [], [], [], []
-    for camera in cameras:
-        device, mount = camera.device, camera.device.mount
-        poses.append(np.array([mount.planar(p) for p in truths]).reshape(-1, 3))
-        n = len(truths)
-        hfov.append(np.full(n, math.radians(device.params.hfov_deg)))
-        far = min(device.params.max_range, 0.5 * local_size - math.hypot(mount.x, mount.y))
-        reach.append(np.full(n, far))
-        min_range.append(np.full(n, device.params.min_range))
-    poses, hfov, reach, min_range = (np.concatenate(v) for v in (poses, hfov, reach, min_range))
-    out = {}
-    for band, grid in maps.items():
-        truth = scene.ground_truth(*BANDS[band], resolution=grid.resolution)
-        measured = taught_map_truth(grid, truth, poses, hfov, reach, min_range)
-        out[band] = {**measured.as_dict(), "truth_band_m": list(BANDS[band])}
-    return out
-
-
-def _write_outputs(
-    out: Path,
-    maps: dict[str, OccupancyGrid],
-    marks: list[dict],
-    log: Path,
-    steps: int,
-    merge: str,
-    truth: dict | None,
-    scene: TaughtScene,
-) -> TeachResult:
-    """Every file is written before any replaces its previous version (a full disk leaves the
-    previous maps and waypoint file as they were, consistent with one another)."""
-    paths = {band: out / f"map_{band}.yaml" for band in maps}
-    writes, digests = [], {}
-    for band, grid in maps.items():
-        (image, write_image), yaml_file = map_files(grid, paths[band])
-
-        def hashed(tmp: str, band=band, write_image=write_image) -> None:
-            write_image(tmp)
-            digests[band] = hashlib.sha1(Path(tmp).read_bytes()).hexdigest()
-
-        writes += [(image, hashed), yaml_file]
-    if truth is not None:
-        truth_text = json.dumps({"merge": merge, "maps": truth}, indent=2)
-        writes.append(
-            (out / "map_truth.json", lambda tmp: Path(tmp).write_text(truth_text, "utf-8"))
-        )
-
-    def taught_map(band: str, p: Path) -> dict:
-        """What ties the waypoints to a map: its file, its image's digest, its geometry."""
-        origin = maps[band].origin
-        return {
-            "file": p.name,
-            "image_sha1": digests[band],
-            "resolution": float(maps[band].resolution),
-            "origin": [float(origin.x), float(origin.y), float(origin.theta)],
-        }
-
-    def waypoints(tmp: str) -> None:  # after the images: it records their digests
-        doc = {
-            "log": log.name,
-            "merge": merge,
-            "scene_file": scene.file,
-            "scene_sha1": scene.sha1,
-            "maps": {band: taught_map(band, p) for band, p in paths.items()},
-            "waypoints": marks,
-        }
-        Path(tmp).write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
-
-    if not marks:  # a waypoint file holds at least one (playback and serve refuse an empty one)
-        atomic_write_all(writes)
-        (out / "waypoints.yaml").unlink(missing_ok=True)  # an earlier teaching's, of other maps
-        return TeachResult(paths, None, log, steps, marks, merge, truth, scene)
-    atomic_write_all([*writes, (out / "waypoints.yaml", waypoints)])
-    return TeachResult(paths, out / "waypoints.yaml", log, steps, marks, merge, truth, scene)
 
 
 class TeachingRun:
@@ -209,7 +94,7 @@ class TeachingRun:
         if not self.cameras:
             raise ValueError(f"{scene.path}: teaching needs the robot's depth cameras")
         self.makers = {b: LocalMapMaker([c.device for c in self.cameras], b) for b in BANDS}
-        self.maps = {b: EnvironmentMap(_environment(scene), merge) for b in BANDS}
+        self.maps = {b: EnvironmentMap(environment_grid(scene), merge) for b in BANDS}
         self.marks: list[dict] = []
         self.truths: list[tuple[float, float, float]] = []  # true pose of every logged step
         self.steps = 0  # steps logged
@@ -313,7 +198,7 @@ class TeachingRun:
         self.close()
         maps = {b: m.map() for b, m in self.maps.items()}
         truth = measure_taught_maps(self.scene, maps, np.array(self.truths), self.cameras)
-        return _write_outputs(
+        return write_teaching_files(
             self.out, maps, self.marks, self.log, self.steps, self.merge, truth, self.scene_id
         )
 
@@ -427,7 +312,7 @@ def recover(
         truth = {round(float(t), 6): tuple(p) for t, p in zip(times, poses, strict=True)}
     images = [dict((round(t, 6), d) for t, d in run.depth_images(f"/{c.name}")) for c in cameras]
     makers = {b: LocalMapMaker([c.device for c in cameras], b) for b in BANDS}
-    maps = {b: EnvironmentMap(_environment(scene), merge) for b in BANDS}
+    maps = {b: EnvironmentMap(environment_grid(scene), merge) for b in BANDS}
     steps, truths = 0, []
     for t in sorted(odom):
         if all(t in im for im in images):
@@ -442,4 +327,5 @@ def recover(
     grids = {b: m.map() for b, m in maps.items()}
     measured = measure_taught_maps(scene, grids, np.array(truths), cameras) if truths else None
     scene_id = TaughtScene(recorded_scene_file(scene.path, out), scene_digest(scene.path), str(out))
-    return _write_outputs(Path(out), grids, marks, Path(log), steps, merge, measured, scene_id)
+    files = (grids, marks, Path(log), steps, merge, measured, scene_id)
+    return write_teaching_files(Path(out), *files)
