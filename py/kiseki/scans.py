@@ -86,11 +86,7 @@ class LaserScans:
                     f"LaserScans: {name} has shape {np.shape(getattr(self, name))}, expected "
                     f"{shape} ({n} scans in times, {b} beams in angles)"
                 )
-        m = self.max_range
-        if isinstance(m, bool) or not isinstance(m, numbers.Real) or not m > 0:
-            raise ValueError(f"LaserScans: max_range must be a number > 0, got {m!r}")
-        if not math.isfinite(m):
-            raise ValueError(f"LaserScans: max_range must be finite, got {m!r}")
+        check_max_range("LaserScans", self.max_range)
 
     def __len__(self) -> int:
         return int(self.times.shape[0])
@@ -190,10 +186,11 @@ def beams_of_one_turn(start: float, step: float, beams: int) -> bool:
 def apply_range_rule(ranges: np.ndarray, max_range: float) -> np.ndarray:
     """Readings as kiseki keeps them (float32, C-contiguous, a new array): invalid readings
     (NaN, -inf, negative, zero) as NaN, +inf (no return) as ``max_range``."""
-    if not (isinstance(max_range, numbers.Real) and 0 < max_range < math.inf):
-        # -1 was stored for every no return
+    if not (isinstance(max_range, numbers.Real) and 0 < max_range <= MAGNITUDE_LIMIT):
+        # -1 was stored for every no return; the bound is check_max_range's
         raise ValueError(
-            f"apply_range_rule: max_range must be a finite number > 0, got {max_range!r}"
+            "apply_range_rule: max_range must be a finite number > 0, at most "
+            f"{MAGNITUDE_LIMIT:g} m, got {max_range!r}"
         )
     with np.errstate(over="ignore", invalid="ignore"):  # beyond float32: +inf, a no return
         out = np.array(ranges, dtype=np.float32, order="C", copy=True)

@@ -69,6 +69,7 @@ from kiseki.scans import (
     LaserScans,
     apply_range_rule,
     beams_of_one_turn,
+    check_max_range,
     check_odometry_jumps,
     largest_reading,
 )
@@ -245,6 +246,10 @@ def _laser_scans(
         max_range = largest_reading(readings)
         if max_range is None:
             raise LogFormatError(f"{path}:{rows[0][0]}: no valid range reading in any {kind}")
+        try:
+            check_max_range(f"{path}: the largest reading (the maximum range)", max_range)
+        except ValueError as err:
+            raise LogFormatError(str(err)) from None
     scans = LaserScans(
         times=values[:, time].copy(),
         poses=values[:, pose : pose + 3].copy(),
@@ -290,9 +295,10 @@ def _flaser_max_range(
         value = float(np.float32(parse_float(text)))
     except ValueError:
         raise LogFormatError(f"{where} is not a number") from None
-    if not np.isfinite(value) or value <= 0:
-        raise LogFormatError(f"{where} is not positive")
-    return value
+    try:
+        return check_max_range(where, value)  # 1e10 was read, refused by the map naming no file
+    except ValueError as err:
+        raise LogFormatError(str(err)) from None
 
 
 def _robotlaser_fields(path: Path, lineno: int, tokens: list[str]) -> list[str]:

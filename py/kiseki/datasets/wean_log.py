@@ -45,7 +45,13 @@ from kiseki._support.numbers_text import NumberTextError, float_array
 from kiseki.datasets._files import GZIP_MAGIC, read_maybe_gzipped
 from kiseki.datasets.carmen import VALUE_LIMIT, flaser_angles
 from kiseki.errors import LogFormatError
-from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps, largest_reading
+from kiseki.scans import (
+    LaserScans,
+    apply_range_rule,
+    check_max_range,
+    check_odometry_jumps,
+    largest_reading,
+)
 
 __all__ = ["MAX_LOG_BYTES", "WeanLog", "is_wean_log", "read_wean_log"]
 
@@ -130,6 +136,10 @@ def read_wean_log(path: str | os.PathLike) -> WeanLog:
     max_range = largest_reading(readings)
     if max_range is None:
         raise LogFormatError(f"{path}:{laser_lines[0]}: no valid range reading in any L line")
+    try:
+        check_max_range(f"{path}: the largest reading (the maximum range)", max_range)
+    except ValueError as err:
+        raise LogFormatError(str(err)) from None
     odometry = np.column_stack([values[:, 3:5] * CM, values[:, 5]])
     scans = LaserScans(
         times=values[:, -1].copy(),

@@ -341,3 +341,23 @@ def test_corrected_logs_hold_no_raw_odometry(shared_data: Path) -> None:
     for path in carmen_logs(shared_data):
         scans = read_carmen_log(path).scans
         np.testing.assert_array_equal(scans.odometry, scans.poses, err_msg=str(path))
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        (
+            "PARAM robot_front_laser_max 1e10 nohost 0\n" + GOOD_FLASER,
+            ":1: PARAM robot_front_laser_max",
+        ),
+        (
+            flaser([1.0, 1e10], [0] * 3, [0] * 3, 1.0),
+            ": the largest reading \\(the maximum range\\)",
+        ),
+    ],
+)
+def test_a_maximum_range_past_a_billion_metres_is_refused_naming_the_log(tmp_path, text, needle):
+    """1e10 m was read, and the map built from the log refused it naming no file."""
+    path = write(tmp_path / "far.log", text + "\n")
+    with pytest.raises(LogFormatError, match=f"far\\.log{needle}.*at most 1e\\+09 m"):
+        read_carmen_log(path)

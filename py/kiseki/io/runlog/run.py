@@ -38,7 +38,13 @@ from kiseki.io.runlog.schemas import (
     TWIST_SCHEMA_NAME,
     MissingTopicError,
 )
-from kiseki.scans import LaserScans, apply_range_rule, check_odometry_jumps, largest_reading
+from kiseki.scans import (
+    LaserScans,
+    apply_range_rule,
+    check_max_range,
+    check_odometry_jumps,
+    largest_reading,
+)
 
 __all__ = ["SimRun"]
 
@@ -293,9 +299,10 @@ class SimRun:
             raise LogFormatError(f"{self.path}: bad max_range {limit_text!r}") from exc
         if limit is None:
             raise LogFormatError(f"{self.path}: no valid range reading on {scan_topic!r}")
-        limit = float(np.float32(limit))
-        if not (math.isfinite(limit) and limit > 0):
-            raise LogFormatError(f"{self.path}: bad max_range {limit_text!r}")
+        try:
+            limit = check_max_range(f"{self.path}: {scan_topic!r}", float(np.float32(limit)))
+        except ValueError as err:
+            raise LogFormatError(str(err)) from None
         laser = LaserScans(
             times=times,
             poses=np.ascontiguousarray(poses, dtype=np.float64),
