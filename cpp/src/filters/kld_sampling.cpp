@@ -15,16 +15,23 @@ void check_err_z(double err, double z) {
     throw std::invalid_argument("KLD sampling: err must lie in (0, 1] and z in [0, 10]");
   }
 }
-}  // namespace
 
-std::size_t kld_sample_bound(std::size_t bins, double err, double z) {
-  check_err_z(err, z);
+// Fox's eq. 14 for err and z already checked.
+std::size_t sample_bound(std::size_t bins, double err, double z) {
   if (bins <= 1) return 0;
   const double k1 = static_cast<double>(bins - 1);
   const double a = 2.0 / (9.0 * k1);
   const double b = 1.0 - a + std::sqrt(a) * z;
   return static_cast<std::size_t>(std::ceil(k1 / (2.0 * err) * b * b * b));
 }
+}  // namespace
+
+std::size_t kld_sample_bound(std::size_t bins, double err, double z) {
+  check_err_z(err, z);
+  return sample_bound(bins, err, z);
+}
+
+KldBins::KldBins(const KldParams& params) : params_(params) { check_err_z(params.err, params.z); }
 
 void KldParams::validate() const {
   check_err_z(err, z);
@@ -58,7 +65,7 @@ bool KldBins::add(double s) {
 bool KldBins::enough(std::size_t n) const {
   if (n < params_.min_particles) return false;
   if (n >= params_.max_particles) return true;
-  return n >= kld_sample_bound(bins_.size(), params_.err, params_.z);
+  return n >= sample_bound(bins_.size(), params_.err, params_.z);  // checked by the constructor
 }
 
 }  // namespace kiseki

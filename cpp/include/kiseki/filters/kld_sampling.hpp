@@ -37,7 +37,8 @@ struct KldParams {
 /// The occupied bins of a growing sample.
 class KldBins {
  public:
-  explicit KldBins(const KldParams& params) : params_(params) {}
+  /// Checks err and z once here: enough() runs for every particle drawn.
+  explicit KldBins(const KldParams& params);
   /// Adds a sample; returns true if it fell into a new bin.
   bool add(const Pose2& pose);
   bool add(double distance);
