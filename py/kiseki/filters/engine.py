@@ -20,6 +20,7 @@ object.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Callable
 from dataclasses import dataclass, fields
 
@@ -27,7 +28,8 @@ import numpy as np
 
 from kiseki import _core
 from kiseki._support.field_types import check_field_types
-from kiseki._support.options import THREAD_LIMIT
+from kiseki._support.options import PARTICLE_LIMIT, THREAD_LIMIT
+from kiseki._support.schema import INT32_MAX
 from kiseki.core import Pose2, check_seed
 from kiseki.filters.initial_pose import check_particles, check_start
 from kiseki.grid import OccupancyGrid
@@ -135,11 +137,11 @@ class MclConfig:
     def __post_init__(self) -> None:
         check_field_types(self)
         _check(
-            isinstance(self.particles, int) and 1 <= self.particles <= 10_000_000,
-            f"particles must be an integer in 1..10,000,000, got {self.particles!r}",
+            isinstance(self.particles, numbers.Integral) and 1 <= self.particles <= PARTICLE_LIMIT,
+            f"particles must be an integer in 1..{PARTICLE_LIMIT:,}, got {self.particles!r}",
         )
         _check(
-            isinstance(self.min_particles, int) and self.min_particles >= 1,
+            isinstance(self.min_particles, numbers.Integral) and self.min_particles >= 1,
             f"min_particles must be an integer >= 1, got {self.min_particles!r}",
         )
         _check(
@@ -163,7 +165,7 @@ class MclConfig:
             f"recovery must be one of {', '.join(RECOVERY_MODES)}, got {self.recovery!r}",
         )
         _check(
-            isinstance(self.threads, int) and 0 <= self.threads <= THREAD_LIMIT,
+            isinstance(self.threads, numbers.Integral) and 0 <= self.threads <= THREAD_LIMIT,
             f"threads must be an integer in 0..{THREAD_LIMIT} (0 = chosen by measured time), "
             f"got {self.threads!r}",
         )
@@ -173,7 +175,8 @@ class MclConfig:
             f"got {self.sensor_reset_proposal!r}",
         )
         _check(
-            isinstance(self.matcher_search_every, int) and 1 <= self.matcher_search_every <= 1000,
+            isinstance(self.matcher_search_every, numbers.Integral)
+            and 1 <= self.matcher_search_every <= 1000,
             "matcher_search_every must be an integer in 1..1000, "
             f"got {self.matcher_search_every!r}",
         )
@@ -189,7 +192,7 @@ class MclConfig:
         )
         for f in fields(self):  # the core's ints (10**300 was a pybind11 list of signatures)
             value = getattr(self, f.name)
-            if f.type == "int" and not -(2**31) <= value < 2**31:
+            if f.type == "int" and not -INT32_MAX - 1 <= value <= INT32_MAX:
                 raise ValueError(f"{f.name} must be a C++ int (within +-2**31), got {value}")
         _check(
             self.update_min_d < MAX_ODOMETRY_JUMP,

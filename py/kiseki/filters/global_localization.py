@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import numbers
 import os
 import time
 from dataclasses import asdict, dataclass, field
@@ -157,7 +158,7 @@ class GlobalConfig:
                     f"global localization: {name} must be an integer in 1..10,000,000, "
                     f"got {value!r}"
                 )
-        if not (isinstance(self.beams, int) and self.beams >= 0):
+        if not (isinstance(self.beams, numbers.Integral) and self.beams >= 0):
             raise ValueError(f"beams must be an integer >= 0 (0 = every beam), got {self.beams!r}")
         if self.recovery not in RECOVERY_MODES:
             raise ValueError(

@@ -6,6 +6,7 @@ saved with every result."""
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass
 
 from kiseki._support.field_types import check_field_types
@@ -142,7 +143,7 @@ class LocalizeConfig:
         )
         check_spread("initial_sd", self.initial_sd)  # 1e300 was refused only by the run
         _check(
-            isinstance(self.beams, int) and self.beams >= 0,
+            isinstance(self.beams, numbers.Integral) and self.beams >= 0,
             f"beams must be an integer >= 0 (0 = every beam), got {self.beams!r}",
         )
         _check(
@@ -214,7 +215,7 @@ class LocalizeConfig:
             0 < self.budget_share <= 1, f"budget_share must lie in (0, 1], got {self.budget_share}"
         )
         _check(
-            isinstance(self.budget_min_beams, int) and self.budget_min_beams >= 1,
+            isinstance(self.budget_min_beams, numbers.Integral) and self.budget_min_beams >= 1,
             f"budget_min_beams must be an integer >= 1, got {self.budget_min_beams!r}",
         )
         # the engine's checks, as ValueError, of the alphas given (1e300 was taken here and

@@ -79,7 +79,7 @@ class LoopTravelConfig:
 
     def __post_init__(self) -> None:
         check_field_types(self)
-        if isinstance(self.particles, bool) or not isinstance(self.particles, int):
+        if isinstance(self.particles, bool) or not isinstance(self.particles, numbers.Integral):
             raise ValueError(f"loop filter: particles must be an integer, got {self.particles!r}")
         if not 1 <= self.particles <= 10_000_000:
             raise ValueError(
@@ -107,7 +107,7 @@ class LoopTravelConfig:
             raise ValueError(
                 f"loop filter: 0 < alpha_slow < alpha_fast <= 1 is needed, got {a!r}, {b!r}"
             )
-        if isinstance(self.seed, bool) or not isinstance(self.seed, int):
+        if isinstance(self.seed, bool) or not isinstance(self.seed, numbers.Integral):
             raise ValueError(f"loop filter: seed must be an integer, got {self.seed!r}")
         if not 0 <= self.seed < 2**64:
             raise ValueError(f"loop filter: seed must be in [0, 2**64), got {self.seed}")

@@ -49,7 +49,8 @@ class DriftCheck:
     limit: float = 3.0  # |mean normalised innovation| above which a sensor is dropped
 
     def __post_init__(self) -> None:
-        if isinstance(self.window, bool) or not isinstance(self.window, int) or self.window < 2:
+        window = self.window
+        if isinstance(window, bool) or not isinstance(window, numbers.Integral) or window < 2:
             raise ValueError(f"drift check: window must be an integer >= 2, got {self.window!r}")
         ok = isinstance(self.limit, numbers.Real) and not isinstance(self.limit, bool)
         if not (ok and math.isfinite(self.limit) and self.limit > 0):

@@ -127,7 +127,7 @@ class DistanceLimiterConfig:
             raise ValueError(
                 f"DistanceLimiterConfig.half_angle must be <= pi, got {self.half_angle}"
             )
-        if not (isinstance(self.free_threshold, int) and self.free_threshold <= 100):
+        if not (isinstance(self.free_threshold, numbers.Integral) and self.free_threshold <= 100):
             raise ValueError("DistanceLimiterConfig.free_threshold must be an integer in 0..100")
 
     @property
@@ -200,7 +200,7 @@ class PolygonLimiterConfig:
             raise ValueError(
                 f"PolygonLimiterConfig.slowdown_ratio must be in (0, 1], got {self.slowdown_ratio}"
             )
-        if not isinstance(self.min_points, int) or isinstance(self.min_points, bool):
+        if not isinstance(self.min_points, numbers.Integral) or isinstance(self.min_points, bool):
             raise ValueError(
                 f"PolygonLimiterConfig.min_points must be an integer, got {self.min_points!r}"
             )

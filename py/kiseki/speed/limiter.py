@@ -174,7 +174,8 @@ class SpeedLimiterConfig:
             )
         if not self.w2 > self.w1:
             raise ValueError(f"SpeedLimiterConfig: w2 ({self.w2}) must exceed w1 ({self.w1})")
-        if not (isinstance(self.free_threshold, int) and 0 <= self.free_threshold <= 100):
+        threshold = self.free_threshold
+        if not (isinstance(threshold, numbers.Integral) and 0 <= threshold <= 100):
             raise ValueError("SpeedLimiterConfig.free_threshold must be an integer in 0..100")
 
     def to_dict(self) -> dict:

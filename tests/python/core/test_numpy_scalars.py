@@ -10,8 +10,10 @@ import numpy as np
 import pytest
 
 from kiseki.control import PriorityArbiter
+from kiseki.filters import MclConfig
 from kiseki.gp import CurlFreeKernel, SquaredExponential
 from kiseki.magnetic import build_linear_map, geometric_features
+from kiseki.magnetic.loop_travel_distance import LoopTravelConfig
 from kiseki.magnetic.navigators import r_z
 from kiseki.magnetic.rahok_navigation import moving_average, taught_peaks
 from kiseki.terrain import attitude_matrix
@@ -56,6 +58,8 @@ def _same(a, b) -> None:
         ),
         (lambda p: PriorityArbiter({"a": p, "b": 1.0}).priorities["a"], (np.int64(3),), (3,)),
         # int64 was refused by checks written as int | float | np.floating
+        (lambda n: MclConfig(particles=n).to_core().particles, (np.int64(500),), (500,)),
+        (lambda n: LoopTravelConfig(particles=n).particles, (np.int64(500),), (500,)),
         (r_z, (np.int64(1), np.int64(0), np.int64(2)), (1, 0, 2)),
         (lambda c: moving_average(np.arange(7.0), c), (np.int64(3),), (3,)),
         (
