@@ -298,12 +298,13 @@ class MagneticFieldMap:
         first, last, counts = cell_span(lo, hi, resolution)
         if d == 3 and np.any(np.abs(np.concatenate([first, last])) > OCTOMAP_KEY_OFFSET):
             raise ValueError(f"the box {lo}..{hi} lies beyond OctoMap's keys at {resolution} m")
-        total = int(np.prod(counts))
-        if total > MAX_CELLS:
+        cells = float(np.prod(counts.astype(float)))  # in int64, 2**32 x 2**32 cells made 0
+        if cells > MAX_CELLS:
             raise ValueError(
-                f"{' x '.join(map(str, counts))} cells at {resolution} m is {total:,} cells, more "
-                f"than {MAX_CELLS:,}: choose a coarser resolution or a smaller box"
+                f"{' x '.join(map(str, counts))} cells at {resolution} m is {cells:,.0f} cells, "
+                f"more than {MAX_CELLS:,}: choose a coarser resolution or a smaller box"
             )
+        total = int(cells)
         origin = first * float(resolution)
         shape = tuple(int(k) for k in counts[::-1])
         at = height if gd > d else None

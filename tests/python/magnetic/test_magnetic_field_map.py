@@ -132,6 +132,9 @@ def test_from_gp_evaluates_the_gp_on_octomap_aligned_cells(monkeypatch):
     for lower, upper, resolution in (([0, 0], [1, 1], 1e-300), ([-1e300, 0], [1e300, 1], 0.1)):
         with pytest.raises(ValueError, match="beyond any grid's cell indices"):
             MagneticFieldMap.from_gp(gp2, lower, upper, resolution)
+    # 2**32 x 2**32 cells: their int64 product wrapped to 0 and passed the cell limit
+    with pytest.raises(ValueError, match="more than 20,000,000"):
+        MagneticFieldMap.from_gp(gp2, [0, 0], [2.0**32, 2.0**32], 1.0)
 
 
 def test_voxel_centres_are_octomap_key_centres():
