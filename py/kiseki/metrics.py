@@ -72,8 +72,10 @@ def as_se3(poses: np.ndarray) -> np.ndarray:
         c, s = np.cos(p[:, 2]), np.sin(p[:, 2])
         out[:, 0, 0], out[:, 0, 1], out[:, 1, 0], out[:, 1, 1] = c, -s, s, c
         out[:, 0, 3], out[:, 1, 3] = p[:, 0], p[:, 1]
-        p = out
-    elif not (p.ndim == 3 and p.shape[1:] == (4, 4)):
+        if not np.isfinite(out).all():
+            raise ValueError("poses contain NaN or infinite values")
+        return out  # built here: rigid by construction
+    if not (p.ndim == 3 and p.shape[1:] == (4, 4)):
         raise ValueError(f"poses must have shape (n, 3) or (n, 4, 4), got {p.shape}")
     if not np.isfinite(p).all():
         raise ValueError("poses contain NaN or infinite values")
