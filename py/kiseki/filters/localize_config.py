@@ -13,6 +13,7 @@ from kiseki._support.field_types import check_field_types
 from kiseki.core import check_seed
 from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS, MclConfig
 from kiseki.filters.initial_pose import check_spread
+from kiseki.filters.odometry_noise import NOISE_FRACTION_LIMIT
 from kiseki.filters.reliability import RELIABILITY_ESTIMATES
 from kiseki.grid import DEFAULT_RAY_CASTER, ray_caster
 
@@ -138,8 +139,9 @@ class LocalizeConfig:
         )
         check_seed(self.seed)
         _check(
-            0 <= self.odometry_noise < 10,  # as noisy_odometry: the SD as a multiple of each step
-            f"odometry noise must be >= 0 and below 10, got {self.odometry_noise}",
+            0 <= self.odometry_noise < NOISE_FRACTION_LIMIT,  # the SD as a multiple of each step
+            f"odometry noise must be >= 0 and below {NOISE_FRACTION_LIMIT:g}, "
+            f"got {self.odometry_noise}",
         )
         check_spread("initial_sd", self.initial_sd)  # 1e300 was refused only by the run
         _check(

@@ -23,7 +23,7 @@ class OdometrySettings(Protocol):
     odometry_noise: float
 
 
-__all__ = ["motion_alphas", "noisy_odometry"]
+__all__ = ["NOISE_FRACTION_LIMIT", "motion_alphas", "noisy_odometry"]
 
 
 def motion_alphas(config: OdometrySettings, scans: LaserScans) -> tuple[float, ...]:
@@ -48,15 +48,23 @@ def motion_alphas(config: OdometrySettings, scans: LaserScans) -> tuple[float, .
     return tuple(max(b + a, 1e-6) for b, a in zip(base, added, strict=True))
 
 
+NOISE_FRACTION_LIMIT = 10.0
+"""The largest odometry noise, as a multiple of each step's size (exclusive): noise ten times the
+motion itself is no odometry."""
+
+
 def noisy_odometry(poses: np.ndarray, fraction: float, seed: int) -> np.ndarray:
     """Odometry rebuilt from the increments of `poses` (in each previous pose's frame), each
     component perturbed by zero-mean Gaussian noise with SD = fraction x |component|."""
     poses = np.asarray(poses, dtype=float)
     if isinstance(fraction, bool) or not (
-        isinstance(fraction, numbers.Real) and 0 <= fraction < 10
+        isinstance(fraction, numbers.Real) and 0 <= fraction < NOISE_FRACTION_LIMIT
     ):
         # -0.5 or NaN added no noise without a word
-        raise ValueError(f"noisy_odometry: fraction must be a number in [0, 10), got {fraction!r}")
+        raise ValueError(
+            f"noisy_odometry: fraction must be a number in [0, {NOISE_FRACTION_LIMIT:g}), "
+            f"got {fraction!r}"
+        )
     if poses.ndim != 2 or poses.shape[1] != 3 or not np.isfinite(poses).all():
         raise ValueError(
             f"noisy_odometry: poses must be an (n, 3) array of finite numbers, got {poses.shape}"
