@@ -23,7 +23,6 @@ the reduced-rank version.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -33,7 +32,7 @@ import scipy.linalg.lapack
 import scipy.optimize
 
 from kiseki.gp._data import check_iterations, inputs_array, targets_array
-from kiseki.gp.kernel import KERNEL_HIGH, KERNEL_LOW, subsample
+from kiseki.gp.kernel import check_hyperparameters, subsample
 
 __all__ = [
     "CurlFreeFit",
@@ -60,19 +59,7 @@ class CurlFreeKernel:
     sigma_n: float
 
     def __post_init__(self) -> None:
-        for name in _NAMES:
-            v = getattr(self, name)
-            if (
-                isinstance(v, bool)
-                or not isinstance(v, numbers.Real)
-                # as a Python float: a float32 would take the bounds as float32 (1e50: inf)
-                or not (KERNEL_LOW if name == "length_scale" else 0.0) < float(v) <= KERNEL_HIGH
-            ):
-                raise ValueError(
-                    f"CurlFreeKernel: {name} must be a finite number > 0 (at most 1e50, "
-                    f"a length at least 1e-50), got {v!r}"
-                )
-            object.__setattr__(self, name, float(v))
+        check_hyperparameters(self, _NAMES)
 
     def to_dict(self) -> dict[str, float]:
         return asdict(self)

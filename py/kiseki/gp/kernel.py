@@ -34,6 +34,24 @@ __all__ = [
 ]
 
 
+def check_hyperparameters(kernel, names: tuple[str, ...]) -> None:
+    """Each of the frozen dataclass ``kernel``'s hyperparameters ``names`` as a float in (0,
+    KERNEL_HIGH] (a length scale at least KERNEL_LOW), refused naming the kernel and the field.
+    Compared as a Python float: a float32 would take the bounds as float32 (1e50: inf)."""
+    for name in names:
+        v = getattr(kernel, name)
+        if (
+            isinstance(v, bool)
+            or not isinstance(v, numbers.Real)
+            or not (KERNEL_LOW if name == "length_scale" else 0.0) < float(v) <= KERNEL_HIGH
+        ):
+            raise ValueError(
+                f"{type(kernel).__name__}: {name} must be a finite number > 0 (at most 1e50, "
+                f"a length at least 1e-50), got {v!r}"
+            )
+        object.__setattr__(kernel, name, float(v))
+
+
 @dataclass(frozen=True)
 class SquaredExponential:
     """k(p, q) = sigma_f^2 exp(-|p - q|^2 / (2 l^2)) (thesis eq. 6.2), plus independent noise
@@ -45,19 +63,7 @@ class SquaredExponential:
     sigma_n: float
 
     def __post_init__(self) -> None:
-        for name in ("sigma_f", "length_scale", "sigma_n"):
-            v = getattr(self, name)
-            if (
-                isinstance(v, bool)
-                or not isinstance(v, numbers.Real)
-                # as a Python float: a float32 would take the bounds as float32 (1e50: inf)
-                or not (KERNEL_LOW if name == "length_scale" else 0.0) < float(v) <= KERNEL_HIGH
-            ):
-                raise ValueError(
-                    f"SquaredExponential: {name} must be a finite number > 0 (at most 1e50, "
-                    f"a length at least 1e-50), got {v!r}"
-                )
-            object.__setattr__(self, name, float(v))
+        check_hyperparameters(self, ("sigma_f", "length_scale", "sigma_n"))
 
     def to_dict(self) -> dict[str, float]:
         return asdict(self)
