@@ -176,11 +176,12 @@ def largest_reading(ranges: np.ndarray) -> float | None:
 
 def beams_of_one_turn(start: float, step: float, beams: int) -> bool:
     """Whether ``beams`` beams from ``start`` every ``step`` rad are a scanner's: a finite start
-    within +-2 pi, a finite non-zero step, and one turn at most (a sliver over it for rounding).
-    A log's step of 0 put every beam on one ray; 1000 rad, or a start of 1e30, were read as
-    given."""
+    within +-2 pi, a finite non-zero step (any finite step for a single beam), and one turn at
+    most (a sliver over it for rounding). A log's step of 0 put every beam on one ray; 1000 rad,
+    or a start of 1e30, were read as given."""
     span = abs(step) * (beams - 1)
-    return bool(abs(start) <= 2 * math.pi and step != 0 and span <= 2.01 * math.pi)
+    moves = step != 0 or beams == 1
+    return bool(abs(start) <= 2 * math.pi and moves and span <= 2.01 * math.pi)
 
 
 def apply_range_rule(ranges: np.ndarray, max_range: float) -> np.ndarray:

@@ -22,6 +22,7 @@ from mcap.writer import CompressionType
 from mcap_protobuf.schema import build_file_descriptor_set
 
 from kiseki.io.runlog.schemas import FOXGLOVE_MESSAGES
+from kiseki.scans import beams_of_one_turn
 
 _MAGIC = b"\x89MCAP0\r\n"
 _NS_PER_S = 1_000_000_000
@@ -210,6 +211,11 @@ def _laser_scan(
                 "angles must be evenly spaced from the first to the last beam"
                 " (foxglove.LaserScan stores only start_angle and end_angle)"
             )
+    if not beams_of_one_turn(beam[0], (beam[-1] - beam[0]) / max(beam.size - 1, 1), beam.size):
+        raise ValueError(
+            f"angles from {beam[0]:g} to {beam[-1]:g} rad: not beams of one turn at most (the"
+            " first within +-2 pi), which kiseki's readers refuse"
+        )
     values = np.asarray(ranges, dtype=np.float32)
     if values.shape != beam.shape:
         raise ValueError(f"ranges have shape {values.shape}, angles {beam.shape}")

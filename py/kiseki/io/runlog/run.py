@@ -41,6 +41,7 @@ from kiseki.io.runlog.schemas import (
 from kiseki.scans import (
     LaserScans,
     apply_range_rule,
+    beams_of_one_turn,
     check_max_range,
     check_odometry_jumps,
     largest_reading,
@@ -274,14 +275,20 @@ class SimRun:
             ) from exc
         if ranges.ndim != 2 or ranges.shape[1] < 1:
             raise LogFormatError(f"{self.path}: laser scans on {scan_topic!r} have no beams")
-        start, end = float(starts[0]), float(ends[0])
-        other = (np.abs(starts - start) > 1e-9) | (np.abs(ends - end) > 1e-9)
+        start, end, beams = float(starts[0]), float(ends[0]), ranges.shape[1]
+        if not beams_of_one_turn(start, (end - start) / max(beams - 1, 1), beams):
+            raise LogFormatError(
+                f"{self.path}: the first scan on {scan_topic!r} has start_angle {start:g} and "
+                f"end_angle {end:g} rad for {beams} beams: not beams of one turn at most "
+                "(start_angle within +-2 pi, end_angle another angle)"
+            )
+        with np.errstate(invalid="ignore"):  # a later scan's NaN or infinite angle is other
+            other = ~((np.abs(starts - start) <= 1e-9) & (np.abs(ends - end) <= 1e-9))
         if np.any(other):
             raise LogFormatError(
                 f"{self.path}: the scan at t={times[np.argmax(other)]} on {scan_topic!r} has"
                 f" other beam angles than the first scan"
             )
-        beams = ranges.shape[1]
         angles = np.linspace(start, end, beams) if beams > 1 else np.array([start])
         poses = np.array([self._xytheta(scan_topic, m.get("pose")) for _, m in scans])
         self._check_finite(scan_topic, "pose", times, poses)
