@@ -62,8 +62,9 @@ from pathlib import Path
 import numpy as np
 
 from kiseki._support.inputs import GIB
-from kiseki._support.numbers_text import NumberTextError, float_array, parse_float, parse_int
+from kiseki._support.numbers_text import parse_float, parse_int
 from kiseki.datasets._files import read_maybe_gzipped
+from kiseki.datasets._log_numbers import log_numbers
 from kiseki.errors import LogFormatError
 from kiseki.scans import (
     LaserScans,
@@ -82,9 +83,6 @@ __all__ = [
     "read_carmen_log",
 ]
 
-# Every number but the range readings within +-1e12: poses in metres and radians, times in
-# seconds since 1970 (about 1.7e9 now); 1e300 passed and made the pose error infinite
-VALUE_LIMIT = 1e12
 MAX_LOG_BYTES = 1 * GIB
 """A log's text (after gunzip) is read up to this size: the largest Radish logs hold a few hundred
 MB, and parsing takes about 16 times the text's size in memory (Freiburg 079: 9.5 MB of text,
@@ -187,35 +185,6 @@ def _int_field(path: Path, lineno: int, token: str, what: str) -> int:
     return value
 
 
-def _to_float(
-    path: Path, rows: Sequence[_Row], fields: list[list[str]], kind: str, ranges: slice = slice(0)
-) -> np.ndarray:
-    """Convert equal-length token lists to a float64 array; errors name the line. Columns
-    ``ranges`` (range readings) may be NaN or infinite; any other column may not."""
-    try:
-        values = float_array(fields)
-    except NumberTextError as bad:
-        msg = f"{path}:{rows[bad.row][0]}: non-numeric value {bad.token!r} in {kind}"
-        raise LogFormatError(msg) from None
-    except ValueError:
-        raise LogFormatError(f"{path}: unreadable numbers in {kind}") from None
-    finite = np.isfinite(values)
-    finite[:, ranges] = True
-    bad = ~finite.all(axis=1)
-    if bad.any():
-        lineno = rows[int(np.argmax(bad))][0]
-        raise LogFormatError(f"{path}:{lineno}: non-finite value (NaN or inf) in {kind}")
-    huge = np.abs(values) > VALUE_LIMIT
-    huge[:, ranges] = False  # a reading beyond the maximum range is a reading without a return
-    if huge.any():
-        row = int(np.argmax(huge.any(axis=1)))
-        value = values[row][huge[row]][0]
-        raise LogFormatError(
-            f"{path}:{rows[row][0]}: value {value:g} in {kind} beyond +-{VALUE_LIMIT:g}"
-        )
-    return values
-
-
 def _check_count(path: Path, lineno: int, tokens: list[str], expected: int, kind: str) -> None:
     if len(tokens) != expected:
         msg = f"{path}:{lineno}: {kind} has {len(tokens)} fields, expected {expected}"
@@ -279,7 +248,7 @@ def _parse_flaser(
             raise LogFormatError(msg)
         _check_count(path, lineno, tokens, n + 11, "FLASER")
         fields.append(tokens[2 : n + 9] + tokens[n + 10 :])  # skip count and hostname
-    values = _to_float(path, rows, fields, "FLASER", ranges=slice(0, n))
+    values = log_numbers(path, [r[0] for r in rows], fields, "FLASER", ranges=slice(0, n))
     max_range = _flaser_max_range(path, params, param_lines)
     return _laser_scans(path, rows, values, (0, n, n + 6), flaser_angles(n), max_range, "FLASER")
 
@@ -320,7 +289,7 @@ def _parse_robotlaser(path: Path, rows: list[_Row]) -> LaserScans:
         if len(row) - 11 != n:
             msg = f"{path}:{lineno}: ROBOTLASER1 has {len(row) - 11} beams, the first has {n}"
             raise LogFormatError(msg)
-    values = _to_float(path, rows, fields, "ROBOTLASER1", ranges=slice(4, 4 + n))
+    values = log_numbers(path, [r[0] for r in rows], fields, "ROBOTLASER1", ranges=slice(4, 4 + n))
     config = values[:, :4]  # start_angle, fov, angular_resolution, maximum_range
     changed = (config != config[0]).any(axis=1)
     if changed.any():
@@ -347,7 +316,7 @@ def _parse_odom(path: Path, rows: list[_Row]) -> OdometryRecords:
     for lineno, tokens in rows:
         _check_count(path, lineno, tokens, 10, "ODOM")
     fields = [tokens[1:8] + tokens[9:] for _, tokens in rows]  # skip hostname
-    values = _to_float(path, rows, fields, "ODOM")
+    values = log_numbers(path, [r[0] for r in rows], fields, "ODOM")
     return OdometryRecords(
         times=values[:, 6].copy(),
         poses=values[:, 0:3].copy(),

@@ -41,9 +41,9 @@ from pathlib import Path
 import numpy as np
 
 from kiseki._support.inputs import GIB, check_input
-from kiseki._support.numbers_text import NumberTextError, float_array
 from kiseki.datasets._files import GZIP_MAGIC, read_maybe_gzipped
-from kiseki.datasets.carmen import VALUE_LIMIT, flaser_angles
+from kiseki.datasets._log_numbers import log_numbers
+from kiseki.datasets.carmen import flaser_angles
 from kiseki.errors import LogFormatError
 from kiseki.scans import (
     LaserScans,
@@ -131,7 +131,7 @@ def read_wean_log(path: str | os.PathLike) -> WeanLog:
             )
     if not lasers:
         raise LogFormatError(f"{path}: no laser (L) lines")
-    values = _numbers(path, laser_lines, lasers, ranges=slice(6, 6 + BEAMS))
+    values = log_numbers(path, laser_lines, lasers, ranges=slice(6, 6 + BEAMS))
     readings = values[:, 6 : 6 + BEAMS] * CM
     max_range = largest_reading(readings)
     if max_range is None:
@@ -150,7 +150,7 @@ def read_wean_log(path: str | os.PathLike) -> WeanLog:
         max_range=max_range,
     )
     check_odometry_jumps(path, scans.times, scans.odometry, laser_lines)
-    odo = _numbers(path, odom_lines, odoms) if odoms else np.empty((0, 4))
+    odo = log_numbers(path, odom_lines, odoms) if odoms else np.empty((0, 4))
     return WeanLog(
         path=path,
         scans=scans,
@@ -164,28 +164,3 @@ def _check(path: Path, lineno: int, tokens: list[str], expected: int) -> None:
         raise LogFormatError(
             f"{path}:{lineno}: {tokens[0]} line has {len(tokens)} fields, expected {expected}"
         )
-
-
-def _numbers(
-    path: Path, linenos: list[int], rows: list[list[str]], ranges: slice = slice(0)
-) -> np.ndarray:
-    """The lines' numbers; columns ``ranges`` (range readings) may be NaN or infinite."""
-    try:
-        values = float_array(rows)
-    except NumberTextError as bad:
-        msg = f"{path}:{linenos[bad.row]}: non-numeric value {bad.token[:20]!r}"
-        raise LogFormatError(msg) from None
-    except ValueError:
-        raise LogFormatError(f"{path}: unreadable numbers") from None
-    finite = np.isfinite(values)
-    finite[:, ranges] = True
-    bad = ~finite.all(axis=1)
-    if bad.any():
-        raise LogFormatError(f"{path}:{linenos[int(np.argmax(bad))]}: non-finite value")
-    huge = np.abs(values) > VALUE_LIMIT  # as CARMEN's: odometry of 1e300 was taken
-    huge[:, ranges] = False  # a reading beyond the maximum range has no return
-    if huge.any():
-        row = int(np.argmax(huge.any(axis=1)))
-        value = values[row][huge[row]][0]
-        raise LogFormatError(f"{path}:{linenos[row]}: value {value:g} beyond +-{VALUE_LIMIT:g}")
-    return values
