@@ -75,8 +75,9 @@ namespace {
 // The likelihood field's evaluation as it was before the sensor's placement was taken out of
 // Pose2::compose (two calls per particle, with the map's rotation's cos and sin each time): the
 // beam ends (model.used_beams, in the sensor frame, in cells) rotated in doubles, a per-beam
-// bounds test in doubles (the model's is in integers on x86-64, and with AVX2 it takes two
-// particles and four beams at a time), the table read, one particle and one beam at a time.
+// bounds test in doubles (the model's is in integers on x86-64, and with AVX2 it takes four
+// (then two) particles and four beams at a time), the table read, one particle and one beam at
+// a time.
 std::vector<double> likelihoods_one_at_a_time(const LikelihoodFieldModel& m, const OccupancyGrid& g,
                                               const std::vector<double>& end_x,
                                               const std::vector<double>& end_y,
@@ -111,7 +112,7 @@ TEST(LikelihoodField, EveryFasterPathGivesTheBitsOfTheOldOne) {
   for (int i = 0; i < 61; ++i) ranges[i] = 0.3f + 0.13f * static_cast<float>(i);
   ranges[7] = ranges[9] = NAN;  // skipped: 59 beams, not a multiple of the 4 taken at a time
   Random rng(5);
-  std::vector<Pose2> poses;  // some near or past the map's edges; an odd count (pairs + 1)
+  std::vector<Pose2> poses;  // some near or past the map's edges; 43: ten fours, a pair and one
   for (int k = 0; k < 40; ++k) poses.emplace_back(rng.uniform(-2.0, 12.0), rng.uniform(-2.0, 8.0), rng.uniform(-kPi, kPi));
   poses.emplace_back(1e-300, -0.0, 0.0);  // zeros of either sign at the sensor
   poses.emplace_back(1e30, -1e300, 1.0);  // ends beyond any integer type
