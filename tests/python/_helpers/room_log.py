@@ -11,6 +11,7 @@ import numpy as np
 
 from kiseki import OccupancyGrid, Pose2, save_map
 from kiseki.io.runlog import RunWriter
+from kiseki.scans import LaserScans
 
 STEPS = 40
 ANGLES = np.linspace(-np.pi / 2, np.pi / 2, 91)
@@ -23,6 +24,16 @@ def room() -> OccupancyGrid:
     cells[:, [0, -1]] = 100
     cells[30:40, 60:66] = 100
     return OccupancyGrid(cells, 0.05, Pose2(-1.0, -2.0, 0.0))
+
+
+def room_scans(n: int, length: float = 1.0, turn: float = 0.0, first: int = 0) -> LaserScans:
+    """``n`` scans of the room (8 m range) from poses along y = -1, x from 0 to ``length`` m and
+    the heading from 0 to ``turn`` rad, at times 0.1 (first + k) s; the odometry is the poses."""
+    poses = np.column_stack(
+        [np.linspace(0.0, length, n), np.full(n, -1.0), np.linspace(0, turn, n)]
+    )
+    ranges = room().cast_scans(poses, ANGLES, max_range=8.0)
+    return LaserScans(0.1 * np.arange(first, first + n), poses, poses.copy(), ranges, ANGLES, 8.0)
 
 
 def write_log(path: Path, scan: bool = True, chunk_size: int = 128 * 1024) -> None:

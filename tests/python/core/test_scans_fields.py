@@ -12,15 +12,13 @@ import math
 import numpy as np
 import pytest
 
-from _helpers.room_log import ANGLES, room
+from _helpers.room_log import room, room_scans
 from kiseki.filters import LocalizeConfig, localize
 from kiseki.scans import LaserScans
 
 
 def _scans(n: int = 6) -> LaserScans:
-    poses = np.column_stack([np.linspace(0.0, 1.0, n), np.full(n, -1.0), np.zeros(n)])
-    ranges = room().cast_scans(poses, ANGLES, max_range=8.0)
-    return LaserScans(0.1 * np.arange(n), poses, poses.copy(), ranges, ANGLES, 8.0)
+    return room_scans(n)
 
 
 def test_fields_of_other_lengths_are_refused_naming_the_field():

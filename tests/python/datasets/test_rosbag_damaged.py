@@ -14,16 +14,14 @@ import pytest
 import yaml
 import zstandard
 
-from _helpers.room_log import ANGLES, room
+from _helpers.room_log import room_scans
 from kiseki.datasets import read_bag_scans, write_bag
 from kiseki.errors import LogFormatError
 from kiseki.scans import LaserScans
 
 
 def _scans(n: int = 12) -> LaserScans:
-    poses = np.column_stack([np.linspace(0.0, 1.0, n), np.full(n, -1.0), np.zeros(n)])
-    ranges = room().cast_scans(poses, ANGLES, max_range=8.0)
-    return LaserScans(0.1 * np.arange(1, n + 1), poses, poses.copy(), ranges, ANGLES, 8.0)
+    return room_scans(n, first=1)
 
 
 def _compress_files(bag: Path, cut: bool = False, plain: bool = False) -> Path:

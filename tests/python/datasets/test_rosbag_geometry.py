@@ -13,16 +13,14 @@ import pytest
 
 import kiseki.datasets.rosbag as rosbag
 import kiseki.datasets.rosbag_writer as rosbag_writer
-from _helpers.room_log import ANGLES, room
+from _helpers.room_log import room_scans
 from kiseki.datasets import read_bag_scans, write_bag
 from kiseki.errors import LogFormatError
 from kiseki.scans import LaserScans
 
 
 def _scans(n: int = 8) -> LaserScans:
-    poses = np.column_stack([np.linspace(0.0, 1.0, n), np.full(n, -1.0), np.linspace(0, 0.5, n)])
-    ranges = room().cast_scans(poses, ANGLES, max_range=8.0)
-    return LaserScans(0.1 * np.arange(1, n + 1), poses, poses.copy(), ranges, ANGLES, 8.0)
+    return room_scans(n, turn=0.5, first=1)
 
 
 @pytest.mark.parametrize("kind", ["ros1", "ros2-mcap"])

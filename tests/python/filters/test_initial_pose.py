@@ -9,10 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from _helpers.room_log import ANGLES, room
+from _helpers.room_log import room, room_scans
 from kiseki.filters import LocalizeConfig, MclConfig, MonteCarloLocalizer
 from kiseki.filters.tracking import localize
-from kiseki.scans import LaserScans
 
 SD = (0.1, 0.1, 0.05)
 
@@ -44,10 +43,7 @@ def test_a_start_within_the_bound_is_drawn_around_it():
 def test_localize_with_an_absurd_initial_spread_is_refused():
     """The estimates were 1e299 m from the log without a word; the config refuses the spread
     where it is given, and a config of the largest spread runs."""
-    n = 4
-    truth = np.column_stack([np.linspace(0.0, 0.3, n), np.full(n, -1.0), np.zeros(n)])
-    ranges = room().cast_scans(truth, ANGLES, max_range=8.0)
-    scans = LaserScans(0.1 * np.arange(n), truth, truth, ranges, ANGLES, 8.0)
+    scans = room_scans(4, length=0.3)
     with pytest.raises(ValueError, match=r"initial_sd must be 3 numbers in \[0, 1e\+09\]"):
         LocalizeConfig(particles=50, initial_sd=(1e300, 1e300, 0.1))
     config = LocalizeConfig(particles=50, initial_sd=(1e9, 1e9, 0.1))

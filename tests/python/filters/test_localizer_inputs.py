@@ -9,16 +9,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from _helpers.room_log import ANGLES, room
+from _helpers.room_log import room, room_scans
 from kiseki.filters import LocalizeConfig, MclConfig, MonteCarloLocalizer
 from kiseki.filters.tracking import localize
 from kiseki.scans import LaserScans
 
 
 def _scans(n: int = 4) -> LaserScans:
-    truth = np.column_stack([np.linspace(0.0, 0.3, n), np.full(n, -1.0), np.zeros(n)])
-    ranges = room().cast_scans(truth, ANGLES, max_range=8.0)
-    return LaserScans(0.1 * np.arange(n), truth, truth, ranges, ANGLES, 8.0)
+    return room_scans(n, length=0.3)
 
 
 @pytest.mark.parametrize(
