@@ -1,12 +1,15 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The public modules that moved in the house layout, importable by their old names for one
-release: ``import kiseki.localization`` gives the module now at ``kiseki.filters`` (the same
-module object, so the old name and the new one share their state) and warns once, with a
-DeprecationWarning naming the new module.
+"""The public modules and names that moved in the house layout, importable by their old names
+for one release, each with a DeprecationWarning naming where it is now.
 
-The old names are answered by a finder on ``sys.meta_path`` that knows only the names in
-:data:`MOVED`; every other import passes it by. ``kiseki/__init__`` installs it."""
+* Modules: ``import kiseki.localization`` gives the module now at ``kiseki.filters`` (the same
+  module object, so the old name and the new one share their state) and warns once. The old
+  names are answered by a finder on ``sys.meta_path`` that knows only the names in
+  :data:`MOVED`; every other import passes it by. ``kiseki/__init__`` installs it.
+* Names that left a module that is still there (a split): the module sets
+  ``__getattr__ = moved_names(__name__, {name: new module})``, and reading such a name from it
+  gives the object of the new module and warns each time."""
 
 from __future__ import annotations
 
@@ -15,9 +18,11 @@ import importlib.abc
 import importlib.machinery
 import sys
 import warnings
+from collections.abc import Callable
 from types import ModuleType
+from typing import Any
 
-__all__ = ["MOVED", "install"]
+__all__ = ["MOVED", "install", "moved_names"]
 
 MOVED = {
     "kiseki.localization": "kiseki.filters",
@@ -26,6 +31,7 @@ MOVED = {
     "kiseki.map_schema": "kiseki.io.map_schema",
     "kiseki.trajectory_csv": "kiseki.io.trajectory_csv",
     "kiseki.sim.mcap_log": "kiseki.io.runlog",
+    "kiseki.datasets.ros_orientation": "kiseki.datasets.ros_messages",
 }
 """old module -> the module that holds its names now."""
 
@@ -57,3 +63,23 @@ def install() -> None:
     """Puts the finder first on ``sys.meta_path`` (once)."""
     if not any(isinstance(f, _MovedModule) for f in sys.meta_path):
         sys.meta_path.insert(0, _MovedModule())
+
+
+def moved_names(module: str, names: dict[str, str]) -> Callable[[str], Any]:
+    """The module-level ``__getattr__`` of ``module`` (PEP 562) that answers the ``names`` that
+    moved out of it (name -> the module holding it now) with a DeprecationWarning, and any other
+    name with the usual AttributeError."""
+
+    def moved_attribute(name: str) -> Any:
+        if name not in names:
+            raise AttributeError(f"module {module!r} has no attribute {name!r}")
+        new = names[name]
+        warnings.warn(
+            f"{module}.{name} moved to {new}.{name}; import it from there (the old name goes in "
+            "the next release)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return getattr(importlib.import_module(new), name)
+
+    return moved_attribute

@@ -69,6 +69,7 @@ from kiseki._support.inputs import (
     describe_bytes,
     read_input_text,
 )
+from kiseki._support.moved import moved_names
 from kiseki._support.yaml import safe_load_12
 from kiseki.datasets.ros_messages import (
     NS_PER_S,
@@ -95,6 +96,10 @@ __all__ = [
     "is_ros_bag",
     "read_bag_scans",
 ]
+
+# write_bag moved to kiseki.datasets.rosbag_writer (and is kiseki.datasets.write_bag as before);
+# the old name answers for one release with a DeprecationWarning (kiseki._support.moved)
+__getattr__ = moved_names(__name__, {"write_bag": "kiseki.datasets.rosbag_writer"})
 
 BAG_KINDS = ("ros1", "ros2-sqlite3", "ros2-mcap")
 

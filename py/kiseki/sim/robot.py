@@ -28,11 +28,9 @@ Motion model (both robots)
 
 from __future__ import annotations
 
-import importlib
 import math
-import warnings
-from typing import Any
 
+from kiseki._support.moved import moved_names
 from kiseki.core import Pose2
 from kiseki.sim.motion import (
     BodyMotion,
@@ -49,25 +47,18 @@ from kiseki.sim.robot_params import DiffDriveParams, OmniParams
 
 __all__ = ["DiffDriveRobot", "OmniRobot"]
 
-# Names this module held before it was split and no longer imports, importable from it for one
-# release (as the moved modules of kiseki._support.moved), with a DeprecationWarning naming their
-# module now (the robots' own parameters and motions it still imports).
-_MOVED_NAMES = {
-    "WheelOdometry": "kiseki.sim.odometry",
-    "OmniOdometry": "kiseki.sim.odometry",
-    "OdometryErrorParams": "kiseki.sim.robot_params",
-    "OmniOdometryErrorParams": "kiseki.sim.robot_params",
-}
-
-
-def __getattr__(name: str) -> Any:
-    if name not in _MOVED_NAMES:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    module = _MOVED_NAMES[name]
-    warnings.warn(
-        f"kiseki.sim.robot.{name} moved to {module}.{name}", DeprecationWarning, stacklevel=2
-    )
-    return getattr(importlib.import_module(module), name)
+# Names this module held before it was split and no longer imports (the robots' own parameters
+# and motions it still imports), importable from it for one release with a DeprecationWarning
+# naming their module now (kiseki._support.moved)
+__getattr__ = moved_names(
+    __name__,
+    {
+        "WheelOdometry": "kiseki.sim.odometry",
+        "OmniOdometry": "kiseki.sim.odometry",
+        "OdometryErrorParams": "kiseki.sim.robot_params",
+        "OmniOdometryErrorParams": "kiseki.sim.robot_params",
+    },
+)
 
 
 def _limit(command: float, current: float, max_rate: float, max_value: float, dt: float) -> float:

@@ -6,6 +6,7 @@ module (kiseki._support.moved)."""
 
 from __future__ import annotations
 
+import importlib
 import json
 import subprocess
 import sys
@@ -41,6 +42,7 @@ NAMES = {
     "kiseki.map_schema": "RosMapYaml",
     "kiseki.trajectory_csv": "read_trajectory_csv",
     "kiseki.sim.mcap_log": "read_run",
+    "kiseki.datasets.ros_orientation": "yaw_or_nan",
 }
 
 
@@ -77,6 +79,31 @@ def test_from_import_of_an_old_name_points_the_warning_at_the_importer(tmp_path)
         check=True,
     )
     assert f"{script}:1: DeprecationWarning: kiseki.map_io moved to kiseki.io.ros_map" in out.stderr
+
+
+# names that left a module still there: (module, name, where it is now)
+MOVED_NAMES = [
+    ("kiseki.datasets.rosbag", "write_bag", "kiseki.datasets.rosbag_writer"),
+    ("kiseki.sim.robot", "WheelOdometry", "kiseki.sim.odometry"),
+    ("kiseki.sim.robot", "OdometryErrorParams", "kiseki.sim.robot_params"),
+]
+
+
+@pytest.mark.parametrize(("module", "name", "new"), MOVED_NAMES)
+def test_a_moved_name_gives_the_new_object_with_a_warning_and_others_stay_unknown(
+    module, name, new
+):
+    old = importlib.import_module(module)
+    with pytest.warns(DeprecationWarning) as caught:
+        got = getattr(old, name)
+    assert got is getattr(importlib.import_module(new), name)
+    assert [str(w.message) for w in caught] == [
+        f"{module}.{name} moved to {new}.{name}; import it from there (the old name goes in the "
+        "next release)"
+    ]
+    assert caught[0].filename == __file__  # pointed at the reader of the name
+    with pytest.raises(AttributeError, match=f"module '{module}' has no attribute 'no_such'"):
+        old.no_such  # noqa: B018
 
 
 def test_an_unknown_name_is_not_answered():
