@@ -14,7 +14,6 @@ from kiseki._support.guard import guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import CELL_LIMITS, REACH_LIMIT, Metres, refuse_given
 from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
-from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki.cli._defaults import default_of
 from kiseki.cli._off_map import has_endpoints
 from kiseki.cli.map import MAP_IMAGE
@@ -88,11 +87,6 @@ def map_from_log(
         raise ValueError(
             f"{log}: no range reading below the max range of {scans.max_range:g} m (a reading "
             "at or beyond it is no return): nothing to map"
-        )
-    far = float(abs(scans.poses[:, :2]).max())
-    if far > MAGNITUDE_LIMIT:  # a map there cannot be saved: the error named the output file
-        raise ValueError(
-            f"{log}: the reference poses reach {far:g} m, beyond +-{MAGNITUDE_LIMIT:g}"
         )
     try:  # the map's size follows from the log's poses: its errors name the log
         if rules in ("teaching", "evidence"):

@@ -14,7 +14,7 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki import _core
-from kiseki._support.schema import parse
+from kiseki._support.schema import MAGNITUDE_LIMIT, parse
 from kiseki.grid import OccupancyGrid
 from kiseki.io.map_schema import MapBuildSettings
 from kiseki.scans import LaserScans, check_max_range
@@ -24,6 +24,7 @@ __all__ = [
     "MIN_MAP_SIDE",
     "MapBuildConfig",
     "build_map",
+    "check_map_poses",
     "check_map_size",
     "endpoint_agreement",
     "scan_local_builder",
@@ -53,6 +54,24 @@ def check_map_size(width_m: float, height_m: float, resolution: float) -> tuple[
             f"{width_m:.3g} x {height_m:.3g} m: more than the limit of {MAX_MAP_CELLS:.0e} cells"
         )
     return width, height
+
+
+def check_map_poses(poses: np.ndarray) -> np.ndarray:
+    """The sensor poses a map is built from, as a C-contiguous float64 (n, 3) array: at least
+    one, finite, and within +-MAGNITUDE_LIMIT m (a map file's origin is bounded so: a map
+    beyond it could be built but not saved)."""
+    poses = np.ascontiguousarray(poses, dtype=np.float64)
+    if poses.ndim != 2 or poses.shape[0] == 0:
+        raise ValueError(f"poses: expected a non-empty (n, 3) array, got shape {poses.shape}")
+    if poses.shape[1:] != (3,) or not np.isfinite(poses).all():
+        raise ValueError(f"poses: expected (n, 3) rows x, y, theta, no NaN or inf: {poses.shape}")
+    far = float(np.abs(poses[:, :2]).max())
+    if far > MAGNITUDE_LIMIT:
+        raise ValueError(
+            f"the poses reach {far:g} m, beyond +-{MAGNITUDE_LIMIT:g} (a map there could not "
+            "be saved)"
+        )
+    return poses
 
 
 @dataclass(frozen=True)
@@ -118,7 +137,8 @@ def build_map(
     """Builds a trinary occupancy grid from scans (ranges (n, b)) taken at sensor poses
     (n, 3: x, y, theta) with beam angles (b,). Readings >= max_range are "no return"; NaN
     readings (no measurement) say nothing and are skipped; a negative reading is an error, as
-    is a pose that is not finite or a resolution giving a map outside `check_map_size`."""
+    is a pose that is not finite or beyond +-MAGNITUDE_LIMIT m (`check_map_poses`), or a
+    resolution giving a map outside `check_map_size`."""
     config = config or MapBuildConfig()
     if not np.isfinite(config.margin) or config.margin < 0:
         raise ValueError(f"margin must be >= 0, got {config.margin}")
@@ -127,12 +147,8 @@ def build_map(
         # -1 gave a map of unknown cells only, 0 Python's "range() arg 3 must not be zero"
         raise ValueError(f"chunk must be an integer >= 1 (scans per pass), got {chunk!r}")
     params = config.core_params(max_range)
-    poses = np.ascontiguousarray(poses, dtype=np.float64)
+    poses = check_map_poses(poses)
     ranges = np.ascontiguousarray(ranges, dtype=np.float32)
-    if poses.ndim != 2 or poses.shape[0] == 0:
-        raise ValueError(f"poses: expected a non-empty (n, 3) array, got shape {poses.shape}")
-    if poses.shape[1:] != (3,) or not np.isfinite(poses).all():
-        raise ValueError(f"poses: expected (n, 3) rows x, y, theta, no NaN or inf: {poses.shape}")
     negative = np.flatnonzero((ranges < 0).any(axis=tuple(range(1, ranges.ndim))))
     if negative.size:
         first = negative[0]

@@ -22,7 +22,7 @@ from tqdm import tqdm
 
 from kiseki import _core
 from kiseki.grid import OccupancyGrid
-from kiseki.mapping import scan_local_builder
+from kiseki.mapping import check_map_poses, check_map_size, scan_local_builder
 
 __all__ = ["MERGE_RULES", "EnvironmentMap", "build_teaching_map"]
 
@@ -70,18 +70,15 @@ def build_teaching_map(
     `kiseki.mapping.scan_local_map`) placed at its pose and merged by `rule`. Walls are as thin
     as single scans see them and the space behind them is occupied, unlike the log-odds map of
     `kiseki.mapping.build_map`."""
-    poses = np.ascontiguousarray(poses, dtype=np.float64)
+    poses = check_map_poses(poses)
     ranges = np.asarray(ranges)
-    if poses.ndim != 2 or poses.shape[1] != 3 or poses.shape[0] == 0:
-        raise ValueError(f"poses: expected a non-empty (n, 3) array, got shape {poses.shape}")
     if ranges.ndim != 2 or ranges.shape[0] != poses.shape[0]:
         raise ValueError(f"ranges: expected ({poses.shape[0]}, beams), got shape {ranges.shape}")
-    if not np.isfinite(poses).all():
-        raise ValueError("poses: every pose must be finite")
     reach = local_size / np.sqrt(2.0) + resolution  # half the diagonal of a local map
     lo = poses[:, :2].min(axis=0) - reach
     hi = poses[:, :2].max(axis=0) + reach
-    width, height = np.ceil((hi - lo) / resolution).astype(int)
+    # poses 1e6 m apart asked for 1e7 x 1e7 cells without a word
+    width, height = check_map_size(*(hi - lo), resolution)
     frame = _core.OccupancyGrid(int(width), int(height), resolution, _core.Pose2(lo[0], lo[1], 0))
     env = EnvironmentMap(frame, rule)
     for k in tqdm(range(len(poses)), desc="teaching map", disable=not progress, leave=False):

@@ -349,7 +349,7 @@ def test_global_localization_from_one_scan_is_run_and_saved_as_such(inputs):
 
 
 @pytest.mark.parametrize(
-    ("x", "needle"), [(1e11, "the reference poses reach 1e+11 m, beyond +-1e+09"), (3e8, "cells")]
+    ("x", "needle"), [(1e11, "the poses reach 1e+11 m, beyond +-1e+09"), (3e8, "cells")]
 )
 def test_a_map_from_a_log_with_far_poses_names_the_log(tmp_path, x, needle):
     """A CARMEN pose of 1e11 m said "resolution 0.05 m makes a map of 2000000000545 x 606

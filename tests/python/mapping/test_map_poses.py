@@ -1,0 +1,54 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Both map builders bound the poses they build from (kiseki.mapping.check_map_poses): poses
+past +-1e9 m made a map that no map file could hold (only `kiseki map from-log` said so), and
+the teaching map's extent was not checked at all (poses 1e6 m apart asked for 1e7 x 1e7 cells)."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from kiseki.mapping import MAX_MAP_CELLS, build_map, check_map_poses
+from kiseki.teach.environment_map import build_teaching_map
+
+ANGLES = np.linspace(-1.0, 1.0, 5)
+RANGES = np.full((2, 5), 1.0, np.float32)
+
+
+def _poses(x: float) -> np.ndarray:
+    return np.array([[0.0, 0.0, 0.0], [x, 0.5, 0.1]])
+
+
+@pytest.mark.parametrize("build", [build_map, build_teaching_map])
+@pytest.mark.parametrize("x", [1e11, -2e9])
+def test_poses_past_a_billion_metres_are_refused(build, x):
+    needle = re.escape(f"the poses reach {abs(x):g} m, beyond +-1e+09")
+    with pytest.raises(ValueError, match=needle):
+        build(_poses(x), RANGES, ANGLES, 5.0)
+
+
+def test_the_teaching_map_states_its_cell_limit():
+    with pytest.raises(ValueError, match=re.escape(f"more than the limit of {MAX_MAP_CELLS:.0e}")):
+        build_teaching_map(np.array([[0.0, 0.0, 0.0], [1e6, 1e6, 0.0]]), RANGES, ANGLES, 5.0)
+
+
+@pytest.mark.parametrize("bad", [np.array([[0.0, np.nan, 0.0]]), np.zeros((0, 3)), np.zeros(3)])
+def test_the_teaching_map_names_poses_that_are_no_poses(bad):
+    with pytest.raises(ValueError, match="poses: expected"):
+        build_teaching_map(bad, RANGES[: max(len(np.atleast_2d(bad)), 1)], ANGLES, 5.0)
+
+
+def test_poses_at_the_bound_build_both_maps_where_the_poses_are():
+    poses = check_map_poses(_poses(1e9 - 10.0))
+    assert poses.flags.c_contiguous and poses.dtype == np.float64
+    for grid in (
+        build_map(_poses(20.0), RANGES, ANGLES, 5.0),
+        build_teaching_map(_poses(20.0), RANGES, ANGLES, 5.0),
+    ):
+        # the map spans the poses' extent (both poses inside it)
+        lo = np.array([grid.origin.x, grid.origin.y])
+        hi = lo + grid.resolution * np.array([grid.width, grid.height])
+        assert (lo < [0.0, 0.0]).all() and (hi > [20.0, 0.5]).all()
