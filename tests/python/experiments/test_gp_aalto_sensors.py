@@ -13,7 +13,13 @@ import pytest
 
 from kiseki.magnetic.localization import MagneticMclConfig, localize_on_magnetic_map
 from kiseki_experiments.gp.gp_aalto import GpAaltoConfig
-from kiseki_experiments.gp.gp_aalto_sensors import SensorsConfig, maps_and_stream, trial
+from kiseki_experiments.gp.gp_aalto_sensors import (
+    SensorsConfig,
+    in_control,
+    maps_and_stream,
+    trial,
+    window_means,
+)
 from kiseki_experiments.gp.gp_aalto_tasks import noisy_odometry
 
 
@@ -41,3 +47,22 @@ def test_arms_against_the_single_map_filter(shared_data):
     assert record["nexus_dropped"] == ("nexus at update" in record["dropped"])
     never = trial(dataclasses.replace(config, limit=1000.0), 0, 7).record
     assert never["dropped"] == "" and never["checked_mean"] == never["both_mean"]
+
+
+def test_window_means_are_the_means_of_every_window():
+    z = np.random.default_rng(3).normal(size=(57, 3)) * [1.0, 10.0, 1e-3]
+    brute = np.array([z[i : i + 20].mean(axis=0) for i in range(57 - 20 + 1)])
+    np.testing.assert_allclose(window_means(z, 20), brute, rtol=1e-12, atol=1e-15)
+
+
+def test_the_in_control_table_counts_windows_past_the_limit(shared_data):
+    folder = shared_data / "magnetic"
+    if not (folder / "aalto" / "nexus" / "4-mag.csv").is_file():
+        pytest.skip(f"{folder}/aalto not found")
+    never = in_control(SensorsConfig(data_dir=str(folder), limit=1000.0))
+    always = in_control(SensorsConfig(data_dir=str(folder), limit=1e-9))
+    assert list(never["sensor"]) == ["invensense"] * 3 + ["nexus"] * 3
+    assert (never["share_past_limit"] == 0).all() and (always["share_past_limit"] == 1).all()
+    # the statistic does not depend on the limit, and is a mean of values of SD about 1
+    np.testing.assert_array_equal(never["largest_abs_mean"], always["largest_abs_mean"])
+    assert (never["largest_abs_mean"] > 0.3).all() and (never["largest_abs_mean"] < 10).all()
