@@ -20,7 +20,6 @@ import numpy as np
 
 from kiseki.datasets.ros_messages import NS_PER_S, TF_MESSAGE_MSG, compose, frame_name, inverse
 from kiseki.datasets.rosbag import (
-    BAG_KINDS,
     BASE_FRAME,
     LASER_SCAN,
     MAP_FRAME,
@@ -29,6 +28,7 @@ from kiseki.datasets.rosbag import (
     TF_MESSAGES,
     TF_STATIC_TOPIC,
 )
+from kiseki.datasets.rosbag_files import BAG_KINDS
 from kiseki.scans import LaserScans
 
 __all__ = ["write_bag"]
@@ -50,7 +50,7 @@ def write_bag(
     with its inverse. The bag is written beside ``path`` under a temporary name and renamed when
     complete; an existing ``path`` is refused. Scan times that step back or repeat (some CARMEN
     logs) are written as they are, but the reader orders scans and poses by stamp."""
-    # here: rosbags loads only for a bag (see _is_ros2_mcap)
+    # here: rosbags loads only for a bag (see rosbag_files._is_ros2_mcap)
     from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
     path = Path(path)

@@ -323,13 +323,13 @@ def test_limits_are_counted_while_reading_and_stated(tmp_path):
             "id": "ros2 mcap chunk bomb",
             "call": "kiseki.datasets:read_bag_scans",
             "args": [str(_mcap_of_zeros(tmp_path / "bag.mcap", "cdr"))],
-            "set": {"kiseki.datasets.rosbag:MAX_BAG_CHUNK_BYTES": low},
+            "set": {"kiseki.datasets.rosbag_files:MAX_BAG_CHUNK_BYTES": low},
         },
         {
             "id": "ros1 bag bz2 chunk bomb",
             "call": "kiseki.datasets:read_bag_scans",
             "args": [str(_ros1_bag_of_zeros(tmp_path / "bomb.bag"))],
-            "set": {"kiseki.datasets.rosbag:MAX_BAG_CHUNK_BYTES": low},
+            "set": {"kiseki.datasets.rosbag_files:MAX_BAG_CHUNK_BYTES": low},
         },
         {
             "id": "kok mat bomb",
@@ -476,7 +476,7 @@ def test_a_long_read_ends_promptly_on_a_signal(tmp_path, project_data, signum):
 def test_the_messages_read_from_a_bag_and_a_pcds_stated_size_are_bounded(tmp_path, monkeypatch):
     import numpy as np
 
-    from kiseki.datasets import LaserScans, read_bag_scans, rosbag, write_bag
+    from kiseki.datasets import LaserScans, read_bag_scans, rosbag_files, write_bag
     from kiseki.terrain.cloud_planes import read_cloud
 
     n, beams = 20, 181
@@ -490,7 +490,8 @@ def test_the_messages_read_from_a_bag_and_a_pcds_stated_size_are_bounded(tmp_pat
     )
     bag = write_bag(scans, tmp_path / "x.bag", "ros1")
     assert len(read_bag_scans(bag)) == n
-    monkeypatch.setattr(rosbag, "MAX_BAG_MESSAGE_BYTES", 4000)  # the scans hold 20 x 760 bytes
+    # the scans hold 20 x 760 bytes
+    monkeypatch.setattr(rosbag_files, "MAX_BAG_MESSAGE_BYTES", 4000)
     with pytest.raises(ValueError, match=r"x\.bag: the messages on /scan, /odom.* hold more than"):
         read_bag_scans(bag)
     # a binary_compressed PCD stating points of 2 GiB (the reader decompresses what it states)

@@ -81,7 +81,6 @@ def test_imports_inside_functions_say_why(folder, at_least):
 # lines: ...").
 LINE_LIMIT = 400
 LONG_FILES = {
-    "datasets/rosbag.py": "one reader for ROS 1 and 2 bags, the checks three storages share",
     "sim/magnetic.py": "the simulated field and the magnetometer that reads it",
 }
 
