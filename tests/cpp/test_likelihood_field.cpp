@@ -112,7 +112,7 @@ TEST(LikelihoodField, EveryFasterPathGivesTheBitsOfTheOldOne) {
   for (int i = 0; i < 61; ++i) ranges[i] = 0.3f + 0.13f * static_cast<float>(i);
   ranges[7] = ranges[9] = NAN;  // skipped: 59 beams, not a multiple of the 4 taken at a time
   Random rng(5);
-  std::vector<Pose2> poses;  // some near or past the map's edges; 43: ten fours, a pair and one
+  std::vector<Pose2> poses;  // some near or past the map's edges; 43 (ten fours, a pair, one)
   for (int k = 0; k < 40; ++k) poses.emplace_back(rng.uniform(-2.0, 12.0), rng.uniform(-2.0, 8.0), rng.uniform(-kPi, kPi));
   poses.emplace_back(1e-300, -0.0, 0.0);  // zeros of either sign at the sensor
   poses.emplace_back(1e30, -1e300, 1.0);  // ends beyond any integer type
@@ -134,9 +134,15 @@ TEST(LikelihoodField, EveryFasterPathGivesTheBitsOfTheOldOne) {
       int just_below_zero = 0;
       const std::vector<double> want = likelihoods_one_at_a_time(m, g, end_x, end_y, poses, just_below_zero);
       EXPECT_GT(just_below_zero, 0);  // ends in (-1, 0): off the map, though truncated to cell 0
-      std::vector<double> got(poses.size());
-      m.log_likelihoods(poses.data(), poses.size(), got.data());
-      for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_EQ(got[k], want[k]) << k;
+      // Runs from each of the first four poses, ending at each of the last three: the three
+      // edge cases at the end are each weighed in a four, in a pair and alone.
+      for (std::size_t first = 0; first < 4; ++first) {
+        for (std::size_t dropped = 0; dropped < 3; ++dropped) {
+          std::vector<double> got(poses.size() - first - dropped);
+          m.log_likelihoods(poses.data() + first, got.size(), got.data());
+          for (std::size_t k = 0; k < got.size(); ++k) EXPECT_EQ(got[k], want[first + k]) << first << " " << k;
+        }
+      }
     }
   }
 }

@@ -119,9 +119,9 @@ def test_a_cloud_that_sees_no_wall_uses_every_beam(intel):
 
 def test_every_pose_gets_its_brute_force_likelihood_wherever_it_falls_in_the_batch(intel):
     """The model places the laser once per pose with the map's rotation taken once per call,
-    and (with AVX2) weighs poses two at a time, four beams at a time: each pose's value must be
-    the numpy reference's, with a laser mounted off the robot's centre, and the same bits
-    whether the pose is evaluated alone (one at a time) or with others."""
+    and (with AVX2) weighs poses four (then two) at a time, four beams at a time: each pose's
+    value must be the numpy reference's, with a laser mounted off the robot's centre, and the
+    same bits whether the pose is evaluated alone (one at a time) or with others."""
     scans, grid = intel
     k = 500
     sensor = _core.Pose2(0.12, -0.04, 0.03)
