@@ -17,6 +17,9 @@ from depth images placed by odometry (`kiseki.apps.teach.teaching`).
 
 from __future__ import annotations
 
+import math
+import numbers
+
 import numpy as np
 from tqdm import tqdm
 
@@ -69,7 +72,13 @@ def build_teaching_map(
     from scans at known poses: each scan's local map (no-return beams left out, as in
     `kiseki.mapping.scan_local_map`) placed at its pose and merged by `rule`. Walls are as thin
     as single scans see them and the space behind them is occupied, unlike the log-odds map of
-    `kiseki.mapping.build_map`."""
+    `kiseki.mapping.build_map`. Refused: a resolution or local size that is not a finite number
+    > 0, poses that `kiseki.mapping.check_map_poses` refuses (not finite, beyond +-1e9 m), ranges
+    not one row per pose, and poses spread over a map larger than `check_map_size` allows."""
+    for name, value in (("resolution", resolution), ("local_size", local_size)):
+        number = isinstance(value, numbers.Real) and not isinstance(value, bool)
+        if not (number and math.isfinite(value) and value > 0):
+            raise ValueError(f"teaching map: {name} must be a finite number > 0 m, got {value!r}")
     poses = check_map_poses(poses)
     ranges = np.asarray(ranges)
     if ranges.ndim != 2 or ranges.shape[0] != poses.shape[0]:

@@ -41,9 +41,25 @@ def test_the_teaching_map_names_poses_that_are_no_poses(bad):
         build_teaching_map(bad, RANGES[: max(len(np.atleast_2d(bad)), 1)], ANGLES, 5.0)
 
 
-def test_poses_at_the_bound_build_both_maps_where_the_poses_are():
-    poses = check_map_poses(_poses(1e9 - 10.0))
-    assert poses.flags.c_contiguous and poses.dtype == np.float64
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [("resolution", np.nan), ("resolution", np.inf), ("resolution", 0.0), ("resolution", True),
+     ("local_size", np.nan), ("local_size", -8.0)],
+)  # fmt: skip
+def test_the_teaching_map_names_a_resolution_or_size_that_is_no_length(name, value):
+    """A NaN resolution said 'check_map_size: width must be a finite number', naming neither."""
+    with pytest.raises(ValueError, match=f"teaching map: {name} must be a finite number > 0 m"):
+        build_teaching_map(_poses(1.0), RANGES, ANGLES, 5.0, **{name: value})
+
+
+def test_the_bound_itself_is_taken_and_a_metre_past_it_is_not():
+    poses = check_map_poses(_poses(1e9))
+    assert poses.flags.c_contiguous and poses.dtype == np.float64 and poses[1, 0] == 1e9
+    with pytest.raises(ValueError, match=re.escape("reach 1e+09 m, beyond")):
+        check_map_poses(_poses(-(1e9 + 1.0)))
+
+
+def test_both_maps_span_the_poses():
     for grid in (
         build_map(_poses(20.0), RANGES, ANGLES, 5.0),
         build_teaching_map(_poses(20.0), RANGES, ANGLES, 5.0),
