@@ -16,6 +16,7 @@ from mcap_protobuf.writer import Writer
 
 from kiseki.errors import LogFormatError
 from kiseki.io.runlog import RunWriter, read_run
+from kiseki.scans import beams_of_one_turn
 
 
 def write_scans(path: Path, start: float, end: float, beams: int, last_start=None) -> None:
@@ -78,3 +79,20 @@ def test_reader_keeps_a_scanners_beams(tmp_path: Path, start: float, end: float,
 def test_writer_refuses_angles_its_reader_would_refuse(tmp_path: Path, angles: list) -> None:
     with RunWriter(tmp_path / "run.mcap") as w, pytest.raises(ValueError, match="not beams of"):
         w.write_laser_scan("/scan", 0.0, (0, 0, 0), angles, [1.0] * len(angles))
+
+
+@pytest.mark.parametrize(
+    ("start", "step", "beams", "kept"),
+    [
+        (0.3, 0.0, 1, True),  # one beam: its step says nothing
+        (0.3, 0.0, 2, False),  # two beams on one ray
+        (-math.pi, 2 * math.pi / 360, 361, True),  # a whole turn, both ends
+        (-math.pi, 2 * math.pi / 300, 361, False),  # past a turn
+        (7.0, 0.01, 1, False),  # one beam, but a start past 2 pi
+        (0.3, math.nan, 1, False),
+        (0.3, math.inf, 3, False),
+    ],
+)
+def test_the_one_turn_rule_of_every_reader(start: float, step: float, beams: int, kept: bool):
+    """The rule the CARMEN, bag and run-log readers share (kiseki.scans.beams_of_one_turn)."""
+    assert beams_of_one_turn(start, step, beams) is kept

@@ -250,7 +250,9 @@ class SimRun:
         * ``odometry``: the odometry pose nearest in time (the earlier one on a tie) on
           ``odom_topic``, a JSON topic whose payload has ``x``, ``y``, ``theta``; NaN when
           ``odom_topic`` is None.
-        * ``angles``: ``linspace(start_angle, end_angle, B)``, equal for every scan (1e-9 rad).
+        * ``angles``: ``linspace(start_angle, end_angle, B)``, equal for every scan (1e-9 rad),
+          beams of one turn at most (``kiseki.scans.beams_of_one_turn``, as the CARMEN and bag
+          readers require: a start within +-2 pi, several beams not all on one ray).
         * ``max_range``: the channel metadata ``max_range`` written by :class:`RunWriter`, else
           ``kiseki.scans.largest_reading`` (as for CARMEN logs without the PARAM), as float32.
         * ``ranges`` follow kiseki's rule (``kiseki.scans``): NaN, ``-inf``, negative and zero
@@ -280,10 +282,10 @@ class SimRun:
             raise LogFormatError(
                 f"{self.path}: the first scan on {scan_topic!r} has start_angle {start:g} and "
                 f"end_angle {end:g} rad for {beams} beams: not beams of one turn at most "
-                "(start_angle within +-2 pi, end_angle another angle)"
+                "(start_angle within +-2 pi, several beams not all on one ray)"
             )
-        with np.errstate(invalid="ignore"):  # a later scan's NaN or infinite angle is other
-            other = ~((np.abs(starts - start) <= 1e-9) & (np.abs(ends - end) <= 1e-9))
+        # a later scan's NaN angle is other too (start and end are finite here)
+        other = ~((np.abs(starts - start) <= 1e-9) & (np.abs(ends - end) <= 1e-9))
         if np.any(other):
             raise LogFormatError(
                 f"{self.path}: the scan at t={times[np.argmax(other)]} on {scan_topic!r} has"

@@ -277,7 +277,8 @@ class RunWriter:
     ) -> None:
         """``foxglove.LaserScan``: ``sensor_pose`` (x, y, theta) is the laser's pose in
         ``frame_id``; ``angles`` (B,) are evenly spaced beam angles in the laser frame (to 1e-6
-        rad) and ``ranges`` (B,) metres, stored as float32 values. ``max_range`` (fixed per
+        rad), one turn at most from a first within +-2 pi (what the reader takes), and ``ranges``
+        (B,) metres, stored as float32 values. ``max_range`` (fixed per
         topic, kept in the channel metadata) is the no-return reading; ``+inf`` readings are
         written as ``max_range`` and need it. Invalid readings (NaN, ``-inf``, negative, zero:
         kiseki's rule, ``kiseki.scans``) are written as NaN."""
