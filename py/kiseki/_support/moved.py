@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The public modules and names that moved in the house layout, importable by their old names
-for one release, each with a DeprecationWarning naming where it is now.
+"""The public modules and names that moved (in the house issue's layout and in later splits),
+importable by their old names for one release, each with a DeprecationWarning naming where it
+is now.
 
 * Modules: ``import kiseki.localization`` gives the module now at ``kiseki.filters`` (the same
   module object, so the old name and the new one share their state) and warns once. The old

@@ -81,12 +81,9 @@ def test_from_import_of_an_old_name_points_the_warning_at_the_importer(tmp_path)
     assert f"{script}:1: DeprecationWarning: kiseki.map_io moved to kiseki.io.ros_map" in out.stderr
 
 
-# names that left a module still there: (module, name, where it is now)
-MOVED_NAMES = [
-    ("kiseki.datasets.rosbag", "write_bag", "kiseki.datasets.rosbag_writer"),
-    ("kiseki.sim.robot", "WheelOdometry", "kiseki.sim.odometry"),
-    ("kiseki.sim.robot", "OdometryErrorParams", "kiseki.sim.robot_params"),
-]
+# names that left a module still there: (module, name, where it is now); kiseki.sim.robot's
+# are tested beside the robot (tests/python/sim/test_sim_robot_inputs.py)
+MOVED_NAMES = [("kiseki.datasets.rosbag", "write_bag", "kiseki.datasets.rosbag_writer")]
 
 
 @pytest.mark.parametrize(("module", "name", "new"), MOVED_NAMES)
