@@ -38,16 +38,13 @@ def room_scans(n: int, length: float = 1.0, turn: float = 0.0, first: int = 0) -
 
 def write_log(path: Path, scan: bool = True, chunk_size: int = 128 * 1024) -> None:
     """A robot driving along y = -1 in the room: truth, odometry and (with ``scan``) scans."""
-    grid = room()
-    poses = np.column_stack([np.linspace(0.0, 2.0, STEPS), np.full(STEPS, -1.0), np.zeros(STEPS)])
-    ranges = grid.cast_scans(poses, ANGLES, max_range=8.0)
+    scans = room_scans(STEPS, length=2.0)
     with RunWriter(path, chunk_size=chunk_size) as w:
-        for k, pose in enumerate(poses):
-            t = 0.1 * k
+        for t, pose, ranges in zip(scans.times, scans.poses, scans.ranges, strict=True):
             w.write_pose("/ground_truth", t, pose)
             w.write_odometry("/odom", t, pose)
             if scan:
-                w.write_laser_scan("/scan", t, pose, ANGLES, ranges[k], max_range=8.0)
+                w.write_laser_scan("/scan", t, pose, ANGLES, ranges, max_range=8.0)
 
 
 def write_inputs(folder: Path) -> Path:
