@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """Checks of the numbers the simulator's magnetic models take (points, poses, times), shared by
-kiseki.sim.magnetic, magnetic_arm and magnetic_lattice."""
+kiseki.sim.magnetic_world, magnetometer, dipoles, magnetic_arm and magnetic_lattice."""
 
 from __future__ import annotations
 

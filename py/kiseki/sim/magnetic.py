@@ -31,9 +31,10 @@ All randomness comes from :class:`kiseki.core.Random`; give each sensor its own 
 ``kiseki.derive_seed(seed, k)``.
 
 The world's field is :mod:`kiseki.sim.magnetic_world`, the magnetometer
-:mod:`kiseki.sim.magnetometer`, the dipoles :mod:`kiseki.sim.dipoles` and the rebar lattice
-:mod:`kiseki.sim.magnetic_lattice`; this module gathers their public names (the one import
-path the library, the experiments and users have used).
+:mod:`kiseki.sim.magnetometer` and the dipoles :mod:`kiseki.sim.dipoles`; this module gathers
+the names of its ``__all__`` from them (the import path the library, the experiments and users
+have used). The rebar lattice is :mod:`kiseki.sim.magnetic_lattice`, the scene section's schema
+:mod:`kiseki.sim.magnetic_schema`.
 """
 
 from __future__ import annotations
