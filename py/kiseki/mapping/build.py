@@ -68,7 +68,7 @@ def check_map_poses(poses: np.ndarray) -> np.ndarray:
     far = float(np.abs(poses[:, :2]).max())
     if far > MAGNITUDE_LIMIT:
         raise ValueError(
-            f"the poses reach {far:g} m, beyond +-{MAGNITUDE_LIMIT:g} (a map there could not "
+            f"the poses reach {far:.10g} m, beyond +-{MAGNITUDE_LIMIT:g} (a map there could not "
             "be saved)"
         )
     return poses

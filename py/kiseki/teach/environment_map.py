@@ -73,8 +73,10 @@ def build_teaching_map(
     `kiseki.mapping.scan_local_map`) placed at its pose and merged by `rule`. Walls are as thin
     as single scans see them and the space behind them is occupied, unlike the log-odds map of
     `kiseki.mapping.build_map`. Refused: a resolution or local size that is not a finite number
-    > 0, poses that `kiseki.mapping.check_map_poses` refuses (not finite, beyond +-1e9 m), ranges
-    not one row per pose, and poses spread over a map larger than `check_map_size` allows."""
+    > 0 (a Python or numpy scalar), poses that `kiseki.mapping.check_map_poses` refuses (not
+    finite, beyond +-1e9 m), ranges not one row per pose, poses spread over a map larger than
+    `check_map_size` allows, and (by the local map, in its own words) a local size below the
+    resolution or over 4096 cells across."""
     for name, value in (("resolution", resolution), ("local_size", local_size)):
         number = isinstance(value, numbers.Real) and not isinstance(value, bool)
         if not (number and math.isfinite(value) and value > 0):

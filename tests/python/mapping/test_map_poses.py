@@ -25,7 +25,7 @@ def _poses(x: float) -> np.ndarray:
 @pytest.mark.parametrize("build", [build_map, build_teaching_map])
 @pytest.mark.parametrize("x", [1e11, -2e9])
 def test_poses_past_a_billion_metres_are_refused(build, x):
-    needle = re.escape(f"the poses reach {abs(x):g} m, beyond +-1e+09")
+    needle = re.escape(f"the poses reach {abs(x):.10g} m, beyond +-1e+09")
     with pytest.raises(ValueError, match=needle):
         build(_poses(x), RANGES, ANGLES, 5.0)
 
@@ -55,7 +55,7 @@ def test_the_teaching_map_names_a_resolution_or_size_that_is_no_length(name, val
 def test_the_bound_itself_is_taken_and_a_metre_past_it_is_not():
     poses = check_map_poses(_poses(1e9))
     assert poses.flags.c_contiguous and poses.dtype == np.float64 and poses[1, 0] == 1e9
-    with pytest.raises(ValueError, match=re.escape("reach 1e+09 m, beyond")):
+    with pytest.raises(ValueError, match=re.escape("reach 1000000001 m, beyond")):
         check_map_poses(_poses(-(1e9 + 1.0)))
 
 
