@@ -93,6 +93,6 @@ def test_writer_refuses_angles_its_reader_would_refuse(tmp_path: Path, angles: l
         (0.3, math.inf, 3, False),
     ],
 )
-def test_the_one_turn_rule_of_every_reader(start: float, step: float, beams: int, kept: bool):
+def test_the_one_turn_rule_case_by_case(start: float, step: float, beams: int, kept: bool):
     """The rule the CARMEN, bag and run-log readers share (kiseki.scans.beams_of_one_turn)."""
     assert beams_of_one_turn(start, step, beams) is kept

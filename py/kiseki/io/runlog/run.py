@@ -281,8 +281,8 @@ class SimRun:
         if not beams_of_one_turn(start, (end - start) / max(beams - 1, 1), beams):
             raise LogFormatError(
                 f"{self.path}: the first scan on {scan_topic!r} has start_angle {start:g} and "
-                f"end_angle {end:g} rad for {beams} beams: not beams of one turn at most "
-                "(start_angle within +-2 pi, several beams not all on one ray)"
+                f"end_angle {end:g} rad for {beams} beam(s): not beams of one turn at most "
+                "(start_angle within +-2 pi, a finite end_angle, several beams not all on one ray)"
             )
         # a later scan's NaN angle is other too (start and end are finite here)
         other = ~((np.abs(starts - start) <= 1e-9) & (np.abs(ends - end) <= 1e-9))
