@@ -28,15 +28,25 @@ def test_numbers_are_read_and_range_columns_may_be_anything():
 @pytest.mark.parametrize(
     ("rows", "kind", "message"),
     [
-        ([["1", "x" * 30]], "ODOM", f"run.log:4: non-numeric value '{'x' * 20}' in ODOM"),
+        (
+            [["1", "2"], ["1", "x" * 30]],
+            "ODOM",
+            f"run.log:5: non-numeric value '{'x' * 20}' in ODOM",
+        ),
         ([["1", "2"], ["nan", "2"]], "", "run.log:5: non-finite value (NaN or inf)"),
         (
             [["1", "2"], ["1", "-inf"]],
             "FLASER",
             "run.log:5: non-finite value (NaN or inf) in FLASER",
         ),
-        ([["2e12", "0"]], "", f"run.log:4: value 2e+12 beyond +-{VALUE_LIMIT:g}"),
-        ([["1_0", "0"]], "ODOM", "run.log:4: non-numeric value '1_0' in ODOM"),
+        (
+            [["0", "0"], ["2e12", "0"]],
+            "ODOM",
+            f"run.log:5: value 2e+12 in ODOM beyond +-{VALUE_LIMIT:g}",
+        ),
+        ([["0", "0"], ["2e12", "0"]], "", f"run.log:5: value 2e+12 beyond +-{VALUE_LIMIT:g}"),
+        ([["0", "0"], ["1_0", "0"]], "ODOM", "run.log:5: non-numeric value '1_0' in ODOM"),
+        ([["0", "0"], ["1"]], "ODOM", "run.log: unreadable numbers in ODOM"),  # rows of two lengths
     ],
 )
 def test_each_error_names_the_file_the_line_and_the_record(rows, kind, message):
