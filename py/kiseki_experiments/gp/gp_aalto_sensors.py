@@ -19,9 +19,8 @@ that map's prediction at the reference positions, over the square root of the pr
 variance plus the map's noise, the mean over every window of ``window`` updates; per sensor and
 axis the largest |mean| and the share of windows past ``limit``: how far below the limit a
 sensor that agrees with its map stays. The check itself reads the gridded map of all four runs
-at the filter's estimate (the Nexus interpolated to the InvenSense's instants): a map of three
-runs predicts a held-out run less well than one of four predicts run 5, so these means are if
-anything larger than the check's would be without a drift.
+at the filter's estimate (the Nexus interpolated to the InvenSense's instants), so the two
+statistics are alike, not equal.
 
 Claims (per-seed ratios of the mean position error, a bootstrap interval over the trials):
 both sensors with the check are at most half as far off as both trusted throughout (the check
