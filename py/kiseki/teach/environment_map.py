@@ -88,7 +88,7 @@ def build_teaching_map(
     reach = local_size / np.sqrt(2.0) + resolution  # half the diagonal of a local map
     lo = poses[:, :2].min(axis=0) - reach
     hi = poses[:, :2].max(axis=0) + reach
-    # poses 1e6 m apart asked for 1e7 x 1e7 cells without a word
+    # kiseki's map limit (poses 2 km apart built a map of 4e8 cells past it)
     width, height = check_map_size(*(hi - lo), resolution)
     frame = _core.OccupancyGrid(int(width), int(height), resolution, _core.Pose2(lo[0], lo[1], 0))
     env = EnvironmentMap(frame, rule)

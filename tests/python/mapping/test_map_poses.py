@@ -2,7 +2,8 @@
 # Copyright (c) 2026 the kiseki authors
 """Both map builders bound the poses they build from (kiseki.mapping.check_map_poses): poses
 past +-1e9 m made a map that no map file could hold (only `kiseki map from-log` said so), and
-the teaching map's extent was not checked at all (poses 1e6 m apart asked for 1e7 x 1e7 cells)."""
+the teaching map's extent was not held to kiseki's map limit (poses 2 km apart built a map of
+4e8 cells, four times the limit; 1e6 m apart were refused only by the C++ grid's own 1e9)."""
 
 from __future__ import annotations
 
@@ -30,9 +31,10 @@ def test_poses_past_a_billion_metres_are_refused(build, x):
         build(_poses(x), RANGES, ANGLES, 5.0)
 
 
-def test_the_teaching_map_states_its_cell_limit():
+@pytest.mark.parametrize("apart", [2e3, 1e6])
+def test_the_teaching_map_states_its_cell_limit(apart):
     with pytest.raises(ValueError, match=re.escape(f"more than the limit of {MAX_MAP_CELLS:.0e}")):
-        build_teaching_map(np.array([[0.0, 0.0, 0.0], [1e6, 1e6, 0.0]]), RANGES, ANGLES, 5.0)
+        build_teaching_map(np.array([[0, 0, 0], [apart, apart, 0.0]]), RANGES, ANGLES, 5.0)
 
 
 @pytest.mark.parametrize("bad", [np.array([[0.0, np.nan, 0.0]]), np.zeros((0, 3)), np.zeros(3)])
