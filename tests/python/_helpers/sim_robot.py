@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""What the simulated robots' tests share: poses as arrays, angle differences and the
-tolerance of a sample SD."""
+"""What the simulated robots' tests share: odometry without errors, a robot without
+acceleration limits, poses as arrays, angle differences and the tolerance of a sample SD."""
 
 from __future__ import annotations
 
@@ -10,6 +10,10 @@ import math
 import numpy as np
 
 from kiseki.core import Pose2
+from kiseki.sim.robot_params import DiffDriveParams, OdometryErrorParams
+
+NONE = OdometryErrorParams.none()
+FAST = DiffDriveParams(max_accel=1e6, max_yaw_accel=1e6)  # limits out of the way
 
 
 def pose_array(p: Pose2) -> np.ndarray:

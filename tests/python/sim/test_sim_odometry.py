@@ -16,7 +16,7 @@ import math
 import numpy as np
 import pytest
 
-from _helpers.sim_robot import angle_diff, pose_array, relative_sd_tolerance
+from _helpers.sim_robot import NONE, angle_diff, pose_array, relative_sd_tolerance
 from kiseki.core import Pose2, Random, derive_seed
 from kiseki.sim.motion import BodyMotion, WheelMotion
 from kiseki.sim.odometry import OmniOdometry, WheelOdometry
@@ -27,10 +27,6 @@ from kiseki.sim.robot_params import (
     OmniOdometryErrorParams,
     OmniParams,
 )
-
-NONE = OdometryErrorParams.none()
-FAST = DiffDriveParams(max_accel=1e6, max_yaw_accel=1e6)  # limits out of the way
-
 
 # ------------------------------------------------------------------------- wheel odometry
 

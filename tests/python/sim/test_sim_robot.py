@@ -10,20 +10,15 @@ import math
 import numpy as np
 import pytest
 
-from _helpers.sim_robot import angle_diff, pose_array
+from _helpers.sim_robot import FAST, NONE, angle_diff, pose_array
 from kiseki.core import Random
 from kiseki.sim.motion import WheelMotion
 from kiseki.sim.odometry import WheelOdometry
 from kiseki.sim.robot import DiffDriveRobot, OmniRobot
 from kiseki.sim.robot_params import (
     DiffDriveParams,
-    OdometryErrorParams,
     OmniParams,
 )
-
-NONE = OdometryErrorParams.none()
-FAST = DiffDriveParams(max_accel=1e6, max_yaw_accel=1e6)  # limits out of the way
-
 
 # ---------------------------------------------------------------------- differential drive
 

@@ -10,6 +10,7 @@ import math
 
 import pytest
 
+from _helpers.sim_robot import NONE
 from kiseki.sim.motion import WheelMotion
 from kiseki.sim.odometry import WheelOdometry
 from kiseki.sim.robot_params import (
@@ -18,10 +19,6 @@ from kiseki.sim.robot_params import (
     OmniOdometryErrorParams,
     OmniParams,
 )
-
-NONE = OdometryErrorParams.none()
-FAST = DiffDriveParams(max_accel=1e6, max_yaw_accel=1e6)  # limits out of the way
-
 
 # ------------------------------------------------------------------------------- parameters
 
