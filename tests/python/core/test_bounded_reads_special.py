@@ -120,6 +120,15 @@ def test_devices_and_fifos_are_refused_by_every_reader_without_being_opened(tmp_
         assert result["seconds"] < 1.0, result
 
 
+def _localize(log, tmp_path: Path, project_data: Path) -> subprocess.Popen:
+    """kiseki localize of ``log`` on the factory corridor's map into tmp_path/out.csv, in a child
+    with the address space limit."""
+    corridor = project_data / "maps" / "factory_corridor.yaml"
+    return kiseki_child(
+        "localize", str(log), "--map", str(corridor), "-o", str(tmp_path / "out.csv")
+    )
+
+
 def test_localize_on_dev_zero_and_on_an_endless_fifo_is_one_line_and_exit_1(tmp_path, project_data):
     fifo = tmp_path / "endless.log"
     os.mkfifo(fifo)
@@ -127,14 +136,7 @@ def test_localize_on_dev_zero_and_on_an_endless_fifo_is_one_line_and_exit_1(tmp_
     try:
         for log, what in (("/dev/zero", "a character device"), (fifo, "a FIFO (named pipe)")):
             start = time.monotonic()
-            proc = kiseki_child(
-                "localize",
-                str(log),
-                "--map",
-                str(project_data / "maps" / "factory_corridor.yaml"),
-                "-o",
-                str(tmp_path / "out.csv"),
-            )
+            proc = _localize(log, tmp_path, project_data)
             _, err = proc.communicate(timeout=20)
             print(f"localize {log}: exit {proc.returncode} in {time.monotonic() - start:.2f} s")
             assert proc.returncode == 1, err
@@ -153,14 +155,7 @@ def test_a_long_read_ends_promptly_on_a_signal(tmp_path, project_data, signum):
     signal, sent once the read is under way, ends kiseki promptly: 0.2-0.5 s measured on 2 cores,
     3 s allowed for a loaded machine; read whole in one call, as before, it took 9-37 s."""
     log = zeros_gz(tmp_path / "long.log.gz", 15)
-    proc = kiseki_child(
-        "localize",
-        str(log),
-        "--map",
-        str(project_data / "maps" / "factory_corridor.yaml"),
-        "-o",
-        str(tmp_path / "out.csv"),
-    )
+    proc = _localize(log, tmp_path, project_data)
     status = Path(f"/proc/{proc.pid}/status")
     deadline = time.monotonic() + 20
     while time.monotonic() < deadline and proc.poll() is None:
