@@ -46,6 +46,7 @@ __all__ = [
     "LaserScans",
     "apply_range_rule",
     "beams_of_one_turn",
+    "check_log_max_range",
     "check_max_range",
     "check_odometry_jumps",
     "largest_reading",
@@ -143,6 +144,16 @@ def check_max_range(where: str, max_range) -> float:
             f"got {max_range!r}"
         )
     return float(max_range)
+
+
+def check_log_max_range(where: str, max_range) -> float:
+    """:func:`check_max_range` for a maximum range a log states or gives (a PARAM, a laser
+    message's field, its largest reading): a LogFormatError naming ``where`` (the file, and its
+    line where there is one) instead of a ValueError."""
+    try:
+        return check_max_range(where, max_range)
+    except ValueError as err:
+        raise LogFormatError(str(err)) from None
 
 
 def largest_reading(ranges: np.ndarray) -> float | None:

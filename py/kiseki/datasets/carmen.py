@@ -70,7 +70,7 @@ from kiseki.scans import (
     LaserScans,
     apply_range_rule,
     beams_of_one_turn,
-    check_max_range,
+    check_log_max_range,
     check_odometry_jumps,
     largest_reading,
 )
@@ -215,10 +215,7 @@ def _laser_scans(
         max_range = largest_reading(readings)
         if max_range is None:
             raise LogFormatError(f"{path}:{rows[0][0]}: no valid range reading in any {kind}")
-        try:
-            check_max_range(f"{path}: the largest reading (the maximum range)", max_range)
-        except ValueError as err:
-            raise LogFormatError(str(err)) from None
+        check_log_max_range(f"{path}: the largest reading (the maximum range)", max_range)
     scans = LaserScans(
         times=values[:, time].copy(),
         poses=values[:, pose : pose + 3].copy(),
@@ -264,10 +261,7 @@ def _flaser_max_range(
         value = float(np.float32(parse_float(text)))
     except ValueError:
         raise LogFormatError(f"{where} is not a number") from None
-    try:
-        return check_max_range(where, value)  # 1e10 was read, refused by the map naming no file
-    except ValueError as err:
-        raise LogFormatError(str(err)) from None
+    return check_log_max_range(where, value)  # 1e10 was read, refused by the map naming no file
 
 
 def _robotlaser_fields(path: Path, lineno: int, tokens: list[str]) -> list[str]:
@@ -296,8 +290,11 @@ def _parse_robotlaser(path: Path, rows: list[_Row]) -> LaserScans:
         lineno = rows[int(np.argmax(changed))][0]
         raise LogFormatError(f"{path}:{lineno}: ROBOTLASER1 laser configuration changes")
     start, _, step, max_range = config[0]
-    if n == 0 or max_range <= 0:
-        raise LogFormatError(f"{path}:{rows[0][0]}: ROBOTLASER1 with no beams or max range <= 0")
+    if n == 0:
+        raise LogFormatError(f"{path}:{rows[0][0]}: ROBOTLASER1 with no beams")
+    # 1e10 was read, then refused by the range rule naming no file
+    where = f"{path}:{rows[0][0]}: ROBOTLASER1 maximum_range"
+    max_range = check_log_max_range(where, float(np.float32(max_range)))
     if not beams_of_one_turn(start, step, n):
         raise LogFormatError(
             f"{path}:{rows[0][0]}: ROBOTLASER1 start_angle {start:g} and angular_resolution "

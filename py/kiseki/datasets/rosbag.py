@@ -81,6 +81,7 @@ from kiseki.scans import (
     LaserScans,
     apply_range_rule,
     beams_of_one_turn,
+    check_log_max_range,
     check_odometry_jumps,
 )
 
@@ -267,12 +268,10 @@ def _scan_arrays(
         ranges[row] = scans[index].ranges
     angle_min = float(first.angle_min)
     angles = angle_min + float(first.angle_increment) * np.arange(beams, dtype=np.float64)
-    max_range = float(np.float32(first.range_max))
-    if not (np.isfinite(max_range) and max_range > 0):
-        raise LogFormatError(
-            f"{path}: the first scan on {topic!r} has range_max {first.range_max}: not a "
-            "positive finite number"
-        )
+    # one bound for every log's maximum range (a range_max of 1e10 was read, then refused by
+    # the range rule naming no file)
+    where = f"{path}: the first scan on {topic!r}: range_max"
+    max_range = check_log_max_range(where, float(np.float32(first.range_max)))
     return laser, ns[order], ranges, angles, max_range
 
 

@@ -48,7 +48,7 @@ from kiseki.errors import LogFormatError
 from kiseki.scans import (
     LaserScans,
     apply_range_rule,
-    check_max_range,
+    check_log_max_range,
     check_odometry_jumps,
     largest_reading,
 )
@@ -136,10 +136,7 @@ def read_wean_log(path: str | os.PathLike) -> WeanLog:
     max_range = largest_reading(readings)
     if max_range is None:
         raise LogFormatError(f"{path}:{laser_lines[0]}: no valid range reading in any L line")
-    try:
-        check_max_range(f"{path}: the largest reading (the maximum range)", max_range)
-    except ValueError as err:
-        raise LogFormatError(str(err)) from None
+    check_log_max_range(f"{path}: the largest reading (the maximum range)", max_range)
     odometry = np.column_stack([values[:, 3:5] * CM, values[:, 5]])
     scans = LaserScans(
         times=values[:, -1].copy(),

@@ -269,6 +269,16 @@ def test_robotlaser1_beams_beyond_one_turn_are_refused(tmp_path: Path, start, re
         read_carmen_log(path)
 
 
+@pytest.mark.parametrize("max_range", [1e10, 0.0, -5.0])
+def test_robotlaser1_maximum_range_past_the_bound_is_refused(tmp_path: Path, max_range) -> None:
+    """A maximum_range of 1e10 was read, then refused by the range rule naming no file."""
+    line = robotlaser([1.0, 2.0], [0.5], [0, 0, 0], [0, 0, 0], 5.0, rmax=max_range)
+    path = write(tmp_path / "rl.log", line + "\n")
+    message = r"rl\.log:1: ROBOTLASER1 maximum_range: max_range must be a number > 0 and at most"
+    with pytest.raises(LogFormatError, match=message):
+        read_carmen_log(path)
+
+
 @pytest.mark.parametrize("value", ["fifty", "8_0"])  # float() read 8_0 as 80
 def test_bad_max_range_param(tmp_path: Path, value: str) -> None:
     text = f"# a log\nPARAM robot_front_laser_max {value}\n" + GOOD_FLASER

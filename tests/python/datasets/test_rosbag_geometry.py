@@ -96,3 +96,15 @@ def test_a_frame_the_scans_do_not_use_may_hold_any_quaternion() -> None:
     )
     assert np.isnan(static["arm"][1][2])
     assert np.isnan(rosbag._mount(Path("b"), static, "base_link", "arm")[2])
+
+
+@pytest.mark.parametrize("range_max", [1e10, 0.0])
+def test_a_range_max_past_the_bound_is_refused_naming_the_bag(tmp_path: Path, range_max) -> None:
+    """A range_max of 1e10 was read, then refused by the range rule naming no file."""
+    scans = _scans()
+    object.__setattr__(scans, "max_range", range_max)  # past what LaserScans itself takes
+    bag = write_bag(scans, tmp_path / "b.bag", "ros1")
+    with pytest.raises(LogFormatError) as caught:
+        read_bag_scans(bag)
+    assert str(caught.value).startswith(f"{bag}: the first scan on '/scan': range_max: ")
+    assert "max_range must be a number > 0 and at most 1e+09 m" in str(caught.value)

@@ -42,7 +42,7 @@ from kiseki.scans import (
     LaserScans,
     apply_range_rule,
     beams_of_one_turn,
-    check_max_range,
+    check_log_max_range,
     check_odometry_jumps,
     largest_reading,
 )
@@ -308,10 +308,7 @@ class SimRun:
             raise LogFormatError(f"{self.path}: bad max_range {limit_text!r}") from exc
         if limit is None:
             raise LogFormatError(f"{self.path}: no valid range reading on {scan_topic!r}")
-        try:
-            limit = check_max_range(f"{self.path}: {scan_topic!r}", float(np.float32(limit)))
-        except ValueError as err:
-            raise LogFormatError(str(err)) from None
+        limit = check_log_max_range(f"{self.path}: {scan_topic!r}", float(np.float32(limit)))
         laser = LaserScans(
             times=times,
             poses=np.ascontiguousarray(poses, dtype=np.float64),
