@@ -52,6 +52,7 @@ import numpy as np
 
 from kiseki import _core
 from kiseki._support.field_types import check_field_types
+from kiseki.core import check_seed
 from kiseki.magnetic.loop_profile import LoopProfile
 
 __all__ = ["LoopTravelConfig", "LoopTravelDistanceLocalizer", "loop_log_likelihood"]
@@ -107,10 +108,7 @@ class LoopTravelConfig:
             raise ValueError(
                 f"loop filter: 0 < alpha_slow < alpha_fast <= 1 is needed, got {a!r}, {b!r}"
             )
-        if isinstance(self.seed, bool) or not isinstance(self.seed, numbers.Integral):
-            raise ValueError(f"loop filter: seed must be an integer, got {self.seed!r}")
-        if not 0 <= self.seed < 2**64:
-            raise ValueError(f"loop filter: seed must be in [0, 2**64), got {self.seed}")
+        check_seed(self.seed, "loop filter: seed")
 
 
 def loop_log_likelihood(

@@ -23,6 +23,7 @@ import yaml
 from pydantic import Field, create_model
 
 from kiseki._support.numbers_text import parse_float
+from kiseki._support.options import PARTICLE_LIMIT
 from kiseki._support.schema import (
     FileModel,
     FiniteFloat,
@@ -73,8 +74,8 @@ NonEmpty = Field(min_length=1)
 ``--set methods=`` ran a trial and failed with "list index out of range", leaving a half-written
 results folder."""
 
-PARTICLE_LIMIT = 10_000_000
-"""The most particles an experiment's filter may take (as ``kiseki.filters.MclConfig``)."""
+# PARTICLE_LIMIT: the most particles an experiment's filter may take, the library's own
+# (kiseki._support.options, as kiseki.filters.MclConfig takes)
 RUN_LIMIT = 100_000
 """The most runs (repetitions of a setting) an experiment's config may ask for."""
 LIST_LIMIT = 10_000
