@@ -296,6 +296,25 @@ TEST(TravelDistanceFilter, ConvergesOnTheDistanceAGaussianLikelihoodPoints) {
   EXPECT_THROW(b.predict(1, 0.1), std::logic_error);
 }
 
+TEST(TravelDistanceFilter, LikelihoodPowerLiesInTheMclsBound) {
+  // the SE(2) engine's (0, 1000]: a power of 1e300 overflowed the log-likelihoods to NaN weights
+  TravelDistanceParams p;
+  for (double power : {1e-9, 0.1, 1.0, 1000.0}) {
+    p.likelihood_power = power;
+    EXPECT_NO_THROW(TravelDistanceFilter(p, 1)) << power;
+  }
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
+  for (double power : {0.0, -1.0, 1000.0001, 1e300, inf, nan}) {
+    p.likelihood_power = power;
+    try {
+      TravelDistanceFilter f(p, 1);
+      ADD_FAILURE() << power << " was taken";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_STREQ(e.what(), "travel distance filter: likelihood_power must lie in (0, 1000]") << power;
+    }
+  }
+}
+
 TEST(TravelDistanceFilter, EachScaleStaysWithItsDistanceThroughKldResampling) {
   TravelDistanceParams p;
   p.particles = 3000;

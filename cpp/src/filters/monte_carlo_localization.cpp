@@ -35,10 +35,7 @@ void MclParams::validate() const {
   if (!(resample_threshold >= 0.0 && resample_threshold <= 1.0)) {
     throw std::invalid_argument("MCL: resample_threshold must lie in [0, 1]");
   }
-  // a scan counted as up to 1,000 scans; 1e300 overflowed the log-likelihoods to NaN weights
-  if (!(likelihood_power > 0.0 && likelihood_power <= 1000.0)) {
-    throw std::invalid_argument("MCL: likelihood_power must lie in (0, 1000]");
-  }
+  check_likelihood_power(likelihood_power, "MCL");  // (0, 1000]: a scan counted as up to 1,000
   if (!(alpha_slow > 0.0 && alpha_slow <= 1.0 && alpha_fast > 0.0 && alpha_fast <= 1.0)) {
     throw std::invalid_argument("MCL: alpha_slow and alpha_fast must lie in (0, 1]");
   }

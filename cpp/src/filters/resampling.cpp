@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -123,6 +124,14 @@ double effective_sample_size(const std::vector<double>& weights) {
   double s = 0.0;
   for (double w : weights) s += w * w;
   return s > 0.0 ? 1.0 / s : 0.0;
+}
+
+void check_likelihood_power(double power, const char* who) {
+  if (!(power > 0.0 && power <= kMaxLikelihoodPower)) {
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g", kMaxLikelihoodPower);
+    throw std::invalid_argument(std::string(who) + ": likelihood_power must lie in (0, " + limit + "]");
+  }
 }
 
 bool apply_log_likelihoods(std::vector<double>& weights, const std::vector<double>& log_l, double power,

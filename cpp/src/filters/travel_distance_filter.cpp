@@ -20,9 +20,7 @@ void TravelDistanceParams::validate() const {
   if (!(resample_threshold >= 0.0) || !std::isfinite(resample_threshold)) {
     throw std::invalid_argument("travel distance filter: resample_threshold must be >= 0");
   }
-  if (!(likelihood_power > 0.0) || !std::isfinite(likelihood_power)) {
-    throw std::invalid_argument("travel distance filter: likelihood_power must be > 0");
-  }
+  check_likelihood_power(likelihood_power, "travel distance filter");  // the MCL's (0, 1000]
   check_threads(threads, "travel distance filter");
 }
 

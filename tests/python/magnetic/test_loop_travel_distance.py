@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """kiseki's loop filter: the likelihood against its closed form, the profile's reading around
-the loop, the engine's scaled motion and resampling of pairs, and the scale estimated on a
-synthetic loop whose odometry is 10 % long (against the same filter without readings)."""
+the loop, the engine's scaled motion and resampling of pairs and its likelihood_power bound (the
+MCL's), and the scale estimated on a synthetic loop whose odometry is 10 % long (against the same
+filter without readings)."""
 
 from __future__ import annotations
 
@@ -103,6 +104,16 @@ def test_engine_moves_each_particle_by_its_own_scale_and_resamples_pairs():
     np.testing.assert_array_equal(f.scales, [2.0] * 4)
     with pytest.raises(ValueError, match="scales must be finite and > 0"):
         f.set_scales([1.0, 0.0, 1.0, 1.0])
+
+
+@pytest.mark.parametrize("power", [0.0, -1.0, 1000.0001, 1e300, math.inf, math.nan])
+def test_engine_refuses_a_likelihood_power_outside_the_mcls_bound(power):
+    params = _core.TravelDistanceParams()
+    params.likelihood_power = 1000.0  # the bound itself is taken, as the MCL engine takes it
+    _core.TravelDistanceFilter(params, 1)
+    params.likelihood_power = power
+    with pytest.raises(ValueError, match=r"likelihood_power must lie in \(0, 1000\]"):
+        _core.TravelDistanceFilter(params, 1)
 
 
 def synthetic_run(scale: float, seed: int, profiles, steps: int = 900):

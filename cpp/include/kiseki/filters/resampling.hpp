@@ -35,6 +35,14 @@ std::vector<std::size_t> resample_indices(const std::vector<double>& weights, st
 /// Effective sample size 1 / sum w_i^2 of normalised weights (Liu 1996).
 double effective_sample_size(const std::vector<double>& weights);
 
+/// The largest likelihood power a filter takes (the MCL engine's and the travel-distance
+/// filter's): a measurement counted as up to 1,000 of them; 1e300 overflowed the
+/// log-likelihoods to NaN weights.
+inline constexpr double kMaxLikelihoodPower = 1000.0;
+
+/// Throws std::invalid_argument naming `who` unless 0 < power <= kMaxLikelihoodPower.
+void check_likelihood_power(double power, const char* who);
+
 /// Multiplies weights by exp(power * log_likelihoods) and normalises, in a way that does not
 /// underflow (the largest term is taken out). -inf log-likelihoods give weight 0; NaN throws.
 /// Returns false and leaves the weights unchanged when no particle has a finite
