@@ -41,9 +41,12 @@ poses, ``base_link`` in ``map`` on the reference topic. Each message is stamped 
 its scan's time.
 
 Recognising a bag, checking its files, opening it and reading the messages of its topics within
-kiseki's limits is :mod:`kiseki.datasets.rosbag_files` (its public names are importable from
-here too). Writing is :mod:`kiseki.datasets.rosbag_writer`; what both share about ROS messages
-(frames, stamps, quaternions, planar poses) is :mod:`kiseki.datasets.ros_messages`.
+kiseki's limits is :mod:`kiseki.datasets.rosbag_files` (``BAG_KINDS`` and ``is_ros_bag`` are
+importable from here too). The limits (``MAX_BAG_CHUNK_BYTES``, ``MAX_BAG_FILE_BYTES``,
+``MAX_BAG_MESSAGE_BYTES``) live there alone, where the reader's checks read them: read or set
+them in :mod:`kiseki.datasets.rosbag_files`. Writing is :mod:`kiseki.datasets.rosbag_writer`;
+what both share about ROS messages (frames, stamps, quaternions, planar poses) is
+:mod:`kiseki.datasets.ros_messages`.
 """
 
 from __future__ import annotations
@@ -68,9 +71,6 @@ from kiseki.datasets.ros_messages import (
 )
 from kiseki.datasets.rosbag_files import (
     BAG_KINDS,
-    MAX_BAG_CHUNK_BYTES,
-    MAX_BAG_FILE_BYTES,
-    MAX_BAG_MESSAGE_BYTES,
     check_bag_files,
     is_ros_bag,
     open_bag,
@@ -87,16 +87,17 @@ from kiseki.scans import (
 
 __all__ = [
     "BAG_KINDS",
-    "MAX_BAG_CHUNK_BYTES",
-    "MAX_BAG_FILE_BYTES",
-    "MAX_BAG_MESSAGE_BYTES",
     "is_ros_bag",
     "read_bag_scans",
 ]
 
 # write_bag moved to kiseki.datasets.rosbag_writer (and is kiseki.datasets.write_bag as before);
-# the old name answers for one release with a DeprecationWarning (kiseki._support.moved)
-__getattr__ = moved_names(__name__, {"write_bag": "kiseki.datasets.rosbag_writer"})
+# the limits are rosbag_files' (copies here, set, changed nothing the reader checks). The old
+# names answer for one release with a DeprecationWarning (kiseki._support.moved), the limits
+# with rosbag_files' value at the time.
+_LIMITS = ("MAX_BAG_CHUNK_BYTES", "MAX_BAG_FILE_BYTES", "MAX_BAG_MESSAGE_BYTES")
+_MOVED = {"write_bag": "kiseki.datasets.rosbag_writer"}
+__getattr__ = moved_names(__name__, _MOVED | dict.fromkeys(_LIMITS, "kiseki.datasets.rosbag_files"))
 
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
 ODOMETRY = "nav_msgs/msg/Odometry"
