@@ -8,6 +8,7 @@ source (datasheet, paper, or stated assumption).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Annotated
@@ -111,7 +112,17 @@ class LaserParams:
 
     @property
     def angles(self) -> np.ndarray:
-        return beam_angles(self.beams, math.radians(self.field_of_view_deg))
+        """The beam angles (rad), read-only: computed once, shared by every scan."""
+        return _beam_angles(self.beams, self.field_of_view_deg)
+
+
+@functools.lru_cache(maxsize=64)
+def _beam_angles(beams: int, field_of_view_deg: float) -> np.ndarray:
+    # kept here, not on the frozen params (whose __dict__ holds its fields alone), by value: a
+    # params object and its equal copies share one array
+    angles = beam_angles(beams, math.radians(field_of_view_deg))
+    angles.setflags(write=False)
+    return angles
 
 
 LASER_PRESETS = {
