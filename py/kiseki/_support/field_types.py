@@ -3,8 +3,11 @@
 """The kinds of a config's fields, checked from their annotations: a field annotated ``bool``
 holds True or False (the string "no" is truthy and was read as True), one annotated ``int`` an
 integer (True counted as 1 particle, 1000.7 as a particle count), one annotated ``float`` a
-number. Other annotations (tuples, strings, optional values) are left to each config's own
-checks, which run after this one and keep their messages for values of the right kind."""
+number. A numpy scalar of the right kind is taken and held as the Python number it is
+(``np.int64(60)`` beams as 60): a config is saved with its results as JSON or YAML, neither of
+which writes a numpy scalar. Other annotations (tuples, strings, optional values) are left to
+each config's own checks, which run after this one and keep their messages for values of the
+right kind."""
 
 from __future__ import annotations
 
@@ -28,7 +31,8 @@ def _kind_ok(kind: str, value) -> bool:
 
 def check_field_types(config) -> None:
     """Raises ValueError naming the first field of the dataclass instance `config` whose value is
-    not of its annotated kind (bool, int or float, each possibly ``| None``)."""
+    not of its annotated kind (bool, int or float, each possibly ``| None``); replaces a numpy
+    scalar field of such a kind by its Python number."""
     for f in dataclasses.fields(config):
         annotation = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", "")
         kind, _, rest = annotation.replace(" ", "").partition("|")
@@ -41,3 +45,5 @@ def check_field_types(config) -> None:
         if not _kind_ok(kind, value):
             want = {"bool": "True or False", "int": "an integer", "float": "a number"}[kind]
             raise ValueError(f"{type(config).__name__}.{f.name} must be {want}, got {value!r}")
+        if isinstance(value, np.generic):  # held as Python's own: saved configs are JSON / YAML
+            object.__setattr__(config, f.name, value.item())

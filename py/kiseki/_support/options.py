@@ -23,6 +23,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from kiseki import _core
+from kiseki._support.counts import integer_rule
 from kiseki._support.numbers_text import parse_float, parse_int
 from kiseki.core import SEED_RULE
 from kiseki.errors import KisekiError
@@ -131,8 +132,7 @@ class Count(_Bounded):
         return None
 
     def rule(self) -> str:
-        note = f" ({self.note})" if self.note else ""
-        return f"an integer in {self.lo:,}..{self.hi:,}{note}"
+        return integer_rule(self.lo, self.hi, self.note)
 
 
 class Seed(Count):

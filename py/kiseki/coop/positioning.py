@@ -56,6 +56,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki.coop.triangulation import MIN_INTERSECTION_ANGLE
 from kiseki.core import check_seed
 
@@ -131,8 +132,7 @@ def paper_angle(form: int, moves: int, start=START, goal=GOAL) -> float:
     start, goal = _check_places(start, goal)
     if form not in FORMS:
         raise ValueError(f"form must be 1 or 2, got {form!r}")
-    if not isinstance(moves, int) or isinstance(moves, bool) or moves < 1:
-        raise ValueError(f"moves must be an integer >= 1, got {moves!r}")
+    check_count(moves, "moves", 1)
     order = np.argsort(start[:, 1])
     w = abs(start[order[1], 0] - start[order[2], 0]) / 2
     if form == 1:
@@ -144,8 +144,7 @@ def paper_angle(form: int, moves: int, start=START, goal=GOAL) -> float:
 def _check(form: int, moves: int, angle: float) -> None:
     if form not in FORMS:
         raise ValueError(f"form must be 1 or 2, got {form!r}")
-    if not isinstance(moves, int) or isinstance(moves, bool) or not 1 <= moves <= 1000:
-        raise ValueError(f"moves must be an integer in 1..1000, got {moves!r}")
+    check_count(moves, "moves", 1, 1000)
     if form == 1 and moves % 2 == 0:
         raise ValueError(
             f"form 1 takes an odd number of moves (scout, pair, ..., scout), got {moves}"
@@ -265,8 +264,7 @@ def _check_runs(the_plan, runs, limit: int, seed, **sigmas) -> None:
     """A Plan (None was an AttributeError), runs in 1..limit, angle SDs in [0, 10 deg)."""
     if not isinstance(the_plan, Plan):
         raise TypeError(f"the_plan must be a Plan (see plan()), got {type(the_plan).__name__}")
-    if isinstance(runs, bool) or not (isinstance(runs, numbers.Integral) and 0 < runs <= limit):
-        raise ValueError(f"runs must be an integer in 1..{limit:,}, got {runs!r}")
+    check_count(runs, "runs", 1, limit)
     for name, v in sigmas.items():
         if isinstance(v, bool) or not (isinstance(v, numbers.Real) and 0 <= v < math.radians(10)):
             raise ValueError(f"{name} must lie in [0, 10 deg), got {v!r}")

@@ -20,13 +20,13 @@ object.
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Callable
 from dataclasses import dataclass, fields
 
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import PARTICLE_LIMIT, THREAD_LIMIT
 from kiseki._support.schema import INT32_MAX
@@ -136,14 +136,8 @@ class MclConfig:
 
     def __post_init__(self) -> None:
         check_field_types(self)
-        _check(
-            isinstance(self.particles, numbers.Integral) and 1 <= self.particles <= PARTICLE_LIMIT,
-            f"particles must be an integer in 1..{PARTICLE_LIMIT:,}, got {self.particles!r}",
-        )
-        _check(
-            isinstance(self.min_particles, numbers.Integral) and self.min_particles >= 1,
-            f"min_particles must be an integer >= 1, got {self.min_particles!r}",
-        )
+        check_count(self.particles, "particles", 1, PARTICLE_LIMIT)
+        check_count(self.min_particles, "min_particles", 1, PARTICLE_LIMIT)
         _check(
             not self.kld or self.min_particles <= self.particles,
             f"with kld, min_particles ({self.min_particles}) must not exceed particles "
@@ -164,22 +158,13 @@ class MclConfig:
             self.recovery in RECOVERY_MODES,
             f"recovery must be one of {', '.join(RECOVERY_MODES)}, got {self.recovery!r}",
         )
-        _check(
-            isinstance(self.threads, numbers.Integral) and 0 <= self.threads <= THREAD_LIMIT,
-            f"threads must be an integer in 0..{THREAD_LIMIT} (0 = chosen by measured time), "
-            f"got {self.threads!r}",
-        )
+        check_count(self.threads, "threads", 0, THREAD_LIMIT, "0 = chosen by measured time")
         _check(
             self.sensor_reset_proposal in RESET_PROPOSALS,
             f"sensor_reset_proposal must be one of {', '.join(RESET_PROPOSALS)}, "
             f"got {self.sensor_reset_proposal!r}",
         )
-        _check(
-            isinstance(self.matcher_search_every, numbers.Integral)
-            and 1 <= self.matcher_search_every <= 1000,
-            "matcher_search_every must be an integer in 1..1000, "
-            f"got {self.matcher_search_every!r}",
-        )
+        check_count(self.matcher_search_every, "matcher_search_every", 1, 1000)
         for name in ("reset_look_elsewhere", "reset_needs_agreement", "sensor_reset_confirm"):
             value = getattr(self, name)
             _check(isinstance(value, bool), f"{name} must be True or False, got {value!r}")

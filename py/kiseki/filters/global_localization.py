@@ -41,7 +41,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import numbers
 import os
 import time
 from dataclasses import asdict, dataclass, field
@@ -51,7 +50,9 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki._support.atomic import atomic_write
+from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
+from kiseki._support.options import BEAM_LIMIT, PARTICLE_LIMIT
 from kiseki.core import check_seed, derive_seed
 from kiseki.filters.convergence import ConvergenceReport, convergence_report, spread_radius
 from kiseki.filters.engine import (
@@ -152,14 +153,8 @@ class GlobalConfig:
                 f"got {self.start!r}"
             )
         for name in ("particles", "tracking_particles", "hypotheses"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 10**7:
-                raise ValueError(
-                    f"global localization: {name} must be an integer in 1..10,000,000, "
-                    f"got {value!r}"
-                )
-        if not (isinstance(self.beams, numbers.Integral) and self.beams >= 0):
-            raise ValueError(f"beams must be an integer >= 0 (0 = every beam), got {self.beams!r}")
+            check_count(getattr(self, name), f"global localization: {name}", 1, PARTICLE_LIMIT)
+        check_count(self.beams, "beams", 0, BEAM_LIMIT, "0 = every beam")
         if self.recovery not in RECOVERY_MODES:
             raise ValueError(
                 f"recovery must be one of {', '.join(RECOVERY_MODES)}, got {self.recovery!r}"

@@ -6,10 +6,11 @@ saved with every result."""
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import asdict, dataclass
 
+from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
+from kiseki._support.options import BEAM_LIMIT
 from kiseki.core import check_seed
 from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS, MclConfig
 from kiseki.filters.initial_pose import check_spread
@@ -144,10 +145,7 @@ class LocalizeConfig:
             f"got {self.odometry_noise}",
         )
         check_spread("initial_sd", self.initial_sd)  # 1e300 was refused only by the run
-        _check(
-            isinstance(self.beams, numbers.Integral) and self.beams >= 0,
-            f"beams must be an integer >= 0 (0 = every beam), got {self.beams!r}",
-        )
+        check_count(self.beams, "beams", 0, BEAM_LIMIT, "0 = every beam")
         _check(
             self.combination in ("product", "nav2"),
             f"combination must be product or nav2, got {self.combination!r}",
@@ -216,10 +214,7 @@ class LocalizeConfig:
         _check(
             0 < self.budget_share <= 1, f"budget_share must lie in (0, 1], got {self.budget_share}"
         )
-        _check(
-            isinstance(self.budget_min_beams, numbers.Integral) and self.budget_min_beams >= 1,
-            f"budget_min_beams must be an integer >= 1, got {self.budget_min_beams!r}",
-        )
+        check_count(self.budget_min_beams, "budget_min_beams", 1, BEAM_LIMIT)
         # the engine's checks, as ValueError, of the alphas given (1e300 was taken here and
         # refused by the run); those derived from odometry_noise stay within them (F < 10)
         self.mcl(REAL_ODOMETRY_ALPHAS if self.alphas is None else self.alphas)

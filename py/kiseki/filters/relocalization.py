@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import BEAM_LIMIT, THREAD_LIMIT
 from kiseki.errors import RelocalizationError
@@ -82,11 +83,9 @@ class RelocalizeConfig:
             "threads": (0, THREAD_LIMIT),
         }
         for name, (low, high) in bounds.items():
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
-                raise RelocalizationError(
-                    f"relocalize: {name} must be an integer in {low}..{high}, got {value!r}"
-                )
+            check_count(
+                getattr(self, name), f"relocalize: {name}", low, high, error=RelocalizationError
+            )
         for name in ("sigma_hit", "max_distance"):
             if not _finite(getattr(self, name)) or getattr(self, name) <= 0:
                 raise RelocalizationError(

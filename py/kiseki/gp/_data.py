@@ -8,6 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._support.counts import check_count
+
 MEANS = ("constant", "zero")
 
 
@@ -53,10 +55,5 @@ def remove_mean(y: np.ndarray, constant: bool) -> np.ndarray:
 
 def check_iterations(max_iterations: Any) -> int:
     """A hyperparameter search's iteration limit: an integer >= 1."""
-    if (
-        isinstance(max_iterations, bool)
-        or not isinstance(max_iterations, int)
-        or max_iterations < 1
-    ):
-        raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+    check_count(max_iterations, "max_iterations", 1)
     return max_iterations

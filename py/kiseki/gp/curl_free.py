@@ -31,6 +31,7 @@ import scipy.linalg
 import scipy.linalg.lapack
 import scipy.optimize
 
+from kiseki._support.counts import check_count
 from kiseki.gp._data import check_iterations, inputs_array, targets_array
 from kiseki.gp.kernel import check_hyperparameters, subsample
 
@@ -357,8 +358,7 @@ class CurlFreeGP:
         if inputs_array(points, "points").shape[1] != self.dimension:
             raise ValueError(f"points must have {self.dimension} coordinates, as the GP's inputs")
         p = field_inputs(points, "points")
-        if isinstance(block, bool) or not isinstance(block, int) or block < 1:
-            raise ValueError(f"block must be an integer >= 1, got {block!r}")
+        check_count(block, "block", 1)
         means, variances = [], []
         prior = self.kernel.anomaly_sd**2 + self.kernel.sigma_lin**2
         for start in range(0, len(p), block):

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki.core import check_seed
 from kiseki.gp._data import (
     check_iterations,
@@ -92,8 +93,7 @@ class HyperparameterFit:
 
 def subsample(n: int, max_points: int, seed: int) -> np.ndarray | None:
     """Indices of a seeded random subsample of max_points of n (None: use them all)."""
-    if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
-        raise ValueError(f"max_points must be an integer >= 2, got {max_points!r}")
+    check_count(max_points, "max_points", 2)
     if n <= max_points:
         return None
     rng = np.random.default_rng(check_seed(seed))
@@ -143,15 +143,12 @@ def fit_hyperparameters(
     x = inputs_array(x)
     y, _ = targets_array(y, x.shape[0])
     constant = check_mean(mean)
-    if isinstance(restarts, bool) or not isinstance(restarts, int) or not 0 <= restarts <= 100:
-        raise ValueError(f"restarts must be an integer in 0..100, got {restarts!r}")
+    check_count(restarts, "restarts", 0, 100)
     if not isinstance(stop_at_repeat, bool):
         raise ValueError(f"stop_at_repeat must be True or False, got {stop_at_repeat!r}")
     check_iterations(max_iterations)
-    if search_points is not None and (
-        isinstance(search_points, bool) or not isinstance(search_points, int) or search_points < 2
-    ):
-        raise ValueError(f"search_points must be an integer >= 2, got {search_points!r}")
+    if search_points is not None:
+        check_count(search_points, "search_points", 2)
     chosen = subsample(x.shape[0], max_points, seed)
     if chosen is not None:
         x, y = x[chosen], y[chosen]

@@ -18,6 +18,7 @@ import numbers
 import numpy as np
 
 from kiseki._core import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from kiseki._support.counts import check_count
 from kiseki._support.options import BEAM_LIMIT
 
 __all__ = ["FREE", "OCCUPIED", "UNKNOWN", "OccupancyGrid", "beam_angles", "grid_summary"]
@@ -26,10 +27,7 @@ __all__ = ["FREE", "OCCUPIED", "UNKNOWN", "OccupancyGrid", "beam_angles", "grid_
 def beam_angles(count: int, field_of_view: float, start: float | None = None) -> np.ndarray:
     """Evenly spaced beam angles (radians) covering ``field_of_view`` with both ends included,
     starting at ``start`` (default ``-field_of_view / 2``)."""
-    if isinstance(count, bool) or not isinstance(count, numbers.Integral) or count < 1:
-        raise ValueError(f"beam count must be an integer >= 1, got {count!r}")
-    if count > BEAM_LIMIT:
-        raise ValueError(f"beam count must be at most {BEAM_LIMIT}, got {count}")
+    check_count(count, "beam count", 1, BEAM_LIMIT)
     fov_ok = isinstance(field_of_view, numbers.Real) and not isinstance(field_of_view, bool)
     # a scanner covers at most one turn (100 rad put every beam on 16 turns)
     if not fov_ok or not 0 < field_of_view <= 2 * math.pi + 1e-9:

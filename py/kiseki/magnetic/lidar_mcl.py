@@ -47,7 +47,9 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
+from kiseki._support.options import BEAM_LIMIT, PARTICLE_LIMIT
 from kiseki.core import Pose2, check_seed, derive_seed
 from kiseki.filters import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
 from kiseki.filters.initial_pose import check_spread
@@ -95,10 +97,8 @@ class LidarMclConfig:
 
     def __post_init__(self) -> None:
         check_field_types(self)
-        for name in ("particles", "beams"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"lidar MCL: {name} must be an integer >= 1, got {value!r}")
+        check_count(self.particles, "lidar MCL: particles", 1, PARTICLE_LIMIT)
+        check_count(self.beams, "lidar MCL: beams", 1, BEAM_LIMIT)
         _number(self.sigma_d, "sigma_d", 1e-6)
         _number(self.sigma_theta, "sigma_theta", 0.0, math.pi)
         _number(self.r_z_gate, "r_z_gate", 0.0, 1.0)

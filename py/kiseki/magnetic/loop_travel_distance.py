@@ -51,7 +51,9 @@ from typing import Any
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
+from kiseki._support.options import PARTICLE_LIMIT
 from kiseki.core import check_seed
 from kiseki.magnetic.loop_profile import LoopProfile
 
@@ -80,12 +82,7 @@ class LoopTravelConfig:
 
     def __post_init__(self) -> None:
         check_field_types(self)
-        if isinstance(self.particles, bool) or not isinstance(self.particles, numbers.Integral):
-            raise ValueError(f"loop filter: particles must be an integer, got {self.particles!r}")
-        if not 1 <= self.particles <= 10_000_000:
-            raise ValueError(
-                f"loop filter: particles must be in 1..10,000,000, got {self.particles}"
-            )
+        check_count(self.particles, "loop filter: particles", 1, PARTICLE_LIMIT)
         for name in ("odometry_noise", "scale_sd", "scale_walk", "initial_sd"):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):

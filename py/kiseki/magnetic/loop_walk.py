@@ -27,6 +27,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from kiseki.core import check_seed
 from kiseki.datasets.magnetic import MagneticSamples
 from kiseki.magnetic.loop_profile import LoopProfile, fit_loop_profile, heading_invariant_channels
 from kiseki.magnetic.loop_travel_distance import LoopTravelConfig, LoopTravelDistanceLocalizer
@@ -114,8 +115,7 @@ def localize_walk_loop(
     config = LoopTravelConfig() if config is None else config
     if not isinstance(odometry, WalkOdometry) or not isinstance(config, LoopTravelConfig):
         raise ValueError("walk: odometry must be a WalkOdometry and config a LoopTravelConfig")
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
-        raise ValueError(f"walk: seed must be an integer in [0, 2**64), got {seed!r}")
+    seed = check_seed(seed, "walk: seed")
     wm = walk if isinstance(walk, LoopWalkMap) else map_walk_loop(walk, odometry)
     w, length = wm.laps, wm.length
     e_scale, odo_step = walk_odometry(w.xy, odometry, seed)

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._support.counts import check_count
 from kiseki.core import check_seed
 from kiseki.filters import MonteCarloLocalizer
 from kiseki.magnetic.localization import (
@@ -49,9 +50,7 @@ class DriftCheck:
     limit: float = 3.0  # |mean normalised innovation| above which a sensor is dropped
 
     def __post_init__(self) -> None:
-        window = self.window
-        if isinstance(window, bool) or not isinstance(window, numbers.Integral) or window < 2:
-            raise ValueError(f"drift check: window must be an integer >= 2, got {self.window!r}")
+        check_count(self.window, "drift check: window", 2)
         ok = isinstance(self.limit, numbers.Real) and not isinstance(self.limit, bool)
         if not (ok and math.isfinite(self.limit) and self.limit > 0):
             raise ValueError(f"drift check: limit must be a number > 0, got {self.limit!r}")

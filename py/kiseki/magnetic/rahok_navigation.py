@@ -44,6 +44,8 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._support.counts import check_count
+
 __all__ = [
     "CHECK_AFTER",
     "PEAK_WINDOW",
@@ -89,8 +91,7 @@ def _finite(value: Any, name: str, ndim: int) -> np.ndarray:
 def moving_average(values: Any, cells: int) -> np.ndarray:
     """Centred moving average over ``cells`` samples along axis 0 (shorter at the ends)."""
     a = np.asarray(values, dtype=np.float64)
-    if isinstance(cells, bool) or not (isinstance(cells, numbers.Integral) and cells >= 1):
-        raise ValueError(f"moving_average: cells must be an integer >= 1, got {cells!r}")
+    check_count(cells, "moving_average: cells", 1)
     if cells == 1:
         return a.copy()
     a2 = a.reshape(len(a), -1)
@@ -300,8 +301,7 @@ class RahokNavigator:
                 f"RahokNavigator: s {self.s_vec.shape} and w {self.w_vec.shape} must be (n, 3)"
                 f" and (n, 4) for the map's {n} nodes"
             )
-        if not (isinstance(average, int) and average >= 1):
-            raise ValueError(f"RahokNavigator: average must be an integer >= 1, got {average!r}")
+        check_count(average, "RahokNavigator: average", 1)
         self.lmap, self.steering, self.peaks = lmap, steering, peaks
         self.speed = _number(speed, "RahokNavigator: speed")
         self.average = average

@@ -49,7 +49,10 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
+from kiseki._support.options import PARTICLE_LIMIT
+from kiseki.core import check_seed
 from kiseki.magnetic.linear_map import LinearMagneticMap
 
 __all__ = [
@@ -79,11 +82,9 @@ DM_THETA_MAX = math.pi
 """rad: dm_theta,max of eq. 4.13 ("= pi rad")."""
 
 
-def _number(value: Any, name: str, low: float, *, strict: bool, integer: bool = False) -> None:
-    kind = int if integer else (int, float)
-    if isinstance(value, bool) or not isinstance(value, kind):
-        what = "an integer" if integer else "a number"
-        raise ValueError(f"travel distance: {name} must be {what}, got {value!r}")
+def _number(value: Any, name: str, low: float, *, strict: bool) -> None:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ValueError(f"travel distance: {name} must be a number, got {value!r}")
     ok = value > low if strict else value >= low
     if not (math.isfinite(value) and ok):
         raise ValueError(
@@ -105,11 +106,7 @@ class TravelDistanceConfig:
 
     def __post_init__(self) -> None:
         check_field_types(self)
-        _number(self.particles, "particles", 0, strict=True, integer=True)
-        if self.particles > 10_000_000:
-            raise ValueError(
-                f"travel distance: particles must be <= 10,000,000, got {self.particles}"
-            )
+        check_count(self.particles, "travel distance: particles", 1, PARTICLE_LIMIT)
         _number(self.gain, "gain a", 0.0, strict=True)
         _number(self.window, "window l", 0.0, strict=True)
         _number(self.odometry_noise, "odometry_noise", 0.0, strict=False)
@@ -120,9 +117,7 @@ class TravelDistanceConfig:
                 "travel distance: resample_threshold must be in [0, 1], got "
                 f"{self.resample_threshold}"
             )
-        _number(self.seed, "seed", 0, strict=False, integer=True)
-        if self.seed >= 2**64:
-            raise ValueError(f"travel distance: seed must be below 2**64, got {self.seed}")
+        check_seed(self.seed, "travel distance: seed")
 
 
 def _map_profile(linear_map: Any) -> tuple[np.ndarray, np.ndarray, float]:

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from kiseki.core import check_seed
 from kiseki.datasets.magnetic import MagneticSamples
 from kiseki.magnetic.linear_map import LinearMagneticMap, build_linear_map, path_identity
 from kiseki.magnetic.travel_distance import TravelDistanceConfig, TravelDistanceLocalizer
@@ -233,8 +234,7 @@ def localize_walk(
     """Map the first lap, localize the later ones (module text)."""
     odometry = WalkOdometry() if odometry is None else odometry
     config = TravelDistanceConfig() if config is None else config
-    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**64:
-        raise ValueError(f"walk: seed must be an integer in [0, 2**64), got {seed!r}")
+    seed = check_seed(seed, "walk: seed")
     w = read_walk_laps(walk, odometry)
     m, laps = w.linear_map, w.laps
     e_scale, odo_step = walk_odometry(w.xy, odometry, seed)

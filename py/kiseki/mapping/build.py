@@ -7,13 +7,13 @@ from logs by the thesis' merge rules is `kiseki.teach.environment_map.build_teac
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import asdict, dataclass
 
 import numpy as np
 from tqdm import tqdm
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki._support.schema import MAGNITUDE_LIMIT, parse
 from kiseki.grid import OccupancyGrid
 from kiseki.io.map_schema import MapBuildSettings
@@ -219,15 +219,7 @@ def endpoint_agreement(
             f"endpoint_agreement: grid must be a kiseki OccupancyGrid, got {type(grid).__name__}"
         )
     max_range = check_max_range("endpoint_agreement", max_range)
-    if (
-        isinstance(neighbourhood, bool)
-        or not isinstance(neighbourhood, numbers.Integral)
-        or not 0 <= neighbourhood <= 10
-    ):
-        raise ValueError(
-            f"endpoint_agreement: neighbourhood must be an integer in 0..10 (cells), "
-            f"got {neighbourhood!r}"
-        )
+    check_count(neighbourhood, "endpoint_agreement: neighbourhood", 0, 10, "cells")
     hits, endpoints = _core.endpoint_agreement(
         grid, poses, ranges, angles, max_range, neighbourhood=int(neighbourhood)
     )

@@ -22,12 +22,12 @@ the map are never occupied.
 
 from __future__ import annotations
 
-import numbers
 from itertools import groupby
 
 import numpy as np
 
 from kiseki._core import LocalMapBuilder, SpaceObservationModel
+from kiseki._support.counts import check_count
 from kiseki.grid import OccupancyGrid
 
 __all__ = [
@@ -50,9 +50,8 @@ def visibility_reference(
     at t = (2n + 1) / (2|dj|), n < |dj| (t = 1 at the border cell's centre); a column and a row
     crossing at the same t are a corner. Exact in integers: times 2 |di| |dj| (a factor 0 taken
     as 1, for a segment along a row or a column), t is (2m + 1) |dj| and (2n + 1) |di|."""
-    if isinstance(span, bool) or not isinstance(span, numbers.Integral) or not 1 <= span <= 1001:
-        # the walk is about span^3 steps: 1,001 cells (50 m at 0.05 m) is past any local map
-        raise ValueError(f"visibility_reference: span must be an integer in 1..1001, got {span!r}")
+    # the walk is about span^3 steps: 1,001 cells (50 m at 0.05 m) is past any local map
+    check_count(span, "visibility_reference: span", 1, 1001)
     if not isinstance(grid, OccupancyGrid):
         raise ValueError(f"visibility_reference: grid must be an OccupancyGrid, got {grid!r}")
     cx, cy = (int(v) for v in cell)

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from kiseki._support.counts import check_count
 from kiseki.core import check_seed
 from kiseki.sim.pose6 import Pose6, resting_pose
 from kiseki.sim.scene import load_scene, read_octree
@@ -123,8 +124,7 @@ def terrain_stops(
 ) -> list[Stop]:
     """The ``moves + 1`` stops of a run in a scene YAML or an OctoMap ``.bt`` (see the module)."""
     seed = check_seed(seed)
-    if isinstance(moves, bool) or not isinstance(moves, int) or not 1 <= moves <= 200:
-        raise ValueError(f"moves must be an integer in 1..200, got {moves!r}")
+    check_count(moves, "moves", 1, 200)
     if not (isinstance(step, numbers.Real) and 0.02 <= step <= 0.6):
         raise ValueError(f"step must be 0.02..0.6 m (the search reaches 0.7 m), got {step!r}")
     path = Path(world_path)

@@ -56,6 +56,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki.control.speed_limit import SpeedLimit
 from kiseki.grid import OccupancyGrid
@@ -127,8 +128,7 @@ class DistanceLimiterConfig:
             raise ValueError(
                 f"DistanceLimiterConfig.half_angle must be <= pi, got {self.half_angle}"
             )
-        if not (isinstance(self.free_threshold, numbers.Integral) and self.free_threshold <= 100):
-            raise ValueError("DistanceLimiterConfig.free_threshold must be an integer in 0..100")
+        check_count(self.free_threshold, "DistanceLimiterConfig.free_threshold", 0, 100)
 
     @property
     def stop_distance(self) -> float:
@@ -199,10 +199,6 @@ class PolygonLimiterConfig:
         if not self.slowdown_ratio <= 1:
             raise ValueError(
                 f"PolygonLimiterConfig.slowdown_ratio must be in (0, 1], got {self.slowdown_ratio}"
-            )
-        if not isinstance(self.min_points, numbers.Integral) or isinstance(self.min_points, bool):
-            raise ValueError(
-                f"PolygonLimiterConfig.min_points must be an integer, got {self.min_points!r}"
             )
 
 

@@ -36,6 +36,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki.control.speed_limit import SpeedLimit
 from kiseki.grid import OccupancyGrid
@@ -174,9 +175,7 @@ class SpeedLimiterConfig:
             )
         if not self.w2 > self.w1:
             raise ValueError(f"SpeedLimiterConfig: w2 ({self.w2}) must exceed w1 ({self.w1})")
-        threshold = self.free_threshold
-        if not (isinstance(threshold, numbers.Integral) and 0 <= threshold <= 100):
-            raise ValueError("SpeedLimiterConfig.free_threshold must be an integer in 0..100")
+        check_count(self.free_threshold, "SpeedLimiterConfig.free_threshold", 0, 100)
 
     def to_dict(self) -> dict:
         return asdict(self)

@@ -12,6 +12,7 @@ from typing import Any, Literal
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 
 __all__ = ["Registration", "register_pcl"]
 
@@ -37,10 +38,7 @@ def register_pcl(
     """Aligns source (n, 3) to target (m, 3) from ``initial`` (4x4 rigid motion; None:
     identity). Raises ValueError for NaN points, points beyond +-1e6 m, fewer than 10 points, a
     guess that is not a rigid motion or bad parameters."""
-    if isinstance(max_iterations, bool) or not isinstance(max_iterations, int | np.integer):
-        raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
-    if max_iterations > 100_000:
-        raise ValueError(f"max_iterations must be at most 100000, got {max_iterations}")
+    check_count(max_iterations, "max_iterations", 1, 100_000)
     guess = np.eye(4) if initial is None else np.asarray(initial, dtype=float)
     if (
         guess.shape == (4, 4)

@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki._support.inputs import GIB, MIB, check_input, describe_bytes, read_input
 from kiseki._support.numbers_text import is_number, parse_float
 from kiseki.core import check_seed
@@ -346,8 +347,7 @@ def cloud_planes(
     if method not in CLOUD_METHODS:
         raise ValueError(f"--method must be one of {CLOUD_METHODS}, got {method!r}")
     seed = check_seed(seed, "--seed")
-    if not isinstance(max_points, int) or max_points < 100:
-        raise ValueError(f"--max-points must be an integer >= 100, got {max_points!r}")
+    check_count(max_points, "--max-points", 100)
     if method == "pcl":
         return _pcl(cloud.points, pcl or PclParams(), seed, max_points)
     return _hough(cloud.points, cloud.origin, hough or HoughParams())

@@ -20,14 +20,15 @@ work on every core (``kiseki/terrain/correlation_search.hpp``).
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki._support.options import THREAD_LIMIT
+from kiseki._support.schema import INT32_MAX
 from kiseki.terrain.sdem import SphereElevationMap
 
 __all__ = ["PAPER_SEARCH", "SearchGrid", "SearchResult", "correlation_search", "search_grid"]
@@ -97,16 +98,8 @@ def correlation_search(
             raise ValueError(f"correlation search: the {name} S-DEM is empty")
     if method not in ("exhaustive", "coarse-to-fine"):
         raise ValueError(f"method must be 'exhaustive' or 'coarse-to-fine', got {method!r}")
-    if isinstance(min_overlap, bool) or not isinstance(min_overlap, int) or min_overlap < 1:
-        raise ValueError(f"min_overlap must be an integer >= 1, got {min_overlap!r}")
-    if (
-        isinstance(threads, bool)
-        or not isinstance(threads, numbers.Integral)
-        or not 0 <= threads <= THREAD_LIMIT
-    ):
-        raise ValueError(
-            f"threads must be an integer in 0..{THREAD_LIMIT} (0 = every core), got {threads!r}"
-        )
+    check_count(min_overlap, "min_overlap", 1, INT32_MAX)
+    check_count(threads, "threads", 0, THREAD_LIMIT, "0 = every core")
     grid = PAPER_SEARCH if grid is None else grid
     if not isinstance(grid, _core.TranslationGrid):
         raise TypeError("correlation search: grid must be a SearchGrid (search_grid())")

@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import json
 
+import numpy as np
 import pytest
 
 CONFIGS = [
@@ -58,3 +60,32 @@ def test_a_value_of_the_wrong_kind_is_refused_naming_the_field(cls, field, kind,
     with pytest.raises(ValueError) as caught:
         cls(**{field: value})
     assert str(caught.value) == f"{cls.__name__}.{field} must be {want}, got {value!r}"
+
+
+def _numpy_twin(value):
+    """The default as the numpy scalar a user's array would give (np.int64 60, np.float32 ...)."""
+    if isinstance(value, bool):
+        return np.bool_(value)
+    return np.int64(value) if isinstance(value, int) else np.float64(value)
+
+
+@pytest.mark.parametrize(("module", "name"), CONFIGS, ids=[name for _, name in CONFIGS])
+def test_numpy_scalars_are_held_as_python_numbers_and_saved_as_json(module, name):
+    """np.int64(60) beams were kept as numpy's: the config compared equal but saving it with the
+    results (JSON, YAML) failed after the run (GlobalConfig(beams=np.int64(60)) in
+    ``write_report``); GlobalConfig refused np.int64 particles outright."""
+    cls = getattr(importlib.import_module(module), name)
+    default = cls()
+    scalar = {
+        f.name: _numpy_twin(getattr(default, f.name))
+        for f in dataclasses.fields(cls)
+        if str(f.type) in ("bool", "int", "float")
+        and isinstance(getattr(default, f.name), bool | int | float)
+    }
+    assert scalar, f"{name} has no numeric field"
+    config = cls(**scalar)
+    assert config == default
+    for field in scalar:
+        value, want = getattr(config, field), getattr(default, field)
+        assert type(value) is type(want) or (type(value), type(want)) == (float, int), field
+    json.dumps(dataclasses.asdict(config))  # numpy's scalars are not JSON

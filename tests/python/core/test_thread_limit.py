@@ -18,14 +18,14 @@ from kiseki.terrain import correlation_search, sdem_from_points
 @pytest.mark.parametrize("config", [MclConfig, RelocalizeConfig])
 def test_configs_take_the_limit_and_refuse_one_more(config):
     assert config(threads=THREAD_LIMIT).threads == THREAD_LIMIT
-    with pytest.raises(ValueError, match=f"0..{THREAD_LIMIT}"):
+    with pytest.raises(ValueError, match=f"0..{THREAD_LIMIT:,}"):
         config(threads=THREAD_LIMIT + 1)
 
 
 def test_the_core_refuses_one_more_naming_the_same_limit():
     floor = np.random.default_rng(0).uniform([-3, -3, -0.6], [3, 3, -0.4], size=(500, 3))
     m = sdem_from_points(floor)
-    with pytest.raises(ValueError, match=f"threads must be an integer in 0..{THREAD_LIMIT}"):
+    with pytest.raises(ValueError, match=f"threads must be an integer in 0..{THREAD_LIMIT:,}"):
         correlation_search(m, m, threads=THREAD_LIMIT + 1)
     in_core = f"correlation search: threads must be in 0..{THREAD_LIMIT}"
     with pytest.raises(ValueError, match=in_core):

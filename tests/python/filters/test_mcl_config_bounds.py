@@ -25,7 +25,7 @@ ABSURD = [
     ({"reset_evidence": 1e300}, "reset_evidence must lie in \\[0, 1e6\\]"),
     ({"expansion_position": 1e300}, "expansion radii must lie in \\[0, 10 m\\]"),
     ({"update_min_a": 1e300}, "update_min_a must be <= 2 pi"),
-    ({"min_particles": 10**300}, "min_particles must be a C\\+\\+ int"),
+    ({"min_particles": 10**300}, "min_particles must be an integer in 1..10,000,000"),
     ({"reset_after": -(10**300)}, "reset_after must be a C\\+\\+ int"),
     ({"sensor_reset_candidates": 10**300}, "sensor_reset_candidates must be a C\\+\\+ int"),
 ]
@@ -41,7 +41,7 @@ JUST_PAST = [
     ({"expansion_orientation": math.pi + 1e-9}, "expansion radii .* and \\[0, pi\\]"),
     ({"update_min_a": 2 * math.pi + 1e-9}, "update_min_a must be <= 2 pi"),
     ({"sensor_reset_after": 1_000_001}, "sensor_reset_after <= 1,000,000"),
-    ({"min_particles": 2**31}, "min_particles must be a C\\+\\+ int"),
+    ({"min_particles": 10_000_001}, "min_particles must be an integer in 1..10,000,000, got"),
 ]
 
 

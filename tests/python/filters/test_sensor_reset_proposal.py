@@ -158,7 +158,7 @@ def test_bad_settings_are_refused_in_one_line(tmp_path):
         (dict(reset_look_elsewhere=1), "reset_look_elsewhere must be True or False"),
         (dict(reset_needs_agreement="yes"), "reset_needs_agreement must be True or False"),
         (dict(sensor_reset_confirm=0), "sensor_reset_confirm must be True or False"),
-        (dict(matcher_search_every=0), "matcher_search_every must be an integer in 1..1000"),
+        (dict(matcher_search_every=0), "matcher_search_every must be an integer in 1..1,000"),
     ):
         with pytest.raises(ValueError, match=word) as caught:
             LocalizeConfig(**bad)

@@ -13,7 +13,7 @@ from _helpers.synthetic_walk import write_walk
 from kiseki.datasets.kok import read_kok_walk
 from kiseki.magnetic.loop_travel_distance import LoopTravelConfig
 from kiseki.magnetic.loop_walk import localize_walk_loop, map_walk_loop
-from kiseki.magnetic.travel_distance_walk import WalkOdometry
+from kiseki.magnetic.travel_distance_walk import WalkOdometry, localize_walk
 
 SCALE_ERROR = 0.08  # the odometry 8 % long: the travel is 1 / 1.08 of it
 SEEDS = range(5)
@@ -46,3 +46,20 @@ def test_the_scale_approaches_the_odometry_s_error_over_seeds(mapped, start):
     assert np.mean(scales) == pytest.approx(1 / (1 + SCALE_ERROR), abs=0.03)
     blind = [late_scale(mapped, start, seed, use_field=False) for seed in SEEDS[:2]]
     assert abs(np.mean(blind) - 1 / (1 + SCALE_ERROR)) > 0.03
+
+
+def test_a_walk_takes_a_numpy_seed_as_its_python_twin(mapped, tmp_path):
+    """A seed from a numpy array (np.int64) was refused by both walks ("walk: seed must be an
+    integer"): each gives the estimates of the same Python seed, and refuses a negative one in
+    the library's seed words."""
+    walk_map, odometry = mapped
+    loop = [localize_walk_loop(walk_map, seed, odometry).scale for seed in (np.int64(3), 3)]
+    np.testing.assert_array_equal(*loop)
+    path = tmp_path / "loop.mat"
+    write_walk(path, laps=2.5)
+    walk = read_kok_walk(path)
+    laps = [localize_walk(walk, seed, odometry).s_est for seed in (np.uint32(3), 3)]
+    np.testing.assert_array_equal(*laps)
+    for call in (lambda: localize_walk_loop(walk_map, -1), lambda: localize_walk(walk, -1)):
+        with pytest.raises(ValueError, match=r"^walk: seed must be an integer in \[0, 2\*\*64\)"):
+            call()

@@ -185,7 +185,7 @@ def test_filters_sharing_one_beam_model_run_as_with_their_own():
 @pytest.mark.parametrize(
     ("kw", "message"),
     [
-        ({"particles": 0}, "particles must be an integer >= 1"),
+        ({"particles": 0}, "particles must be an integer in 1..10,000,000, got 0"),
         ({"sigma_d": -1.0}, "sigma_d"),
         ({"sigma_theta": float("nan")}, "sigma_theta"),
         ({"r_z_gate": 1.5}, "r_z_gate"),

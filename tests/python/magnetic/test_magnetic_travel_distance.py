@@ -168,13 +168,13 @@ def test_heading_from_map_uses_the_nearest_node():
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"particles": 0}, "particles must be > 0"),
+        ({"particles": 0}, "particles must be an integer in 1..10,000,000, got 0"),
         ({"particles": 2.5}, "particles must be an integer"),
         ({"window": -1.0}, "window l must be > 0"),
         ({"gain": float("nan")}, "gain a must be > 0"),
         ({"odometry_noise": -0.1}, "odometry_noise must be >= 0"),
         ({"resample_threshold": 1.5}, "resample_threshold must be in"),
-        ({"seed": -1}, "seed must be >= 0"),
+        ({"seed": -1}, r"seed must be an integer in \[0, 2\*\*64\), got -1"),
     ],
 )
 def test_bad_config(kwargs, message):

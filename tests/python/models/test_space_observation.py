@@ -171,7 +171,7 @@ def test_bad_input(corridor):
     with pytest.raises(ValueError, match="heading_step_deg must be >= 0.1"):
         SpaceObservationModel(grid, heading_step_deg=1e-9)
     for span in (10**5, 0, True):
-        with pytest.raises(ValueError, match="span must be an integer in 1..1001"):
+        with pytest.raises(ValueError, match="span must be an integer in 1..1,001"):
             visibility_reference(grid, (5, 5), span)
     with pytest.raises(RuntimeError, match="local map first"):
         SpaceObservationModel(grid).counts(Pose2())

@@ -277,7 +277,7 @@ def test_search_refuses_an_empty_map_and_a_non_rotation():
         correlation_search(m, m, method="annealing")
     # a million threads went straight to OpenMP (a crash under a memory limit)
     for threads in (10**6, -1, True, 2.0):
-        with pytest.raises(ValueError, match="threads must be an integer in 0..1024"):
+        with pytest.raises(ValueError, match="threads must be an integer in 0..1,024"):
             correlation_search(m, m, threads=threads)
     with pytest.raises(ValueError, match="threads must be in 0..1024"):
         _core.CorrelationSearch(m.to_points()[0], m, None, "sum", 50, 10**6)

@@ -24,7 +24,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
+from kiseki._support.options import BEAM_LIMIT, PARTICLE_LIMIT
 from kiseki.control import PurePursuit, SpeedLimit, SpeedLimitSource
 from kiseki.core import derive_seed
 from kiseki.filters import MclConfig, MonteCarloLocalizer
@@ -72,20 +74,14 @@ class PlaybackConfig:
         check_field_types(self)
         if self.method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, got {self.method!r}")
-        if not (isinstance(self.particles, int) and 1 <= self.particles <= 10_000_000):
-            raise ValueError(
-                f"particles must be an integer in 1..10,000,000, got {self.particles!r}"
-            )
+        check_count(self.particles, "particles", 1, PARTICLE_LIMIT)
         if not self.dt > 0 or not self.goal_tolerance > 0:
             raise ValueError("dt > 0 and goal_tolerance > 0 are needed")
         if self.model not in PLAYBACK_MODELS:
             raise ValueError(
                 f"model must be one of {', '.join(PLAYBACK_MODELS)}, got {self.model!r}"
             )
-        if not (isinstance(self.scan_beams, int) and 1 <= self.scan_beams <= 100_000):
-            raise ValueError(
-                f"scan_beams must be an integer in 1..100,000, got {self.scan_beams!r}"
-            )
+        check_count(self.scan_beams, "scan_beams", 1, BEAM_LIMIT)
         if not 0.1 <= self.scan_range_scale <= 10.0:
             raise ValueError(f"scan_range_scale must lie in [0.1, 10], got {self.scan_range_scale}")
 

@@ -50,6 +50,7 @@ from foxglove_schemas_protobuf.PoseInFrame_pb2 import PoseInFrame
 from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
 from mcap.writer import LIBRARY_IDENTIFIER, Writer
 
+from kiseki._support.counts import check_count
 from kiseki._support.signal_hold import SignalHold
 from kiseki.io.runlog._encoding import (
     _COMPRESSIONS,
@@ -94,8 +95,7 @@ class RunWriter:
         compression: str = "zstd",
     ) -> None:
         self.path = Path(path)
-        if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1:
-            raise ValueError(f"chunk_size must be a positive integer of bytes, got {chunk_size!r}")
+        check_count(chunk_size, "chunk_size", 1, note="bytes")
         if compression not in _COMPRESSIONS:
             raise ValueError(
                 f"compression must be one of {sorted(_COMPRESSIONS)}, got {compression!r}"
