@@ -198,12 +198,7 @@ def beams_of_one_turn(start: float, step: float, beams: int) -> bool:
 def apply_range_rule(ranges: np.ndarray, max_range: float) -> np.ndarray:
     """Readings as kiseki keeps them (float32, C-contiguous, a new array): invalid readings
     (NaN, -inf, negative, zero) as NaN, +inf (no return) as ``max_range``."""
-    if not (isinstance(max_range, numbers.Real) and 0 < max_range <= MAGNITUDE_LIMIT):
-        # -1 was stored for every no return; the bound is check_max_range's
-        raise ValueError(
-            "apply_range_rule: max_range must be a finite number > 0, at most "
-            f"{MAGNITUDE_LIMIT:g} m, got {max_range!r}"
-        )
+    max_range = check_max_range("apply_range_rule", max_range)  # -1 was every no return
     with np.errstate(over="ignore", invalid="ignore"):  # beyond float32: +inf, a no return
         out = np.array(ranges, dtype=np.float32, order="C", copy=True)
         out[~(out > 0)] = np.nan
