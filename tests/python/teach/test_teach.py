@@ -5,6 +5,7 @@ maps, the particle filter, and bad input."""
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import signal
@@ -238,3 +239,26 @@ def test_experiment_trial_records_the_goal_likelihood_profile():
     assert max(side[0], side[-1]) < side[mid] - 0.03
     assert min(along) >= 0.99
     assert record["proposal1_reached"]
+
+
+@pytest.mark.parametrize(
+    ("fields", "message"),
+    [
+        ({"goal_tolerance": math.inf}, "goal_tolerance must be a finite number > 0, got inf"),
+        ({"dt": math.inf}, "dt must be a finite number > 0, got inf"),
+        ({"speed": -0.5}, "speed must be a finite number > 0, got -0.5"),
+        ({"max_duration": math.nan}, "max_duration must be in [dt, 86,400] s"),
+        ({"max_duration": -1.0}, "max_duration must be in [dt, 86,400] s"),
+        ({"max_duration": 86_400.5}, "max_duration must be in [dt, 86,400] s"),
+        ({"dt": 0.2, "max_duration": 0.1}, "max_duration must be in [dt, 86,400] s"),
+    ],
+)
+def test_a_playback_that_could_not_run_as_asked_is_refused_by_its_config(fields, message):
+    """Taken before: an infinite goal_tolerance "reached" the goal before the first step, an
+    infinite dt or a negative max_duration made no step at all, a NaN one a ValueError about
+    converting NaN to an integer after the robot was built, 86,400.5 s more than a simulated run
+    may last (kiseki.sim.run's day), a negative speed was refused only by the route follower."""
+    with pytest.raises(ValueError) as caught:
+        PlaybackConfig(**fields)
+    assert str(caught.value).startswith(message)
+    assert PlaybackConfig(dt=0.1, max_duration=0.1).max_duration == 0.1  # one step: taken

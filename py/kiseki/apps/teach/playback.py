@@ -31,6 +31,7 @@ from kiseki.control import PurePursuit, SpeedLimit, SpeedLimitSource
 from kiseki.core import derive_seed
 from kiseki.filters import MclConfig, MonteCarloLocalizer
 from kiseki.grid import OccupancyGrid
+from kiseki.sim.run import MAX_SIM_SECONDS
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import SensorSetup, build_robot, build_sensors
 from kiseki.teach.local_maps import METHODS, LocalMapMaker, local_map_scan
@@ -75,8 +76,17 @@ class PlaybackConfig:
         if self.method not in METHODS:
             raise ValueError(f"method must be one of {', '.join(METHODS)}, got {self.method!r}")
         check_count(self.particles, "particles", 1, PARTICLE_LIMIT)
-        if not self.dt > 0 or not self.goal_tolerance > 0:
-            raise ValueError("dt > 0 and goal_tolerance > 0 are needed")
+        # an infinite goal_tolerance "reached" the goal before the first step, an infinite dt
+        # or a negative, NaN or infinite max_duration made no step or none that ends
+        for name in ("dt", "speed", "goal_tolerance"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+        if not self.dt <= self.max_duration <= MAX_SIM_SECONDS:
+            raise ValueError(
+                f"max_duration must be in [dt, {MAX_SIM_SECONDS:,.0f}] s (24 h, as a simulated "
+                f"run), got {self.max_duration!r} with dt {self.dt!r}"
+            )
         if self.model not in PLAYBACK_MODELS:
             raise ValueError(
                 f"model must be one of {', '.join(PLAYBACK_MODELS)}, got {self.model!r}"
