@@ -112,8 +112,11 @@ class LaserParams:
 
     @property
     def angles(self) -> np.ndarray:
-        """The beam angles (rad), read-only: computed once, shared by every scan."""
-        return _beam_angles(self.beams, self.field_of_view_deg)
+        """The beam angles (rad), a read-only view: computed once per beam count and field of
+        view (while among the 64 last used), shared by every scan."""
+        view = _beam_angles(self.beams, self.field_of_view_deg).view()
+        view.setflags(write=False)  # and cannot be made writeable: its base is read-only
+        return view
 
 
 @functools.lru_cache(maxsize=64)
