@@ -3,9 +3,11 @@
 """The kinds of a config's fields, checked from their annotations: a field annotated ``bool``
 holds True or False (the string "no" is truthy and was read as True), one annotated ``int`` an
 integer (True counted as 1 particle, 1000.7 as a particle count), one annotated ``float`` a
-number. A numpy scalar of the right kind is taken and held as the Python number it is
-(``np.int64(60)`` beams as 60): a config is saved with its results as JSON or YAML, neither of
-which writes a numpy scalar. Other annotations (tuples, strings, optional values) are left to
+number. A numpy scalar of the right kind is taken and held as the Python bool, int or float
+it is (``np.int64(60)`` beams as 60, ``np.float32(0.5)`` as 0.5, a long double rounded to a
+float): a config is saved with its results as JSON or YAML, neither of which writes a numpy
+scalar; so ``np.bool_`` switches and ``np.float32`` numbers pass the configs' own checks
+that compare with Python's types. Other annotations (tuples, strings, optional values) are left to
 each config's own checks, which run after this one and keep their messages for values of the
 right kind."""
 
@@ -46,4 +48,5 @@ def check_field_types(config) -> None:
             want = {"bool": "True or False", "int": "an integer", "float": "a number"}[kind]
             raise ValueError(f"{type(config).__name__}.{f.name} must be {want}, got {value!r}")
         if isinstance(value, np.generic):  # held as Python's own: saved configs are JSON / YAML
-            object.__setattr__(config, f.name, value.item())
+            python = {"bool": bool, "int": int}.get(kind, float)
+            object.__setattr__(config, f.name, python(value))

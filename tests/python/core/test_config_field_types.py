@@ -13,6 +13,9 @@ import json
 import numpy as np
 import pytest
 
+from kiseki.filters.engine import MclConfig
+from kiseki.magnetic.travel_distance import TravelDistanceConfig
+
 CONFIGS = [
     ("kiseki.filters.localize_config", "LocalizeConfig"),
     ("kiseki.filters.engine", "MclConfig"),
@@ -63,10 +66,13 @@ def test_a_value_of_the_wrong_kind_is_refused_naming_the_field(cls, field, kind,
 
 
 def _numpy_twin(value):
-    """The default as the numpy scalar a user's array would give (np.int64 60, np.float32 ...)."""
+    """The default as the numpy scalar a user's array would give: np.bool_, np.int64, and
+    np.float32 where it holds the value exactly (0.5), np.float64 elsewhere (0.1)."""
     if isinstance(value, bool):
         return np.bool_(value)
-    return np.int64(value) if isinstance(value, int) else np.float64(value)
+    if isinstance(value, int):
+        return np.int64(value)
+    return np.float32(value) if float(np.float32(value)) == value else np.float64(value)
 
 
 @pytest.mark.parametrize(("module", "name"), CONFIGS, ids=[name for _, name in CONFIGS])
@@ -86,6 +92,17 @@ def test_numpy_scalars_are_held_as_python_numbers_and_saved_as_json(module, name
     config = cls(**scalar)
     assert config == default
     for field in scalar:
-        value, want = getattr(config, field), getattr(default, field)
-        assert type(value) is type(want) or (type(value), type(want)) == (float, int), field
+        assert type(getattr(config, field)) is type(getattr(default, field)), field
     json.dumps(dataclasses.asdict(config))  # numpy's scalars are not JSON
+
+
+def test_a_float32_or_a_numpy_bool_passes_checks_written_for_python_types():
+    """TravelDistanceConfig checked its numbers as int | float (np.float32 is neither: 'gain a
+    must be a number, got np.float32(0.5)') and MclConfig its switches as bool (np.True_ is
+    none): both are taken now, as the Python values they are."""
+    config = TravelDistanceConfig(gain=np.float32(0.5), window=np.float32(2.0))
+    assert config == TravelDistanceConfig(gain=0.5, window=2.0) and type(config.gain) is float
+    switched = MclConfig(reset_look_elsewhere=np.bool_(True))
+    assert switched.reset_look_elsewhere is True
+    long_double = TravelDistanceConfig(gain=np.longdouble(0.5))
+    assert type(long_double.gain) is float and long_double.gain == 0.5
