@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kiseki._support.counts import check_count
+
 __all__ = [
     "ErrorStatistics",
     "MapTruth",
@@ -182,8 +184,7 @@ def rpe(
     (est_i^-1 est_j). Without all_pairs the pairs do not overlap (evo's default)."""
     if relation not in RELATIONS:
         raise ValueError(f"relation must be one of {', '.join(RELATIONS)}, got {relation!r}")
-    if isinstance(delta, bool) or not isinstance(delta, int | np.integer) or delta < 1:
-        raise ValueError(f"delta must be an integer >= 1 (frames), got {delta!r}")
+    delta = check_count(delta, "delta", 1, note="frames")
     e, r = _pair(est, ref)
     n = len(e)
     if all_pairs:

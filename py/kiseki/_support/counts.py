@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The one check of a count (particles, beams, threads, moves, a window's length): an integer
+"""The check of a count (particles, beams, threads, moves, a window's length): an integer
 in a range, a Python or a numpy integer alike, never a bool (True is not one particle) and
 never a float (1000.7 is not a particle count). A count with no upper bound of its own stops
 at what the C++ type it reaches can hold (``kiseki._support.schema.INT32_MAX`` for a C++

@@ -132,7 +132,7 @@ def paper_angle(form: int, moves: int, start=START, goal=GOAL) -> float:
     start, goal = _check_places(start, goal)
     if form not in FORMS:
         raise ValueError(f"form must be 1 or 2, got {form!r}")
-    check_count(moves, "moves", 1)
+    moves = check_count(moves, "moves", 1)
     order = np.argsort(start[:, 1])
     w = abs(start[order[1], 0] - start[order[2], 0]) / 2
     if form == 1:
@@ -141,10 +141,13 @@ def paper_angle(form: int, moves: int, start=START, goal=GOAL) -> float:
     return math.atan(2 * w / ((goal[1] - start[:, 1].max()) / moves))
 
 
+MAX_MOVES = 1000  # the most moves a plan takes
+
+
 def _check(form: int, moves: int, angle: float) -> None:
     if form not in FORMS:
         raise ValueError(f"form must be 1 or 2, got {form!r}")
-    check_count(moves, "moves", 1, 1000)
+    moves = check_count(moves, "moves", 1, MAX_MOVES)
     if form == 1 and moves % 2 == 0:
         raise ValueError(
             f"form 1 takes an odd number of moves (scout, pair, ..., scout), got {moves}"
@@ -170,6 +173,7 @@ def plan(
     start, goal = _check_places(start, goal)
     if reading not in FORM1_READINGS:
         raise ValueError(f"reading must be one of {', '.join(FORM1_READINGS)}, got {reading!r}")
+    moves = check_count(moves, "moves", 1, MAX_MOVES)  # the Plan holds Python's int
     if angle is None:
         angle = paper_angle(form, moves, start, goal)
     _check(form, moves, angle)
@@ -264,7 +268,7 @@ def _check_runs(the_plan, runs, limit: int, seed, **sigmas) -> None:
     """A Plan (None was an AttributeError), runs in 1..limit, angle SDs in [0, 10 deg)."""
     if not isinstance(the_plan, Plan):
         raise TypeError(f"the_plan must be a Plan (see plan()), got {type(the_plan).__name__}")
-    check_count(runs, "runs", 1, limit)
+    runs = check_count(runs, "runs", 1, limit)
     for name, v in sigmas.items():
         if isinstance(v, bool) or not (isinstance(v, numbers.Real) and 0 <= v < math.radians(10)):
             raise ValueError(f"{name} must lie in [0, 10 deg), got {v!r}")

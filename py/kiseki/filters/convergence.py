@@ -20,6 +20,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.counts import check_count
 from kiseki.grid import OccupancyGrid
 from kiseki.scans import LaserScans, check_max_range
 
@@ -151,8 +152,7 @@ def elapsed_time(times: np.ndarray, k: int) -> float:
     time negative or shorter than what passed. Equals ``times[k] - times[0]`` when the clock
     only goes forward."""
     times = np.asarray(times, dtype=np.float64)
-    if isinstance(k, bool) or not isinstance(k, numbers.Integral) or not 0 <= k < len(times):
-        raise ValueError(f"elapsed_time: k must be a scan index in 0..{len(times) - 1}, got {k!r}")
+    k = check_count(k, "elapsed_time: k", 0, len(times) - 1, "a scan index")
     steps = np.diff(times[: k + 1])
     return float(times[k] - times[0] - steps[steps < 0].sum())  # less the steps back
 

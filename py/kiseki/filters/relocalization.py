@@ -289,8 +289,7 @@ def hypothesis_cloud(
     Gaussian of ``sd_xy`` per axis and ``sd_theta`` around it."""
     if not hypotheses:
         raise RelocalizationError("relocalize: no hypotheses to draw a cloud around")
-    if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 1:
-        raise RelocalizationError(f"relocalize: count must be an integer >= 1, got {count!r}")
+    count = check_count(count, "relocalize: count", 1, error=RelocalizationError)
     scores = np.array([h.score for h in hypotheses])
     share = np.exp(power * (scores - scores.max()))
     share *= count / share.sum()

@@ -55,5 +55,4 @@ def remove_mean(y: np.ndarray, constant: bool) -> np.ndarray:
 
 def check_iterations(max_iterations: Any) -> int:
     """A hyperparameter search's iteration limit: an integer >= 1."""
-    check_count(max_iterations, "max_iterations", 1)
-    return max_iterations
+    return check_count(max_iterations, "max_iterations", 1)

@@ -358,7 +358,7 @@ class CurlFreeGP:
         if inputs_array(points, "points").shape[1] != self.dimension:
             raise ValueError(f"points must have {self.dimension} coordinates, as the GP's inputs")
         p = field_inputs(points, "points")
-        check_count(block, "block", 1)
+        block = check_count(block, "block", 1)
         means, variances = [], []
         prior = self.kernel.anomaly_sd**2 + self.kernel.sigma_lin**2
         for start in range(0, len(p), block):

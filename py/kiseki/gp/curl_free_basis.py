@@ -47,7 +47,7 @@ def laplacian_basis(half_widths: Any, count: int) -> np.ndarray:
     if half.size not in (2, 3) or not (np.isfinite(half).all() and (half > 0).all()):
         raise ValueError(f"half_widths: 2 or 3 finite lengths > 0, got {half_widths!r}")
     # the fit keeps a (count + 3)^2 factor: 10,000 functions are 800 MB
-    check_count(count, "count", 1, MAX_BASIS)
+    count = check_count(count, "count", 1, MAX_BASIS)
     d = half.size
     # enough candidates per axis that the `count` smallest eigenvalues are among them
     per_axis = np.ceil(2.0 * count ** (1.0 / d) * half / half.min()) + 1
@@ -100,7 +100,7 @@ class ReducedRankCurlFreeGP:
         y = field_targets(y, len(x))
         if not (isinstance(margin, numbers.Real) and math.isfinite(margin) and margin >= 0):
             raise ValueError(f"margin must be a finite number >= 0, got {margin!r}")
-        check_count(block, "block", 1)
+        block = check_count(block, "block", 1)
         if domain is None:
             grow = margin * kernel.length_scale
             lower, upper = x.min(axis=0) - grow, x.max(axis=0) + grow
@@ -262,7 +262,7 @@ class ReducedRankCurlFreeGP:
     ) -> tuple[np.ndarray, np.ndarray | None]:
         """(mean (m, 3), variance of the noise-free field (m, 3) or None) at points (m, d);
         inside the box only (beyond it the eigenfunctions continue as sines: not the GP)."""
-        check_count(block, "block", 1)
+        block = check_count(block, "block", 1)
         p = inputs_array(points, "points")
         means, variances = [], []
         for start in range(0, len(p), block):

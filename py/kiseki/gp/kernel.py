@@ -93,7 +93,7 @@ class HyperparameterFit:
 
 def subsample(n: int, max_points: int, seed: int) -> np.ndarray | None:
     """Indices of a seeded random subsample of max_points of n (None: use them all)."""
-    check_count(max_points, "max_points", 2)
+    max_points = check_count(max_points, "max_points", 2)
     if n <= max_points:
         return None
     rng = np.random.default_rng(check_seed(seed))
@@ -143,12 +143,12 @@ def fit_hyperparameters(
     x = inputs_array(x)
     y, _ = targets_array(y, x.shape[0])
     constant = check_mean(mean)
-    check_count(restarts, "restarts", 0, 100)
+    restarts = check_count(restarts, "restarts", 0, 100)
     if not isinstance(stop_at_repeat, bool):
         raise ValueError(f"stop_at_repeat must be True or False, got {stop_at_repeat!r}")
     check_iterations(max_iterations)
     if search_points is not None:
-        check_count(search_points, "search_points", 2)
+        search_points = check_count(search_points, "search_points", 2)
     chosen = subsample(x.shape[0], max_points, seed)
     if chosen is not None:
         x, y = x[chosen], y[chosen]

@@ -27,7 +27,7 @@ __all__ = ["FREE", "OCCUPIED", "UNKNOWN", "OccupancyGrid", "beam_angles", "grid_
 def beam_angles(count: int, field_of_view: float, start: float | None = None) -> np.ndarray:
     """Evenly spaced beam angles (radians) covering ``field_of_view`` with both ends included,
     starting at ``start`` (default ``-field_of_view / 2``)."""
-    check_count(count, "beam count", 1, BEAM_LIMIT)
+    count = check_count(count, "beam count", 1, BEAM_LIMIT)
     fov_ok = isinstance(field_of_view, numbers.Real) and not isinstance(field_of_view, bool)
     # a scanner covers at most one turn (100 rad put every beam on 16 turns)
     if not fov_ok or not 0 < field_of_view <= 2 * math.pi + 1e-9:

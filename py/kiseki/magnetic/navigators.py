@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._support.counts import check_count
 from kiseki.control.arbitration import PriorityArbiter
 from kiseki.control.pd_steering import PdSteering
 
@@ -157,8 +158,7 @@ class MultiNavigator:
         self, node: int, theta_t: float, reading: Any, g_t: Any
     ) -> dict[str, tuple[float, bool]]:
         """{navigator: (steering error u, valid)} at node ``node``."""
-        if not (isinstance(node, int | np.integer) and 0 <= node < len(self.lmap)):
-            raise ValueError(f"MultiNavigator: node must be in [0, {len(self.lmap)}), got {node}")
+        node = check_count(node, "MultiNavigator: node", 0, len(self.lmap) - 1)  # True was 1
         m = np.asarray(reading, dtype=np.float64)
         if m.shape != (3,) or not np.all(np.isfinite(m)):
             raise ValueError(f"MultiNavigator: the reading must be 3 finite numbers, got {reading}")

@@ -91,7 +91,7 @@ def _finite(value: Any, name: str, ndim: int) -> np.ndarray:
 def moving_average(values: Any, cells: int) -> np.ndarray:
     """Centred moving average over ``cells`` samples along axis 0 (shorter at the ends)."""
     a = np.asarray(values, dtype=np.float64)
-    check_count(cells, "moving_average: cells", 1)
+    cells = check_count(cells, "moving_average: cells", 1)
     if cells == 1:
         return a.copy()
     a2 = a.reshape(len(a), -1)
@@ -301,7 +301,7 @@ class RahokNavigator:
                 f"RahokNavigator: s {self.s_vec.shape} and w {self.w_vec.shape} must be (n, 3)"
                 f" and (n, 4) for the map's {n} nodes"
             )
-        check_count(average, "RahokNavigator: average", 1)
+        average = check_count(average, "RahokNavigator: average", 1)
         self.lmap, self.steering, self.peaks = lmap, steering, peaks
         self.speed = _number(speed, "RahokNavigator: speed")
         self.average = average

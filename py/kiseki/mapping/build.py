@@ -143,9 +143,8 @@ def build_map(
     if not np.isfinite(config.margin) or config.margin < 0:
         raise ValueError(f"margin must be >= 0, got {config.margin}")
     max_range = check_max_range("build_map", max_range)
-    if isinstance(chunk, bool) or not isinstance(chunk, int | np.integer) or chunk < 1:
-        # -1 gave a map of unknown cells only, 0 Python's "range() arg 3 must not be zero"
-        raise ValueError(f"chunk must be an integer >= 1 (scans per pass), got {chunk!r}")
+    # -1 gave a map of unknown cells only, 0 Python's "range() arg 3 must not be zero"
+    chunk = check_count(chunk, "chunk", 1, note="scans per pass")
     params = config.core_params(max_range)
     poses = check_map_poses(poses)
     ranges = np.ascontiguousarray(ranges, dtype=np.float32)
@@ -219,7 +218,7 @@ def endpoint_agreement(
             f"endpoint_agreement: grid must be a kiseki OccupancyGrid, got {type(grid).__name__}"
         )
     max_range = check_max_range("endpoint_agreement", max_range)
-    check_count(neighbourhood, "endpoint_agreement: neighbourhood", 0, 10, "cells")
+    neighbourhood = check_count(neighbourhood, "endpoint_agreement: neighbourhood", 0, 10, "cells")
     hits, endpoints = _core.endpoint_agreement(
         grid, poses, ranges, angles, max_range, neighbourhood=int(neighbourhood)
     )

@@ -51,7 +51,7 @@ def visibility_reference(
     crossing at the same t are a corner. Exact in integers: times 2 |di| |dj| (a factor 0 taken
     as 1, for a segment along a row or a column), t is (2m + 1) |dj| and (2n + 1) |di|."""
     # the walk is about span^3 steps: 1,001 cells (50 m at 0.05 m) is past any local map
-    check_count(span, "visibility_reference: span", 1, 1001)
+    span = check_count(span, "visibility_reference: span", 1, 1001)
     if not isinstance(grid, OccupancyGrid):
         raise ValueError(f"visibility_reference: grid must be an OccupancyGrid, got {grid!r}")
     cx, cy = (int(v) for v in cell)

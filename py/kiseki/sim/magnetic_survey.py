@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._support.counts import check_count
 from kiseki.core import Random, check_seed
 from kiseki.sim.magnetic import DEFAULT_NOISE_SD, MagneticWorld
 
@@ -136,8 +137,7 @@ class MeasurementGrid:
     def mask(self, step: int) -> np.ndarray:
         """(size,) bool: every ``step``-th point along each axis from the lower corner, the
         thinned-out grid of spacing ``step * spacing`` (Table 6.2's training sets)."""
-        if isinstance(step, bool) or not isinstance(step, int | np.integer) or step < 1:
-            raise ValueError(f"{self.where}: step must be a positive integer, got {step!r}")
+        step = check_count(step, f"{self.where}: step", 1)
         keep = np.zeros(self.shape, dtype=bool)
         keep[::step, ::step, ::step] = True
         return keep.ravel()

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._support.counts import check_count
 from kiseki._support.schema import SchemaError, location_text, parse
 from kiseki.core import check_seed, derive_seed
 from kiseki.sim.collisions import check_free_start
@@ -78,10 +79,7 @@ class SensorSetup:
 
 def _robot_at(scene: Scene, index: int) -> tuple[str | int, ...]:
     """Where robot ``index`` is in the scene file: ``robot`` or ``robots[index]``."""
-    if not isinstance(index, int) or not 0 <= index < len(scene.robot_specs):
-        raise ValueError(
-            f"{scene.path}: robot index must be in 0..{len(scene.robot_specs) - 1}, got {index!r}"
-        )
+    index = check_count(index, f"{scene.path}: robot index", 0, len(scene.robot_specs) - 1)
     single = len(scene.robot_specs) == 1 and scene.robot_specs[0]["name"] == "robot"
     return ("robot",) if single else ("robots", index)
 

@@ -124,7 +124,7 @@ def terrain_stops(
 ) -> list[Stop]:
     """The ``moves + 1`` stops of a run in a scene YAML or an OctoMap ``.bt`` (see the module)."""
     seed = check_seed(seed)
-    check_count(moves, "moves", 1, 200)
+    moves = check_count(moves, "moves", 1, 200)
     if not (isinstance(step, numbers.Real) and 0.02 <= step <= 0.6):
         raise ValueError(f"step must be 0.02..0.6 m (the search reaches 0.7 m), got {step!r}")
     path = Path(world_path)

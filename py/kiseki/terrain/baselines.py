@@ -38,7 +38,7 @@ def register_pcl(
     """Aligns source (n, 3) to target (m, 3) from ``initial`` (4x4 rigid motion; None:
     identity). Raises ValueError for NaN points, points beyond +-1e6 m, fewer than 10 points, a
     guess that is not a rigid motion or bad parameters."""
-    check_count(max_iterations, "max_iterations", 1, 100_000)
+    max_iterations = check_count(max_iterations, "max_iterations", 1, 100_000)
     guess = np.eye(4) if initial is None else np.asarray(initial, dtype=float)
     if (
         guess.shape == (4, 4)

@@ -347,7 +347,7 @@ def cloud_planes(
     if method not in CLOUD_METHODS:
         raise ValueError(f"--method must be one of {CLOUD_METHODS}, got {method!r}")
     seed = check_seed(seed, "--seed")
-    check_count(max_points, "--max-points", 100)
+    max_points = check_count(max_points, "--max-points", 100)
     if method == "pcl":
         return _pcl(cloud.points, pcl or PclParams(), seed, max_points)
     return _hough(cloud.points, cloud.origin, hough or HoughParams())

@@ -98,8 +98,8 @@ def correlation_search(
             raise ValueError(f"correlation search: the {name} S-DEM is empty")
     if method not in ("exhaustive", "coarse-to-fine"):
         raise ValueError(f"method must be 'exhaustive' or 'coarse-to-fine', got {method!r}")
-    check_count(min_overlap, "min_overlap", 1, INT32_MAX)
-    check_count(threads, "threads", 0, THREAD_LIMIT, "0 = every core")
+    min_overlap = check_count(min_overlap, "min_overlap", 1, INT32_MAX)
+    threads = check_count(threads, "threads", 0, THREAD_LIMIT, "0 = every core")
     grid = PAPER_SEARCH if grid is None else grid
     if not isinstance(grid, _core.TranslationGrid):
         raise TypeError("correlation search: grid must be a SearchGrid (search_grid())")

@@ -10,6 +10,7 @@ the C++ model then refused it in a TypeError listing its signatures; the same ra
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -23,11 +24,12 @@ from kiseki.coop.positioning import paper_angle, simulate
 from kiseki.core import Pose2
 from kiseki.errors import RelocalizationError
 from kiseki.filters import MclConfig
+from kiseki.filters.convergence import elapsed_time
 from kiseki.filters.global_localization import GlobalConfig
 from kiseki.filters.localize_config import LocalizeConfig
 from kiseki.filters.relocalization import RelocalizeConfig
 from kiseki.gp.curl_free_basis import laplacian_basis
-from kiseki.gp.kernel import subsample
+from kiseki.gp.kernel import fit_hyperparameters, subsample
 from kiseki.grid import OccupancyGrid, beam_angles
 from kiseki.io.runlog.writer import RunWriter
 from kiseki.magnetic.lidar_mcl import LidarMclConfig
@@ -36,10 +38,12 @@ from kiseki.magnetic.multi_sensor import DriftCheck
 from kiseki.magnetic.rahok_navigation import moving_average
 from kiseki.magnetic.travel_distance import TravelDistanceConfig
 from kiseki.mapping import endpoint_agreement
+from kiseki.metrics import rpe
 from kiseki.models.space_observation import visibility_reference
 from kiseki.sim.terrain_moves import terrain_stops
 from kiseki.speed.baselines import DistanceLimiterConfig
 from kiseki.speed.limiter import SpeedLimiterConfig
+from kiseki.terrain import correlation_search, sdem_from_points
 from kiseki.terrain.baselines import register_pcl
 
 
@@ -47,6 +51,15 @@ def _grid() -> OccupancyGrid:
     cells = np.zeros((20, 20), np.int8)
     cells[0, :] = 100
     return OccupancyGrid(cells, 0.1, Pose2(0.0, 0.0, 0.0))
+
+
+def _gp_data():
+    x = np.linspace(0.0, 4.0, 12)[:, None]
+    return x, np.sin(x[:, 0])
+
+
+_SDEM = sdem_from_points(np.random.default_rng(0).uniform([-3, -3, -0.6], [3, 3, -0.4], (500, 3)))
+_PATH = np.column_stack([np.linspace(0.0, 2.0, 8), np.zeros(8), np.zeros(8)])
 
 
 def _agreement(n):
@@ -204,6 +217,28 @@ CASES = {
         1,
         100_000,
     ),
+    "GlobalConfig.tracking_particles": _c(
+        lambda v: GlobalConfig(tracking_particles=v),
+        "global localization: tracking_particles",
+        1,
+        PARTICLE_LIMIT,
+    ),
+    "LidarMclConfig.particles": _c(
+        lambda v: LidarMclConfig(particles=v), "lidar MCL: particles", 1, PARTICLE_LIMIT
+    ),
+    "fit_hyperparameters.restarts": _c(
+        lambda v: fit_hyperparameters(*_gp_data(), restarts=v).start_values, "restarts", 0, 100
+    ),
+    "correlation_search.min_overlap": _c(
+        lambda v: correlation_search(_SDEM, _SDEM, min_overlap=v).overlap,
+        "min_overlap",
+        1,
+        2**31 - 1,
+    ),
+    "elapsed_time.k": _c(
+        lambda v: elapsed_time(np.arange(5.0), v), "elapsed_time: k", 0, 4, "a scan index"
+    ),
+    "rpe.delta": _c(lambda v: rpe(_PATH, _PATH, delta=v).rmse, "delta", 1, None, "frames"),
 }
 
 
@@ -246,18 +281,46 @@ def test_each_count_takes_a_numpy_integer_as_its_python_twin(label):
         assert a == b
 
 
+# the configs' field kinds are checked first, in check_field_types' words (its own test)
+FUNCTIONS = [label for label in CASES if not label[0].isupper()]
+
+
 @pytest.mark.parametrize("bad", [True, np.bool_(True), 2.0, "3", None])
-def test_a_bool_a_float_or_text_is_no_count(bad):
-    for label in (
-        "plan.moves",
-        "laplacian_basis.count",
-        "moving_average.cells",
-        "beam_angles.count",
-    ):
-        _, name, low, high, note, _ = _case(label)
-        assert (
-            _refused(label, bad) == f"{name} must be {integer_rule(low, high, note)}, got {bad!r}"
-        )
+@pytest.mark.parametrize("label", FUNCTIONS)
+def test_a_bool_a_float_or_text_is_no_count(label, bad):
+    _, name, low, high, note, _ = _case(label)
+    assert _refused(label, bad) == f"{name} must be {integer_rule(low, high, note)}, got {bad!r}"
+
+
+@pytest.mark.parametrize(
+    ("label", "value", "message"),
+    [  # the words themselves, not built by the function under test
+        (
+            "RelocalizeConfig.beams",
+            100_001,
+            "relocalize: beams must be an integer in 0..100,000, got 100001",
+        ),
+        (
+            "MclConfig.threads",
+            -1,
+            "threads must be an integer in 0..1,024 (0 = chosen by measured time), got -1",
+        ),
+        ("DriftCheck.window", 1, "drift check: window must be an integer >= 2, got 1"),
+        (
+            "elapsed_time.k",
+            np.int64(5),
+            "elapsed_time: k must be an integer in 0..4 (a scan index), got np.int64(5)",
+        ),
+    ],
+)
+def test_the_words_of_a_refused_count(label, value, message):
+    assert _refused(label, value) == message
+
+
+def test_a_count_a_result_keeps_is_python_s_int():
+    """plan(2, np.int64(4)).moves stayed np.int64, which a JSON record of the plan refuses."""
+    moves = plan(form=2, moves=np.int64(4)).moves
+    assert type(moves) is int and json.dumps(moves) == "4"
 
 
 def test_the_library_and_the_command_line_word_a_range_alike():

@@ -95,7 +95,7 @@ class RunWriter:
         compression: str = "zstd",
     ) -> None:
         self.path = Path(path)
-        check_count(chunk_size, "chunk_size", 1, note="bytes")
+        chunk_size = check_count(chunk_size, "chunk_size", 1, note="bytes")
         if compression not in _COMPRESSIONS:
             raise ValueError(
                 f"compression must be one of {sorted(_COMPRESSIONS)}, got {compression!r}"
