@@ -21,6 +21,7 @@ from kiseki.cli._off_map import warn_if_off_the_map
 from kiseki.datasets import open_scans
 from kiseki.io.ros_map import load_map
 from kiseki.speed import SpeedLimiterConfig
+from kiseki.speed.acceleration import SPEED_LIMIT
 from kiseki.speed.along_log import limits_along_log
 from kiseki.speed.render import render_limits
 
@@ -60,10 +61,9 @@ def speed_limits(
         parser=Degrees("--half-angle", 0, 180, lo_open=True),
         help="theta: +-degrees around the motion (paper 90); not with --method width.",
     ),
-    # 10 m/s is faster than any robot that drives among people, which the limit is for
     v_max: float = typer.Option(
         SpeedLimiterConfig.v_max,
-        parser=Quantity("--v-max", 0, 10, "m/s", lo_open=True),
+        parser=Quantity("--v-max", 0, SPEED_LIMIT, "m/s", lo_open=True),
         help="The robot's maximum speed (m/s).",
     ),
     heading: str = typer.Option(

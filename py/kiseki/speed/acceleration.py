@@ -13,7 +13,11 @@ from __future__ import annotations
 import math
 import numbers
 
-__all__ = ["AccelerationLimit", "check_initial_speed"]
+__all__ = ["SPEED_LIMIT", "AccelerationLimit", "check_initial_speed", "check_top_speed"]
+
+SPEED_LIMIT = 10.0
+"""m/s: the most a limiter's v_max may be; faster than any robot that drives among people, which
+the limits are for (and v_max^2 of 1e200 m/s overflowed the stopping distance)."""
 
 
 class AccelerationLimit:
@@ -35,6 +39,13 @@ class AccelerationLimit:
         reach = self.a_max * dt
         self.value += min(reach, max(-reach, target - self.value))
         return self.value
+
+
+def check_top_speed(name: str, v_max) -> None:
+    """A limiter's v_max: a number in (0, SPEED_LIMIT] m/s."""
+    number = isinstance(v_max, numbers.Real) and not isinstance(v_max, bool)
+    if not (number and 0 < v_max <= SPEED_LIMIT):
+        raise ValueError(f"{name} must be in (0, {SPEED_LIMIT:g}] m/s, got {v_max!r}")
 
 
 def check_initial_speed(name: str, initial, v_max: float) -> None:

@@ -60,7 +60,7 @@ from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki.control.speed_limit import SpeedLimit
 from kiseki.grid import OccupancyGrid
-from kiseki.speed.acceleration import AccelerationLimit, check_initial_speed
+from kiseki.speed.acceleration import AccelerationLimit, check_initial_speed, check_top_speed
 
 __all__ = [
     "DistanceLimiterConfig",
@@ -79,6 +79,7 @@ def _check_config(config, non_negative=()) -> None:
         if not (number and math.isfinite(value) and low_ok):
             kind = ">= 0" if f.name in non_negative else "positive"
             raise ValueError(f"{type(config).__name__}.{f.name} must be {kind}, got {value!r}")
+    check_top_speed(type(config).__name__ + ".v_max", config.v_max)
     check_initial_speed(
         type(config).__name__ + ".initial_speed", config.initial_speed, config.v_max
     )

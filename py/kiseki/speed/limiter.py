@@ -40,7 +40,7 @@ from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki.control.speed_limit import SpeedLimit
 from kiseki.grid import OccupancyGrid
-from kiseki.speed.acceleration import AccelerationLimit, check_initial_speed
+from kiseki.speed.acceleration import AccelerationLimit, check_initial_speed, check_top_speed
 
 __all__ = [
     "LimitTerms",
@@ -169,6 +169,7 @@ class SpeedLimiterConfig:
                 raise ValueError(f"SpeedLimiterConfig.{name} must be a number, got {value!r}")
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"SpeedLimiterConfig.{name} must be positive, got {value!r}")
+        check_top_speed("SpeedLimiterConfig.v_max", self.v_max)
         if not (0 < self.half_angle <= math.pi):
             raise ValueError(
                 f"SpeedLimiterConfig.half_angle must be in (0, pi], got {self.half_angle}"

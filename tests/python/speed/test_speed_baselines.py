@@ -20,6 +20,7 @@ from kiseki.speed import (
     DistanceSpeedLimiter,
     PolygonLimiterConfig,
     PolygonSpeedLimiter,
+    SpeedLimiterConfig,
 )
 
 MAX_RANGE = 4.0
@@ -273,3 +274,17 @@ def test_no_limiter_starts_above_the_robots_maximum_speed():
     limiter = SpeedLimiter(grid, SpeedLimiterConfig(), initial=0.5)
     limit = limiter.update((2.0, 2.0, 0.0), ANGLES, wall_ahead(MAX_RANGE), MAX_RANGE, 0.1)
     assert limit.speed_limit <= 0.5
+
+
+@pytest.mark.parametrize(
+    "config", [SpeedLimiterConfig, DistanceLimiterConfig, PolygonLimiterConfig]
+)
+def test_a_top_speed_past_the_limit_is_refused_in_the_config(config):
+    """v_max = 1e200 m/s was taken, and the distance-only baseline's stopping distance then
+    raised OverflowError (v_max^2); the limit is the command line's --v-max bound, 10 m/s."""
+    assert config(v_max=10.0).v_max == 10.0
+    for bad in (10.000001, 1e200):
+        with pytest.raises(
+            ValueError, match=rf"^{config.__name__}\.v_max must be in \(0, 10\] m/s"
+        ):
+            config(v_max=bad)
