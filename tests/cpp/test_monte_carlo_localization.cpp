@@ -202,6 +202,15 @@ TEST(MonteCarloLocalization, WeightsCanBeSetAndBadInputIsRefused) {
   MclParams bad;
   bad.particles = 0;
   EXPECT_THROW(MonteCarloLocalization(bad, 1), std::invalid_argument);
+  // KLD's err and z are checked without kld too: parameters that hold a NaN are refused
+  MclParams unused_kld;
+  unused_kld.kld_params.err = NAN;
+  EXPECT_THROW(unused_kld.validate(), std::invalid_argument);
+  unused_kld.kld_params.err = 0.05;
+  unused_kld.kld_params.z = 10.5;
+  EXPECT_THROW(unused_kld.validate(), std::invalid_argument);
+  unused_kld.kld_params.z = 10.0;
+  EXPECT_NO_THROW(unused_kld.validate());
 }
 
 TEST(MonteCarloLocalization, AnOdometryJumpOverTheLimitIsRefusedAndOneJustUnderIsAMotion) {

@@ -24,6 +24,7 @@ Recovery recovery_from_name(const std::string& name) {
 
 void MclParams::validate() const {
   if (particles < 1 || particles > 10'000'000) throw std::invalid_argument("MCL: particles must be in 1..10,000,000");
+  check_kld_err_z(kld_params.err, kld_params.z);  // also without kld: a config holds no NaN
   if (kld) {
     KldParams k = kld_params;
     k.max_particles = particles;

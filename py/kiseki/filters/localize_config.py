@@ -154,7 +154,7 @@ class LocalizeConfig:
         for name in ("sigma_hit", "lambda_short"):
             value = getattr(self, name)
             _check(value > 0 and math.isfinite(value), f"{name} must be > 0, got {value}")
-        for name in ("z_hit", "z_rand", "z_short", "z_max"):
+        for name in ("z_hit", "z_rand", "z_short", "z_max", "z_intrusion"):
             value = getattr(self, name)
             _check(value >= 0 and math.isfinite(value), f"{name} must be >= 0, got {value}")
         _check(self.z_hit + self.z_rand > 0, "z_hit and z_rand must not both be 0")

@@ -59,8 +59,10 @@ class SimConfig:
                 raise ValueError(
                     f"{name} must be in (0, {MAX_SIM_SECONDS:,.0f}] s (24 h), got {value}"
                 )
-        if not (self.lookahead > 0 and self.goal_tolerance > 0):
-            raise ValueError("lookahead and goal_tolerance must be positive")
+        for name in ("lookahead", "goal_tolerance"):  # inf was taken, then refused by the
+            value = getattr(self, name)  # route follower once the robot was built
+            if not (value > 0 and math.isfinite(value)):
+                raise ValueError(f"{name} must be a finite number > 0 m, got {value!r}")
         check_seed(self.seed)
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import json
+import math
 
 import numpy as np
 import pytest
@@ -106,3 +107,21 @@ def test_a_float32_or_a_numpy_bool_passes_checks_written_for_python_types():
     assert switched.reset_look_elsewhere is True
     long_double = TravelDistanceConfig(gain=np.longdouble(0.5))
     assert type(long_double.gain) is float and long_double.gain == 0.5
+
+
+FLOAT_FIELDS = [
+    pytest.param(cls, f.name, id=f"{cls.__name__}.{f.name}")
+    for cls in (getattr(importlib.import_module(m), n) for m, n in CONFIGS)
+    for f in dataclasses.fields(cls)
+    if str(f.type).replace(" ", "").split("|")[0] == "float"
+]
+
+
+@pytest.mark.parametrize(("cls", "field"), FLOAT_FIELDS)
+def test_no_float_field_takes_a_nan_or_an_infinity(cls, field):
+    """PlaybackConfig took goal_tolerance = inf (the goal 'reached' before the first step) and a
+    NaN max_duration, SimConfig an infinite lookahead and goal_tolerance (refused later by the
+    route follower, once the robot was built)."""
+    for bad in (math.nan, math.inf, -math.inf):
+        with pytest.raises(ValueError):
+            cls(**{field: bad})
