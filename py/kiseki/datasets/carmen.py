@@ -100,6 +100,7 @@ _FLASER_STEPS = {
 }
 
 _Row = tuple[int, list[str]]  # (1-based line number, whitespace-separated tokens)
+_Param = tuple[int, str]  # a PARAM's (1-based line number, value text)
 
 
 @dataclass(frozen=True, eq=False)
@@ -135,15 +136,16 @@ def flaser_angles(num_beams: int) -> np.ndarray:
 def read_carmen_log(path: str | os.PathLike) -> CarmenLog:
     """Read a CARMEN log (gzip if the file starts with the gzip magic bytes)."""
     path = Path(path)
-    rows, params, param_lines = _split_messages(path, _read_text(path))
+    rows, params = _split_messages(path, _read_text(path))
     if rows["FLASER"]:
-        scans = _parse_flaser(path, rows["FLASER"], params, param_lines)
+        scans = _parse_flaser(path, rows["FLASER"], params)
     elif rows["ROBOTLASER1"]:
         scans = _parse_robotlaser(path, rows["ROBOTLASER1"])
     else:
         raise LogFormatError(f"{path}: no FLASER or ROBOTLASER1 messages")
     odometry = _parse_odom(path, rows["ODOM"])
-    return CarmenLog(path=path, scans=scans, odometry=odometry, params=params)
+    values = {name: text for name, (_, text) in params.items()}
+    return CarmenLog(path=path, scans=scans, odometry=odometry, params=values)
 
 
 def _read_text(path: Path) -> str:
@@ -153,13 +155,10 @@ def _read_text(path: Path) -> str:
     return text
 
 
-def _split_messages(
-    path: Path, text: str
-) -> tuple[dict[str, list[_Row]], dict[str, str], dict[str, int]]:
-    """The rows of each message read, the PARAM values and the line of each PARAM."""
+def _split_messages(path: Path, text: str) -> tuple[dict[str, list[_Row]], dict[str, _Param]]:
+    """The rows of each message read, and each PARAM's line and value (the last one given)."""
     rows: dict[str, list[_Row]] = {"FLASER": [], "ROBOTLASER1": [], "ODOM": []}
-    params: dict[str, str] = {}
-    param_lines: dict[str, int] = {}
+    params: dict[str, _Param] = {}
     for lineno, line in enumerate(text.split("\n"), start=1):
         tokens = line.split()
         if not tokens or tokens[0].startswith("#"):
@@ -170,9 +169,8 @@ def _split_messages(
         elif kind == "PARAM":
             if len(tokens) < 3:
                 raise LogFormatError(f"{path}:{lineno}: PARAM needs a name and a value")
-            params[tokens[1]] = tokens[2]
-            param_lines[tokens[1]] = lineno
-    return rows, params, param_lines
+            params[tokens[1]] = (lineno, tokens[2])
+    return rows, params
 
 
 def _int_field(path: Path, lineno: int, token: str, what: str) -> int:
@@ -229,9 +227,7 @@ def _laser_scans(
     return scans
 
 
-def _parse_flaser(
-    path: Path, rows: list[_Row], params: dict[str, str], param_lines: dict[str, int]
-) -> LaserScans:
+def _parse_flaser(path: Path, rows: list[_Row], params: dict[str, _Param]) -> LaserScans:
     first_line, first = rows[0]
     _check_min_count(path, first_line, first, 2, "FLASER")
     n = _int_field(path, first_line, first[1], "FLASER beam count")
@@ -246,17 +242,15 @@ def _parse_flaser(
         _check_count(path, lineno, tokens, n + 11, "FLASER")
         fields.append(tokens[2 : n + 9] + tokens[n + 10 :])  # skip count and hostname
     values = log_numbers(path, [r[0] for r in rows], fields, "FLASER", ranges=slice(0, n))
-    max_range = _flaser_max_range(path, params, param_lines)
+    max_range = _flaser_max_range(path, params)
     return _laser_scans(path, rows, values, (0, n, n + 6), flaser_angles(n), max_range, "FLASER")
 
 
-def _flaser_max_range(
-    path: Path, params: dict[str, str], param_lines: dict[str, int]
-) -> float | None:
-    text = params.get(_MAX_RANGE_PARAM)
-    if text is None:
+def _flaser_max_range(path: Path, params: dict[str, _Param]) -> float | None:
+    if _MAX_RANGE_PARAM not in params:
         return None
-    where = f"{path}:{param_lines[_MAX_RANGE_PARAM]}: PARAM {_MAX_RANGE_PARAM} {text!r}"
+    lineno, text = params[_MAX_RANGE_PARAM]
+    where = f"{path}:{lineno}: PARAM {_MAX_RANGE_PARAM} {text!r}"
     try:
         value = float(np.float32(parse_float(text)))
     except ValueError:
