@@ -125,6 +125,10 @@ def umeyama_alignment(src: np.ndarray, dst: np.ndarray, with_scale: bool = False
         sign[-1, -1] = -1
     rot = u @ sign @ vt
     var = np.mean(np.sum(xs**2, axis=1))
+    if with_scale and not var > 0:  # the scale was NaN (or inf): every error NaN
+        raise ValueError(
+            "the estimate's positions (src) are all the same: no scale can be estimated"
+        )
     scale = float(np.trace(np.diag(d) @ sign) / var) if with_scale else 1.0
     return rot, mu_d - scale * rot @ mu_s, scale
 

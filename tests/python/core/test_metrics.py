@@ -179,3 +179,27 @@ def test_area_under_roc_against_counting_and_its_labels_checked():
     assert area_under_roc(score, positive.astype(int)) == want
     with pytest.raises(ValueError, match="labels must be booleans"):  # both read as True
         area_under_roc([0.1, 0.9], ["no", "yes"])
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda ref: ape(np.zeros((3, 3)), ref, alignment="sim3"),
+        lambda ref: ape(np.zeros((3, 3)), ref, alignment="scale"),
+        lambda ref: align_trajectory(np.zeros((3, 3)), ref, "scale"),
+        lambda ref: umeyama_alignment(np.zeros((3, 2)), ref[:, :2], with_scale=True),
+        # a spread of 1e-200 m squares to 0: the scale was inf
+        lambda ref: umeyama_alignment([[0, 0], [1e-200, 0], [0, 0]], ref[:, :2], with_scale=True),
+    ],
+    ids=["ape-sim3", "ape-scale", "align-scale", "umeyama", "umeyama-underflow"],
+)
+def test_a_scale_from_an_estimate_standing_still_is_refused(call):
+    """All statistics were NaN: the scale divided by the estimate's zero spread."""
+    ref = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0]])
+    with pytest.raises(ValueError) as caught:
+        call(ref)
+    assert str(caught.value) == (
+        "the estimate's positions (src) are all the same: no scale can be estimated"
+    )
+    # without scale the same estimate aligns: onto the reference's centroid
+    assert ape(np.zeros((3, 3)), ref, alignment="se3").max == pytest.approx(1.0)
