@@ -203,3 +203,18 @@ def test_a_scale_from_an_estimate_standing_still_is_refused(call):
     )
     # without scale the same estimate aligns: onto the reference's centroid
     assert ape(np.zeros((3, 3)), ref, alignment="se3").max == pytest.approx(1.0)
+
+
+def test_wilson_interval_refuses_counts_no_float_holds_exactly():
+    """n = 10**400 raised OverflowError (z * z / (2 n)); 2**53 is the largest count taken."""
+    from kiseki.metrics import wilson_interval
+
+    for k, n in ((1, 10**400), (1, 2**53 + 1), (2**53 + 1, 2**53 + 1)):
+        with pytest.raises(ValueError) as caught:
+            wilson_interval(k, n)
+        assert str(caught.value) == (
+            f"wilson_interval: need counts 0 <= k <= n <= 2**53 and z > 0, got {k}, {n}, 1.96"
+        )
+    lo, hi = wilson_interval(2**52, 2**53)  # a half: 0.5 +- 1.96 / (2 sqrt(n))
+    assert (lo + hi) / 2 == pytest.approx(0.5, abs=1e-15)
+    assert hi - lo == pytest.approx(1.96 / 2**26.5, rel=1e-6)
