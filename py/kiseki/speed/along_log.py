@@ -60,6 +60,10 @@ def motion_headings(poses: np.ndarray, min_step: float = 0.01) -> np.ndarray:
     poses = np.asarray(poses, dtype=float)
     if poses.ndim != 2 or poses.shape[1] != 3:
         raise ValueError(f"motion_headings: poses must be (n, 3) x, y, theta, got {poses.shape}")
+    bad = ~np.isfinite(poses).all(axis=1)
+    if bad.any():  # a NaN pose took its neighbour's heading, or its own NaN
+        i = int(np.argmax(bad))
+        raise ValueError(f"motion_headings: poses must be finite, pose {i} is {poses[i].tolist()}")
     step_ok = isinstance(min_step, numbers.Real) and not isinstance(min_step, bool)
     if not (step_ok and 0 <= min_step < math.inf):  # NaN or -1 took the pose's own heading
         raise ValueError(

@@ -58,11 +58,21 @@ class NavigatorLog:
         return {name: np.asarray(getattr(self, name)) for name in self.__dataclass_fields__}
 
 
+def _finite_pose(name: str, value) -> tuple[float, float, float]:
+    try:
+        p = np.asarray(value, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        p = np.empty(0)
+    if p.shape != (3,) or not np.isfinite(p).all():  # a NaN made every beam NaN
+        raise ValueError(f"{name} must be three finite numbers (x, y, theta), got {value!r}")
+    return float(p[0]), float(p[1]), float(p[2])
+
+
 def scan_about_body(pose, sensor_pose, angles, ranges, max_range):
     """(angles, ranges) of the scan's returns seen from the body centre, in the body frame;
     beams without a return (>= max_range or NaN) come back with range +inf."""
-    x, y, theta = (float(v) for v in np.asarray(pose, dtype=float).reshape(3))
-    sx, sy, st = (float(v) for v in np.asarray(sensor_pose, dtype=float).reshape(3))
+    x, y, theta = _finite_pose("pose", pose)
+    sx, sy, st = _finite_pose("sensor_pose", sensor_pose)
     angles = np.asarray(angles, dtype=float).reshape(-1)
     ranges = np.asarray(ranges, dtype=float).reshape(-1)
     if angles.shape != ranges.shape:

@@ -38,6 +38,20 @@ def test_motion_headings_refuse_a_bad_min_step(min_step):
         motion_headings(np.zeros((3, 2)))
 
 
+@pytest.mark.parametrize("bad", [math.nan, math.inf])
+def test_motion_headings_refuse_a_pose_that_is_not_finite(bad):
+    """[[0, 0, 0], [nan, 0, 0]] gave headings [0, 0] without a word."""
+    poses = np.array([[0, 0, 0], [1, 0, 0], [bad, 0, 0.0]])
+    with pytest.raises(ValueError) as caught:
+        motion_headings(poses)
+    assert (
+        str(caught.value) == f"motion_headings: poses must be finite, pose 2 is [{bad}, 0.0, 0.0]"
+    )
+    poses[2] = [0.0, 0.0, bad]
+    with pytest.raises(ValueError, match=r"motion_headings: poses must be finite, pose 2 is"):
+        motion_headings(poses)
+
+
 @pytest.fixture(scope="module")
 def intel(shared_data):
     scans = read_carmen_log(shared_data / "carmen" / "intel-corrected.log.gz").scans

@@ -95,3 +95,13 @@ def test_scan_about_body_by_hand():
     assert a[:2] == pytest.approx([0.0, math.pi / 4])
     assert r[:2] == pytest.approx([0.5, math.hypot(0.2, 0.2)])
     assert r[2] == math.inf
+
+
+@pytest.mark.parametrize("name", ["pose", "sensor_pose"])
+@pytest.mark.parametrize("bad", [(math.nan, 0.0, 0.0), (0.0, 0.0, math.inf), (0.0, 0.0), "abc"])
+def test_scan_about_body_refuses_a_pose_that_is_not_three_finite_numbers(name, bad):
+    """A NaN pose gave every beam a NaN angle and range; two numbers a numpy reshape error."""
+    poses = {"pose": (0.0, 0.0, 0.0), "sensor_pose": (0.2, 0.0, 0.0), name: bad}
+    with pytest.raises(ValueError) as caught:
+        scan_about_body(poses["pose"], poses["sensor_pose"], [0.0, 0.1], [1.0, 2.0], 10.0)
+    assert str(caught.value) == f"{name} must be three finite numbers (x, y, theta), got {bad!r}"
