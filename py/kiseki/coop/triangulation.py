@@ -104,8 +104,19 @@ def _check_angles(theta1: float, theta2: float) -> None:
         )
 
 
+def _check_d(d: float) -> None:
+    # a NaN d gave (NaN, NaN), a negative one swapped the robots without a word
+    if not (_real(d) and 0 < d < math.inf):
+        raise ValueError(f"d must be a finite number > 0 m (robots 1 and 2 at -d and d), got {d!r}")
+
+
+def _real(value) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
 def paper_position(d: float, theta1: float, theta2: float) -> np.ndarray:
     """Eqs. 1-2: robot 3's (x, y) from robot 1 at (-d, 0) and robot 2 at (d, 0)."""
+    _check_d(d)
     _check_angles(theta1, theta2)
     t1, t2 = math.tan(theta1), math.tan(theta2)
     return np.array([d * (-t1 + t2) / (t1 + t2), 2 * d * t1 * t2 / (t1 + t2)])
@@ -116,7 +127,12 @@ def paper_error(
 ) -> np.ndarray:
     """Eqs. 3-4 (eq. 3's first sign corrected, see the module): (dx, dy) for small angle
     errors dtheta1, dtheta2."""
+    _check_d(d)
     _check_angles(theta1, theta2)
+    if not all(_real(v) and math.isfinite(v) for v in (dtheta1, dtheta2)):  # NaN gave NaN
+        raise ValueError(
+            f"dtheta1 and dtheta2 must be finite numbers (rad), got {dtheta1!r}, {dtheta2!r}"
+        )
     s2 = math.sin(theta1 + theta2) ** 2
     dx = d * (-math.sin(2 * theta2) * dtheta1 + math.sin(2 * theta1) * dtheta2) / s2
     dy = 2 * d * (math.sin(theta2) ** 2 * dtheta1 + math.sin(theta1) ** 2 * dtheta2) / s2

@@ -118,3 +118,29 @@ def test_bad_sigma_and_paper_angles() -> None:
         paper_position(1.0, 2.0, 1.5)
     with pytest.raises(ValueError, match="nearly parallel"):
         paper_position(1.0, 1e-4, 1e-4)
+
+
+@pytest.mark.parametrize("d", [math.nan, math.inf, -1.0, 0.0, "1.0", True])
+def test_paper_forms_refuse_a_half_baseline_d_that_is_not_a_positive_distance(d) -> None:
+    """paper_position(nan, ...) gave (nan, nan); d = -1 was taken (robots 1 and 2 swapped)."""
+    message = f"d must be a finite number > 0 m (robots 1 and 2 at -d and d), got {d!r}"
+    with pytest.raises(ValueError) as caught:
+        paper_position(d, 0.5, 0.6)
+    assert str(caught.value) == message
+    with pytest.raises(ValueError) as caught:
+        paper_error(d, 0.5, 0.6, 0.001, 0.0)
+    assert str(caught.value) == message
+
+
+@pytest.mark.parametrize(("dtheta1", "dtheta2"), [(math.nan, 0.0), (0.0, -math.inf), ("0", 0)])
+def test_paper_error_refuses_angle_errors_that_are_not_finite(dtheta1, dtheta2) -> None:
+    """paper_error(1, 0.5, 0.6, nan, 0) gave (nan, nan)."""
+    with pytest.raises(ValueError) as caught:
+        paper_error(1.0, 0.5, 0.6, dtheta1, dtheta2)
+    assert str(caught.value) == (
+        f"dtheta1 and dtheta2 must be finite numbers (rad), got {dtheta1!r}, {dtheta2!r}"
+    )
+    # zero and negative errors, and any d > 0, stay: eq. 4's dy is linear in both
+    dy = paper_error(1e-3, 0.5, 0.6, -0.002, 0.0)[1]
+    assert dy == pytest.approx(2e-3 * math.sin(0.6) ** 2 * -0.002 / math.sin(1.1) ** 2, rel=1e-12)
+    assert paper_error(1.0, 0.5, 0.6, 0, 0).tolist() == [0.0, 0.0]
