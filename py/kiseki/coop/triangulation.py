@@ -57,6 +57,11 @@ def triangulate(
         # an SD of 1e300 rad gave a NaN and infinite covariance; beyond pi a bearing says nothing
         if value is not None and not (isinstance(value, numbers.Real) and 0 <= value <= math.pi):
             raise ValueError(f"{name} must be a number in [0, pi] rad, got {value!r}")
+    if elevation_sigma is not None and bearing_sigma is None:  # was ignored: a position only
+        raise ValueError(
+            f"elevation_sigma ({elevation_sigma!r}) needs bearing_sigma, which is None: the "
+            "covariance is returned only with bearing_sigma"
+        )
     sigma = 0.0 if bearing_sigma is None else float(bearing_sigma)
     try:
         points = np.asarray(standing_positions, dtype=float)

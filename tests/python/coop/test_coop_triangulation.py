@@ -144,3 +144,21 @@ def test_paper_error_refuses_angle_errors_that_are_not_finite(dtheta1, dtheta2) 
     dy = paper_error(1e-3, 0.5, 0.6, -0.002, 0.0)[1]
     assert dy == pytest.approx(2e-3 * math.sin(0.6) ** 2 * -0.002 / math.sin(1.1) ** 2, rel=1e-12)
     assert paper_error(1.0, 0.5, 0.6, 0, 0).tolist() == [0.0, 0.0]
+
+
+def test_an_elevation_sigma_without_a_bearing_sigma_is_refused() -> None:
+    """It was ignored without a word: the position came back, without a covariance."""
+    standing, bearings, elevations = [[0.0, 0, 0], [1.0, 0, 0]], [1.0, 2.0], [0.1, 0.1]
+    with pytest.raises(ValueError) as caught:
+        triangulate(standing, bearings, elevations, None, 0.1)
+    assert str(caught.value) == (
+        "elevation_sigma (0.1) needs bearing_sigma, which is None: the covariance is returned "
+        "only with bearing_sigma"
+    )
+    # with bearing_sigma it gives the covariance too; without either sigma the position alone
+    standing = np.array(standing)
+    bearings, elevations = _bearings(standing, np.array([0.5, 1.0, 0.2]))
+    position, covariance = triangulate(standing, bearings, elevations, 0.01, 0.1)
+    assert covariance.shape == (3, 3) and np.all(np.linalg.eigvalsh(covariance) > 0)
+    np.testing.assert_allclose(position, [0.5, 1.0, 0.2], atol=1e-12)
+    np.testing.assert_allclose(triangulate(standing, bearings, elevations), position, atol=1e-12)
