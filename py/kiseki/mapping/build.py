@@ -42,7 +42,13 @@ def check_map_size(width_m: float, height_m: float, resolution: float) -> tuple[
     for name, v in (("width", width_m), ("height", height_m), ("resolution", resolution)):
         if not (math.isfinite(v) and v > 0):  # 0 was a ZeroDivisionError, inf an OverflowError
             raise ValueError(f"check_map_size: {name} must be a finite number > 0 m, got {v!r}")
-    width, height = (math.ceil(side / resolution) for side in (width_m, height_m))
+    wide, high = width_m / resolution, height_m / resolution
+    if not math.isfinite(wide * high):  # 1e300 m at 1e-300 m: math.ceil(inf) was an OverflowError
+        raise ValueError(
+            f"resolution {resolution:g} m makes a map of {wide:.3g} x {high:.3g} cells over "
+            f"{width_m:.3g} x {height_m:.3g} m: more than the limit of {MAX_MAP_CELLS:.0e} cells"
+        )
+    width, height = math.ceil(wide), math.ceil(high)
     if min(width, height) < MIN_MAP_SIDE:
         raise ValueError(
             f"resolution {resolution:g} m makes a map of {width} x {height} cells over "
@@ -54,6 +60,15 @@ def check_map_size(width_m: float, height_m: float, resolution: float) -> tuple[
             f"{width_m:.3g} x {height_m:.3g} m: more than the limit of {MAX_MAP_CELLS:.0e} cells"
         )
     return width, height
+
+
+def _real(values, name: str) -> np.ndarray:
+    """``values`` as an array of real numbers (bool, integer or float); complex ones lost their
+    imaginary part in the float32 cast, strings and objects were parsed or failed in numpy."""
+    array = np.asarray(values)
+    if array.dtype.kind not in "biuf":
+        raise ValueError(f"{name}: expected real numbers, got dtype {array.dtype}")
+    return array
 
 
 def check_map_poses(poses: np.ndarray) -> np.ndarray:
@@ -139,7 +154,9 @@ def build_map(
     readings (no measurement) say nothing and are skipped; a negative reading is an error, as
     is a pose that is not finite or beyond +-MAGNITUDE_LIMIT m (`check_map_poses`), or a
     resolution giving a map outside `check_map_size`."""
-    config = config or MapBuildConfig()
+    config = MapBuildConfig() if config is None else config
+    if not isinstance(config, MapBuildConfig):  # a dict was "no attribute 'margin'"
+        raise TypeError(f"build_map: config must be a MapBuildConfig, got {type(config).__name__}")
     if not np.isfinite(config.margin) or config.margin < 0:
         raise ValueError(f"margin must be >= 0, got {config.margin}")
     max_range = check_max_range("build_map", max_range)
@@ -147,7 +164,10 @@ def build_map(
     chunk = check_count(chunk, "chunk", 1, note="scans per pass")
     params = config.core_params(max_range)
     poses = check_map_poses(poses)
-    ranges = np.ascontiguousarray(ranges, dtype=np.float32)
+    ranges = np.ascontiguousarray(_real(ranges, "ranges"), dtype=np.float32)
+    if ranges.ndim != 2 or ranges.shape[1] == 0:  # no beam built a map of unknown cells
+        raise ValueError(f"ranges: expected (scans, beams), beams >= 1, got shape {ranges.shape}")
+    angles = _real(angles, "angles")
     negative = np.flatnonzero((ranges < 0).any(axis=tuple(range(1, ranges.ndim))))
     if negative.size:
         first = negative[0]
@@ -184,7 +204,16 @@ def scan_local_builder(
     beam. Readings that are NaN, zero or negative are no reading and add nothing. Its `build()`
     is L, its `hits()` the cells a beam ended in."""
     max_range = check_max_range("local map", max_range)
-    ranges = np.array(ranges, dtype=np.float32)  # a copy: the caller's scan stays as it was
+    angles = _real(angles, "local map: angles")
+    # a copy: the caller's scan stays as it was
+    ranges = np.array(_real(ranges, "local map: ranges"), dtype=np.float32)
+    if angles.ndim != 1 or ranges.shape != angles.shape or angles.size == 0:
+        raise ValueError(
+            "local map: angles and ranges must be one scan's (beams,) each, beams >= 1, got "
+            f"shapes {angles.shape} and {ranges.shape}"
+        )
+    if not np.isfinite(angles).all():  # a NaN angle's beam was left out without a word
+        raise ValueError("local map: angles: contains NaN or infinite values")
     ranges[ranges >= max_range] = np.nan
     builder = _core.LocalMapBuilder(size, resolution)
     builder.add_scan(_core.Pose2(), angles, ranges, max_range)
