@@ -67,6 +67,7 @@ def triangulate(
         points = np.asarray(standing_positions, dtype=float)
     except (TypeError, ValueError) as error:
         raise ValueError(f"standing_positions: expected numbers ({error})") from None
+    origin = _first_robot(points)
     if elevations is None:
         if points.ndim != 2 or points.shape[1] != 2:
             raise ValueError(
@@ -74,7 +75,7 @@ def triangulate(
                 f"{points.shape}"
             )
         position, covariance, _ranges, _angle = _core.triangulate_2d(
-            points, bearings, sigma, float(min_intersection_angle)
+            points - origin, bearings, sigma, float(min_intersection_angle)
         )
     else:
         if points.ndim != 2 or points.shape[1] != 3:
@@ -82,16 +83,27 @@ def triangulate(
                 f"standing_positions: expected shape (n, 3) with elevations, got {points.shape}"
             )
         position, covariance, _ranges, _angle = _core.triangulate_3d(
-            points,
+            points - origin,
             bearings,
             elevations,
             sigma,
             0.0 if elevation_sigma is None else float(elevation_sigma),
             float(min_intersection_angle),
         )
+    position = position + origin
     if bearing_sigma is None:
         return position
     return position, covariance
+
+
+def _first_robot(points: np.ndarray) -> np.ndarray | float:
+    """Where the first standing robot is: the solver works on positions relative to it. Its test
+    for coincident robots, closer than 1e-9 (1 + |position|) m, took robots 1 m apart 1e9 m
+    from the origin for one. 0 when a position is not finite or beyond 1e300 m (the solver
+    names those, or any difference would overflow)."""
+    if points.ndim != 2 or points.size == 0 or not np.abs(points).max() < 1e300:
+        return 0.0
+    return points[0].copy()
 
 
 def _check_angles(theta1: float, theta2: float) -> None:

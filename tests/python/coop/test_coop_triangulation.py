@@ -162,3 +162,17 @@ def test_an_elevation_sigma_without_a_bearing_sigma_is_refused() -> None:
     assert covariance.shape == (3, 3) and np.all(np.linalg.eigvalsh(covariance) > 0)
     np.testing.assert_allclose(position, [0.5, 1.0, 0.2], atol=1e-12)
     np.testing.assert_allclose(triangulate(standing, bearings, elevations), position, atol=1e-12)
+
+
+@pytest.mark.parametrize("far", [1e9, -1e11])
+def test_robots_far_from_the_origin_do_not_coincide_by_the_tolerance(far) -> None:
+    """Robots 1 m apart 1e9 m from the origin "coincided": the solver's tolerance for that,
+    1e-9 (1 + |position|), grew with the coordinates; it now works relative to robot 0."""
+    near = triangulate([[0.0, 0.0], [1.0, 0.0]], [1.0, 2.0])
+    found = triangulate([[far, far], [far + 1, far]], [1.0, 2.0])
+    np.testing.assert_allclose(found - far, near, atol=1e-4)  # a float holds 1e11 to 1.5e-5
+    near = triangulate([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]], [1.0, 2.0], [0.1, 0.1])
+    found = triangulate([[far, far, 5.0], [far + 1, far, 5.0]], [1.0, 2.0], [0.1, 0.1])
+    np.testing.assert_allclose(found - [far, far, 5.0], near, atol=1e-4)
+    with pytest.raises(ValueError, match="standing robots 0 and 1 coincide"):
+        triangulate([[far, far], [far, far]], [1.0, 2.0])  # one spot still is one
