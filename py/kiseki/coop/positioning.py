@@ -147,7 +147,6 @@ MAX_MOVES = 1000  # the most moves a plan takes
 def _check(form: int, moves: int, angle: float) -> None:
     if form not in FORMS:
         raise ValueError(f"form must be 1 or 2, got {form!r}")
-    moves = check_count(moves, "moves", 1, MAX_MOVES)
     if form == 1 and moves % 2 == 0:
         raise ValueError(
             f"form 1 takes an odd number of moves (scout, pair, ..., scout), got {moves}"

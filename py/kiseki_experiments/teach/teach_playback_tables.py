@@ -56,7 +56,7 @@ def stop_table(config, trials: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-# kiseki.metrics.taught_map_truth's shares: forgiving a one-cell shift (a taught cell counts
+# kiseki.teach.map_truth.taught_map_truth's shares: forgiving a one-cell shift (a taught cell counts
 # only with its 8 neighbours agreeing), and cell by cell
 TAUGHT_SHARES = (
     "erased_share",
@@ -67,8 +67,8 @@ TAUGHT_SHARES = (
 
 
 def taught_table(config, trials: pd.DataFrame) -> pd.DataFrame:
-    """The taught maps against the scene's truth (kiseki.metrics.taught_map_truth), per band:
-    mean and worst share of obstacle cells in reach erased, and of visible free cells marked
+    """The taught maps against the scene's truth (kiseki.teach.map_truth), per band: mean and
+    worst share of obstacle cells in reach erased, and of visible free cells marked
     occupied, over the trials (each teaches its own map), both with the one-cell shift forgiven
     and cell by cell."""
     rows = []

@@ -83,7 +83,11 @@ def test_from_import_of_an_old_name_points_the_warning_at_the_importer(tmp_path)
 
 # names that left a module still there: (module, name, where it is now); kiseki.sim.robot's
 # are tested beside the robot (tests/python/sim/test_sim_robot_inputs.py)
-MOVED_NAMES = [("kiseki.datasets.rosbag", "write_bag", "kiseki.datasets.rosbag_writer")]
+MOVED_NAMES = [
+    ("kiseki.datasets.rosbag", "write_bag", "kiseki.datasets.rosbag_writer"),
+    ("kiseki.metrics", "MapTruth", "kiseki.teach.map_truth"),
+    ("kiseki.metrics", "taught_map_truth", "kiseki.teach.map_truth"),
+]
 
 
 @pytest.mark.parametrize(("module", "name", "new"), MOVED_NAMES)

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""`kiseki.metrics.taught_map_truth`'s two measures, the forgiving one (a taught cell counts
+"""`kiseki.teach.map_truth.taught_map_truth`'s two measures, the forgiving one (a taught cell counts
 only with all 8 neighbours agreeing) and the cell-by-cell one, against counts written out as
 plain loops over small synthetic maps: a one-cell-wide false wall that the forgiving measure
 hides and the cell-by-cell one counts, a one-cell-deep hole in a thick wall, and random maps."""
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from kiseki import _core
-from kiseki.metrics import taught_map_truth
+from kiseki.teach.map_truth import taught_map_truth
 
 RES = 0.1
 POSE = (0.55, 2.0, 0.0)  # x, y, yaw: on a cell border in y, looking east

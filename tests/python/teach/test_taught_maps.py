@@ -2,7 +2,7 @@
 # Copyright (c) 2026 the kiseki authors
 """Taught maps against the truth: local maps from depth images add nothing where a column has no
 reading (the wall-erasing column rule), the thesis' and the evidence-counting merge rules, the
-truth measure of `kiseki.metrics.taught_map_truth`, and a real Kinect frame."""
+truth measure of `kiseki.teach.map_truth.taught_map_truth`, and a real Kinect frame."""
 
 from __future__ import annotations
 
@@ -17,11 +17,11 @@ from kiseki import _core
 from kiseki.apps.teach.teaching_files import environment_grid, measure_taught_maps
 from kiseki.control import PurePursuit
 from kiseki.core import Pose2
-from kiseki.metrics import taught_map_truth
 from kiseki.sim.scene import load_scene
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import EnvironmentMap, build_teaching_map
 from kiseki.teach.local_maps import BANDS, LocalMapMaker
+from kiseki.teach.map_truth import taught_map_truth
 
 
 @pytest.fixture(scope="module")

@@ -19,9 +19,9 @@ from kiseki._support.atomic import atomic_write_all
 from kiseki.core import Pose2
 from kiseki.grid import OccupancyGrid
 from kiseki.io.ros_map import map_files
-from kiseki.metrics import taught_map_truth
 from kiseki.sim.scene import Scene
 from kiseki.teach.local_maps import BANDS
+from kiseki.teach.map_truth import taught_map_truth
 from kiseki.teach.scene_identity import TaughtScene
 
 __all__ = ["TeachResult", "environment_grid", "measure_taught_maps", "write_teaching_files"]
@@ -56,7 +56,7 @@ def measure_taught_maps(
 ) -> dict:
     """Each taught map against the scene's ground truth at its own band's heights (and its
     resolution), over what the cameras could reach from the true poses of the run: see
-    `kiseki.metrics.taught_map_truth` (every camera's poses together: a cell that several
+    `kiseki.teach.map_truth.taught_map_truth` (every camera's poses together: a cell that several
     reach counts once). A camera's reach is half the local map's size less the mount's offset
     from the robot's centre (so every cell in reach lies inside L), within its max range, and
     no nearer than its minimum depth (a bench under it is invisible)."""
