@@ -138,8 +138,22 @@ void bind_ray_casting(py::class_<OccupancyGrid>& cls) {
 
 void bind_occupancy_grid(py::module_& m) {
   py::class_<OccupancyGrid> cls(m, "OccupancyGrid");
-  cls.def(py::init<int, int, double, const Pose2&, std::int8_t>(), "width"_a, "height"_a,
-          "resolution"_a, "origin"_a = Pose2(), "fill"_a = kUnknown)
+  // the sides as 64-bit integers checked here, the fill as an int the constructor checks: 2**31
+  // cells across or a fill of 200 were pybind11's list of signatures
+  cls.def(py::init([](std::int64_t width, std::int64_t height, double resolution,
+                      const Pose2& origin, int fill) {
+            constexpr std::int64_t kMaxSide = 1'000'000'000;  // the constructor's 1e9 cells
+            const auto sides = std::to_string(width) + " x " + std::to_string(height);
+            if (width < 1 || height < 1) {
+              throw std::invalid_argument("OccupancyGrid: width and height must be positive, got " + sides);
+            }
+            if (width > kMaxSide || height > kMaxSide) {
+              throw std::invalid_argument("OccupancyGrid: more than 1e9 cells requested (" + sides + ")");
+            }
+            return OccupancyGrid(static_cast<int>(width), static_cast<int>(height), resolution, origin,
+                                 fill);
+          }),
+          "width"_a, "height"_a, "resolution"_a, "origin"_a = Pose2(), "fill"_a = kUnknown)
       .def(py::init(&grid_from_cells), "cells"_a, "resolution"_a, "origin"_a = Pose2(),
            "A grid holding a copy of int8 cells (row = y).")
       .def_property_readonly("width", &OccupancyGrid::width)
@@ -159,6 +173,11 @@ void bind_occupancy_grid(py::module_& m) {
              py::array_t<int> out({a.shape(0), py::ssize_t{2}});
              auto* o = out.mutable_data();
              for (py::ssize_t i = 0; i < a.shape(0); ++i) {
+               const Eigen::Vector2d at = g.world_to_grid({a.data()[2 * i], a.data()[2 * i + 1]});
+               if (std::abs(at.x()) >= 1e9 || std::abs(at.y()) >= 1e9) {  // was clamped to 1e9
+                 throw std::invalid_argument("points: row " + std::to_string(i) +
+                                             " lies 1e9 cells or more from the map's origin");
+               }
                const CellIndex c = g.world_to_cell({a.data()[2 * i], a.data()[2 * i + 1]});
                o[2 * i] = c.x, o[2 * i + 1] = c.y;
              }
@@ -168,6 +187,7 @@ void bind_occupancy_grid(py::module_& m) {
            [](const OccupancyGrid& g, const py::handle& cells) {
              const auto a = as_doubles(cells, "cells");
              require_shape(a, "cells", 2, 2);
+             require_finite(a, "cells");  // a NaN cell was a NaN point
              py::array_t<double> out({a.shape(0), py::ssize_t{2}});
              auto* o = out.mutable_data();
              for (py::ssize_t i = 0; i < a.shape(0); ++i) {

@@ -15,6 +15,9 @@ OccupancyGrid extract_window(const OccupancyGrid& map, const Pose2& center, doub
   if (!std::isfinite(center.x) || !std::isfinite(center.y) || !std::isfinite(center.theta)) {
     throw std::invalid_argument("extract_window: pose must be finite");
   }
+  if (!(resolution >= 0.0) || !std::isfinite(resolution)) {  // -0.1 and NaN took the map's
+    throw std::invalid_argument("extract_window: resolution must be 0 (the map's) or finite and > 0");
+  }
   const double res = resolution > 0.0 ? resolution : map.resolution();
   const int cols = static_cast<int>(std::lround(width / res));
   const int rows = static_cast<int>(std::lround(height / res));

@@ -34,7 +34,7 @@ void check_cell_value(int v) {
 }  // namespace
 
 OccupancyGrid::OccupancyGrid(int width, int height, double resolution, const Pose2& origin,
-                             std::int8_t fill)
+                             int fill)
     : resolution_(resolution) {
   if (width <= 0 || height <= 0) {
     throw std::invalid_argument("OccupancyGrid: width and height must be positive, got " +

@@ -28,9 +28,10 @@ struct CellIndex {
 /// map origin, yaw included). Cells are stored in a CV_8SC1 cv::Mat indexed (row = y, col = x).
 class OccupancyGrid {
  public:
-  /// A width x height grid filled with one value (in -1..100, else std::invalid_argument).
+  /// A width x height grid filled with one value (in -1..100, else std::invalid_argument; an
+  /// int, so that 200 is refused by that check rather than wrapped to int8 by a caller).
   OccupancyGrid(int width, int height, double resolution, const Pose2& origin = {},
-                std::int8_t fill = kUnknown);
+                int fill = kUnknown);
   /// Wraps existing cells (CV_8SC1); the matrix buffer is shared, not copied.
   OccupancyGrid(const cv::Mat& cells, double resolution, const Pose2& origin);
 
