@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import numbers
 from typing import Any
 
 import numpy as np
@@ -102,6 +103,9 @@ class ExactGP:
             raise ValueError(
                 f"points have {p.shape[1]} coordinates, the GP was fitted on {self.dimension}"
             )
+        # "a" was pybind11's signature list; the range [0, 1) is the core's to check
+        if isinstance(truncation, bool) or not isinstance(truncation, numbers.Real):
+            raise ValueError(f"predict: truncation must be a number in [0, 1), got {truncation!r}")
         means, variances = [], []
         for core in self._cores:
             m, v = core.predict(p, truncation)

@@ -39,6 +39,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 __all__ = [
+    "MAX_NODES",
     "NODE_SPACING",
     "WINDOW_ANGLE",
     "WINDOW_RANGE",
@@ -57,6 +58,9 @@ range r and an angle alpha without values; 10 m covers the walls of a path 2-8 m
 WINDOW_ANGLE = math.radians(60.0)
 """rad: full width alpha of each window, centred on +90 deg (left) and -90 deg (right) of the
 laser's x axis; our choice (the thesis gives no value)."""
+
+MAX_NODES = 10_000_000
+"""Nodes of one map: 1,000 km at 0.1 m, about 0.9 GB (11 numbers a node); the file format's too."""
 
 _SHA1_HEX = 40
 
@@ -234,6 +238,15 @@ def build_linear_map(
         raise ValueError(f"linear magnetic map: spacing must be positive, got {spacing} m")
     if not (isinstance(tolerance, numbers.Real) and math.isfinite(tolerance) and tolerance >= 0):
         raise ValueError(f"linear magnetic map: tolerance must be >= 0, got {tolerance!r}")
+    try:  # a float was "'float' object is not subscriptable", (-1, 0) taken
+        reach, width = (float(v) for v in window)
+    except (TypeError, ValueError):
+        reach = width = math.nan
+    if not (0 < reach < math.inf and 0 < width <= math.pi):
+        raise ValueError(
+            "linear magnetic map: window must be (range m > 0, full angle in (0, pi] rad), as "
+            f"geometric_features takes it, got {window!r}"
+        )
     if not (isinstance(path_id, str) and len(path_id) == _SHA1_HEX):
         raise ValueError(f"linear magnetic map: path_id must be 40 hex digits, got {path_id!r}")
     if any(ch not in "0123456789abcdef" for ch in path_id):
@@ -255,12 +268,17 @@ def build_linear_map(
             f"linear magnetic map: s is not monotonic: s[{i}] = {s[i]:.6g} m is"
             f" {-step[i - 1]:.3g} m before s[{i - 1}] (tolerance {tolerance} m)"
         )
+    # counted in floats first: s of 1e300 m overflowed the int64 node indices (numpy's
+    # "'list' argument must have no negative elements")
+    span = np.floor(s.max() / spacing + 0.5) - np.floor(s.min() / spacing + 0.5)
+    if not span < MAX_NODES:
+        raise ValueError(
+            f"linear magnetic map: {span + 1:.6g} nodes is over the limit of {MAX_NODES:,}"
+        )
     idx = np.floor(s / spacing + 0.5).astype(np.int64)
     k0 = int(idx.min())
     bins = idx - k0
     nodes = int(bins.max()) + 1
-    if nodes > 10_000_000:
-        raise ValueError(f"linear magnetic map: {nodes} nodes is over the limit of 10,000,000")
     count = np.bincount(bins, minlength=nodes)
     seen = np.maximum(count, 1)
 
@@ -294,6 +312,6 @@ def build_linear_map(
         g=g_mean,
         count=count.astype(np.int64),
         position=p_mean,
-        window=(float(window[0]), float(window[1])),
+        window=(reach, width),
         provenance=dict(provenance or {}),
     )

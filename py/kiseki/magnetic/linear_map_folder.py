@@ -39,7 +39,7 @@ from kiseki._support.schema import (
 )
 from kiseki._support.yaml import read_yaml_file, safe_load_12
 from kiseki.errors import KisekiError, MapFormatError
-from kiseki.magnetic.linear_map import LinearMagneticMap
+from kiseki.magnetic.linear_map import MAX_NODES, LinearMagneticMap
 
 __all__ = [
     "KIND",
@@ -76,7 +76,7 @@ class LinearMapDoc(FileModel):
     kind: Literal["linear_magnetic_map"]
     format_version: Literal[1]
     node_spacing: PositiveFloat
-    nodes: PositiveInt = Field(le=10_000_000)
+    nodes: PositiveInt = Field(le=MAX_NODES)
     first_node_s: FiniteFloat
     path_id: str = Field(pattern=r"^[0-9a-f]{40}$")
     units: Literal["G"]

@@ -54,6 +54,19 @@ def test_prediction_equals_scikit_learn(data):
     assert var.shape == (len(q), 3)
 
 
+def test_a_truncation_that_is_not_a_number_is_refused_by_name(data):
+    """'a' was pybind11's "incompatible function arguments" with the signature list; the
+    range stays the core's own check."""
+    x, y, q = data
+    gp = ExactGP.fit(x, y, SquaredExponential(1.1, 0.6, 0.07), mean="zero")
+    for bad in ("a", True, None):
+        with pytest.raises(ValueError, match=r"^predict: truncation must be a number in \[0, 1\)"):
+            gp.predict(q, truncation=bad)
+    with pytest.raises(ValueError, match=r"truncation must be in \[0, 1\)"):
+        gp.predict(q, truncation=1.5)
+    np.testing.assert_array_equal(gp.predict(q, truncation=0)[0], gp.predict(q, truncation=0.0)[0])
+
+
 def test_log_marginal_likelihood_and_gradient_equal_scikit_learn(data):
     x, y, _ = data
     kernel = SquaredExponential(0.9, 0.5, 0.1)

@@ -238,6 +238,12 @@ def test_gp_and_linear_map_folders_refuse_each_other(tmp_path):
         ({"s": [0.0, 0.5, 0.2]}, r"not monotonic: s\[2\]"),
         ({"path_id": "abc"}, "path_id must be 40 hex digits"),
         ({"readings": [[0.1, 0.2, 0.3]] * 2}, r"readings has shape \(2, 3\)"),
+        # a float window was "'float' object is not subscriptable", (-1, 0) was taken, and s of
+        # 1e300 m overflowed the node indices ("'list' argument must have no negative ...")
+        ({"window": 1.0}, r"window must be \(range m > 0, full angle .*, got 1\.0$"),
+        ({"window": (-1.0, 0.0)}, r"window must be .*, got \(-1\.0, 0\.0\)$"),
+        ({"window": (10.0, 4.0)}, r"window must be .* in \(0, pi\] rad"),
+        ({"s": [0.0, 1e300, 2e300]}, r"2e\+301 nodes is over the limit of 10,000,000$"),
     ],
 )
 def test_bad_input_is_refused(change, message):
