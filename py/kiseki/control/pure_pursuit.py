@@ -53,7 +53,10 @@ class PurePursuit:
     def __init__(
         self, waypoints, speed: float, lookahead: float, tolerance: float, max_accel: float
     ) -> None:
-        pts = np.asarray(waypoints, dtype=float).reshape(-1, 2)
+        pts = np.asarray(waypoints, dtype=float)
+        if pts.size % 2:  # three numbers were numpy's "cannot reshape array of size 3"
+            raise ValueError(f"a route's waypoints are (x, y) pairs, got {pts.size} numbers")
+        pts = pts.reshape(-1, 2)
         if len(pts) < 2 or not np.isfinite(pts).all():
             raise ValueError("a route needs at least two finite waypoints")
         for name, value in (

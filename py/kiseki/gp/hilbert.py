@@ -135,6 +135,8 @@ def spectral_tolerance(kernel: SquaredExponential) -> float:
     over a 12 x 5 m strip at l = 0.5 m (two seeds) a fixed 1e-4 (810 functions) put the mean
     up to 0.14 sigma_n from the exact GP's at sigma_f / sigma_n = 10 and 2.1 sigma_n at 60;
     the rule's 1e-6 and 2.8e-8 (1,224 and 1,542 functions) 0.002-0.003 sigma_n."""
+    if not isinstance(kernel, SquaredExponential):  # None was "no attribute 'sigma_n'"
+        raise TypeError(f"kernel must be a SquaredExponential, got {type(kernel).__name__}")
     return 1e-4 * min(1.0, (kernel.sigma_n / kernel.sigma_f) ** 2)
 
 

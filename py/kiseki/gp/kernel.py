@@ -224,6 +224,10 @@ def refine_hyperparameters(
     no scan and no random restarts, which on every reading would cost the most. It climbs to the
     optimum of all readings nearest the subsample's (on the thesis' 3-D floor, 9 evaluations
     from a 1,000-point subsample's, where a full fit on 2,000 points takes 195)."""
+    if not isinstance(start, HyperparameterFit):  # None was "no attribute 'kernel'"
+        raise TypeError(
+            f"start must be a HyperparameterFit (fit_hyperparameters'), got {type(start).__name__}"
+        )
     x = inputs_array(x)
     y, _ = targets_array(y, x.shape[0])
     y = remove_mean(y, check_mean(mean))

@@ -43,6 +43,8 @@ def beam_angles(count: int, field_of_view: float, start: float | None = None) ->
 
 def grid_summary(grid: OccupancyGrid) -> dict[str, float | int]:
     """Size, extent and cell counts of a grid."""
+    if not isinstance(grid, OccupancyGrid):  # None was "no attribute 'cells'"
+        raise TypeError(f"grid must be a kiseki OccupancyGrid, got {type(grid).__name__}")
     cells = grid.cells
     return {
         "width": grid.width,

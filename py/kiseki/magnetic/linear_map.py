@@ -103,6 +103,8 @@ def geometric_features(
     a = np.asarray(angles, dtype=np.float64)
     if r.ndim != 2 or a.ndim != 1 or r.shape[1] != a.shape[0]:
         raise ValueError(f"geometric_features: ranges {r.shape} do not match angles {a.shape}")
+    if a.size == 0:  # NaN features, as if the windows had seen no return
+        raise ValueError("geometric_features: the scan has no beams")
     if not np.all(np.isfinite(a)):
         raise ValueError("geometric_features: the beam angles hold NaN or infinity")
     for name, value in (("max_range", max_range), ("window_range", window_range)):

@@ -92,7 +92,7 @@ def moving_average(values: Any, cells: int) -> np.ndarray:
     """Centred moving average over ``cells`` samples along axis 0 (shorter at the ends)."""
     a = np.asarray(values, dtype=np.float64)
     cells = check_count(cells, "moving_average: cells", 1)
-    if cells == 1:
+    if cells == 1 or a.size == 0:  # nothing to average: [] was numpy's "cannot reshape"
         return a.copy()
     a2 = a.reshape(len(a), -1)
     c = np.vstack([np.zeros((1, a2.shape[1])), np.cumsum(a2, axis=0)])

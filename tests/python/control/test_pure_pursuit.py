@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from kiseki.control import PurePursuit
@@ -36,6 +37,16 @@ def test_the_arc_through_the_lookahead_point():
 def test_bad_settings_are_refused(args, message):
     with pytest.raises(ValueError, match=message):
         PurePursuit(ROUTE, *args)
+
+
+def test_waypoints_that_are_not_pairs_are_refused():
+    """Three numbers were numpy's "cannot reshape array of size 3 into shape (2)"."""
+    with pytest.raises(
+        ValueError, match=r"^a route's waypoints are \(x, y\) pairs, got 3 numbers$"
+    ):
+        PurePursuit([0.0, 1.0, 2.0], 0.5, 0.6, 0.1, 0.5)
+    flat = PurePursuit([0.0, 0.0, 2.0, 0.0], 0.5, 0.6, 0.1, 0.5)  # pairs given flat: taken
+    np.testing.assert_array_equal(flat.points, [[0.0, 0.0], [2.0, 0.0]])
 
 
 def test_a_nan_pose_is_refused():

@@ -159,6 +159,9 @@ def test_geometric_features_in_a_corridor_of_known_width():
     assert np.isnan(geometric_features(np.full(angles.shape, 30.0), angles, 30.0)).all()
     many = geometric_features(np.stack([ranges, post]), angles, 30.0)
     assert many.shape == (2, 2) and many[1, 0] == pytest.approx(g[0])
+    # a scan of no beam is no scan (it gave NaN features, as if the windows saw nothing)
+    with pytest.raises(ValueError, match=r"^geometric_features: the scan has no beams$"):
+        geometric_features(np.zeros(0), np.zeros(0), 30.0)
 
 
 def test_lookup_nearest_and_interpolated():
