@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstring>
 #include <ctime>
+#include <limits>
 
 #include "kiseki/grid/distance_field.hpp"
 #include "kiseki/grid/local_window.hpp"
@@ -138,17 +139,14 @@ void bind_ray_casting(py::class_<OccupancyGrid>& cls) {
 
 void bind_occupancy_grid(py::module_& m) {
   py::class_<OccupancyGrid> cls(m, "OccupancyGrid");
-  // the sides as 64-bit integers checked here, the fill as an int the constructor checks: 2**31
-  // cells across or a fill of 200 were pybind11's list of signatures
+  // the sides as 64-bit integers, the fill as an int, all checked by the constructor once they
+  // fit its ints: 2**31 cells across or a fill of 200 were pybind11's list of signatures
   cls.def(py::init([](std::int64_t width, std::int64_t height, double resolution,
                       const Pose2& origin, int fill) {
-            constexpr std::int64_t kMaxSide = 1'000'000'000;  // the constructor's 1e9 cells
-            const auto sides = std::to_string(width) + " x " + std::to_string(height);
-            if (width < 1 || height < 1) {
-              throw std::invalid_argument("OccupancyGrid: width and height must be positive, got " + sides);
-            }
-            if (width > kMaxSide || height > kMaxSide) {
-              throw std::invalid_argument("OccupancyGrid: more than 1e9 cells requested (" + sides + ")");
+            constexpr std::int64_t kInt = std::numeric_limits<int>::max();
+            if (std::max(width, height) > kInt || std::min(width, height) < -kInt) {
+              throw std::invalid_argument("OccupancyGrid: more than 1e9 cells requested (" +
+                                          std::to_string(width) + " x " + std::to_string(height) + ")");
             }
             return OccupancyGrid(static_cast<int>(width), static_cast<int>(height), resolution, origin,
                                  fill);
@@ -173,16 +171,13 @@ void bind_occupancy_grid(py::module_& m) {
              py::array_t<int> out({a.shape(0), py::ssize_t{2}});
              auto* o = out.mutable_data();
              for (py::ssize_t i = 0; i < a.shape(0); ++i) {
-               const Eigen::Vector2d at = g.world_to_grid({a.data()[2 * i], a.data()[2 * i + 1]});
-               if (std::abs(at.x()) >= 1e9 || std::abs(at.y()) >= 1e9) {  // was clamped to 1e9
-                 throw std::invalid_argument("points: row " + std::to_string(i) +
-                                             " lies 1e9 cells or more from the map's origin");
-               }
                const CellIndex c = g.world_to_cell({a.data()[2 * i], a.data()[2 * i + 1]});
                o[2 * i] = c.x, o[2 * i + 1] = c.y;
              }
              return out;
-           }, "points"_a, "Cells (n, 2) containing world points (n, 2); may lie outside.")
+           }, "points"_a,
+           "Cells (n, 2) containing world points (n, 2); may lie outside (an index beyond 1e9 "
+           "cells is clamped there, outside any map).")
       .def("cell_to_world",
            [](const OccupancyGrid& g, const py::handle& cells) {
              const auto a = as_doubles(cells, "cells");
