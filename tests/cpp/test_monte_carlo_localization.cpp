@@ -202,7 +202,7 @@ TEST(MonteCarloLocalization, WeightsCanBeSetAndBadInputIsRefused) {
   MclParams bad;
   bad.particles = 0;
   EXPECT_THROW(MonteCarloLocalization(bad, 1), std::invalid_argument);
-  // KLD's err and z are checked without kld too: parameters that hold a NaN are refused
+  // KLD's err, z and bins are checked without kld too: parameters that hold a NaN are refused
   MclParams unused_kld;
   unused_kld.kld_params.err = NAN;
   EXPECT_THROW(unused_kld.validate(), std::invalid_argument);
@@ -210,6 +210,10 @@ TEST(MonteCarloLocalization, WeightsCanBeSetAndBadInputIsRefused) {
   unused_kld.kld_params.z = 10.5;
   EXPECT_THROW(unused_kld.validate(), std::invalid_argument);
   unused_kld.kld_params.z = 10.0;
+  unused_kld.kld_params.bin_xy = NAN;
+  EXPECT_THROW(unused_kld.validate(), std::invalid_argument);
+  unused_kld.kld_params.bin_xy = 0.5;
+  unused_kld.kld_params.min_particles = 5000;  // above particles: used only with kld
   EXPECT_NO_THROW(unused_kld.validate());
 }
 

@@ -7,13 +7,15 @@
 
 namespace kiseki {
 
-void check_kld_err_z(double err, double z) {
+namespace {
+// err: the KL bound epsilon (nav2's pf_err 0.01-0.05; above 1 any cloud passes); z: the upper
+// standard normal quantile (nav2's pf_z 0.99; 10 is 1 - 1e-23)
+void check_err_z(double err, double z) {
   if (!(err > 0.0 && err <= 1.0) || !(z >= 0.0 && z <= 10.0)) {
     throw std::invalid_argument("KLD sampling: err must lie in (0, 1] and z in [0, 10]");
   }
 }
 
-namespace {
 // Fox's eq. 14 for err and z already checked.
 std::size_t sample_bound(std::size_t bins, double err, double z) {
   if (bins <= 1) return 0;
@@ -25,14 +27,14 @@ std::size_t sample_bound(std::size_t bins, double err, double z) {
 }  // namespace
 
 std::size_t kld_sample_bound(std::size_t bins, double err, double z) {
-  check_kld_err_z(err, z);
+  check_err_z(err, z);
   return sample_bound(bins, err, z);
 }
 
-KldBins::KldBins(const KldParams& params) : params_(params) { check_kld_err_z(params.err, params.z); }
+KldBins::KldBins(const KldParams& params) : params_(params) { check_err_z(params.err, params.z); }
 
 void KldParams::validate() const {
-  check_kld_err_z(err, z);
+  check_err_z(err, z);
   if (!(bin_xy > 0.0) || !(bin_theta > 0.0) || !(bin_distance > 0.0) || !std::isfinite(bin_xy + bin_theta + bin_distance)) {
     throw std::invalid_argument("KLD sampling: bin sizes must be finite and > 0");
   }

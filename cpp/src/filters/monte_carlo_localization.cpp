@@ -24,13 +24,13 @@ Recovery recovery_from_name(const std::string& name) {
 
 void MclParams::validate() const {
   if (particles < 1 || particles > 10'000'000) throw std::invalid_argument("MCL: particles must be in 1..10,000,000");
-  check_kld_err_z(kld_params.err, kld_params.z);  // also without kld: a config holds no NaN
-  if (kld) {
-    KldParams k = kld_params;
-    k.max_particles = particles;
-    if (k.min_particles > particles) throw std::invalid_argument("MCL: KLD min_particles exceeds particles (the maximum)");
-    k.validate();
-  }
+  // KLD's err, z and bins are checked with kld off too (a NaN err was held unused); the counts
+  // only with it on
+  KldParams k = kld_params;
+  k.max_particles = particles;
+  if (!kld) k.min_particles = 1;
+  if (k.min_particles > particles) throw std::invalid_argument("MCL: KLD min_particles exceeds particles (the maximum)");
+  k.validate();
   motion.validate();
   // a share of n (1: every update); above it the same as 1
   if (!(resample_threshold >= 0.0 && resample_threshold <= 1.0)) {

@@ -22,10 +22,6 @@ namespace kiseki {
 /// itself (nav2's pf_z, default 0.99) and err is pf_err (default 0.05). k <= 1 gives 0.
 std::size_t kld_sample_bound(std::size_t bins, double err, double z);
 
-/// err in (0, 1] (nav2's pf_err 0.01-0.05; above 1 any cloud passes) and z in [0, 10] (nav2's
-/// pf_z 0.99; 10 is 1 - 1e-23); std::invalid_argument otherwise.
-void check_kld_err_z(double err, double z);
-
 /// Parameters of KLD sampling: the bound and the bin sizes of the histogram over the state.
 struct KldParams {
   double err = 0.05;  ///< nav2's pf_err
