@@ -112,11 +112,9 @@ class LaserParams:
 
     @property
     def angles(self) -> np.ndarray:
-        """The beam angles (rad), a read-only view: computed once per beam count and field of
-        view (while among the 64 last used), shared by every scan."""
-        view = _beam_angles(self.beams, self.field_of_view_deg).view()
-        view.setflags(write=False)  # and cannot be made writeable: its base is read-only
-        return view
+        """The beam angles (rad), read-only: computed once per beam count and field of view
+        (while among the 64 last used), shared by every scan."""
+        return _beam_angles(self.beams, self.field_of_view_deg)
 
 
 @functools.lru_cache(maxsize=64)
@@ -124,8 +122,8 @@ def _beam_angles(beams: int, field_of_view_deg: float) -> np.ndarray:
     # kept here, not on the frozen params (whose __dict__ holds its fields alone), by value: a
     # params object and its equal copies share one array
     angles = beam_angles(beams, math.radians(field_of_view_deg))
-    angles.setflags(write=False)
-    return angles
+    # over immutable bytes: read-only for good (an array that owns its data can be unlocked)
+    return np.frombuffer(angles.tobytes(), dtype=angles.dtype)
 
 
 LASER_PRESETS = {
