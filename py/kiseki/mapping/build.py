@@ -7,6 +7,7 @@ from logs by the thesis' merge rules is `kiseki.teach.environment_map.build_teac
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -63,10 +64,16 @@ def check_map_size(width_m: float, height_m: float, resolution: float) -> tuple[
 
 
 def _real(values, name: str) -> np.ndarray:
-    """``values`` as an array of real numbers (bool, integer or float); complex ones lost their
-    imaginary part in the float32 cast, strings and objects were parsed or failed in numpy."""
+    """``values`` as an array of real numbers (integers or floats; Python's None, in a list, is
+    a NaN: no reading); complex ones lost their imaginary part in the float32 cast, strings
+    were parsed ("1_0" as 10), booleans read as 0 and 1 m."""
     array = np.asarray(values)
-    if array.dtype.kind not in "biuf":
+    if array.dtype.kind == "O" and all(
+        v is None or (isinstance(v, numbers.Real) and not isinstance(v, bool | np.bool_))
+        for v in array.flat
+    ):
+        array = array.astype(np.float64)  # None -> NaN
+    if array.dtype.kind not in "iuf":
         raise ValueError(f"{name}: expected real numbers, got dtype {array.dtype}")
     return array
 
@@ -207,11 +214,8 @@ def scan_local_builder(
     angles = _real(angles, "local map: angles")
     # a copy: the caller's scan stays as it was
     ranges = np.array(_real(ranges, "local map: ranges"), dtype=np.float32)
-    if angles.ndim != 1 or ranges.shape != angles.shape or angles.size == 0:
-        raise ValueError(
-            "local map: angles and ranges must be one scan's (beams,) each, beams >= 1, got "
-            f"shapes {angles.shape} and {ranges.shape}"
-        )
+    if angles.size == 0:  # their shapes are the binding's to check
+        raise ValueError("local map: the scan has no beams")
     if not np.isfinite(angles).all():  # a NaN angle's beam was left out without a word
         raise ValueError("local map: angles: contains NaN or infinite values")
     ranges[ranges >= max_range] = np.nan
