@@ -17,7 +17,7 @@ from kiseki._support.options import Count, Degrees, Metres, Seed
 from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki.coop import START, plan, simulate
 from kiseki.coop.planner import plan_moves
-from kiseki.coop.positioning import FORM1_READINGS
+from kiseki.coop.positioning import FORM1_READINGS, MAX_MOVES
 from kiseki.coop.render import render_run
 
 __all__ = ["app"]
@@ -37,11 +37,11 @@ def coop_simulate(
         parser=Count("--form", 1, 2),
         help="Movement form: 1 (pair and scout, the default) or 2 (leapfrog).",
     ),
-    # kiseki.coop.plan's limits: up to 1000 moves, angles of 5..85 deg (the triangles of the
+    # kiseki.coop.plan's limits: up to MAX_MOVES moves, angles of 5..85 deg (the triangles of the
     # formation degenerate beyond); an angle SD of 10 deg or more leaves nothing to triangulate
     moves: int | None = typer.Option(
         None,
-        parser=Count("--moves", 1, 1000),
+        parser=Count("--moves", 1, MAX_MOVES),
         help="Moves to the goal (form 1: odd; default 15).",
     ),
     angle: float | None = typer.Option(

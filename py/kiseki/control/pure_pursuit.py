@@ -54,8 +54,9 @@ class PurePursuit:
         self, waypoints, speed: float, lookahead: float, tolerance: float, max_accel: float
     ) -> None:
         pts = np.asarray(waypoints, dtype=float)
-        if pts.size % 2:  # three numbers were numpy's "cannot reshape array of size 3"
-            raise ValueError(f"a route's waypoints are (x, y) pairs, got {pts.size} numbers")
+        # three numbers were numpy's "cannot reshape"; (n, 3) poses were read as pairs
+        if pts.size % 2 or (pts.ndim >= 2 and pts.shape[-1] != 2):
+            raise ValueError(f"a route's waypoints are (x, y) pairs, got shape {pts.shape}")
         pts = pts.reshape(-1, 2)
         if len(pts) < 2 or not np.isfinite(pts).all():
             raise ValueError("a route needs at least two finite waypoints")

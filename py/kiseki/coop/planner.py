@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from kiseki.coop.positioning import ANGLE_SIGMA, GOAL, START, Move, Plan
+from kiseki.coop.positioning import ANGLE_SIGMA, GOAL, MAX_MOVES, START, Move, Plan
 from kiseki.coop.triangulation import MIN_INTERSECTION_ANGLE
 
 
@@ -142,9 +142,9 @@ def plan_moves(
         raise ValueError("start must be 3 finite (x, y) rows and goal a finite (x, y)")
     if not (math.isfinite(angle_sigma) and 0 < angle_sigma < math.radians(10)):
         raise ValueError(f"angle_sigma must lie in (0, 10 deg), got {angle_sigma}")
-    if not (spacing > 0 and reach > spacing and half_width > 0 and 1 <= max_moves <= 1000):
+    if not (spacing > 0 and reach > spacing and half_width > 0 and 1 <= max_moves <= MAX_MOVES):
         raise ValueError(
-            "need spacing > 0, reach > spacing, half_width > 0 and 1 <= max_moves <= 1000"
+            f"need spacing > 0, reach > spacing, half_width > 0 and 1 <= max_moves <= {MAX_MOVES}"
         )
     at, g = start.copy(), np.zeros((6, 0))
     steps: list[Move] = []

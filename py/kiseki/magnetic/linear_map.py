@@ -275,7 +275,7 @@ def build_linear_map(
     span = np.floor(s.max() / spacing + 0.5) - np.floor(s.min() / spacing + 0.5)
     if not span < MAX_NODES:
         raise ValueError(
-            f"linear magnetic map: {span + 1:.6g} nodes is over the limit of {MAX_NODES:,}"
+            f"linear magnetic map: {span + 1:.10g} nodes is over the limit of {MAX_NODES:,}"
         )
     idx = np.floor(s / spacing + 0.5).astype(np.int64)
     k0 = int(idx.min())

@@ -40,11 +40,13 @@ def test_bad_settings_are_refused(args, message):
 
 
 def test_waypoints_that_are_not_pairs_are_refused():
-    """Three numbers were numpy's "cannot reshape array of size 3 into shape (2)"."""
-    with pytest.raises(
-        ValueError, match=r"^a route's waypoints are \(x, y\) pairs, got 3 numbers$"
-    ):
-        PurePursuit([0.0, 1.0, 2.0], 0.5, 0.6, 0.1, 0.5)
+    """Three numbers were numpy's "cannot reshape array of size 3 into shape (2)", and (2, 3)
+    poses were read as three pairs of numbers."""
+    for bad, shape in (([0.0, 1.0, 2.0], r"\(3,\)"), (np.zeros((2, 3)), r"\(2, 3\)")):
+        with pytest.raises(
+            ValueError, match=rf"^a route's waypoints are \(x, y\) pairs, got shape {shape}$"
+        ):
+            PurePursuit(bad, 0.5, 0.6, 0.1, 0.5)
     flat = PurePursuit([0.0, 0.0, 2.0, 0.0], 0.5, 0.6, 0.1, 0.5)  # pairs given flat: taken
     np.testing.assert_array_equal(flat.points, [[0.0, 0.0], [2.0, 0.0]])
 

@@ -251,13 +251,16 @@ def test_experiment_trial_records_the_goal_likelihood_profile():
         ({"max_duration": -1.0}, "max_duration must be in [dt, 86,400] s"),
         ({"max_duration": 86_400.5}, "max_duration must be in [dt, 86,400] s"),
         ({"dt": 0.2, "max_duration": 0.1}, "max_duration must be in [dt, 86,400] s"),
+        ({"initial_sd": (math.nan, 0.05, 0.01)}, "initial_sd must be 3 numbers in [0, 1e+09]"),
+        ({"alphas": (math.nan, 0.002, 0.0005, 0.0005)}, "motion model: alphas must lie in"),
     ],
 )
 def test_a_playback_that_could_not_run_as_asked_is_refused_by_its_config(fields, message):
     """Taken before: an infinite goal_tolerance "reached" the goal before the first step, an
     infinite dt or a negative max_duration made no step at all, a NaN one a ValueError about
     converting NaN to an integer after the robot was built, 86,400.5 s more than a simulated run
-    may last (kiseki.sim.run's day), a negative speed was refused only by the route follower."""
+    may last (kiseki.sim.run's day), a negative speed was refused only by the route follower, a
+    NaN initial spread or alpha only once the run started."""
     with pytest.raises(ValueError) as caught:
         PlaybackConfig(**fields)
     assert str(caught.value).startswith(message)

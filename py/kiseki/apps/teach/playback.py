@@ -30,6 +30,7 @@ from kiseki._support.options import BEAM_LIMIT, PARTICLE_LIMIT
 from kiseki.control import PurePursuit, SpeedLimit, SpeedLimitSource
 from kiseki.core import derive_seed
 from kiseki.filters import MclConfig, MonteCarloLocalizer
+from kiseki.filters.initial_pose import check_spread
 from kiseki.grid import OccupancyGrid
 from kiseki.sim.run import MAX_SIM_SECONDS
 from kiseki.sim.scene import Scene
@@ -92,6 +93,8 @@ class PlaybackConfig:
                 f"model must be one of {', '.join(PLAYBACK_MODELS)}, got {self.model!r}"
             )
         check_count(self.scan_beams, "scan_beams", 1, BEAM_LIMIT)
+        check_spread("initial_sd", self.initial_sd)  # a NaN was refused once the run started
+        MclConfig(particles=self.particles, alphas=tuple(self.alphas))  # and an alpha
         if not 0.1 <= self.scan_range_scale <= 10.0:
             raise ValueError(f"scan_range_scale must lie in [0.1, 10], got {self.scan_range_scale}")
 
