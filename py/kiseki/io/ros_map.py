@@ -152,6 +152,8 @@ def _check_image_header(path: Path, image: Path) -> None:
         size = os.fstat(f.fileno()).st_size
         if head.startswith(_PNG):
             if head[12:16] == b"IHDR":
+                if len(head) < 24:  # struct.error ("unpack requires a buffer of 8 bytes")
+                    raise refused(_PNG_CUT)
                 _check_cells(path, image, *struct.unpack(">II", head[16:24]))
             if not _png_is_whole(f, size):
                 raise refused(_PNG_CUT)
