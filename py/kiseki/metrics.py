@@ -20,6 +20,7 @@ import numpy as np
 
 from kiseki._support.counts import check_count
 from kiseki._support.moved import moved_names
+from kiseki._support.real_arrays import real_array
 
 __all__ = [
     "ErrorStatistics",
@@ -73,7 +74,7 @@ class ErrorStatistics:
 
 def as_se3(poses: np.ndarray) -> np.ndarray:
     """(n, 3) planar poses or (n, 4, 4) matrices -> (n, 4, 4) matrices (checked, finite)."""
-    p = np.asarray(poses, dtype=float)
+    p = np.asarray(real_array(poses, "poses"), dtype=float)  # complex lost its imaginary part
     if p.ndim == 2 and p.shape[1] == 3:
         out = np.tile(np.eye(4), (len(p), 1, 1))
         c, s = np.cos(p[:, 2]), np.sin(p[:, 2])

@@ -9,16 +9,14 @@ from typing import Any
 import numpy as np
 
 from kiseki._support.counts import check_count
+from kiseki._support.real_arrays import real_array
 
 MEANS = ("constant", "zero")
 
 
 def inputs_array(x: Any, name: str = "X") -> np.ndarray:
     """(n, d) float64, C-contiguous; a 1-D array is n points of one coordinate."""
-    try:
-        a = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as e:
-        raise ValueError(f"{name}: expected numbers, got {type(x).__name__} ({e})") from None
+    a = np.asarray(real_array(x, name), dtype=np.float64)  # complex lost its imaginary part
     if a.ndim == 1:
         a = a[:, None]
     if a.ndim != 2 or a.shape[1] < 1:
@@ -28,10 +26,7 @@ def inputs_array(x: Any, name: str = "X") -> np.ndarray:
 
 def targets_array(y: Any, n: int, name: str = "Y") -> tuple[np.ndarray, bool]:
     """(n, k) float64 and whether the caller gave a 1-D array (one field component)."""
-    try:
-        a = np.asarray(y, dtype=np.float64)
-    except (TypeError, ValueError) as e:
-        raise ValueError(f"{name}: expected numbers, got {type(y).__name__} ({e})") from None
+    a = np.asarray(real_array(y, name), dtype=np.float64)
     flat = a.ndim == 1
     if flat:
         a = a[:, None]

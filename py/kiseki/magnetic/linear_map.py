@@ -38,6 +38,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from kiseki._support.real_arrays import real_array
+
 __all__ = [
     "MAX_NODES",
     "NODE_SPACING",
@@ -188,10 +190,7 @@ class LinearMagneticMap:
 
 
 def _array(value: Any, name: str, shape: tuple, allow_nan: bool = False) -> np.ndarray:
-    try:
-        a = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"linear magnetic map: {name} must be numbers") from None
+    a = np.asarray(real_array(value, f"linear magnetic map: {name}"), dtype=np.float64)
     pairs = zip(a.shape, shape, strict=False)
     if a.ndim != len(shape) or any(e is not None and e != n for n, e in pairs):
         want = tuple("n" if e is None else e for e in shape)

@@ -7,7 +7,6 @@ from logs by the thesis' merge rules is `kiseki.teach.environment_map.build_teac
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -15,6 +14,7 @@ from tqdm import tqdm
 
 from kiseki import _core
 from kiseki._support.counts import check_count
+from kiseki._support.real_arrays import real_array
 from kiseki._support.schema import MAGNITUDE_LIMIT, parse
 from kiseki.grid import OccupancyGrid
 from kiseki.io.map_schema import MapBuildSettings
@@ -61,21 +61,6 @@ def check_map_size(width_m: float, height_m: float, resolution: float) -> tuple[
             f"{width_m:.3g} x {height_m:.3g} m: more than the limit of {MAX_MAP_CELLS:.0e} cells"
         )
     return width, height
-
-
-def _real(values, name: str) -> np.ndarray:
-    """``values`` as an array of real numbers (integers or floats; Python's None, in a list, is
-    a NaN: no reading); complex ones lost their imaginary part in the float32 cast, strings
-    were parsed ("1_0" as 10), booleans read as 0 and 1 m."""
-    array = np.asarray(values)
-    if array.dtype.kind == "O" and all(
-        v is None or (isinstance(v, numbers.Real) and not isinstance(v, bool | np.bool_))
-        for v in array.flat
-    ):
-        array = array.astype(np.float64)  # None -> NaN
-    if array.dtype.kind not in "iuf":
-        raise ValueError(f"{name}: expected real numbers, got dtype {array.dtype}")
-    return array
 
 
 def check_map_poses(poses: np.ndarray) -> np.ndarray:
@@ -171,10 +156,10 @@ def build_map(
     chunk = check_count(chunk, "chunk", 1, note="scans per pass")
     params = config.core_params(max_range)
     poses = check_map_poses(poses)
-    ranges = np.ascontiguousarray(_real(ranges, "ranges"), dtype=np.float32)
+    ranges = np.ascontiguousarray(real_array(ranges, "ranges"), dtype=np.float32)
     if ranges.ndim != 2 or ranges.shape[1] == 0:  # no beam built a map of unknown cells
         raise ValueError(f"ranges: expected (scans, beams), beams >= 1, got shape {ranges.shape}")
-    angles = _real(angles, "angles")
+    angles = real_array(angles, "angles")
     negative = np.flatnonzero((ranges < 0).any(axis=tuple(range(1, ranges.ndim))))
     if negative.size:
         first = negative[0]
@@ -211,9 +196,9 @@ def scan_local_builder(
     beam. Readings that are NaN, zero or negative are no reading and add nothing. Its `build()`
     is L, its `hits()` the cells a beam ended in."""
     max_range = check_max_range("local map", max_range)
-    angles = _real(angles, "local map: angles")
+    angles = real_array(angles, "local map: angles")
     # a copy: the caller's scan stays as it was
-    ranges = np.array(_real(ranges, "local map: ranges"), dtype=np.float32)
+    ranges = np.array(real_array(ranges, "local map: ranges"), dtype=np.float32)
     if angles.size == 0:  # their shapes are the binding's to check
         raise ValueError("local map: the scan has no beams")
     if not np.isfinite(angles).all():  # a NaN angle's beam was left out without a word

@@ -238,7 +238,7 @@ def test_restarts_stop_once_a_start_ends_at_an_earlier_optimum(data):
         (np.arange(20.0).reshape(10, 2), np.zeros(9), "10 points but Y has 9 rows"),
         (np.arange(20.0).reshape(10, 2), np.r_[np.zeros(9), np.nan], "target row 9 is NaN"),
         (np.r_[np.arange(18.0), np.nan, 1].reshape(10, 2), np.zeros(10), "input point 9 is NaN"),
-        ([["a", "b"]], [1.0], "expected numbers"),
+        ([["a", "b"]], [1.0], "X: expected real numbers, got dtype <U1"),
     ],
 )
 def test_bad_input_is_refused(x, y, message):
