@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
 """The bounded-reads tests' means (tests/python/core/test_bounded_reads*.py): readers called in
-a child process with an address space limit (RLIMIT_AS), a SIGALRM per case and a timeout for
-the whole, each case's time and peak memory printed; files of zeros that decompress past a
-limit; the kiseki command in such a child."""
+a child process with an address space limit (RLIMIT_AS), a limit on each case's CPU time and
+on its wall-clock time and a timeout for the whole, each case's time and peak memory printed;
+files of zeros that decompress past a limit; the kiseki command in such a child."""
 
 from __future__ import annotations
 
@@ -18,8 +18,12 @@ from pathlib import Path
 from kiseki._support.inputs import GIB, MIB
 
 MEMORY_LIMIT = 3 * GIB  # the children's address space
-CASE_SECONDS = 5  # SIGALRM per case: a blocking open or an endless read is a failure
-CHILD_SECONDS = 60  # the whole child; a reader stuck in C (no SIGALRM) ends here
+# Per case: an endless read is caught by its CPU time (SIGPROF), which other processes on the
+# machine do not stretch (a wall-clock limit of 5 s tripped under a loaded machine's load); a
+# read that blocks (no CPU) by the wall-clock alarm (SIGALRM).
+CASE_CPU_SECONDS = 5
+CASE_WALL_SECONDS = 30
+CHILD_SECONDS = 120  # the whole child; a reader stuck in C (no signal handled) ends here
 ZEROS = 64 * MIB
 
 CHILD = r"""
@@ -28,9 +32,10 @@ limit = int(sys.argv[1])
 resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 
 def alarm(signum, frame):
-    raise TimeoutError("no answer within the case's seconds")
+    raise TimeoutError("no answer within the case's CPU or wall-clock seconds")
 
 signal.signal(signal.SIGALRM, alarm)
+signal.signal(signal.SIGPROF, alarm)
 
 def peak_mb():
     with open("/proc/self/status") as f:
@@ -50,8 +55,9 @@ for case in json.loads(sys.argv[2]):
     module, attr = target(case["call"])
     with open("/proc/self/clear_refs", "w") as f:
         f.write("5")  # the peak resident size starts again from here
-    start = time.monotonic()
-    signal.alarm(int(sys.argv[3]))
+    start, cpu_start = time.monotonic(), time.process_time()
+    signal.setitimer(signal.ITIMER_PROF, float(sys.argv[3]))
+    signal.alarm(int(sys.argv[4]))
     try:
         getattr(module, attr)(*case["args"])
         error, message = None, ""
@@ -59,21 +65,24 @@ for case in json.loads(sys.argv[2]):
         error, message = type(exc).__name__, (str(exc).splitlines() or [""])[0]
     finally:
         signal.alarm(0)
-    seconds = time.monotonic() - start
+        signal.setitimer(signal.ITIMER_PROF, 0)
+    seconds, cpu_seconds = time.monotonic() - start, time.process_time() - cpu_start
     for name, value in saved.items():
         module, attr = target(name)
         setattr(module, attr, value)
     result = {"id": case["id"], "error": error, "message": message, "seconds": seconds,
-              "peak_mb": peak_mb()}
+              "cpu_seconds": cpu_seconds, "peak_mb": peak_mb()}
     print(json.dumps(result), flush=True)
 """
 
 
 def run_cases(cases: list[dict], cwd: Path) -> dict[str, dict]:
-    """Runs the reader calls of ``cases`` in one child (RLIMIT_AS, SIGALRM per case, a timeout
-    for the whole); returns each case's outcome by id and prints the measurements."""
+    """Runs the reader calls of ``cases`` in one child (RLIMIT_AS, a CPU-time and a wall-clock
+    limit per case, a timeout for the whole); returns each case's outcome by id and prints the
+    measurements."""
+    limits = [str(CASE_CPU_SECONDS), str(CASE_WALL_SECONDS)]
     proc = subprocess.run(
-        [sys.executable, "-c", CHILD, str(MEMORY_LIMIT), json.dumps(cases), str(CASE_SECONDS)],
+        [sys.executable, "-c", CHILD, str(MEMORY_LIMIT), json.dumps(cases), *limits],
         capture_output=True,
         text=True,
         timeout=CHILD_SECONDS,

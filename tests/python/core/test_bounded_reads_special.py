@@ -117,7 +117,7 @@ def test_devices_and_fifos_are_refused_by_every_reader_without_being_opened(tmp_
         kind = "a character device" if "zero" in case["id"] else "a FIFO (named pipe)"
         assert result["error"] in ("ValueError", "LogFormatError", "MapFormatError"), result
         assert kind in result["message"] and "not a regular file or folder" in result["message"]
-        assert result["seconds"] < 1.0, result
+        assert result["cpu_seconds"] < 1.0, result  # a blocking open: TimeoutError above
 
 
 def _localize(log, tmp_path: Path, project_data: Path) -> subprocess.Popen:
