@@ -5,8 +5,6 @@ kiseki.sim.magnetic_world, magnetometer, dipoles, magnetic_arm and magnetic_latt
 
 from __future__ import annotations
 
-import math
-import numbers
 from typing import Any
 
 import numpy as np
@@ -30,20 +28,6 @@ def finite_array(value: Any, shape: tuple[int | None, ...], name: str) -> np.nda
     if not np.all(np.isfinite(a)):
         raise ValueError(f"{name}: must be finite, got {value!r}")
     return a
-
-
-def finite_scalar(
-    value: Any, name: str, *, minimum: float | None = None, strict: bool = False
-) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{name}: expected a number, got {value!r}")
-    v = float(value)
-    if not math.isfinite(v):
-        raise ValueError(f"{name}: must be finite, got {value!r}")
-    if minimum is not None and (v <= minimum if strict else v < minimum):
-        rel = ">" if strict else ">="
-        raise ValueError(f"{name}: must be {rel} {minimum}, got {value!r}")
-    return v
 
 
 def points(points: Any, name: str = "points") -> tuple[np.ndarray, bool]:

@@ -15,8 +15,8 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.sim._values import finite_array as _finite_array
-from kiseki.sim._values import finite_scalar as _finite_scalar
 from kiseki.sim._values import points as _points
 
 __all__ = ["DEFAULT_DIPOLE_RADIUS", "MU0_OVER_4PI_GAUSS", "Dipole", "DipoleLine", "dipole_field"]
@@ -86,7 +86,7 @@ class Dipole:
     def __post_init__(self) -> None:
         object.__setattr__(self, "position", _finite_array(self.position, (3,), "position"))
         object.__setattr__(self, "moment", _finite_array(self.moment, (3,), "moment"))
-        r = _finite_scalar(self.radius, "radius", minimum=0.0, strict=True)
+        r = check_number(self.radius, "radius", 0.0, low_open=True, unit="m")
         object.__setattr__(self, "radius", r)
 
     def field_at(self, points: Any) -> np.ndarray:
@@ -120,12 +120,12 @@ class DipoleLine:
         a = _finite_array(self.start, (3,), "start")
         b = _finite_array(self.end, (3,), "end")
         mpm = _finite_array(self.moment_per_metre, (3,), "moment_per_metre")
-        spacing = _finite_scalar(self.spacing, "spacing", minimum=0.0, strict=True)
+        spacing = check_number(self.spacing, "spacing", 0.0, low_open=True, unit="m")
         length = float(np.linalg.norm(b - a))
         if length == 0.0:
             raise ValueError("DipoleLine: start and end coincide (zero length)")
         radius = spacing / 2 if self.radius is None else self.radius
-        radius = _finite_scalar(radius, "radius", minimum=0.0, strict=True)
+        radius = check_number(radius, "radius", 0.0, low_open=True, unit="m")
         n = max(1, round(length / spacing))
         frac = (np.arange(n) + 0.5) / n
         object.__setattr__(self, "start", a)

@@ -41,10 +41,10 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki._support.schema import SchemaError, parse
 from kiseki.core import derive_seed
 from kiseki.sim._values import finite_array as _finite_array
-from kiseki.sim._values import finite_scalar as _finite_scalar
 from kiseki.sim._values import poses as _poses
 from kiseki.sim._values import times as _times
 from kiseki.sim.magnetic import (
@@ -96,9 +96,9 @@ class ArmMagnetometers:
         self_sources: Iterable[Dipole] | None = None,
     ) -> None:
         self.pivot = _finite_array(pivot, (3,), "pivot")
-        self.inner = _finite_scalar(inner, "inner", minimum=0.0, strict=True)
-        self.sensors_apart = _finite_scalar(
-            sensors_apart, "sensors_apart", minimum=0.0, strict=True
+        self.inner = check_number(inner, "inner", 0.0, low_open=True, unit="m")
+        self.sensors_apart = check_number(
+            sensors_apart, "sensors_apart", 0.0, low_open=True, unit="m"
         )
         self.reach = np.array([self.inner, self.inner + self.sensors_apart])
         zmin, zmax = _finite_array(heights, (2,), "heights")
@@ -115,7 +115,7 @@ class ArmMagnetometers:
         self.pitch_range = tuple(
             math.asin(max(-1.0, min(1.0, (z - self.pivot[2]) / far))) for z in self.heights
         )
-        self.period = _finite_scalar(period, "period", minimum=0.0, strict=True)
+        self.period = check_number(period, "period", 0.0, low_open=True, unit="s")
         lo, hi = (math.radians(v) for v in _finite_array(yaw_deg, (2,), "yaw_deg"))
         if hi < lo:
             raise ValueError(f"yaw_deg: expected [lo, hi] with lo <= hi, got {yaw_deg!r}")
@@ -125,9 +125,9 @@ class ArmMagnetometers:
         self.yaw_period = (
             None
             if yaw_period is None
-            else _finite_scalar(yaw_period, "yaw_period", minimum=0.0, strict=True)
+            else check_number(yaw_period, "yaw_period", 0.0, low_open=True, unit="s")
         )
-        self.mount_yaw = _finite_scalar(mount_yaw, "mount_yaw")
+        self.mount_yaw = check_number(mount_yaw, "mount_yaw")
         self.world = world
         self.sensors = tuple(
             ArmMagnetometer(self, k, noise_sd, derive_seed(seed, k), self_sources) for k in range(2)

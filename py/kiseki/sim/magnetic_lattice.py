@@ -23,9 +23,9 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.core import Random, check_seed
 from kiseki.sim._values import finite_array as _finite_array
-from kiseki.sim._values import finite_scalar as _finite_scalar
 from kiseki.sim._values import points as _points
 from kiseki.sim.dipoles import dipole_field
 
@@ -62,14 +62,14 @@ class DipoleLattice:
         hi = _finite_array(self.upper, (3,), "upper")
         if np.any(hi < lo):
             raise ValueError(f"upper: must be >= lower in x, y and z, got {hi} < {lo}")
-        spacing = _finite_scalar(self.spacing, "spacing", minimum=0.0, strict=True)
+        spacing = check_number(self.spacing, "spacing", 0.0, low_open=True, unit="m")
         sd = _finite_array(self.moment_sd, (3,), "moment_sd")
         if np.any(sd < 0):
             raise ValueError(f"moment_sd: must be >= 0, got {sd}")
         mean = _finite_array(self.moment_mean, (3,), "moment_mean")
         seed = check_seed(self.seed, "seed:")
         radius = spacing / 2 if self.radius is None else self.radius
-        radius = _finite_scalar(radius, "radius", minimum=0.0, strict=True)
+        radius = check_number(radius, "radius", 0.0, low_open=True, unit="m")
         extent = hi - lo
         counts = [max(1, round(e / spacing)) if e > 0 else 1 for e in extent]
         total = int(np.prod(counts))

@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki._support.schema import parse
 from kiseki.sim._values import finite_array as _finite_array
-from kiseki.sim._values import finite_scalar as _finite_scalar
 from kiseki.sim._values import points as _points
 from kiseki.sim._values import times as _times
 from kiseki.sim.dipoles import Dipole, DipoleLine, dipole_field
@@ -65,11 +65,9 @@ def earth_field_from_angles(
     ``total`` G; ``inclination_deg`` positive when the field points down (northern
     hemisphere); ``declination_deg`` positive when magnetic north is east of true north.
     """
-    f = _finite_scalar(total, "total", minimum=0.0)
-    inc = math.radians(_finite_scalar(inclination_deg, "inclination_deg"))
-    dec = math.radians(_finite_scalar(declination_deg, "declination_deg"))
-    if abs(inc) > math.pi / 2:
-        raise ValueError(f"inclination_deg: must be within [-90, 90], got {inclination_deg!r}")
+    f = check_number(total, "total", 0.0, unit="G")
+    inc = math.radians(check_number(inclination_deg, "inclination_deg", -90.0, 90.0, unit="deg"))
+    dec = math.radians(check_number(declination_deg, "declination_deg"))
     h = f * math.cos(inc)
     return np.array([h * math.sin(dec), h * math.cos(dec), -f * math.sin(inc)])
 
@@ -137,9 +135,9 @@ class MagneticWorld:
             np.zeros((3, 3)) if gradient is None else _finite_array(gradient, (3, 3), "gradient")
         )
         self.gradient_origin = _finite_array(gradient_origin, (3,), "gradient_origin")
-        self.drift_amplitude = _finite_scalar(drift_amplitude, "drift_amplitude", minimum=0.0)
-        self.drift_period = _finite_scalar(drift_period, "drift_period", minimum=0.0, strict=True)
-        self.drift_phase = _finite_scalar(drift_phase, "drift_phase")
+        self.drift_amplitude = check_number(drift_amplitude, "drift_amplitude", 0.0, unit="G")
+        self.drift_period = check_number(drift_period, "drift_period", 0.0, low_open=True, unit="s")
+        self.drift_phase = check_number(drift_phase, "drift_phase")
         norm = float(np.linalg.norm(self.earth_field))
         self.drift_direction = self.earth_field / norm if norm > 0 else np.array([0.0, 0.0, -1.0])
         spread = (*self.lines, *self.lattices)

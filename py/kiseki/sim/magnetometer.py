@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.core import Random, check_seed, normalize_angle
 from kiseki.sim._values import finite_array as _finite_array
-from kiseki.sim._values import finite_scalar as _finite_scalar
 from kiseki.sim._values import float_array as _float_array
 from kiseki.sim._values import poses as _poses
 from kiseki.sim._values import times as _times
@@ -97,8 +97,8 @@ class Magnetometer:
             raise ValueError(f"world: expected a MagneticWorld, got {type(world).__name__}")
         self.world = world
         self.mount = _finite_array(mount, (3,), "mount")
-        self.yaw = _finite_scalar(yaw, "yaw")
-        self.noise_sd = _finite_scalar(noise_sd, "noise_sd", minimum=0.0)
+        self.yaw = check_number(yaw, "yaw")
+        self.noise_sd = check_number(noise_sd, "noise_sd", 0.0, unit="G")
         self.seed = check_seed(seed)
         self.self_sources: tuple[Dipole, ...] = tuple(
             robot_self_sources() if self_sources is None else self_sources

@@ -311,6 +311,43 @@ def test_constructors_reject_bad_values():
         MagneticWorld().field_at(np.zeros((4, 3)), np.zeros(3))
 
 
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        (
+            lambda: Dipole((0, 0, 0), (0, 0, 1), 0.0),
+            "radius must be a finite number > 0 m, got 0.0",
+        ),
+        (
+            lambda: DipoleLine((0, 0, 0), (1, 0, 0), (0, 0, 1), float("nan")),
+            "spacing must be a finite number > 0 m, got nan",
+        ),
+        (
+            lambda: MagneticWorld(drift_period=0.0),
+            "drift_period must be a finite number > 0 s, got 0.0",
+        ),
+        (
+            lambda: MagneticWorld(drift_amplitude=-1),
+            "drift_amplitude must be a finite number >= 0 G, got -1",
+        ),
+        (lambda: MagneticWorld(drift_phase=True), "drift_phase must be a finite number, got True"),
+        (
+            lambda: earth_field_from_angles(0.4, 95, 0),
+            "inclination_deg must be a finite number in [-90, 90] deg, got 95",
+        ),
+        (
+            lambda: Magnetometer(quiet_world(), noise_sd=-0.01),
+            "noise_sd must be a finite number >= 0 G, got -0.01",
+        ),
+        (lambda: Magnetometer(quiet_world(), yaw="0"), "yaw must be a finite number, got '0'"),
+    ],
+)
+def test_constructors_word_a_bad_number_as_one_rule(make, message):
+    with pytest.raises(ValueError) as e:
+        make()
+    assert str(e.value) == message
+
+
 # ------------------------------------------------------------------------------ magnetometer
 
 
