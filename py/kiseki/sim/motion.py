@@ -3,20 +3,17 @@
 """What one step of a simulated robot is, as its sensors and its odometry see it: the two
 wheels' ground travel (:class:`WheelMotion`, the differential-drive AGV) or the body's motion
 (:class:`BodyMotion`, the omnidirectional robot), and the geometry both robots and their odometry
-share (checked numbers and poses, the exact circular-arc step).
+share (checked poses, the exact circular-arc step).
 
 Units are SI throughout (m, s, rad); poses are ``(x, y, theta)`` in the world frame."""
 
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
-import numpy as np
-
+from kiseki._support.real_numbers import check_number
 from kiseki.core import Pose2, normalize_angle
 
 __all__ = ["BodyMotion", "WheelMotion"]
@@ -40,10 +37,9 @@ class WheelMotion:
 
     def __post_init__(self) -> None:
         for name in ("left", "right"):
-            object.__setattr__(
-                self, name, finite_number(getattr(self, name), f"WheelMotion.{name}")
-            )
-        object.__setattr__(self, "dt", positive_dt(self.dt, "WheelMotion.dt"))
+            object.__setattr__(self, name, check_number(getattr(self, name), f"WheelMotion.{name}"))
+        dt = check_number(self.dt, "WheelMotion.dt", 0.0, low_open=True, unit="s")
+        object.__setattr__(self, "dt", dt)
 
 
 @dataclass(frozen=True)
@@ -64,35 +60,12 @@ class BodyMotion:
     dt: float
 
     def __post_init__(self) -> None:
-        for name in ("dx", "dy", "dtheta", "distance"):
-            object.__setattr__(self, name, finite_number(getattr(self, name), f"BodyMotion.{name}"))
-        if self.distance < 0:
-            raise ValueError(f"BodyMotion.distance must be >= 0, got {self.distance!r}")
-        object.__setattr__(self, "dt", positive_dt(self.dt, "BodyMotion.dt"))
-
-
-def finite_number(value: Any, name: str) -> float:
-    """``value`` as a float: a finite real number (a 0-d array too); a bool or a string is none
-    (True drove at 1 m/s, "1_0" at 10)."""
-    if isinstance(value, bool | np.bool_ | str | bytes):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    if not isinstance(value, numbers.Real):
-        try:
-            number = float(value)
-        except (TypeError, ValueError):
-            raise ValueError(f"{name} must be a finite number, got {value!r}") from None
-    else:
-        number = float(value)
-    if not math.isfinite(number):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return number
-
-
-def positive_dt(value: Any, name: str) -> float:
-    dt = finite_number(value, name)
-    if dt <= 0:
-        raise ValueError(f"{name} must be > 0 s, got {value!r}")
-    return dt
+        for name in ("dx", "dy", "dtheta"):
+            object.__setattr__(self, name, check_number(getattr(self, name), f"BodyMotion.{name}"))
+        distance = check_number(self.distance, "BodyMotion.distance", 0.0, unit="m")
+        object.__setattr__(self, "distance", distance)
+        dt = check_number(self.dt, "BodyMotion.dt", 0.0, low_open=True, unit="s")
+        object.__setattr__(self, "dt", dt)
 
 
 def as_pose(pose: PoseLike, name: str) -> tuple[float, float, float]:
@@ -103,9 +76,9 @@ def as_pose(pose: PoseLike, name: str) -> tuple[float, float, float]:
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a Pose2 or (x, y, theta), got {pose!r}") from None
     return (
-        finite_number(x, f"{name}.x"),
-        finite_number(y, f"{name}.y"),
-        finite_number(theta, f"{name}.theta"),
+        check_number(x, f"{name}.x"),
+        check_number(y, f"{name}.y"),
+        check_number(theta, f"{name}.theta"),
     )
 
 

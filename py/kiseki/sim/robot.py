@@ -31,6 +31,7 @@ from __future__ import annotations
 import math
 
 from kiseki._support.moved import moved_names
+from kiseki._support.real_numbers import check_number
 from kiseki.core import Pose2
 from kiseki.sim.motion import (
     BodyMotion,
@@ -38,8 +39,6 @@ from kiseki.sim.motion import (
     WheelMotion,
     arc_displacement,
     as_pose,
-    finite_number,
-    positive_dt,
     sinc,
     wrap_angle,
 )
@@ -86,7 +85,7 @@ class DiffDriveRobot:
         self.params = params if params is not None else DiffDriveParams()
         self._x, self._y, theta = as_pose(pose, "pose")
         self._theta = wrap_angle(theta)
-        v, w = (finite_number(c, f"velocity[{i}]") for i, c in enumerate(velocity))
+        v, w = (check_number(c, f"velocity[{i}]") for i, c in enumerate(velocity))
         if abs(v) > self.params.max_speed or abs(w) > self.params.max_yaw_rate:
             raise ValueError(
                 f"initial velocity {(v, w)} exceeds max_speed {self.params.max_speed} m/s "
@@ -114,9 +113,9 @@ class DiffDriveRobot:
         Raises:
             ValueError: a NaN or infinite command, or ``dt <= 0``.
         """
-        v_cmd = finite_number(v_cmd, "v_cmd")
-        w_cmd = finite_number(w_cmd, "w_cmd")
-        dt = positive_dt(dt, "dt")
+        v_cmd = check_number(v_cmd, "v_cmd")
+        w_cmd = check_number(w_cmd, "w_cmd")
+        dt = check_number(dt, "dt", 0.0, low_open=True, unit="s")
         p = self.params
         self._v = _limit(v_cmd, self._v, p.max_accel, p.max_speed, dt)
         self._w = _limit(w_cmd, self._w, p.max_yaw_accel, p.max_yaw_rate, dt)
@@ -147,7 +146,7 @@ class OmniRobot:
         self.params = params if params is not None else OmniParams()
         self._x, self._y, theta = as_pose(pose, "pose")
         self._theta = wrap_angle(theta)
-        vx, vy, w = (finite_number(c, f"velocity[{i}]") for i, c in enumerate(velocity))
+        vx, vy, w = (check_number(c, f"velocity[{i}]") for i, c in enumerate(velocity))
         if math.hypot(vx, vy) > self.params.max_speed or abs(w) > self.params.max_yaw_rate:
             raise ValueError(
                 f"initial velocity {(vx, vy, w)} exceeds max_speed {self.params.max_speed} m/s "
@@ -180,10 +179,10 @@ class OmniRobot:
         Raises:
             ValueError: a NaN or infinite command, or ``dt <= 0``.
         """
-        vx_cmd = finite_number(vx_cmd, "vx_cmd")
-        vy_cmd = finite_number(vy_cmd, "vy_cmd")
-        w_cmd = finite_number(w_cmd, "w_cmd")
-        dt = positive_dt(dt, "dt")
+        vx_cmd = check_number(vx_cmd, "vx_cmd")
+        vy_cmd = check_number(vy_cmd, "vy_cmd")
+        w_cmd = check_number(w_cmd, "w_cmd")
+        dt = check_number(dt, "dt", 0.0, low_open=True, unit="s")
         p = self.params
         ax, ay = vx_cmd - self._vx, vy_cmd - self._vy
         change = math.hypot(ax, ay)

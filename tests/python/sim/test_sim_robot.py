@@ -108,8 +108,8 @@ def test_ramp_from_rest_takes_vmax_over_amax():
     [
         ((float("nan"), 0.0, 0.1), "v_cmd must be a finite number"),
         ((0.0, float("inf"), 0.1), "w_cmd must be a finite number"),
-        ((0.1, 0.0, 0.0), "dt must be > 0"),
-        ((0.1, 0.0, -0.1), "dt must be > 0"),
+        ((0.1, 0.0, 0.0), "dt must be a finite number > 0 s, got 0.0"),
+        ((0.1, 0.0, -0.1), "dt must be a finite number > 0 s, got -0.1"),
         ((0.1, 0.0, float("nan")), "dt must be a finite number"),
     ],
 )
@@ -131,7 +131,7 @@ def test_bad_poses_and_velocities_are_rejected():
         OmniRobot(OmniParams(), velocity=(0.4, 0.4, 0.0))
     with pytest.raises(ValueError, match="WheelMotion.left"):
         WheelMotion(float("nan"), 0.0, 0.1)
-    with pytest.raises(ValueError, match="WheelMotion.dt must be > 0"):
+    with pytest.raises(ValueError, match="WheelMotion.dt must be a finite number > 0 s, got -1.0"):
         WheelMotion(0.0, 0.0, -1.0)
     with pytest.raises(ValueError, match="seed must be an integer"):
         WheelOdometry(DiffDriveParams(), NONE, seed=-1)
@@ -213,5 +213,5 @@ def test_omni_rejects_bad_commands():
     robot = OmniRobot()
     with pytest.raises(ValueError, match="vy_cmd must be a finite number"):
         robot.step(0.0, float("nan"), 0.0, 0.1)
-    with pytest.raises(ValueError, match="dt must be > 0"):
+    with pytest.raises(ValueError, match="dt must be a finite number > 0 s, got -0.05"):
         robot.step(0.0, 0.0, 0.0, -0.05)

@@ -6,6 +6,7 @@ held before, answered for one release with a warning."""
 from __future__ import annotations
 
 import importlib
+from decimal import Decimal
 
 import pytest
 
@@ -13,9 +14,10 @@ import kiseki.sim.robot as robot_module
 from kiseki.sim.robot import DiffDriveRobot
 
 
-@pytest.mark.parametrize("bad", [True, "0.5", "1_0"])
+@pytest.mark.parametrize("bad", [True, "0.5", "1_0", Decimal("0.5")])
 def test_a_command_that_is_no_number_is_refused(bad):
-    """True drove at 1 m/s and the text "1_0" at 10 m/s (float() of anything not a number)."""
+    """True drove at 1 m/s and the text "1_0" at 10 m/s (float() of anything not a number); a
+    Decimal is no real number to numbers.Real (nor to the library's one check of a number)."""
     with pytest.raises(ValueError, match="v_cmd must be a finite number"):
         DiffDriveRobot().step(bad, 0.0, 0.1)
 
