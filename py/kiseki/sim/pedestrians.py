@@ -13,10 +13,11 @@ kiseki.sim.run counts them, and a run logs their positions on ``/pedestrians``.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
+
+from kiseki._support.real_numbers import check_number
 
 __all__ = ["PEDESTRIANS_SCHEMA", "DiscStamp", "Pedestrian"]
 
@@ -30,16 +31,10 @@ PEDESTRIANS_SCHEMA = {
 }
 
 
-def _finite(value, what: str, n: int = 1) -> tuple[float, ...]:
-    items = value if n > 1 else [value]
-    if (
-        not isinstance(items, list | tuple)
-        or len(items) != n
-        or not all(isinstance(v, numbers.Real) and not isinstance(v, bool) for v in items)
-        or not all(math.isfinite(v) for v in items)
-    ):
-        raise ValueError(f"{what} must be {n} finite number(s), got {value!r}")
-    return tuple(float(v) for v in items)
+def _pair(value: list, what: str) -> tuple[float, float]:
+    if len(value) != 2:
+        raise ValueError(f"{what} must be 2 finite numbers, got {value!r}")
+    return check_number(value[0], f"{what}[0]"), check_number(value[1], f"{what}[1]")
 
 
 @dataclass(frozen=True)
@@ -56,18 +51,14 @@ class Pedestrian:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise ValueError(f"a pedestrian needs a name, got {self.name!r}")
-        object.__setattr__(self, "start", _finite(list(self.start), "start", 2))
-        object.__setattr__(self, "velocity", _finite(list(self.velocity), "velocity", 2))
-        (radius,) = _finite(self.radius, "radius")
-        (start_time,) = _finite(self.start_time, "start_time")
-        if radius <= 0 or start_time < 0:
-            raise ValueError(f"radius must be > 0 and start_time >= 0, got {radius}, {start_time}")
+        object.__setattr__(self, "start", _pair(list(self.start), "start"))
+        object.__setattr__(self, "velocity", _pair(list(self.velocity), "velocity"))
+        radius = check_number(self.radius, "radius", 0.0, low_open=True, unit="m")
+        start_time = check_number(self.start_time, "start_time", 0.0, unit="s")
         object.__setattr__(self, "radius", radius)
         object.__setattr__(self, "start_time", start_time)
         if self.stop_after is not None:
-            (stop,) = _finite(self.stop_after, "stop_after")
-            if stop < 0:
-                raise ValueError(f"stop_after must be >= 0 m, got {stop}")
+            stop = check_number(self.stop_after, "stop_after", 0.0, unit="m")
             object.__setattr__(self, "stop_after", stop)
 
     def position(self, t: float) -> tuple[float, float]:

@@ -180,3 +180,21 @@ def test_pedestrian_timing_stop_and_validation(tmp_path):
         scene_file(tmp_path, pedestrians=[{"name": "q", "start": [0, 0], "velocity": [1, 0],
                                            "speed": 2}])  # fmt: skip
     assert math.isclose(p.radius, 0.25)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"radius": 0.0}, "radius must be a finite number > 0 m, got 0.0"),
+        ({"start_time": -1.0}, "start_time must be a finite number >= 0 s, got -1.0"),
+        ({"stop_after": float("nan")}, "stop_after must be a finite number >= 0 m, got nan"),
+        ({"radius": True}, "radius must be a finite number > 0 m, got True"),
+        ({"start": (0.0, float("inf"))}, "start[1] must be a finite number, got inf"),
+        ({"velocity": (1.0,)}, "velocity must be 2 finite numbers, got [1.0]"),
+    ],
+)
+def test_a_pedestrian_names_its_bad_number(change, message):
+    p = Pedestrian("p", (1.0, 2.0), (0.6, 0.8))
+    with pytest.raises(ValueError) as e:
+        dataclasses.replace(p, **change)
+    assert str(e.value) == message
