@@ -39,7 +39,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import numbers
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -49,6 +48,7 @@ from scipy.optimize import nnls
 
 from kiseki._support.atomic import atomic_write
 from kiseki._support.inputs import MIB, read_input_text
+from kiseki._support.real_numbers import check_number
 from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki.filters.engine import MonteCarloLocalizer
 from kiseki.filters.localize_config import LocalizeConfig
@@ -87,12 +87,7 @@ class CostModel:
 
     def __post_init__(self) -> None:
         for name in _COEFFICIENTS:
-            value = getattr(self, name)
-            number = isinstance(value, numbers.Real) and not isinstance(value, bool)
-            if not (number and math.isfinite(value) and 0 <= value <= MAGNITUDE_LIMIT):
-                raise ValueError(
-                    f"{name} must be a finite number in [0, {MAGNITUDE_LIMIT:g}] ms, got {value!r}"
-                )
+            check_number(getattr(self, name), name, 0.0, MAGNITUDE_LIMIT, unit="ms")
         if self.per_particle_ms + self.per_beam_ms <= 0:
             raise ValueError("per_particle_ms and per_beam_ms must not both be 0")
 
@@ -159,8 +154,7 @@ def choose_counts(
     share: float,
 ) -> BudgetChoice:
     """The particle and beam counts for a budget, by the module's rule (1-3)."""
-    if not (budget_ms > 0 and math.isfinite(budget_ms)):
-        raise ValueError(f"the budget must be > 0 ms, got {budget_ms}")
+    check_number(budget_ms, "the budget", 0.0, low_open=True, unit="ms")
     if not 1 <= min_particles <= max_particles or beams < 1 or min_beams < 1:
         raise ValueError(
             f"need 1 <= min_particles ({min_particles}) <= max_particles ({max_particles}), "

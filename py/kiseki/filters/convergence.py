@@ -14,13 +14,13 @@ endpoints inside the map to the nearest occupied cell. The same figures for the 
 from __future__ import annotations
 
 import contextlib
-import numbers
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
 from kiseki import _core
 from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 from kiseki.grid import OccupancyGrid
 from kiseki.scans import LaserScans, check_max_range
 
@@ -83,8 +83,7 @@ def spread_radius(poses: np.ndarray, weights: np.ndarray, share: float = 0.9) ->
     if not (np.isfinite(w).all() and (w >= 0).all() and w.sum() > 0):
         # all zero gave NaN with a numpy warning
         raise ValueError("spread_radius: weights must be finite, >= 0 and not all 0")
-    if not (isinstance(share, numbers.Real) and 0 < share <= 1):
-        raise ValueError(f"spread_radius: share must lie in (0, 1], got {share!r}")
+    share = check_number(share, "spread_radius: share", 0.0, 1.0, low_open=True)
     w = w / w.sum()
     centre = w @ poses[:, :2]
     d = np.hypot(poses[:, 0] - centre[0], poses[:, 1] - centre[1])

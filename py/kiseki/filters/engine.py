@@ -29,6 +29,7 @@ from kiseki import _core
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import PARTICLE_LIMIT, THREAD_LIMIT
+from kiseki._support.real_numbers import check_number
 from kiseki._support.schema import INT32_MAX
 from kiseki.core import Pose2, check_seed
 from kiseki.filters.initial_pose import check_particles, check_start
@@ -169,8 +170,7 @@ class MclConfig:
             value = getattr(self, name)
             _check(isinstance(value, bool), f"{name} must be True or False, got {value!r}")
         for name in ("update_min_d", "update_min_a"):
-            value = getattr(self, name)
-            _check(value >= 0 and math.isfinite(value), f"{name} must be >= 0, got {value}")
+            check_number(getattr(self, name), name, 0.0)
         _check(  # a turn is wrapped to at most pi: above it means never on rotation alone
             self.update_min_a <= 2 * math.pi,
             f"update_min_a must be <= 2 pi, got {self.update_min_a}",

@@ -53,6 +53,7 @@ from kiseki._support.atomic import atomic_write
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import BEAM_LIMIT, PARTICLE_LIMIT
+from kiseki._support.real_numbers import check_number
 from kiseki.core import check_seed, derive_seed
 from kiseki.filters.convergence import ConvergenceReport, convergence_report, spread_radius
 from kiseki.filters.engine import (
@@ -164,17 +165,12 @@ class GlobalConfig:
         self.mcl()  # the engine's own checks
         positive = ("sigma_hit", "shrink_radius", "converged_radius", "likelihood_power")
         for name in positive:
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a positive number, got {value}")
+            check_number(getattr(self, name), name, 0.0, low_open=True)
         for name in ("update_min_d", "update_min_a"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be >= 0, got {value}")
+            check_number(getattr(self, name), name, 0.0)
         if self.shrink_after < 1:
             raise ValueError(f"shrink_after must be >= 1, got {self.shrink_after}")
-        if not 0 < self.weight_share <= 1:
-            raise ValueError(f"weight_share must lie in (0, 1], got {self.weight_share}")
+        check_number(self.weight_share, "weight_share", 0.0, 1.0, low_open=True)
 
     def mcl(self) -> MclConfig:
         """The engine's settings: the start's likelihood power, recovery off until the cut."""

@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import BEAM_LIMIT
+from kiseki._support.real_numbers import check_number
 from kiseki.core import check_seed
 from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS, MclConfig
 from kiseki.filters.initial_pose import check_spread
@@ -139,10 +140,9 @@ class LocalizeConfig:
             f"method must be one of {', '.join(LOCALIZATION_METHODS)}, got {self.method!r}",
         )
         check_seed(self.seed)
-        _check(
-            0 <= self.odometry_noise < NOISE_FRACTION_LIMIT,  # the SD as a multiple of each step
-            f"odometry noise must be >= 0 and below {NOISE_FRACTION_LIMIT:g}, "
-            f"got {self.odometry_noise}",
+        # the SD as a multiple of each step
+        check_number(
+            self.odometry_noise, "odometry_noise", 0.0, NOISE_FRACTION_LIMIT, high_open=True
         )
         check_spread("initial_sd", self.initial_sd)  # 1e300 was refused only by the run
         check_count(self.beams, "beams", 0, BEAM_LIMIT, "0 = every beam")
@@ -152,11 +152,9 @@ class LocalizeConfig:
         )
         ray_caster(self.caster)  # ValueError unless it names one
         for name in ("sigma_hit", "lambda_short"):
-            value = getattr(self, name)
-            _check(value > 0 and math.isfinite(value), f"{name} must be > 0, got {value}")
+            check_number(getattr(self, name), name, 0.0, low_open=True)
         for name in ("z_hit", "z_rand", "z_short", "z_max", "z_intrusion"):
-            value = getattr(self, name)
-            _check(value >= 0 and math.isfinite(value), f"{name} must be >= 0, got {value}")
+            check_number(getattr(self, name), name, 0.0)
         _check(self.z_hit + self.z_rand > 0, "z_hit and z_rand must not both be 0")
         _check(
             self.alphas is None or len(self.alphas) in (4, 5),
@@ -196,24 +194,18 @@ class LocalizeConfig:
             not self.beam_skip or self.method == "likelihood-field",
             f"beam skipping applies only to the likelihood field, not to {self.method}",
         )
-        _check(
-            self.beam_skip_distance >= 0 and math.isfinite(self.beam_skip_distance),
-            f"beam_skip_distance must be >= 0, got {self.beam_skip_distance}",
-        )
+        check_number(self.beam_skip_distance, "beam_skip_distance", 0.0)
         for name in ("beam_skip_threshold", "beam_skip_error_threshold"):
-            value = getattr(self, name)
-            _check(0 <= value <= 1, f"{name} must lie in [0, 1], got {value}")
-        _check(
-            self.budget_ms is None or (self.budget_ms > 0 and math.isfinite(self.budget_ms)),
-            f"budget_ms must be > 0 (or None: no budget), got {self.budget_ms}",
-        )
+            check_number(getattr(self, name), name, 0.0, 1.0)
+        if self.budget_ms is not None:
+            check_number(
+                self.budget_ms, "budget_ms", 0.0, low_open=True, unit="(or None: no budget)"
+            )
         _check(
             self.budget_ms is None or self.method in ("likelihood-field", "beam"),
             f"a time budget applies to the likelihood-field and beam models, not to {self.method}",
         )
-        _check(
-            0 < self.budget_share <= 1, f"budget_share must lie in (0, 1], got {self.budget_share}"
-        )
+        check_number(self.budget_share, "budget_share", 0.0, 1.0, low_open=True)
         check_count(self.budget_min_beams, "budget_min_beams", 1, BEAM_LIMIT)
         # the engine's checks, as ValueError, of the alphas given (1e300 was taken here and
         # refused by the run); those derived from odometry_noise stay within them (F < 10)

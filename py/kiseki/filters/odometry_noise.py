@@ -6,11 +6,11 @@ increments with added noise) and the motion noise the filter assumes for it
 
 from __future__ import annotations
 
-import numbers
 from typing import Protocol
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.core import Pose2, Random
 from kiseki.filters.engine import REAL_ODOMETRY_ALPHAS
 from kiseki.scans import LaserScans
@@ -57,14 +57,10 @@ def noisy_odometry(poses: np.ndarray, fraction: float, seed: int) -> np.ndarray:
     """Odometry rebuilt from the increments of `poses` (in each previous pose's frame), each
     component perturbed by zero-mean Gaussian noise with SD = fraction x |component|."""
     poses = np.asarray(poses, dtype=float)
-    if isinstance(fraction, bool) or not (
-        isinstance(fraction, numbers.Real) and 0 <= fraction < NOISE_FRACTION_LIMIT
-    ):
-        # -0.5 or NaN added no noise without a word
-        raise ValueError(
-            f"noisy_odometry: fraction must be a number in [0, {NOISE_FRACTION_LIMIT:g}), "
-            f"got {fraction!r}"
-        )
+    # -0.5 or NaN added no noise without a word
+    fraction = check_number(
+        fraction, "noisy_odometry: fraction", 0.0, NOISE_FRACTION_LIMIT, high_open=True
+    )
     if poses.ndim != 2 or poses.shape[1] != 3 or not np.isfinite(poses).all():
         raise ValueError(
             f"noisy_odometry: poses must be an (n, 3) array of finite numbers, got {poses.shape}"

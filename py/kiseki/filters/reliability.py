@@ -49,6 +49,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
+
 __all__ = [
     "FEATURES",
     "LEARNED_RELIABILITY",
@@ -83,13 +85,14 @@ class ReliabilityModel:
     provenance: str = "unfitted"
 
     def __post_init__(self) -> None:
-        if len(self.coefficients) != 1 + len(FEATURES) or not all(
-            math.isfinite(c) for c in self.coefficients
-        ):
+        if len(self.coefficients) != 1 + len(FEATURES):
             raise ValueError(
                 f"reliability model: need {1 + len(FEATURES)} finite coefficients, "
                 f"got {self.coefficients!r}"
             )
+        names = ("b0", *(f"b_{feature}" for feature in FEATURES))
+        for name, value in zip(names, self.coefficients, strict=True):
+            check_number(value, f"reliability model: {name}")
 
     def probability(self, features: np.ndarray) -> np.ndarray:
         """P(localised) for features (..., 2); NaN where a feature is NaN."""

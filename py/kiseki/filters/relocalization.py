@@ -16,7 +16,6 @@ the same for any thread count; the GIL is released during the search.
 from __future__ import annotations
 
 import math
-import numbers
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,6 +26,7 @@ from kiseki import _core
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import BEAM_LIMIT, THREAD_LIMIT
+from kiseki._support.real_numbers import check_number
 from kiseki.errors import RelocalizationError
 from kiseki.grid import OccupancyGrid
 
@@ -87,15 +87,15 @@ class RelocalizeConfig:
                 getattr(self, name), f"relocalize: {name}", low, high, error=RelocalizationError
             )
         for name in ("sigma_hit", "max_distance"):
-            if not _finite(getattr(self, name)) or getattr(self, name) <= 0:
-                raise RelocalizationError(
-                    f"relocalize: {name} must be a positive number, got {getattr(self, name)!r}"
-                )
+            check_number(
+                getattr(self, name),
+                f"relocalize: {name}",
+                0.0,
+                low_open=True,
+                error=RelocalizationError,
+            )
         for name in ("z_hit", "z_rand", "angular_step", "min_distance", "min_angle"):
-            if not _finite(getattr(self, name)) or getattr(self, name) < 0:
-                raise RelocalizationError(
-                    f"relocalize: {name} must be a number >= 0, got {getattr(self, name)!r}"
-                )
+            check_number(getattr(self, name), f"relocalize: {name}", 0.0, error=RelocalizationError)
         if not isinstance(self.free_only, bool):
             raise RelocalizationError(
                 f"relocalize: free_only must be True or False, got {self.free_only!r}"
@@ -130,10 +130,12 @@ class SearchDisc:
     inside: bool = True
 
     def __post_init__(self) -> None:
-        if not all(_finite(v) for v in (self.x, self.y, self.radius)) or self.radius < 0:
-            raise RelocalizationError(
-                "relocalize: a search disc needs a finite centre and a radius >= 0, got "
-                f"({self.x!r}, {self.y!r}), {self.radius!r}"
+        for name, low in (("x", -math.inf), ("y", -math.inf), ("radius", 0.0)):
+            check_number(
+                getattr(self, name),
+                f"relocalize: the search disc's {name}",
+                low,
+                error=RelocalizationError,
             )
 
 
@@ -153,14 +155,15 @@ class Relocalizer:
             raise RelocalizationError(
                 f"relocalize: map must be an OccupancyGrid, got {type(grid).__name__}"
             )
-        if not _finite(max_range) or max_range <= 0:
+        check_number(
+            max_range, "relocalize: max_range", 0.0, low_open=True, error=RelocalizationError
+        )
+        if len(sensor) != 3:
             raise RelocalizationError(
-                f"relocalize: max_range must be a positive number, got {max_range!r}"
+                f"relocalize: sensor must be three numbers (x, y, theta), got {sensor!r}"
             )
-        if len(sensor) != 3 or not all(_finite(v) for v in sensor):
-            raise RelocalizationError(
-                f"relocalize: sensor must be three finite numbers, got {sensor!r}"
-            )
+        for axis, value in zip(("x", "y", "theta"), sensor, strict=True):
+            check_number(value, f"relocalize: sensor {axis}", error=RelocalizationError)
         self.config = config
         self._grid, self._max_range = grid, float(max_range)
         self._sensor = _core.Pose2(*(float(v) for v in sensor))
@@ -330,11 +333,3 @@ def render_hypotheses(
         ax.legend(loc="upper right", fontsize=8)
     ax.set_title(title or "relocalization hypotheses")
     return save_figure(fig, path)
-
-
-def _finite(value: object) -> bool:
-    return (
-        isinstance(value, numbers.Real)
-        and not isinstance(value, bool)
-        and math.isfinite(float(value))
-    )

@@ -28,8 +28,11 @@ def test_spread_radius_is_the_smallest_radius_holding_the_share():
     for bad in (np.zeros(200), np.full(200, np.nan), -weights):
         with pytest.raises(ValueError, match="spread_radius: weights must be finite"):
             spread_radius(poses, bad)
-    with pytest.raises(ValueError, match="share must lie in"):
-        spread_radius(poses, weights, 1.5)
+    for bad in (1.5, 0.0, math.nan, True):  # True was taken as the share 1
+        with pytest.raises(
+            ValueError, match=r"^spread_radius: share must be a finite number in \(0, 1\], got "
+        ):
+            spread_radius(poses, weights, bad)
 
 
 def test_noisy_odometry_without_noise_is_the_path_and_bad_fractions_are_refused():
@@ -38,7 +41,10 @@ def test_noisy_odometry_without_noise_is_the_path_and_bad_fractions_are_refused(
     np.testing.assert_allclose(noisy_odometry(path, 0.0, 1), path, atol=1e-12)
     assert not np.allclose(noisy_odometry(path, 0.1, 1), path)
     for bad in (-0.5, math.nan, True, 10.0):
-        with pytest.raises(ValueError, match="noisy_odometry: fraction must be a number"):
+        with pytest.raises(
+            ValueError,
+            match=r"^noisy_odometry: fraction must be a finite number in \[0, 10\), got ",
+        ):
             noisy_odometry(path, bad, 1)
 
 

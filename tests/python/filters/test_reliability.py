@@ -100,5 +100,10 @@ def test_the_default_reliability_is_still_the_engines_and_bad_names_are_refused(
         LocalizeConfig(reliability="confidence")
     with pytest.raises(ValueError, match="need 3 finite coefficients"):
         ReliabilityModel((1.0, 2.0))
+    for bad in (np.nan, True):  # True was taken as the coefficient 1
+        with pytest.raises(
+            ValueError, match="^reliability model: b_agreement must be a finite number, got "
+        ):
+            ReliabilityModel((1.0, bad, 2.0))
     assert "seeds 101-130" in LEARNED_RELIABILITY.provenance
     assert dataclasses.is_dataclass(LEARNED_RELIABILITY)

@@ -89,9 +89,9 @@ def test_bad_input_is_one_line_naming_the_problem():
     grid, angles, ranges = random_case(0)
     with pytest.raises(RelocalizationError, match="hypotheses must be an integer"):
         RelocalizeConfig(hypotheses=0)
-    with pytest.raises(RelocalizationError, match="sigma_hit must be a positive"):
+    with pytest.raises(RelocalizationError, match="sigma_hit must be a finite number > 0"):
         RelocalizeConfig(sigma_hit=float("nan"))
-    with pytest.raises(RelocalizationError, match="max_range must be a positive"):
+    with pytest.raises(RelocalizationError, match="max_range must be a finite number > 0"):
         relocalize(grid, angles, ranges, 0.0)
     with pytest.raises(RelocalizationError, match="angles and ranges"):
         relocalize(grid, angles, ranges[:-1], MAX_RANGE)
@@ -100,7 +100,9 @@ def test_bad_input_is_one_line_naming_the_problem():
     with pytest.raises(RelocalizationError, match="map must be an OccupancyGrid"):
         relocalize(np.zeros((5, 5)), angles, ranges, MAX_RANGE)
     assert relocalize(grid, angles, np.full(len(angles), np.inf, np.float32), MAX_RANGE) == []
-    with pytest.raises(RelocalizationError, match="radius >= 0"):
+    with pytest.raises(
+        RelocalizationError, match="search disc's radius must be a finite number >= 0"
+    ):
         SearchDisc(0.0, 0.0, -1.0)
     with pytest.raises(RelocalizationError, match="disc must be a SearchDisc"):
         Relocalizer(grid, MAX_RANGE).match(angles, ranges, (0.0, 0.0, 1.0))
