@@ -40,7 +40,6 @@ One map kind serves chapters 3-5 this way, and the nodes need positions (the map
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -50,6 +49,7 @@ from kiseki import _core
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import BEAM_LIMIT, PARTICLE_LIMIT
+from kiseki._support.real_numbers import check_number
 from kiseki.core import Pose2, check_seed, derive_seed
 from kiseki.filters import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
 from kiseki.filters.initial_pose import check_spread
@@ -67,14 +67,6 @@ __all__ = [
 
 SIGMA_THETA = math.radians(1.0)
 """rad: sigma_theta of eq. 5.6 (the thesis prints "sigma_theta^2 = 1 deg"; read as 1 deg)."""
-
-
-def _number(value: Any, name: str, low: float, high: float = math.inf) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"lidar MCL: {name} must be a number, got {value!r}")
-    if not (math.isfinite(value) and low <= value <= high):
-        raise ValueError(f"lidar MCL: {name} must be in [{low}, {high}], got {value}")
-    return float(value)
 
 
 @dataclass(frozen=True)
@@ -99,12 +91,12 @@ class LidarMclConfig:
         check_field_types(self)
         check_count(self.particles, "lidar MCL: particles", 1, PARTICLE_LIMIT)
         check_count(self.beams, "lidar MCL: beams", 1, BEAM_LIMIT)
-        _number(self.sigma_d, "sigma_d", 1e-6)
-        _number(self.sigma_theta, "sigma_theta", 0.0, math.pi)
-        _number(self.r_z_gate, "r_z_gate", 0.0, 1.0)
-        _number(self.r_theta_gate, "r_theta_gate", 0.0, 1.0)
-        _number(self.reach, "reach", 0.0)
-        _number(self.resample_threshold, "resample_threshold", 0.0, 1.0)
+        check_number(self.sigma_d, "lidar MCL: sigma_d", 1e-6, unit="m")
+        check_number(self.sigma_theta, "lidar MCL: sigma_theta", 0.0, math.pi, unit="rad")
+        check_number(self.r_z_gate, "lidar MCL: r_z_gate", 0.0, 1.0)
+        check_number(self.r_theta_gate, "lidar MCL: r_theta_gate", 0.0, 1.0)
+        check_number(self.reach, "lidar MCL: reach", 0.0, unit="m")
+        check_number(self.resample_threshold, "lidar MCL: resample_threshold", 0.0, 1.0)
         if not isinstance(self.magnetic, bool):
             raise ValueError(f"lidar MCL: magnetic must be true or false, got {self.magnetic!r}")
         check_seed(self.seed)
@@ -137,7 +129,7 @@ class PathHeadingMap:
                 "positions in the map frame); some are NaN"
             )
         self.map = linear_map
-        self.reach = _number(reach, "reach", 0.0)
+        self.reach = check_number(reach, "lidar MCL: reach", 0.0, unit="m")
 
     def nearest(self, xy: Any) -> int | None:
         """The index of the node nearest ``xy`` (2,), or None beyond ``reach``."""
@@ -229,7 +221,7 @@ class MagneticLidarMcl:
     def reset_headings(self, theta: float) -> None:
         """Eq. 5.6: every particle's heading becomes theta + N(0, sigma_theta^2); positions
         and weights are kept."""
-        theta = _number(theta, "theta", -math.inf)
+        theta = check_number(theta, "lidar MCL: theta")
         engine = self.localizer.engine
         poses = engine.poses.copy()
         noise = self.rng.normal(0.0, self.config.sigma_theta, len(poses))
@@ -254,7 +246,7 @@ class MagneticLidarMcl:
             raise ValueError("lidar MCL: scan must be (angles, ranges, max_range)")
         angles = np.asarray(scan[0], dtype=np.float64)
         ranges = np.asarray(scan[1], dtype=np.float32)
-        max_range = _number(scan[2], "max_range", 1e-6)
+        max_range = check_number(scan[2], "lidar MCL: max_range", 1e-6, unit="m")
         if angles.ndim != 1 or angles.shape != ranges.shape or not np.isfinite(angles).all():
             raise ValueError("lidar MCL: the scan's angles and ranges must be 1-D of one length")
         m = None if reading is None else _reading(reading)

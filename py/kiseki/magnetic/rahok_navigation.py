@@ -38,13 +38,13 @@ Methods take readings and travel distances; nothing here knows the simulator.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 
 __all__ = [
     "CHECK_AFTER",
@@ -66,14 +66,6 @@ CHECK_AFTER = 3.0
 """m past a taught peak at which the window is compared (sec. 3.3.3)."""
 S_THRESHOLD = 0.01
 """G: m_t of eq. 3.1 (sec. 3.3.2)."""
-
-
-def _number(value: Any, name: str, positive: bool = True) -> float:
-    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
-    if not ok or not math.isfinite(value) or (positive and value <= 0):
-        need = "a finite number > 0" if positive else "a finite number"
-        raise ValueError(f"{name} must be {need}, got {value!r}")
-    return float(value)
 
 
 def _finite(value: Any, name: str, ndim: int) -> np.ndarray:
@@ -123,8 +115,10 @@ def taught_peaks(
     mz = _finite(mz, "taught_peaks: mz", 1)
     if s.shape != mz.shape:
         raise ValueError(f"taught_peaks: s {s.shape} and mz {mz.shape} differ in length")
-    threshold = _number(threshold, "taught_peaks: threshold")
-    min_separation = _number(min_separation, "taught_peaks: min_separation")
+    threshold = check_number(threshold, "taught_peaks: threshold", 0.0, low_open=True)
+    min_separation = check_number(
+        min_separation, "taught_peaks: min_separation", 0.0, low_open=True
+    )
     reference = float(np.median(mz))
     dev = np.abs(mz - reference)
     peaks: list[TaughtPeak] = []
@@ -153,10 +147,12 @@ class PeakCorrection:
     ) -> None:
         if not isinstance(peaks, list | tuple) or not all(isinstance(p, TaughtPeak) for p in peaks):
             raise ValueError("PeakCorrection: peaks must be a list of TaughtPeak")
-        self.spacing = _number(spacing, "PeakCorrection: spacing")
-        self.window = _number(window, "PeakCorrection: window")
-        self.check_after = _number(check_after, "PeakCorrection: check_after")
-        self.tolerance = _number(tolerance, "PeakCorrection: tolerance")
+        self.spacing = check_number(spacing, "PeakCorrection: spacing", 0.0, low_open=True)
+        self.window = check_number(window, "PeakCorrection: window", 0.0, low_open=True)
+        self.check_after = check_number(
+            check_after, "PeakCorrection: check_after", 0.0, low_open=True
+        )
+        self.tolerance = check_number(tolerance, "PeakCorrection: tolerance", 0.0, low_open=True)
         if self.check_after >= self.window:
             raise ValueError(
                 f"PeakCorrection: check_after ({check_after} m) must be shorter than the window"
@@ -171,8 +167,8 @@ class PeakCorrection:
         return math.floor(d / self.spacing + 0.5)
 
     def update(self, d: float, mz: float) -> float:
-        d = _number(d, "PeakCorrection.update: d", positive=False)
-        mz = _number(mz, "PeakCorrection.update: mz", positive=False)
+        d = check_number(d, "PeakCorrection.update: d")
+        mz = check_number(mz, "PeakCorrection.update: mz")
         c = self._cell(d)
         entry = self._cells.setdefault(c, [0.0, 0])
         entry[0] += mz
@@ -215,7 +211,7 @@ def identification_vector(
             f"identification_vector: center {c.shape}, left {lm.shape} and right {rm.shape}"
             " must all be (n, 3)"
         )
-    t = _number(threshold, "identification_vector: threshold")
+    t = check_number(threshold, "identification_vector: threshold", 0.0, low_open=True)
     s = np.zeros(c.shape, dtype=np.int8)
     s[(lm - t > c) & (c > rm + t)] = 1
     s[(lm + t < c) & (c < rm - t)] = -1
@@ -238,11 +234,11 @@ def weight_vector(
     mt = _finite(m_theta, "weight_vector: m_theta", 1)
     if sv.shape != (len(mt), 3):
         raise ValueError(f"weight_vector: s {sv.shape} must be (n, 3) with n = {len(mt)}")
-    spacing = _number(spacing, "weight_vector: spacing")
-    field_gain = _number(field_gain, "weight_vector: field_gain")
-    theta_gain = _number(theta_gain, "weight_vector: theta_gain")
-    spread0 = _number(spread0, "weight_vector: spread0")
-    reach = _number(reach, "weight_vector: reach")
+    spacing = check_number(spacing, "weight_vector: spacing", 0.0, low_open=True)
+    field_gain = check_number(field_gain, "weight_vector: field_gain", 0.0, low_open=True)
+    theta_gain = check_number(theta_gain, "weight_vector: theta_gain", 0.0, low_open=True)
+    spread0 = check_number(spread0, "weight_vector: spread0", 0.0, low_open=True)
+    reach = check_number(reach, "weight_vector: reach", 0.0, low_open=True)
     cells = max(1, int(round(reach / spacing)))
     unit = moving_average(np.column_stack([np.cos(mt), np.sin(mt)]), cells)
     smooth = np.unwrap(np.arctan2(unit[:, 1], unit[:, 0]))
@@ -268,8 +264,8 @@ def deviation_vector(
             f"deviation_vector: node field {mi.shape}, reading {mt.shape} and s {si.shape} must"
             f" be (3,), w {wi.shape} (4,)"
         )
-    d_theta = _number(node_theta, "deviation_vector: node theta", positive=False) - _number(
-        theta, "deviation_vector: theta", positive=False
+    d_theta = check_number(node_theta, "deviation_vector: node theta") - check_number(
+        theta, "deviation_vector: theta"
     )
     d_theta = math.atan2(math.sin(d_theta), math.cos(d_theta))
     return np.concatenate([si * wi[:3] * (mi - mt), [wi[3] * d_theta]])
@@ -303,7 +299,7 @@ class RahokNavigator:
             )
         average = check_count(average, "RahokNavigator: average", 1)
         self.lmap, self.steering, self.peaks = lmap, steering, peaks
-        self.speed = _number(speed, "RahokNavigator: speed")
+        self.speed = check_number(speed, "RahokNavigator: speed", 0.0, low_open=True)
         self.average = average
         self.d = float(lmap.s[0])
         self.done = False
@@ -312,7 +308,7 @@ class RahokNavigator:
     def step(self, travelled: float, reading: Any | None, dt: float) -> tuple[float, float]:
         """(v, w) for the step after odometry moved ``travelled`` m; ``reading`` (3,) G, or
         None when the magnetometer gave nothing new."""
-        self.d += _number(travelled, "RahokNavigator.step: travelled", positive=False)
+        self.d += check_number(travelled, "RahokNavigator.step: travelled")
         if reading is not None:
             m = _finite(reading, "RahokNavigator.step: reading", 1)
             if m.shape != (3,):

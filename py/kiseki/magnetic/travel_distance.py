@@ -52,6 +52,7 @@ from kiseki import _core
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import PARTICLE_LIMIT
+from kiseki._support.real_numbers import check_number
 from kiseki.core import check_seed
 from kiseki.magnetic.linear_map import LinearMagneticMap
 
@@ -82,16 +83,6 @@ DM_THETA_MAX = math.pi
 """rad: dm_theta,max of eq. 4.13 ("= pi rad")."""
 
 
-def _number(value: Any, name: str, low: float, *, strict: bool) -> None:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ValueError(f"travel distance: {name} must be a number, got {value!r}")
-    ok = value > low if strict else value >= low
-    if not (math.isfinite(value) and ok):
-        raise ValueError(
-            f"travel distance: {name} must be {'>' if strict else '>='} {low}, got {value}"
-        )
-
-
 @dataclass(frozen=True)
 class TravelDistanceConfig:
     """The filter's settings (sec. 4.4.1; see the module text)."""
@@ -107,16 +98,11 @@ class TravelDistanceConfig:
     def __post_init__(self) -> None:
         check_field_types(self)
         check_count(self.particles, "travel distance: particles", 1, PARTICLE_LIMIT)
-        _number(self.gain, "gain a", 0.0, strict=True)
-        _number(self.window, "window l", 0.0, strict=True)
-        _number(self.odometry_noise, "odometry_noise", 0.0, strict=False)
-        _number(self.initial_sd, "initial_sd", 0.0, strict=False)
-        _number(self.resample_threshold, "resample_threshold", 0.0, strict=False)
-        if self.resample_threshold > 1.0:
-            raise ValueError(
-                "travel distance: resample_threshold must be in [0, 1], got "
-                f"{self.resample_threshold}"
-            )
+        check_number(self.gain, "travel distance: gain a", 0.0, low_open=True)
+        check_number(self.window, "travel distance: window l", 0.0, low_open=True, unit="m")
+        check_number(self.odometry_noise, "travel distance: odometry_noise", 0.0)
+        check_number(self.initial_sd, "travel distance: initial_sd", 0.0, unit="m")
+        check_number(self.resample_threshold, "travel distance: resample_threshold", 0.0, 1.0)
         check_seed(self.seed, "travel distance: seed")
 
 
@@ -182,7 +168,7 @@ class TravelDistanceLocalizer:
         self.config = TravelDistanceConfig() if config is None else config
         if not isinstance(self.config, TravelDistanceConfig):
             raise ValueError("travel distance: config must be a TravelDistanceConfig")
-        _number(start, "start", -math.inf, strict=True)
+        start = check_number(start, "travel distance: start", unit="m")
         self._s, self._mz, self._spacing = _map_profile(linear_map)
         params = _core.TravelDistanceParams()
         params.particles = self.config.particles
@@ -245,8 +231,8 @@ class TravelDistanceLocalizer:
     def step(self, distance: float, mz: float) -> float:
         """One reading: the odometry's travel since the last reading (m) and mz (G). Returns
         the estimate of eq. 4.10."""
-        _number(distance, "the odometry increment", -math.inf, strict=True)
-        _number(mz, "the mz reading", -math.inf, strict=True)
+        distance = check_number(distance, "travel distance: the odometry increment", unit="m")
+        mz = check_number(mz, "travel distance: the mz reading", unit="G")
         sd = self.config.odometry_noise * math.sqrt(abs(distance))
         self._filter.predict(float(distance), sd)  # eq. 4.6 plus the spread
         self._odometry += float(distance)
@@ -327,8 +313,10 @@ def azimuth_heading(
         "r_z_gate",
         "r_theta_gate",
     )
-    for name, value in zip(names, values, strict=True):
-        _number(value, name, -math.inf, strict=True)
+    theta, m_theta, m_z, node_heading, node_m_theta, node_m_z, r_z_gate, r_theta_gate = (
+        check_number(value, f"travel distance: {name}")
+        for name, value in zip(names, values, strict=True)
+    )
     r_z = 1.0 - abs(node_m_z - m_z) / DM_Z_MAX
     r_theta = 1.0 - abs(_wrap(node_m_theta - m_theta)) / DM_THETA_MAX
     if r_z >= r_z_gate and r_theta >= r_theta_gate:
@@ -346,7 +334,7 @@ def heading_from_map(
     estimate, "after the travel distance is estimated, the robot is at node n"), for a reading
     (mx, my, mz) G in the sensor frame (x forward, y right, z down)."""
     _map_profile(linear_map)
-    _number(d, "d", -math.inf, strict=True)
+    d = check_number(d, "travel distance: d", unit="m")
     m = _stream(reading, "the reading")
     if m.shape != (3,):
         raise ValueError(f"travel distance: the reading must be (mx, my, mz), got {m.shape}")

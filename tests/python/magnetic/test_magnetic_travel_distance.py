@@ -170,10 +170,11 @@ def test_heading_from_map_uses_the_nearest_node():
     [
         ({"particles": 0}, "particles must be an integer in 1..10,000,000, got 0"),
         ({"particles": 2.5}, "particles must be an integer"),
-        ({"window": -1.0}, "window l must be > 0"),
-        ({"gain": float("nan")}, "gain a must be > 0"),
-        ({"odometry_noise": -0.1}, "odometry_noise must be >= 0"),
-        ({"resample_threshold": 1.5}, "resample_threshold must be in"),
+        ({"window": -1.0}, r"^travel distance: window l must be a finite number > 0 m, got -1\.0$"),
+        ({"gain": float("nan")}, r"^travel distance: gain a must be a finite number > 0, got nan$"),
+        ({"odometry_noise": -0.1}, r"odometry_noise must be a finite number >= 0, got -0\.1$"),
+        ({"initial_sd": float("inf")}, r"initial_sd must be a finite number >= 0 m, got inf$"),
+        ({"resample_threshold": 1.5}, r"resample_threshold must be a finite number in \[0, 1\]"),
         ({"seed": -1}, r"seed must be an integer in \[0, 2\*\*64\), got -1"),
     ],
 )
@@ -197,8 +198,23 @@ def test_bad_input():
     ):
         TravelDistanceLocalizer(m, TravelDistanceConfig(window=1e6))
     loc = TravelDistanceLocalizer(m, TravelDistanceConfig(particles=10))
-    with pytest.raises(ValueError, match="mz reading"):
+    with pytest.raises(
+        ValueError, match=r"^travel distance: the mz reading must be a finite number G, got nan$"
+    ):
         loc.step(0.1, float("nan"))
+    with pytest.raises(
+        ValueError,
+        match=r"^travel distance: the odometry increment must be a finite number m, got '0\.1'$",
+    ):
+        loc.step("0.1", 0.4)
+    with pytest.raises(
+        ValueError, match=r"^travel distance: d must be a finite number m, got nan$"
+    ):
+        heading_from_map(m, float("nan"), 0.0, [0.1, 0.2, 0.3])
+    with pytest.raises(
+        ValueError, match=r"^travel distance: node_m_z must be a finite number, got inf$"
+    ):
+        azimuth_heading(0.0, 0.0, 0.4, 0.0, 0.0, float("inf"))
     with pytest.raises(ValueError, match=r"mz readings\[2\] is NaN"):
         loc.run([0.1, 0.1, 0.1], [0.4, 0.4, float("nan")])
     with pytest.raises(ValueError, match="3 odometry increments but 2 mz"):
