@@ -11,11 +11,11 @@ answers with a too-short length scale. Averaging per cell gives one reading per 
 
 from __future__ import annotations
 
-import math
-import numbers
 from typing import Any
 
 import numpy as np
+
+from kiseki._support.real_numbers import check_number
 
 __all__ = ["bin_readings"]
 
@@ -32,8 +32,7 @@ def bin_readings(
         raise ValueError(
             f"positions (n, d) and field (n, k) must have the same n >= 1, got {x.shape}, {y.shape}"
         )
-    if not (isinstance(size, numbers.Real) and math.isfinite(size) and size > 0):
-        raise ValueError(f"the bin size must be a positive number of metres, got {size!r}")
+    size = check_number(size, "the bin size", 0.0, low_open=True, unit="m")
     if not (np.isfinite(x).all() and np.isfinite(y).all()):
         raise ValueError("positions and field must be finite")
     keys = np.floor(x / size).astype(np.int64)

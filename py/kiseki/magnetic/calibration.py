@@ -20,12 +20,12 @@ Readings are (n, 3) arrays in any one unit; the results are in the same unit.
 
 from __future__ import annotations
 
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares
 
+from kiseki._support.real_numbers import check_number
 from kiseki._support.schema import MAGNITUDE_LIMIT
 
 __all__ = [
@@ -138,11 +138,8 @@ def fit_ellipsoid(readings: np.ndarray, radius: float | None = None) -> Ellipsoi
     geometric mean of the semi-axes (the ellipsoid's volume is kept)."""
     m = _as_readings(readings, 9, "ellipsoid fit")
     _check_spread(m, "ellipsoid fit")
-    if radius is not None and not _positive(radius):
-        raise ValueError(
-            f"ellipsoid fit: radius must be a positive number up to {MAGNITUDE_LIMIT:g}, "
-            f"got {radius!r}"
-        )
+    if radius is not None:
+        check_number(radius, "ellipsoid fit: radius", 0.0, MAGNITUDE_LIMIT, low_open=True)
     mean = m.mean(axis=0)
     scale = np.sqrt(np.mean(np.sum((m - mean) ** 2, axis=1)))
     x, y, z = ((m - mean) / scale).T
@@ -204,11 +201,7 @@ def calibrated_magnitude(
             f"eq. 6.16: m_ref must be 3 finite numbers within +-{MAGNITUDE_LIMIT:g}, got {m_ref!r}"
         )
     for name, value in (("r_ref", r_ref), ("r_base", r_base)):
-        if not _positive(value):
-            raise ValueError(
-                f"eq. 6.16: {name} must be a positive number up to {MAGNITUDE_LIMIT:g}, "
-                f"got {value!r}"
-            )
+        check_number(value, f"eq. 6.16: {name}", 0.0, MAGNITUDE_LIMIT, low_open=True)
     magnitude = np.linalg.norm(m - centre, axis=1) - (r_base - r_ref)
     return float(magnitude[0]) if single else magnitude
 
@@ -237,15 +230,6 @@ def _as_readings(readings: np.ndarray, minimum: int, what: str) -> np.ndarray:
             f"any unit), the first in row {row} (counting from 0): {m[row].tolist()}"
         )
     return m
-
-
-def _positive(value) -> bool:
-    """A number (not a bool) in (0, MAGNITUDE_LIMIT]."""
-    return (
-        isinstance(value, numbers.Real)
-        and not isinstance(value, bool)
-        and 0 < value <= MAGNITUDE_LIMIT
-    )
 
 
 def _check_spread(m: np.ndarray, what: str) -> None:

@@ -23,8 +23,6 @@ in :mod:`kiseki.magnetic.map_gp`; the folder's files in :mod:`kiseki.magnetic.ma
 from __future__ import annotations
 
 import itertools
-import math
-import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +30,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.errors import MapFormatError
 from kiseki.gp import CurlFreeKernel, SquaredExponential
 from kiseki.magnetic.map_cells import MAX_CELLS, cell_span
@@ -158,12 +157,11 @@ class MagneticFieldMap:
         if np.any(self.variance < 0):
             raise ValueError("variance must be >= 0")
         set_(self, "origin", _finite("origin", self.origin, (d,)))
-        r = self.resolution
-        if isinstance(r, bool) or not isinstance(r, numbers.Real) or not r > 0:
-            raise ValueError(f"resolution must be a positive number of metres, got {r!r}")
-        if not math.isfinite(r):
-            raise ValueError(f"resolution must be finite, got {r!r}")
-        set_(self, "resolution", float(r))
+        set_(
+            self,
+            "resolution",
+            check_number(self.resolution, "resolution", 0.0, low_open=True, unit="m"),
+        )
         set_(self, "prior_mean", _finite("prior_mean", self.prior_mean, (3,)))
         set_(self, "prior_variance", _finite("prior_variance", self.prior_variance, (3,)))
         if np.any(self.prior_variance <= 0):
@@ -174,7 +172,7 @@ class MagneticFieldMap:
         if self.height is not None:
             if d == 3:
                 raise ValueError("height is for 2-D maps: a 3-D map has z in its voxels")
-            set_(self, "height", float(_finite("height", self.height, ())))
+            set_(self, "height", check_number(self.height, "height", unit="m"))
         set_(self, "provenance", MappingProxyType(dict(self.provenance)))
         if self.training is not None:
             if not isinstance(self.training, TrainingData):
@@ -291,10 +289,7 @@ class MagneticFieldMap:
         if gd != d and not (d == 2 and gd == 3 and height is not None):
             hint = " (give height for a 2-D slice of a 3-D GP)" if (d, gd) == (2, 3) else ""
             raise ValueError(f"the GP is {gd}-D but the box is {d}-D{hint}")
-        if not (isinstance(resolution, numbers.Real) and math.isfinite(resolution)):
-            raise ValueError(f"resolution must be a positive number of metres, got {resolution!r}")
-        if resolution <= 0:
-            raise ValueError(f"resolution must be a positive number of metres, got {resolution!r}")
+        check_number(resolution, "resolution", 0.0, low_open=True, unit="m")
         first, last, counts = cell_span(lo, hi, resolution)
         if d == 3 and np.any(np.abs(np.concatenate([first, last])) > OCTOMAP_KEY_OFFSET):
             raise ValueError(f"the box {lo}..{hi} lies beyond OctoMap's keys at {resolution} m")

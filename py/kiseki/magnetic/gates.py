@@ -21,11 +21,11 @@ noise).
 
 from __future__ import annotations
 
-import math
-import numbers
 from typing import Any
 
 import numpy as np
+
+from kiseki._support.real_numbers import check_number
 
 __all__ = ["GATE_Z", "gate_limits", "reading_noise_sd"]
 
@@ -67,10 +67,7 @@ def gate_limits(noise_sd: float, counts: Any, z: float = GATE_Z) -> np.ndarray:
     """Per node: the largest |m_z,n - m_z,t| the gate passes, ``z sigma sqrt(1 + 1/c_n)``
     (an interpolated node, c = 0, counts as one reading)."""
     for name, value in (("noise_sd", noise_sd), ("z", z)):
-        if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            raise ValueError(f"gates: {name} must be a number, got {value!r}")
-        if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"gates: {name} must be > 0, got {value}")
+        check_number(value, f"gates: {name}", 0.0, low_open=True)
     c = np.maximum(np.asarray(counts, dtype=np.float64), 1.0)
     if c.ndim != 1:
         raise ValueError(f"gates: counts must be (n,), got {c.shape}")

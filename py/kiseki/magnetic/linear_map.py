@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import hashlib
 import math
-import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
@@ -39,6 +38,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from kiseki._support.real_arrays import real_array
+from kiseki._support.real_numbers import check_number
 
 __all__ = [
     "MAX_NODES",
@@ -110,10 +110,10 @@ def geometric_features(
     if not np.all(np.isfinite(a)):
         raise ValueError("geometric_features: the beam angles hold NaN or infinity")
     for name, value in (("max_range", max_range), ("window_range", window_range)):
-        if not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
-            raise ValueError(f"geometric_features: {name} must be a positive number, got {value}")
-    if not (isinstance(window_angle, numbers.Real) and 0 < window_angle <= math.pi):
-        raise ValueError(f"geometric_features: window_angle must be in (0, pi], got {window_angle}")
+        check_number(value, f"geometric_features: {name}", 0.0, low_open=True, unit="m")
+    check_number(
+        window_angle, "geometric_features: window_angle", 0.0, math.pi, low_open=True, unit="rad"
+    )
     wrapped = np.angle(np.exp(1j * a))
     half = window_angle / 2
     with np.errstate(invalid="ignore"):
@@ -233,12 +233,8 @@ def build_linear_map(
     the sensor frame, odometry ``heading`` (n,) rad, optional geometric features ``g`` (n, 2)
     (NaN: no obstacle) and reference ``position`` (n, 2). ``path_id``: 40 hex digits
     (:func:`path_identity`). ValueError names the first bad sample."""
-    if not (isinstance(spacing, numbers.Real) and not isinstance(spacing, bool)):
-        raise ValueError(f"linear magnetic map: spacing must be a number, got {spacing!r}")
-    if not (math.isfinite(spacing) and spacing > 0):
-        raise ValueError(f"linear magnetic map: spacing must be positive, got {spacing} m")
-    if not (isinstance(tolerance, numbers.Real) and math.isfinite(tolerance) and tolerance >= 0):
-        raise ValueError(f"linear magnetic map: tolerance must be >= 0, got {tolerance!r}")
+    spacing = check_number(spacing, "linear magnetic map: spacing", 0.0, low_open=True, unit="m")
+    check_number(tolerance, "linear magnetic map: tolerance", 0.0, unit="m")
     try:  # a float was "'float' object is not subscriptable", (-1, 0) taken
         reach, width = (float(v) for v in window)
     except (TypeError, ValueError):

@@ -11,8 +11,6 @@ The thesis' settings: 1000 particles, resampling when the ESS falls below n/2.
 
 from __future__ import annotations
 
-import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
@@ -22,6 +20,7 @@ from tqdm import tqdm
 
 from kiseki import _core
 from kiseki._support.field_types import check_field_types
+from kiseki._support.real_numbers import check_number
 from kiseki.core import check_seed
 from kiseki.filters import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
 from kiseki.filters.initial_pose import check_spread
@@ -65,8 +64,7 @@ class MagneticMapModel:
             raise ValueError("magnetic-map localization needs a 2-D field map (dimension 2)")
         if frame not in FRAMES:
             raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
-        if not (isinstance(noise_sd, numbers.Real) and math.isfinite(noise_sd) and noise_sd >= 0):
-            raise ValueError(f"noise_sd must be a finite number >= 0, got {noise_sd!r}")
+        noise_sd = check_number(noise_sd, "noise_sd", 0.0)
         self.offsets = sensor_offsets(offsets)
         self.frame = frame
         self.field_map = field_map
@@ -118,8 +116,8 @@ class MagneticMclConfig:
 
     def __post_init__(self) -> None:
         check_field_types(self)
-        if self.noise_sd is not None and not (math.isfinite(self.noise_sd) and self.noise_sd >= 0):
-            raise ValueError(f"noise_sd must be >= 0 or None, got {self.noise_sd!r}")
+        if self.noise_sd is not None:  # None: the map's kernel sigma_n
+            check_number(self.noise_sd, "noise_sd", 0.0)
         check_spread("initial_sd", self.initial_sd)  # 1e300 was refused only by the run
         self.mcl()  # the engine's own checks
 

@@ -35,7 +35,6 @@ them back checked; the map type (:mod:`kiseki.magnetic.field_map`) builds on thi
 from __future__ import annotations
 
 import math
-import numbers
 import os
 import shutil
 import struct
@@ -50,6 +49,7 @@ import yaml
 
 from kiseki._support.atomic import record_written
 from kiseki._support.inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
+from kiseki._support.real_numbers import check_number
 from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki._support.yaml import read_yaml_file, safe_load_12
 from kiseki.errors import MapFormatError
@@ -243,19 +243,13 @@ def _check_picture_scale(meta: Path, name: str, entry: dict) -> None:
     """A layer's scale and offset say how its picture's pixels read as values (value = pixel x
     scale + offset, for other tools; kiseki reads the arrays): finite, within the arrays' bound,
     the scale >= 0, or the folder was edited by hand."""
-    for key in ("scale", "offset"):
-        v = entry.get(key)
-        if (
-            isinstance(v, bool)
-            or not isinstance(v, numbers.Real)
-            or not abs(v) <= 2 * MAGNITUDE_LIMIT
-            or (key == "scale" and v < 0)
-        ):
-            want = "a finite number >= 0" if key == "scale" else "a finite number"
-            raise _fail(
-                meta,
-                f"layer '{name}': {key} must be {want} (value = pixel x scale + offset), got {v!r}",
-            )
+    bound = 2 * MAGNITUDE_LIMIT
+    for key, low in (("scale", 0.0), ("offset", -bound)):
+        what = f"layer '{name}': {key} (value = pixel x scale + offset)"
+        try:
+            check_number(entry.get(key), what, low, bound)
+        except ValueError as err:
+            raise _fail(meta, str(err)) from None
 
 
 def _read_2d(folder: Path, doc: MagneticMapDoc, meta: Path, origin, resolution, shape) -> tuple:

@@ -29,8 +29,10 @@ def test_means_and_counts_equal_a_loop_over_cells():
 
 
 def test_bad_input_is_refused():
-    with pytest.raises(ValueError, match="bin size must be a positive"):
+    with pytest.raises(ValueError, match=r"^the bin size must be a finite number > 0 m, got 0.0$"):
         bin_readings(np.zeros((3, 2)), np.zeros((3, 3)), 0.0)
+    with pytest.raises(ValueError, match=r"^the bin size must be a finite number > 0 m, got True$"):
+        bin_readings(np.zeros((3, 2)), np.zeros((3, 3)), True)  # was taken as 1 m
     with pytest.raises(ValueError, match="same n"):
         bin_readings(np.zeros((3, 2)), np.zeros((2, 3)), 0.1)
     with pytest.raises(ValueError, match="finite"):

@@ -19,6 +19,8 @@ from kiseki.magnetic import (
 
 CENTRE = np.array([12.0, -30.0, 5.0])  # hard-iron offset, uT
 RADIUS = 48.0  # field strength, uT
+# the rule of a radius: positive, up to kiseki's bound on every number of its files
+POSITIVE = r"a finite number in \(0, 1e\+09\]"
 # Symmetric positive-definite soft-iron distortion with off-diagonal terms (a tilted ellipsoid).
 SOFT_IRON = np.array([[1.10, 0.05, -0.02], [0.05, 0.90, 0.03], [-0.02, 0.03, 1.00]])
 
@@ -180,7 +182,7 @@ def test_hyperboloid_refused_by_the_ellipsoid_fit() -> None:
 def test_bad_radius_refused() -> None:
     readings = CENTRE + RADIUS * directions(20, seed=1)
     for radius in (0.0, -1.0, np.nan):
-        with pytest.raises(ValueError, match="radius must be a positive number"):
+        with pytest.raises(ValueError, match=r"^ellipsoid fit: radius must be " + POSITIVE):
             fit_ellipsoid(readings, radius=radius)
 
 
@@ -209,8 +211,8 @@ def test_eq_6_16_through_a_sphere_fit() -> None:
     [
         ([1.0, 2.0], 1.0, 1.0, "m_ref must be 3 finite numbers"),
         ([1.0, np.nan, 2.0], 1.0, 1.0, "m_ref must be 3 finite numbers"),
-        ([0.0, 0.0, 0.0], 0.0, 1.0, "r_ref must be a positive number"),
-        ([0.0, 0.0, 0.0], 1.0, np.inf, "r_base must be a positive number"),
+        ([0.0, 0.0, 0.0], 0.0, 1.0, r"^eq. 6.16: r_ref must be " + POSITIVE + ", got 0.0$"),
+        ([0.0, 0.0, 0.0], 1.0, np.inf, r"^eq. 6.16: r_base must be " + POSITIVE + ", got inf$"),
     ],
 )
 def test_eq_6_16_bad_parameters_refused(m_ref, r_ref, r_base, message: str) -> None:
@@ -262,11 +264,11 @@ def test_readings_beyond_a_billion_are_refused_naming_the_row(fit) -> None:
 def test_offsets_and_radii_that_are_no_numbers_are_refused() -> None:
     readings = CENTRE + RADIUS * directions(20, seed=1)
     for radius in ("48", True, 1e300):
-        with pytest.raises(ValueError, match=r"radius must be a positive number up to 1e\+09"):
+        with pytest.raises(ValueError, match="radius must be " + POSITIVE):
             fit_ellipsoid(readings, radius=radius)
     with pytest.raises(ValueError, match=r"m_ref must be 3 finite numbers within \+-1e\+09"):
         calibrated_magnitude(readings, [1e300, 0.0, 0.0], 1.0, 1.0)
     for bad in ("1", True, 1e300):
-        with pytest.raises(ValueError, match=r"r_base must be a positive number up to 1e\+09"):
+        with pytest.raises(ValueError, match="r_base must be " + POSITIVE):
             calibrated_magnitude(readings, CENTRE, RADIUS, bad)
     assert calibrated_magnitude(readings[0], CENTRE, np.float32(RADIUS), 48) == pytest.approx(48)

@@ -135,6 +135,11 @@ def test_from_gp_evaluates_the_gp_on_octomap_aligned_cells(monkeypatch):
     # 2**32 x 2**32 cells: their int64 product wrapped to 0 and passed the cell limit
     with pytest.raises(ValueError, match="more than 20,000,000"):
         MagneticFieldMap.from_gp(gp2, [0, 0], [2.0**32, 2.0**32], 1.0)
+    for resolution, shown in ((0.0, "0.0"), (np.nan, "nan"), (True, "True")):  # True was 1 m
+        with pytest.raises(
+            ValueError, match=rf"^resolution must be a finite number > 0 m, got {shown}$"
+        ):
+            MagneticFieldMap.from_gp(gp2, [0, 0], [1, 1], resolution)
 
 
 def test_voxel_centres_are_octomap_key_centres():
@@ -187,7 +192,11 @@ def test_bad_maps_are_refused():
         ({"variance": -good.variance}, "variance must be >= 0"),
         ({"variance": good.variance[:, :3]}, "variance must have shape"),
         ({"origin": [0.0, 0.0, 0.0]}, "origin must have shape"),
-        ({"resolution": 0.0}, "resolution"),
+        ({"resolution": 0.0}, r"^resolution must be a finite number > 0 m, got 0.0$"),
+        ({"resolution": np.inf}, r"^resolution must be a finite number > 0 m, got inf$"),
+        ({"height": np.nan}, r"^height must be a finite number m, got nan$"),
+        ({"height": "0.2"}, r"^height must be a finite number m, got '0.2'$"),  # was 0.2 m
+        ({"height": True}, r"^height must be a finite number m, got True$"),  # was 1 m
         ({"mean": good.mean[..., :2]}, "mean must have shape"),
         ({"kernel": "se"}, "kernel"),
         ({"prior_variance": [1.0, 0.0, 1.0]}, "prior_variance"),

@@ -78,7 +78,7 @@ def test_bad_inputs():
         reading_noise_sd(np.zeros(8), np.ones(8))
     with pytest.raises(ValueError, match="counts >= 0"):
         reading_noise_sd(np.zeros(30), -np.ones(30))
-    with pytest.raises(ValueError, match="noise_sd must be > 0"):
+    with pytest.raises(ValueError, match=r"^gates: noise_sd must be a finite number > 0, got 0.0$"):
         gate_limits(0.0, [1, 2])
-    with pytest.raises(ValueError, match="z must be a number"):
+    with pytest.raises(ValueError, match="^gates: z must be a finite number > 0, got '3'$"):
         gate_limits(0.01, [1], z="3")

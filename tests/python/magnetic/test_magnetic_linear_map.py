@@ -164,6 +164,23 @@ def test_geometric_features_in_a_corridor_of_known_width():
         geometric_features(np.zeros(0), np.zeros(0), 30.0)
 
 
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"max_range": 0.0}, r"max_range must be a finite number > 0 m, got 0\.0$"),
+        ({"max_range": True}, r"max_range must be a finite number > 0 m, got True$"),  # was 1 m
+        ({"window_range": np.nan}, r"window_range must be a finite number > 0 m, got nan$"),
+        ({"window_angle": 4.0}, r"window_angle must be a finite number in \(0, 3\.14159\] rad"),
+        ({"window_angle": True}, r"window_angle must be .* rad, got True$"),  # was 1 rad
+    ],
+)
+def test_geometric_features_bad_settings_are_refused(kw, message):
+    angles = np.radians(np.arange(-135.0, 135.01, 15.0))
+    kw = {"max_range": 30.0, **kw}
+    with pytest.raises(ValueError, match="^geometric_features: " + message):
+        geometric_features(np.ones(angles.shape), angles, **kw)
+
+
 def test_lookup_nearest_and_interpolated():
     s = [0.0, 0.1, 0.2]
     readings = [[0.0, 1.0, 0.1], [0.0, 1.0, 0.3], [0.0, 1.0, 0.5]]
@@ -236,8 +253,10 @@ def test_gp_and_linear_map_folders_refuse_each_other(tmp_path):
         ({"s": [], "readings": np.empty((0, 3)), "heading": []}, "no samples"),
         ({"readings": [[0.1, 0.2, 0.3], [0.1, math.nan, 0.3], [0.1, 0.2, 0.3]]}, r"readings\[1\]"),
         ({"heading": [0.0, 0.0, math.inf]}, r"heading\[2\]"),
-        ({"spacing": 0.0}, "spacing must be positive"),
-        ({"spacing": -0.1}, "spacing must be positive"),
+        ({"spacing": 0.0}, r"spacing must be a finite number > 0 m, got 0\.0$"),
+        ({"spacing": -0.1}, r"spacing must be a finite number > 0 m, got -0\.1$"),
+        ({"tolerance": math.nan}, r"tolerance must be a finite number >= 0 m, got nan$"),
+        ({"tolerance": True}, r"tolerance must be a finite number >= 0 m, got True$"),  # was 1 m
         ({"s": [0.0, 0.5, 0.2]}, r"not monotonic: s\[2\]"),
         ({"path_id": "abc"}, "path_id must be 40 hex digits"),
         ({"readings": [[0.1, 0.2, 0.3]] * 2}, r"readings has shape \(2, 3\)"),

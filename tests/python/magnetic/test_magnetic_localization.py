@@ -126,6 +126,16 @@ def test_bad_input_is_refused(field_map):
     offsets = np.array([[0.0, 0.0]])
     with pytest.raises(ValueError, match="frame must be one of"):
         MagneticMapModel(field_map, offsets, 0.01, frame="enu")
+    for bad, shown in ((-0.01, "-0.01"), (np.nan, "nan"), (True, "True")):  # True was 1
+        with pytest.raises(
+            ValueError, match=rf"^noise_sd must be a finite number >= 0, got {shown}$"
+        ):
+            MagneticMapModel(field_map, offsets, bad)
+        if bad is not True:  # the config's field types refuse a bool themselves
+            with pytest.raises(
+                ValueError, match=rf"^noise_sd must be a finite number >= 0, got {shown}$"
+            ):
+                MagneticMclConfig(noise_sd=bad)
     model = MagneticMapModel(field_map, offsets, 0.01)
     with pytest.raises(ValueError, match=r"expected shape \(1, 3\)"):
         model.set_readings(np.zeros((2, 3)))

@@ -18,10 +18,15 @@ from kiseki.magnetic.map_folder import MAP_FILE
 @pytest.mark.parametrize(
     ("key", "value", "match"),
     [
-        ("scale", float("nan"), "scale must be a finite number >= 0 .*, got nan"),
-        ("scale", -0.5, "scale must be a finite number >= 0"),
-        ("offset", 1e300, "offset must be a finite number .*, got 1e\\+300"),
-        ("offset", "low", "offset must be a finite number .*, got 'low'"),
+        ("scale", float("nan"), r"scale .* must be a finite number in \[0, 2e\+09\], got nan$"),
+        ("scale", -0.5, r"scale .* must be a finite number in \[0, 2e\+09\], got -0\.5$"),
+        (
+            "offset",
+            1e300,
+            r"offset .* must be a finite number in \[-2e\+09, 2e\+09\], got 1e\+300$",
+        ),
+        ("offset", "low", r"offset .* must be a finite number in \[-2e\+09, 2e\+09\], got 'low'$"),
+        ("offset", None, r"offset \(value = pixel x scale \+ offset\) must be .*, got None$"),
     ],
 )
 def test_an_edited_picture_scale_is_refused_naming_the_yaml(tmp_path, key, value, match):
