@@ -20,13 +20,13 @@ channel, fitted to a mapping lap's readings (kiseki's loop filter,
 
 from __future__ import annotations
 
-import math
 import numbers
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.gp import ExactGP, SquaredExponential, fit_hyperparameters
 
 __all__ = ["LoopProfile", "fit_loop_profile", "heading_invariant_channels"]
@@ -74,10 +74,7 @@ def fit_loop_profile(
     """The profile of one channel (module text). ``s`` (n,) m in [0, length], ``values`` (n,);
     ``noise_floor``: the least sigma_n (the channel's units) the profile keeps, for a lap whose
     readings carry no noise (a synthetic one): without it the likelihood's width is zero."""
-    if isinstance(length, bool) or not isinstance(length, numbers.Real):
-        raise ValueError(f"loop profile: the loop's length must be a number, got {length!r}")
-    if not (math.isfinite(length) and length > 0):
-        raise ValueError(f"loop profile: the loop's length must be > 0, got {length}")
+    check_number(length, "loop profile: the loop's length", 0.0, low_open=True, unit="m")
     if isinstance(resolution, bool) or not (
         isinstance(resolution, numbers.Real) and length / 100_000 <= resolution <= length / 4
     ):  # the profile's grid: 4 to 100,000 points (1e-9 m asked for 149 GiB)
@@ -88,8 +85,7 @@ def fit_loop_profile(
     v = np.asarray(values, dtype=np.float64)
     if s.ndim != 1 or v.shape != s.shape:
         raise ValueError(f"loop profile: s {s.shape} and values {v.shape} must be (n,) alike")
-    if not (isinstance(noise_floor, numbers.Real) and 0 <= noise_floor < math.inf):
-        raise ValueError(f"loop profile: noise_floor must be a number >= 0, got {noise_floor!r}")
+    check_number(noise_floor, "loop profile: noise_floor", 0.0)
     if len(s) < 4:
         raise ValueError(f"loop profile: {len(s)} readings; at least 4 are needed")
     if len(s) > MAX_READINGS:

@@ -54,6 +54,7 @@ from kiseki import _core
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import PARTICLE_LIMIT
+from kiseki._support.real_numbers import check_number
 from kiseki.core import check_seed
 from kiseki.magnetic.loop_profile import LoopProfile
 
@@ -84,16 +85,9 @@ class LoopTravelConfig:
         check_field_types(self)
         check_count(self.particles, "loop filter: particles", 1, PARTICLE_LIMIT)
         for name in ("odometry_noise", "scale_sd", "scale_walk", "initial_sd"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
-                raise ValueError(f"loop filter: {name} must be a finite number, got {v!r}")
-            if v < 0:
-                raise ValueError(f"loop filter: {name} must be >= 0, got {v}")
-        if self.scale_sd >= 0.5:
-            raise ValueError(f"loop filter: scale_sd must be < 0.5, got {self.scale_sd}")
-        r = self.resample_threshold
-        if isinstance(r, bool) or not isinstance(r, numbers.Real) or not 0 <= r <= 1:
-            raise ValueError(f"loop filter: resample_threshold must be in [0, 1], got {r!r}")
+            check_number(getattr(self, name), f"loop filter: {name}", 0.0)
+        check_number(self.scale_sd, "loop filter: scale_sd", 0.0, 0.5, high_open=True)
+        check_number(self.resample_threshold, "loop filter: resample_threshold", 0.0, 1.0)
         if self.start not in STARTS:
             raise ValueError(f"loop filter: start must be one of {STARTS}, got {self.start!r}")
         if not isinstance(self.reentry, bool):
@@ -148,20 +142,21 @@ class LoopTravelDistanceLocalizer:
         profiles = tuple(profiles)
         if not all(isinstance(p, LoopProfile) for p in profiles):
             raise ValueError("loop filter: profiles must be LoopProfile")
-        lengths = {p.length for p in profiles} | ({float(length)} if length is not None else set())
+        if length is not None:
+            length = check_number(
+                length, "loop filter: the loop's length", 0.0, low_open=True, unit="m"
+            )
+        lengths = {p.length for p in profiles} | ({length} if length is not None else set())
         if len(lengths) != 1:
             raise ValueError(
                 "loop filter: the profiles and the length disagree on the loop's length"
                 if lengths
                 else "loop filter: no profile: the loop's length must be given"
             )
-        loop = lengths.pop()
-        if not (math.isfinite(loop) and loop > 0):
-            raise ValueError(f"loop filter: the loop's length must be > 0, got {loop}")
-        if isinstance(start, bool) or not isinstance(start, numbers.Real):
-            raise ValueError(f"loop filter: start must be a number, got {start!r}")
-        if not math.isfinite(start):
-            raise ValueError(f"loop filter: start must be finite, got {start}")
+        loop = check_number(
+            lengths.pop(), "loop filter: the loop's length", 0.0, low_open=True, unit="m"
+        )
+        check_number(start, "loop filter: start", unit="m")
         self.profiles = profiles
         self.length = loop
         c = self.config
@@ -204,13 +199,10 @@ class LoopTravelDistanceLocalizer:
     def step(self, distance: float, reading: Any) -> float:
         """One reading: the odometry's travel since the last one (m) and one value per channel.
         Returns the estimate in [0, L)."""
-        if isinstance(distance, bool) or not isinstance(distance, numbers.Real):
-            raise ValueError(
-                f"loop filter: the odometry increment must be a number, got {distance!r}"
-            )
+        check_number(distance, "loop filter: the odometry increment", unit="m")
         r = np.asarray(reading, dtype=np.float64)
-        if not (math.isfinite(distance) and np.all(np.isfinite(r))):
-            raise ValueError("loop filter: the increment and the reading must be finite")
+        if not np.all(np.isfinite(r)):
+            raise ValueError("loop filter: the reading must be finite")
         c = self.config
         root = math.sqrt(abs(distance))
         self._filter.predict_scaled(float(distance), c.odometry_noise * root, c.scale_walk * root)

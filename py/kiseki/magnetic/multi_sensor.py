@@ -20,7 +20,6 @@ readings drift away from its map.
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -28,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 from kiseki.core import check_seed
 from kiseki.filters import MonteCarloLocalizer
 from kiseki.magnetic.localization import (
@@ -51,9 +51,7 @@ class DriftCheck:
 
     def __post_init__(self) -> None:
         check_count(self.window, "drift check: window", 2)
-        ok = isinstance(self.limit, numbers.Real) and not isinstance(self.limit, bool)
-        if not (ok and math.isfinite(self.limit) and self.limit > 0):
-            raise ValueError(f"drift check: limit must be a number > 0, got {self.limit!r}")
+        check_number(self.limit, "drift check: limit", 0.0, low_open=True)
 
 
 @dataclass(frozen=True)

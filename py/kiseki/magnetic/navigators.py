@@ -30,13 +30,13 @@ runs) drives whatever its validity.
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
 from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 from kiseki.control.arbitration import PriorityArbiter
 from kiseki.control.pd_steering import PdSteering
 
@@ -63,23 +63,14 @@ G_CHANGE_MAX = 1.0
 """m: |g_n - g_t| above this disables the geometric navigators (sec. 4.3.2)."""
 
 
-def _angle(value: Any, name: str) -> float:
-    ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
-    if not ok or not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return float(value)
-
-
 def _wrap(a: float) -> float:
     return math.atan2(math.sin(a), math.cos(a))
 
 
 def r_z(mz_node: float, mz_now: float, dmz_max: float = DMZ_MAX) -> float:
     """Eq. 4.5: ``1 - |m_z,n - m_z,t| / dm_z,max``."""
-    a, b = _angle(mz_node, "r_z: m_z,n"), _angle(mz_now, "r_z: m_z,t")
-    d = _angle(dmz_max, "r_z: dm_z,max")
-    if d <= 0:
-        raise ValueError(f"r_z: dm_z,max must be > 0, got {dmz_max!r}")
+    a, b = check_number(mz_node, "r_z: m_z,n"), check_number(mz_now, "r_z: m_z,t")
+    d = check_number(dmz_max, "r_z: dm_z,max", 0.0, low_open=True)
     return 1.0 - abs(a - b) / d
 
 
@@ -138,9 +129,7 @@ class MultiNavigator:
                 f"MultiNavigator: navigators must be distinct names among {NAVIGATORS}, got"
                 f" {list(navigators)!r}"
             )
-        self.geometric_gain = _angle(geometric_gain, "MultiNavigator: geometric_gain")
-        if self.geometric_gain < 0:
-            raise ValueError(f"MultiNavigator: geometric_gain must be >= 0, got {geometric_gain}")
+        self.geometric_gain = check_number(geometric_gain, "MultiNavigator: geometric_gain", 0.0)
         self.lmap, self.names, self.alone = lmap, names, len(names) == 1
         self.mz_limits = None
         if mz_limits is not None:
@@ -162,7 +151,7 @@ class MultiNavigator:
         m = np.asarray(reading, dtype=np.float64)
         if m.shape != (3,) or not np.all(np.isfinite(m)):
             raise ValueError(f"MultiNavigator: the reading must be 3 finite numbers, got {reading}")
-        theta_t = _angle(theta_t, "MultiNavigator: theta_t")
+        theta_t = check_number(theta_t, "MultiNavigator: theta_t")
         lm = self.lmap
         e_o = _wrap(float(lm.heading[node]) - theta_t)  # eq. 4.1
         e_m = _wrap(float(lm.m_theta[node]) - math.atan2(m[1], m[0]))  # eq. 4.3

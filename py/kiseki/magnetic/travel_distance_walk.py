@@ -28,12 +28,12 @@ positions from the visual-inertial odometry, the field turned to the world frame
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.core import check_seed
 from kiseki.datasets.magnetic import MagneticSamples
 from kiseki.magnetic.linear_map import LinearMagneticMap, build_linear_map, path_identity
@@ -72,14 +72,9 @@ class WalkOdometry:
 
     def __post_init__(self) -> None:
         for name in ("scale_sd", "noise", "radius", "min_travel", "max_offset", "truth_window"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, numbers.Real):
-                raise ValueError(f"walk: {name} must be a number, got {value!r}")
-            if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"walk: {name} must be a number >= 0, got {value}")
-        e = self.scale_error
-        if e is not None and not (isinstance(e, numbers.Real) and math.isfinite(e) and e > -1):
-            raise ValueError(f"walk: scale_error must be a number > -1, got {e!r}")
+            check_number(getattr(self, name), f"walk: {name}", 0.0)
+        if self.scale_error is not None:
+            check_number(self.scale_error, "walk: scale_error", -1.0, low_open=True)
 
 
 @dataclass(frozen=True)

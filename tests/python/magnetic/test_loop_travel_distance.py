@@ -157,8 +157,14 @@ def test_bad_inputs_are_refused_with_one_line():
     p = table_profile(grid_values, 0.01)
     with pytest.raises(ValueError, match="start must be one of"):
         LoopTravelConfig(start="somewhere")
-    with pytest.raises(ValueError, match="scale_sd must be < 0.5"):
+    with pytest.raises(
+        ValueError, match=r"scale_sd must be a finite number in \[0, 0.5\), got 0.7$"
+    ):
         LoopTravelConfig(scale_sd=0.7)
+    with pytest.raises(ValueError, match=r"scale_walk must be a finite number >= 0, got -0.1$"):
+        LoopTravelConfig(scale_walk=-0.1)
+    with pytest.raises(ValueError, match=r"resample_threshold must be a finite number in \[0, 1\]"):
+        LoopTravelConfig(resample_threshold=math.nan)
     with pytest.raises(ValueError, match="alpha_slow < alpha_fast"):
         LoopTravelConfig(alpha_slow=0.2, alpha_fast=0.1)
     with pytest.raises(ValueError, match="reentry must be True or False"):
@@ -167,15 +173,39 @@ def test_bad_inputs_are_refused_with_one_line():
         LoopTravelDistanceLocalizer([])
     with pytest.raises(ValueError, match="disagree"):
         LoopTravelDistanceLocalizer([p], length=LOOP + 1)
+    for length in (0.0, math.inf, True, str(LOOP)):  # True was a 1 m loop, text parsed
+        with pytest.raises(
+            ValueError, match=r"^loop filter: the loop's length must be a finite number > 0 m, got "
+        ):
+            LoopTravelDistanceLocalizer([], length=length)
+    with pytest.raises(
+        ValueError, match=r"^loop filter: start must be a finite number m, got nan$"
+    ):
+        LoopTravelDistanceLocalizer([p], start=math.nan)
     loc = LoopTravelDistanceLocalizer([p])
     with pytest.raises(ValueError, match="reading for 1 channel"):
         loc.step(0.1, [0.1, 0.2])
-    with pytest.raises(ValueError, match="must be finite"):
+    with pytest.raises(
+        ValueError,
+        match=r"^loop filter: the odometry increment must be a finite number m, got nan$",
+    ):
         loc.step(math.nan, [0.1])
+    with pytest.raises(ValueError, match=r"^loop filter: the reading must be finite$"):
+        loc.step(0.1, [math.inf])
     with pytest.raises(ValueError, match="do not match"):
         loc.run(np.zeros(3), np.zeros((4, 1)))
     with pytest.raises(ValueError, match="at least 4"):
         fit_loop_profile([0.0, 1.0], [0.0, 1.0], LOOP)
+    with pytest.raises(
+        ValueError,
+        match=r"^loop profile: the loop's length must be a finite number > 0 m, got -1.0$",
+    ):
+        fit_loop_profile([0.0, 1.0, 2.0, 3.0], [0.0, 1.0, 2.0, 3.0], -1.0)
+    for floor in (-0.1, math.nan, True):  # True was a floor of 1
+        with pytest.raises(
+            ValueError, match=r"^loop profile: noise_floor must be a finite number >= 0, got "
+        ):
+            fit_loop_profile([0.0, 1.0, 2.0, 3.0], [0.0, 1.0, 2.0, 3.0], LOOP, noise_floor=floor)
     with pytest.raises(ValueError, match=r"s must lie in \[0"):
         fit_loop_profile([0.0, 1.0, 2.0, 40.0], [0.0, 1.0, 2.0, 3.0], LOOP)
     # a 1e-9 m grid asked for 149 GiB

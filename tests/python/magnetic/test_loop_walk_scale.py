@@ -63,3 +63,18 @@ def test_a_walk_takes_a_numpy_seed_as_its_python_twin(mapped, tmp_path):
     for call in (lambda: localize_walk_loop(walk_map, -1), lambda: localize_walk(walk, -1)):
         with pytest.raises(ValueError, match=r"^walk: seed must be an integer in \[0, 2\*\*64\)"):
             call()
+
+
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"noise": -0.1}, r"^walk: noise must be a finite number >= 0, got -0\.1$"),
+        ({"radius": float("nan")}, r"^walk: radius must be a finite number >= 0, got nan$"),
+        ({"scale_error": -1.0}, r"^walk: scale_error must be a finite number > -1, got -1\.0$"),
+        ({"scale_error": True}, r"^walk: scale_error must be a finite number > -1, got True$"),
+    ],
+)
+def test_bad_walk_odometry_is_refused(kw, message):
+    """A scale error of True was taken as an odometry 100 % long."""
+    with pytest.raises(ValueError, match=message):
+        WalkOdometry(**kw)

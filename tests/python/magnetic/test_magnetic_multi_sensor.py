@@ -122,5 +122,8 @@ def test_bad_inputs(maps):
         localize_with_magnetometers(maps, odo, z[:, :1], [[0.0, 0.0]] * 2, **kw)
     with pytest.raises(ValueError, match="window must be an integer >= 2"):
         DriftCheck(window=1)
-    with pytest.raises(ValueError, match="limit must be a number > 0"):
-        DriftCheck(limit=0.0)
+    for limit, shown in ((0.0, "0.0"), (float("inf"), "inf"), (True, "True")):
+        with pytest.raises(
+            ValueError, match=rf"^drift check: limit must be a finite number > 0, got {shown}$"
+        ):
+            DriftCheck(limit=limit)

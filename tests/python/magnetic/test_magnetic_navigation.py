@@ -295,7 +295,15 @@ def test_the_simulator_gives_a_controller_odometry_and_magnetometer(tmp_path, pr
         (lambda: PdSteering(1.0).update(float("inf"), 0.1), "finite"),
         (lambda: MultiNavigator(None, ("odometry", "bogus")), "distinct names among"),
         (lambda: geometric_valid([1.0], [1.0, 2.0]), r"\(g_l, g_r\)"),
-        (lambda: r_z(0.3, 0.3, dmz_max=0.0), "dm_z,max must be > 0"),
+        (
+            lambda: r_z(0.3, 0.3, dmz_max=0.0),
+            r"^r_z: dm_z,max must be a finite number > 0, got 0\.0$",
+        ),
+        (lambda: r_z(0.3, float("nan")), r"^r_z: m_z,t must be a finite number, got nan$"),
+        (
+            lambda: MultiNavigator(None, geometric_gain=-0.1),
+            r"^MultiNavigator: geometric_gain must be a finite number >= 0, got -0\.1$",
+        ),
     ],
 )
 def test_bad_input_is_refused(make, message):
