@@ -13,12 +13,12 @@ them; this module knows only names, priorities and opaque commands.
 
 from __future__ import annotations
 
-import math
-import numbers
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
+
+from kiseki._support.real_numbers import check_number
 
 __all__ = ["PriorityArbiter"]
 
@@ -39,12 +39,7 @@ class PriorityArbiter:
         for name, value in priorities.items():
             if not isinstance(name, str) or not name:
                 raise ValueError(f"PriorityArbiter: a navigator name must be text, got {name!r}")
-            ok = isinstance(value, numbers.Real) and not isinstance(value, bool)
-            if not (ok and math.isfinite(value) and value > 0):
-                raise ValueError(
-                    f"PriorityArbiter: priority of {name!r} must be a finite number > 0,"
-                    f" got {value!r}"
-                )
+            check_number(value, f"PriorityArbiter: priority of {name!r}", 0.0, low_open=True)
         values = list(priorities.values())
         if len(set(values)) != len(values):
             raise ValueError(

@@ -69,12 +69,12 @@ they say.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
 
 from kiseki._support.field_types import check_field_types
+from kiseki._support.real_numbers import check_number
 
 __all__ = ["FuzzyPotentialConfig", "FuzzyPotentialMethod"]
 
@@ -95,14 +95,17 @@ class FuzzyPotentialConfig:
 
     def __post_init__(self) -> None:
         check_field_types(self)
-        for name in ("v_max", "robot_radius", "stop_distance", "influence_distance", "step"):
-            value = getattr(self, name)
-            if not (isinstance(value, numbers.Real) and math.isfinite(value) and value > 0):
-                raise ValueError(
-                    f"FuzzyPotentialConfig.{name} must be a positive number, got {value!r}"
-                )
-        if not (math.isfinite(self.margin) and self.margin >= 0):
-            raise ValueError(f"FuzzyPotentialConfig.margin must be >= 0, got {self.margin!r}")
+        for name, unit in (
+            ("v_max", "m/s"),
+            ("robot_radius", "m"),
+            ("stop_distance", "m"),
+            ("influence_distance", "m"),
+            ("step", "rad"),
+        ):
+            check_number(
+                getattr(self, name), f"FuzzyPotentialConfig.{name}", 0.0, low_open=True, unit=unit
+            )
+        check_number(self.margin, "FuzzyPotentialConfig.margin", 0.0, unit="m")
         if not self.influence_distance > self.stop_distance:
             raise ValueError(
                 "FuzzyPotentialConfig.influence_distance must exceed stop_distance, got "
@@ -169,8 +172,7 @@ def _checked(goal_xy, angles, ranges, max_range):
         raise ValueError(f"{angles.size} angles but {ranges.size} ranges")
     if not np.isfinite(angles).all():
         raise ValueError("the scan's angles must be finite")
-    if not (math.isfinite(max_range) and max_range > 0):
-        raise ValueError(f"max_range must be a positive number, got {max_range!r}")
+    check_number(max_range, "max_range", 0.0, low_open=True, unit="m")
     # kiseki's rule for readings (kiseki.scans): a negative or zero one is invalid, as NaN; it
     # counted as an obstacle at the robot, blocking half the directions
     ranges = np.where(ranges > 0, ranges, np.nan)

@@ -10,18 +10,9 @@ Convention: a positive error means "turn left" (counter-clockwise, the world's z
 
 from __future__ import annotations
 
-import math
-import numbers
+from kiseki._support.real_numbers import check_number
 
 __all__ = ["PdSteering"]
-
-
-def _positive(value: float, name: str, allow_zero: bool = False) -> float:
-    ok = isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(value)
-    if not ok or value < 0 or (value == 0 and not allow_zero):
-        need = ">= 0" if allow_zero else "> 0"
-        raise ValueError(f"PdSteering: {name} must be a finite number {need}, got {value!r}")
-    return float(value)
 
 
 class PdSteering:
@@ -30,23 +21,20 @@ class PdSteering:
     :meth:`reset`) it is 0."""
 
     def __init__(self, kp: float, kd: float = 0.0, max_rate: float = 1.0) -> None:
-        self.kp = _positive(kp, "kp")
-        self.kd = _positive(kd, "kd", allow_zero=True)
-        self.max_rate = _positive(max_rate, "max_rate")
+        self.kp = check_number(kp, "PdSteering: kp", 0.0, low_open=True)
+        self.kd = check_number(kd, "PdSteering: kd", 0.0)
+        self.max_rate = check_number(
+            max_rate, "PdSteering: max_rate", 0.0, low_open=True, unit="rad/s"
+        )
         self._last: float | None = None
 
     def reset(self) -> None:
         self._last = None
 
     def update(self, u: float, dt: float) -> float:
-        try:
-            u = float(u)
-        except (TypeError, ValueError):
-            raise ValueError(f"PdSteering.update: the error must be a number, got {u!r}") from None
-        if not math.isfinite(u):
-            raise ValueError(f"PdSteering.update: the error must be finite, got {u!r}")
-        dt = _positive(dt, "dt")
+        u = check_number(u, "PdSteering.update: the error")
+        dt = check_number(dt, "PdSteering: dt", 0.0, low_open=True, unit="s")
         derivative = 0.0 if self._last is None else (u - self._last) / dt
-        self._last = float(u)
+        self._last = u
         w = self.kp * u + self.kd * derivative
         return max(-self.max_rate, min(self.max_rate, w))

@@ -36,9 +36,10 @@ of the last waypoint with less than 0.5 m of the path left to go.
 from __future__ import annotations
 
 import math
-import numbers
 
 import numpy as np
+
+from kiseki._support.real_numbers import check_number
 
 __all__ = ["PurePursuit"]
 
@@ -60,16 +61,13 @@ class PurePursuit:
         pts = pts.reshape(-1, 2)
         if len(pts) < 2 or not np.isfinite(pts).all():
             raise ValueError("a route needs at least two finite waypoints")
-        for name, value in (
-            ("route speed", speed),
-            ("lookahead", lookahead),
-            ("tolerance", tolerance),
-            ("max_accel", max_accel),
+        for name, value, unit in (
+            ("route speed", speed, "m/s"),
+            ("lookahead", lookahead, "m"),
+            ("tolerance", tolerance, "m"),
+            ("max_accel", max_accel, "m/s^2"),
         ):  # a NaN lookahead gave NaN yaw rates, a negative max_accel "math domain error"
-            if isinstance(value, bool) or not isinstance(value, numbers.Real):
-                raise ValueError(f"{name} must be a number, got {value!r}")
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+            check_number(value, name, 0.0, low_open=True, unit=unit)
         seg = np.diff(pts, axis=0)
         self.lengths = np.hypot(seg[:, 0], seg[:, 1])
         if (self.lengths <= 0).any():
@@ -104,8 +102,8 @@ class PurePursuit:
     def command(self, pose, *, max_speed: float | None = None) -> tuple[float, float, float]:
         """(v_forward, v_left, yaw_rate) in the body frame; ``max_speed`` (m/s, finite and
         >= 0) caps the forward speed below the route speed and the braking cap."""
-        if max_speed is not None and not (math.isfinite(max_speed) and max_speed >= 0):
-            raise ValueError(f"max_speed must be a finite number >= 0 m/s, got {max_speed}")
+        if max_speed is not None:
+            check_number(max_speed, "max_speed", 0.0, unit="m/s")
         x, y, th = (float(v) for v in pose)
         if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(th)):
             raise ValueError(f"pose must be three finite numbers (x, y, theta), got {tuple(pose)}")

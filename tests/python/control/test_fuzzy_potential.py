@@ -194,3 +194,29 @@ def test_negative_and_zero_readings_are_invalid_as_nan():
         ranges = free.copy()
         ranges[[10, 40]] = bad
         assert FuzzyPotentialMethod().direction((5.0, 0.0), angles, ranges, MAX_RANGE) == want
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("v_max", 0.0, "FuzzyPotentialConfig.v_max must be a finite number > 0 m/s, got 0.0"),
+        (
+            "robot_radius",
+            -1.0,
+            "FuzzyPotentialConfig.robot_radius must be a finite number > 0 m, got -1.0",
+        ),
+        ("margin", math.nan, "FuzzyPotentialConfig.margin must be a finite number >= 0 m, got nan"),
+        ("step", -0.1, "FuzzyPotentialConfig.step must be a finite number > 0 rad, got -0.1"),
+    ],
+)
+def test_a_bad_config_number_is_worded_as_one_rule(field, value, message):
+    with pytest.raises(ValueError) as e:
+        FuzzyPotentialConfig(**{field: value})
+    assert str(e.value) == message
+
+
+@pytest.mark.parametrize("bad", [0.0, math.inf, True])  # True was a range of 1 m
+def test_a_bad_max_range_is_refused(bad):
+    with pytest.raises(ValueError) as e:
+        FuzzyPotentialMethod().direction((1.0, 0.0), [0.0], [1.0], bad)
+    assert str(e.value) == f"max_range must be a finite number > 0 m, got {bad!r}"

@@ -28,10 +28,10 @@ def test_the_arc_through_the_lookahead_point():
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        ((0.5, math.nan, 0.1, 0.5), "lookahead must be a finite number > 0, got nan"),
-        ((0.5, 0.6, 0.1, -0.5), "max_accel must be a finite number > 0, got -0.5"),
-        ((0.5, 0.6, 0.0, 0.5), "tolerance must be a finite number > 0"),
-        ((True, 0.6, 0.1, 0.5), "route speed must be a number, got True"),
+        ((0.5, math.nan, 0.1, 0.5), r"lookahead must be a finite number > 0 m, got nan"),
+        ((0.5, 0.6, 0.1, -0.5), r"max_accel must be a finite number > 0 m/s\^2, got -0.5"),
+        ((0.5, 0.6, 0.0, 0.5), "tolerance must be a finite number > 0 m, got 0.0"),
+        ((True, 0.6, 0.1, 0.5), "route speed must be a finite number > 0 m/s, got True"),
     ],
 )
 def test_bad_settings_are_refused(args, message):
@@ -54,3 +54,10 @@ def test_waypoints_that_are_not_pairs_are_refused():
 def test_a_nan_pose_is_refused():
     with pytest.raises(ValueError, match="pose must be three finite numbers"):
         PurePursuit(ROUTE, 0.5, 0.6, 0.1, 0.5).command((math.nan, 0.0, 0.0))
+
+
+@pytest.mark.parametrize("bad", [-0.1, math.nan, True])  # True capped the speed at 1 m/s
+def test_a_bad_speed_cap_is_refused(bad):
+    with pytest.raises(ValueError) as e:
+        PurePursuit(ROUTE, 0.5, 0.6, 0.1, 0.5).command((1.0, 0.0, 0.0), max_speed=bad)
+    assert str(e.value) == f"max_speed must be a finite number >= 0 m/s, got {bad!r}"
