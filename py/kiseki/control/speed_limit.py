@@ -15,12 +15,12 @@ never imports the limiter's area (kiseki.speed), so playback stays independent o
 
 from __future__ import annotations
 
-import math
-import numbers
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 import numpy as np
+
+from kiseki._support.real_numbers import check_number
 
 __all__ = ["SpeedLimit", "SpeedLimitSource"]
 
@@ -42,16 +42,10 @@ class SpeedLimit:
     def __post_init__(self) -> None:
         if not isinstance(self.percentage, bool | np.bool_):  # "no" read as True
             raise ValueError(f"percentage must be True or False, got {self.percentage!r}")
-        for name in ("speed_limit", "max_speed"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, numbers.Real):
-                raise ValueError(f"{name} must be a number (m/s, or percent), got {v!r}")
-        if not (math.isfinite(self.speed_limit) and self.speed_limit >= 0):
-            raise ValueError(f"speed_limit must be a finite number >= 0, got {self.speed_limit}")
-        if not (math.isfinite(self.max_speed) and self.max_speed > 0):
-            raise ValueError(f"max_speed must be positive, got {self.max_speed}")
-        if self.percentage and self.speed_limit > 100:
-            raise ValueError(f"a percentage limit must be in 0..100, got {self.speed_limit}")
+        # a percentage is of max_speed, at most all of it
+        high, unit = (100.0, "%") if self.percentage else (float("inf"), "m/s")
+        check_number(self.speed_limit, "speed_limit", 0.0, high, unit=unit)
+        check_number(self.max_speed, "max_speed", 0.0, low_open=True, unit="m/s")
 
     @property
     def metres_per_second(self) -> float:

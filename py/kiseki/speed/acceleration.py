@@ -6,12 +6,13 @@ speed it starts from.
 ``AccelerationLimit``: the output moves towards the wanted limit by at most a_max * dt per
 update, up and down alike (the robot can neither speed up nor brake faster than a_max), starting
 from ``initial`` (0 m/s by default: the robot starts at rest). ``check_initial_speed``: that
-start lies in [0, v_max]."""
+start lies in [0, v_max]; ``check_top_speed``: v_max lies in (0, SPEED_LIMIT]."""
 
 from __future__ import annotations
 
-import math
 import numbers
+
+from kiseki._support.real_numbers import check_number
 
 __all__ = ["SPEED_LIMIT", "AccelerationLimit", "check_initial_speed", "check_top_speed"]
 
@@ -24,28 +25,21 @@ class AccelerationLimit:
     """Rate limiter: each ``step`` moves ``value`` towards ``target`` by at most a_max * dt."""
 
     def __init__(self, a_max: float, initial: float = 0.0) -> None:
-        if not (math.isfinite(a_max) and a_max > 0):
-            raise ValueError(f"a_max must be positive, got {a_max!r}")
-        if not math.isfinite(initial):
-            raise ValueError(f"initial must be finite, got {initial!r}")
-        self.a_max, self.value = float(a_max), float(initial)
+        self.a_max = check_number(a_max, "a_max", 0.0, low_open=True, unit="m/s^2")
+        self.value = check_number(initial, "initial")
 
     def step(self, target: float, dt: float) -> float:
         """The new value after ``dt`` seconds of moving towards ``target`` (m/s)."""
-        if not (math.isfinite(dt) and dt >= 0):
-            raise ValueError(f"dt must be a finite number >= 0, got {dt!r}")
-        if not math.isfinite(target):
-            raise ValueError(f"target must be finite, got {target!r}")
+        check_number(dt, "dt", 0.0, unit="s")
+        check_number(target, "target")
         reach = self.a_max * dt
         self.value += min(reach, max(-reach, target - self.value))
         return self.value
 
 
 def check_top_speed(name: str, v_max) -> None:
-    """A limiter's v_max: a number in (0, SPEED_LIMIT] m/s."""
-    number = isinstance(v_max, numbers.Real) and not isinstance(v_max, bool)
-    if not (number and 0 < v_max <= SPEED_LIMIT):
-        raise ValueError(f"{name} must be in (0, {SPEED_LIMIT:g}] m/s, got {v_max!r}")
+    """A limiter's v_max: a finite number in (0, SPEED_LIMIT] m/s."""
+    check_number(v_max, name, 0.0, SPEED_LIMIT, low_open=True, unit="m/s")
 
 
 def check_initial_speed(name: str, initial, v_max: float) -> None:

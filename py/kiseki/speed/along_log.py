@@ -15,11 +15,11 @@ width's search; the scan's own ``max_range`` readings are no return as always.
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.grid import OccupancyGrid
 from kiseki.scans import LaserScans
 from kiseki.speed.limiter import SpeedLimiter, SpeedLimiterConfig
@@ -64,11 +64,8 @@ def motion_headings(poses: np.ndarray, min_step: float = 0.01) -> np.ndarray:
     if bad.any():  # a NaN pose took its neighbour's heading, or its own NaN
         i = int(np.argmax(bad))
         raise ValueError(f"motion_headings: poses must be finite, pose {i} is {poses[i].tolist()}")
-    step_ok = isinstance(min_step, numbers.Real) and not isinstance(min_step, bool)
-    if not (step_ok and 0 <= min_step < math.inf):  # NaN or -1 took the pose's own heading
-        raise ValueError(
-            f"motion_headings: min_step must be a finite number >= 0 m, got {min_step!r}"
-        )
+    # NaN or -1 took the pose's own heading
+    check_number(min_step, "motion_headings: min_step", 0.0, unit="m")
     headings = poses[:, 2].copy()
     target = None
     for i in range(len(poses) - 1, -1, -1):
@@ -98,8 +95,7 @@ def limits_along_log(
         raise ValueError("the log has no scans")
     if not scans.has_reference_poses:
         raise ValueError("the log has no reference poses: the limit needs where each scan was")
-    if not (math.isfinite(reach) and reach > 0):
-        raise ValueError(f"reach must be a positive number of metres, got {reach}")
+    check_number(reach, "reach", 0.0, low_open=True, unit="m")
     limiter = SpeedLimiter(grid, config)
     headings = motion_headings(scans.poses) if heading == "motion" else scans.poses[:, 2].copy()
     reach = min(reach, scans.max_range)

@@ -50,7 +50,6 @@ no-return reading sees up to the range, a NaN one sees nothing).
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -58,6 +57,7 @@ import numpy as np
 from kiseki import _core
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
+from kiseki._support.real_numbers import check_number
 from kiseki.control.speed_limit import SpeedLimit
 from kiseki.grid import OccupancyGrid
 from kiseki.speed.acceleration import AccelerationLimit, check_initial_speed, check_top_speed
@@ -72,17 +72,15 @@ __all__ = [
 
 
 def _check_config(config, non_negative=()) -> None:
+    """Every number of ``config`` finite and > 0 (>= 0 for those in ``non_negative``), v_max
+    at most SPEED_LIMIT and initial_speed at most v_max; its counts are checked by the config."""
+    kind = type(config).__name__
+    check_top_speed(kind + ".v_max", config.v_max)
     for f in fields(config):
-        value = getattr(config, f.name)
-        number = isinstance(value, numbers.Real) and not isinstance(value, bool)
-        low_ok = number and (value >= 0 if f.name in non_negative else value > 0)
-        if not (number and math.isfinite(value) and low_ok):
-            kind = ">= 0" if f.name in non_negative else "positive"
-            raise ValueError(f"{type(config).__name__}.{f.name} must be {kind}, got {value!r}")
-    check_top_speed(type(config).__name__ + ".v_max", config.v_max)
-    check_initial_speed(
-        type(config).__name__ + ".initial_speed", config.initial_speed, config.v_max
-    )
+        if f.type == "float" and f.name != "v_max":
+            positive = f.name not in non_negative
+            check_number(getattr(config, f.name), f"{kind}.{f.name}", 0.0, low_open=positive)
+    check_initial_speed(kind + ".initial_speed", config.initial_speed, config.v_max)
 
 
 def points_in_motion_frame(sensor_pose, angles, ranges, max_range, heading, sensor_offset):
@@ -92,11 +90,10 @@ def points_in_motion_frame(sensor_pose, angles, ranges, max_range, heading, sens
     ranges = np.asarray(ranges, dtype=float).reshape(-1)
     if angles.shape != ranges.shape:
         raise ValueError(f"{angles.size} angles but {ranges.size} ranges")
-    if not (math.isfinite(max_range) and max_range > 0):
-        raise ValueError(f"max_range must be a positive number, got {max_range!r}")
-    heading = theta if heading is None else float(heading)
-    if not all(map(math.isfinite, (x, y, theta, heading))):
-        raise ValueError("the sensor pose and the heading must be finite")
+    check_number(max_range, "max_range", 0.0, low_open=True, unit="m")
+    if not all(map(math.isfinite, (x, y, theta))):
+        raise ValueError("the sensor pose must be finite")
+    heading = theta if heading is None else check_number(heading, "heading")
     hit = np.isfinite(ranges) & (ranges < max_range)
     r, a = ranges[hit], angles[hit] + theta - heading
     dx = sensor_offset * math.cos(theta - heading)  # sensor relative to the centre, motion frame
@@ -122,9 +119,8 @@ class DistanceLimiterConfig:
         check_field_types(self)
         _check_config(
             self,
-            non_negative=("reaction_time", "half_length", "free_threshold", "sensor_offset",
-                          "initial_speed"),
-        )  # fmt: skip
+            non_negative=("reaction_time", "half_length", "sensor_offset", "initial_speed"),
+        )
         if self.half_angle > math.pi:
             raise ValueError(
                 f"DistanceLimiterConfig.half_angle must be <= pi, got {self.half_angle}"
@@ -197,10 +193,9 @@ class PolygonLimiterConfig:
     def __post_init__(self) -> None:
         check_field_types(self)
         _check_config(self, non_negative=("stop_ahead", "sensor_offset", "initial_speed"))
-        if not self.slowdown_ratio <= 1:
-            raise ValueError(
-                f"PolygonLimiterConfig.slowdown_ratio must be in (0, 1], got {self.slowdown_ratio}"
-            )
+        name = "PolygonLimiterConfig.slowdown_ratio"
+        check_number(self.slowdown_ratio, name, 0.0, 1.0, low_open=True)
+        check_count(self.min_points, "PolygonLimiterConfig.min_points", 1)
 
 
 class PolygonSpeedLimiter:

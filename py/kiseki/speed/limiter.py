@@ -30,7 +30,6 @@ cells 0..25 are free, nav2 map_server's free_thresh 0.25).
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -38,6 +37,7 @@ import numpy as np
 from kiseki import _core
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
+from kiseki._support.real_numbers import check_number
 from kiseki.control.speed_limit import SpeedLimit
 from kiseki.grid import OccupancyGrid
 from kiseki.speed.acceleration import AccelerationLimit, check_initial_speed, check_top_speed
@@ -163,13 +163,11 @@ class SpeedLimiterConfig:
 
     def __post_init__(self) -> None:
         check_field_types(self)
-        for name in ("v_max", "a_max", "w1", "w2", "a", "half_band"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, numbers.Real):
-                raise ValueError(f"SpeedLimiterConfig.{name} must be a number, got {value!r}")
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"SpeedLimiterConfig.{name} must be positive, got {value!r}")
         check_top_speed("SpeedLimiterConfig.v_max", self.v_max)
+        for name, unit in (("a_max", "m/s^2"), ("w1", "m"), ("w2", "m"), ("a", "1/m"),
+                           ("half_band", "m")):  # fmt: skip
+            value = getattr(self, name)
+            check_number(value, f"SpeedLimiterConfig.{name}", 0.0, low_open=True, unit=unit)
         if not (0 < self.half_angle <= math.pi):
             raise ValueError(
                 f"SpeedLimiterConfig.half_angle must be in (0, pi], got {self.half_angle}"

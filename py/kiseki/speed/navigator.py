@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.control import FuzzyPotentialMethod, SpeedLimitSource
 
 __all__ = ["NavigatorLog", "SpeedControlledNavigator", "scan_about_body"]
@@ -105,10 +106,9 @@ class SpeedControlledNavigator:
         goal = np.asarray(goal_xy, dtype=float).reshape(-1)
         if goal.shape != (2,) or not np.isfinite(goal).all():
             raise ValueError(f"goal_xy must be two finite numbers, got {goal_xy!r}")
-        for name, value in (("v_max", v_max), ("goal_tolerance", goal_tolerance),
-                            ("a_max", a_max), ("period", period)):  # fmt: skip
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be positive, got {value!r}")
+        for name, value, unit in (("v_max", v_max, "m/s"), ("goal_tolerance", goal_tolerance, "m"),
+                                  ("a_max", a_max, "m/s^2"), ("period", period, "s")):  # fmt: skip
+            check_number(value, name, 0.0, low_open=True, unit=unit)
         self.goal, self.fpm, self.limiter = goal, fpm, limiter
         self.v_max, self.goal_tolerance, self.laser = v_max, goal_tolerance, laser
         self.a_max, self.period = a_max, period

@@ -210,3 +210,43 @@ def test_limiter_combines_the_terms_and_limits_acceleration():
 def test_bad_input_is_refused_by_name(call, match):
     with pytest.raises((ValueError, TypeError), match=match):
         call(_field())
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("a_max", 0.0, "SpeedLimiterConfig.a_max must be a finite number > 0 m/s^2, got 0.0"),
+        ("w1", math.nan, "SpeedLimiterConfig.w1 must be a finite number > 0 m, got nan"),
+        ("a", -4.9, "SpeedLimiterConfig.a must be a finite number > 0 1/m, got -4.9"),
+        ("v_max", 0.0, "SpeedLimiterConfig.v_max must be a finite number in (0, 10] m/s, got 0.0"),
+    ],
+)
+def test_a_bad_limiter_number_is_worded_as_one_rule(field, value, message):
+    with pytest.raises(ValueError) as e:
+        SpeedLimiterConfig(**{field: value})
+    assert str(e.value) == message
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"speed_limit": -0.1}, "speed_limit must be a finite number >= 0 m/s, got -0.1"),
+        (
+            {"speed_limit": 150, "percentage": True},
+            "speed_limit must be a finite number in [0, 100] %, got 150",
+        ),
+        ({"speed_limit": math.inf}, "speed_limit must be a finite number >= 0 m/s, got inf"),
+        (
+            {"speed_limit": 0.2, "max_speed": 0.0},
+            "max_speed must be a finite number > 0 m/s, got 0.0",
+        ),
+        (
+            {"speed_limit": 0.2, "max_speed": "0.5"},
+            "max_speed must be a finite number > 0 m/s, got '0.5'",
+        ),
+    ],
+)
+def test_a_bad_speed_limit_is_worded_as_one_rule(kwargs, message):
+    with pytest.raises(ValueError) as e:
+        SpeedLimit(**kwargs)
+    assert str(e.value) == message

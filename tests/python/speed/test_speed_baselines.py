@@ -262,6 +262,65 @@ def test_bad_config_names_the_field(cls, field, value):
         cls(**{field: value})
 
 
+@pytest.mark.parametrize(
+    ("cls", "field", "value", "rule"),
+    [
+        (DistanceLimiterConfig, "a_max", 0.0, "a finite number > 0"),
+        (DistanceLimiterConfig, "reaction_time", -0.1, "a finite number >= 0"),
+        (DistanceLimiterConfig, "free_threshold", -1, "an integer in 0..100"),
+        (PolygonLimiterConfig, "slowdown_ratio", 1.5, "a finite number in (0, 1]"),
+        (PolygonLimiterConfig, "min_points", 0, "an integer >= 1"),
+        (PolygonLimiterConfig, "half_width", math.inf, "a finite number > 0"),
+    ],
+)
+def test_a_bad_config_number_is_worded_as_one_rule(cls, field, value, rule):
+    with pytest.raises(ValueError) as e:
+        cls(**{field: value})
+    assert str(e.value) == f"{cls.__name__}.{field} must be {rule}, got {value!r}"
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: AccelerationLimit(0.0), "a_max must be a finite number > 0 m/s^2, got 0.0"),
+        (lambda: AccelerationLimit(True), "a_max must be a finite number > 0 m/s^2, got True"),
+        (lambda: AccelerationLimit(0.5, math.nan), "initial must be a finite number, got nan"),
+        (
+            lambda: AccelerationLimit(0.5).step(0.1, -0.1),
+            "dt must be a finite number >= 0 s, got -0.1",
+        ),
+        (
+            lambda: AccelerationLimit(0.5).step(0.1, True),
+            "dt must be a finite number >= 0 s, got True",
+        ),
+        (
+            lambda: AccelerationLimit(0.5).step(True, 0.1),
+            "target must be a finite number, got True",
+        ),
+    ],
+)
+def test_the_acceleration_limit_refuses_a_bad_number(call, message):
+    """True was a rate of 1 m/s^2, a step of 1 s or a target of 1 m/s."""
+    with pytest.raises(ValueError) as e:
+        call()
+    assert str(e.value) == message
+
+
+@pytest.mark.parametrize(
+    ("max_range", "heading", "message"),
+    [
+        (0.0, None, "max_range must be a finite number > 0 m, got 0.0"),
+        (True, None, "max_range must be a finite number > 0 m, got True"),  # was 1 m
+        (MAX_RANGE, math.nan, "heading must be a finite number, got nan"),
+        (MAX_RANGE, "0.5", "heading must be a finite number, got '0.5'"),  # was 0.5 rad
+    ],
+)
+def test_the_polygon_refuses_a_bad_range_or_heading(max_range, heading, message):
+    with pytest.raises(ValueError) as e:
+        PolygonSpeedLimiter().counts(FACING_Y, ANGLES, wall_ahead(2.0), max_range, heading)
+    assert str(e.value) == message
+
+
 def test_no_limiter_starts_above_the_robots_maximum_speed():
     """SpeedLimiter(grid, initial=5.0) gave 4.95 m/s on a 0.5 m/s robot (the limit falls from
     the starting speed at a_max); a start at v_max is the most it takes."""
@@ -285,6 +344,7 @@ def test_a_top_speed_past_the_limit_is_refused_in_the_config(config):
     assert config(v_max=10.0).v_max == 10.0
     for bad in (10.000001, 1e200):
         with pytest.raises(
-            ValueError, match=rf"^{config.__name__}\.v_max must be in \(0, 10\] m/s"
+            ValueError,
+            match=rf"^{config.__name__}\.v_max must be a finite number in \(0, 10\] m/s, got",
         ):
             config(v_max=bad)

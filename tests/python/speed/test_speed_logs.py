@@ -114,3 +114,11 @@ def test_speed_limits_command_writes_the_csv_and_refuses_bad_input(intel, shared
     wean = shared_data / "cmu_wean" / "robotdata1.log.gz"
     bad = run("speed", "limits", wean, "--map", map_yaml, "-o", tmp_path / "w.csv")
     assert bad.returncode == 1 and "reference poses" in bad.stderr
+
+
+@pytest.mark.parametrize("reach", [0.0, math.nan, True])  # True was a reach of 1 m
+def test_limits_along_a_log_refuse_a_bad_reach(intel, reach):
+    scans, grid = intel
+    with pytest.raises(ValueError) as caught:
+        limits_along_log(scans.first(3), grid, reach=reach)
+    assert str(caught.value) == f"reach must be a finite number > 0 m, got {reach!r}"

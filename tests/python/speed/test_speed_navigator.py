@@ -105,3 +105,15 @@ def test_scan_about_body_refuses_a_pose_that_is_not_three_finite_numbers(name, b
     with pytest.raises(ValueError) as caught:
         scan_about_body(poses["pose"], poses["sensor_pose"], [0.0, 0.1], [1.0, 2.0], 10.0)
     assert str(caught.value) == f"{name} must be three finite numbers (x, y, theta), got {bad!r}"
+
+
+@pytest.mark.parametrize(
+    ("name", "bad", "unit"),
+    [("v_max", True, "m/s"), ("goal_tolerance", 0.0, "m"), ("a_max", -0.5, "m/s^2"),
+     ("period", math.nan, "s")],
+)  # fmt: skip
+def test_the_navigator_refuses_a_bad_setting(name, bad, unit):
+    """True was a top speed of 1 m/s."""
+    with pytest.raises(ValueError) as caught:
+        SpeedControlledNavigator((1.0, 0.0), FuzzyPotentialMethod(), None, **{name: bad})
+    assert str(caught.value) == f"{name} must be a finite number > 0 {unit}, got {bad!r}"
