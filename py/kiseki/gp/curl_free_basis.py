@@ -25,13 +25,13 @@ weights on the same basis with density S_2(w) / l^2.
 from __future__ import annotations
 
 import math
-import numbers
 from typing import Any
 
 import numpy as np
 import scipy.linalg
 
 from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 from kiseki.gp._data import inputs_array
 from kiseki.gp.curl_free import CurlFreeKernel, field_targets
 
@@ -98,8 +98,7 @@ class ReducedRankCurlFreeGP:
         if x.shape[1] not in (2, 3) or not np.isfinite(x).all():
             raise ValueError(f"X: finite positions with 2 or 3 coordinates, got shape {x.shape}")
         y = field_targets(y, len(x))
-        if not (isinstance(margin, numbers.Real) and math.isfinite(margin) and margin >= 0):
-            raise ValueError(f"margin must be a finite number >= 0, got {margin!r}")
+        check_number(margin, "margin", 0.0)
         block = check_count(block, "block", 1)
         if domain is None:
             grow = margin * kernel.length_scale

@@ -4,12 +4,12 @@
 
 from __future__ import annotations
 
-import numbers
 from typing import Any
 
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.real_numbers import check_number
 from kiseki.gp._data import check_mean, inputs_array, targets_array
 from kiseki.gp.kernel import (
     HyperparameterFit,
@@ -103,9 +103,8 @@ class ExactGP:
             raise ValueError(
                 f"points have {p.shape[1]} coordinates, the GP was fitted on {self.dimension}"
             )
-        # "a" was pybind11's signature list; the range [0, 1) is the core's to check
-        if isinstance(truncation, bool) or not isinstance(truncation, numbers.Real):
-            raise ValueError(f"predict: truncation must be a number in [0, 1), got {truncation!r}")
+        # "a" was pybind11's signature list
+        truncation = check_number(truncation, "predict: truncation", 0.0, 1.0, high_open=True)
         means, variances = [], []
         for core in self._cores:
             m, v = core.predict(p, truncation)

@@ -5,12 +5,12 @@
 from __future__ import annotations
 
 import math
-import numbers
 from typing import Any
 
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.real_numbers import check_number
 from kiseki.gp._data import check_mean, inputs_array, targets_array
 from kiseki.gp.kernel import SquaredExponential
 
@@ -73,10 +73,7 @@ class HilbertGP:
             lower, upper = (np.asarray(v, dtype=float).reshape(-1) for v in domain)
         if tolerance is None:
             tolerance = spectral_tolerance(kernel)
-        if not (
-            isinstance(tolerance, numbers.Real) and 0 < tolerance < 1 and math.isfinite(tolerance)
-        ):
-            raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
+        tolerance = check_number(tolerance, "tolerance", 0.0, 1.0, low_open=True, high_open=True)
         core = _core.HilbertGaussianProcess(
             x,
             y,
@@ -146,13 +143,10 @@ def hilbert_basis_size(sides: Any, length_scale: float, tolerance: float) -> int
     Laplacian's eigenfunctions sin(pi j_d (x_d - lower_d) / side_d), j_d = 1, 2, ..., whose
     frequency sqrt(sum_d (pi j_d / side_d)^2) is at most w_max, S(w_max) = tolerance S(0) (at
     least one function)."""
-    for name, value in (("length_scale", length_scale), ("tolerance", tolerance)):
-        if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            raise ValueError(f"hilbert_basis_size: {name} must be a number, got {value!r}")
-    if not (math.isfinite(length_scale) and length_scale > 0):
-        raise ValueError(f"hilbert_basis_size: length_scale must be > 0, got {length_scale!r}")
-    if not 0 < tolerance < 1:
-        raise ValueError(f"hilbert_basis_size: tolerance must be in (0, 1), got {tolerance!r}")
+    check_number(length_scale, "hilbert_basis_size: length_scale", 0.0, low_open=True)
+    check_number(
+        tolerance, "hilbert_basis_size: tolerance", 0.0, 1.0, low_open=True, high_open=True
+    )
     box = np.atleast_1d(np.asarray(sides, dtype=float))
     if box.ndim != 1 or not 1 <= len(box) <= 3 or not (np.isfinite(box) & (box > 0)).all():
         raise ValueError(f"hilbert_basis_size: sides must be 1-3 lengths > 0, got {sides!r}")

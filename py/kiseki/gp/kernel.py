@@ -4,7 +4,6 @@
 
 from __future__ import annotations
 
-import numbers
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
@@ -12,6 +11,7 @@ import numpy as np
 
 from kiseki import _core
 from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 from kiseki.core import check_seed
 from kiseki.gp._data import (
     check_iterations,
@@ -37,20 +37,13 @@ __all__ = [
 
 def check_hyperparameters(kernel, names: tuple[str, ...]) -> None:
     """Each of the frozen dataclass ``kernel``'s hyperparameters ``names`` as a float in (0,
-    KERNEL_HIGH] (a length scale at least KERNEL_LOW), refused naming the kernel and the field.
+    KERNEL_HIGH] (a length scale above KERNEL_LOW), refused naming the kernel and the field.
     Compared as a Python float: a float32 would take the bounds as float32 (1e50: inf)."""
     for name in names:
-        v = getattr(kernel, name)
-        if (
-            isinstance(v, bool)
-            or not isinstance(v, numbers.Real)
-            or not (KERNEL_LOW if name == "length_scale" else 0.0) < float(v) <= KERNEL_HIGH
-        ):
-            raise ValueError(
-                f"{type(kernel).__name__}: {name} must be a finite number > 0 (at most 1e50, "
-                f"a length at least 1e-50), got {v!r}"
-            )
-        object.__setattr__(kernel, name, float(v))
+        low = KERNEL_LOW if name == "length_scale" else 0.0
+        label = f"{type(kernel).__name__}: {name}"
+        value = check_number(getattr(kernel, name), label, low, KERNEL_HIGH, low_open=True)
+        object.__setattr__(kernel, name, value)
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,6 @@
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 from typing import Any
 
@@ -13,6 +12,7 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki import _core
+from kiseki._support.real_numbers import check_number
 from kiseki.gp._data import check_mean, inputs_array, targets_array
 from kiseki.gp.hilbert import hilbert_basis_size, spectral_tolerance
 from kiseki.gp.kernel import SquaredExponential
@@ -112,12 +112,11 @@ class TiledGP:
         snr2 = (kernel.sigma_f / kernel.sigma_n) ** 2
         if overlap is None:  # sigma_f^2 exp(-o^2 / (2 l^2)) = sigma_n^2 / 10
             overlap = ell * max(3.0, math.sqrt(2.0 * math.log(max(10.0 * snr2, 1.0))))
-        overlap = _distance("overlap", overlap)
-        margin = _distance("margin", 1.0 * ell if margin is None else margin)
+        overlap = check_number(overlap, "overlap", 0.0, unit="m")
+        margin = check_number(1.0 * ell if margin is None else margin, "margin", 0.0, unit="m")
         if tolerance is None:
             tolerance = spectral_tolerance(kernel)
-        if not (isinstance(tolerance, numbers.Real) and 0 < tolerance < 1):
-            raise ValueError(f"tolerance must be in (0, 1), got {tolerance!r}")
+        tolerance = check_number(tolerance, "tolerance", 0.0, 1.0, low_open=True, high_open=True)
         lower, upper = x.min(axis=0), x.max(axis=0)
         extent = upper - lower
         if tiles_per_axis is None:
@@ -289,14 +288,6 @@ def _build_tile(plan: _TilePlan, data: _TileData, kernel: SquaredExponential) ->
     return _core.HilbertGaussianProcess(
         xt, yt, f, ell, sn, plan.box_lo, plan.box_hi, data.tolerance, _MAX_BASIS, False
     )
-
-
-def _distance(name: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not value >= 0:
-        raise ValueError(f"{name} must be a distance >= 0 in metres, got {value!r}")
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return float(value)
 
 
 def _grid_argument(value: Any, d: int) -> np.ndarray:

@@ -228,6 +228,18 @@ def test_hyperparameters_reach_at_least_the_truths_likelihood() -> None:
             ),
             "hold every",
         ),
+        (  # True was a margin of one length scale
+            lambda: ReducedRankCurlFreeGP.fit(
+                np.zeros((3, 2)), np.zeros((3, 3)), KERNEL, margin=True
+            ),
+            r"^margin must be a finite number >= 0, got True$",
+        ),
+        (
+            lambda: ReducedRankCurlFreeGP.fit(
+                np.zeros((3, 2)), np.zeros((3, 3)), KERNEL, margin=-1
+            ),
+            r"^margin must be a finite number >= 0, got -1$",
+        ),
         (
             lambda: CurlFreeGP.fit(np.zeros((3, 2)), np.zeros((3, 3)), KERNEL).predict(
                 np.zeros((2, 2)), block=0

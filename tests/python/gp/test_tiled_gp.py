@@ -128,9 +128,9 @@ def test_basis_size_counted_by_search_equals_every_combination(monkeypatch, side
     ("args", "message"),
     [
         (([1e9, 3.0], 0.5, 1e-4), "a side of 1e\\+09 at length scale 0.5 holds 2.73e\\+09"),
-        (([3.0, 3.0], 0.0, 1e-4), "length_scale must be > 0, got 0"),
-        (([3.0, 3.0], 0.5, 0.0), "tolerance must be in \\(0, 1\\), got 0"),
-        (([3.0, 3.0], 0.5, True), "tolerance must be a number"),
+        (([3.0, 3.0], 0.0, 1e-4), r"length_scale must be a finite number > 0, got 0\.0$"),
+        (([3.0, 3.0], 0.5, 0.0), r"tolerance must be a finite number in \(0, 1\), got 0\.0$"),
+        (([3.0, 3.0], 0.5, True), r"tolerance must be a finite number in \(0, 1\), got True$"),
         (([-1.0, 3.0], 0.5, 1e-4), "sides must be 1-3 lengths > 0"),
     ],
 )
@@ -150,8 +150,14 @@ def test_what_it_is_given_is_checked(strip):
     x, y, _, _ = strip
     with pytest.raises(ValueError, match="solver must be one of"):
         TiledGP.fit(x, y, KERNEL, solver="fast")
-    with pytest.raises(ValueError, match="overlap must be a distance"):
+    with pytest.raises(ValueError, match=r"^overlap must be a finite number >= 0 m, got -1\.0$"):
         TiledGP.fit(x, y, KERNEL, overlap=-1.0)
+    with pytest.raises(ValueError, match=r"^margin must be a finite number >= 0 m, got inf$"):
+        TiledGP.fit(x, y, KERNEL, margin=np.inf)
+    with pytest.raises(
+        ValueError, match=r"^tolerance must be a finite number in \(0, 1\), got nan$"
+    ):
+        TiledGP.fit(x, y, KERNEL, tolerance=np.nan)
     with pytest.raises(ValueError, match="tiles_per_axis must be 2 integers"):
         TiledGP.fit(x, y, KERNEL, tiles_per_axis=[2])
     with pytest.raises(ValueError, match="1-3 coordinates"):
