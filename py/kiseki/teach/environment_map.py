@@ -17,13 +17,11 @@ from depth images placed by odometry (`kiseki.apps.teach.teaching`).
 
 from __future__ import annotations
 
-import math
-import numbers
-
 import numpy as np
 from tqdm import tqdm
 
 from kiseki import _core
+from kiseki._support.real_numbers import check_number
 from kiseki.grid import OccupancyGrid
 from kiseki.mapping import check_map_poses, check_map_size, scan_local_builder
 
@@ -78,9 +76,7 @@ def build_teaching_map(
     `check_map_size` allows, and (by the local map, in its own words) a local size below the
     resolution or over 4096 cells across."""
     for name, value in (("resolution", resolution), ("local_size", local_size)):
-        number = isinstance(value, numbers.Real) and not isinstance(value, bool)
-        if not (number and math.isfinite(value) and value > 0):
-            raise ValueError(f"teaching map: {name} must be a finite number > 0 m, got {value!r}")
+        check_number(value, f"teaching map: {name}", 0.0, low_open=True, unit="m")
     poses = check_map_poses(poses)
     ranges = np.asarray(ranges)
     if ranges.ndim != 2 or ranges.shape[0] != poses.shape[0]:

@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.grid import OccupancyGrid
 from kiseki.io.runlog import read_run
 from kiseki.teach.waypoint_schema import read_waypoint_file
@@ -97,12 +98,10 @@ class _Footprints:
         poses = np.asarray(poses, dtype=float)
         if poses.ndim != 2 or poses.shape[1] != 3 or not np.isfinite(poses).all():
             raise ValueError(f"travelled: expected finite (n, 3) poses, got shape {poses.shape}")
-        if (
-            footprint is None
-            or len(footprint) != 2
-            or not all(math.isfinite(f) and f > 0 for f in footprint)
-        ):
+        if footprint is None or len(footprint) != 2:
             raise ValueError(f"footprint: expected (length, width) > 0 m, got {footprint}")
+        for name, value in zip(("length", "width"), footprint, strict=True):
+            check_number(value, f"footprint: {name}", 0.0, low_open=True, unit="m")
         self.poses = poses
         self.half = 0.5 * np.asarray(footprint, dtype=float)
 

@@ -80,6 +80,11 @@ def test_a_cell_under_the_taught_footprint_does_not_block_and_one_beside_it_does
     assert grid.cells[15, 30] == 100  # the map given is not changed
     with pytest.raises(ValueError, match="footprint"):
         check_route(grid, marks, at, None)
+    for bad in (0.0, math.nan, True):  # True was taken as a length of 1 m
+        with pytest.raises(
+            ValueError, match="^footprint: length must be a finite number > 0 m, got "
+        ):
+            check_route(grid, marks, at, (bad, FOOTPRINT[1]))
     with pytest.raises(ValueError, match="travelled"):
         check_route(grid, marks, at[:, :2], FOOTPRINT)
 

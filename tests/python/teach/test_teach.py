@@ -253,6 +253,7 @@ def test_experiment_trial_records_the_goal_likelihood_profile():
         ({"dt": 0.2, "max_duration": 0.1}, "max_duration must be in [dt, 86,400] s"),
         ({"initial_sd": (math.nan, 0.05, 0.01)}, "initial_sd must be 3 numbers in [0, 1e+09]"),
         ({"alphas": (math.nan, 0.002, 0.0005, 0.0005)}, "motion model: alphas must lie in"),
+        ({"scan_range_scale": 0.05}, "scan_range_scale must be a finite number in [0.1, 10], got"),
     ],
 )
 def test_a_playback_that_could_not_run_as_asked_is_refused_by_its_config(fields, message):

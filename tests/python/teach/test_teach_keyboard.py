@@ -21,8 +21,14 @@ import pytest
 import yaml
 
 from kiseki import load_map
-from kiseki.apps.teach.keyboard import KeyScript, Teleop, decode_keys, teach_keyboard
-from kiseki.apps.teach.teaching import recover
+from kiseki.apps.teach.keyboard import (
+    KeyScript,
+    Teleop,
+    TerminalKeys,
+    decode_keys,
+    teach_keyboard,
+)
+from kiseki.apps.teach.teaching import TeachingRun, recover
 from kiseki.io.runlog import read_run
 from kiseki.sim.scene import load_scene
 from kiseki.teach.waypoint_schema import read_waypoint_file
@@ -50,6 +56,29 @@ def test_keys_are_decoded_and_commands_stay_within_the_limits():
     assert teleop.v == -0.1  # reverse
     with pytest.raises(ValueError, match="unknown key 'x'"):
         teleop.press("x")
+
+
+@pytest.mark.parametrize("bad", [0.0, math.nan, math.inf, True])
+def test_limits_and_times_that_are_no_positive_finite_number_are_refused(tmp_path, bad):
+    """An infinite limit and True (1 m/s, 1 s) were taken; 0 and NaN were refused before too
+    (the limits' message named neither limit nor value)."""
+    with pytest.raises(
+        ValueError, match=r"^the robot's max_speed must be a finite number > 0 m/s, got "
+    ):
+        Teleop(max_speed=bad, max_yaw_rate=0.5)
+    with pytest.raises(
+        ValueError, match=r"^the robot's max_yaw_rate must be a finite number > 0 rad/s, got "
+    ):
+        Teleop(max_speed=1.0, max_yaw_rate=bad)
+    with pytest.raises(ValueError, match=r"^dt must be a finite number > 0 s, got "):
+        TeachingRun(None, tmp_path / "run", dt=bad)  # refused before the scene is read
+    leader, follower = os.openpty()
+    try:
+        with pytest.raises(ValueError, match=r"^the period must be a finite number > 0 s, got "):
+            TerminalKeys(follower, bad)
+    finally:
+        os.close(leader)
+        os.close(follower)
 
 
 @pytest.mark.parametrize(

@@ -28,6 +28,7 @@ import sys
 import time
 from typing import TextIO
 
+from kiseki._support.real_numbers import check_number
 from kiseki.apps.teach.teaching import TeachingRun
 from kiseki.apps.teach.teaching_files import TeachResult
 from kiseki.sim.scene import Scene
@@ -82,8 +83,8 @@ class Teleop:
     robot's limits (max_speed m/s, max_yaw_rate rad/s)."""
 
     def __init__(self, max_speed: float, max_yaw_rate: float) -> None:
-        if not (max_speed > 0 and max_yaw_rate > 0):
-            raise ValueError("the robot's speed limits must be positive")
+        check_number(max_speed, "the robot's max_speed", 0.0, low_open=True, unit="m/s")
+        check_number(max_yaw_rate, "the robot's max_yaw_rate", 0.0, low_open=True, unit="rad/s")
         self.max_speed, self.max_yaw_rate = float(max_speed), float(max_yaw_rate)
         self.v = 0.0
         self.w = 0.0
@@ -145,8 +146,7 @@ class TerminalKeys:
             raise RuntimeError("keyboard teaching needs a POSIX terminal (termios)") from None
         if not os.isatty(fd):
             raise ValueError("keyboard teaching needs a terminal on stdin")
-        if not (math.isfinite(period) and period > 0):
-            raise ValueError(f"the period must be a positive number of seconds, got {period}")
+        check_number(period, "the period", 0.0, low_open=True, unit="s")
         self._termios, self._tty = termios, tty
         self.fd, self.period = fd, float(period)
         self._saved = None

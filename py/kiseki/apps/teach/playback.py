@@ -27,6 +27,7 @@ from kiseki import _core
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import BEAM_LIMIT, PARTICLE_LIMIT
+from kiseki._support.real_numbers import check_number
 from kiseki.control import PurePursuit, SpeedLimit, SpeedLimitSource
 from kiseki.core import derive_seed
 from kiseki.filters import MclConfig, MonteCarloLocalizer
@@ -80,9 +81,7 @@ class PlaybackConfig:
         # an infinite goal_tolerance "reached" the goal before the first step, an infinite dt
         # or a negative, NaN or infinite max_duration made no step or none that ends
         for name in ("dt", "speed", "goal_tolerance"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a finite number > 0, got {value!r}")
+            check_number(getattr(self, name), name, 0.0, low_open=True)
         if not self.dt <= self.max_duration <= MAX_SIM_SECONDS:
             raise ValueError(
                 f"max_duration must be in [dt, {MAX_SIM_SECONDS:,.0f}] s (24 h, as a simulated "
@@ -95,8 +94,7 @@ class PlaybackConfig:
         check_count(self.scan_beams, "scan_beams", 1, BEAM_LIMIT)
         check_spread("initial_sd", self.initial_sd)  # a NaN was refused once the run started
         MclConfig(particles=self.particles, alphas=tuple(self.alphas))  # and an alpha
-        if not 0.1 <= self.scan_range_scale <= 10.0:
-            raise ValueError(f"scan_range_scale must lie in [0.1, 10], got {self.scan_range_scale}")
+        check_number(self.scan_range_scale, "scan_range_scale", 0.1, 10.0)
 
 
 PLAYBACK_MODELS = ("space-observation", "ray-space-observation")

@@ -13,7 +13,6 @@ The files a run writes (its maps, their truth, the waypoint file) are `teaching_
 from __future__ import annotations
 
 import contextlib
-import math
 import os
 from pathlib import Path
 
@@ -21,6 +20,7 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki._support.atomic import check_writable_folder, reworded
+from kiseki._support.real_numbers import check_number
 from kiseki.apps.teach.teaching_files import (
     TeachResult,
     environment_grid,
@@ -77,8 +77,7 @@ class TeachingRun:
         metadata: dict[str, str] | None = None,
         merge: str = "thesis",
     ) -> None:
-        if not (math.isfinite(dt) and dt > 0):
-            raise ValueError(f"dt must be a positive number of seconds, got {dt}")
+        check_number(dt, "dt", 0.0, low_open=True, unit="s")
         if merge not in MERGE_RULES:
             raise ValueError(f"merge rule must be one of {', '.join(MERGE_RULES)}, got {merge!r}")
         self.merge = merge
