@@ -15,6 +15,7 @@ from tqdm import tqdm
 from kiseki import _core
 from kiseki._support.counts import check_count
 from kiseki._support.real_arrays import real_array
+from kiseki._support.real_numbers import check_number
 from kiseki._support.schema import MAGNITUDE_LIMIT, parse
 from kiseki.grid import OccupancyGrid
 from kiseki.io.map_schema import MapBuildSettings
@@ -41,8 +42,8 @@ def check_map_size(width_m: float, height_m: float, resolution: float) -> tuple[
     """The (width, height) in cells of a map of this extent, refused in one line when it has
     fewer than MIN_MAP_SIDE cells across or more than MAX_MAP_CELLS cells (limits stated)."""
     for name, v in (("width", width_m), ("height", height_m), ("resolution", resolution)):
-        if not (math.isfinite(v) and v > 0):  # 0 was a ZeroDivisionError, inf an OverflowError
-            raise ValueError(f"check_map_size: {name} must be a finite number > 0 m, got {v!r}")
+        # 0 was a ZeroDivisionError, inf an OverflowError
+        check_number(v, f"check_map_size: {name}", 0.0, low_open=True, unit="m")
     wide, high = width_m / resolution, height_m / resolution
     if not math.isfinite(wide * high):  # 1e300 m at 1e-300 m: math.ceil(inf) was an OverflowError
         raise ValueError(
@@ -149,8 +150,7 @@ def build_map(
     config = MapBuildConfig() if config is None else config
     if not isinstance(config, MapBuildConfig):  # a dict was "no attribute 'margin'"
         raise TypeError(f"build_map: config must be a MapBuildConfig, got {type(config).__name__}")
-    if not np.isfinite(config.margin) or config.margin < 0:
-        raise ValueError(f"margin must be >= 0, got {config.margin}")
+    check_number(config.margin, "margin", 0.0, unit="m")
     max_range = check_max_range("build_map", max_range)
     # -1 gave a map of unknown cells only, 0 Python's "range() arg 3 must not be zero"
     chunk = check_count(chunk, "chunk", 1, note="scans per pass")

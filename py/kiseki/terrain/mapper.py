@@ -17,7 +17,6 @@ pose. Nothing here uses the simulator: sweeps are ranges and attitudes, from a l
 
 from __future__ import annotations
 
-import numbers
 from dataclasses import asdict, dataclass, field
 from typing import Any, Literal
 
@@ -25,6 +24,7 @@ import numpy as np
 
 from kiseki import _core
 from kiseki._support.field_types import check_field_types
+from kiseki._support.real_numbers import check_number
 from kiseki.core import check_seed, derive_seed, rotation_zyx
 from kiseki.terrain.correlation import SearchResult, correlation_search, search_grid
 from kiseki.terrain.plane_removal import HoughParams, PclParams, remove_planes
@@ -63,8 +63,7 @@ class MapperConfig:
             raise ValueError(f"search must be exhaustive or coarse-to-fine, got {self.search!r}")
         if self.cost not in ("sum", "mean"):
             raise ValueError(f"cost must be sum (eq. 4) or mean, got {self.cost!r}")
-        if not (isinstance(self.voxel, numbers.Real) and 0.005 <= self.voxel <= 10):
-            raise ValueError(f"voxel must be in 0.005..10 m, got {self.voxel!r}")
+        check_number(self.voxel, "voxel", 0.005, 10.0, unit="m")
         check_seed(self.seed)
         search_grid(self.x, self.y, self.z, self.step)  # raises for a bad box
 

@@ -12,14 +12,13 @@ by eq. 3. The C++ core does the work (``kiseki/terrain/sphere_elevation_map.hpp`
 
 from __future__ import annotations
 
-import math
-import numbers
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.real_numbers import check_number
 from kiseki.core import rotation_zyx
 
 __all__ = [
@@ -64,11 +63,8 @@ PAPER_GRID = sphere_grid()
 def attitude_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
     """R = Rz(yaw) Ry(pitch) Rx(roll), angles in rad (the gyro's attitude: from the sensor
     frame to the level frame). Raises ValueError for a non-finite angle (a failed gyro)."""
-    values = (roll, pitch, yaw)
-    if not all(
-        isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v) for v in values
-    ):
-        raise ValueError(f"attitude: roll, pitch, yaw must be finite numbers, got {values}")
+    for name, value in (("roll", roll), ("pitch", pitch), ("yaw", yaw)):
+        check_number(value, f"attitude: {name}")
     return rotation_zyx(float(yaw), float(pitch), float(roll))
 
 

@@ -185,8 +185,10 @@ def test_check_map_size_refuses_what_it_cannot_divide():
     """resolution 0 was a ZeroDivisionError, NaN "cannot convert float NaN to integer", inf an
     OverflowError; a good extent gives the ceiling of each side over the resolution."""
     assert check_map_size(10.0, 4.01, 0.5) == (20, 9)
-    for bad in (0.0, float("nan"), float("inf"), -0.1):
-        with pytest.raises(ValueError, match="check_map_size: resolution must be a finite number"):
+    for bad in (0.0, float("nan"), float("inf"), -0.1, True):  # True was taken as 1 m
+        with pytest.raises(
+            ValueError, match="^check_map_size: resolution must be a finite number > 0 m, got "
+        ):
             check_map_size(10.0, 10.0, bad)
 
 

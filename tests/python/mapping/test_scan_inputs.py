@@ -52,6 +52,9 @@ def test_build_map_needs_a_config_real_readings_and_a_beam():
         build_map(POSES, np.tile(RANGES, (2, 1)), ANGLES, 10.0, {"resolution": 0.1})
     same = build_map(POSES, np.tile(RANGES, (2, 1)), ANGLES, 10.0, MapBuildConfig())
     np.testing.assert_array_equal(same.cells, grid.cells)
+    for margin in (-1.0, np.nan, True):  # True was taken as a margin of 1 m
+        with pytest.raises(ValueError, match="^margin must be a finite number >= 0 m, got "):
+            build_map(POSES, np.tile(RANGES, (2, 1)), ANGLES, 10.0, MapBuildConfig(margin=margin))
 
 
 def test_a_map_too_large_for_a_float_is_over_the_limit_not_an_overflow():

@@ -120,6 +120,14 @@ def test_mapper_levels_each_sweep_with_the_gyro():
     np.testing.assert_allclose(result.translation[:2], in_frame, atol=0.06)
 
 
+@pytest.mark.parametrize("voxel", [0.001, 10.5, float("nan")])
+def test_a_voxel_outside_its_range_is_refused(voxel):
+    with pytest.raises(
+        ValueError, match=r"^voxel must be a finite number in \[0.005, 10\] m, got "
+    ):
+        MapperConfig(voxel=voxel)
+
+
 @pytest.mark.skipif(not GEB079.exists(), reason="the recorded Freiburg 079 octree is absent")
 def test_run_in_a_real_building_finds_its_own_start(tmp_path):
     done = run(GEB079, "--moves", 2, "-o", tmp_path / "bt", "--seed", 1)

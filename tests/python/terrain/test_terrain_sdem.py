@@ -251,7 +251,11 @@ def test_exhaustive_costs_equal_one_candidates_cost_and_numpy_on_a_sparse_rotate
         (lambda: sdem_from_points(np.zeros((0, 3))), "non-empty"),
         (lambda: sdem_from_points([[1, 0, math.nan]]), "NaN"),
         (lambda: sdem_from_points([[1, 0, 0]], attitude=np.full((3, 3), math.nan)), "NaN"),
-        (lambda: attitude_matrix(math.nan, 0.0, 0.0), "finite"),
+        (lambda: attitude_matrix(math.nan, 0.0, 0.0), "^attitude: roll must be a finite number, "),
+        (
+            lambda: attitude_matrix(0.0, 0.0, True),
+            "^attitude: yaw must be a finite number, got True",
+        ),
         (lambda: search_grid(step=0.0), "zero steps"),
         (lambda: search_grid(x=(0.5, 0.1)), "min <= max"),
         (lambda: sphere_grid(step_deg=0.0), "step_deg"),
