@@ -25,6 +25,8 @@ import math
 
 import numpy as np
 
+from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 from kiseki.coop.positioning import ANGLE_SIGMA, GOAL, MAX_MOVES, START, Move, Plan
 from kiseki.coop.triangulation import MIN_INTERSECTION_ANGLE
 
@@ -142,10 +144,10 @@ def plan_moves(
         raise ValueError("start must be 3 finite (x, y) rows and goal a finite (x, y)")
     if not (math.isfinite(angle_sigma) and 0 < angle_sigma < math.radians(10)):
         raise ValueError(f"angle_sigma must lie in (0, 10 deg), got {angle_sigma}")
-    if not (spacing > 0 and reach > spacing and half_width > 0 and 1 <= max_moves <= MAX_MOVES):
-        raise ValueError(
-            f"need spacing > 0, reach > spacing, half_width > 0 and 1 <= max_moves <= {MAX_MOVES}"
-        )
+    check_count(max_moves, "max_moves", 1, MAX_MOVES)
+    check_number(spacing, "spacing", 0.0, low_open=True, unit="m")
+    check_number(reach, "reach", spacing, low_open=True, unit="m")  # more than one spacing
+    check_number(half_width, "half_width", 0.0, low_open=True, unit="m")
     at, g = start.copy(), np.zeros((6, 0))
     steps: list[Move] = []
     half = float(half_width)

@@ -57,6 +57,7 @@ import numpy as np
 
 from kiseki import _core
 from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 from kiseki.coop.triangulation import MIN_INTERSECTION_ANGLE
 from kiseki.core import check_seed
 
@@ -347,10 +348,7 @@ def simulate_3d(
     ``angle_sigma``."""
     e_sigma = angle_sigma if elevation_sigma is None else elevation_sigma
     _check_runs(the_plan, runs, 100_000, seed, angle_sigma=angle_sigma, elevation_sigma=e_sigma)
-    if isinstance(marker_height, bool) or not (
-        isinstance(marker_height, numbers.Real) and 0 <= marker_height < 10
-    ):
-        raise ValueError(f"marker_height must lie in [0, 10) m, got {marker_height!r}")
+    check_number(marker_height, "marker_height", 0.0, 10.0, high_open=True, unit="m")
     if not callable(ground):
         raise TypeError(f"ground must be a function z(x, y), got {type(ground).__name__}")
     flat = the_plan.nominal_positions()

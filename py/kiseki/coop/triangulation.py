@@ -22,11 +22,11 @@ found by testing the formulas against each other:
 from __future__ import annotations
 
 import math
-import numbers
 
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.real_numbers import check_number
 
 #: Lines of sight meeting at less than this (rad) cannot fix a position (a ValueError).
 MIN_INTERSECTION_ANGLE: float = _core.TRIANGULATION_MIN_ANGLE
@@ -55,8 +55,8 @@ def triangulate(
     """
     for name, value in (("bearing_sigma", bearing_sigma), ("elevation_sigma", elevation_sigma)):
         # an SD of 1e300 rad gave a NaN and infinite covariance; beyond pi a bearing says nothing
-        if value is not None and not (isinstance(value, numbers.Real) and 0 <= value <= math.pi):
-            raise ValueError(f"{name} must be a number in [0, pi] rad, got {value!r}")
+        if value is not None:
+            check_number(value, name, 0.0, math.pi, unit="rad")
     if elevation_sigma is not None and bearing_sigma is None:  # was ignored: a position only
         raise ValueError(
             f"elevation_sigma ({elevation_sigma!r}) needs bearing_sigma, which is None: the "
@@ -107,8 +107,8 @@ def _first_robot(points: np.ndarray) -> np.ndarray | float:
 
 
 def _check_angles(theta1: float, theta2: float) -> None:
-    if not (math.isfinite(theta1) and math.isfinite(theta2)):
-        raise ValueError("theta1 and theta2 must be finite")
+    check_number(theta1, "theta1", unit="rad")
+    check_number(theta2, "theta2", unit="rad")
     if not (0 < theta1 < math.pi and 0 < theta2 < math.pi and theta1 + theta2 < math.pi):
         raise ValueError(
             f"theta1 = {theta1:.4g} and theta2 = {theta2:.4g} rad must be interior angles of a "
@@ -123,12 +123,7 @@ def _check_angles(theta1: float, theta2: float) -> None:
 
 def _check_d(d: float) -> None:
     # a NaN d gave (NaN, NaN), a negative one swapped the robots without a word
-    if not (_real(d) and 0 < d < math.inf):
-        raise ValueError(f"d must be a finite number > 0 m (robots 1 and 2 at -d and d), got {d!r}")
-
-
-def _real(value) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+    check_number(d, "d (robots 1 and 2 at -d and d)", 0.0, low_open=True, unit="m")
 
 
 def paper_position(d: float, theta1: float, theta2: float) -> np.ndarray:
@@ -146,10 +141,8 @@ def paper_error(
     errors dtheta1, dtheta2."""
     _check_d(d)
     _check_angles(theta1, theta2)
-    if not all(_real(v) and math.isfinite(v) for v in (dtheta1, dtheta2)):  # NaN gave NaN
-        raise ValueError(
-            f"dtheta1 and dtheta2 must be finite numbers (rad), got {dtheta1!r}, {dtheta2!r}"
-        )
+    check_number(dtheta1, "dtheta1", unit="rad")  # NaN gave NaN
+    check_number(dtheta2, "dtheta2", unit="rad")
     s2 = math.sin(theta1 + theta2) ** 2
     dx = d * (-math.sin(2 * theta2) * dtheta1 + math.sin(2 * theta1) * dtheta2) / s2
     dy = 2 * d * (math.sin(theta2) ** 2 * dtheta1 + math.sin(theta1) ** 2 * dtheta2) / s2

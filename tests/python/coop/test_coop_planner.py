@@ -50,3 +50,21 @@ def test_planner_beats_every_swept_setting() -> None:
     assert ours < theirs
     with pytest.raises(ValueError, match="spacing"):
         plan_moves(spacing=0.0)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"spacing": 0.0}, "spacing must be a finite number > 0 m, got 0.0"),
+        ({"spacing": True}, "spacing must be a finite number > 0 m, got True"),  # was 1 m
+        ({"reach": 0.2}, "reach must be a finite number > 0.25 m, got 0.2"),  # not one spacing
+        ({"reach": math.inf}, "reach must be a finite number > 0.25 m, got inf"),
+        ({"half_width": math.nan}, "half_width must be a finite number > 0 m, got nan"),
+        ({"max_moves": 2.5}, "max_moves must be an integer in 1..1,000, got 2.5"),
+        ({"max_moves": True}, "max_moves must be an integer in 1..1,000, got True"),
+    ],
+)
+def test_the_planner_names_a_bad_setting(kwargs, message):
+    with pytest.raises(ValueError) as caught:
+        plan_moves(**kwargs)
+    assert str(caught.value) == message

@@ -38,7 +38,9 @@ def test_numbers_of_the_wrong_kind_are_refused_and_numpy_numbers_taken():
     for runs in (True, 2.0, 0, "3"):
         with pytest.raises(ValueError, match=r"runs must be an integer in 1\.\.1,000,000, got "):
             simulate(p, runs)
-    with pytest.raises(ValueError, match=r"marker_height must lie in \[0, 10\) m, got True"):
+    with pytest.raises(
+        ValueError, match=r"marker_height must be a finite number in \[0, 10\) m, got True"
+    ):
         simulate_3d(p, _flat, 3, marker_height=True)
     with pytest.raises(TypeError, match="ground must be a function z\\(x, y\\), got NoneType"):
         simulate_3d(p, None, 3)

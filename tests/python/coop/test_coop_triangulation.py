@@ -108,10 +108,18 @@ def test_bad_sigma_and_paper_angles() -> None:
     with pytest.raises(ValueError, match="bearing_sigma"):
         triangulate([[-1.0, 0.0], [1.0, 0.0]], [0.8, 2.3], bearing_sigma=-1.0)
     # an SD of 1e300 rad gave a NaN and infinite covariance
-    with pytest.raises(ValueError, match=r"bearing_sigma must be a number in \[0, pi\] rad"):
+    with pytest.raises(
+        ValueError,
+        match=r"bearing_sigma must be a finite number in \[0, 3.14159\] rad, got 1e\+300",
+    ):
         triangulate([[-1.0, 0.0], [1.0, 0.0]], [0.8, 2.3], bearing_sigma=1e300)
-    with pytest.raises(ValueError, match=r"elevation_sigma must be a number in \[0, pi\]"):
+    with pytest.raises(
+        ValueError, match=r"elevation_sigma must be a finite number in \[0, 3.14159\]"
+    ):
         triangulate([[-1.0, 0.0], [1.0, 0.0]], [0.8, 2.3], bearing_sigma=0.01, elevation_sigma=9)
+    # True was an SD of 1 rad
+    with pytest.raises(ValueError, match=r"bearing_sigma must be a finite number .* got True$"):
+        triangulate([[-1.0, 0.0], [1.0, 0.0]], [0.8, 2.3], bearing_sigma=True)
     with pytest.raises(ValueError, match="elevation 0"):
         triangulate([[0.0, 0, 0], [1.0, 0, 0]], [0.5, 2.0], [math.pi / 2, 0.0])
     with pytest.raises(ValueError, match="interior angles"):
@@ -123,7 +131,7 @@ def test_bad_sigma_and_paper_angles() -> None:
 @pytest.mark.parametrize("d", [math.nan, math.inf, -1.0, 0.0, "1.0", True])
 def test_paper_forms_refuse_a_half_baseline_d_that_is_not_a_positive_distance(d) -> None:
     """paper_position(nan, ...) gave (nan, nan); d = -1 was taken (robots 1 and 2 swapped)."""
-    message = f"d must be a finite number > 0 m (robots 1 and 2 at -d and d), got {d!r}"
+    message = f"d (robots 1 and 2 at -d and d) must be a finite number > 0 m, got {d!r}"
     with pytest.raises(ValueError) as caught:
         paper_position(d, 0.5, 0.6)
     assert str(caught.value) == message
@@ -137,9 +145,8 @@ def test_paper_error_refuses_angle_errors_that_are_not_finite(dtheta1, dtheta2) 
     """paper_error(1, 0.5, 0.6, nan, 0) gave (nan, nan)."""
     with pytest.raises(ValueError) as caught:
         paper_error(1.0, 0.5, 0.6, dtheta1, dtheta2)
-    assert str(caught.value) == (
-        f"dtheta1 and dtheta2 must be finite numbers (rad), got {dtheta1!r}, {dtheta2!r}"
-    )
+    name, bad = ("dtheta2", dtheta2) if dtheta1 == 0.0 else ("dtheta1", dtheta1)
+    assert str(caught.value) == f"{name} must be a finite number rad, got {bad!r}"
     # zero and negative errors, and any d > 0, stay: eq. 4's dy is linear in both
     dy = paper_error(1e-3, 0.5, 0.6, -0.002, 0.0)[1]
     assert dy == pytest.approx(2e-3 * math.sin(0.6) ** 2 * -0.002 / math.sin(1.1) ** 2, rel=1e-12)
@@ -176,3 +183,14 @@ def test_robots_far_from_the_origin_do_not_coincide_by_the_tolerance(far) -> Non
     np.testing.assert_allclose(found - [far, far, 5.0], near, atol=1e-4)
     with pytest.raises(ValueError, match="standing robots 0 and 1 coincide"):
         triangulate([[far, far], [far, far]], [1.0, 2.0])  # one spot still is one
+
+
+@pytest.mark.parametrize(
+    ("theta1", "theta2", "name"), [(True, 0.6, "theta1"), (0.5, math.nan, "theta2")]
+)
+def test_paper_forms_refuse_angles_that_are_no_finite_number(theta1, theta2, name) -> None:
+    """True was an angle of 1 rad."""
+    bad = theta1 if name == "theta1" else theta2
+    with pytest.raises(ValueError) as caught:
+        paper_position(1.0, theta1, theta2)
+    assert str(caught.value) == f"{name} must be a finite number rad, got {bad!r}"
