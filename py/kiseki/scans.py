@@ -30,7 +30,6 @@ the odometry is raw, how ``max_range`` was found). What every reader does alike:
 from __future__ import annotations
 
 import math
-import numbers
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -38,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kiseki import _core
+from kiseki._support.real_numbers import check_number
 from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki.errors import LogFormatError
 
@@ -134,16 +134,9 @@ def check_max_range(where: str, max_range) -> float:
     """``max_range`` as a float: a number in (0, MAGNITUDE_LIMIT] m, refused naming ``where``
     otherwise (a NaN one compared false with every reading, so that every reading counted as an
     endpoint; 1e300 overflowed the float32 readings it is compared with)."""
-    if (
-        isinstance(max_range, bool)
-        or not isinstance(max_range, numbers.Real)
-        or not 0 < max_range <= MAGNITUDE_LIMIT
-    ):
-        raise ValueError(
-            f"{where}: max_range must be a number > 0 and at most {MAGNITUDE_LIMIT:g} m, "
-            f"got {max_range!r}"
-        )
-    return float(max_range)
+    return check_number(
+        max_range, f"{where}: max_range", 0.0, MAGNITUDE_LIMIT, low_open=True, unit="m"
+    )
 
 
 def check_log_max_range(where: str, max_range) -> float:

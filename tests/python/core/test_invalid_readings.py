@@ -188,7 +188,10 @@ def test_the_stored_invalid_reading_is_one_every_model_skips():
     assert np.isnan(kept[[3, 11, 29, 40]]).all() and kept[50] == np.float32(8.0)
     # -1 was stored for every no return; True was taken as 1 m
     for bad in (-1.0, 0.0, np.nan, np.inf, True, 1e9 * (1 + 1e-15)):
-        with pytest.raises(ValueError, match="apply_range_rule: max_range must be a number > 0"):
+        with pytest.raises(
+            ValueError,
+            match=r"apply_range_rule: max_range must be a finite number in \(0, 1e\+09\] m",
+        ):
             apply_range_rule(raw, bad)
     keep = np.ones(len(angles), dtype=bool)
     keep[[3, 11, 29, 40]] = False

@@ -274,7 +274,10 @@ def test_robotlaser1_maximum_range_past_the_bound_is_refused(tmp_path: Path, max
     """A maximum_range of 1e10 was read, then refused by the range rule naming no file."""
     line = robotlaser([1.0, 2.0], [0.5], [0, 0, 0], [0, 0, 0], 5.0, rmax=max_range)
     path = write(tmp_path / "rl.log", line + "\n")
-    message = r"rl\.log:1: ROBOTLASER1 maximum_range: max_range must be a number > 0 and at most"
+    message = (
+        r"rl\.log:1: ROBOTLASER1 maximum_range: "
+        r"max_range must be a finite number in \(0, 1e\+09\] m"
+    )
     with pytest.raises(LogFormatError, match=message):
         read_carmen_log(path)
 
@@ -369,5 +372,5 @@ def test_corrected_logs_hold_no_raw_odometry(shared_data: Path) -> None:
 def test_a_maximum_range_past_a_billion_metres_is_refused_naming_the_log(tmp_path, text, needle):
     """1e10 m was read, and the map built from the log refused it naming no file."""
     path = write(tmp_path / "far.log", text + "\n")
-    with pytest.raises(LogFormatError, match=f"far\\.log{needle}.*at most 1e\\+09 m"):
+    with pytest.raises(LogFormatError, match=f"far\\.log{needle}.*in \\(0, 1e\\+09\\] m"):
         read_carmen_log(path)

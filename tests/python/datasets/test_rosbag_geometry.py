@@ -107,4 +107,4 @@ def test_a_range_max_past_the_bound_is_refused_naming_the_bag(tmp_path: Path, ra
     with pytest.raises(LogFormatError) as caught:
         read_bag_scans(bag)
     assert str(caught.value).startswith(f"{bag}: the first scan on '/scan': range_max: ")
-    assert "max_range must be a number > 0 and at most 1e+09 m" in str(caught.value)
+    assert "max_range must be a finite number in (0, 1e+09] m" in str(caught.value)

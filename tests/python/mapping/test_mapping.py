@@ -213,7 +213,7 @@ def test_a_max_range_that_is_no_length_is_refused(bad):
     angles = np.linspace(-1.0, 1.0, 9)
     poses, ranges = np.zeros((1, 3)), np.full((1, 9), 2.0)
     grid = build_map(poses, ranges, angles, 10.0)
-    needle = r"max_range must be a number > 0 and at most 1e\+09 m, got "
+    needle = r"max_range must be a finite number in \(0, 1e\+09\] m, got "
     with pytest.raises(ValueError, match="endpoint_agreement: " + needle):
         endpoint_agreement(grid, poses, ranges, angles, bad)
     with pytest.raises(ValueError, match="local map: " + needle):
