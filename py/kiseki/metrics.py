@@ -21,6 +21,7 @@ import numpy as np
 from kiseki._support.counts import check_count
 from kiseki._support.moved import moved_names
 from kiseki._support.real_arrays import real_array
+from kiseki._support.real_numbers import check_number
 
 __all__ = [
     "ErrorStatistics",
@@ -236,10 +237,11 @@ def wilson_interval(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
     """The Wilson score interval of a share k/n (95 % with z = 1.96; E. B. Wilson, JASA 22,
     1927); (NaN, NaN) when n is 0."""
     counts = all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in (k, n))
-    if not (counts and 0 <= k <= n <= 2**53 and isinstance(z, numbers.Real) and 0 < z < math.inf):
+    if not (counts and 0 <= k <= n <= 2**53):
         raise ValueError(  # 5 of 3: "math domain error"; n = -3: an interval; 10**400: overflow
             f"wilson_interval: need counts 0 <= k <= n <= 2**53 and z > 0, got {k!r}, {n!r}, {z!r}"
         )
+    check_number(z, "wilson_interval: z", 0.0, low_open=True)
     if n == 0:
         return (math.nan, math.nan)
     p = k / n

@@ -156,6 +156,11 @@ def test_wilson_interval_against_its_closed_form_values():
     for k, n in ((5, 3), (1, -3), (True, 3), (1.5, 3)):
         with pytest.raises(ValueError, match="wilson_interval"):
             wilson_interval(k, n)
+    for z in (0.0, np.nan, np.inf, True):  # True was taken as z = 1
+        with pytest.raises(
+            ValueError, match="^wilson_interval: z must be a finite number > 0, got "
+        ):
+            wilson_interval(5, 20, z)
 
 
 def test_poses_written_with_four_decimals_are_rigid_enough():
