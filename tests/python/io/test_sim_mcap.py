@@ -14,6 +14,7 @@ import os
 import signal
 import subprocess
 import sys
+import types
 import warnings
 from pathlib import Path
 
@@ -699,6 +700,26 @@ def test_bad_messages_raise_value_error(tmp_path: Path) -> None:
         w.write_pose("/p", 1.0, (0, 0, 0))
     # nothing invalid reached the file
     assert read_run(path).topics() == {"/p": ("foxglove.PoseInFrame", 1)}
+
+
+@pytest.mark.parametrize("bad", [True, "1.5", -0.5, math.nan])
+def test_a_time_range_or_resolution_that_is_no_number_is_refused(tmp_path: Path, bad) -> None:
+    """True was written as 1 s, 1 m or 1 m per cell and "1.5" as 1.5 s or m (a negative or NaN
+    value was refused before too); a max range that no float32 holds is refused as before."""
+    grid = types.SimpleNamespace(cells=np.zeros((2, 2), np.int8), resolution=bad, origin=None)
+    with RunWriter(tmp_path / "bad.mcap") as w:
+        with pytest.raises(ValueError, match=r"^time must be a finite number >= 0 s, got "):
+            w.write_pose("/p", bad, (0, 0, 0))
+        with pytest.raises(ValueError, match=r"^max_range must be a finite number > 0 m, got "):
+            w.write_laser_scan("/s", 0.0, (0, 0, 0), [0.0, 0.1], [1, 2], max_range=bad)
+        with pytest.raises(
+            ValueError, match=r"^grid resolution must be a finite number > 0 m, got "
+        ):
+            w.write_grid("/map", 0.0, grid)
+        for past in (1e39, 1e-50):  # no float32 holds them: inf and 0
+            with pytest.raises(ValueError, match=r"m is outside a float32's range$"):
+                w.write_laser_scan("/s", 0.0, (0, 0, 0), [0.0, 0.1], [1, 2], max_range=past)
+    assert read_run(tmp_path / "bad.mcap").topics() == {}
 
 
 def test_missing_and_garbage_files(tmp_path: Path, sample: Path) -> None:

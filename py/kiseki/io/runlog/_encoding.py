@@ -21,6 +21,7 @@ from mcap.records import Schema
 from mcap.writer import CompressionType
 from mcap_protobuf.schema import build_file_descriptor_set
 
+from kiseki._support.real_numbers import check_number
 from kiseki.io.runlog.schemas import FOXGLOVE_MESSAGES
 from kiseki.scans import beams_of_one_turn
 
@@ -39,12 +40,7 @@ _COMPRESSIONS = {
 
 
 def _time_ns(t: float) -> int:
-    try:
-        value = float(t)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"time must be a number of seconds, got {t!r}") from exc
-    if not math.isfinite(value) or value < 0:
-        raise ValueError(f"time must be finite and >= 0 seconds, got {value}")
+    value = check_number(t, "time", 0.0, unit="s")
     ns = round(Fraction(value) * _NS_PER_S)  # the nearest nanosecond, exactly
     if ns > _MAX_NS:
         raise ValueError(f"time {value} s does not fit in 64-bit nanoseconds")
@@ -221,9 +217,11 @@ def _laser_scan(
         raise ValueError(f"ranges have shape {values.shape}, angles {beam.shape}")
     meta = None
     if max_range is not None:
-        limit = float(np.float32(max_range))
-        if not math.isfinite(limit) or limit <= 0:
-            raise ValueError(f"max_range must be finite and positive, got {max_range}")
+        check_number(max_range, "max_range", 0.0, low_open=True, unit="m")
+        with np.errstate(over="ignore"):  # past a float32: inf, refused below
+            limit = float(np.float32(max_range))  # the ranges' own type
+        if not 0 < limit < math.inf:
+            raise ValueError(f"max_range {max_range!r} m is outside a float32's range")
         meta = {_MAX_RANGE_KEY: repr(limit)}
     if np.any(np.isposinf(values)):
         if meta is None:

@@ -35,7 +35,6 @@ Writing (:class:`RunWriter`)
 from __future__ import annotations
 
 import json
-import math
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -51,6 +50,7 @@ from foxglove_schemas_protobuf.RawImage_pb2 import RawImage
 from mcap.writer import LIBRARY_IDENTIFIER, Writer
 
 from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 from kiseki._support.signal_hold import SignalHold
 from kiseki.io.runlog._encoding import (
     _COMPRESSIONS,
@@ -322,9 +322,7 @@ class RunWriter:
         cells = np.asarray(grid.cells)
         if cells.ndim != 2 or cells.dtype != np.int8:
             raise ValueError(f"grid cells must be an int8 (H, W) array, got {cells.dtype}")
-        resolution = float(grid.resolution)
-        if not math.isfinite(resolution) or resolution <= 0:
-            raise ValueError(f"grid resolution must be positive, got {resolution}")
+        resolution = check_number(grid.resolution, "grid resolution", 0.0, low_open=True, unit="m")
         pose7 = _pose7(grid.origin, "grid origin")
         width = int(cells.shape[1])
         message = Grid(
