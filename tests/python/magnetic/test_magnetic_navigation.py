@@ -322,8 +322,15 @@ def test_bad_navigation_requests_are_refused(tmp_path, project_data):
                  travel="filter")  # fmt: skip
     with pytest.raises(ValueError, match="maps must be TaughtMaps"):
         navigate(project_data / "worlds" / "magnetic_path.yaml", None, "multi", tmp_path / "x")
-    with pytest.raises(ValueError, match="offset must be a positive"):
-        teach(project_data / "worlds" / "magnetic_path.yaml", tmp_path, offset=-1.0)
+    for bad in (-1.0, math.nan, True):  # True was taken as an offset of 1 m
+        with pytest.raises(ValueError, match="^teach: offset must be a finite number > 0 m, got "):
+            teach(project_data / "worlds" / "magnetic_path.yaml", tmp_path, offset=bad)
+    for bad in (0.0, math.inf, True):  # True was taken as a scale of 1
+        with pytest.raises(
+            ValueError, match="^navigate: gate_scale must be a finite number > 0, got "
+        ):
+            navigate(project_data / "worlds" / "magnetic_path.yaml", None, "multi",
+                     tmp_path / "x", gate_scale=bad)  # fmt: skip
     lmap = build_linear_map([0.0, 0.1], [[0.2, 0.0, MZ0]] * 2, [0.0, 0.0], path_id=PATH)
     nav = MultiNavigator(lmap)
     with pytest.raises(ValueError, match="3 finite numbers"):

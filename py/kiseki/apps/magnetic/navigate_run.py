@@ -32,13 +32,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import numbers
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.apps.magnetic.teach_checks import (
     check_magnetometer,
     check_route_length,
@@ -166,8 +166,7 @@ def teach(
     """Three teaching runs (taught path, left and right parallel paths) written to
     ``out_dir/teach_{center,left,right}.mcap``; returns their linear maps."""
 
-    if not (isinstance(offset, numbers.Real) and math.isfinite(offset) and offset > 0):
-        raise ValueError(f"teach: offset must be a positive number of metres, got {offset!r}")
+    check_number(offset, "teach: offset", 0.0, low_open=True, unit="m")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     scene = load_scene(scene_path, "teach")
@@ -338,8 +337,7 @@ def navigate(
         raise ValueError(
             f"navigate: navigators must be some of {', '.join(NAVIGATORS)}, got {navigators!r}"
         )
-    if not (isinstance(gate_scale, numbers.Real) and 0 < gate_scale < math.inf):
-        raise ValueError(f"navigate: gate_scale must be a number > 0, got {gate_scale!r}")
+    check_number(gate_scale, "navigate: gate_scale", 0.0, low_open=True)
 
     if method not in METHODS:
         raise ValueError(f"navigate: method must be one of {', '.join(METHODS)}, got {method!r}")
