@@ -26,24 +26,18 @@ the worst case, and setting bias_sd and N to 0 models the compensated unit.
 from __future__ import annotations
 
 import math
-import numbers
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.core import Random, check_seed, derive_seed
 
 __all__ = ["Gyro", "error_sd"]
 
 
-def _non_negative(name: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 <= value < math.inf:
-        raise ValueError(f"gyro: {name} must be a finite number >= 0, got {value!r}")
-    return float(value)
-
-
 def error_sd(t: float, reading_sd_deg: float, bias_sd_deg_s: float, arw_deg_rt_s: float) -> float:
     """SD (deg) of one axis's attitude error t seconds after the start (closed form)."""
-    t = _non_negative("t", t)
+    t = check_number(t, "gyro: t", 0.0, unit="s")
     return math.sqrt(reading_sd_deg**2 + (bias_sd_deg_s * t) ** 2 + arw_deg_rt_s**2 * t)
 
 
@@ -59,9 +53,9 @@ class Gyro:
         arw_deg_rt_s: float = 0.005,
         seed: int = 0,
     ) -> None:
-        self.reading_sd_deg = _non_negative("reading_sd_deg", reading_sd_deg)
-        self.bias_sd_deg_s = _non_negative("bias_sd_deg_s", bias_sd_deg_s)
-        self.arw_deg_rt_s = _non_negative("arw_deg_rt_s", arw_deg_rt_s)
+        self.reading_sd_deg = check_number(reading_sd_deg, "gyro: reading_sd_deg", 0.0)
+        self.bias_sd_deg_s = check_number(bias_sd_deg_s, "gyro: bias_sd_deg_s", 0.0)
+        self.arw_deg_rt_s = check_number(arw_deg_rt_s, "gyro: arw_deg_rt_s", 0.0)
         seed = check_seed(seed)
         self.bias_deg_s = self.bias_sd_deg_s * Random(derive_seed(seed, 0)).normal(0.0, 1.0, 3)
         self._walk_rng = Random(derive_seed(seed, 1))
@@ -71,7 +65,7 @@ class Gyro:
 
     def error_deg(self, t: float) -> np.ndarray:
         """The drift part of the error at t (deg): b t + N W(t), advancing the walk to t."""
-        t = _non_negative("t", t)
+        t = check_number(t, "gyro: t", 0.0, unit="s")
         if t < self._t:
             raise ValueError(f"gyro: time must not go back, got {t} s after {self._t} s")
         if t > self._t and self.arw_deg_rt_s > 0:

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 from kiseki.core import Random, check_seed
 from kiseki.sim.magnetic import DEFAULT_NOISE_SD, MagneticWorld
 
@@ -72,9 +73,7 @@ class MeasurementGrid:
     def __post_init__(self) -> None:
         w = self.where
         lo, hi = _triple(self.lower, "lower", w), _triple(self.upper, "upper", w)
-        s = self.spacing
-        if isinstance(s, bool) or not isinstance(s, numbers.Real) or not math.isfinite(s) or s <= 0:
-            raise ValueError(f"{w}: spacing must be a positive number of metres, got {s!r}")
+        s = check_number(self.spacing, f"{w}: spacing", 0.0, low_open=True, unit="m")
         counts = []
         for axis, a, b in zip("xyz", lo, hi, strict=True):
             if b < a:
@@ -91,7 +90,7 @@ class MeasurementGrid:
             raise ValueError(f"{w}: {total:,} points, more than {MAX_GRID_POINTS:,}")
         object.__setattr__(self, "lower", lo)
         object.__setattr__(self, "upper", hi)
-        object.__setattr__(self, "spacing", float(s))
+        object.__setattr__(self, "spacing", s)
 
     @classmethod
     def from_dict(cls, value: Any, where: str = "measurement_grid") -> MeasurementGrid:
@@ -162,8 +161,7 @@ def hand_survey(
     row order). Default noise: the 3DM-DH's 0.01 G (thesis sec. 6.3.2)."""
     if not isinstance(world, MagneticWorld):
         raise ValueError(f"world: expected a MagneticWorld, got {type(world).__name__}")
-    if isinstance(noise_sd, bool) or not isinstance(noise_sd, numbers.Real) or not noise_sd >= 0:
-        raise ValueError(f"noise_sd: must be a number >= 0, got {noise_sd!r}")
+    check_number(noise_sd, "noise_sd", 0.0, unit="G")
     seed = check_seed(seed)
     truth = np.reshape(world.field_at(points, times), (-1, 3))
     if noise_sd == 0:
@@ -204,8 +202,7 @@ def route_stops(waypoints: Any, step: float = 0.1) -> tuple[np.ndarray, np.ndarr
     """The robot's poses (n, 3) every ``step`` m of travel along the route from its first
     waypoint (the thesis records a reading every 0.1 m, sec. 6.5.1), and their travel distances
     (n,): ``floor(length / step) + 1`` stops."""
-    if isinstance(step, bool) or not isinstance(step, numbers.Real) or not step > 0:
-        raise ValueError(f"step: must be a positive number of metres, got {step!r}")
+    check_number(step, "step", 0.0, low_open=True, unit="m")
     total = float(_legs(waypoints)[1].sum())
     s = step * np.arange(int(math.floor(total / step + 1e-9)) + 1)
     return poses_along_route(waypoints, s), s

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kiseki._support.real_numbers import check_number
 from kiseki.sim.primitives import rotation
 
 __all__ = ["PAPER_MOVES", "Pose6", "attitude", "pose_matrix", "resting_pose", "terrain_pose"]
@@ -106,11 +107,10 @@ def terrain_pose(world, x: float, y: float, yaw: float, length: float, width: fl
     with heading ``yaw`` (rad), resting on the surface of ``world`` (anything with
     ``cast_many(origins, directions, max_range)``): rays are cast down from height ``from_z``
     (below any ceiling, above the ground) at the footprint's corners."""
-    values = (x, y, yaw, length, width, from_z)
-    if not all(isinstance(v, numbers.Real) and math.isfinite(v) for v in values):
-        raise ValueError(f"terrain_pose: expected finite numbers, got {values}")
-    if length <= 0 or width <= 0:
-        raise ValueError(f"terrain_pose: footprint must be > 0 m, got {length} x {width}")
+    for name, value in (("x", x), ("y", y), ("yaw", yaw), ("from_z", from_z)):
+        check_number(value, f"terrain_pose: {name}")
+    for name, value in (("length", length), ("width", width)):  # the footprint
+        check_number(value, f"terrain_pose: {name}", 0.0, low_open=True, unit="m")
     u = np.array([1.0, 1.0, -1.0, -1.0]) * length / 2
     v = np.array([1.0, -1.0, 1.0, -1.0]) * width / 2
     c, s = math.cos(yaw), math.sin(yaw)

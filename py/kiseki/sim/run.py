@@ -20,6 +20,7 @@ import numpy as np
 from tqdm import tqdm
 
 from kiseki._support.field_types import check_field_types
+from kiseki._support.real_numbers import check_number
 from kiseki.control import PurePursuit
 from kiseki.core import check_seed
 from kiseki.io.runlog import TWIST_SCHEMA, TWIST_SCHEMA_NAME, RunWriter, read_run
@@ -51,18 +52,14 @@ class SimConfig:
 
     def __post_init__(self) -> None:
         check_field_types(self)
-        if not (self.dt > 0 and math.isfinite(self.dt)):
-            raise ValueError(f"dt must be positive, got {self.dt}")
-        for name in ("duration", "max_duration"):
+        check_number(self.dt, "dt", 0.0, low_open=True, unit="s")
+        for name in ("duration", "max_duration"):  # at most a day of simulated time
             value = getattr(self, name)
-            if value is not None and not 0 < value <= MAX_SIM_SECONDS:
-                raise ValueError(
-                    f"{name} must be in (0, {MAX_SIM_SECONDS:,.0f}] s (24 h), got {value}"
-                )
+            if value is not None:
+                check_number(value, name, 0.0, MAX_SIM_SECONDS, low_open=True, unit="s")
         for name in ("lookahead", "goal_tolerance"):  # inf was taken, then refused by the
-            value = getattr(self, name)  # route follower once the robot was built
-            if not (value > 0 and math.isfinite(value)):
-                raise ValueError(f"{name} must be a finite number > 0 m, got {value!r}")
+            # route follower once the robot was built
+            check_number(getattr(self, name), name, 0.0, low_open=True, unit="m")
         check_seed(self.seed)
 
 

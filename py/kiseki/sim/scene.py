@@ -42,6 +42,7 @@ import yaml
 
 from kiseki import _core
 from kiseki._support.inputs import MIB, YAML_LIMIT, check_input, read_input
+from kiseki._support.real_numbers import check_number
 from kiseki._support.schema import SchemaError, parse
 from kiseki._support.yaml import safe_load_12, yaml_problem
 from kiseki.core import Pose2
@@ -123,9 +124,8 @@ class Scene:
         """The 2-D ground-truth grid of a height band (metres above the floor), at the scene's
         grid resolution or at `resolution`."""
         lo, hi = self.bounds
-        res = self.grid_resolution if resolution is None else float(resolution)
-        if not (np.isfinite(res) and res > 0):
-            raise ValueError(f"resolution must be a positive number of metres, got {resolution}")
+        res = self.grid_resolution if resolution is None else resolution
+        res = check_number(res, "resolution", 0.0, low_open=True, unit="m")
         key = (id(self.world), float(z_min), float(z_max), res)
         if key not in self._bands:  # rasterising takes 0.1-0.3 s: once per band and scene
             width = max(1, int(np.ceil((hi[0] - lo[0]) / res)))

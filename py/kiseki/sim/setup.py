@@ -18,13 +18,13 @@ through their models here to build them."""
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 from kiseki._support.schema import SchemaError, location_text, parse
 from kiseki.core import check_seed, derive_seed
 from kiseki.sim.collisions import check_free_start
@@ -159,8 +159,7 @@ def build_sensors(
 ) -> list[SensorSetup]:
     """The sensors of robot `index`; each gets its own seeded stream."""
     seed = check_seed(seed)
-    if isinstance(dt, bool) or not isinstance(dt, numbers.Real) or not 0 < dt < math.inf:
-        raise ValueError(f"{scene.path}: dt must be a finite number of seconds > 0, got {dt!r}")
+    check_number(dt, f"{scene.path}: dt", 0.0, low_open=True, unit="s")
     robot_at = _robot_at(scene, index)
     out: list[SensorSetup] = []
     magnetic = (

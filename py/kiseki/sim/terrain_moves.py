@@ -18,7 +18,6 @@ grows along the run as it would on a robot.
 from __future__ import annotations
 
 import math
-import numbers
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from kiseki._support.counts import check_count
+from kiseki._support.real_numbers import check_number
 from kiseki.core import check_seed
 from kiseki.sim.pose6 import Pose6, resting_pose
 from kiseki.sim.scene import load_scene, read_octree
@@ -125,8 +125,7 @@ def terrain_stops(
     """The ``moves + 1`` stops of a run in a scene YAML or an OctoMap ``.bt`` (see the module)."""
     seed = check_seed(seed)
     moves = check_count(moves, "moves", 1, 200)
-    if not (isinstance(step, numbers.Real) and 0.02 <= step <= 0.6):
-        raise ValueError(f"step must be 0.02..0.6 m (the search reaches 0.7 m), got {step!r}")
+    check_number(step, "step", 0.02, 0.6, unit="m")  # the search reaches 0.7 m
     path = Path(world_path)
     if path.suffix == ".bt":
         world = read_octree(path)
