@@ -152,7 +152,8 @@ def _check(form: int, moves: int, angle: float) -> None:
         raise ValueError(
             f"form 1 takes an odd number of moves (scout, pair, ..., scout), got {moves}"
         )
-    if not (math.isfinite(angle) and math.radians(5) <= angle <= math.radians(85)):
+    check_number(angle, "the representative angle", unit="rad")  # True was 1 rad (57 deg)
+    if not math.radians(5) <= angle <= math.radians(85):
         raise ValueError(
             f"the representative angle must lie in 5..85 deg, got {math.degrees(angle)}"
         )

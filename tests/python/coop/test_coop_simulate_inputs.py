@@ -49,3 +49,17 @@ def test_numbers_of_the_wrong_kind_are_refused_and_numpy_numbers_taken():
     plain = simulate(p, 4, angle_sigma=float(np.float32(0.002)), seed=5)
     np.testing.assert_array_equal(same.goal_errors, plain.goal_errors)
     assert simulate_3d(p, _flat, np.int32(2), seed=1).goal_errors.shape == (2,)
+
+
+@pytest.mark.parametrize(
+    ("angle", "message"),
+    [
+        (True, "the representative angle must be a finite number rad, got True"),  # was 57 deg
+        (np.nan, "the representative angle must be a finite number rad, got nan"),
+        (np.radians(90.0), "the representative angle must lie in 5..85 deg, got 90.0"),
+    ],
+)
+def test_a_representative_angle_is_a_number_in_its_range(angle, message):
+    with pytest.raises(ValueError) as caught:
+        plan(2, 7, angle)
+    assert str(caught.value) == message
