@@ -22,6 +22,7 @@ import threading
 import time
 from dataclasses import dataclass, field
 
+from kiseki._support.real_numbers import check_number
 from kiseki.apps.teach.playback import check_route
 from kiseki.serve.history import RouteHistory
 from kiseki.serve.robot import Robot, RobotState
@@ -111,8 +112,9 @@ class RouteRunner:
         speed_up: float = 1.0,
         history: RouteHistory | None = None,
     ) -> None:
-        if not dwell >= 0 or not speed_up > 0:
-            raise ValueError(f"dwell >= 0 s and speed_up > 0 are needed, got {dwell}, {speed_up}")
+        check_number(dwell, "dwell", 0.0, unit="s")  # inf was an OverflowError at the goal
+        if not speed_up > 0:  # not check_number's: math.inf is a speed-up
+            raise ValueError(f"speed_up must be > 0 (inf: as fast as it steps), got {speed_up!r}")
         self.robot, self.taught, self.dwell, self.speed_up = robot, taught, dwell, speed_up
         self.history = history if history is not None else RouteHistory()
         self.broadcaster = Broadcaster()

@@ -328,6 +328,18 @@ def test_command_refuses_bad_input_in_one_line(taught, tmp_path, project_root):
         assert lines[0].startswith("kiseki: error:") and words in lines[0], lines[0]
 
 
+def test_a_dwell_that_is_no_finite_time_and_a_speed_up_not_above_0_are_refused():
+    """An infinite dwell was taken (an OverflowError at the goal) and True as 1 s."""
+    from kiseki.serve.routes import RouteRunner
+
+    for dwell in (-1.0, math.nan, math.inf, True):
+        with pytest.raises(ValueError, match=r"^dwell must be a finite number >= 0 s, got "):
+            RouteRunner(None, None, dwell=dwell)
+    for speed_up in (0.0, -1.0, math.nan):
+        with pytest.raises(ValueError, match=r"^speed_up must be > 0 \(inf: as fast as it steps\)"):
+            RouteRunner(None, None, speed_up=speed_up)
+
+
 # The route page's stop at the goal over seeds, with every option of the server at its default
 # (method both, 1000 particles; the default seed 0 and the next seven). The criterion: the robot
 # stops within the thesis' 0.1 m (sec. 2.2) in most routes, decided by the 95 % Wilson interval
