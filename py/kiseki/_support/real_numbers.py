@@ -30,7 +30,8 @@ def number_rule(
     unit: str = "",
 ) -> str:
     """``a finite number in [LOW, HIGH] UNIT`` (parentheses for an open end), or ``> LOW``,
-    ``>= LOW``, ``< HIGH``, ``<= HIGH`` where only one end is finite, or nothing where none is."""
+    ``>= LOW``, ``< HIGH``, ``<= HIGH`` where only one end is finite; with neither,
+    ``a finite number (UNIT)``."""
     if math.isinf(low) and math.isinf(high):
         span = ""
     elif math.isinf(high):
@@ -40,6 +41,8 @@ def number_rule(
     else:
         left, right = "(" if low_open else "[", ")" if high_open else "]"
         span = f" in {left}{low:,g}, {high:,g}{right}"
+    if not span:  # no bound: "a finite number (m)" reads as the unit, "a finite number m" not
+        return "a finite number" + (f" ({unit})" if unit else "")
     return "a finite number" + span + (f" {unit}" if unit else "")
 
 

@@ -54,8 +54,8 @@ def test_numbers_of_the_wrong_kind_are_refused_and_numpy_numbers_taken():
 @pytest.mark.parametrize(
     ("angle", "message"),
     [
-        (True, "the representative angle must be a finite number rad, got True"),  # was 57 deg
-        (np.nan, "the representative angle must be a finite number rad, got nan"),
+        (True, "the representative angle must be a finite number (rad), got True"),  # was 57 deg
+        (np.nan, "the representative angle must be a finite number (rad), got nan"),
         (np.radians(90.0), "the representative angle must lie in 5..85 deg, got 90.0"),
     ],
 )

@@ -146,7 +146,7 @@ def test_paper_error_refuses_angle_errors_that_are_not_finite(dtheta1, dtheta2) 
     with pytest.raises(ValueError) as caught:
         paper_error(1.0, 0.5, 0.6, dtheta1, dtheta2)
     name, bad = ("dtheta2", dtheta2) if dtheta1 == 0.0 else ("dtheta1", dtheta1)
-    assert str(caught.value) == f"{name} must be a finite number rad, got {bad!r}"
+    assert str(caught.value) == f"{name} must be a finite number (rad), got {bad!r}"
     # zero and negative errors, and any d > 0, stay: eq. 4's dy is linear in both
     dy = paper_error(1e-3, 0.5, 0.6, -0.002, 0.0)[1]
     assert dy == pytest.approx(2e-3 * math.sin(0.6) ** 2 * -0.002 / math.sin(1.1) ** 2, rel=1e-12)
@@ -193,4 +193,4 @@ def test_paper_forms_refuse_angles_that_are_no_finite_number(theta1, theta2, nam
     bad = theta1 if name == "theta1" else theta2
     with pytest.raises(ValueError) as caught:
         paper_position(1.0, theta1, theta2)
-    assert str(caught.value) == f"{name} must be a finite number rad, got {bad!r}"
+    assert str(caught.value) == f"{name} must be a finite number (rad), got {bad!r}"

@@ -18,6 +18,7 @@ from kiseki._support.real_numbers import check_number, number_rule
     ("kwargs", "rule"),
     [
         ({}, "a finite number"),
+        ({"unit": "rad"}, "a finite number (rad)"),
         ({"low": 0.0, "low_open": True}, "a finite number > 0"),
         ({"low": 0.0, "unit": "m"}, "a finite number >= 0 m"),
         ({"high": 1.0, "high_open": True}, "a finite number < 1"),

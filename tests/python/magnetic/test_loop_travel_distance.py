@@ -179,7 +179,7 @@ def test_bad_inputs_are_refused_with_one_line():
         ):
             LoopTravelDistanceLocalizer([], length=length)
     with pytest.raises(
-        ValueError, match=r"^loop filter: start must be a finite number m, got nan$"
+        ValueError, match=r"^loop filter: start must be a finite number \(m\), got nan$"
     ):
         LoopTravelDistanceLocalizer([p], start=math.nan)
     loc = LoopTravelDistanceLocalizer([p])
@@ -187,7 +187,7 @@ def test_bad_inputs_are_refused_with_one_line():
         loc.step(0.1, [0.1, 0.2])
     with pytest.raises(
         ValueError,
-        match=r"^loop filter: the odometry increment must be a finite number m, got nan$",
+        match=r"^loop filter: the odometry increment must be a finite number \(m\), got nan$",
     ):
         loc.step(math.nan, [0.1])
     with pytest.raises(ValueError, match=r"^loop filter: the reading must be finite$"):

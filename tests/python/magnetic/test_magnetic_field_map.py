@@ -194,9 +194,9 @@ def test_bad_maps_are_refused():
         ({"origin": [0.0, 0.0, 0.0]}, "origin must have shape"),
         ({"resolution": 0.0}, r"^resolution must be a finite number > 0 m, got 0.0$"),
         ({"resolution": np.inf}, r"^resolution must be a finite number > 0 m, got inf$"),
-        ({"height": np.nan}, r"^height must be a finite number m, got nan$"),
-        ({"height": "0.2"}, r"^height must be a finite number m, got '0.2'$"),  # was 0.2 m
-        ({"height": True}, r"^height must be a finite number m, got True$"),  # was 1 m
+        ({"height": np.nan}, r"^height must be a finite number \(m\), got nan$"),
+        ({"height": "0.2"}, r"^height must be a finite number \(m\), got '0.2'$"),  # was 0.2 m
+        ({"height": True}, r"^height must be a finite number \(m\), got True$"),  # was 1 m
         ({"mean": good.mean[..., :2]}, "mean must have shape"),
         ({"kernel": "se"}, "kernel"),
         ({"prior_variance": [1.0, 0.0, 1.0]}, "prior_variance"),

@@ -199,16 +199,18 @@ def test_bad_input():
         TravelDistanceLocalizer(m, TravelDistanceConfig(window=1e6))
     loc = TravelDistanceLocalizer(m, TravelDistanceConfig(particles=10))
     with pytest.raises(
-        ValueError, match=r"^travel distance: the mz reading must be a finite number G, got nan$"
+        ValueError,
+        match=r"^travel distance: the mz reading must be a finite number \(G\), got nan$",
     ):
         loc.step(0.1, float("nan"))
     with pytest.raises(
         ValueError,
-        match=r"^travel distance: the odometry increment must be a finite number m, got '0\.1'$",
+        match=r"^travel distance: the odometry increment must be a finite number \(m\), "
+        r"got '0\.1'$",
     ):
         loc.step("0.1", 0.4)
     with pytest.raises(
-        ValueError, match=r"^travel distance: d must be a finite number m, got nan$"
+        ValueError, match=r"^travel distance: d must be a finite number \(m\), got nan$"
     ):
         heading_from_map(m, float("nan"), 0.0, [0.1, 0.2, 0.3])
     with pytest.raises(
