@@ -17,10 +17,13 @@ import asyncio
 import itertools
 import json
 import math
+import numbers
 import secrets
 import threading
 import time
 from dataclasses import dataclass, field
+
+import numpy as np
 
 from kiseki._support.real_numbers import check_number
 from kiseki.apps.teach.playback import check_route
@@ -113,7 +116,8 @@ class RouteRunner:
         history: RouteHistory | None = None,
     ) -> None:
         check_number(dwell, "dwell", 0.0, unit="s")  # inf was an OverflowError at the goal
-        if not speed_up > 0:  # not check_number's: math.inf is a speed-up
+        real = isinstance(speed_up, numbers.Real) and not isinstance(speed_up, bool | np.bool_)
+        if not (real and speed_up > 0):  # not check_number's: math.inf is a speed-up
             raise ValueError(f"speed_up must be > 0 (inf: as fast as it steps), got {speed_up!r}")
         self.robot, self.taught, self.dwell, self.speed_up = robot, taught, dwell, speed_up
         self.history = history if history is not None else RouteHistory()

@@ -329,13 +329,14 @@ def test_command_refuses_bad_input_in_one_line(taught, tmp_path, project_root):
 
 
 def test_a_dwell_that_is_no_finite_time_and_a_speed_up_not_above_0_are_refused():
-    """An infinite dwell was taken (an OverflowError at the goal) and True as 1 s."""
+    """An infinite dwell was taken (an OverflowError at the goal) and True as 1 s; True as a
+    speed-up of 1, text as a TypeError from the comparison."""
     from kiseki.serve.routes import RouteRunner
 
     for dwell in (-1.0, math.nan, math.inf, True):
         with pytest.raises(ValueError, match=r"^dwell must be a finite number >= 0 s, got "):
             RouteRunner(None, None, dwell=dwell)
-    for speed_up in (0.0, -1.0, math.nan):
+    for speed_up in (0.0, -1.0, math.nan, True, "2"):
         with pytest.raises(ValueError, match=r"^speed_up must be > 0 \(inf: as fast as it steps\)"):
             RouteRunner(None, None, speed_up=speed_up)
 
