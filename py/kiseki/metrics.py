@@ -239,7 +239,7 @@ def wilson_interval(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
     counts = all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in (k, n))
     if not (counts and 0 <= k <= n <= 2**53):
         raise ValueError(  # 5 of 3: "math domain error"; n = -3: an interval; 10**400: overflow
-            f"wilson_interval: need counts 0 <= k <= n <= 2**53 and z > 0, got {k!r}, {n!r}, {z!r}"
+            f"wilson_interval: need counts 0 <= k <= n <= 2**53, got {k!r}, {n!r}"
         )
     check_number(z, "wilson_interval: z", 0.0, low_open=True)
     if n == 0:
