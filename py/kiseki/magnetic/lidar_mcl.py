@@ -91,12 +91,18 @@ class LidarMclConfig:
         check_field_types(self)
         check_count(self.particles, "lidar MCL: particles", 1, PARTICLE_LIMIT)
         check_count(self.beams, "lidar MCL: beams", 1, BEAM_LIMIT)
-        check_number(self.sigma_d, "lidar MCL: sigma_d", 1e-6, unit="m")
-        check_number(self.sigma_theta, "lidar MCL: sigma_theta", 0.0, math.pi, unit="rad")
-        check_number(self.r_z_gate, "lidar MCL: r_z_gate", 0.0, 1.0)
-        check_number(self.r_theta_gate, "lidar MCL: r_theta_gate", 0.0, 1.0)
-        check_number(self.reach, "lidar MCL: reach", 0.0, unit="m")
-        check_number(self.resample_threshold, "lidar MCL: resample_threshold", 0.0, 1.0)
+
+        def hold(name: str, *bounds: float, **rule: Any) -> None:
+            # held as checked: -0.0 as 0.0 (numpy's normal refuses a scale of -0.0)
+            value = check_number(getattr(self, name), f"lidar MCL: {name}", *bounds, **rule)
+            object.__setattr__(self, name, value)
+
+        hold("sigma_d", 1e-6, unit="m")
+        hold("sigma_theta", 0.0, math.pi, unit="rad")
+        hold("r_z_gate", 0.0, 1.0)
+        hold("r_theta_gate", 0.0, 1.0)
+        hold("reach", 0.0, unit="m")
+        hold("resample_threshold", 0.0, 1.0)
         if not isinstance(self.magnetic, bool):
             raise ValueError(f"lidar MCL: magnetic must be true or false, got {self.magnetic!r}")
         check_seed(self.seed)

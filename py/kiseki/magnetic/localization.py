@@ -116,8 +116,13 @@ class MagneticMclConfig:
 
     def __post_init__(self) -> None:
         check_field_types(self)
-        if self.noise_sd is not None:  # None: the map's kernel sigma_n
-            check_number(self.noise_sd, "noise_sd", 0.0)
+        if self.noise_sd is not None:
+            check_number(
+                self.noise_sd,
+                "MagneticMclConfig.noise_sd",
+                0.0,
+                unit="(or None: the map's sigma_n)",
+            )
         check_spread("initial_sd", self.initial_sd)  # 1e300 was refused only by the run
         self.mcl()  # the engine's own checks
 

@@ -84,7 +84,7 @@ class LoopTravelConfig:
     def __post_init__(self) -> None:
         check_field_types(self)
         check_count(self.particles, "loop filter: particles", 1, PARTICLE_LIMIT)
-        for name in ("odometry_noise", "scale_sd", "scale_walk", "initial_sd"):
+        for name in ("odometry_noise", "scale_walk", "initial_sd"):
             check_number(getattr(self, name), f"loop filter: {name}", 0.0)
         check_number(self.scale_sd, "loop filter: scale_sd", 0.0, 0.5, high_open=True)
         check_number(self.resample_threshold, "loop filter: resample_threshold", 0.0, 1.0)

@@ -51,7 +51,8 @@ class DriftCheck:
 
     def __post_init__(self) -> None:
         check_count(self.window, "drift check: window", 2)
-        check_number(self.limit, "drift check: limit", 0.0, low_open=True)
+        limit = check_number(self.limit, "drift check: limit", 0.0, low_open=True)
+        object.__setattr__(self, "limit", limit)  # a numpy number held as a Python float
 
 
 @dataclass(frozen=True)

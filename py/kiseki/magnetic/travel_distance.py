@@ -98,11 +98,17 @@ class TravelDistanceConfig:
     def __post_init__(self) -> None:
         check_field_types(self)
         check_count(self.particles, "travel distance: particles", 1, PARTICLE_LIMIT)
-        check_number(self.gain, "travel distance: gain a", 0.0, low_open=True)
-        check_number(self.window, "travel distance: window l", 0.0, low_open=True, unit="m")
-        check_number(self.odometry_noise, "travel distance: odometry_noise", 0.0)
-        check_number(self.initial_sd, "travel distance: initial_sd", 0.0, unit="m")
-        check_number(self.resample_threshold, "travel distance: resample_threshold", 0.0, 1.0)
+
+        def hold(name: str, label: str, *bounds: float, **rule: Any) -> None:
+            # held as checked: -0.0 as 0.0, a numpy number as a Python float
+            value = check_number(getattr(self, name), f"travel distance: {label}", *bounds, **rule)
+            object.__setattr__(self, name, value)
+
+        hold("gain", "gain a", 0.0, low_open=True)
+        hold("window", "window l", 0.0, low_open=True, unit="m")
+        hold("odometry_noise", "odometry_noise", 0.0)
+        hold("initial_sd", "initial_sd", 0.0, unit="m")
+        hold("resample_threshold", "resample_threshold", 0.0, 1.0)
         check_seed(self.seed, "travel distance: seed")
 
 

@@ -71,10 +71,13 @@ class WalkOdometry:
     truth_window: float = 3.0
 
     def __post_init__(self) -> None:
+        # held as checked: -0.0 as 0.0 (numpy's normal refuses a scale of -0.0), a numpy
+        # number as a Python float
         for name in ("scale_sd", "noise", "radius", "min_travel", "max_offset", "truth_window"):
-            check_number(getattr(self, name), f"walk: {name}", 0.0)
+            object.__setattr__(self, name, check_number(getattr(self, name), f"walk: {name}", 0.0))
         if self.scale_error is not None:
-            check_number(self.scale_error, "walk: scale_error", -1.0, low_open=True)
+            e = check_number(self.scale_error, "walk: scale_error", -1.0, low_open=True)
+            object.__setattr__(self, "scale_error", e)
 
 
 @dataclass(frozen=True)

@@ -157,10 +157,12 @@ def test_bad_inputs_are_refused_with_one_line():
     p = table_profile(grid_values, 0.01)
     with pytest.raises(ValueError, match="start must be one of"):
         LoopTravelConfig(start="somewhere")
-    with pytest.raises(
-        ValueError, match=r"scale_sd must be a finite number in \[0, 0.5\), got 0.7$"
-    ):
-        LoopTravelConfig(scale_sd=0.7)
+    for scale_sd, shown in ((0.7, r"0\.7"), (-0.1, r"-0\.1"), (math.nan, "nan")):  # one rule
+        with pytest.raises(
+            ValueError,
+            match=rf"^loop filter: scale_sd must be a finite number in \[0, 0\.5\), got {shown}$",
+        ):
+            LoopTravelConfig(scale_sd=scale_sd)
     with pytest.raises(ValueError, match=r"scale_walk must be a finite number >= 0, got -0.1$"):
         LoopTravelConfig(scale_walk=-0.1)
     with pytest.raises(ValueError, match=r"resample_threshold must be a finite number in \[0, 1\]"):
@@ -201,7 +203,10 @@ def test_bad_inputs_are_refused_with_one_line():
         match=r"^loop profile: the loop's length must be a finite number > 0 m, got -1.0$",
     ):
         fit_loop_profile([0.0, 1.0, 2.0, 3.0], [0.0, 1.0, 2.0, 3.0], -1.0)
-    for floor in (-0.1, math.nan, True):  # True was a floor of 1
+    # True passed the old check but was no floor of 1: where the fitted sigma_n was below 1 (as
+    # here) the kernel refused it, naming sigma_n (sigma_f when that was below 1 too), and where
+    # sigma_n was 1 or more it changed nothing
+    for floor in (-0.1, math.nan, True):
         with pytest.raises(
             ValueError, match=r"^loop profile: noise_floor must be a finite number >= 0, got "
         ):

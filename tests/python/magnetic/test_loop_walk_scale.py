@@ -6,6 +6,8 @@ control, the same filter without the field's readings."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -13,7 +15,7 @@ from _helpers.synthetic_walk import write_walk
 from kiseki.datasets.kok import read_kok_walk
 from kiseki.magnetic.loop_travel_distance import LoopTravelConfig
 from kiseki.magnetic.loop_walk import localize_walk_loop, map_walk_loop
-from kiseki.magnetic.travel_distance_walk import WalkOdometry, localize_walk
+from kiseki.magnetic.travel_distance_walk import WalkOdometry, localize_walk, walk_odometry
 
 SCALE_ERROR = 0.08  # the odometry 8 % long: the travel is 1 / 1.08 of it
 SEEDS = range(5)
@@ -78,3 +80,15 @@ def test_bad_walk_odometry_is_refused(kw, message):
     """A scale error of True was taken as an odometry 100 % long."""
     with pytest.raises(ValueError, match=message):
         WalkOdometry(**kw)
+
+
+def test_a_walk_odometry_of_minus_zero_is_one_of_zero():
+    """-0.0 is held as 0.0: numpy's normal refused a scale_sd of -0.0 ('scale < 0')."""
+    odometry = WalkOdometry(scale_sd=-0.0, noise=-0.0, scale_error=None)
+    assert math.copysign(1.0, odometry.scale_sd) == 1.0
+    assert math.copysign(1.0, odometry.noise) == 1.0
+    xy = np.column_stack([np.linspace(0.0, 5.0, 20), np.zeros(20)])
+    e, steps = walk_odometry(xy, odometry, 0)
+    e_zero, steps_zero = walk_odometry(xy, WalkOdometry(scale_sd=0.0, noise=0.0), 0)
+    assert e == e_zero == 0.0
+    np.testing.assert_array_equal(steps, steps_zero)

@@ -202,6 +202,15 @@ def test_bad_settings_are_named(kw, message):
         LidarMclConfig(**kw)
 
 
+def test_a_sigma_theta_of_minus_zero_resets_to_theta_exactly():
+    """-0.0 was held as given, and numpy's normal refused it in the reset ('scale < 0')."""
+    mcl = _mcl(100, sigma_theta=-0.0)
+    assert math.copysign(1.0, mcl.config.sigma_theta) == 1.0
+    step = mcl.step((5.0, 0.0, 0.1), EMPTY_SCAN, _reading(0.5))
+    assert step.reset
+    np.testing.assert_allclose(mcl.localizer.poses[:, 2], math.radians(0.5), rtol=0, atol=1e-12)
+
+
 def test_bad_inputs_are_named():
     mcl = _mcl(100)
     with pytest.raises(ValueError, match="odometry must be 3 finite"):

@@ -133,7 +133,9 @@ def test_bad_input_is_refused(field_map):
             MagneticMapModel(field_map, offsets, bad)
         if bad is not True:  # the config's field types refuse a bool themselves
             with pytest.raises(
-                ValueError, match=rf"^noise_sd must be a finite number >= 0, got {shown}$"
+                ValueError,
+                match=r"^MagneticMclConfig\.noise_sd must be a finite number >= 0 "
+                rf"\(or None: the map's sigma_n\), got {shown}$",
             ):
                 MagneticMclConfig(noise_sd=bad)
     model = MagneticMapModel(field_map, offsets, 0.01)

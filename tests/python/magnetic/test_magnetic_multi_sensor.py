@@ -127,3 +127,9 @@ def test_bad_inputs(maps):
             ValueError, match=rf"^drift check: limit must be a finite number > 0, got {shown}$"
         ):
             DriftCheck(limit=limit)
+
+
+def test_a_drift_limit_is_held_as_a_python_float():
+    """A numpy limit was held as given (a float32 in the config)."""
+    limit = DriftCheck(limit=np.float32(2.5)).limit
+    assert type(limit) is float and limit == 2.5

@@ -183,6 +183,47 @@ def test_bad_config(kwargs, message):
         TravelDistanceConfig(**kwargs)
 
 
+def test_a_config_holds_minus_zero_as_zero():
+    """-0.0 was held as given (and passed on to the engine as a spread)."""
+    config = TravelDistanceConfig(odometry_noise=-0.0, initial_sd=-0.0, resample_threshold=-0.0)
+    for value in (config.odometry_noise, config.initial_sd, config.resample_threshold):
+        assert value == 0.0 and math.copysign(1.0, value) == 1.0
+
+
+def _step(x):
+    loc = TravelDistanceLocalizer(linear_map(length=5.0), TravelDistanceConfig(particles=20))
+    return loc.step(x, x), loc.particles
+
+
+def _start(x):
+    config = TravelDistanceConfig(particles=20, initial_sd=0.1, seed=3)
+    loc = TravelDistanceLocalizer(linear_map(length=5.0), config, start=x)
+    return loc.estimate, loc.particles
+
+
+def _heading_from_map(x):
+    return heading_from_map(linear_map(length=5.0), x, x, [0.2, 0.0, 0.45])
+
+
+@pytest.mark.parametrize(
+    "call",
+    [_step, _start, lambda x: azimuth_heading(*[x] * 8), _heading_from_map],
+    ids=["step", "start", "azimuth_heading", "heading_from_map"],
+)
+@pytest.mark.parametrize(
+    ("numpy_value", "python_value"),
+    [(np.float32(0.5), 0.5), (np.int64(1), 1.0)],  # 0.5 is exact in a float32
+    ids=["float32", "int64"],
+)
+def test_numpy_numbers_are_taken_as_their_python_floats(call, numpy_value, python_value):
+    """The filter's increment, reading and start, azimuth_heading's values and heading_from_map's
+    d and theta refused np.float32 and numpy integers ('must be a number'; they took int, float
+    and np.float64): each now gives what the Python float of its value gives."""
+    got, want = call(numpy_value), call(python_value)
+    for a, b in zip(got, want, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
 def test_bad_input():
     m = linear_map(length=5.0)
     with pytest.raises(ValueError, match="1 node"):
