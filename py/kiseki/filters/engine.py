@@ -169,8 +169,8 @@ class MclConfig:
         for name in ("reset_look_elsewhere", "reset_needs_agreement", "sensor_reset_confirm"):
             value = getattr(self, name)
             _check(isinstance(value, bool), f"{name} must be True or False, got {value!r}")
-        for name in ("update_min_d", "update_min_a"):
-            check_number(getattr(self, name), name, 0.0)
+        for name, unit in (("update_min_d", "m"), ("update_min_a", "rad")):
+            check_number(getattr(self, name), name, 0.0, unit=unit)
         _check(  # a turn is wrapped to at most pi: above it means never on rotation alone
             self.update_min_a <= 2 * math.pi,
             f"update_min_a must be <= 2 pi, got {self.update_min_a}",

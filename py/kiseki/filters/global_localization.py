@@ -163,11 +163,16 @@ class GlobalConfig:
         if self.kld and self.tracking_particles > self.particles:
             raise ValueError("with kld, tracking_particles (the minimum) must not exceed particles")
         self.mcl()  # the engine's own checks
-        positive = ("sigma_hit", "shrink_radius", "converged_radius", "likelihood_power")
-        for name in positive:
-            check_number(getattr(self, name), name, 0.0, low_open=True)
-        for name in ("update_min_d", "update_min_a"):
-            check_number(getattr(self, name), name, 0.0)
+        positive = (
+            ("sigma_hit", "m"),
+            ("shrink_radius", "m"),
+            ("converged_radius", "m"),
+            ("likelihood_power", ""),
+        )
+        for name, unit in positive:
+            check_number(getattr(self, name), name, 0.0, low_open=True, unit=unit)
+        for name, unit in (("update_min_d", "m"), ("update_min_a", "rad")):
+            check_number(getattr(self, name), name, 0.0, unit=unit)
         if self.shrink_after < 1:
             raise ValueError(f"shrink_after must be >= 1, got {self.shrink_after}")
         check_number(self.weight_share, "weight_share", 0.0, 1.0, low_open=True)

@@ -151,8 +151,8 @@ class LocalizeConfig:
             f"combination must be product or nav2, got {self.combination!r}",
         )
         ray_caster(self.caster)  # ValueError unless it names one
-        for name in ("sigma_hit", "lambda_short"):
-            check_number(getattr(self, name), name, 0.0, low_open=True)
+        for name, unit in (("sigma_hit", "m"), ("lambda_short", "1/m")):
+            check_number(getattr(self, name), name, 0.0, low_open=True, unit=unit)
         for name in ("z_hit", "z_rand", "z_short", "z_max", "z_intrusion"):
             check_number(getattr(self, name), name, 0.0)
         _check(self.z_hit + self.z_rand > 0, "z_hit and z_rand must not both be 0")
@@ -194,12 +194,12 @@ class LocalizeConfig:
             not self.beam_skip or self.method == "likelihood-field",
             f"beam skipping applies only to the likelihood field, not to {self.method}",
         )
-        check_number(self.beam_skip_distance, "beam_skip_distance", 0.0)
+        check_number(self.beam_skip_distance, "beam_skip_distance", 0.0, unit="m")
         for name in ("beam_skip_threshold", "beam_skip_error_threshold"):
             check_number(getattr(self, name), name, 0.0, 1.0)
         if self.budget_ms is not None:
             check_number(
-                self.budget_ms, "budget_ms", 0.0, low_open=True, unit="(or None: no budget)"
+                self.budget_ms, "budget_ms", 0.0, low_open=True, unit="ms (or None: no budget)"
             )
         _check(
             self.budget_ms is None or self.method in ("likelihood-field", "beam"),

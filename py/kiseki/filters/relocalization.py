@@ -92,10 +92,23 @@ class RelocalizeConfig:
                 f"relocalize: {name}",
                 0.0,
                 low_open=True,
+                unit="m",
                 error=RelocalizationError,
             )
-        for name in ("z_hit", "z_rand", "angular_step", "min_distance", "min_angle"):
-            check_number(getattr(self, name), f"relocalize: {name}", 0.0, error=RelocalizationError)
+        for name, unit in (
+            ("z_hit", ""),
+            ("z_rand", ""),
+            ("angular_step", "rad"),
+            ("min_distance", "m"),
+            ("min_angle", "rad"),
+        ):
+            check_number(
+                getattr(self, name),
+                f"relocalize: {name}",
+                0.0,
+                unit=unit,
+                error=RelocalizationError,
+            )
         if not isinstance(self.free_only, bool):
             raise RelocalizationError(
                 f"relocalize: free_only must be True or False, got {self.free_only!r}"
@@ -135,6 +148,7 @@ class SearchDisc:
                 getattr(self, name),
                 f"relocalize: the search disc's {name}",
                 low,
+                unit="m",
                 error=RelocalizationError,
             )
 
@@ -156,14 +170,19 @@ class Relocalizer:
                 f"relocalize: map must be an OccupancyGrid, got {type(grid).__name__}"
             )
         check_number(
-            max_range, "relocalize: max_range", 0.0, low_open=True, error=RelocalizationError
+            max_range,
+            "relocalize: max_range",
+            0.0,
+            low_open=True,
+            unit="m",
+            error=RelocalizationError,
         )
         if len(sensor) != 3:
             raise RelocalizationError(
                 f"relocalize: sensor must be three numbers (x, y, theta), got {sensor!r}"
             )
-        for axis, value in zip(("x", "y", "theta"), sensor, strict=True):
-            check_number(value, f"relocalize: sensor {axis}", error=RelocalizationError)
+        for axis, value, unit in zip(("x", "y", "theta"), sensor, ("m", "m", "rad"), strict=True):
+            check_number(value, f"relocalize: sensor {axis}", unit=unit, error=RelocalizationError)
         self.config = config
         self._grid, self._max_range = grid, float(max_range)
         self._sensor = _core.Pose2(*(float(v) for v in sensor))

@@ -133,7 +133,8 @@ def test_cost_model_file_round_trip_and_bad_files(tmp_path):
 def test_config_refuses_a_bad_budget():
     for budget in (0.0, -5.0, math.inf):
         with pytest.raises(
-            ValueError, match=r"^budget_ms must be a finite number > 0 \(or None: no budget\), got "
+            ValueError,
+            match=r"^budget_ms must be a finite number > 0 ms \(or None: no budget\), got ",
         ):
             LocalizeConfig(budget_ms=budget)
     with pytest.raises(ValueError, match="a time budget applies"):

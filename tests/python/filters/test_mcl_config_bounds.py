@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from kiseki.filters import LocalizeConfig, MclConfig
+from kiseki.filters import GlobalConfig, LocalizeConfig, MclConfig
 from kiseki.filters.odometry_noise import motion_alphas
 from kiseki.magnetic import MagneticMclConfig
 from kiseki.scans import LaserScans
@@ -98,3 +98,30 @@ def test_localize_config_checks_the_alphas_it_is_given():
     alphas = motion_alphas(config, scans)
     assert max(alphas) > 99.9
     assert config.mcl(alphas).alphas == alphas
+
+
+UNITS = [
+    (LocalizeConfig, "sigma_hit", "sigma_hit must be a finite number > 0 m, got nan"),
+    (LocalizeConfig, "lambda_short", "lambda_short must be a finite number > 0 1/m, got nan"),
+    (
+        LocalizeConfig,
+        "beam_skip_distance",
+        "beam_skip_distance must be a finite number >= 0 m, got nan",
+    ),
+    (MclConfig, "update_min_d", "update_min_d must be a finite number >= 0 m, got nan"),
+    (MclConfig, "update_min_a", "update_min_a must be a finite number >= 0 rad, got nan"),
+    (GlobalConfig, "sigma_hit", "sigma_hit must be a finite number > 0 m, got nan"),
+    (GlobalConfig, "shrink_radius", "shrink_radius must be a finite number > 0 m, got nan"),
+    (GlobalConfig, "converged_radius", "converged_radius must be a finite number > 0 m, got nan"),
+    (GlobalConfig, "update_min_d", "update_min_d must be a finite number >= 0 m, got nan"),
+    (GlobalConfig, "update_min_a", "update_min_a must be a finite number >= 0 rad, got nan"),
+]
+
+
+@pytest.mark.parametrize(("config", "name", "message"), UNITS)
+def test_a_length_or_an_angle_is_refused_in_its_unit(config, name, message):
+    """The filters' lengths and angles read bare ('sigma_hit must be a finite number > 0')
+    where the other areas name theirs."""
+    with pytest.raises(ValueError) as caught:
+        config(**{name: math.nan})
+    assert str(caught.value) == message

@@ -89,9 +89,14 @@ def test_bad_input_is_one_line_naming_the_problem():
     grid, angles, ranges = random_case(0)
     with pytest.raises(RelocalizationError, match="hypotheses must be an integer"):
         RelocalizeConfig(hypotheses=0)
-    with pytest.raises(RelocalizationError, match="sigma_hit must be a finite number > 0"):
+    with pytest.raises(
+        RelocalizationError, match=r"^relocalize: sigma_hit must be a finite number > 0 m, got nan$"
+    ):
         RelocalizeConfig(sigma_hit=float("nan"))
-    with pytest.raises(RelocalizationError, match="max_range must be a finite number > 0"):
+    with pytest.raises(
+        RelocalizationError,
+        match=r"^relocalize: max_range must be a finite number > 0 m, got 0\.0$",
+    ):
         relocalize(grid, angles, ranges, 0.0)
     with pytest.raises(RelocalizationError, match="angles and ranges"):
         relocalize(grid, angles, ranges[:-1], MAX_RANGE)
@@ -101,11 +106,48 @@ def test_bad_input_is_one_line_naming_the_problem():
         relocalize(np.zeros((5, 5)), angles, ranges, MAX_RANGE)
     assert relocalize(grid, angles, np.full(len(angles), np.inf, np.float32), MAX_RANGE) == []
     with pytest.raises(
-        RelocalizationError, match="search disc's radius must be a finite number >= 0"
+        RelocalizationError,
+        match=r"^relocalize: the search disc's radius must be a finite number >= 0 m, got -1\.0$",
     ):
         SearchDisc(0.0, 0.0, -1.0)
     with pytest.raises(RelocalizationError, match="disc must be a SearchDisc"):
         Relocalizer(grid, MAX_RANGE).match(angles, ranges, (0.0, 0.0, 1.0))
+
+
+@pytest.mark.parametrize(
+    ("fields", "message"),
+    [
+        ({"max_distance": -1.0}, "max_distance must be a finite number > 0 m, got -1.0"),
+        ({"angular_step": -1.0}, "angular_step must be a finite number >= 0 rad, got -1.0"),
+        ({"min_distance": -1.0}, "min_distance must be a finite number >= 0 m, got -1.0"),
+        ({"min_angle": -1.0}, "min_angle must be a finite number >= 0 rad, got -1.0"),
+    ],
+)
+def test_a_relocalize_setting_is_refused_in_its_unit(fields, message):
+    """The lengths and angles read bare ('min_angle must be a finite number >= 0')."""
+    with pytest.raises(RelocalizationError) as caught:
+        RelocalizeConfig(**fields)
+    assert str(caught.value) == f"relocalize: {message}"
+
+
+def test_the_disc_and_the_sensor_are_refused_in_their_units():
+    grid, _, _ = random_case(0)
+    for axis, disc, bad in (("x", (math.nan, 0.0, 1.0), "nan"), ("y", (0.0, math.inf, 1.0), "inf")):
+        with pytest.raises(RelocalizationError) as caught:
+            SearchDisc(*disc)
+        assert str(caught.value) == (
+            f"relocalize: the search disc's {axis} must be a finite number (m), got {bad}"
+        )
+    for axis, sensor, unit in (
+        ("x", (math.nan, 0.0, 0.0), "m"),
+        ("y", (0.0, math.nan, 0.0), "m"),
+        ("theta", (0.0, 0.0, math.nan), "rad"),
+    ):
+        with pytest.raises(RelocalizationError) as caught:
+            Relocalizer(grid, MAX_RANGE, sensor=sensor)
+        assert str(caught.value) == (
+            f"relocalize: sensor {axis} must be a finite number ({unit}), got nan"
+        )
 
 
 def test_a_depth_past_the_map_finds_the_brute_force_selection():
