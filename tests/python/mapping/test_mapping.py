@@ -190,6 +190,12 @@ def test_check_map_size_refuses_what_it_cannot_divide():
             ValueError, match="^check_map_size: resolution must be a finite number > 0 m, got "
         ):
             check_map_size(10.0, 10.0, bad)
+    for name, sides in (("width", (True, 10.0)), ("height", (10.0, True))):  # 1 m: 2 cells
+        with pytest.raises(ValueError) as caught:
+            check_map_size(*sides, 0.5)
+        assert (
+            str(caught.value) == f"check_map_size: {name} must be a finite number > 0 m, got True"
+        )
 
 
 def test_scan_local_map_takes_readings_at_or_below_zero_as_no_reading():

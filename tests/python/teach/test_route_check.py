@@ -85,6 +85,9 @@ def test_a_cell_under_the_taught_footprint_does_not_block_and_one_beside_it_does
             ValueError, match="^footprint: length must be a finite number > 0 m, got "
         ):
             check_route(grid, marks, at, (bad, FOOTPRINT[1]))
+    with pytest.raises(ValueError) as caught:  # True was taken as a width of 1 m
+        check_route(grid, marks, at, (FOOTPRINT[0], True))
+    assert str(caught.value) == "footprint: width must be a finite number > 0 m, got True"
     with pytest.raises(ValueError, match="travelled"):
         check_route(grid, marks, at[:, :2], FOOTPRINT)
 
