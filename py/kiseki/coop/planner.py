@@ -146,7 +146,7 @@ def plan_moves(
         raise ValueError(f"angle_sigma must lie in (0, 10 deg), got {angle_sigma}")
     check_count(max_moves, "max_moves", 1, MAX_MOVES)
     check_number(spacing, "spacing", 0.0, low_open=True, unit="m")
-    check_number(reach, "reach", spacing, low_open=True, unit="m")  # more than one spacing
+    check_number(reach, "reach (more than the spacing)", spacing, low_open=True, unit="m")
     check_number(half_width, "half_width", 0.0, low_open=True, unit="m")
     at, g = start.copy(), np.zeros((6, 0))
     steps: list[Move] = []

@@ -57,8 +57,15 @@ def test_planner_beats_every_swept_setting() -> None:
     [
         ({"spacing": 0.0}, "spacing must be a finite number > 0 m, got 0.0"),
         ({"spacing": True}, "spacing must be a finite number > 0 m, got True"),  # was 1 m
-        ({"reach": 0.2}, "reach must be a finite number > 0.25 m, got 0.2"),  # not one spacing
-        ({"reach": math.inf}, "reach must be a finite number > 0.25 m, got inf"),
+        ({"reach": 0.2}, "reach (more than the spacing) must be a finite number > 0.25 m, got 0.2"),
+        (
+            {"reach": math.inf},
+            "reach (more than the spacing) must be a finite number > 0.25 m, got inf",
+        ),
+        (
+            {"spacing": 0.5, "reach": 0.4},
+            "reach (more than the spacing) must be a finite number > 0.5 m, got 0.4",
+        ),
         ({"half_width": math.nan}, "half_width must be a finite number > 0 m, got nan"),
         ({"max_moves": 2.5}, "max_moves must be an integer in 1..1,000, got 2.5"),
         ({"max_moves": True}, "max_moves must be an integer in 1..1,000, got True"),
