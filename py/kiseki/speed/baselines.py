@@ -50,7 +50,7 @@ no-return reading sees up to the range, a NaN one sees nothing).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -71,15 +71,16 @@ __all__ = [
 ]
 
 
-def _check_config(config, non_negative=()) -> None:
-    """Every number of ``config`` finite and > 0 (>= 0 for those in ``non_negative``), v_max
-    at most SPEED_LIMIT and initial_speed at most v_max; its counts are checked by the config."""
+def _check_config(config, numbers: tuple[tuple[str, str, bool], ...]) -> None:
+    """v_max in (0, SPEED_LIMIT] m/s; each of ``numbers`` (name, unit, whether 0 is taken)
+    finite and > 0 (>= 0 where 0 is taken), in its unit; initial_speed at most v_max. Named
+    one by one: a test that each float field is among them keeps a new one from going
+    unchecked. The counts are checked by the config."""
     kind = type(config).__name__
     check_top_speed(kind + ".v_max", config.v_max)
-    for f in fields(config):
-        if f.type == "float" and f.name != "v_max":
-            positive = f.name not in non_negative
-            check_number(getattr(config, f.name), f"{kind}.{f.name}", 0.0, low_open=positive)
+    for name, unit, zero in numbers:
+        value = getattr(config, name)
+        check_number(value, f"{kind}.{name}", 0.0, low_open=not zero, unit=unit)
     check_initial_speed(kind + ".initial_speed", config.initial_speed, config.v_max)
 
 
@@ -119,7 +120,14 @@ class DistanceLimiterConfig:
         check_field_types(self)
         _check_config(
             self,
-            non_negative=("reaction_time", "half_length", "sensor_offset", "initial_speed"),
+            (
+                ("a_max", "m/s^2", False),
+                ("reaction_time", "s", True),
+                ("half_angle", "rad", False),  # at most pi: below
+                ("half_length", "m", True),
+                ("sensor_offset", "m", True),
+                ("initial_speed", "m/s", True),
+            ),
         )
         if self.half_angle > math.pi:
             raise ValueError(
@@ -192,7 +200,18 @@ class PolygonLimiterConfig:
 
     def __post_init__(self) -> None:
         check_field_types(self)
-        _check_config(self, non_negative=("stop_ahead", "sensor_offset", "initial_speed"))
+        _check_config(
+            self,
+            (
+                ("a_max", "m/s^2", False),
+                ("half_length", "m", False),
+                ("half_width", "m", False),
+                ("stop_ahead", "m", True),
+                ("slowdown_ahead", "m", False),
+                ("sensor_offset", "m", True),
+                ("initial_speed", "m/s", True),
+            ),
+        )
         name = "PolygonLimiterConfig.slowdown_ratio"
         check_number(self.slowdown_ratio, name, 0.0, 1.0, low_open=True)
         check_count(self.min_points, "PolygonLimiterConfig.min_points", 1)
