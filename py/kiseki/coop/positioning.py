@@ -265,15 +265,16 @@ def _wrap(a: np.ndarray) -> np.ndarray:
     return np.remainder(a + np.pi, 2 * np.pi) - np.pi
 
 
-def _check_runs(the_plan, runs, limit: int, seed, **sigmas) -> None:
-    """A Plan (None was an AttributeError), runs in 1..limit, angle SDs in [0, 10 deg)."""
+def _check_runs(the_plan, runs, limit: int, seed, *sigmas) -> list[float]:
+    """A Plan (None was an AttributeError), runs in 1..limit, the angle SDs in [0, 10 deg)."""
     if not isinstance(the_plan, Plan):
         raise TypeError(f"the_plan must be a Plan (see plan()), got {type(the_plan).__name__}")
     runs = check_count(runs, "runs", 1, limit)
-    for name, v in sigmas.items():
+    for name, v in zip(("angle_sigma", "elevation_sigma"), sigmas, strict=False):
         if isinstance(v, bool) or not (isinstance(v, numbers.Real) and 0 <= v < math.radians(10)):
             raise ValueError(f"{name} must lie in [0, 10 deg), got {v!r}")
     check_seed(seed)
+    return [float(v) + 0.0 for v in sigmas]  # -0.0 as 0.0, a scale numpy's normal refuses
 
 
 def simulate(
@@ -281,7 +282,7 @@ def simulate(
 ) -> CoopRun:
     """``runs`` runs of a plan with Gaussian noise of SD ``angle_sigma`` (rad) on every measured
     angle. Seeded: the same seed gives the same runs."""
-    _check_runs(the_plan, runs, 1_000_000, seed, angle_sigma=angle_sigma)
+    (angle_sigma,) = _check_runs(the_plan, runs, 1_000_000, seed, angle_sigma)
     rng = np.random.default_rng(seed)
     truth = the_plan.nominal_positions()
     est = np.empty((runs, len(the_plan.steps) + 1, 3, 2))
@@ -348,7 +349,7 @@ def simulate_3d(
     3-D (kiseki.coop.triangulate with elevations). ``elevation_sigma`` defaults to
     ``angle_sigma``."""
     e_sigma = angle_sigma if elevation_sigma is None else elevation_sigma
-    _check_runs(the_plan, runs, 100_000, seed, angle_sigma=angle_sigma, elevation_sigma=e_sigma)
+    angle_sigma, e_sigma = _check_runs(the_plan, runs, 100_000, seed, angle_sigma, e_sigma)
     check_number(marker_height, "marker_height", 0.0, 10.0, high_open=True, unit="m")
     if not callable(ground):
         raise TypeError(f"ground must be a function z(x, y), got {type(ground).__name__}")

@@ -6,6 +6,8 @@ SD a TypeError from math.isfinite, and numpy's integers were refused as run coun
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -49,6 +51,16 @@ def test_numbers_of_the_wrong_kind_are_refused_and_numpy_numbers_taken():
     plain = simulate(p, 4, angle_sigma=float(np.float32(0.002)), seed=5)
     np.testing.assert_array_equal(same.goal_errors, plain.goal_errors)
     assert simulate_3d(p, _flat, np.int32(2), seed=1).goal_errors.shape == (2,)
+
+
+def test_a_negative_zero_sd_is_no_noise():
+    """-0.0 passed the check (0 <= -0.0) and numpy's normal refused it: 'scale < 0'."""
+    p = plan(2, 7)
+    run = simulate(p, 3, angle_sigma=-0.0)
+    assert run.goal_errors.max() < 1e-9 and math.copysign(1.0, run.angle_sigma) == 1.0
+    run = simulate_3d(p, _flat, 3, angle_sigma=np.float32(-0.0), elevation_sigma=-0.0)
+    assert run.goal_errors.max() < 1e-9
+    assert [math.copysign(1.0, v) for v in (run.angle_sigma, run.elevation_sigma)] == [1.0, 1.0]
 
 
 @pytest.mark.parametrize(
