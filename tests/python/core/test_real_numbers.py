@@ -1,10 +1,12 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""The one check of a real number: finite, in its interval, a Python or numpy number or a 0-d
-array, never a bool or text; returned as a Python float. Messages are stated word for word."""
+"""The one check of a real number: finite, in its interval, a Python or numpy integer or float,
+never a bool, text, an array (0-d too), a Fraction or a Decimal; returned as a Python float.
+Messages are stated word for word."""
 
 from __future__ import annotations
 
+import decimal
 import fractions
 import math
 
@@ -30,6 +32,12 @@ from kiseki._support.real_numbers import check_number, number_rule
         ),
         ({"low": -1.0, "high": 86400.0, "high_open": True}, "a finite number in [-1, 86,400)"),
         ({"low": 1e-9, "high": 1e50}, "a finite number in [1e-09, 1e+50]"),
+        ({"low": 0.0, "high": math.pi, "unit": "rad"}, "a finite number in [0, pi] rad"),
+        ({"low": -math.pi, "high": math.pi, "high_open": True}, "a finite number in [-pi, pi)"),
+        ({"low": 0.0, "high": 2 * math.pi}, "a finite number in [0, 2 pi]"),
+        ({"high": math.pi / 2}, "a finite number <= pi/2"),
+        ({"low": math.pi / 4, "low_open": True}, "a finite number > pi/4"),
+        ({"low": 0.0, "high": 3.1416}, "a finite number in [0, 3.1416]"),
     ],
 )
 def test_rule_words_each_interval(kwargs, rule):
@@ -38,8 +46,7 @@ def test_rule_words_each_interval(kwargs, rule):
 
 @pytest.mark.parametrize(
     "value",
-    [2, 2.0, np.float32(2.0), np.float64(2.0), np.int64(2), np.uint8(2), np.array(2.0),
-     fractions.Fraction(4, 2)],
+    [2, 2.0, np.float32(2.0), np.float64(2.0), np.float16(2.0), np.int64(2), np.uint8(2)],
 )  # fmt: skip
 def test_numbers_of_every_kind_are_taken_as_python_floats(value):
     got = check_number(value, "x", 0.0, 5.0)
@@ -66,6 +73,9 @@ def test_negative_zero_becomes_zero():
         (None, "None"),
         (1 + 0j, "(1+0j)"),
         (np.array([1.0]), "array([1.])"),
+        (np.array(1.0), "array(1.)"),  # a 0-d array: callers keeping the value would hold it
+        (fractions.Fraction(1, 2), "Fraction(1, 2)"),
+        (decimal.Decimal("0.5"), "Decimal('0.5')"),
         (10**400, str(10**400)),
     ],
 )
@@ -102,3 +112,26 @@ def test_the_callers_error_kind_is_raised():
 
     with pytest.raises(ConfigError, match=r"^dt must be a finite number > 0 s, got -1$"):
         check_number(-1, "dt", 0.0, low_open=True, unit="s", error=ConfigError)
+
+
+@pytest.mark.parametrize(
+    ("value", "kwargs"),
+    [
+        (np.float32(0.6), {"low": 0.02, "high": 0.6}),  # 0.6000000238 as a double
+        (np.float32(math.pi), {"low": 0.0, "high": math.pi}),  # 3.1415927 as a double
+        (np.float32(0.02), {"low": 0.02, "high": 0.6}),  # 0.0199999996 as a double
+    ],
+)
+def test_a_numpy_float_at_a_bound_is_in_as_numpy_compares_it(value, kwargs):
+    """A float32 written at a bound is past it as a double; it meets the bound in its own
+    precision (numpy's comparison, which the checks before this one used) and is taken, as
+    the double it is."""
+    assert not kwargs["low"] <= float(value) <= kwargs["high"]
+    assert check_number(value, "step", **kwargs) == float(value)
+
+
+def test_a_numpy_float_past_a_bound_in_its_own_precision_is_refused():
+    with pytest.raises(
+        ValueError, match=r"^step must be a finite number in \[0\.02, 0\.6\] m, got"
+    ):
+        check_number(np.float32(0.6001), "step", 0.02, 0.6, unit="m")

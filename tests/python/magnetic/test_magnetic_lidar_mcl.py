@@ -189,7 +189,7 @@ def test_filters_sharing_one_beam_model_run_as_with_their_own():
         ({"sigma_d": -1.0}, r"^lidar MCL: sigma_d must be a finite number >= 1e-06 m, got -1\.0$"),
         (
             {"sigma_theta": float("nan")},
-            r"^lidar MCL: sigma_theta must be a finite number in \[0, 3\.14159\] rad, got nan$",
+            r"^lidar MCL: sigma_theta must be a finite number in \[0, pi\] rad, got nan$",
         ),
         ({"r_z_gate": 1.5}, r"^lidar MCL: r_z_gate must be a finite number in \[0, 1\], got 1\.5$"),
         ({"reach": -0.1}, r"^lidar MCL: reach must be a finite number >= 0 m, got -0\.1$"),
