@@ -10,8 +10,10 @@
   ``double``) and a physical or compute limit; the shared limits below say why. A value outside
   it, or not a number, is an :class:`OptionValueError` naming the option, raised while the
   command line is parsed, before the command does anything: ``kiseki: error: --beams must be
-  an integer in 0..100,000 (0 = every beam), got 2147483648`` and exit status 1, as every bad
-  value (:func:`kiseki.cli.main`); never a NaN, an overflow in C++ or a numpy warning later.
+  an integer in 0..100,000 (0 = every beam), got 2147483648``, ``--dwell must be a finite number
+  in [0, 3,600] s, got 1e308`` (the library's words: :func:`integer_rule`, :func:`number_rule`)
+  and exit status 1, as every bad value (:func:`kiseki.cli.main`); never a NaN, an overflow in
+  C++ or a numpy warning later.
 * :func:`refuse_given`: options that do not apply to the chosen mode are errors too. An option
   counts as given when the command line set it, not its default (click's parameter source).
 """
@@ -25,6 +27,7 @@ from typing import Any
 from kiseki import _core
 from kiseki._support.counts import integer_rule
 from kiseki._support.numbers_text import parse_float, parse_int
+from kiseki._support.real_numbers import number_rule
 from kiseki.core import SEED_RULE
 from kiseki.errors import KisekiError
 
@@ -178,9 +181,9 @@ class Quantity(_Bounded):
         return number + 0.0 if math.isfinite(number) else None
 
     def rule(self) -> str:
-        left, right = "(" if self.lo_open else "[", ")" if self.hi_open else "]"
-        unit = f" {self.unit}" if self.unit else ""
-        return f"in {left}{self.lo:,g}, {self.hi:,g}{right}{unit}"
+        return number_rule(
+            self.lo, self.hi, low_open=self.lo_open, high_open=self.hi_open, unit=self.unit
+        )
 
 
 def Metres(name: str, lo: float, hi: float, **ends: bool) -> Quantity:  # noqa: N802 (a type)

@@ -74,11 +74,11 @@ def test_map_info_and_render(tmp_path):
         (["demo", "--out", "d", "--particles", "2147483648"], "1..10,000,000, got 2147483648"),
         (
             ["sim", "run", "WORLDS/speed_corridor.yaml", "-o", "r.mcap", "--duration", "1e308"],
-            "duration must be in (0, 86,400] s",
+            "duration must be a finite number in (0, 86,400] s",
         ),
         (
             ["sim", "run", "WORLDS/speed_corridor.yaml", "-o", "r.mcap", "--duration", "nan"],
-            "duration must be in",
+            "duration must be a finite number in",
         ),
         (
             [

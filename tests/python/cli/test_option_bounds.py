@@ -211,10 +211,11 @@ LOCALIZE = ("localize", "log.mcap", "--map", "room.yaml", "-o", "t.csv")
         ([*LOCALIZE, "--beams", "2147483648"],
          "--beams must be an integer in 0..100,000 (0 = every beam), got 2147483648"),
         # was a numpy overflow warning, then "Pose2: x, y and theta must be finite"
-        ([*LOCALIZE, "--odometry-noise", "1e308"], "--odometry-noise must be in [0, 1], got 1e308"),
+        ([*LOCALIZE, "--odometry-noise", "1e308"],
+         "--odometry-noise must be a finite number in [0, 1], got 1e308"),
         # was taken: the robot would wait 1e308 s at the goal
         (["serve", "--taught", "taught", "--dwell", "1e308"],
-         "--dwell must be in [0, 3,600] s, got 1e308"),
+         "--dwell must be a finite number in [0, 3,600] s, got 1e308"),
         # ran and exited 0, ignoring all five
         ([*LOCALIZE, "--method", "odometry", "--recovery", "resetting", "--kld", "--particles",
           "700", "--beams", "3", "--threads", "7"],
