@@ -10,15 +10,12 @@ from kiseki.coop.positioning import (
     FORMS,
     GOAL,
     START,
-    CoopRun,
-    CoopRun3D,
     Move,
     Plan,
     paper_angle,
     plan,
-    simulate,
-    simulate_3d,
 )
+from kiseki.coop.simulation import CoopRun, CoopRun3D, simulate, simulate_3d
 from kiseki.coop.triangulation import (
     MIN_INTERSECTION_ANGLE,
     paper_error,

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from kiseki.coop.positioning import CoopRun
+from kiseki.coop.simulation import CoopRun
 from kiseki.plots import new_figure, save_figure
 
 if TYPE_CHECKING:

@@ -20,7 +20,8 @@ from kiseki._support.counts import check_count, integer_rule
 from kiseki._support.options import BEAM_LIMIT, PARTICLE_LIMIT, THREAD_LIMIT, Count
 from kiseki.apps.teach.playback import PlaybackConfig
 from kiseki.coop import plan
-from kiseki.coop.positioning import paper_angle, simulate
+from kiseki.coop.positioning import paper_angle
+from kiseki.coop.simulation import simulate
 from kiseki.core import Pose2
 from kiseki.errors import RelocalizationError
 from kiseki.filters import MclConfig

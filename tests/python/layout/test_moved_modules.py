@@ -87,6 +87,10 @@ MOVED_NAMES = [
     ("kiseki.datasets.rosbag", "write_bag", "kiseki.datasets.rosbag_writer"),
     ("kiseki.metrics", "MapTruth", "kiseki.teach.map_truth"),
     ("kiseki.metrics", "taught_map_truth", "kiseki.teach.map_truth"),
+    ("kiseki.coop.positioning", "CoopRun", "kiseki.coop.simulation"),
+    ("kiseki.coop.positioning", "CoopRun3D", "kiseki.coop.simulation"),
+    ("kiseki.coop.positioning", "simulate", "kiseki.coop.simulation"),
+    ("kiseki.coop.positioning", "simulate_3d", "kiseki.coop.simulation"),
 ]
 
 
