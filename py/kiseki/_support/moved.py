@@ -10,7 +10,9 @@ is now.
   :data:`MOVED`; every other import passes it by. ``kiseki/__init__`` installs it.
 * Names that left a module that is still there (a split): the module sets
   ``__getattr__ = moved_names(__name__, {name: new module})``, and reading such a name from it
-  gives the object of the new module and warns each time."""
+  gives the object of the new module and warns each time. Assigning such a name there is
+  refused: it would set a copy that the code, now in the new module, never reads (a ROS bag
+  limit raised by its old name changed nothing the reader checks)."""
 
 from __future__ import annotations
 
@@ -66,10 +68,27 @@ def install() -> None:
         sys.meta_path.insert(0, _MovedModule())
 
 
+class _ModuleWithMovedNames(ModuleType):
+    """A module some of whose names moved out (``__moved_names__``: name -> new module)."""
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        new = self.__dict__.get("__moved_names__", {}).get(name)
+        if new is not None:
+            raise AttributeError(
+                f"{self.__name__}.{name} moved to {new}.{name}; set it there (here it would "
+                "change nothing)"
+            )
+        super().__setattr__(name, value)
+
+
 def moved_names(module: str, names: dict[str, str]) -> Callable[[str], Any]:
     """The module-level ``__getattr__`` of ``module`` (PEP 562) that answers the ``names`` that
     moved out of it (name -> the module holding it now) with a DeprecationWarning, and any other
-    name with the usual AttributeError."""
+    name with the usual AttributeError. ``module`` (being imported: it calls this) refuses from
+    then on an assignment of those names, naming where to set them."""
+    target = sys.modules[module]
+    target.__class__ = _ModuleWithMovedNames
+    vars(target)["__moved_names__"] = dict(names)
 
     def moved_attribute(name: str) -> Any:
         if name not in names:

@@ -94,7 +94,7 @@ __all__ = [
 # write_bag moved to kiseki.datasets.rosbag_writer (and is kiseki.datasets.write_bag as before);
 # the limits are rosbag_files' (copies here, set, changed nothing the reader checks). The old
 # names answer for one release with a DeprecationWarning (kiseki._support.moved), the limits
-# with rosbag_files' value at the time.
+# with rosbag_files' value at the time; assigning one here is refused, naming rosbag_files.
 _LIMITS = ("MAX_BAG_CHUNK_BYTES", "MAX_BAG_FILE_BYTES", "MAX_BAG_MESSAGE_BYTES")
 _MOVED = {"write_bag": "kiseki.datasets.rosbag_writer"}
 __getattr__ = moved_names(__name__, _MOVED | dict.fromkeys(_LIMITS, "kiseki.datasets.rosbag_files"))

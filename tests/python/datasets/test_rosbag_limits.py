@@ -33,3 +33,22 @@ def test_a_limit_lowered_in_rosbag_files_is_the_one_the_reader_and_the_old_name_
             assert getattr(rosbag, name) == getattr(rosbag_files, name)
     with pytest.warns(DeprecationWarning):
         assert rosbag.MAX_BAG_MESSAGE_BYTES == 4000  # the live value, not the one at import
+
+
+@pytest.mark.parametrize("name", LIMITS)
+def test_a_limit_set_by_its_old_name_is_refused_naming_where_to_set_it(name):
+    """``rosbag.MAX_BAG_FILE_BYTES = ...`` set a module attribute that the reader, which reads
+    rosbag_files', never looked at: a limit raised that way was silently not raised."""
+    before = getattr(rosbag_files, name)
+    with pytest.raises(AttributeError) as caught:
+        setattr(rosbag, name, before * 2)
+    assert str(caught.value) == (
+        f"kiseki.datasets.rosbag.{name} moved to kiseki.datasets.rosbag_files.{name}; set it "
+        "there (here it would change nothing)"
+    )
+    assert name not in vars(rosbag) and getattr(rosbag_files, name) == before
+
+
+def test_names_that_stayed_in_the_module_are_set_as_before(monkeypatch):
+    monkeypatch.setattr(rosbag, "ODOM_FRAME", "odom_combined")
+    assert rosbag.ODOM_FRAME == "odom_combined"
