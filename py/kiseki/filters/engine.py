@@ -171,6 +171,14 @@ class MclConfig:
             _check(isinstance(value, bool), f"{name} must be True or False, got {value!r}")
         for name, unit in (("update_min_d", "m"), ("update_min_a", "rad")):
             check_number(getattr(self, name), name, 0.0, unit=unit)
+        # the engine's bounds (KldParams and MclParams::validate), each named here: the engine
+        # words two fields in one message ('err must lie in (0, 1] and z in [0, 10]')
+        check_number(self.kld_err, "kld_err", 0.0, 1.0, low_open=True)
+        check_number(self.kld_z, "kld_z", 0.0, 10.0)
+        check_number(
+            self.expansion_position, "expansion_position", 0.0, MAX_ODOMETRY_JUMP, unit="m"
+        )
+        check_number(self.expansion_orientation, "expansion_orientation", 0.0, math.pi, unit="rad")
         _check(  # a turn is wrapped to at most pi: above it means never on rotation alone
             self.update_min_a <= 2 * math.pi,
             f"update_min_a must be <= 2 pi, got {self.update_min_a}",

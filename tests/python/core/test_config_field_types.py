@@ -121,7 +121,9 @@ FLOAT_FIELDS = [
 def test_no_float_field_takes_a_nan_or_an_infinity(cls, field):
     """PlaybackConfig took goal_tolerance = inf (the goal 'reached' before the first step) and a
     NaN max_duration, SimConfig an infinite lookahead and goal_tolerance (refused later by the
-    route follower, once the robot was built)."""
+    route follower, once the robot was built). The message names the field: MclConfig's KLD
+    err and z and its expansion radii were refused in the engine's words, two fields in one
+    message ('KLD sampling: err must lie in (0, 1] and z in [0, 10]')."""
     for bad in (math.nan, math.inf, -math.inf):
-        with pytest.raises(ValueError):
+        with pytest.raises(ValueError, match=rf"\b{field}\b"):
             cls(**{field: bad})

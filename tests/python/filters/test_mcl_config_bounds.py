@@ -18,12 +18,12 @@ from kiseki.scans import LaserScans
 
 ABSURD = [
     ({"alphas": (1e300, 0.0, 0.0, 0.0)}, "alphas must lie in \\[0, 1000\\]"),
-    ({"kld": True, "kld_err": 1e300}, "err must lie in \\(0, 1\\]"),
-    ({"kld": True, "kld_z": 1e300}, "z in \\[0, 10\\]"),
+    ({"kld": True, "kld_err": 1e300}, "^kld_err must be a finite number in \\(0, 1\\]"),
+    ({"kld": True, "kld_z": 1e300}, "^kld_z must be a finite number in \\[0, 10\\]"),
     ({"resample_threshold": 1e300}, "resample_threshold must lie in \\[0, 1\\]"),
     ({"likelihood_power": 1e300}, "likelihood_power must lie in \\(0, 1000\\]"),
     ({"reset_evidence": 1e300}, "reset_evidence must lie in \\[0, 1e6\\]"),
-    ({"expansion_position": 1e300}, "expansion radii must lie in \\[0, 10 m\\]"),
+    ({"expansion_position": 1e300}, "^expansion_position must be a finite number in \\[0, 10\\] m"),
     ({"update_min_a": 1e300}, "update_min_a must be <= 2 pi"),
     ({"min_particles": 10**300}, "min_particles must be an integer in 1..10,000,000"),
     ({"reset_after": -(10**300)}, "reset_after must be a C\\+\\+ int"),
@@ -32,13 +32,16 @@ ABSURD = [
 # just past each bound: the bounds are where they are said to be, not somewhere beyond
 JUST_PAST = [
     ({"alphas": (1000.01, 0.0, 0.0, 0.0)}, "alphas must lie in \\[0, 1000\\]"),
-    ({"kld": True, "kld_err": 1.0001}, "err must lie in \\(0, 1\\]"),
-    ({"kld": True, "kld_z": 10.001}, "z in \\[0, 10\\]"),
+    ({"kld": True, "kld_err": 1.0001}, "^kld_err must be a finite number in \\(0, 1\\]"),
+    ({"kld": True, "kld_z": 10.001}, "^kld_z must be a finite number in \\[0, 10\\]"),
     ({"resample_threshold": 1.0001}, "resample_threshold must lie in \\[0, 1\\]"),
     ({"likelihood_power": 1000.1}, "likelihood_power must lie in \\(0, 1000\\]"),
     ({"reset_evidence": 1e6 + 1}, "reset_evidence must lie in \\[0, 1e6\\]"),
-    ({"expansion_position": 10.01}, "expansion radii must lie in \\[0, 10 m\\]"),
-    ({"expansion_orientation": math.pi + 1e-9}, "expansion radii .* and \\[0, pi\\]"),
+    ({"expansion_position": 10.01}, "^expansion_position must be a finite number in \\[0, 10\\] m"),
+    (
+        {"expansion_orientation": math.pi + 1e-9},
+        "^expansion_orientation must be a finite number in \\[0, pi\\] rad",
+    ),
     ({"update_min_a": 2 * math.pi + 1e-9}, "update_min_a must be <= 2 pi"),
     ({"sensor_reset_after": 1_000_001}, "sensor_reset_after <= 1,000,000"),
     ({"min_particles": 10_000_001}, "min_particles must be an integer in 1..10,000,000, got"),
