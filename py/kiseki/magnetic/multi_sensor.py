@@ -50,8 +50,9 @@ class DriftCheck:
     limit: float = 3.0  # |mean normalised innovation| above which a sensor is dropped
 
     def __post_init__(self) -> None:
-        check_count(self.window, "drift check: window", 2)
+        window = check_count(self.window, "drift check: window", 2)
         limit = check_number(self.limit, "drift check: limit", 0.0, low_open=True)
+        object.__setattr__(self, "window", window)  # a numpy integer held as a Python int
         object.__setattr__(self, "limit", limit)  # a numpy number held as a Python float
 
 

@@ -129,7 +129,9 @@ def test_bad_inputs(maps):
             DriftCheck(limit=limit)
 
 
-def test_a_drift_limit_is_held_as_a_python_float():
-    """A numpy limit was held as given (a float32 in the config)."""
-    limit = DriftCheck(limit=np.float32(2.5)).limit
-    assert type(limit) is float and limit == 2.5
+def test_a_drift_limit_and_window_are_held_as_python_numbers():
+    """A numpy limit was held as given (a float32 in the config), and so was a numpy window
+    (np.int64, which json refuses)."""
+    check = DriftCheck(window=np.int64(12), limit=np.float32(2.5))
+    assert type(check.limit) is float and check.limit == 2.5
+    assert type(check.window) is int and check.window == 12
