@@ -58,19 +58,30 @@ class ErrorStatistics:
 
     @classmethod
     def of(cls, errors: np.ndarray) -> ErrorStatistics:
+        """The statistics of ``errors``. ``sse`` is inf once the sum of squares passes the
+        largest double (errors of about 1e154 and more); ``rmse`` and ``std`` stay finite for
+        finite errors (computed on the errors scaled by the largest where the squares overflow,
+        as they were computed before elsewhere)."""
         e = np.asarray(errors, dtype=float)
         if e.size == 0:
             raise ValueError("no pose pairs to compute an error from")
-        return cls(
-            e,
-            float(np.sqrt(np.mean(e**2))),
-            float(e.mean()),
-            float(np.median(e)),
-            float(e.std()),
-            float(e.min()),
-            float(e.max()),
-            float(np.sum(e**2)),
-        )
+        with np.errstate(over="ignore"):
+            squares = e**2
+            rmse, std = float(np.sqrt(np.mean(squares))), float(e.std())
+            if not (math.isfinite(rmse) and math.isfinite(std)) and np.isfinite(e).all():
+                scale = float(np.abs(e).max())
+                rmse = scale * float(np.sqrt(np.mean((e / scale) ** 2)))
+                std = scale * float((e / scale).std())
+            return cls(
+                e,
+                rmse,
+                float(e.mean()),
+                float(np.median(e)),
+                std,
+                float(e.min()),
+                float(e.max()),
+                float(np.sum(squares)),
+            )
 
 
 def as_se3(poses: np.ndarray) -> np.ndarray:
@@ -98,6 +109,20 @@ def as_se3(poses: np.ndarray) -> np.ndarray:
             f"pose {int(np.argmax(bad))} is not a rigid motion (a rotation, and a last row 0 0 0 1)"
         )
     return p
+
+
+def _lengths(rows: np.ndarray) -> np.ndarray:
+    """Euclidean length of each row of ``rows`` (n, k), as np.linalg.norm gives it; where the
+    squares overflow (components of about 1e154 and more), of the row scaled by its largest
+    component, so that a finite row has a finite length (1e200 m was an error of inf m)."""
+    with np.errstate(over="ignore"):
+        out = np.linalg.norm(rows, axis=1)
+    over = np.isinf(out) & np.isfinite(rows).all(axis=1)
+    if over.any():
+        big = rows[over]
+        scale = np.abs(big).max(axis=1)
+        out[over] = scale * np.linalg.norm(big / scale[:, None], axis=1)
+    return out
 
 
 def _pair(est, ref) -> tuple[np.ndarray, np.ndarray]:
@@ -163,9 +188,14 @@ def align_trajectory(est, ref, alignment: str = "se3") -> np.ndarray:
 
 def _errors(e: np.ndarray, relation: str) -> np.ndarray:
     if relation == "translation":
-        return np.linalg.norm(e[:, :3, 3], axis=1)
+        return _lengths(e[:, :3, 3])
     if relation == "full":
-        return np.linalg.norm(e - np.eye(4), axis=(1, 2))
+        off = e - np.eye(4)
+        with np.errstate(over="ignore"):
+            out = np.linalg.norm(off, axis=(1, 2))
+        over = np.isinf(out)  # the Frobenius norm is the length of the 16 entries
+        out[over] = _lengths(off[over].reshape(-1, 16))
+        return out
     rot = e[:, :3, :3]
     # angle = atan2(sin, cos) from the skew part and the trace: accurate near 0 and pi
     skew = np.stack(
@@ -184,7 +214,7 @@ def ape(est, ref, relation: str = "translation", alignment: str = "none") -> Err
     e = align_trajectory(est, ref, alignment)
     r = as_se3(ref)
     if relation == "translation":  # evo: the difference of the positions
-        return ErrorStatistics.of(np.linalg.norm(e[:, :3, 3] - r[:, :3, 3], axis=1))
+        return ErrorStatistics.of(_lengths(e[:, :3, 3] - r[:, :3, 3]))
     return ErrorStatistics.of(_errors(_inv(r) @ e, relation))
 
 

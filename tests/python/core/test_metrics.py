@@ -223,3 +223,31 @@ def test_wilson_interval_refuses_counts_no_float_holds_exactly():
     lo, hi = wilson_interval(2**52, 2**53)  # a half: 0.5 +- 1.96 / (2 sqrt(n))
     assert (lo + hi) / 2 == pytest.approx(0.5, abs=1e-15)
     assert hi - lo == pytest.approx(1.96 / 2**26.5, rel=1e-6)
+
+
+@pytest.mark.parametrize("big", [1e155, 1e200, 1e300])
+def test_errors_whose_squares_overflow_stay_finite(big):
+    """An estimate 1e200 m off gave an error of inf (np.linalg.norm squares it), an RMSE of
+    inf and a NaN SD; the errors are finite and have finite statistics (closed forms below:
+    errors big and 0, and big sqrt(2) for a diagonal offset). sse overflows, as documented."""
+    est = np.array([[big, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    stats = ape(est, np.zeros((2, 3)))
+    assert stats.max == big and stats.min == 0.0 and stats.mean == big / 2
+    assert stats.rmse == pytest.approx(big / np.sqrt(2), rel=1e-15)
+    assert stats.std == pytest.approx(big / 2, rel=1e-15)
+    diagonal = ape(np.array([[big, big, 0.0]]), np.zeros((1, 3)))
+    assert diagonal.max == pytest.approx(big * np.sqrt(2), rel=1e-15)
+    assert ape(est, np.zeros((2, 3)), relation="full").max == pytest.approx(big, rel=1e-15)
+    assert rpe(est, np.zeros((2, 3))).rmse == pytest.approx(big, rel=1e-15)
+    if big > 1e160:
+        assert stats.sse == np.inf
+
+
+def test_ordinary_errors_are_the_plain_formulas_bit_for_bit():
+    """The overflow path is taken only where the plain formulas overflow: the statistics of
+    ordinary errors are numpy's own, so no reported RMSE moves in its last digit."""
+    ref, est = trajectories(3)
+    stats = ape(est, ref)
+    e = np.linalg.norm(est[:, :2] - ref[:, :2], axis=1)
+    assert np.array_equal(stats.errors, e)
+    assert stats.rmse == float(np.sqrt(np.mean(e**2))) and stats.std == float(e.std())
