@@ -17,6 +17,7 @@ from kiseki._support.atomic import atomic_write
 from kiseki._support.guard import Folder, guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import Count, Metres, Seed, refuse_given
+from kiseki._support.replaced_files import refuse_replacing
 from kiseki.cli._defaults import default_of
 from kiseki.sim.terrain_moves import terrain_stops
 from kiseki.terrain.cloud_picture import planes_summary, render_cloud_planes, write_planes_csv
@@ -44,6 +45,8 @@ def _destination(out: Path) -> None:
         raise ValueError(f"-o {out}: exists and is not a folder")
     if (out / "trajectory.csv").exists():
         raise ValueError(f"-o {out}: already holds a run (trajectory.csv); choose another folder")
+    # a folder of the user's own files (-o . holding a config.yaml) keeps them
+    refuse_replacing(out, _RUN_FILES.writes, "-o", "choose another folder")
     out.mkdir(parents=True, exist_ok=True)
 
 

@@ -226,6 +226,22 @@ def test_missing_world_and_occupied_output(tmp_path, rubble_run):
     assert done.returncode == 1 and "already holds a run" in done.stderr
 
 
+@pytest.mark.parametrize("name", ["config.yaml", "trajectory.png", "sdem_000.pcd"])
+def test_a_folder_of_the_users_files_is_refused_and_kept(tmp_path, name):
+    """-o . in a folder holding the user's config.yaml or trajectory.png replaced them (only
+    trajectory.csv was looked for); every file the run writes is looked for now."""
+    (tmp_path / name).write_text("the user's own")
+    (tmp_path / "notes.txt").write_text("not the run's")
+    done = run(RUBBLE_A, "--moves", 1, "-o", tmp_path)
+    lines = [line for line in done.stderr.splitlines() if line.strip()]
+    assert done.returncode == 1 and lines == [
+        f"kiseki: error: -o {tmp_path} holds {name}, which this command would replace: "
+        "choose another folder"
+    ]
+    assert (tmp_path / name).read_text() == "the user's own"
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([name, "notes.txt"])
+
+
 def test_plane_removal_keeps_the_rubble_and_drops_the_walls():
     stops = terrain_stops(RUBBLE_A, 1, seed=6)
     sdem = sdem_from_ranges(stops[0].ranges)
