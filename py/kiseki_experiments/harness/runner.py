@@ -24,6 +24,7 @@ from pydantic import Field, RootModel
 from tqdm import tqdm
 
 from kiseki._support.atomic import atomic_write, check_writable_folder
+from kiseki._support.replaced_files import refuse_replacing
 from kiseki._support.schema import FileModel, SchemaError, Seed, parse
 from kiseki._support.yaml import read_yaml_file
 from kiseki.core import check_seed, derive_seed
@@ -189,6 +190,19 @@ def _extend(experiment, config, saved: SavedRun, runs: int, path: Path) -> None:
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
 
+# what a run writes in its folder besides trials.jsonl (report.write_outputs and _prepare)
+RUN_FILES = (
+    "config.yaml",
+    "manifest.json",
+    "trials.parquet",
+    "timings.parquet",
+    "tables",
+    "figures",
+    "claims.csv",
+    "report.md",
+)
+
+
 def _prepare(name, runs, seed, overrides, out, resume, results_root):
     experiment = get_experiment(name)
     if resume:
@@ -227,6 +241,8 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
     run_dir = Path(out) if out else _results_dir(name, results_root)
     if (run_dir / "trials.jsonl").exists():
         raise KisekiError(f"{run_dir}: already holds trials: use --resume or another --out")
+    # --out . holding the user's own config.yaml or report.md: kept
+    refuse_replacing(run_dir, RUN_FILES, "--out", "give a new or empty folder", KisekiError)
     check_writable_folder(run_dir, "results")
     if experiment.preflight is not None:  # before the folder: a refused run leaves none
         experiment.preflight(config)

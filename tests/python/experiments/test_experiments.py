@@ -349,3 +349,29 @@ def test_the_manifest_names_the_checkout_the_trials_ran_from(tmp_path, monkeypat
     run_experiment("corridor-scans", runs=2, out=tmp_path / "still", progress=False)
     git = json.loads((tmp_path / "still" / "manifest.json").read_text())["git"]
     assert git == start
+    # what a run writes is what a new run refuses to replace (RUN_FILES, and trials.jsonl)
+    written = {p.name for p in (tmp_path / "still").iterdir()}
+    assert written == {*runner.RUN_FILES, "trials.jsonl"}
+
+
+@pytest.mark.parametrize("name", ["config.yaml", "report.md", "tables"])
+def test_a_new_run_keeps_the_users_files_in_its_out_folder(tmp_path, name):
+    """--out . in a folder holding the user's config.yaml or report.md replaced them (only
+    trials.jsonl, an earlier run's, was looked for); every file a run writes is looked for
+    now, before the run starts, and a run's own folder is still resumed (test above)."""
+    from kiseki_experiments.harness.runner import RUN_FILES
+
+    mine = tmp_path / name
+    if name == "tables":
+        mine.mkdir()
+        (mine / "mine.csv").write_text("the user's own")
+    else:
+        mine.write_text("the user's own")
+    with pytest.raises(KisekiError) as err:
+        run_experiment("corridor-scans", runs=1, out=tmp_path, progress=False)
+    assert str(err.value) == (
+        f"--out {tmp_path} holds {name}, which this command would replace: give a new or "
+        "empty folder"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]  # nothing written
+    assert name in RUN_FILES
