@@ -6,12 +6,15 @@ the log readers that ``kiseki map from-log`` needs)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import typer
 
 from kiseki._support.guard import Derived
+from kiseki._support.yaml import read_yaml_file
 from kiseki.cli._lazy import Entry, LazyGroup
 
-__all__ = ["COMMANDS", "MAP_IMAGE", "app"]
+__all__ = ["COMMANDS", "MAP_IMAGE", "app", "refuse_foreign_image"]
 
 # the image a map YAML names, written beside it (kiseki._support.guard)
 MAP_IMAGE = Derived("--output's image", lambda a: a["output"].with_suffix(".pgm"))
@@ -49,3 +52,25 @@ class _MapGroup(LazyGroup):
 app = typer.Typer(
     cls=_MapGroup, no_args_is_help=True, help="Occupancy-grid maps: build, render, inspect."
 )
+
+
+def refuse_foreign_image(output: Path) -> None:
+    """An image where --output's is written (X.pgm beside X.yaml) is replaced only as the image
+    of the map X.yaml already is (an earlier map saved there, replaced whole); a file of the
+    user's own under that name is refused, before any work, and kept."""
+    image = output.with_suffix(".pgm")
+    if not (image.exists() or image.is_symlink()):
+        return
+    named = None
+    if output.is_file():
+        try:
+            content = read_yaml_file(output, "ROS map YAML")
+        except (OSError, ValueError):  # not a map: the image is not its
+            content = None
+        if isinstance(content, dict) and isinstance(content.get("image"), str):
+            named = output.parent / content["image"]
+    if named is None or named.resolve() != image.resolve():
+        raise FileExistsError(
+            f"--output's image {image} exists and is not the image of the map {output}: "
+            f"give another --output name, or move {image.name}"
+        )

@@ -12,7 +12,7 @@ from rich.console import Console
 from kiseki._support.guard import guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.outputs import check_suffix
-from kiseki.cli.map import MAP_IMAGE
+from kiseki.cli.map import MAP_IMAGE, refuse_foreign_image
 from kiseki.grid import grid_summary
 from kiseki.io.ros_map import load_map, save_map
 
@@ -33,6 +33,7 @@ def map_convert(
 
     Example: kiseki map convert data/maps/factory_corridor.yaml -o corridor.yaml"""
     check_suffix("--output", output, (".yaml", ".yml"))
+    refuse_foreign_image(output)
     grid = load_map(map_file)
     save_map(grid, output)
     summary = grid_summary(grid)

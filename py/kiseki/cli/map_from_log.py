@@ -16,7 +16,7 @@ from kiseki._support.options import CELL_LIMITS, REACH_LIMIT, Metres, refuse_giv
 from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki.cli._defaults import default_of
 from kiseki.cli._off_map import has_endpoints
-from kiseki.cli.map import MAP_IMAGE
+from kiseki.cli.map import MAP_IMAGE, refuse_foreign_image
 from kiseki.datasets import open_scans
 from kiseki.datasets.rosbag import is_ros_bag
 from kiseki.io.ros_map import load_map, save_map
@@ -74,6 +74,7 @@ def map_from_log(
     if rules != "log-odds":  # teaching maps merge 8 m local maps: they have no usable range
         refuse_given(ctx, ["usable_range"], f"to --rules {rules} (only to log-odds)")
     check_suffix("--output", output, (".yaml", ".yml"))
+    refuse_foreign_image(output)
     check_suffix("--render", render, FIGURE_SUFFIXES)
     config = MapBuildConfig(resolution=resolution, usable_range=usable_range)
     start = time.perf_counter()
