@@ -33,7 +33,14 @@ from kiseki_experiments.harness.report import (
 )
 from kiseki_experiments.harness.run_reader import read_latest, read_timings, trial_seconds
 
-__all__ = ["Result", "claims_block", "gather", "summary_block", "update_readme"]
+__all__ = [
+    "Result",
+    "check_markers",
+    "claims_block",
+    "gather",
+    "summary_block",
+    "update_readme",
+]
 
 _CLAIMS = re.compile(r"(<!-- claims: ([a-z0-9-]+) -->\n)(.*?)(<!-- /claims -->)", re.S)
 _SUMMARY = re.compile(
@@ -130,10 +137,55 @@ def summary_block(results: dict[str, Result]) -> str:
     return f"{markdown_table(table)}\n\nAll results: {tally_text(total)}; {spent}.\n"
 
 
+# a line that is a marker (a marker quoted inside a line of prose is prose)
+_MARKER_LINE = re.compile(r"<!--\s*(/?)\s*(claims|reproduction-summary)\b(.*?)-->")
+_CLAIMS_OPEN = re.compile(r"<!-- claims: [a-z0-9-]+ -->")
+
+
+def check_markers(text: str, readme: Path) -> None:
+    """Raises ValueError naming the README and the line of a marker that would leave a block
+    unwritten or half written: an opening marker never closed, or opened again before it is
+    closed (nested), a closing marker with no block open, a claims marker not written as
+    ``<!-- claims: NAME -->`` (NAME in lower case); and a README with no block at all. Such
+    a README was left as it was (or half replaced), the command exiting 0."""
+    opened: tuple[int, str, str] | None = None  # line, kind, marker
+    blocks = 0
+    for number, line in enumerate(text.splitlines(), start=1):
+        m = _MARKER_LINE.fullmatch(line.strip())
+        if m is None:
+            continue
+        closing, kind, marker = m.group(1) == "/", m.group(2), line.strip()
+        where = f"{readme}:{number}"
+        if not closing:
+            if kind == "claims" and not _CLAIMS_OPEN.fullmatch(marker):
+                raise ValueError(f"{where}: {marker} is not a marker: write <!-- claims: NAME -->")
+            if opened is not None:
+                raise ValueError(
+                    f"{where}: {marker} opens a block inside the one opened at line {opened[0]}"
+                    f" ({opened[2]}): close that one first with <!-- /{opened[1]} -->"
+                )
+            opened = (number, kind, marker)
+            continue
+        if opened is None or opened[1] != kind:
+            raise ValueError(f"{where}: {marker} closes no block")
+        opened, blocks = None, blocks + 1
+    if opened is not None:
+        raise ValueError(
+            f"{readme}:{opened[0]}: {opened[2]} is never closed with <!-- /{opened[1]} -->"
+        )
+    if blocks == 0:
+        raise ValueError(
+            f"{readme}: holds no block to regenerate (<!-- claims: NAME --> ... <!-- /claims -->"
+            " or <!-- reproduction-summary --> ... <!-- /reproduction-summary -->)"
+        )
+
+
 def update_readme(text: str, readme: Path, results_root: Path) -> tuple[str, list[str]]:
     """(``text``, the README's, with every marked block regenerated from ``results_root``; the
     names of the experiments whose blocks were written). A block naming no registered
-    experiment is a ValueError naming the README and the name."""
+    experiment, and markers :func:`check_markers` refuses, are a ValueError naming the README
+    (and the line)."""
+    check_markers(text, readme)
     known = all_experiments()
     results = gather(results_root)
     named = [m.group(2) for m in _CLAIMS.finditer(text)]

@@ -168,3 +168,45 @@ def test_a_damaged_timings_file_is_refused_by_report_and_readme_naming_it(result
     with pytest.raises(ValueError, match="not a timings table") as err:
         write_reproduction(root, tmp_path / "R.md")
     assert str(bad) in str(err.value) and not (tmp_path / "R.md").exists()
+
+
+@pytest.mark.parametrize(
+    ("body", "message"),
+    [
+        ("No markers at all.\n", "README.md: holds no block to regenerate"),
+        (
+            "<!-- claims: corridor-scans -->\nold\n",
+            "README.md:5: <!-- claims: corridor-scans --> is never closed with <!-- /claims -->",
+        ),
+        (
+            "<!-- claims: corridor-scans -->\n<!-- claims: exp1-corridor -->\n<!-- /claims -->\n",
+            "README.md:6: <!-- claims: exp1-corridor --> opens a block inside the one opened "
+            "at line 5 (<!-- claims: corridor-scans -->): close that one first",
+        ),
+        ("<!-- /claims -->\n", "README.md:5: <!-- /claims --> closes no block"),
+        (
+            "<!-- reproduction-summary -->\n<!-- /claims -->\n",
+            "README.md:6: <!-- /claims --> closes no block",
+        ),
+        (
+            "<!-- claims: Corridor Scans -->\n<!-- /claims -->\n",
+            "README.md:5: <!-- claims: Corridor Scans --> is not a marker",
+        ),
+    ],
+    ids=["none", "unclosed", "nested", "stray-close", "mismatched", "malformed"],
+)
+def test_markers_that_would_leave_a_block_unwritten_are_refused_with_the_line(
+    results, tmp_path, body, message
+):
+    """These READMEs were left as they were (or, nested, half replaced) and the command exited
+    0 with 'readme_blocks 0'. A marker quoted inside a line of prose stays prose (the README's
+    own description of the markers)."""
+    with pytest.raises(ValueError) as err:
+        update_readme(PROSE + body, tmp_path / "README.md", results)
+    assert str(err.value).startswith(f"{tmp_path / 'README.md'}")
+    assert message.split("README.md", 1)[1] in str(err.value)
+    quoted = PROSE + "The `<!-- claims: NAME -->` markers.\n" + README[len(PROSE) :]
+    assert update_readme(quoted, tmp_path / "README.md", results)[1] == [
+        "corridor-scans",
+        "exp1-corridor",
+    ]
