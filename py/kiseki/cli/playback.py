@@ -90,7 +90,12 @@ def playback_command(
     config = PlaybackConfig(method=method, seed=seed)
     band, _ = METHODS[method]
     names = [n.strip() for n in route.split(",")]
+    if not all(names):  # ',,' read as waypoints named '' ('no waypoint named , ,')
+        raise ValueError(f"--route {route!r}: a waypoint name is empty: give names as P0,P1,P2")
     if taught is not None:
+        if not taught.is_dir():  # its waypoint file was named as missing, not the folder
+            what = "no such folder" if not taught.exists() else "not a folder"
+            raise ValueError(f"--taught {taught}: {what} (kiseki teach writes one)")
         waypoints = taught / "waypoints.yaml"
     map_path, marks = load_route(waypoints, band, names, map_file)
     if not scene_file.is_file():

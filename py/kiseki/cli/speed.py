@@ -18,7 +18,7 @@ from kiseki._support.interrupt import interruptible
 from kiseki._support.options import REACH_LIMIT, Degrees, Metres, Quantity, refuse_given
 from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki.cli._off_map import warn_if_off_the_map
-from kiseki.datasets import open_scans
+from kiseki.datasets import is_ros_bag, open_scans
 from kiseki.io.ros_map import load_map
 from kiseki.speed import SpeedLimiterConfig
 from kiseki.speed.acceleration import SPEED_LIMIT
@@ -98,8 +98,9 @@ def speed_limits(
     if reference_topic is not None:
         topics["reference_topic"] = reference_topic
     scans = open_scans(log, **topics)
-    if not scans.has_reference_poses:
-        raise ValueError(f"{log}: the log has no reference poses (give --reference-topic)")
+    if not scans.has_reference_poses:  # a topic can be named in a ROS bag only
+        hint = " (give --reference-topic)" if is_ros_bag(log) else ""
+        raise ValueError(f"{log}: the log has no reference poses{hint}")
     limits = limits_along_log(scans, grid, config, reach, heading)
     warn_if_off_the_map(grid, scans.poses, scans, map_file, poses="reference")
     columns = limits.columns()

@@ -253,6 +253,8 @@ def load_map(path: str | os.PathLike) -> OccupancyGrid:
 
         wean = read_wean_map(path)
         return OccupancyGrid(wean.to_cells(), wean.resolution)
+    if path.is_dir():  # '' is '.' ('.: unknown map format')
+        raise MapFormatError(f"{path}: a folder, not a map file (.yaml, .yml, .dat or .dat.gz)")
     if not name.endswith((".yaml", ".yml")):
         raise MapFormatError(f"{path}: unknown map format (expected .yaml, .yml, .dat or .dat.gz)")
     return _load_ros_map(path)

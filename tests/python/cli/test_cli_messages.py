@@ -1,0 +1,59 @@
+# SPDX-License-Identifier: BSD-3-Clause
+# Copyright (c) 2026 the kiseki authors
+"""Mistakes whose one line named the wrong thing, found by probing the commands: each line now
+names what the user typed and what is wrong with it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from _helpers.boundaries_cli import digests, one_error, run
+from _helpers.room_log import room
+from kiseki import save_map
+
+SCENE = Path(__file__).resolve().parents[3] / "data" / "worlds" / "factory_corridor.yaml"
+
+
+@pytest.fixture
+def inputs(tmp_path: Path) -> Path:
+    save_map(room(), tmp_path / "room.yaml")
+    # a CMU robotdata log (odometry and scans in cm, no reference poses): two scans
+    laser = "L 100 -50 0 125 -50 0 " + " ".join(["200"] * 180)
+    text = f"O 100 -50 0 0.01\n{laser} 0.05\nO 100 -50 0 0.1\n{laser} 0.15\n"
+    (tmp_path / "robotdata.log").write_text(text)
+    (tmp_path / "taught-file").write_text("not a folder")
+    return tmp_path
+
+
+@pytest.mark.parametrize(
+    ("args", "line"),
+    [
+        (  # it asked for --reference-topic, an option of ROS bags only
+            ["speed", "limits", "robotdata.log", "--map", "room.yaml", "-o", "s.csv"],
+            "robotdata.log: the log has no reference poses",
+        ),
+        (  # it named the waypoint file inside the missing folder
+            ["playback", SCENE, "--taught", "nowhere", "--route", "P0,P1"],
+            "--taught nowhere: no such folder (kiseki teach writes one)",
+        ),
+        (
+            ["playback", SCENE, "--taught", "taught-file", "--route", "P0,P1"],
+            "--taught taught-file: not a folder (kiseki teach writes one)",
+        ),
+        (  # 'no waypoint named , ,'
+            ["playback", SCENE, "--taught", ".", "--route", ",,"],
+            "--route ',,': a waypoint name is empty: give names as P0,P1,P2",
+        ),
+        (  # '' is the current folder: '.: unknown map format'
+            ["map", "info", ""],
+            ".: a folder, not a map file (.yaml, .yml, .dat or .dat.gz)",
+        ),
+    ],
+    ids=["reference-topic", "taught-missing", "taught-file", "empty-route", "map-folder"],
+)
+def test_the_line_names_what_was_typed_and_what_is_wrong(inputs, args, line):
+    before = digests(inputs)
+    assert one_error(run(*args, cwd=inputs)) == f"kiseki: error: {line}"
+    assert digests(inputs) == before
