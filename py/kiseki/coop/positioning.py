@@ -171,6 +171,13 @@ def plan(
     moves = check_count(moves, "moves", 1, MAX_MOVES)  # the Plan holds Python's int
     if angle is None:
         angle = paper_angle(form, moves, start, goal)
+        if form in FORMS and not math.radians(5) <= angle <= math.radians(85):
+            raise ValueError(  # it read as if an angle given were out of range
+                f"form {form} keeping the start's width to the goal ({goal[0]:g}, {goal[1]:g}) "
+                f"in {moves} move{'s' if moves > 1 else ''} stands at "
+                f"{math.degrees(angle):.3g} deg, out of the representative angle's 5..85 deg: "
+                "move the goal, change the moves or give the angle"
+            )
     _check(form, moves, angle)
     if form == 2:
         return Plan(form, moves, angle, start, _form2(moves, angle, start, goal))

@@ -118,3 +118,20 @@ def test_form1_readings_meet_at_their_closed_form_sight_angles(deg) -> None:
         np.testing.assert_allclose(p.steps[-1].target, GOAL)
     with pytest.raises(ValueError, match="reading must be one of"):
         plan(1, 15, theta, reading="diagonal")
+
+
+def test_an_angle_that_follows_from_the_goal_names_the_goal_and_the_moves() -> None:
+    """Without an angle, it follows from the goal's distance and the moves (paper_angle); out
+    of range it read 'the representative angle must lie in 5..85 deg, got 0.00716...', as if
+    the user had given it, and the command line's --goal was never named."""
+    angle = math.degrees(paper_angle(1, 15, START, (0.0, 0.001)))
+    with pytest.raises(ValueError) as caught:
+        plan(1, 15, None, START, (0.0, 0.001))
+    assert str(caught.value) == (
+        f"form 1 keeping the start's width to the goal (0, 0.001) in 15 moves stands at "
+        f"{angle:.3g} deg, out of the representative angle's 5..85 deg: move the goal, change "
+        "the moves or give the angle"
+    )
+    with pytest.raises(ValueError, match=r"to the goal \(0, 900\) in 1 move stands at 89.9 deg"):
+        plan(1, 1, None, START, (0.0, 900.0))
+    assert 5 < math.degrees(plan(1, 15, None, START, (0.0, 20.0)).angle) < 85  # in range: taken
