@@ -31,6 +31,7 @@ import io
 import math
 import os
 import struct
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -286,7 +287,20 @@ def _hough(points: np.ndarray, origin: np.ndarray, params: HoughParams) -> Cloud
     reach = float(np.max(np.linalg.norm(local, axis=1)))
     grid = sphere_grid((-180.0, 180.0), (-90.0, 90.0), 1.0, max(1.01 * reach + 0.01, 0.1))
     sdem = sdem_from_points(local, grid=grid)
-    result = remove_planes(sdem, "hough", hough=params)
+    widest = int((np.asarray(sdem.ranges) > 0).sum(axis=1).max())  # cells of one tilt scan
+    if widest < params.min_votes:  # no line can get its votes: nothing will be removed
+        where = ", ".join(f"{v:g}" for v in origin)
+        warnings.warn(
+            f"seen from the origin ({where}), the cloud spans at most {widest} cells of one tilt "
+            f"scan, fewer than the {params.min_votes} a Hough line needs: no plane can be found "
+            "(is the origin the sensor's position?)",
+            stacklevel=3,
+        )
+        # the Hough's result without its accumulators, which span the far points' range (1.7 km
+        # of 3 cm bins took 39 s; 10 km was refused as 'rho_step is too small')
+        result = remove_planes(sdem, "none")
+    else:
+        result = remove_planes(sdem, "hough", hough=params)
     x, y, z = local.T
     r = np.linalg.norm(local, axis=1)
     step = math.radians(grid.step_deg)

@@ -126,6 +126,32 @@ def test_hough_removes_a_plane_seen_from_the_sensor_and_not_a_rough_blob():
     np.testing.assert_array_equal(shifted.label, floor_r.label)
 
 
+def test_a_cloud_seen_from_far_off_warns_that_no_line_can_get_its_votes():
+    """From an origin 170 m off, a 6 m floor spans a few 1-degree cells of a tilt scan: no
+    Hough line can reach its 30 votes. The command took 39 s over accumulators spanning 1.7 km
+    and printed '0 lines, kept 100 %' without a word (10 km: 'rho_step is too small'). It
+    warns now, and the answer is the Hough's own (checked by running it on the same S-DEM)."""
+    from kiseki.terrain.plane_removal import remove_planes
+    from kiseki.terrain.sdem import sdem_from_points, sphere_grid
+
+    xy = np.random.default_rng(2).uniform(-3, 3, (5000, 2))
+    floor = np.c_[xy, np.full(len(xy), -0.6)]
+    origin = np.array([100.0, 100.0, 100.0])
+    with pytest.warns(
+        UserWarning,
+        match=r"^seen from the origin \(100, 100, 100\), the cloud "
+        r"spans at most \d cells of one tilt scan, fewer than the 30 a Hough line "
+        r"needs: no plane can be found \(is the origin the sensor's position\?\)$",
+    ):
+        far = cloud_planes(Cloud(floor, origin, 0, "floor"), "hough")
+    assert far.lines == 0 and far.kept_share == 1.0
+    local = floor - origin
+    reach = float(np.max(np.linalg.norm(local, axis=1)))
+    grid = sphere_grid((-180.0, 180.0), (-90.0, 90.0), 1.0, 1.01 * reach + 0.01)
+    hough = remove_planes(sdem_from_points(local, grid=grid), "hough")
+    assert hough.found == 0 and not hough.removed.any()
+
+
 def test_sac_plane_test_planes_match_least_squares_and_the_files_normals():
     raw = SAC.read_text().split("DATA ascii\n", 1)[1] if need(SAC) else ""
     table = np.loadtxt(raw.splitlines())
