@@ -25,8 +25,10 @@ from kiseki._support.atomic import atomic_write
 from kiseki._support.guard import guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import PARTICLE_LIMIT, Count, Seed
+from kiseki._support.replaced_files import refuse_replacing
 from kiseki._support.table import show
 from kiseki.apps.teach import PlaybackConfig, playback, teach
+from kiseki.apps.teach.teaching import TEACHING_FILES
 from kiseki.cli._defaults import default_of
 from kiseki.cli.teach import merge_rule
 from kiseki.core import derive_seed
@@ -36,7 +38,7 @@ from kiseki.sim.render import render_scene
 from kiseki.sim.scene import load_scene
 from kiseki.teach.local_maps import METHODS
 
-__all__ = ["DemoConfig", "app", "run_demo"]
+__all__ = ["DEMO_FILES", "DemoConfig", "app", "run_demo"]
 
 # Thesis Table 4.5 (5 runs each): stop error mean (m), estimate error mean (m), stops within 0.1 m
 THESIS = {
@@ -56,6 +58,15 @@ class DemoConfig:
     particles: int = default_of(PlaybackConfig, "particles")  # the filter's own default
     merge: str = "thesis"  # the environment maps' merge rule (kiseki.teach.environment_map)
 
+
+# what the demo writes in its --out folder, in order (the teaching run's files in teach/)
+DEMO_FILES = (
+    "scene.png",
+    *(f"teach/{name}" for name in TEACHING_FILES),
+    "taught_map_band.png",
+    "config.yaml",
+    "summary.json",
+)
 
 app = typer.Typer()
 console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
@@ -90,6 +101,15 @@ def demo(
     run_demo(scene, out, seed, console, particles, merge_rule(merge))
 
 
+def _check_out(out: Path) -> None:
+    """Before any work: an earlier demo's folder (its teaching log and summary) is replaced;
+    another folder holding a file the demo writes (a user's own config.yaml) is refused."""
+    if (out / "teach" / "teach.mcap").is_file() and (out / "summary.json").is_file():
+        return
+    remedy = "give a new or empty folder as --out (an earlier demo's folder is replaced)"
+    refuse_replacing(out, DEMO_FILES, "--out", remedy)
+
+
 def _write_text(path: Path, text: str) -> None:
     atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
 
@@ -107,6 +127,7 @@ def run_demo(
     scene = load_scene(scene_file)
     if not scene.route.get("waypoints"):  # teach's own check, before anything is written
         raise ValueError(f"{scene_file}: the demo teaches along the scene's route: it has none")
+    _check_out(out)
     out.mkdir(parents=True, exist_ok=True)
     render_scene(scene, out / "scene.png")
     console.print("teaching: pushing the AGV along the route ...")

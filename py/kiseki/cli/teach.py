@@ -12,8 +12,9 @@ from rich.console import Console
 
 from kiseki._support.guard import guarded
 from kiseki._support.options import Seed, refuse_given
+from kiseki._support.replaced_files import refuse_replacing
 from kiseki.apps.teach.keyboard import KeyScript, TerminalKeys, teach_keyboard
-from kiseki.apps.teach.teaching import recover, teach
+from kiseki.apps.teach.teaching import TEACHING_FILES, recover, teach
 from kiseki.sim.scene import load_scene
 from kiseki.teach.environment_map import MERGE_RULES
 
@@ -30,6 +31,22 @@ def merge_rule(value: str) -> str:
     return value
 
 
+def _check_out(out: Path, log: Path, resume: bool, overwrite: bool) -> None:
+    """Before any work: --resume needs the log; without --resume or --overwrite, the folder
+    holds no file a teaching run writes (the log, or a user's own map or waypoint file)."""
+    if resume:
+        if not log.is_file():
+            raise FileNotFoundError(f"{log}: no teaching log to resume from")
+    elif not overwrite:
+        if log.exists():
+            raise FileExistsError(
+                f"{log}: a teaching log exists; --resume rebuilds from it, --overwrite replaces it"
+            )
+        refuse_replacing(
+            out, TEACHING_FILES, "--out", "give a new or empty folder as --out, or add --overwrite"
+        )
+
+
 @app.command("teach")
 @guarded(inputs=("scene_file", "keys"), output_folders=("out",))
 def teach_command(
@@ -40,7 +57,9 @@ def teach_command(
     out: Path = typer.Option(..., "-o", "--out", help="Folder for maps, waypoints and the log."),
     seed: int = typer.Option(0, parser=Seed(), help="Seed of the run's noise."),
     resume: bool = typer.Option(False, help="Rebuild maps and waypoints from OUT/teach.mcap."),
-    overwrite: bool = typer.Option(False, help="Replace an existing teaching log."),
+    overwrite: bool = typer.Option(
+        False, help="Replace the teaching log, maps and waypoint file OUT holds."
+    ),
     keyboard: bool = typer.Option(
         False,
         help="Push the robot from the terminal instead of along the route: w/s or Up/Down "
@@ -79,14 +98,9 @@ def teach_command(
         raise ValueError("--keyboard needs a terminal on stdin (or --keys FILE of timed keys)")
     scene = load_scene(scene_file)
     log = out / "teach.mcap"
+    _check_out(out, log, resume, overwrite)
     if resume:
-        if not log.is_file():
-            raise FileNotFoundError(f"{log}: no teaching log to resume from")
         result = recover(scene, log, out, merge)
-    elif log.exists() and not overwrite:
-        raise FileExistsError(
-            f"{log}: a teaching log exists; --resume rebuilds from it, --overwrite replaces it"
-        )
     elif keyboard:
         source = KeyScript(keys) if keys is not None else TerminalKeys(sys.stdin.fileno(), 0.1)
         try:

@@ -41,7 +41,16 @@ from kiseki.teach.scene_identity import (
     scene_digest,
 )
 
-__all__ = ["TeachingRun", "recover", "teach"]
+__all__ = ["TEACHING_FILES", "TeachingRun", "recover", "teach"]
+
+# what a teaching run writes in its folder, the log first (`write_teaching_files` the rest: each
+# band's map YAML and image, their truth, the waypoint file, removed when no waypoint is marked)
+TEACHING_FILES = (
+    "teach.mcap",
+    *(name for band in BANDS for name in (f"map_{band}.yaml", f"map_{band}.pgm")),
+    "map_truth.json",
+    "waypoints.yaml",
+)
 
 MARK_SCHEMA = {
     "type": "object",
