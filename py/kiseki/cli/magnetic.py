@@ -17,6 +17,7 @@ from kiseki._support.guard import Folder, guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import Count, Fraction, Metres, Seed, refuse_given
 from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
+from kiseki._support.replaced_files import refuse_replacing
 from kiseki.apps.magnetic.navigate_outputs import navigate_folder, teach_folder
 from kiseki.cli.magnetic_fit import fit
 from kiseki.datasets.kok import read_kok_walk
@@ -35,8 +36,11 @@ app = typer.Typer(
 )
 app.command("fit")(fit)  # first in the listing: the map the other commands read
 console = Console(soft_wrap=True)  # piped: one line stays one line (grep, awk)
-# what kiseki magnetic navigate writes in its -o folder (kiseki._support.guard)
+# what kiseki magnetic walk and navigate write in their -o folders (kiseki._support.guard);
+# an existing one is replaced only with --overwrite (kiseki._support.replaced_files)
+_WALK = Folder("output", ("trajectory.csv",))
 _NAVIGATION = Folder("output", ("run.mcap", "navigation.csv", "navigation.png"))
+_OVERWRITE = "give --overwrite, or another folder"
 
 
 @app.command("predict")
@@ -110,7 +114,7 @@ def render(
 
 
 @app.command("walk")
-@guarded(inputs=("walk_file",), output_folders=(Folder("output", ("trajectory.csv",)),))
+@guarded(inputs=("walk_file",), output_folders=(_WALK,))
 @interruptible()
 def walk(
     walk_file: Path = typer.Argument(
@@ -135,6 +139,9 @@ def walk(
         LoopTravelConfig.start,
         help="With --filter loop: known (the loop's start) or global (anywhere on it).",
     ),
+    overwrite: bool = typer.Option(
+        False, help="Replace an existing output trajectory.csv in the folder."
+    ),
 ) -> None:
     """Travel distance along a real walk's loop from odometry and the magnetic field. The first
     lap (until the walker comes back within 1.5 m of the start after 10 m) is the map.
@@ -156,7 +163,8 @@ def walk(
     (1 + e) |dp| + N(0, (0.1 |dp|)^2), e drawn once from N(0, 0.05^2) by the seed. The walk's
     positions are used to map the first lap and to score, never by --filter loop to localize.
     Writes OUT/trajectory.csv (t,s_true,s_est,s_odom[,scale]; s_true from the map node nearest
-    the true position) and prints the RMSE of s_est and s_odom.
+    the true position; an existing one is replaced only with --overwrite) and prints the RMSE
+    of s_est and s_odom.
 
     Example: kiseki magnetic walk eight.mat -o eight-walk --seed 0"""
     target = output / "trajectory.csv"
@@ -164,6 +172,8 @@ def walk(
         raise ValueError(f"--filter must be loop or thesis, got {filter_name!r}")
     if start not in STARTS:
         raise ValueError(f"--start must be {' or '.join(STARTS)}, got {start!r}")
+    if not overwrite:
+        refuse_replacing(output, _WALK.writes, "-o", _OVERWRITE)
     if filter_name == "loop":
         _walk_loop(walk_file, target, seed, scale_error, start)
         return
@@ -252,15 +262,21 @@ def navigate(
     gates: str = typer.Option(
         "thesis", help="Magnetic navigators' validity: thesis (r_z >= 0.998) or sensor."
     ),
+    overwrite: bool = typer.Option(
+        False, help="Replace an existing output run.mcap, navigation.csv or navigation.png."
+    ),
 ) -> None:
     """Plays the taught route back steering with one navigator (thesis ch. 3: rahok; ch. 4:
     the four navigators alone, or multi, arbitrated by priority). Writes OUT/run.mcap,
-    OUT/navigation.csv and OUT/navigation.png (path, cross-track error, priority history).
+    OUT/navigation.csv and OUT/navigation.png (path, cross-track error, priority history);
+    existing ones are replaced only with --overwrite.
     --gates sensor: the magnetic navigators are valid while |m_z,n - m_z,t| <= 3 sigma
     sqrt(1 + 1/c_n), sigma the sensor's noise read from the taught map, c_n the readings its
     node averaged (kiseki's rule; the thesis' r_z >= 0.998 passes 0.002 G).
 
     Example: kiseki magnetic navigate data/worlds/magnetic_path.yaml --map taught -o nav"""
+    if not overwrite:
+        refuse_replacing(output, _NAVIGATION.writes, "-o", _OVERWRITE)
     r = navigate_folder(scene, map_folder, navigator, output, seed, gates)
     off = np.abs(r.cross_track)
     console.print(

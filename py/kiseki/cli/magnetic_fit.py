@@ -198,7 +198,9 @@ def fit(
         help="Measurements: Aalto run prefixes DIR/N (DIR/N-loc.csv, -mag.csv, -time.csv), CSV "
         "files with columns x,y[,z],mx,my,mz, or .mat hand-held walks.",
     ),
-    output: Path = typer.Option(..., "-o", "--output", help="Map folder to write."),
+    output: Path = typer.Option(
+        ..., "-o", "--output", help="Map folder to write (an earlier map there is replaced)."
+    ),
     dimension: int | None = typer.Option(
         None,
         parser=Count("--dimension", 2, 3),
@@ -263,7 +265,7 @@ def fit(
     """
     _check_fit_options(ctx, kernel, max_points, method, units, model)
     fixed = _parse_kernel(kernel, model) if kernel is not None else None
-    check_map_destination(output)
+    check_map_destination(output, "-o")  # before the fit: a user's file in it is refused
     x, y, height, units = _read_data(data, units, dimension)
     n_read = len(x)
     if bin_size is None and model == "curl-free":

@@ -65,6 +65,7 @@ from kiseki.magnetic.map_doc import (
 __all__ = [
     "COMPONENTS",
     "MAP_FILE",
+    "MAP_FOLDER_FILES",
     "MAX_FILE_BYTES",
     "KIND",
     "MapFolderContents",
@@ -76,6 +77,12 @@ __all__ = [
 MAP_FILE = "magnetic_map.yaml"
 LINEAR_MAP_FILE = "linear_map.yaml"  # kiseki.magnetic.linear_map_folder.MAP_FILE: refused here
 LAYERS = tuple(f"{c}_{q}" for q in ("mean", "variance") for c in COMPONENTS)
+# every file write_map_folder writes (2-D or 3-D, with or without training data): a map folder
+# is replaced whole, so one holding anything else is refused
+MAP_FOLDER_FILES = frozenset(
+    {MAP_FILE, "layers.npz", "voxels.npz", "training.npz", "predictor.npz"}
+    | {f"{name}.png" for name in LAYERS}
+)
 MAX_FILE_BYTES = 2 * GIB
 """Each file of a map folder, and the arrays of each ``.npz``, hold at most this: a map of
 MAX_CELLS cells keeps its mean and variance in 960 MB, 10 million training points in 480 MB."""
@@ -91,10 +98,11 @@ def _is_map_folder(path: Path) -> bool:
     return isinstance(doc, dict) and doc.get("kind") == KIND
 
 
-def check_map_destination(folder) -> Path:
+def check_map_destination(folder, label: str = "") -> Path:
     """Checks before any work that a map can be written to `folder`: its parent exists and is
-    writable, and the folder is absent, empty, or a magnetic field map (which is replaced).
-    Returns the folder as a Path."""
+    writable, and the folder is absent, empty, or a magnetic field map holding only a map's own
+    files (it is replaced whole: a user's file in it would go with it). `label` (``-o``) starts
+    that refusal. Returns the folder as a Path."""
     folder = Path(folder)
     parent = folder.parent if str(folder.parent) else Path(".")
     if not parent.is_dir():
@@ -107,6 +115,14 @@ def check_map_destination(folder) -> Path:
         if any(folder.iterdir()) and not _is_map_folder(folder):
             raise FileExistsError(
                 f"{folder} exists and is not a magnetic field map folder: refusing to replace it"
+            )
+        foreign = sorted(p.name for p in folder.iterdir() if p.name not in MAP_FOLDER_FILES)
+        if foreign:
+            more = f" (and {len(foreign) - 1} more)" if len(foreign) > 1 else ""
+            raise FileExistsError(
+                f"{label + ' ' if label else ''}{folder} holds {foreign[0]}{more}, which is not "
+                "part of a magnetic field map: the map folder is replaced whole; move "
+                f"{'them' if more else 'it'} out, or give a new folder"
             )
     return folder
 

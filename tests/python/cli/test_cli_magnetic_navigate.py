@@ -92,6 +92,39 @@ def test_navigate_writes_a_run_csv_and_plot(taught, tmp_path):
     assert (out / "navigation.png").stat().st_size > 10_000
 
 
+def test_navigate_refuses_to_replace_its_outputs_unless_told_to_overwrite(taught, tmp_path):
+    """navigate replaced an existing navigation.csv, navigation.png and run.mcap without a
+    word; now only with --overwrite, and the refusal comes before the run."""
+    from kiseki.io.runlog import read_run
+
+    scene, folder = taught
+    out = tmp_path / "F"
+    out.mkdir()
+    (out / "navigation.csv").write_text("my table\n", encoding="utf-8")
+    (out / "notes.txt").write_text("my notes\n", encoding="utf-8")
+    done = run("navigate", scene, "--map", folder, "-o", out)
+    assert done.returncode == 1
+    assert done.stderr.splitlines() == [
+        f"kiseki: error: -o {out} holds navigation.csv, which this command would replace: give "
+        "--overwrite, or another folder"
+    ]
+    assert sorted(p.name for p in out.iterdir()) == ["navigation.csv", "notes.txt"]
+    assert (out / "navigation.csv").read_text(encoding="utf-8") == "my table\n"
+    (out / "run.mcap").write_bytes(b"my run")
+    assert refused("navigate", scene, "--map", folder, "-o", out) == (
+        f"-o {out} holds run.mcap (and 1 more), which this command would replace: give "
+        "--overwrite, or another folder"
+    )
+    assert (out / "run.mcap").read_bytes() == b"my run"
+    code, output, error = invoke("navigate", scene, "--map", folder, "-o", out, "--overwrite")
+    assert code == 0, (output, error)
+    header = (out / "navigation.csv").read_text(encoding="utf-8").splitlines()[0]
+    assert header.startswith("t,x,y,theta,")
+    assert len(read_run(out / "run.mcap").poses("/ground_truth")[0]) > 100
+    assert (out / "navigation.png").stat().st_size > 10_000
+    assert (out / "notes.txt").read_text(encoding="utf-8") == "my notes\n"  # not an output
+
+
 def test_navigate_refuses_another_path_in_one_line(taught, tmp_path, project_data):
     _, folder = taught
     other = run("navigate", project_data / "worlds" / "magnetic_path.yaml", "--map", folder,

@@ -353,6 +353,11 @@ def test_saving_replaces_a_map_but_never_another_folder(tmp_path):
     linear_map(3).save(tmp_path / "map")  # a map folder is replaced whole
     assert MagneticFieldMap.load(tmp_path / "map").dimension == 3
     assert not (tmp_path / "map" / "layers.npz").exists()
+    (tmp_path / "map" / "notes.txt").write_text("mine")  # replaced whole: it would go with it
+    with pytest.raises(FileExistsError, match="map holds notes.txt, which is not part of a mag"):
+        fmap.save(tmp_path / "map")
+    assert (tmp_path / "map" / "notes.txt").read_text() == "mine"
+    (tmp_path / "map" / "notes.txt").unlink()
     (tmp_path / "photos").mkdir()
     (tmp_path / "photos" / "cat.jpg").write_bytes(b"meow")
     with pytest.raises(FileExistsError, match="not a magnetic field map folder"):
