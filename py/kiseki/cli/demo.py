@@ -102,9 +102,10 @@ def demo(
 
 
 def _check_out(out: Path) -> None:
-    """Before any work: an earlier demo's folder (its teaching log and summary) is replaced;
+    """Before any work: an earlier demo's folder (its teaching log, teach/teach.mcap, the
+    demo's first file, so that a demo interrupted before its summary is one too) is replaced;
     another folder holding a file the demo writes (a user's own config.yaml) is refused."""
-    if (out / "teach" / "teach.mcap").is_file() and (out / "summary.json").is_file():
+    if (out / "teach" / "teach.mcap").is_file():
         return
     remedy = "give a new or empty folder as --out (an earlier demo's folder is replaced)"
     refuse_replacing(out, DEMO_FILES, "--out", remedy)

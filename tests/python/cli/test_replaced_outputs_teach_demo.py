@@ -151,3 +151,14 @@ def test_an_earlier_demos_folder_is_replaced(tmp_path, short_scene):
     config = yaml.safe_load((tmp_path / "d" / "config.yaml").read_text())
     assert (config["particles"], config["seed"]) == (30, 4)  # the second run's
     assert json.loads((tmp_path / "d" / "summary.json").read_text())["waypoints"] == ["P0", "G"]
+
+
+def test_a_demo_interrupted_before_its_summary_is_still_the_demos_own(tmp_path, short_scene):
+    """A demo stopped after its teaching, before summary.json, left a folder the demo refused
+    to run into again: its teaching log, the demo's first file, marks it as the demo's."""
+    (tmp_path / "d" / "teach").mkdir(parents=True)
+    (tmp_path / "d" / "teach" / "teach.mcap").write_bytes(b"cut short")
+    (tmp_path / "d" / "config.yaml").write_text("the interrupted run's\n")
+    done = run("demo", "--scene", short_scene, "--out", "d", "--particles", "20", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert set(contents(tmp_path / "d")) == set(DEMO_FILES)
