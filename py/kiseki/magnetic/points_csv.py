@@ -77,6 +77,11 @@ def read_points(path: str | os.PathLike, d: int) -> tuple[np.ndarray, bool]:
                         f"{where}: a row needs the header's columns {', '.join(need)} "
                         f"(at least {max(columns) + 1} values), got {','.join(row)[:60]!r}"
                     )
+                if len(row) > len(names):  # a value no column names ('0,0,0' under 'x,y')
+                    raise ValueError(
+                        f"{where}: {len(row)} values where the header names {len(names)} "
+                        f"columns ({','.join(names)}), got {','.join(row)[:60]!r}"
+                    )
                 if len(points) == MAX_POINTS:
                     raise ValueError(f"{where}: a points file holds at most {MAX_POINTS:,} points")
                 point = parse(model, {n: row[c] for n, c in zip(need, columns, strict=True)}, where)

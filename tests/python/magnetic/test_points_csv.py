@@ -32,6 +32,11 @@ def test_a_valid_file_reads_to_its_numbers(tmp_path):
         ("x,y\n0,\n", "p.csv:2: y: must be a number, got ''"),
         ("x,y\n0\n", "p.csv:2: a row needs the header's columns x, y (at least 2 values), got '0'"),
         ("a,y\n0,1\n", "p.csv: the header has no x column (got ['a', 'y'])"),
+        # the third value was dropped without a word (a z under a header of x, y)
+        (
+            "x,y\n0,1\n0,0,0\n",
+            "p.csv:3: 3 values where the header names 2 columns (x,y), got '0,0,0'",
+        ),
         ("x,y\n", "p.csv: header but no points"),
         ("\n\n", "p.csv: empty file: expected a header x,y[,z] and rows"),
     ],
