@@ -179,7 +179,7 @@ def walk(
         return
     if start != LoopTravelConfig.start:
         raise ValueError("--start is for --filter loop (the thesis' laps start at the map's start)")
-    result = localize_walk(read_kok_walk(walk_file), seed, WalkOdometry(scale_error=scale_error))
+    result = _of_walk(walk_file, localize_walk, seed, WalkOdometry(scale_error=scale_error))
     for lap, t, metres in result.off_path:
         console.print(
             f"lap {lap} leaves the map's path ({metres:.2f} m from the nearest map node at "
@@ -199,12 +199,21 @@ def walk(
     console.print(f"RMSE s_est {result.rmse('s_est'):.3f} m, s_odom {result.rmse('s_odom'):.3f} m")
 
 
+def _of_walk(walk_file: Path, localize, *args):
+    """``localize(walk, *args)`` on the walk read from ``walk_file``; what it finds wrong with
+    the walk's own data (no lap, one lap only) names the file ('walk: the walker never comes
+    back ...' did not)."""
+    walk = read_kok_walk(walk_file)
+    try:
+        return localize(walk, *args)
+    except ValueError as err:
+        raise ValueError(f"{walk_file}: {err}") from None
+
+
 def _walk_loop(walk_file: Path, target: Path, seed: int, scale_error, start: str) -> None:
     """kiseki's loop filter on a walk (``kiseki magnetic walk --filter loop``)."""
     odometry = WalkOdometry(scale_error=scale_error)
-    result = localize_walk_loop(
-        read_kok_walk(walk_file), seed, odometry, LoopTravelConfig(start=start)
-    )
+    result = _of_walk(walk_file, localize_walk_loop, seed, odometry, LoopTravelConfig(start=start))
     if result.t.size == 0:
         raise ValueError(f"{walk_file}: every later sample leaves the map's path: nothing scored")
     rows = np.column_stack([result.t, result.s_true, result.s_est, result.s_dr, result.scale])

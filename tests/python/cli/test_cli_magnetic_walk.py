@@ -110,14 +110,17 @@ def test_bad_files(tmp_path, override, message):
 
 def test_bad_options(tmp_path):
     write_walk(tmp_path / "loop.mat", laps=1.02)  # a 0.5 m tail is no lap
-    result = run(tmp_path / "loop.mat", "-o", tmp_path / "out")
-    assert result.returncode == 1 and "one lap only" in result.stderr
+    for how in ((), THESIS):  # the walk's own problems name its file (they did not)
+        result = run(tmp_path / "loop.mat", "-o", tmp_path / "out", *how)
+        assert result.returncode == 1 and "one lap only" in result.stderr
+        assert result.stderr.startswith(f"kiseki: error: {tmp_path / 'loop.mat'}: ")
     result = run(tmp_path / "loop.mat", "-o", tmp_path / "out", "--scale-error", "-1")
     assert result.returncode == 1 and "--scale-error must be" in result.stderr
     short = tmp_path / "short.mat"
     write_walk(short, laps=0.3)
     result = run(short, "-o", tmp_path / "out")
     assert result.returncode == 1 and "never comes back within 1.5 m" in result.stderr
+    assert result.stderr.startswith(f"kiseki: error: {short}: walk: the walker never comes back")
     for bad, message in (
         (("--filter", "kalman"), "--filter must be loop or thesis"),
         (("--start", "nowhere"), "--start must be known or global"),
