@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import hashlib
 import subprocess
-import sys
 from pathlib import Path
 
 import yaml
 
+from _helpers.boundaries_cli import run as run_cli
 from _helpers.synthetic_walk import write_walk
 
 # four readings and a given kernel: a fit in milliseconds (nothing to search)
@@ -25,12 +25,7 @@ INDEPENDENT = ("--model", "independent", "--kernel", "3,1,0.1")
 
 def run(*args, cwd=None) -> subprocess.CompletedProcess:
     """The CLI in a process of its own: exit status and stderr as a user sees them."""
-    return subprocess.run(
-        [sys.executable, "-m", "kiseki.cli", "magnetic", *map(str, args)],
-        capture_output=True,
-        text=True,
-        cwd=cwd,
-    )
+    return run_cli("magnetic", *args, cwd=Path.cwd() if cwd is None else cwd)
 
 
 def invoke(*args):
