@@ -137,28 +137,46 @@ def summary_block(results: dict[str, Result]) -> str:
     return f"{markdown_table(table)}\n\nAll results: {tally_text(total)}; {spent}.\n"
 
 
-# a line that is a marker (a marker quoted inside a line of prose is prose)
+# a line that looks like a marker (a marker quoted inside a line of prose is prose); each must
+# be written exactly as _CLAIMS and _SUMMARY read it, or a block is skipped or swallows prose
 _MARKER_LINE = re.compile(r"<!--\s*(/?)\s*(claims|reproduction-summary)\b(.*?)-->")
-_CLAIMS_OPEN = re.compile(r"<!-- claims: [a-z0-9-]+ -->")
+_EXACT = {
+    ("", "claims"): re.compile(r"<!-- claims: [a-z0-9-]+ -->"),
+    ("/", "claims"): re.compile(r"<!-- /claims -->"),
+    ("", "reproduction-summary"): re.compile(r"<!-- reproduction-summary -->"),
+    ("/", "reproduction-summary"): re.compile(r"<!-- /reproduction-summary -->"),
+}
+_WRITTEN_AS = {
+    ("", "claims"): "<!-- claims: NAME --> (NAME in lower case)",
+    ("/", "claims"): "<!-- /claims -->",
+    ("", "reproduction-summary"): "<!-- reproduction-summary -->",
+    ("/", "reproduction-summary"): "<!-- /reproduction-summary -->",
+}
 
 
 def check_markers(text: str, readme: Path) -> None:
     """Raises ValueError naming the README and the line of a marker that would leave a block
-    unwritten or half written: an opening marker never closed, or opened again before it is
-    closed (nested), a closing marker with no block open, a claims marker not written as
-    ``<!-- claims: NAME -->`` (NAME in lower case); and a README with no block at all. Such
-    a README was left as it was (or half replaced), the command exiting 0."""
+    unwritten, half written or swallowing the prose after it: a marker not written exactly as
+    ``<!-- claims: NAME -->``, ``<!-- /claims -->``, ``<!-- reproduction-summary -->`` or
+    ``<!-- /reproduction-summary -->`` on a line of its own (other spacing, a trailing space, a
+    carriage return of CRLF line ends), an opening marker never closed or opened again before
+    it is closed, a closing marker with no block open; and a README with no block at all. Such
+    a README was left as it was, half replaced or cut, the command exiting 0."""
     opened: tuple[int, str, str] | None = None  # line, kind, marker
     blocks = 0
-    for number, line in enumerate(text.splitlines(), start=1):
+    for number, line in enumerate(text.split("\n"), start=1):
         m = _MARKER_LINE.fullmatch(line.strip())
         if m is None:
             continue
-        closing, kind, marker = m.group(1) == "/", m.group(2), line.strip()
-        where = f"{readme}:{number}"
-        if not closing:
-            if kind == "claims" and not _CLAIMS_OPEN.fullmatch(marker):
-                raise ValueError(f"{where}: {marker} is not a marker: write <!-- claims: NAME -->")
+        key, kind = (m.group(1), m.group(2)), m.group(2)
+        where, marker = f"{readme}:{number}", line.strip()
+        if not _EXACT[key].fullmatch(line):
+            ending = " (its line ends with a carriage return: CRLF)" if line.endswith("\r") else ""
+            raise ValueError(
+                f"{where}: {marker} is not a marker as written{ending}: write "
+                f"{_WRITTEN_AS[key]} alone on its line"
+            )
+        if not m.group(1):
             if opened is not None:
                 raise ValueError(
                     f"{where}: {marker} opens a block inside the one opened at line {opened[0]}"
@@ -178,6 +196,9 @@ def check_markers(text: str, readme: Path) -> None:
             f"{readme}: holds no block to regenerate (<!-- claims: NAME --> ... <!-- /claims -->"
             " or <!-- reproduction-summary --> ... <!-- /reproduction-summary -->)"
         )
+    found = len(_CLAIMS.findall(text)) + len(_SUMMARY.findall(text))
+    if found != blocks:  # what the checks above cannot see must not pass either
+        raise ValueError(f"{readme}: {blocks} blocks are marked but {found} can be read")
 
 
 def update_readme(text: str, readme: Path, results_root: Path) -> tuple[str, list[str]]:

@@ -192,8 +192,38 @@ def test_a_damaged_timings_file_is_refused_by_report_and_readme_naming_it(result
             "<!-- claims: Corridor Scans -->\n<!-- /claims -->\n",
             "README.md:5: <!-- claims: Corridor Scans --> is not a marker",
         ),
+        (  # the block read on to the next block's end, and the prose between was lost
+            "<!-- claims: corridor-scans -->\nold\n<!-- /claims  -->\nProse to keep.\n"
+            "<!-- claims: exp1-corridor -->\nold\n<!-- /claims -->\n",
+            "README.md:7: <!-- /claims  --> is not a marker as written: write <!-- /claims -->",
+        ),
+        (  # CRLF line ends: no block was read, exit 0
+            "<!-- claims: corridor-scans -->\r\nold\r\n<!-- /claims -->\r\n",
+            "README.md:5: <!-- claims: corridor-scans --> is not a marker as written (its line "
+            "ends with a carriage return: CRLF)",
+        ),
+        (
+            "<!-- claims: corridor-scans --> \n<!-- /claims -->\n",
+            "README.md:5: <!-- claims: corridor-scans --> is not a marker as written",
+        ),
+        (
+            "<!--reproduction-summary-->\n<!--/reproduction-summary-->\n",
+            "README.md:5: <!--reproduction-summary--> is not a marker as written: write "
+            "<!-- reproduction-summary --> alone on its line",
+        ),
     ],
-    ids=["none", "unclosed", "nested", "stray-close", "mismatched", "malformed"],
+    ids=[
+        "none",
+        "unclosed",
+        "nested",
+        "stray-close",
+        "mismatched",
+        "malformed",
+        "spaced-close",
+        "crlf",
+        "trailing-space",
+        "unspaced-summary",
+    ],
 )
 def test_markers_that_would_leave_a_block_unwritten_are_refused_with_the_line(
     results, tmp_path, body, message
