@@ -61,8 +61,8 @@ class DemoConfig:
 
 # what the demo writes in its --out folder, in order (the teaching run's files in teach/)
 DEMO_FILES = (
-    "scene.png",
     *(f"teach/{name}" for name in TEACHING_FILES),
+    "scene.png",
     "taught_map_band.png",
     "config.yaml",
     "summary.json",
@@ -130,9 +130,11 @@ def run_demo(
         raise ValueError(f"{scene_file}: the demo teaches along the scene's route: it has none")
     _check_out(out)
     out.mkdir(parents=True, exist_ok=True)
-    render_scene(scene, out / "scene.png")
     console.print("teaching: pushing the AGV along the route ...")
+    # the teaching log first: it marks the folder as the demo's own (_check_out), so that a
+    # demo cut short after it can be run into again
     taught = teach(scene, out / "teach", seed=derive_seed(seed, 1), overwrite=True, merge=merge)
+    render_scene(scene, out / "scene.png")
     goal = taught.marks[-1]
     maps = {band: load_map(path) for band, path in taught.maps.items()}
     marks_xy = np.array([[m["x"], m["y"]] for m in taught.marks])

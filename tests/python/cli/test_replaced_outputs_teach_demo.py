@@ -162,3 +162,17 @@ def test_a_demo_interrupted_before_its_summary_is_still_the_demos_own(tmp_path, 
     done = run("demo", "--scene", short_scene, "--out", "d", "--particles", "20", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert set(contents(tmp_path / "d")) == set(DEMO_FILES)
+
+
+def test_a_demo_that_failed_in_its_teaching_can_be_run_into_again(tmp_path, short_scene):
+    """The demo drew scene.png before teaching, so a teaching that failed (a goal off the
+    scene) left a folder holding scene.png only, which the demo then refused as not its own.
+    It teaches first now: a failed teaching leaves nothing the demo would refuse."""
+    doc = yaml.safe_load((tmp_path / short_scene).read_text())
+    doc["route"]["waypoints"] = [[0.0, 0.0], [500.0, 0.0]]
+    (tmp_path / "far.yaml").write_text(yaml.safe_dump(doc))
+    failed = run("demo", "--scene", "far.yaml", "--out", "d", "--particles", "20", cwd=tmp_path)
+    assert failed.returncode == 1 and "Traceback" not in failed.stderr
+    assert not [p for p in (tmp_path / "d").rglob("*") if p.is_file()]
+    done = run("demo", "--scene", short_scene, "--out", "d", "--particles", "20", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
