@@ -46,7 +46,8 @@ def _destination(out: Path) -> None:
     if (out / "trajectory.csv").exists():
         raise ValueError(f"-o {out}: already holds a run (trajectory.csv); choose another folder")
     # a folder of the user's own files (-o . holding a config.yaml) keeps them
-    refuse_replacing(out, _RUN_FILES.writes, "-o", "choose another folder")
+    remedy = "choose another folder (an unfinished run leaves its sdem_*.pcd: remove them)"
+    refuse_replacing(out, _RUN_FILES.writes, "-o", remedy)
     out.mkdir(parents=True, exist_ok=True)
 
 

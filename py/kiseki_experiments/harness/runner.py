@@ -242,7 +242,8 @@ def _prepare(name, runs, seed, overrides, out, resume, results_root):
     if (run_dir / "trials.jsonl").exists():
         raise KisekiError(f"{run_dir}: already holds trials: use --resume or another --out")
     # --out . holding the user's own config.yaml or report.md: kept
-    refuse_replacing(run_dir, RUN_FILES, "--out", "give a new or empty folder", KisekiError)
+    remedy = "give a new or empty folder (or --resume, to continue a run interrupted there)"
+    refuse_replacing(run_dir, RUN_FILES, "--out", remedy, KisekiError)
     check_writable_folder(run_dir, "results")
     if experiment.preflight is not None:  # before the folder: a refused run leaves none
         experiment.preflight(config)

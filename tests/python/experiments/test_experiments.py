@@ -371,7 +371,7 @@ def test_a_new_run_keeps_the_users_files_in_its_out_folder(tmp_path, name):
         run_experiment("corridor-scans", runs=1, out=tmp_path, progress=False)
     assert str(err.value) == (
         f"--out {tmp_path} holds {name}, which this command would replace: give a new or "
-        "empty folder"
+        "empty folder (or --resume, to continue a run interrupted there)"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == [name]  # nothing written
     assert name in RUN_FILES

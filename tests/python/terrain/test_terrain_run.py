@@ -236,7 +236,7 @@ def test_a_folder_of_the_users_files_is_refused_and_kept(tmp_path, name):
     lines = [line for line in done.stderr.splitlines() if line.strip()]
     assert done.returncode == 1 and lines == [
         f"kiseki: error: -o {tmp_path} holds {name}, which this command would replace: "
-        "choose another folder"
+        "choose another folder (an unfinished run leaves its sdem_*.pcd: remove them)"
     ]
     assert (tmp_path / name).read_text() == "the user's own"
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([name, "notes.txt"])
