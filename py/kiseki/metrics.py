@@ -61,11 +61,12 @@ class ErrorStatistics:
         """The statistics of ``errors``. ``sse`` is inf once the sum of squares passes the
         largest double (errors of about 1e154 and more); ``rmse`` and ``std`` stay finite for
         finite errors (computed on the errors scaled by the largest where the squares overflow,
-        as they were computed before elsewhere)."""
+        as they were computed before elsewhere); ``mean`` is inf when the sum of the errors
+        passes the largest double."""
         e = np.asarray(errors, dtype=float)
         if e.size == 0:
             raise ValueError("no pose pairs to compute an error from")
-        with np.errstate(over="ignore"):
+        with np.errstate(over="ignore", invalid="ignore"):  # an error of inf: its std NaN
             squares = e**2
             rmse, std = float(np.sqrt(np.mean(squares))), float(e.std())
             if not (math.isfinite(rmse) and math.isfinite(std)) and np.isfinite(e).all():
@@ -114,14 +115,15 @@ def as_se3(poses: np.ndarray) -> np.ndarray:
 def _lengths(rows: np.ndarray) -> np.ndarray:
     """Euclidean length of each row of ``rows`` (n, k), as np.linalg.norm gives it; where the
     squares overflow (components of about 1e154 and more), of the row scaled by its largest
-    component, so that a finite row has a finite length (1e200 m was an error of inf m)."""
+    component, so that a finite row has a finite length unless the length itself passes the
+    largest double (1e200 m was an error of inf m)."""
     with np.errstate(over="ignore"):
         out = np.linalg.norm(rows, axis=1)
-    over = np.isinf(out) & np.isfinite(rows).all(axis=1)
-    if over.any():
-        big = rows[over]
-        scale = np.abs(big).max(axis=1)
-        out[over] = scale * np.linalg.norm(big / scale[:, None], axis=1)
+        over = np.isinf(out) & np.isfinite(rows).all(axis=1)
+        if over.any():
+            big = rows[over]
+            scale = np.abs(big).max(axis=1)
+            out[over] = scale * np.linalg.norm(big / scale[:, None], axis=1)
     return out
 
 

@@ -251,3 +251,17 @@ def test_ordinary_errors_are_the_plain_formulas_bit_for_bit():
     e = np.linalg.norm(est[:, :2] - ref[:, :2], axis=1)
     assert np.array_equal(stats.errors, e)
     assert stats.rmse == float(np.sqrt(np.mean(e**2))) and stats.std == float(e.std())
+    full = ape(est, ref, relation="full")
+    rel = np.linalg.inv(as_se3(ref)) @ as_se3(est)
+    np.testing.assert_allclose(full.errors, np.linalg.norm(rel - np.eye(4), axis=(1, 2)))
+    step = rpe(est, ref)  # the plain path's own arrays, through the same code as before
+    assert step.rmse == float(np.sqrt(np.mean(step.errors**2)))
+
+
+def test_a_length_past_the_largest_double_is_inf_without_a_warning():
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the rescaled path warned 'overflow in multiply'
+        stats = ape(np.array([[1.5e308, 1.5e308, 0.0]]), np.zeros((1, 3)))  # 2.1e308
+    assert stats.max == np.inf
