@@ -77,7 +77,9 @@ def read_points(path: str | os.PathLike, d: int) -> tuple[np.ndarray, bool]:
                         f"{where}: a row needs the header's columns {', '.join(need)} "
                         f"(at least {max(columns) + 1} values), got {','.join(row)[:60]!r}"
                     )
-                if len(row) > len(names):  # a value no column names ('0,0,0' under 'x,y')
+                # a value no column names ('0,0,0' under 'x,y'); empty cells past the header's,
+                # a spreadsheet's trailing commas, are none
+                if any(cell.strip() for cell in row[len(names) :]):
                     raise ValueError(
                         f"{where}: {len(row)} values where the header names {len(names)} "
                         f"columns ({','.join(names)}), got {','.join(row)[:60]!r}"

@@ -49,6 +49,13 @@ def test_a_bad_file_is_refused_in_one_line(tmp_path, text, problem):
     assert str(err.value) == f"{tmp_path}/{problem}"
 
 
+def test_trailing_empty_cells_are_no_values(tmp_path):
+    """A spreadsheet's trailing commas ('0,1,' under 'x,y') are empty cells, not values."""
+    path = tmp_path / "p.csv"
+    path.write_text("x,y\n0,1,\n2,3,,\n")
+    np.testing.assert_array_equal(read_points(path, 2)[0], [[0.0, 1.0], [2.0, 3.0]])
+
+
 def test_the_row_limit_is_in_the_message(tmp_path, monkeypatch):
     assert MAX_POINTS == 1_000_000
     monkeypatch.setattr(points_csv, "MAX_POINTS", 3)
