@@ -171,7 +171,8 @@ def plan(
     moves = check_count(moves, "moves", 1, MAX_MOVES)  # the Plan holds Python's int
     if angle is None:
         angle = paper_angle(form, moves, start, goal)
-        if form in FORMS and not math.radians(5) <= angle <= math.radians(85):
+        odd = form == 2 or moves % 2 == 1  # form 1's rule on the moves is said first (_check)
+        if form in FORMS and odd and not math.radians(5) <= angle <= math.radians(85):
             raise ValueError(  # it read as if an angle given were out of range
                 f"form {form} keeping the start's width to the goal ({goal[0]:g}, {goal[1]:g}) "
                 f"in {moves} move{'s' if moves > 1 else ''} stands at "

@@ -135,3 +135,5 @@ def test_an_angle_that_follows_from_the_goal_names_the_goal_and_the_moves() -> N
     with pytest.raises(ValueError, match=r"to the goal \(0, 900\) in 1 move stands at 89.9 deg"):
         plan(1, 1, None, START, (0.0, 900.0))
     assert 5 < math.degrees(plan(1, 15, None, START, (0.0, 20.0)).angle) < 85  # in range: taken
+    with pytest.raises(ValueError, match="^form 1 takes an odd number of moves"):  # said first
+        plan(1, 14, None, START, (0.0, 0.001))
