@@ -29,13 +29,11 @@ def existing_outputs(folder: str | os.PathLike, patterns: Sequence[str]) -> list
     found: list[Path] = []
     for pattern in patterns:
         escaped = glob.escape(str(folder))
+        # glob lists a broken link too (os.path.lexists for a literal name, listdir for a
+        # pattern): the command would replace it (tested)
         for match in sorted(glob.glob(os.path.join(escaped, pattern.rstrip("/")))):
             path = Path(match)
             if path not in found:
-                found.append(path)
-        if not glob.has_magic(pattern):  # a broken link is no glob match
-            path = folder / pattern.rstrip("/")
-            if path.is_symlink() and path not in found:
                 found.append(path)
     return found
 

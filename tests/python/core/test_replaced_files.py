@@ -27,7 +27,11 @@ def test_only_the_entries_the_command_writes_are_found_in_pattern_order(tmp_path
 
 def test_a_link_is_an_entry_even_when_broken(tmp_path):
     os.symlink(tmp_path / "nowhere", tmp_path / "config.yaml")
-    assert existing_outputs(tmp_path, PATTERNS) == [tmp_path / "config.yaml"]
+    os.symlink(tmp_path / "nowhere", tmp_path / "sdem_000.pcd")  # under a pattern too
+    assert existing_outputs(tmp_path, PATTERNS) == [
+        tmp_path / "config.yaml",
+        tmp_path / "sdem_000.pcd",
+    ]
 
 
 def test_a_folder_whose_name_holds_glob_characters_is_searched_literally(tmp_path):
