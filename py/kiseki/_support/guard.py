@@ -9,6 +9,9 @@ runs, refuses in one line whatever would let an output destroy an input: the rul
 :func:`kiseki._support.outputs.check_outputs`'s. Labels are the ones the user typed: an option's
 long name (``--output``), an argument's metavar (``MAP``).
 
+A file written beside an output (a result's config, a map's image) that is already there while
+that output is not is no earlier output of the command: it is refused too, and kept.
+
 Checks that need the work's own results (the scene a recorded run names, read from the run)
 stay in the command, through :func:`~kiseki._support.outputs.check_outputs` itself.
 
@@ -48,10 +51,13 @@ _F = TypeVar("_F", bound=Callable[..., Any])
 @dataclass(frozen=True)
 class Derived:
     """A file that no option names, made from the command's arguments (a map YAML's image, a
-    result's config beside it): ``label`` and ``path(arguments)``, None when not this time."""
+    result's config beside it): ``label`` and ``path(arguments)``, None when not this time.
+    As an output it is written beside the output parameter ``beside`` names: one already there
+    while that output is not is no earlier output of the command, and is not replaced."""
 
     label: str
     path: Callable[[Mapping[str, Any]], Path | None]
+    beside: str = "output"
 
 
 @dataclass(frozen=True)
@@ -90,7 +96,10 @@ class GuardSpec:
         return {i if isinstance(i, str) else i.param for i in items}
 
     def check(self, arguments: Mapping[str, Any]) -> None:
-        """Raises (ValueError, OSError) as :func:`check_outputs` does for these arguments."""
+        """Raises (ValueError, OSError) as :func:`check_outputs` does for these arguments, and
+        FileExistsError for a derived output already there beside an output that is not (a
+        user's run.config.yaml beside a run.csv to come), checked after the inputs' rules (a
+        derived output that is an input is refused as that)."""
         check_outputs(
             self._paths(self.outputs, arguments),
             self._paths(self.inputs, arguments),
@@ -100,6 +109,26 @@ class GuardSpec:
             },
             {self.labels[i.param]: i.files for i in self.inputs if isinstance(i, Rewrites)},
         )
+        self._refuse_orphans(arguments)
+
+    def _refuse_orphans(self, arguments: Mapping[str, Any]) -> None:
+        for item in self.outputs:
+            if not isinstance(item, Derived) or item.beside not in self.labels:
+                continue
+            named = _path_of(arguments.get(item.beside))
+            try:
+                path = item.path(arguments)
+            except (AttributeError, KeyError, TypeError, ValueError):  # the body reports it
+                path = None
+            if named is None or path is None or named.exists():
+                continue
+            if Path(path).exists() or Path(path).is_symlink():
+                label = self.labels[item.beside]
+                raise FileExistsError(
+                    f"{item.label} {path} exists and {label} {named} does not: it is no earlier "
+                    f"output of this command, and is not replaced: give another {label}, or "
+                    f"move {Path(path).name}"
+                )
 
     def _paths(self, items, arguments: Mapping[str, Any]) -> dict[str, list[Path]]:
         out: dict[str, list[Path]] = {}

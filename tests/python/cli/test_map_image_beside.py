@@ -29,11 +29,12 @@ def inputs(tmp_path: Path) -> Path:
 
 
 @pytest.mark.parametrize("args", COMMANDS, ids=["convert", "from-log"])
-@pytest.mark.parametrize("yaml_text", [None, "a note of the user's\n", "image: other.pgm\n"])
+@pytest.mark.parametrize("yaml_text", ["a note of the user's\n", "image: other.pgm\n"])
 def test_a_user_image_under_the_maps_image_name_is_refused_and_kept(inputs, args, yaml_text):
+    """Beside a YAML that is no map, or a map naming another image (no YAML at all: the guard's
+    rule for every derived output, tests/python/cli/test_derived_outputs.py)."""
     (inputs / "out.pgm").write_bytes(b"the user's own picture")
-    if yaml_text is not None:  # no YAML; a YAML that is no map; a map naming another image
-        (inputs / "out.yaml").write_text(yaml_text)
+    (inputs / "out.yaml").write_text(yaml_text)
     before = digests(inputs)
     line = one_error(run(*args, cwd=inputs))
     assert line == (
