@@ -180,6 +180,8 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
     if variant not in VARIANTS:
         raise ValueError(f"variant must be teach or playback, got {variant!r}")
     check_input(path)
+    if path.is_dir():  # it read 'not found' of a folder that is there
+        raise IsADirectoryError(f"{path}: a folder, not a scene file")
     if not path.is_file():
         raise FileNotFoundError(f"{path}: scene file not found")
     try:

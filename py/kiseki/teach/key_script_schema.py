@@ -85,6 +85,8 @@ def read_key_script(path: str | os.PathLike) -> list[tuple[float, str]]:
     there is none, ValueError naming the file (and the line, the field and the value)."""
     path = Path(path)
     check_input(path)
+    if path.is_dir():  # it read 'not found' of a folder that is there
+        raise IsADirectoryError(f"{path}: a folder, not a key script")
     if not path.is_file():
         raise FileNotFoundError(f"{path}: key script not found")
     try:

@@ -24,6 +24,7 @@ def inputs(tmp_path: Path) -> Path:
     text = f"O 100 -50 0 0.01\n{laser} 0.05\nO 100 -50 0 0.1\n{laser} 0.15\n"
     (tmp_path / "robotdata.log").write_text(text)
     (tmp_path / "taught-file").write_text("not a folder")
+    (tmp_path / "sub").mkdir()
     return tmp_path
 
 
@@ -50,8 +51,24 @@ def inputs(tmp_path: Path) -> Path:
             ["map", "info", ""],
             ".: a folder, not a map file (.yaml, .yml, .dat or .dat.gz)",
         ),
+        (
+            ["demo", "--scene", "sub", "--out", "d"],
+            "sub: a folder, not a scene file",
+        ),  # 'not found'
+        (
+            ["teach", SCENE, "--keyboard", "--keys", "sub", "-o", "t"],
+            "sub: a folder, not a key script",
+        ),
     ],
-    ids=["reference-topic", "taught-missing", "taught-file", "empty-route", "map-folder"],
+    ids=[
+        "reference-topic",
+        "taught-missing",
+        "taught-file",
+        "empty-route",
+        "map-folder",
+        "scene-folder",
+        "keys-folder",
+    ],
 )
 def test_the_line_names_what_was_typed_and_what_is_wrong(inputs, args, line):
     before = digests(inputs)
