@@ -171,6 +171,11 @@ def navigate_folder(
         raise ValueError(f"{scene}: the scene has no route")
     check_magnetometer(played, scene)  # before the output folder is made
     maps = load_taught(map_folder, waypoints)
+    if method == "rahok" and (maps.left is None or maps.right is None):  # before the run
+        raise ValueError(
+            f"--map {map_folder}: Rahok's method needs the maps of the left and right parallel "
+            "paths (left/ and right/ in a folder of kiseki magnetic teach)"
+        )
     folder.mkdir(parents=True, exist_ok=True)
     result = navigate(scene, maps, method, folder / "run.mcap", seed, gates=gates)
     write_navigation(result, folder, waypoints)
