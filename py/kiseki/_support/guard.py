@@ -115,19 +115,15 @@ class GuardSpec:
         for item in self.outputs:
             if not isinstance(item, Derived) or item.beside not in self.labels:
                 continue
-            named = _path_of(arguments.get(item.beside))
-            try:
-                path = item.path(arguments)
-            except (AttributeError, KeyError, TypeError, ValueError):  # the body reports it
-                path = None
+            named, path = _path_of(arguments.get(item.beside)), _derived_path(item, arguments)
             if named is None or path is None or named.exists():
                 continue
-            if Path(path).exists() or Path(path).is_symlink():
+            if path.exists() or path.is_symlink():
                 label = self.labels[item.beside]
                 raise FileExistsError(
                     f"{item.label} {path} exists and {label} {named} does not: it is no earlier "
                     f"output of this command, and is not replaced: give another {label}, or "
-                    f"move {Path(path).name}"
+                    f"move {path.name}"
                 )
 
     def _paths(self, items, arguments: Mapping[str, Any]) -> dict[str, list[Path]]:
@@ -136,16 +132,23 @@ class GuardSpec:
             if isinstance(item, Rewrites):
                 item = item.param
             if isinstance(item, Derived):
-                try:
-                    path = item.path(arguments)
-                except (AttributeError, KeyError, TypeError, ValueError):  # the body reports it
-                    # (with_suffix of '.', an argument missing in a direct call)
-                    path = None
-                label, paths = item.label, [] if path is None else [Path(path)]
+                path = _derived_path(item, arguments)
+                label, paths = item.label, [] if path is None else [path]
             else:
                 label, paths = self.labels[item], _paths_of(arguments.get(item))
             out.setdefault(label, []).extend(paths)
         return out
+
+
+def _derived_path(item: Derived, arguments: Mapping[str, Any]) -> Path | None:
+    """A derived file's path for these arguments, None when not this time or when the arguments
+    cannot make one (with_suffix of '.', an argument missing in a direct call: the command's
+    body reports it)."""
+    try:
+        path = item.path(arguments)
+    except (AttributeError, KeyError, TypeError, ValueError):
+        return None
+    return None if path is None else Path(path)
 
 
 def _path_of(value: Any) -> Path | None:
