@@ -57,18 +57,18 @@ app = typer.Typer(
 def refuse_foreign_image(output: Path) -> None:
     """An image where --output's is written (X.pgm beside X.yaml) is replaced only as the image
     of the map X.yaml already is (an earlier map saved there, replaced whole); a file of the
-    user's own under that name is refused, before any work, and kept."""
+    user's own under that name is refused, before any work, and kept. (With no X.yaml at all
+    the output guard has refused it already: MAP_IMAGE is a derived output.)"""
     image = output.with_suffix(".pgm")
     if not (image.exists() or image.is_symlink()):
         return
+    try:
+        content = read_yaml_file(output, "ROS map YAML")
+    except (OSError, ValueError):  # not a map: the image is not its
+        content = None
     named = None
-    if output.is_file():
-        try:
-            content = read_yaml_file(output, "ROS map YAML")
-        except (OSError, ValueError):  # not a map: the image is not its
-            content = None
-        if isinstance(content, dict) and isinstance(content.get("image"), str):
-            named = output.parent / content["image"]
+    if isinstance(content, dict) and isinstance(content.get("image"), str):
+        named = output.parent / content["image"]
     if named is None or named.resolve() != image.resolve():
         raise FileExistsError(
             f"--output's image {image} exists and is not the image of the map {output}: "
