@@ -191,13 +191,8 @@ def align_trajectory(est, ref, alignment: str = "se3") -> np.ndarray:
 def _errors(e: np.ndarray, relation: str) -> np.ndarray:
     if relation == "translation":
         return _lengths(e[:, :3, 3])
-    if relation == "full":
-        off = e - np.eye(4)
-        with np.errstate(over="ignore"):
-            out = np.linalg.norm(off, axis=(1, 2))
-        over = np.isinf(out)  # the Frobenius norm is the length of the 16 entries
-        out[over] = _lengths(off[over].reshape(-1, 16))
-        return out
+    if relation == "full":  # the Frobenius norm: the length of the 16 entries
+        return _lengths((e - np.eye(4)).reshape(len(e), 16))
     rot = e[:, :3, :3]
     # angle = atan2(sin, cos) from the skew part and the trace: accurate near 0 and pi
     skew = np.stack(
