@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["check_number", "number_rule"]
+__all__ = ["check_number", "hold_number", "number_rule"]
 
 
 # bounds written as the angle they are
@@ -95,3 +95,10 @@ def check_number(
         rule = number_rule(low, high, low_open=low_open, high_open=high_open, unit=unit)
         raise error(f"{name} must be {rule}, got {value!r}")
     return number + 0.0
+
+
+def hold_number(obj: Any, field: str, name: str, *bounds: float, **rule: Any) -> None:
+    """Checks ``obj.field`` by :func:`check_number` (``name`` in its message, ``bounds`` and
+    ``rule`` its own) and holds the float it returns there, also in a frozen dataclass: -0.0 as
+    0.0 (numpy's normal refuses a scale of -0.0), a numpy number as a Python float."""
+    object.__setattr__(obj, field, check_number(getattr(obj, field), name, *bounds, **rule))

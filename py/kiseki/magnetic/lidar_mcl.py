@@ -49,7 +49,7 @@ from kiseki import _core
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import BEAM_LIMIT, PARTICLE_LIMIT
-from kiseki._support.real_numbers import check_number
+from kiseki._support.real_numbers import check_number, hold_number
 from kiseki.core import Pose2, check_seed, derive_seed
 from kiseki.filters import REAL_ODOMETRY_ALPHAS, MclConfig, MonteCarloLocalizer
 from kiseki.filters.initial_pose import check_spread
@@ -93,9 +93,7 @@ class LidarMclConfig:
         check_count(self.beams, "lidar MCL: beams", 1, BEAM_LIMIT)
 
         def hold(name: str, *bounds: float, **rule: Any) -> None:
-            # held as checked: -0.0 as 0.0 (numpy's normal refuses a scale of -0.0)
-            value = check_number(getattr(self, name), f"lidar MCL: {name}", *bounds, **rule)
-            object.__setattr__(self, name, value)
+            hold_number(self, name, f"lidar MCL: {name}", *bounds, **rule)
 
         hold("sigma_d", 1e-6, unit="m")
         hold("sigma_theta", 0.0, math.pi, unit="rad")

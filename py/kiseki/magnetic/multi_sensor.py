@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from kiseki._support.counts import check_count
-from kiseki._support.real_numbers import check_number
+from kiseki._support.real_numbers import hold_number
 from kiseki.core import check_seed
 from kiseki.filters import MonteCarloLocalizer
 from kiseki.magnetic.localization import (
@@ -51,9 +51,8 @@ class DriftCheck:
 
     def __post_init__(self) -> None:
         window = check_count(self.window, "drift check: window", 2)
-        limit = check_number(self.limit, "drift check: limit", 0.0, low_open=True)
         object.__setattr__(self, "window", window)  # a numpy integer held as a Python int
-        object.__setattr__(self, "limit", limit)  # a numpy number held as a Python float
+        hold_number(self, "limit", "drift check: limit", 0.0, low_open=True)
 
 
 @dataclass(frozen=True)

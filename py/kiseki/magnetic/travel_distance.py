@@ -52,7 +52,7 @@ from kiseki import _core
 from kiseki._support.counts import check_count
 from kiseki._support.field_types import check_field_types
 from kiseki._support.options import PARTICLE_LIMIT
-from kiseki._support.real_numbers import check_number
+from kiseki._support.real_numbers import check_number, hold_number
 from kiseki.core import check_seed
 from kiseki.magnetic.linear_map import LinearMagneticMap
 
@@ -100,9 +100,7 @@ class TravelDistanceConfig:
         check_count(self.particles, "travel distance: particles", 1, PARTICLE_LIMIT)
 
         def hold(name: str, label: str, *bounds: float, **rule: Any) -> None:
-            # held as checked: -0.0 as 0.0, a numpy number as a Python float
-            value = check_number(getattr(self, name), f"travel distance: {label}", *bounds, **rule)
-            object.__setattr__(self, name, value)
+            hold_number(self, name, f"travel distance: {label}", *bounds, **rule)
 
         hold("gain", "gain a", 0.0, low_open=True)
         hold("window", "window l", 0.0, low_open=True, unit="m")

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from kiseki._support.real_numbers import check_number
+from kiseki._support.real_numbers import hold_number
 from kiseki.core import check_seed
 from kiseki.datasets.magnetic import MagneticSamples
 from kiseki.magnetic.linear_map import LinearMagneticMap, build_linear_map, path_identity
@@ -71,13 +71,10 @@ class WalkOdometry:
     truth_window: float = 3.0
 
     def __post_init__(self) -> None:
-        # held as checked: -0.0 as 0.0 (numpy's normal refuses a scale of -0.0), a numpy
-        # number as a Python float
         for name in ("scale_sd", "noise", "radius", "min_travel", "max_offset", "truth_window"):
-            object.__setattr__(self, name, check_number(getattr(self, name), f"walk: {name}", 0.0))
+            hold_number(self, name, f"walk: {name}", 0.0)
         if self.scale_error is not None:
-            e = check_number(self.scale_error, "walk: scale_error", -1.0, low_open=True)
-            object.__setattr__(self, "scale_error", e)
+            hold_number(self, "scale_error", "walk: scale_error", -1.0, low_open=True)
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from kiseki._support.real_numbers import check_number
+from kiseki._support.real_numbers import check_number, hold_number
 from kiseki.core import Pose2, normalize_angle
 
 __all__ = ["BodyMotion", "WheelMotion"]
@@ -37,9 +37,8 @@ class WheelMotion:
 
     def __post_init__(self) -> None:
         for name in ("left", "right"):
-            object.__setattr__(self, name, check_number(getattr(self, name), f"WheelMotion.{name}"))
-        dt = check_number(self.dt, "WheelMotion.dt", 0.0, low_open=True, unit="s")
-        object.__setattr__(self, "dt", dt)
+            hold_number(self, name, f"WheelMotion.{name}")
+        hold_number(self, "dt", "WheelMotion.dt", 0.0, low_open=True, unit="s")
 
 
 @dataclass(frozen=True)
@@ -61,11 +60,9 @@ class BodyMotion:
 
     def __post_init__(self) -> None:
         for name in ("dx", "dy", "dtheta"):
-            object.__setattr__(self, name, check_number(getattr(self, name), f"BodyMotion.{name}"))
-        distance = check_number(self.distance, "BodyMotion.distance", 0.0, unit="m")
-        object.__setattr__(self, "distance", distance)
-        dt = check_number(self.dt, "BodyMotion.dt", 0.0, low_open=True, unit="s")
-        object.__setattr__(self, "dt", dt)
+            hold_number(self, name, f"BodyMotion.{name}")
+        hold_number(self, "distance", "BodyMotion.distance", 0.0, unit="m")
+        hold_number(self, "dt", "BodyMotion.dt", 0.0, low_open=True, unit="s")
 
 
 def as_pose(pose: PoseLike, name: str) -> tuple[float, float, float]:
