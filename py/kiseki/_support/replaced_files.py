@@ -15,7 +15,7 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["existing_outputs", "refuse_replacing"]
+__all__ = ["existing_outputs", "first_of", "refuse_replacing"]
 
 
 def existing_outputs(folder: str | os.PathLike, patterns: Sequence[str]) -> list[Path]:
@@ -49,8 +49,12 @@ def refuse_replacing(
     '``label`` FOLDER holds NAME (and K more), which this command would replace: ``remedy``'."""
     found = existing_outputs(folder, patterns)
     if found:
-        first = found[0].relative_to(Path(folder))
-        more = f" (and {len(found) - 1} more)" if len(found) > 1 else ""
+        names = [str(p.relative_to(Path(folder))) for p in found]
         raise error(
-            f"{label} {folder} holds {first}{more}, which this command would replace: {remedy}"
+            f"{label} {folder} holds {first_of(names)}, which this command would replace: {remedy}"
         )
+
+
+def first_of(names: Sequence[str]) -> str:
+    """'NAME' or 'NAME (and K more)': the entries an output folder's refusal names."""
+    return names[0] + (f" (and {len(names) - 1} more)" if len(names) > 1 else "")

@@ -50,6 +50,7 @@ import yaml
 from kiseki._support.atomic import record_written
 from kiseki._support.inputs import GIB, YAML_LIMIT, check_input, check_npz, read_input_text
 from kiseki._support.real_numbers import check_number
+from kiseki._support.replaced_files import first_of
 from kiseki._support.schema import MAGNITUDE_LIMIT
 from kiseki._support.yaml import read_yaml_file, safe_load_12
 from kiseki.errors import MapFormatError
@@ -118,11 +119,10 @@ def check_map_destination(folder, label: str = "") -> Path:
             )
         foreign = sorted(p.name for p in folder.iterdir() if p.name not in MAP_FOLDER_FILES)
         if foreign:
-            more = f" (and {len(foreign) - 1} more)" if len(foreign) > 1 else ""
             raise FileExistsError(
-                f"{label + ' ' if label else ''}{folder} holds {foreign[0]}{more}, which is not "
+                f"{label + ' ' if label else ''}{folder} holds {first_of(foreign)}, which is not "
                 "part of a magnetic field map: the map folder is replaced whole; move "
-                f"{'them' if more else 'it'} out, or give a new folder"
+                f"{'them' if len(foreign) > 1 else 'it'} out, or give a new folder"
             )
     return folder
 
