@@ -140,17 +140,17 @@ def summary_block(results: dict[str, Result]) -> str:
 # a line that looks like a marker (a marker quoted inside a line of prose is prose); each must
 # be written exactly as _CLAIMS and _SUMMARY read it, or a block is skipped or swallows prose
 _MARKER_LINE = re.compile(r"<!--\s*(/?)\s*(claims|reproduction-summary)\b(.*?)-->")
-_EXACT = {
-    ("", "claims"): re.compile(r"<!-- claims: [a-z0-9-]+ -->"),
-    ("/", "claims"): re.compile(r"<!-- /claims -->"),
-    ("", "reproduction-summary"): re.compile(r"<!-- reproduction-summary -->"),
-    ("/", "reproduction-summary"): re.compile(r"<!-- /reproduction-summary -->"),
-}
-_WRITTEN_AS = {
-    ("", "claims"): "<!-- claims: NAME --> (NAME in lower case)",
-    ("/", "claims"): "<!-- /claims -->",
-    ("", "reproduction-summary"): "<!-- reproduction-summary -->",
-    ("/", "reproduction-summary"): "<!-- /reproduction-summary -->",
+_EXACT = {  # (opening "" or closing "/", kind): the marker's pattern, and how to write it
+    ("", "claims"): (r"<!-- claims: [a-z0-9-]+ -->", "<!-- claims: NAME --> (NAME in lower case)"),
+    ("/", "claims"): (r"<!-- /claims -->", "<!-- /claims -->"),
+    ("", "reproduction-summary"): (
+        r"<!-- reproduction-summary -->",
+        "<!-- reproduction-summary -->",
+    ),
+    ("/", "reproduction-summary"): (
+        r"<!-- /reproduction-summary -->",
+        "<!-- /reproduction-summary -->",
+    ),
 }
 
 
@@ -170,11 +170,12 @@ def check_markers(text: str, readme: Path) -> None:
             continue
         key, kind = (m.group(1), m.group(2)), m.group(2)
         where, marker = f"{readme}:{number}", line.strip()
-        if not _EXACT[key].fullmatch(line):
+        pattern, written_as = _EXACT[key]
+        if not re.fullmatch(pattern, line):
             ending = " (its line ends with a carriage return: CRLF)" if line.endswith("\r") else ""
             raise ValueError(
                 f"{where}: {marker} is not a marker as written{ending}: write "
-                f"{_WRITTEN_AS[key]} alone on its line"
+                f"{written_as} alone on its line"
             )
         if not m.group(1):
             if opened is not None:
