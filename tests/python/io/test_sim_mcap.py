@@ -37,13 +37,6 @@ from kiseki.io.runlog import (
 )
 
 
-@pytest.fixture
-def sample(tmp_path: Path) -> Path:
-    path = tmp_path / "run.mcap"
-    write_sample(path)
-    return path
-
-
 def plain_messages(path: Path) -> dict[str, list]:
     out: dict[str, list] = {}
     with open(path, "rb") as f:

@@ -31,14 +31,6 @@ from kiseki.io.runlog import (
     read_run,
 )
 
-
-@pytest.fixture
-def sample(tmp_path: Path) -> Path:
-    path = tmp_path / "run.mcap"
-    write_sample(path)
-    return path
-
-
 # --- truncated files ---
 
 

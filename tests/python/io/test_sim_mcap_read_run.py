@@ -26,7 +26,6 @@ from _helpers.sim_mcap_sample import (
     odom_pose,
     scan_ranges,
     truth_pose,
-    write_sample,
 )
 from kiseki.errors import LogFormatError
 from kiseki.io.runlog import (
@@ -36,14 +35,6 @@ from kiseki.io.runlog import (
     read_run,
 )
 from kiseki.scans import LaserScans
-
-
-@pytest.fixture
-def sample(tmp_path: Path) -> Path:
-    path = tmp_path / "run.mcap"
-    write_sample(path)
-    return path
-
 
 # --- read_run ---
 
