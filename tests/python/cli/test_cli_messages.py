@@ -13,7 +13,9 @@ from _helpers.boundaries_cli import digests, one_error, run
 from _helpers.room_log import room
 from kiseki import save_map
 
-SCENE = Path(__file__).resolve().parents[3] / "data" / "worlds" / "factory_corridor.yaml"
+WORLDS = Path(__file__).resolve().parents[3] / "data" / "worlds"
+SCENE = WORLDS / "factory_corridor.yaml"
+MAGNETIC = WORLDS / "magnetic_path.yaml"  # walls 4 m to the left and right of the start
 
 
 @pytest.fixture
@@ -59,6 +61,12 @@ def inputs(tmp_path: Path) -> Path:
             ["teach", SCENE, "--keyboard", "--keys", "sub", "-o", "t"],
             "sub: a folder, not a key script",
         ),
+        (  # '...magnetic_path.yaml: the robot's start footprint overlaps an obstacle'
+            ["magnetic", "teach", MAGNETIC, "-o", "taught", "--offset", "4"],
+            "--offset 4 m: the left parallel path would start at (0.00, 4.00), where the robot's "
+            f"footprint overlaps an obstacle in {MAGNETIC}; the parallel paths start clear up to "
+            "--offset 3.50 m",
+        ),
     ],
     ids=[
         "reference-topic",
@@ -68,6 +76,7 @@ def inputs(tmp_path: Path) -> Path:
         "map-folder",
         "scene-folder",
         "keys-folder",
+        "offset-too-wide",
     ],
 )
 def test_the_line_names_what_was_typed_and_what_is_wrong(inputs, args, line):

@@ -148,7 +148,7 @@ def teach_folder(scene: Path, folder: Path, seed: int, offset: float) -> TaughtM
         raise ValueError(f"-o {folder}: a non-empty folder that is not a linear magnetic map")
     folder.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=folder.parent, prefix=".teach-") as tmp:
-        maps = teach(scene, tmp, seed, offset)
+        maps = teach(scene, tmp, seed, offset, option="--offset")
         save_taught(maps, folder, sorted(Path(tmp).glob("teach_*.mcap")))
     return maps
 

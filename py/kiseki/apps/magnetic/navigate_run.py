@@ -41,6 +41,7 @@ import numpy as np
 from kiseki._support.real_numbers import check_number
 from kiseki.apps.magnetic.teach_checks import (
     check_magnetometer,
+    check_offset,
     check_route_length,
     check_taught_run,
 )
@@ -162,9 +163,11 @@ def teach(
     out_dir: str | os.PathLike,
     seed: int = 0,
     offset: float = OFFSET,
+    option: str = "offset",
 ) -> TaughtMaps:
     """Three teaching runs (taught path, left and right parallel paths) written to
-    ``out_dir/teach_{center,left,right}.mcap``; returns their linear maps."""
+    ``out_dir/teach_{center,left,right}.mcap``; returns their linear maps. ``option`` names
+    the offset in the errors (``--offset`` on the command line)."""
 
     check_number(offset, "teach: offset", 0.0, low_open=True, unit="m")
     out = Path(out_dir)
@@ -175,6 +178,7 @@ def teach(
     check_magnetometer(scene, scene_path)
     waypoints = np.asarray(scene.route["waypoints"], dtype=np.float64)
     check_route_length(scene, scene_path, waypoints)
+    check_offset(scene, scene_path, offset, _shifted(waypoints, 1.0)[0] - waypoints[0], option)
     path_id = path_identity(waypoints)
     maps = {}
     for k, (name, shift) in enumerate((("center", 0.0), ("left", offset), ("right", -offset))):
