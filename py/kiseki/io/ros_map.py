@@ -92,8 +92,11 @@ def read_map_metadata(path: str | os.PathLike) -> MapMetadata:
         raise FileNotFoundError(f"{path}: map YAML file not found")
     doc = _parse_yaml(path)
     image = Path(doc.image)
+    image = image if image.is_absolute() else path.parent / image
+    if image.is_dir():  # 'image: .' read 'image file . not found' of a folder that is there
+        raise MapFormatError(f"{path}: image {doc.image!r} is a folder, not a map image")
     return MapMetadata(
-        image=image if image.is_absolute() else path.parent / image,
+        image=image,
         resolution=doc.resolution,
         origin=doc.origin,
         mode=doc.mode,

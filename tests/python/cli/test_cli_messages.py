@@ -27,6 +27,10 @@ def inputs(tmp_path: Path) -> Path:
     (tmp_path / "robotdata.log").write_text(text)
     (tmp_path / "taught-file").write_text("not a folder")
     (tmp_path / "sub").mkdir()
+    for name, image in (("dot", "."), ("folder", "sub")):  # map YAMLs whose image is a folder
+        (tmp_path / f"{name}.yaml").write_text(
+            f"image: {image}\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n"
+        )
     return tmp_path
 
 
@@ -67,6 +71,14 @@ def inputs(tmp_path: Path) -> Path:
             f"footprint overlaps an obstacle in {MAGNETIC}; the parallel paths start clear up to "
             "--offset 3.50 m",
         ),
+        (  # 'dot.yaml: image file . not found' of the folder the YAML is in
+            ["map", "info", "dot.yaml"],
+            "dot.yaml: image '.' is a folder, not a map image",
+        ),
+        (
+            ["speed", "limits", "robotdata.log", "--map", "folder.yaml", "-o", "s.csv"],
+            "folder.yaml: image 'sub' is a folder, not a map image",
+        ),
     ],
     ids=[
         "reference-topic",
@@ -77,6 +89,8 @@ def inputs(tmp_path: Path) -> Path:
         "scene-folder",
         "keys-folder",
         "offset-too-wide",
+        "map-image-dot",
+        "map-image-folder",
     ],
 )
 def test_the_line_names_what_was_typed_and_what_is_wrong(inputs, args, line):
