@@ -20,7 +20,7 @@ from kiseki.apps.teach.taught_route import load_route
 from kiseki.cli._defaults import default_of
 from kiseki.grid import OccupancyGrid
 from kiseki.io.ros_map import load_map
-from kiseki.sim.scene import load_scene
+from kiseki.sim.scene import check_scene_file, load_scene
 from kiseki.speed import SpeedLimiter, SpeedLimiterConfig
 from kiseki.teach.local_maps import METHODS
 from kiseki.teach.route_check import read_travelled
@@ -98,8 +98,7 @@ def playback_command(
             raise ValueError(f"--taught {taught}: {what} (kiseki teach writes one)")
         waypoints = taught / "waypoints.yaml"
     map_path, marks = load_route(waypoints, band, names, map_file)
-    if not scene_file.is_file():
-        raise FileNotFoundError(f"{scene_file}: scene file not found")
+    check_scene_file(scene_file)
     taught_scene = taught_scene_of(waypoints)
     identity = check_scene(taught_scene, scene_file, variant)
     if log is not None and log.exists():

@@ -19,7 +19,7 @@ from kiseki.serve.listen import listening_sockets
 from kiseki.serve.robot import Robot, RobotState, SimulatedAgv
 from kiseki.serve.routes import RouteRequest, RouteRunner
 from kiseki.serve.taught import TaughtRun, taught_scene
-from kiseki.sim.scene import load_scene
+from kiseki.sim.scene import check_scene_file, load_scene
 from kiseki.teach.scene_identity import resolve_scene_file, scene_digest, taught_scene_of
 
 __all__ = [
@@ -75,8 +75,7 @@ def scene_of(folder: str | os.PathLike, scene: str | os.PathLike | None) -> Path
             )
         return found
     scene = Path(scene)
-    if not scene.is_file():
-        raise FileNotFoundError(f"{scene}: scene file not found")
+    check_scene_file(scene)
     if not recorded:
         return scene
     if identity is not None:  # the scene's SHA-1, as teaching recorded it

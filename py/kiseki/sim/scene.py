@@ -54,7 +54,14 @@ from kiseki.sim.pedestrians import Pedestrian
 from kiseki.sim.primitives import BoxList, boxes_of
 from kiseki.sim.scene_schema import Poses, SceneDoc, Turns, extent_problem
 
-__all__ = ["MAX_OCTOMAP_BYTES", "Scene", "check_route_in_bounds", "load_scene", "read_octree"]
+__all__ = [
+    "MAX_OCTOMAP_BYTES",
+    "Scene",
+    "check_route_in_bounds",
+    "check_scene_file",
+    "load_scene",
+    "read_octree",
+]
 
 MAX_OCTOMAP_BYTES = 32 * MIB
 """An OctoMap ``.bt`` file holds at most this: reading one takes about 120 times its size in
@@ -180,10 +187,7 @@ def load_scene(path: str | os.PathLike, variant: str = "teach") -> Scene:
     if variant not in VARIANTS:
         raise ValueError(f"variant must be teach or playback, got {variant!r}")
     check_input(path)
-    if path.is_dir():  # it read 'not found' of a folder that is there
-        raise IsADirectoryError(f"{path}: a folder, not a scene file")
-    if not path.is_file():
-        raise FileNotFoundError(f"{path}: scene file not found")
+    check_scene_file(path)
     try:
         # 5e-2 is a number, as in YAML 1.2
         data = read_input(path, "scene files", YAML_LIMIT)
@@ -305,6 +309,16 @@ def _robot_specs(doc: SceneDoc) -> list[dict]:
             }
         )
     return specs
+
+
+def check_scene_file(path: str | os.PathLike) -> None:
+    """IsADirectoryError for a folder (it read 'not found' of a folder that is there), else
+    FileNotFoundError when `path` is no file."""
+    path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(f"{path}: a folder, not a scene file")
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: scene file not found")
 
 
 def check_route_in_bounds(scene: Scene, waypoints, names=None) -> None:
