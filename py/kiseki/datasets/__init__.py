@@ -77,7 +77,17 @@ def open_scans(
             "chosen for ROS bags"
         )
     if path.suffix.lower() == ".mcap":
-        return read_run(path).laser_scans()
+        run = read_run(path)
+        topics = run.topics()
+        if "/scan" in topics and "/ground_truth" not in topics:
+            # laser_scans' hint is its argument (truth_topic=None), which no caller of this
+            # function, nor the command line, can give
+            raise LogFormatError(
+                f"{path}: no ground-truth topic '/ground_truth' (topics: {sorted(topics)}): "
+                "the scans are placed by its poses; give a run that records it (kiseki sim run "
+                "does)"
+            )
+        return run.laser_scans()
     if is_wean_log(path):
         return read_wean_log(path).scans
     return read_carmen_log(path).scans

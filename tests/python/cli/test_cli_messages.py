@@ -10,8 +10,9 @@ from pathlib import Path
 import pytest
 
 from _helpers.boundaries_cli import digests, one_error, run
-from _helpers.room_log import room
+from _helpers.room_log import ANGLES, room, room_scans
 from kiseki import save_map
+from kiseki.io.runlog import RunWriter
 
 WORLDS = Path(__file__).resolve().parents[3] / "data" / "worlds"
 SCENE = WORLDS / "factory_corridor.yaml"
@@ -31,6 +32,11 @@ def inputs(tmp_path: Path) -> Path:
         (tmp_path / f"{name}.yaml").write_text(
             f"image: {image}\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n"
         )
+    scans = room_scans(3)
+    with RunWriter(tmp_path / "no_truth.mcap") as w:  # a run without /ground_truth
+        for t, pose, ranges in zip(scans.times, scans.poses, scans.ranges, strict=True):
+            w.write_odometry("/odom", t, pose)
+            w.write_laser_scan("/scan", t, pose, ANGLES, ranges, max_range=8.0)
     return tmp_path
 
 
@@ -79,6 +85,11 @@ def inputs(tmp_path: Path) -> Path:
             ["speed", "limits", "robotdata.log", "--map", "folder.yaml", "-o", "s.csv"],
             "folder.yaml: image 'sub' is a folder, not a map image",
         ),
+        (  # '(pass truth_topic=None to use the scan poses as written)': an API argument
+            ["map", "from-log", "no_truth.mcap", "-o", "m.yaml"],
+            "no_truth.mcap: no ground-truth topic '/ground_truth' (topics: ['/odom', '/scan']): "
+            "the scans are placed by its poses; give a run that records it (kiseki sim run does)",
+        ),
     ],
     ids=[
         "reference-topic",
@@ -91,6 +102,7 @@ def inputs(tmp_path: Path) -> Path:
         "offset-too-wide",
         "map-image-dot",
         "map-image-folder",
+        "run-without-truth",
     ],
 )
 def test_the_line_names_what_was_typed_and_what_is_wrong(inputs, args, line):
