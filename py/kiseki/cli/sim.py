@@ -61,6 +61,7 @@ def sim_run(
         raise ValueError(f"--controller must be route or commands, got {controller!r}")
     if (controller == "commands") != (commands is not None):
         raise ValueError("--commands FILE goes with --controller commands, and only with it")
+    check_suffix("--output", output, (".mcap",))  # the run is MCAP whatever the name says
     if output.exists() and not overwrite:
         raise FileExistsError(f"--output {output} exists: give --overwrite to replace it")
     script = read_commands(commands) if commands is not None else None
@@ -148,6 +149,7 @@ def sim_show(
     if octree is None:
         refuse_given(ctx, ["resolution"], "without --octree (the voxels of the .bt export)")
     check_suffix("--output", output, FIGURE_SUFFIXES)
+    check_suffix("--octree", octree, (".bt",))  # write_binary writes OctoMap's binary .bt
     scene = load_scene(scene_file)
     if octree is not None:  # checked before anything is written
         if not isinstance(scene.world, _core.BoxWorld):

@@ -90,6 +90,14 @@ def inputs(tmp_path: Path) -> Path:
             "no_truth.mcap: no ground-truth topic '/ground_truth' (topics: ['/odom', '/scan']): "
             "the scans are placed by its poses; give a run that records it (kiseki sim run does)",
         ),
+        (  # an MCAP run written to x.txt
+            ["sim", "run", SCENE, "-o", "x.txt"],
+            "--output x.txt: extension '.txt'; give a file ending in .mcap",
+        ),
+        (  # an OctoMap .bt written to x.txt
+            ["sim", "show", SCENE, "-o", "s.png", "--octree", "x.txt"],
+            "--octree x.txt: extension '.txt'; give a file ending in .bt",
+        ),
     ],
     ids=[
         "reference-topic",
@@ -103,6 +111,8 @@ def inputs(tmp_path: Path) -> Path:
         "map-image-dot",
         "map-image-folder",
         "run-without-truth",
+        "sim-run-suffix",
+        "octree-suffix",
     ],
 )
 def test_the_line_names_what_was_typed_and_what_is_wrong(inputs, args, line):
