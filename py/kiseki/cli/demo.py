@@ -34,6 +34,7 @@ from kiseki.cli.teach import merge_rule
 from kiseki.core import derive_seed
 from kiseki.io.ros_map import load_map
 from kiseki.plots import render_map
+from kiseki.sim.collisions import Collision
 from kiseki.sim.render import render_scene
 from kiseki.sim.scene import load_scene
 from kiseki.teach.local_maps import METHODS
@@ -164,6 +165,7 @@ def run_demo(
             "stop_offset_m": [tx, ty],
             "reached": r.reached,
             "steps": r.steps,
+            "collision": None if r.collision is None else r.collision.payload(),
         }
     summary = {
         "scene": str(scene_file),
@@ -225,4 +227,7 @@ def _print(results: dict, scene_name: str, out: Path, console: Console) -> None:
         )
     title = f"{scene_name}: one run per method, beside the thesis' Exp. 2 (Table 4.5)"
     show(title, columns, rows, as_json=False, data=None, console=console)
+    for method, r in results.items():
+        if r["collision"] is not None:
+            console.print(f"{method}: " + Collision(**r["collision"]).line())
     console.print(f"teaching log, taught maps, waypoints, figures and summary in {out}/")

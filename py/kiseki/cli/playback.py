@@ -111,6 +111,8 @@ def playback_command(
         scene, environment, marks, config, limiter, log, taught_scene, variant, travelled
     )
     console.print(_stop_summary(method, result, marks[-1]))
+    if result.collision is not None:
+        console.print("  " + result.collision.line(), soft_wrap=True)
     if variant is not None:
         console.print(
             f"  scene variant {variant!r}: {scene_file} (SHA-1 {identity['scene_sha1']}), taught "

@@ -85,11 +85,7 @@ def sim_run(
         + ", ".join(f"{k} {v}" for k, v in summary.messages.items())
     )
     if summary.collision is not None:
-        c = summary.collision
-        console.print(
-            f"COLLISION at t = {c.t:.2f} s: {c.robot} hit {c.hit} at "
-            f"({c.contact[0]:.3f}, {c.contact[1]:.3f}); the run ended there"
-        )
+        console.print(summary.collision.line())
 
 
 @app.command("render")

@@ -34,6 +34,7 @@ class RobotState:
     done: bool  # the robot rests at the end of the route, or after a stop
     reached: bool  # the estimate came within the goal tolerance of the goal
     pose: tuple[float, float, float] | None = None  # the true pose (simulation only)
+    fault: str | None = None  # why the robot ended the route itself (a simulated collision)
 
 
 @runtime_checkable
@@ -126,4 +127,5 @@ class SimulatedAgv:
             done=run.done,
             reached=run.reached,
             pose=run.truth,
+            fault=None if run.collision is None else run.collision.line(),
         )

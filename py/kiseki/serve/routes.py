@@ -280,6 +280,8 @@ class RouteRunner:
             state = self.robot.step()
             self._update(phase, marks, state)
             if state.done:
+                if state.fault is not None:  # a simulated collision
+                    raise RuntimeError(state.fault)
                 return state.reached and not stopped
             clock.wait()
 

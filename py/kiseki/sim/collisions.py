@@ -9,7 +9,8 @@ the scene's grid resolution: the footprint is sampled every half cell (edges inc
 sample in an occupied cell is a contact, so a contact is found to within one cell (0.05 m) of
 the obstacle's face. Robots against robots (separating axes) and against pedestrians (the
 nearest point of the rectangle to the disc's centre) are exact. Used by kiseki.sim.setup (a
-robot must start free) and kiseki.sim.run (a collision ends the run).
+robot must start free), kiseki.sim.run and playback (a collision ends the run) and teaching (a
+push into an obstacle is not made).
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ __all__ = [
     "FootprintChecker",
     "body_grid",
     "check_free_start",
+    "check_route_clear",
     "disc_contact",
     "footprint_points",
     "rectangle_contact",
@@ -55,6 +57,14 @@ class Collision:
 
     def payload(self) -> dict:
         return {"t": self.t, "robot": self.robot, "hit": self.hit, "contact": list(self.contact)}
+
+    def line(self) -> str:
+        """The contact as the commands print it."""
+        x, y = self.contact
+        return (
+            f"COLLISION at t = {self.t:.2f} s: {self.robot} hit {self.hit} at ({x:.3f}, {y:.3f}); "
+            "the run ended there"
+        )
 
 
 def footprint_points(pose, length: float, width: float, spacing: float) -> np.ndarray:
@@ -112,6 +122,29 @@ def check_free_start(scene, pose, length: float, width: float, height: float) ->
         raise ValueError(f"{scene.path}: the robot's start footprint leaves the scene's bounds")
     if checker.contact(pose) is not None:
         raise ValueError(f"{scene.path}: the robot's start footprint overlaps an obstacle")
+
+
+def check_route_clear(scene, waypoints, names, width: float, height: float) -> None:
+    """ValueError naming the scene and the first route waypoint (x, y) where the robot cannot
+    stand in any heading: an obstacle cell (the truth of the band 0.05 m .. `height`) lies
+    within half its `width` of the point, inside the disc every footprint centred there
+    covers. Cells are taken by their centres, so an obstacle grazing the disc by less than
+    half a cell passes (the run's own contact check finds it)."""
+    grid = body_grid(scene, height)
+    occupied = np.argwhere(grid.cells == 100)  # (row, col)
+    if not len(occupied):
+        return
+    centres = grid.cell_to_world(occupied[:, ::-1].astype(float))
+    for name, point in zip(names, waypoints, strict=True):
+        near = np.hypot(centres[:, 0] - point[0], centres[:, 1] - point[1])
+        k = int(np.argmin(near))
+        if near[k] <= width / 2:
+            x, y = centres[k]
+            raise ValueError(
+                f"{scene.path}: route waypoint {name} {list(point)} lies {near[k]:.2f} m from "
+                f"an obstacle at ({x:.2f}, {y:.2f}) m, within half the robot's width "
+                f"({width / 2:.2f} m): the robot cannot stand there"
+            )
 
 
 def _corners(pose, length: float, width: float) -> np.ndarray:

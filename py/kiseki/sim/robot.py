@@ -127,6 +127,13 @@ class DiffDriveRobot:
         half_track_turn = 0.5 * p.track_width * dtheta
         return WheelMotion(left=ds - half_track_turn, right=ds + half_track_turn, dt=dt)
 
+    def halt(self, pose: PoseLike) -> None:
+        """A contact: the robot stands at `pose` (where its last step began) at rest, as a cart
+        pushed against a wall stops there."""
+        self._x, self._y, theta = as_pose(pose, "pose")
+        self._theta = wrap_angle(theta)
+        self._v = self._w = 0.0
+
 
 class OmniRobot:
     """True motion of the omnidirectional hospital robot; velocities are in the body frame.

@@ -8,6 +8,8 @@ keeps every complete chunk). Topics, one message per control step:
 * ``/odom``: ``kiseki.Odometry2D``;
 * ``/cmd_vel``: ``kiseki.Twist`` as the simulator writes it (the follower's command before the
   robot's acceleration limits; :meth:`SimRun.velocities` reads it);
+* ``/collision``: ``kiseki.Collision`` (:meth:`PlaybackLog.record`), once, when the simulated
+  robot touched an obstacle or a pedestrian and the run ended, as a simulated run writes it;
 * with a speed limiter, ``/scan`` (``foxglove.LaserScan``, the true sensor pose in the world)
   and ``/speed_limit``: ``kiseki.SpeedLimit``, the fields of ``nav2_msgs/msg/SpeedLimit``
   (``percentage``, ``speed_limit``; the header as ``timestamp`` and ``frame_id``) and the
@@ -85,6 +87,10 @@ class PlaybackLog:
             **limit.to_message(),
         }
         self._writer.write_json("/speed_limit", t, "kiseki.SpeedLimit", payload, SPEED_LIMIT_SCHEMA)
+
+    def record(self, topic: str, t: float, schema_name: str, payload: dict, schema: dict) -> None:
+        """Another JSON message of the run (a simulated run's ``/collision``)."""
+        self._writer.write_json(topic, t, schema_name, payload, schema)
 
     def command(self, t: float, v: float, w: float) -> None:
         payload = {"vx": float(v), "vy": 0.0, "w": float(w)}

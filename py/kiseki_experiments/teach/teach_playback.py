@@ -88,6 +88,7 @@ def _errors(result, goal: dict) -> dict:
         "stop_error": math.hypot(tx, ty),
         "estimate_error": math.hypot(ex - tx, ey - ty),
         "reached": bool(result.reached),
+        "collided": result.collision is not None,  # the run ended on an obstacle
     }
 
 

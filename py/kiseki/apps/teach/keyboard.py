@@ -9,7 +9,8 @@ Keys (like ``teleop_twist_keyboard``, but each press changes the command by one 
 w / Up and s / Down raise and lower the forward speed by 0.1 m/s, a / Left and d / Right the
 turn rate (counter-clockwise positive) by 0.1 rad/s, both within the robot's limits; space
 stops; m marks a waypoint at the odometry pose, named P0, P1, ...; q finishes and writes the
-maps and the waypoint file (no waypoint file when nothing was marked).
+maps and the waypoint file (no waypoint file when nothing was marked). A push into an obstacle
+is not made: the robot stops where it is and the command returns to zero (a line says where).
 
 Keys come from the terminal (cbreak mode, no Enter needed; the terminal's mode is restored on
 exit, also on an exception, Ctrl-C or SIGTERM) or from a key script for tests and demos: lines
@@ -265,4 +266,13 @@ def _drive(run: TeachingRun, keys, teleop: Teleop, stream: TextIO, in_place: boo
             stream.flush()
         if done:
             return
-        run.step(teleop.v, teleop.w)
+        contact = run.step(teleop.v, teleop.w)
+        if contact is not None:  # the cart stopped at the obstacle: so does the operator's push
+            teleop.press("space")
+            x, y = contact.contact
+            start = "\r" if in_place else ""
+            stream.write(
+                f"{start}bumped into an obstacle at ({x:.2f}, {y:.2f}) m: the robot stopped; "
+                "back off (s) or turn (a, d)\n"
+            )
+            stream.flush()

@@ -29,6 +29,7 @@ from kiseki.control import PurePursuit, SpeedLimit, SpeedLimitSource
 from kiseki.core import derive_seed
 from kiseki.filters import MclConfig, MonteCarloLocalizer
 from kiseki.grid import OccupancyGrid
+from kiseki.sim.collisions import COLLISION_SCHEMA, Collision, CollisionCheck
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import SensorSetup, build_robot, build_sensors
 from kiseki.teach.local_maps import METHODS, LocalMapMaker, local_map_scan
@@ -59,6 +60,7 @@ class PlaybackResult:
     times: np.ndarray | None = None  # s, of each step (truth[k] and estimates[k] at times[k])
     speed_limits: np.ndarray | None = None  # m/s the limiter allowed at each step, if any
     scene_identity: dict = field(default_factory=dict)  # scene_sha1, taught_scene_sha1, variant
+    collision: Collision | None = None  # the contact that ended the run, if one did
 
     @property
     def duration(self) -> float:
@@ -149,6 +151,9 @@ class PlaybackRun:
         self.scene, self.environment, self.writer = scene, environment, writer
         self.setup = build_robot(scene, derive_seed(config.seed, 1))
         check_route(environment, waypoints, travelled, self.setup.footprint)
+        # the robot against the scene's truth (and its pedestrians): a contact ends the run
+        self._collisions = CollisionCheck(scene, [self.setup], scene.pedestrians)
+        self.collision: Collision | None = None
         sensors = build_sensors(scene, self.setup, config.seed, config.dt)
         self.cameras = [s.device for s in sensors if s.kind == "depth_camera"]
         self.limiter = None
@@ -189,6 +194,8 @@ class PlaybackRun:
         (the filter is not reset: the start waypoint should be where the robot is)."""
         if not self.done:
             raise ValueError("the robot is still on its route: stop it or let it finish first")
+        if self.collision is not None:
+            raise ValueError(f"the last route ended in a collision ({self.collision.line()})")
         _need_start_and_goal(waypoints)
         check_route(self.environment, waypoints, self.travelled, self.setup.footprint)
         self._begin(waypoints)
@@ -216,8 +223,9 @@ class PlaybackRun:
 
     @property
     def reached(self) -> bool:
-        """The estimate came within the goal tolerance of the goal (the follower's stop rule)."""
-        return bool(self.controller.done)
+        """The estimate came within the goal tolerance of the goal (the follower's stop rule)
+        and the robot touched nothing on the way."""
+        return bool(self.controller.done) and self.collision is None
 
     def particles(self, count: int | None = None) -> np.ndarray:
         """The filter's particles (n, 3), or `count` of them, evenly spaced in its array."""
@@ -235,7 +243,10 @@ class PlaybackRun:
         """One control period: the filter's update at the current pose (recorded), then the
         follower's command for dt, unless the route is over (reached or stopped) and the robot
         at rest. Returns False when the robot rests at the end (that step recorded, no command),
-        and from then on."""
+        and from then on. A move that brings the robot into contact (its footprint on the
+        scene's obstacles or a pedestrian, :class:`~kiseki.sim.collisions.CollisionCheck`)
+        ends the run as a simulated run ends: the next step records the pose of the contact
+        and returns False; ``collision`` holds the contact."""
         if self.done:
             return False
         config, setup, writer = self.config, self.setup, self.writer
@@ -253,7 +264,8 @@ class PlaybackRun:
             cap = self.limiter.update(t, truth, estimate, writer)
         if writer is not None:
             writer.step(t, truth, estimate, odometry)
-        if (self.controller.done or self.stopping) and not any(setup.robot.velocity):
+        resting = (self.controller.done or self.stopping) and not any(setup.robot.velocity)
+        if resting or self.collision is not None:
             self.done, self.command = True, (0.0, 0.0)
             return False  # the stop pose is where the robot comes to rest, not where it was told
         if self.stopping:
@@ -264,6 +276,10 @@ class PlaybackRun:
         if writer is not None:
             writer.command(t, v, w)
         setup.odometry.update(setup.robot.step(v, w, config.dt))
+        self.collision = self._collisions.check(t + config.dt)
+        if self.collision is not None and writer is not None:
+            c = self.collision
+            writer.record("/collision", c.t, "kiseki.Collision", c.payload(), COLLISION_SCHEMA)
         return True
 
     def _observe(self):
@@ -290,6 +306,7 @@ class PlaybackRun:
             np.array(self._estimates),
             np.arange(len(self._truths)) * self.config.dt,
             None if self.limiter is None else np.array(self.limiter.limits),
+            collision=self.collision,
         )
 
 

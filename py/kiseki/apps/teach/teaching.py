@@ -30,6 +30,7 @@ from kiseki.apps.teach.teaching_files import (
 from kiseki.control import PurePursuit
 from kiseki.core import Pose2
 from kiseki.io.runlog import RunWriter, read_run
+from kiseki.sim.collisions import Collision, FootprintChecker, body_grid, check_route_clear
 from kiseki.sim.scene import Scene, check_route_in_bounds
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import MERGE_RULES, EnvironmentMap
@@ -96,6 +97,8 @@ class TeachingRun:
         self.setup = build_robot(scene, seed)
         if self.setup.kind != "diff_drive":
             raise ValueError(f"{scene.path}: teaching pushes a diff_drive robot")
+        s = self.setup
+        self._body = FootprintChecker(body_grid(scene, s.height), s.length, s.width)
         self.cameras = [
             s for s in build_sensors(scene, self.setup, seed, dt) if s.kind == "depth_camera"
         ]
@@ -145,10 +148,24 @@ class TeachingRun:
         p = self.setup.robot.params
         return float(p.max_speed), float(p.max_yaw_rate)
 
-    def step(self, v: float, w: float) -> None:
-        """Moves the robot by (v m/s, w rad/s) for dt (within its limits) and logs the step."""
-        self.setup.odometry.update(self.setup.robot.step(v, w, self.dt))
+    def step(self, v: float, w: float) -> Collision | None:
+        """Moves the robot by (v m/s, w rad/s) for dt (within its limits) and logs the step.
+        A move that would bring the robot's footprint onto an obstacle (the scene's truth at
+        its height, :mod:`kiseki.sim.collisions`) is not made: the robot stays where it was,
+        at rest, its wheels still (the odometry unchanged), the step is logged there, and the
+        contact is returned (else None)."""
+        robot = self.setup.robot
+        before = robot.pose
+        motion = robot.step(v, w, self.dt)
+        contact = self._body.contact(_pose(robot.pose))
+        if contact is None:
+            self.setup.odometry.update(motion)
+        else:
+            robot.halt(before)
         self._record()
+        if contact is None:
+            return None
+        return Collision(self.t, self.setup.name, "obstacle", contact)
 
     def _record(self) -> None:
         t, truth, odom = self.steps * self.dt, self.truth, self.odom
@@ -237,6 +254,8 @@ def teach(
         raise ValueError(f"{scene.path}: scripted teaching needs a route (or use the keyboard)")
     names = route.get("names") or [f"W{i}" for i in range(len(route["waypoints"]))]
     check_route_in_bounds(scene, route["waypoints"], names)
+    body = build_robot(scene, seed)
+    check_route_clear(scene, route["waypoints"], names, body.width, body.height)
     with TeachingRun(scene, out, seed, dt, overwrite, {"names": ",".join(names)}, merge) as run:
         controller = PurePursuit(
             route["waypoints"],
@@ -254,13 +273,27 @@ def teach(
             if resting or run.steps >= int(900 / dt):
                 break
             v, _, w = controller.command(run.truth)
-            run.step(v, w)
+            contact = run.step(v, w)
+            if contact is not None:
+                raise ValueError(_blocked(scene, names, run, contact))
         bar.close()
         return run.finish()
 
 
 def _pose(p) -> tuple[float, float, float]:
     return (float(p.x), float(p.y), float(p.theta))
+
+
+def _blocked(scene: Scene, names, run: TeachingRun, contact: Collision) -> str:
+    """Why scripted teaching stopped: the robot, following the route, touched an obstacle."""
+    after = f"after waypoint {run.marks[-1]['name']}" if run.marks else f"before {names[0]}"
+    x, y = contact.contact
+    return (
+        f"{scene.path}: pushed along the route, the robot touches an obstacle at ({x:.2f}, "
+        f"{y:.2f}) m at t = {contact.t:.1f} s, {after}: move the route's waypoints away from "
+        f"it (the robot cuts corners, steering to a point 0.6 m ahead); {run.log} holds the "
+        "run up to there"
+    )
 
 
 def _integrate(maps, makers, images, odom) -> None:
