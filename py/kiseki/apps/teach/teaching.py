@@ -21,6 +21,7 @@ from tqdm import tqdm
 
 from kiseki._support.atomic import check_writable_folder, reworded
 from kiseki._support.real_numbers import check_number
+from kiseki._support.replaced_files import refuse_replacing
 from kiseki.apps.teach.teaching_files import (
     TeachResult,
     environment_grid,
@@ -75,7 +76,9 @@ class TeachingRun:
     depth images and merges the local maps placed by odometry; :meth:`mark` records a waypoint
     at the current odometry pose. Use it as a context manager (the log is closed on exit, also
     on an exception, so that :func:`recover` can rebuild the run). `merge` is the environment
-    maps' merge rule (`kiseki.teach.environment_map`)."""
+    maps' merge rule (`kiseki.teach.environment_map`). Unless `overwrite`, a folder holding any
+    file the run writes (:data:`TEACHING_FILES`) is refused (FileExistsError) before anything is
+    written."""
 
     def __init__(
         self,
@@ -94,6 +97,9 @@ class TeachingRun:
         self.scene, self.dt = scene, float(dt)
         self.out = Path(out)
         check_writable_folder(self.out, "teaching")
+        if not overwrite:  # a user's map_plane.yaml beside no teach.mcap was replaced
+            remedy = "give a new or empty folder, or overwrite=True"
+            refuse_replacing(self.out, TEACHING_FILES, "out", remedy)
         self.setup = build_robot(scene, seed)
         if self.setup.kind != "diff_drive":
             raise ValueError(f"{scene.path}: teaching pushes a diff_drive robot")
