@@ -109,8 +109,8 @@ def check_scene(
     """The scene identity to record with a playback: ``scene_sha1``, and ``taught_scene_file``
     and ``taught_scene_sha1`` when the taught scene is known, and ``variant`` when one is named.
     Raises ValueError when the scene file's bytes differ from the taught scene's and no
-    `variant` label names the change, or when the label is not 1-64 letters, digits, '_', '.'
-    or '-'."""
+    `variant` label names the change, when a label names a scene whose bytes are the taught
+    scene's, or when the label is not 1-64 letters, digits, '_', '.' or '-'."""
     if variant is not None and not (isinstance(variant, str) and _LABEL.fullmatch(variant)):
         raise ValueError(
             f"a scene variant label must be 1-64 letters, digits, '_', '.' or '-', got {variant!r}"
@@ -124,6 +124,12 @@ def check_scene(
                 f"{scene_path} is not the scene the route was taught in "
                 f"({taught.shown() or 'unnamed'}; the files' SHA-1s differ): give that scene, or "
                 "name the changed scene with --variant LABEL to play back in it on purpose"
+            )
+        if taught.sha1 == record["scene_sha1"] and variant is not None:
+            # the log recorded a variant of a scene that was the taught one, byte for byte
+            raise ValueError(
+                f"scene variant {variant!r} names a changed scene, but {scene_path} is the scene "
+                "the route was taught in (the same SHA-1): play back without a variant label"
             )
     if variant is not None:
         record["variant"] = variant

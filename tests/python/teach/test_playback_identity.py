@@ -110,6 +110,22 @@ def test_the_api_refuses_a_changed_scene_without_a_label(taught):
     assert check_scene(None, moved) == {"scene_sha1": sha1(moved)}  # a hand-made waypoint file
 
 
+def test_a_variant_label_on_the_taught_scene_itself_is_refused(taught):
+    """The label went into the log's metadata as if the scene had been changed."""
+    root, scene, _ = taught
+    with pytest.raises(ValueError) as err:
+        check_scene(TaughtScene(str(scene), sha1(scene)), scene, "boxes")
+    assert str(err.value) == (
+        f"scene variant 'boxes' names a changed scene, but {scene} is the scene the route was "
+        "taught in (the same SHA-1): play back without a variant label"
+    )
+    done = kiseki("playback", scene, "--taught", "t", "--route", "P0,P2", "--log", "u.mcap",
+                  "--variant", "boxes", cwd=root)  # fmt: skip
+    assert done.returncode == 1 and not (root / "u.mcap").exists()
+    assert done.stderr.strip().endswith("play back without a variant label")
+    assert "Traceback" not in done.stderr
+
+
 def test_serve_knows_the_taught_scene_by_its_sha1_when_the_file_is_gone(tmp_path, project_root):
     """The taught scene file moved away: a byte-identical copy is accepted, a changed copy of
     the same name is refused (a name alone once let it through)."""
