@@ -33,6 +33,7 @@ from kiseki.cli._defaults import default_of
 from kiseki.cli.teach import merge_rule
 from kiseki.core import derive_seed
 from kiseki.io.ros_map import load_map
+from kiseki.io.runlog import read_run
 from kiseki.plots import render_map
 from kiseki.sim.collisions import Collision
 from kiseki.sim.render import render_scene
@@ -102,12 +103,23 @@ def demo(
     run_demo(scene, out, seed, console, particles, merge_rule(merge))
 
 
+# the demo's teaching log says in its metadata that the demo wrote it
+WRITTEN_BY = {"written_by": "kiseki demo"}
+
+
 def _check_out(out: Path) -> None:
-    """Before any work: an earlier demo's folder (its teaching log, teach/teach.mcap, the
-    demo's first file, so that a demo interrupted before its summary is one too) is replaced;
-    another folder holding a file the demo writes (a user's own config.yaml) is refused."""
-    if (out / "teach" / "teach.mcap").is_file():
-        return
+    """Before any work: an earlier demo's folder is replaced, known by its teaching log
+    (teach/teach.mcap, the demo's first file, so that a demo interrupted before its summary is
+    one too) whose metadata says the demo wrote it (a user's own `kiseki teach -o OUT/teach`
+    is not the demo's); another folder holding a file the demo writes (a user's own
+    config.yaml) is refused."""
+    log = out / "teach" / "teach.mcap"
+    if log.is_file() and not log.is_symlink():
+        try:
+            if read_run(log).metadata.get("written_by") == WRITTEN_BY["written_by"]:
+                return
+        except (OSError, ValueError):  # not a log the demo could read back: not its own
+            pass
     remedy = "give a new or empty folder as --out (an earlier demo's folder is replaced)"
     refuse_replacing(out, DEMO_FILES, "--out", remedy)
 
@@ -134,7 +146,9 @@ def run_demo(
     console.print("teaching: pushing the AGV along the route ...")
     # the teaching log first: it marks the folder as the demo's own (_check_out), so that a
     # demo cut short after it can be run into again
-    taught = teach(scene, out / "teach", seed=derive_seed(seed, 1), overwrite=True, merge=merge)
+    taught = teach(
+        scene, out / "teach", derive_seed(seed, 1), overwrite=True, merge=merge, metadata=WRITTEN_BY
+    )
     render_scene(scene, out / "scene.png")
     goal = taught.marks[-1]
     maps = {band: load_map(path) for band, path in taught.maps.items()}

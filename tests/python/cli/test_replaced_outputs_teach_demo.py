@@ -14,8 +14,10 @@ import sys
 import pytest
 import yaml
 
+from kiseki.apps.teach import teach
 from kiseki.apps.teach.teaching import TEACHING_FILES
-from kiseki.cli.demo import DEMO_FILES
+from kiseki.cli.demo import DEMO_FILES, WRITTEN_BY
+from kiseki.sim.scene import load_scene
 
 TEACH_REMEDY = "give a new or empty folder as --out, or add --overwrite"
 DEMO_REMEDY = "give a new or empty folder as --out (an earlier demo's folder is replaced)"
@@ -153,15 +155,40 @@ def test_an_earlier_demos_folder_is_replaced(tmp_path, short_scene):
     assert json.loads((tmp_path / "d" / "summary.json").read_text())["waypoints"] == ["P0", "G"]
 
 
-def test_a_demo_interrupted_before_its_summary_is_still_the_demos_own(tmp_path, short_scene):
+@pytest.mark.parametrize("cut", [False, True])
+def test_a_demo_interrupted_before_its_summary_is_still_the_demos_own(tmp_path, short_scene, cut):
     """A demo stopped after its teaching, before summary.json, left a folder the demo refused
-    to run into again: its teaching log, the demo's first file, marks it as the demo's."""
-    (tmp_path / "d" / "teach").mkdir(parents=True)
-    (tmp_path / "d" / "teach" / "teach.mcap").write_bytes(b"cut short")
+    to run into again: its teaching log, the demo's first file, marks it as the demo's by its
+    metadata, also when the log was cut short by a kill (`cut`: its last third gone)."""
+    taught = teach(
+        load_scene(tmp_path / short_scene), tmp_path / "d" / "teach", metadata=WRITTEN_BY
+    )
+    if cut:
+        data = taught.log.read_bytes()
+        taught.log.write_bytes(data[: 2 * len(data) // 3])
     (tmp_path / "d" / "config.yaml").write_text("the interrupted run's\n")
     done = run("demo", "--scene", short_scene, "--out", "d", "--particles", "20", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     assert set(contents(tmp_path / "d")) == set(DEMO_FILES)
+
+
+def test_a_users_own_teaching_run_named_like_the_demos_is_not_replaced(tmp_path, short_scene):
+    """The user's `kiseki teach -o d/teach` counted as a demo's teaching (any teach/teach.mcap
+    did), so `kiseki demo --out d` replaced the user's run."""
+    taught = run("teach", short_scene, "-o", "d/teach", cwd=tmp_path)
+    assert taught.returncode == 0, taught.stderr
+    before = contents(tmp_path)
+    done = run("demo", "--scene", short_scene, "--out", "d", "--particles", "20", cwd=tmp_path)
+    files = len([n for n in before if n.startswith("d/")])
+    refused(
+        done,
+        f"--out d holds teach/teach.mcap (and {files - 1} more), which this command would "
+        f"replace: {DEMO_REMEDY}",
+    )
+    assert contents(tmp_path) == before
+    (tmp_path / "d" / "teach" / "teach.mcap").write_bytes(b"not a log")  # nor is a broken one
+    done = run("demo", "--scene", short_scene, "--out", "d", "--particles", "20", cwd=tmp_path)
+    assert done.returncode == 1 and "holds teach/teach.mcap" in done.stderr
 
 
 def test_a_demo_that_failed_in_its_teaching_can_be_run_into_again(tmp_path, short_scene):

@@ -128,7 +128,7 @@ class TeachingRun:
             "dt": str(dt),
             "merge": merge,
         }
-        self._writer = RunWriter(self.log, {**meta, **(metadata or {})}, overwrite=overwrite)
+        self._writer = RunWriter(self.log, {**(metadata or {}), **meta}, overwrite=overwrite)
         try:
             self._record()
         except BaseException:
@@ -251,10 +251,12 @@ def teach(
     overwrite: bool = False,
     progress: bool = False,
     merge: str = "thesis",
+    metadata: dict[str, str] | None = None,
 ) -> TeachResult:
     """Pushes the robot along the scene's route (pure pursuit stands in for the operator),
     marks each named route point as a waypoint, and builds one environment map per local-map
-    band ("plane" and "band") with the merge rule `merge`."""
+    band ("plane" and "band") with the merge rule `merge`. `metadata`: more entries for the
+    log's metadata (text keys and values; the run's own entries win)."""
     route = scene.route
     if not route.get("waypoints"):
         raise ValueError(f"{scene.path}: scripted teaching needs a route (or use the keyboard)")
@@ -262,7 +264,8 @@ def teach(
     check_route_in_bounds(scene, route["waypoints"], names)
     body = build_robot(scene, seed)
     check_route_clear(scene, route["waypoints"], names, body.width, body.height)
-    with TeachingRun(scene, out, seed, dt, overwrite, {"names": ",".join(names)}, merge) as run:
+    meta = {**(metadata or {}), "names": ",".join(names)}
+    with TeachingRun(scene, out, seed, dt, overwrite, meta, merge) as run:
         controller = PurePursuit(
             route["waypoints"],
             route["speed"],
