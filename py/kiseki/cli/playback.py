@@ -15,7 +15,9 @@ from rich.console import Console
 from kiseki._support.guard import Derived, guarded
 from kiseki._support.interrupt import interruptible
 from kiseki._support.options import Seed
+from kiseki._support.outputs import FIGURE_SUFFIXES, check_suffix
 from kiseki.apps.teach import PlaybackConfig, playback
+from kiseki.apps.teach.playback_picture import render_playback
 from kiseki.apps.teach.taught_route import load_route
 from kiseki.cli._defaults import default_of
 from kiseki.grid import OccupancyGrid
@@ -39,7 +41,7 @@ _TAUGHT_WAYPOINTS = Derived(
 @app.command("playback")
 @guarded(
     inputs=("scene_file", "taught", _TAUGHT_WAYPOINTS, "waypoints", "map_file"),
-    outputs=("log",),
+    outputs=("log", "plot"),
 )
 @interruptible()
 def playback_command(
@@ -68,6 +70,11 @@ def playback_command(
         help="MCAP file to write the run to (poses, /cmd_vel; with a limiter /scan and "
         "/speed_limit as nav2_msgs/SpeedLimit fields).",
     ),
+    plot: Path | None = typer.Option(
+        None,
+        help="Picture to draw (PNG): the taught map, the route, the estimate, the true path, "
+        "the stop and a contact.",
+    ),
     variant: str | None = typer.Option(
         None,
         help="Label of a deliberately changed copy of the taught scene (its SHA-1 differs from "
@@ -85,6 +92,7 @@ def playback_command(
         raise ValueError("give either --taught FOLDER or --waypoints FILE (with --map MAP.yaml)")
     if taught is not None and map_file is not None:
         raise ValueError("--map goes with --waypoints, not with --taught")
+    check_suffix("--plot", plot, FIGURE_SUFFIXES)
     if speed_limit not in SPEED_LIMITS:
         raise ValueError(f"--speed-limit must be {', '.join(SPEED_LIMITS)}, got {speed_limit!r}")
     config = PlaybackConfig(method=method, seed=seed)
@@ -129,6 +137,12 @@ def playback_command(
         )
     if log is not None:
         console.print(f"  run logged to {log}", soft_wrap=True)
+    if plot is not None:
+        title = f"{scene_file.name}, {method}: " + (
+            "goal reached" if result.reached else "goal not reached"
+        )
+        render_playback(result, environment, marks, plot, title=title)
+        console.print(f"  picture in {plot}", soft_wrap=True)
 
 
 SPEED_LIMITS = ("none", "occlusion", "occlusion-width")

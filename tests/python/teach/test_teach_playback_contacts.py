@@ -15,8 +15,10 @@ import pytest
 import yaml
 
 from _helpers.cli_main import kiseki
+from _helpers.pixels import blobs, rgb
 from kiseki.apps.teach import PlaybackConfig, playback, teach
 from kiseki.apps.teach.keyboard import KeyScript, teach_keyboard
+from kiseki.apps.teach.playback_picture import render_playback
 from kiseki.io.ros_map import load_map
 from kiseki.io.runlog import read_run
 from kiseki.sim.collisions import FootprintChecker, body_grid, check_route_clear
@@ -156,6 +158,19 @@ def test_playback_ends_at_an_obstacle_on_the_route_and_logs_the_contact(taught_c
     assert result.truth[-1, 0] < 1.5  # nowhere near the goal at x = 3
     logged = list(read_run(log).messages("/collision"))
     assert len(logged) == 1 and logged[0][1]["contact"] == list(result.collision.contact)
+    # the picture: the contact's cross between P1 and P2's squares, where the pillar's face is
+    picture = render_playback(result, maps, taught.marks, root / "blocked.png")
+    image = rgb(picture)
+    squares = [c for c, size in blobs(image, (255, 127, 14)) if max(size) < 20]
+    row = np.median([c[1] for c in squares])
+    p0, p1, p2 = sorted(c[0] for c in squares if abs(c[1] - row) < 15)  # not the legend's
+    crosses = [c for c, _ in blobs(image, (214, 39, 40), tol=30) if abs(c[1] - row) < 15]
+    assert len(crosses) == 1
+    x0, x1, x2 = (m["x"] for m in taught.marks)
+    scale = (p2 - p0) / (x2 - x0)  # pixels per metre, from the squares' places
+    assert p1 == pytest.approx(p0 + scale * (x1 - x0), abs=2)
+    at = x1 + (crosses[0][0] - p1) / scale
+    assert at == pytest.approx(result.collision.contact[0], abs=0.05)
     control = playback(
         load_scene(path, "playback"), maps, taught.marks, config, taught_scene=taught.scene
     )
@@ -167,9 +182,10 @@ def test_the_playback_command_prints_the_contact(taught_corridor, monkeypatch, c
     monkeypatch.chdir(root)
     status, out, err = kiseki(
         monkeypatch, capsys, "playback", blocked, "--taught", "t", "--route", "P0,P1,P2",
-        "--variant", "pillar",
+        "--variant", "pillar", "--plot", "cli.png",
     )  # fmt: skip
     assert status == 0, err
+    assert rgb(root / "cli.png").shape[2] == 3 and "picture in cli.png" in out
     text = " ".join(out.split())
     assert "goal reached: False" in text
     assert "COLLISION at t = " in text and ": robot hit obstacle at (1.8" in text
