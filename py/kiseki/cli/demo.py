@@ -28,6 +28,7 @@ from kiseki._support.options import PARTICLE_LIMIT, Count, Seed
 from kiseki._support.replaced_files import refuse_replacing
 from kiseki._support.table import show
 from kiseki.apps.teach import PlaybackConfig, playback, teach
+from kiseki.apps.teach.playback_picture import render_playback
 from kiseki.apps.teach.teaching import TEACHING_FILES
 from kiseki.cli._defaults import default_of
 from kiseki.cli.teach import merge_rule
@@ -66,6 +67,7 @@ DEMO_FILES = (
     *(f"teach/{name}" for name in TEACHING_FILES),
     "scene.png",
     "taught_map_band.png",
+    *(f"playback_{method}.png" for method in METHODS),
     "config.yaml",
     "summary.json",
 )
@@ -171,6 +173,8 @@ def run_demo(
             PlaybackConfig(method=method, particles=particles, seed=derive_seed(seed, 2)),
             taught_scene=taught.scene,
         )
+        picture = out / f"playback_{method}.png"
+        render_playback(r, maps[band], taught.marks, picture, label=f"{scene.name}, {method}")
         tx, ty = r.stop_true[0] - goal["truth"][0], r.stop_true[1] - goal["truth"][1]
         ex, ey = r.stop_estimate[0] - goal["x"], r.stop_estimate[1] - goal["y"]
         results[method] = {

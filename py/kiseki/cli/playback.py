@@ -138,10 +138,7 @@ def playback_command(
     if log is not None:
         console.print(f"  run logged to {log}", soft_wrap=True)
     if plot is not None:
-        title = f"{scene_file.name}, {method}: " + (
-            "goal reached" if result.reached else "goal not reached"
-        )
-        render_playback(result, environment, marks, plot, title=title)
+        render_playback(result, environment, marks, plot, label=f"{scene_file.name}, {method}")
         console.print(f"  picture in {plot}", soft_wrap=True)
 
 

@@ -32,6 +32,8 @@ def test_demo_teaches_and_plays_back_every_method(tmp_path, project_root):
     for name in (
         "scene.png",
         "taught_map_band.png",
+        "playback_conventional.png",
+        "playback_both.png",
         "teach/teach.mcap",
         "teach/map_band.yaml",
         "teach/map_plane.pgm",
@@ -54,6 +56,7 @@ def test_demo_teaches_and_plays_back_every_method(tmp_path, project_root):
         assert result["reached"] and result["stop_error_m"] <= 0.1
         assert result["estimate_error_m"] <= 0.1
         assert np.hypot(*result["stop_offset_m"]) == pytest.approx(result["stop_error_m"])
+        assert result["collision"] is None
     again = run_demo(scene, tmp_path / "b", seed=3, console=Console(quiet=True), particles=300)
     assert again["playback"] == summary["playback"]  # same seed, same runs
 

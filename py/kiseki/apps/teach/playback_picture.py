@@ -27,11 +27,11 @@ def render_playback(
     environment: OccupancyGrid,
     waypoints: list[dict],
     path: str | os.PathLike,
-    title: str | None = None,
+    label: str = "playback",
 ) -> Path:
     """Draws `result` (a :func:`~kiseki.apps.teach.playback` run) over its taught map
     `environment` with the route's `waypoints` (the taught marks it followed) to the PNG
-    `path`; returns the path."""
+    `path`, titled 'LABEL: goal reached (or not), N steps (T s)'; returns the path."""
     if not isinstance(result, PlaybackResult):
         raise TypeError(f"result must be a PlaybackResult, got {type(result).__name__}")
     if not waypoints:
@@ -58,7 +58,7 @@ def render_playback(
     _zoom(ax, environment, marks, result)
     ax.legend(loc="upper right", fontsize=8)
     reached = "goal reached" if result.reached else "goal not reached"
-    ax.set_title(title or f"playback: {reached}, {result.steps} steps ({result.duration:.1f} s)")
+    ax.set_title(f"{label}: {reached}, {result.steps} steps ({result.duration:.1f} s)")
     return save_figure(fig, path)
 
 
