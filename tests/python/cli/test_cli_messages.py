@@ -19,6 +19,21 @@ from kiseki.scans import LaserScans
 WORLDS = Path(__file__).resolve().parents[3] / "data" / "worlds"
 SCENE = WORLDS / "factory_corridor.yaml"
 MAGNETIC = WORLDS / "magnetic_path.yaml"  # walls 4 m to the left and right of the start
+ROUTE = "[[0.0, 0.0], [118.0, 0.0]]"  # magnetic_path.yaml's route
+
+
+def write_magnetic_scenes(folder: Path) -> None:
+    """The first 16 m of magnetic_path.yaml with a box 2 m left of its middle and one 3 m right
+    of its end (boxes.yaml), and its route slanted 1 m to the left over 16 m (slant.yaml)."""
+    text = MAGNETIC.read_text(encoding="utf-8")
+    assert text.count(ROUTE) == 1 and text.count("objects:\n") == 1
+    boxes = "".join(
+        f"  - {{type: box, center: {at}, size: [0.4, 0.4, 1.0]}}\n"
+        for at in ([8.0, 2.0], [16.0, -3.0])
+    )
+    short = text.replace(ROUTE, "[[0.0, 0.0], [16.0, 0.0]]")
+    (folder / "boxes.yaml").write_text(short.replace("objects:\n", "objects:\n" + boxes))
+    (folder / "slant.yaml").write_text(text.replace(ROUTE, "[[0.0, 0.0], [16.0, 1.0]]"))
 
 
 @pytest.fixture
@@ -39,6 +54,7 @@ def inputs(tmp_path: Path) -> Path:
         for t, pose, ranges in zip(scans.times, scans.poses, scans.ranges, strict=True):
             w.write_odometry("/odom", t, pose)
             w.write_laser_scan("/scan", t, pose, ANGLES, ranges, max_range=8.0)
+    write_magnetic_scenes(tmp_path)
     return tmp_path
 
 
@@ -76,8 +92,27 @@ def inputs(tmp_path: Path) -> Path:
         (  # '...magnetic_path.yaml: the robot's start footprint overlaps an obstacle'
             ["magnetic", "teach", MAGNETIC, "-o", "taught", "--offset", "4"],
             "--offset 4 m: the left parallel path would start at (0.00, 4.00), where the robot's "
-            f"footprint overlaps an obstacle in {MAGNETIC}; the parallel paths start clear up to "
-            "--offset 3.50 m",
+            f"footprint overlaps an obstacle in {MAGNETIC}; the parallel paths' starts and "
+            "waypoints are clear up to --offset 3.50 m",
+        ),
+        (  # 'boxes.yaml: the teaching run along the left parallel path did not reach its end...'
+            ["magnetic", "teach", "boxes.yaml", "-o", "taught", "--offset", "2"],
+            "--offset 2 m: the teaching run along the left parallel path did not reach its end "
+            "in boxes.yaml (hit obstacle at (7.81, 2.00) at t = 12.7 s): no map; give an "
+            "--offset whose parallel paths clear the scene's obstacles",
+        ),
+        (  # '...the teaching run along the right parallel path did not reach its end...'
+            ["magnetic", "teach", "boxes.yaml", "-o", "taught", "--offset", "3"],
+            "--offset 3 m: the right parallel path would pass waypoint W1 at (16.00, -3.00), "
+            "where the robot cannot stand in any heading (an obstacle 0.07 m away, within half "
+            "its width of 0.29 m) in boxes.yaml; the parallel paths' starts and waypoints are "
+            "clear up to --offset 2.56 m",
+        ),
+        (  # 'slant.yaml: route waypoint W1 [15.55..., 8.18...] lies outside the scene's bounds'
+            ["magnetic", "teach", "slant.yaml", "-o", "taught", "--offset", "7.2"],
+            "--offset 7.2 m: the left parallel path would pass waypoint W1 at (15.55, 8.19), "
+            "outside the scene's bounds (x -5..125, y -8..8) in slant.yaml; the parallel paths' "
+            "starts and waypoints are clear up to --offset 2.56 m",
         ),
         (  # 'dot.yaml: image file . not found' of the folder the YAML is in
             ["map", "info", "dot.yaml"],
@@ -110,6 +145,9 @@ def inputs(tmp_path: Path) -> Path:
         "scene-folder",
         "keys-folder",
         "offset-too-wide",
+        "offset-blocked-midway",
+        "offset-waypoint-blocked",
+        "offset-waypoint-outside",
         "map-image-dot",
         "map-image-folder",
         "run-without-truth",

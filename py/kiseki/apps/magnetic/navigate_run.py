@@ -40,8 +40,8 @@ import numpy as np
 
 from kiseki._support.real_numbers import check_number
 from kiseki.apps.magnetic.teach_checks import (
+    OffsetCheck,
     check_magnetometer,
-    check_offset,
     check_route_length,
     check_taught_run,
 )
@@ -178,7 +178,8 @@ def teach(
     check_magnetometer(scene, scene_path)
     waypoints = np.asarray(scene.route["waypoints"], dtype=np.float64)
     check_route_length(scene, scene_path, waypoints)
-    check_offset(scene, scene_path, offset, _shifted(waypoints, 1.0)[0] - waypoints[0], option)
+    offsets = OffsetCheck(scene, scene_path, offset, lambda d: _shifted(waypoints, d), option)
+    offsets.before_runs()
     path_id = path_identity(waypoints)
     maps = {}
     for k, (name, shift) in enumerate((("center", 0.0), ("left", offset), ("right", -offset))):
@@ -188,7 +189,9 @@ def teach(
             here, run, SimConfig(seed=derive_seed(seed, k)), overwrite=True, progress=False
         )
         # a run that did not reach the route's end maps part of it: refused, not a short map
-        check_taught_run(summary, scene_path, name)
+        check_taught_run(summary, scene_path, name, offset, option)
+        if name == "center":  # it reached its end: what blocks a parallel path is the offset
+            offsets.after_route()
         maps[name] = linear_map_from_run(run, path_id, provenance={"path": name})
     if len(maps["center"]) < 2:
         n = len(maps["center"])
