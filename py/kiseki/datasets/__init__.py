@@ -87,6 +87,12 @@ def open_scans(
                 "the scans are placed by its poses; give a run that records it (kiseki sim run "
                 "does)"
             )
+        if "/scan" in topics and "/odom" not in topics:
+            # laser_scans' hint is its argument (odom_topic=None), as for /ground_truth above
+            raise LogFormatError(
+                f"{path}: no odometry topic '/odom' (topics: {sorted(topics)}): the scans' "
+                "odometry is read from it; give a run that records it (kiseki sim run does)"
+            )
         return run.laser_scans()
     if is_wean_log(path):
         return read_wean_log(path).scans

@@ -54,6 +54,10 @@ def inputs(tmp_path: Path) -> Path:
         for t, pose, ranges in zip(scans.times, scans.poses, scans.ranges, strict=True):
             w.write_odometry("/odom", t, pose)
             w.write_laser_scan("/scan", t, pose, ANGLES, ranges, max_range=8.0)
+    with RunWriter(tmp_path / "no_odom.mcap") as w:  # a run without /odom
+        for t, pose, ranges in zip(scans.times, scans.poses, scans.ranges, strict=True):
+            w.write_pose("/ground_truth", t, pose)
+            w.write_laser_scan("/scan", t, pose, ANGLES, ranges, max_range=8.0)
     write_magnetic_scenes(tmp_path)
     return tmp_path
 
@@ -127,6 +131,11 @@ def inputs(tmp_path: Path) -> Path:
             "no_truth.mcap: no ground-truth topic '/ground_truth' (topics: ['/odom', '/scan']): "
             "the scans are placed by its poses; give a run that records it (kiseki sim run does)",
         ),
+        (  # '(...; pass odom_topic=None for NaN odometry)': an API argument
+            ["map", "from-log", "no_odom.mcap", "-o", "m.yaml"],
+            "no_odom.mcap: no odometry topic '/odom' (topics: ['/ground_truth', '/scan']): the "
+            "scans' odometry is read from it; give a run that records it (kiseki sim run does)",
+        ),
         (  # an MCAP run written to x.txt
             ["sim", "run", SCENE, "-o", "x.txt"],
             "--output x.txt: extension '.txt'; give a file ending in .mcap",
@@ -151,6 +160,7 @@ def inputs(tmp_path: Path) -> Path:
         "map-image-dot",
         "map-image-folder",
         "run-without-truth",
+        "run-without-odom",
         "sim-run-suffix",
         "octree-suffix",
     ],
