@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -34,7 +35,7 @@ from kiseki.cli._defaults import default_of
 from kiseki.cli.teach import merge_rule
 from kiseki.core import derive_seed
 from kiseki.io.ros_map import load_map
-from kiseki.io.runlog import read_run
+from kiseki.io.runlog import TruncatedRunWarning, read_run
 from kiseki.plots import render_map
 from kiseki.sim.collisions import Collision
 from kiseki.sim.render import render_scene
@@ -118,8 +119,10 @@ def _check_out(out: Path) -> None:
     log = out / "teach" / "teach.mcap"
     if log.is_file() and not log.is_symlink():
         try:
-            if read_run(log).metadata.get("written_by") == WRITTEN_BY["written_by"]:
-                return
+            with warnings.catch_warnings():  # a demo killed while teaching cut its log short
+                warnings.simplefilter("ignore", TruncatedRunWarning)
+                if read_run(log).metadata.get("written_by") == WRITTEN_BY["written_by"]:
+                    return
         except (OSError, ValueError):  # not a log the demo could read back: not its own
             pass
     remedy = "give a new or empty folder as --out (an earlier demo's folder is replaced)"
@@ -240,7 +243,7 @@ def _print(results: dict, scene_name: str, out: Path, console: Console) -> None:
                 "-" if est is None else f"{est:.2f}",
                 f"{r['estimate_error_m']:.3f}",
                 within,
-                "yes" if r["stop_error_m"] <= 0.1 else "no",
+                "yes" if r["stop_error_m"] <= 0.1 and r["collision"] is None else "no",
             )
         )
     title = f"{scene_name}: one run per method, beside the thesis' Exp. 2 (Table 4.5)"

@@ -32,7 +32,7 @@ class RobotState:
     leg: int  # the route's leg the robot is on: waypoints[leg] -> waypoints[leg + 1]
     t: float  # s since the route started
     done: bool  # the robot rests at the end of the route, or after a stop
-    reached: bool  # the estimate came within the goal tolerance of the goal
+    reached: bool  # the estimate came within the goal tolerance of the goal, touching nothing
     pose: tuple[float, float, float] | None = None  # the true pose (simulation only)
     fault: str | None = None  # why the robot ended the route itself (a simulated collision)
 

@@ -28,6 +28,7 @@ __all__ = [
     "body_grid",
     "check_free_start",
     "check_route_clear",
+    "refuse_pedestrians",
     "disc_contact",
     "footprint_points",
     "rectangle_contact",
@@ -124,13 +125,12 @@ def check_free_start(scene, pose, length: float, width: float, height: float) ->
         raise ValueError(f"{scene.path}: the robot's start footprint overlaps an obstacle")
 
 
-def check_route_clear(scene, waypoints, names, width: float, height: float) -> None:
+def check_route_clear(scene, waypoints, names, width: float, grid) -> None:
     """ValueError naming the scene and the first route waypoint (x, y) where the robot cannot
-    stand in any heading: an obstacle cell (the truth of the band 0.05 m .. `height`) lies
-    within half its `width` of the point, inside the disc every footprint centred there
-    covers. Cells are taken by their centres, so an obstacle grazing the disc by less than
-    half a cell passes (the run's own contact check finds it)."""
-    grid = body_grid(scene, height)
+    stand in any heading: an obstacle cell of `grid` (the scene's :func:`body_grid` at the
+    robot's height) lies within half its `width` of the point, inside the disc every footprint
+    centred there covers. Cells are taken by their centres, so an obstacle grazing the disc by
+    less than half a cell passes (the run's own contact check finds it)."""
     occupied = np.argwhere(grid.cells == 100)  # (row, col)
     if not len(occupied):
         return
@@ -145,6 +145,17 @@ def check_route_clear(scene, waypoints, names, width: float, height: float) -> N
                 f"an obstacle at ({x:.2f}, {y:.2f}) m, within half the robot's width "
                 f"({width / 2:.2f} m): the robot cannot stand there"
             )
+
+
+def refuse_pedestrians(scene, run: str) -> None:
+    """ValueError for a scene with pedestrians in a run that does not simulate them (teaching,
+    playback: their sensors would not see them, their logs would not hold them)."""
+    if scene.pedestrians:
+        names = ", ".join(p.name for p in scene.pedestrians)
+        raise ValueError(
+            f"{scene.path}: {run} does not simulate the scene's pedestrians ({names}): remove "
+            "them for it (kiseki sim run simulates them)"
+        )
 
 
 def _corners(pose, length: float, width: float) -> np.ndarray:

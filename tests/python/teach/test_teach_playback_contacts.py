@@ -19,6 +19,7 @@ from _helpers.pixels import blobs, rgb
 from kiseki.apps.teach import PlaybackConfig, playback, teach
 from kiseki.apps.teach.keyboard import KeyScript, teach_keyboard
 from kiseki.apps.teach.playback_picture import render_playback
+from kiseki.grid import OccupancyGrid
 from kiseki.io.ros_map import load_map
 from kiseki.io.runlog import read_run
 from kiseki.sim.collisions import FootprintChecker, body_grid, check_route_clear
@@ -87,7 +88,8 @@ def test_a_waypoint_within_half_the_robot_width_of_a_wall_is_refused(tmp_path, p
         teach(scene, tmp_path / "near")
     assert not (tmp_path / "near").exists()
     setup = build_robot(scene, 0)
-    check_route_clear(scene, [(0.0, 0.0), (-0.5, 1.15)], ["P0", "P1"], setup.width, setup.height)
+    grid = body_grid(scene, setup.height)
+    check_route_clear(scene, [(0.0, 0.0), (-0.5, 1.15)], ["P0", "P1"], setup.width, grid)
 
 
 def test_scripted_teaching_stops_at_the_first_contact_and_names_it(tmp_path, project_root):
@@ -100,8 +102,11 @@ def test_scripted_teaching_stops_at_the_first_contact_and_names_it(tmp_path, pro
     assert message.startswith(f"{path}: pushed along the route, the robot touches an obstacle at")
     x = float(message.split("obstacle at (")[1].split(",")[0])
     assert WALL_FACE_X - 0.05 <= x <= WALL_FACE_X + 0.05  # the wall's face, within a cell
-    assert "after waypoint P0: move the route's waypoints away from it" in message
-    assert message.endswith(f"{tmp_path / 't' / 'teach.mcap'} holds the run up to there")
+    assert "after waypoint P0: move the route's waypoints so that its path stays clear" in message
+    assert message.endswith(
+        f"{tmp_path / 't' / 'teach.mcap'} holds the run up to there (to teach into "
+        f"{tmp_path / 't'} again: --overwrite, or overwrite=True)"
+    )
     truth = read_run(tmp_path / "t" / "teach.mcap").poses("/ground_truth")[1]
     assert contacts(load_scene(path), truth) == 0  # no logged step is in the wall
 
@@ -124,7 +129,11 @@ def test_keyboard_teaching_stops_the_robot_at_a_wall(tmp_path, project_root):
     assert contacts(scene, truth) == 0
     assert result.marks[0]["truth"][0] == pytest.approx(truth[-1, 0])
     bumps = [line for line in status.getvalue().splitlines() if line.startswith("bumped")]
-    assert len(bumps) >= 1 and bumps[0].endswith("the robot stopped; back off (s) or turn (a, d)")
+    assert len(bumps) >= 1
+    assert bumps[0].endswith("the robot stopped; back off (s) before turning (a, d)")
+    logged = [m for _, m in read_run(result.log).messages("/collision")]  # each bump, logged
+    assert len(logged) == len(bumps)
+    assert all(abs(m["contact"][0] - WALL_FACE_X) <= 0.05 for m in logged)
 
 
 @pytest.fixture(scope="module")
@@ -205,3 +214,26 @@ def test_the_playback_and_serve_commands_call_a_folder_given_as_a_scene_a_folder
         assert status == 1 and err.strip() == "kiseki: error: sub: a folder, not a scene file", (
             command
         )
+
+
+def test_teaching_and_playback_refuse_a_scene_with_pedestrians(tmp_path, project_root):
+    """Neither simulates them (their cameras would not see them, their logs would not hold
+    them): teaching drove through a standing pedestrian, playback ended on one it never saw."""
+    anna = {"name": "anna", "start": [2.0, 0.0], "velocity": [0.0, 0.0]}
+    path = corridor(tmp_path, project_root, "c.yaml", [(0.0, 0.0), (3.0, 0.0)])
+    doc = yaml.safe_load(path.read_text())
+    doc["pedestrians"] = [anna]
+    path.write_text(yaml.safe_dump(doc, sort_keys=False))
+    expected = (
+        f"{path}: {{}} does not simulate the scene's pedestrians (anna): remove them for it "
+        "(kiseki sim run simulates them)"
+    )
+    with pytest.raises(ValueError) as err:
+        teach(load_scene(path), tmp_path / "t")
+    assert str(err.value) == expected.format("teaching") and not (tmp_path / "t").exists()
+    marks = [
+        {"id": i, "name": f"P{i}", "x": x, "y": 0.0, "theta": 0.0} for i, x in enumerate((0.0, 3.0))
+    ]
+    with pytest.raises(ValueError) as err:
+        playback(load_scene(path, "playback"), OccupancyGrid(80, 80, 0.1), marks)
+    assert str(err.value) == expected.format("playback")

@@ -273,6 +273,6 @@ def _drive(run: TeachingRun, keys, teleop: Teleop, stream: TextIO, in_place: boo
             start = "\r" if in_place else ""
             stream.write(
                 f"{start}bumped into an obstacle at ({x:.2f}, {y:.2f}) m: the robot stopped; "
-                "back off (s) or turn (a, d)\n"
+                "back off (s) before turning (a, d)\n"
             )
             stream.flush()

@@ -4,7 +4,10 @@
 estimate and stops when the estimate is within 0.1 m of the goal; it then decelerates at its
 acceleration limit (the filter still running) and its stop pose is where it comes to rest. The
 filter (kiseki's Monte Carlo engine, :mod:`kiseki.filters`) predicts from odometry and
-weighs particles with the space observation model on the chosen method's local map.
+weighs particles with the space observation model on the chosen method's local map. In
+simulation the run ends where the robot touches an obstacle (:mod:`kiseki.sim.collisions`),
+as a simulated run does; a scene with pedestrians is refused (playback does not simulate
+them).
 
 A speed limiter (any :class:`~kiseki.control.SpeedLimitSource`; playback never imports the
 limiter's area) caps the follower's speed at every control step: the scene's first laser scans
@@ -29,7 +32,12 @@ from kiseki.control import PurePursuit, SpeedLimit, SpeedLimitSource
 from kiseki.core import derive_seed
 from kiseki.filters import MclConfig, MonteCarloLocalizer
 from kiseki.grid import OccupancyGrid
-from kiseki.sim.collisions import COLLISION_SCHEMA, Collision, CollisionCheck
+from kiseki.sim.collisions import (
+    COLLISION_SCHEMA,
+    Collision,
+    CollisionCheck,
+    refuse_pedestrians,
+)
 from kiseki.sim.scene import Scene
 from kiseki.sim.setup import SensorSetup, build_robot, build_sensors
 from kiseki.teach.local_maps import METHODS, LocalMapMaker, local_map_scan
@@ -151,8 +159,9 @@ class PlaybackRun:
         self.scene, self.environment, self.writer = scene, environment, writer
         self.setup = build_robot(scene, derive_seed(config.seed, 1))
         check_route(environment, waypoints, travelled, self.setup.footprint)
-        # the robot against the scene's truth (and its pedestrians): a contact ends the run
-        self._collisions = CollisionCheck(scene, [self.setup], scene.pedestrians)
+        refuse_pedestrians(scene, "playback")
+        # the robot against the scene's truth: a contact ends the run
+        self._collisions = CollisionCheck(scene, [self.setup])
         self.collision: Collision | None = None
         sensors = build_sensors(scene, self.setup, config.seed, config.dt)
         self.cameras = [s.device for s in sensors if s.kind == "depth_camera"]
@@ -246,7 +255,8 @@ class PlaybackRun:
         and from then on. A move that brings the robot into contact (its footprint on the
         scene's obstacles or a pedestrian, :class:`~kiseki.sim.collisions.CollisionCheck`)
         ends the run as a simulated run ends: the next step records the pose of the contact
-        and returns False; ``collision`` holds the contact."""
+        and returns False; ``collision`` holds the contact (its time counted, as ``steps``,
+        from the start of the current route)."""
         if self.done:
             return False
         config, setup, writer = self.config, self.setup, self.writer

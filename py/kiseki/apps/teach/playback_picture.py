@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Copyright (c) 2026 the kiseki authors
-"""A playback as a picture (PNG): the taught map, the waypoints of the route with their names,
-the filter's estimate along the run, the simulated robot's true path and where it came to rest,
-and the contact when the run ended on one.
+"""A playback as a picture (PNG, or another format matplotlib writes): the taught map, the
+waypoints of the route with their names, the filter's estimate along the run, the simulated
+robot's true path and where it came to rest, and the contact when the run ended on one.
 
 The taught map is in the teaching run's odometry frame, which starts at the robot's true start
 pose: the true path is drawn in the world frame on the same axes, so that where the two paths
@@ -30,8 +30,9 @@ def render_playback(
     label: str = "playback",
 ) -> Path:
     """Draws `result` (a :func:`~kiseki.apps.teach.playback` run) over its taught map
-    `environment` with the route's `waypoints` (the taught marks it followed) to the PNG
-    `path`, titled 'LABEL: goal reached (or not), N steps (T s)'; returns the path."""
+    `environment` with the route's `waypoints` (the taught marks it followed) to `path` (the
+    format from its suffix), titled 'LABEL: goal reached (or not), N steps (T s)'; returns
+    the path."""
     if not isinstance(result, PlaybackResult):
         raise TypeError(f"result must be a PlaybackResult, got {type(result).__name__}")
     if not waypoints:

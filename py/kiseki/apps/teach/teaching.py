@@ -31,7 +31,14 @@ from kiseki.apps.teach.teaching_files import (
 from kiseki.control import PurePursuit
 from kiseki.core import Pose2
 from kiseki.io.runlog import RunWriter, read_run
-from kiseki.sim.collisions import Collision, FootprintChecker, body_grid, check_route_clear
+from kiseki.sim.collisions import (
+    COLLISION_SCHEMA,
+    Collision,
+    FootprintChecker,
+    body_grid,
+    check_route_clear,
+    refuse_pedestrians,
+)
 from kiseki.sim.scene import Scene, check_route_in_bounds
 from kiseki.sim.setup import build_robot, build_sensors
 from kiseki.teach.environment_map import MERGE_RULES, EnvironmentMap
@@ -72,13 +79,16 @@ class TeachingRun:
     """The state of one teaching run and its one step, shared by scripted and keyboard
     teaching: the robot, its depth cameras, the environment maps being merged, the waypoint
     marks and the MCAP log. Opening the run logs step 0 at the start pose; each :meth:`step`
-    moves the robot by a velocity command for ``dt``, then logs the new true pose, odometry and
-    depth images and merges the local maps placed by odometry; :meth:`mark` records a waypoint
-    at the current odometry pose. Use it as a context manager (the log is closed on exit, also
-    on an exception, so that :func:`recover` can rebuild the run). `merge` is the environment
-    maps' merge rule (`kiseki.teach.environment_map`). Unless `overwrite`, a folder holding any
-    file the run writes (:data:`TEACHING_FILES`) is refused (FileExistsError) before anything is
-    written."""
+    moves the robot by a velocity command for ``dt`` (unless the move would touch an obstacle:
+    then it stays, see :meth:`step`), then logs the true pose, odometry and depth images and
+    merges the local maps placed by odometry; :meth:`mark` records a waypoint at the current
+    odometry pose. Use it as a context manager (the log is closed on exit, also on an exception,
+    so that :func:`recover` can rebuild the run). `merge` is the environment maps' merge rule
+    (`kiseki.teach.environment_map`). Before anything is written: unless `overwrite`, a folder
+    holding any file the run writes (:data:`TEACHING_FILES`) is refused (FileExistsError); a
+    scene with pedestrians is refused (teaching does not simulate them); with `route` ((n, 2)
+    points and their `names`), a route point where the robot cannot stand is refused
+    (:func:`~kiseki.sim.collisions.check_route_clear`)."""
 
     def __init__(
         self,
@@ -89,6 +99,7 @@ class TeachingRun:
         overwrite: bool = False,
         metadata: dict[str, str] | None = None,
         merge: str = "thesis",
+        route: tuple[list, list[str]] | None = None,
     ) -> None:
         check_number(dt, "dt", 0.0, low_open=True, unit="s")
         if merge not in MERGE_RULES:
@@ -103,13 +114,16 @@ class TeachingRun:
         self.setup = build_robot(scene, seed)
         if self.setup.kind != "diff_drive":
             raise ValueError(f"{scene.path}: teaching pushes a diff_drive robot")
-        s = self.setup
-        self._body = FootprintChecker(body_grid(scene, s.height), s.length, s.width)
         self.cameras = [
             s for s in build_sensors(scene, self.setup, seed, dt) if s.kind == "depth_camera"
         ]
         if not self.cameras:
             raise ValueError(f"{scene.path}: teaching needs the robot's depth cameras")
+        refuse_pedestrians(scene, "teaching")
+        body = body_grid(scene, self.setup.height)
+        if route is not None:
+            check_route_clear(scene, *route, self.setup.width, body)
+        self._body = FootprintChecker(body, self.setup.length, self.setup.width)
         self.makers = {b: LocalMapMaker([c.device for c in self.cameras], b) for b in BANDS}
         self.maps = {b: EnvironmentMap(environment_grid(scene), merge) for b in BANDS}
         self.marks: list[dict] = []
@@ -171,7 +185,11 @@ class TeachingRun:
         self._record()
         if contact is None:
             return None
-        return Collision(self.t, self.setup.name, "obstacle", contact)
+        c = Collision(self.t, self.setup.name, "obstacle", contact)
+        self._writer.write_json(
+            "/collision", c.t, "kiseki.Collision", c.payload(), COLLISION_SCHEMA
+        )
+        return c
 
     def _record(self) -> None:
         t, truth, odom = self.steps * self.dt, self.truth, self.odom
@@ -262,10 +280,9 @@ def teach(
         raise ValueError(f"{scene.path}: scripted teaching needs a route (or use the keyboard)")
     names = route.get("names") or [f"W{i}" for i in range(len(route["waypoints"]))]
     check_route_in_bounds(scene, route["waypoints"], names)
-    body = build_robot(scene, seed)
-    check_route_clear(scene, route["waypoints"], names, body.width, body.height)
     meta = {**(metadata or {}), "names": ",".join(names)}
-    with TeachingRun(scene, out, seed, dt, overwrite, meta, merge) as run:
+    points = (route["waypoints"], names)
+    with TeachingRun(scene, out, seed, dt, overwrite, meta, merge, points) as run:
         controller = PurePursuit(
             route["waypoints"],
             route["speed"],
@@ -273,19 +290,18 @@ def teach(
             0.1,
             run.setup.robot.params.max_accel,
         )
-        bar = tqdm(desc="teaching", unit="step", disable=not progress, mininterval=0.1)
-        while True:
-            # the operator stops pushing at the goal and marks it once the cart is at rest
-            resting = controller.done and not any(run.setup.robot.velocity)
-            _mark(run, names, controller, resting)
-            bar.update(1)  # this step is written
-            if resting or run.steps >= int(900 / dt):
-                break
-            v, _, w = controller.command(run.truth)
-            contact = run.step(v, w)
-            if contact is not None:
-                raise ValueError(_blocked(scene, names, run, contact))
-        bar.close()
+        with tqdm(desc="teaching", unit="step", disable=not progress, mininterval=0.1) as bar:
+            while True:
+                # the operator stops pushing at the goal and marks it once the cart is at rest
+                resting = controller.done and not any(run.setup.robot.velocity)
+                _mark(run, names, controller, resting)
+                bar.update(1)  # this step is written
+                if resting or run.steps >= int(900 / dt):
+                    break
+                v, _, w = controller.command(run.truth)
+                contact = run.step(v, w)
+                if contact is not None:
+                    raise ValueError(_blocked(scene, names, run, contact))
         return run.finish()
 
 
@@ -299,9 +315,10 @@ def _blocked(scene: Scene, names, run: TeachingRun, contact: Collision) -> str:
     x, y = contact.contact
     return (
         f"{scene.path}: pushed along the route, the robot touches an obstacle at ({x:.2f}, "
-        f"{y:.2f}) m at t = {contact.t:.1f} s, {after}: move the route's waypoints away from "
-        f"it (the robot cuts corners, steering to a point 0.6 m ahead); {run.log} holds the "
-        "run up to there"
+        f"{y:.2f}) m at t = {contact.t:.1f} s, {after}: move the route's waypoints so that its "
+        "path stays clear of it (the robot cuts corners, steering to a point 0.6 m ahead); "
+        f"{run.log} holds the run up to there (to teach into {run.out} again: --overwrite, "
+        "or overwrite=True)"
     )
 
 
