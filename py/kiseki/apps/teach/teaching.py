@@ -3,9 +3,9 @@
 """Teaching (thesis sec. 3.4): the robot is pushed once along the route; every step its local
 map is placed by odometry into the environment map M with the thesis' merge rules, and a
 waypoint (id, name, odometry pose) is recorded where the operator marks one. The run is logged
-to MCAP as it goes (odometry, depth images, waypoint marks), so that `recover` rebuilds the map
-and the waypoints from the log after a crash, losing at most the last unwritten chunk (well
-under a second at 10 Hz).
+to MCAP as it goes (odometry, depth images, waypoint marks), so that `recover` (in `recovery`,
+importable from here) rebuilds the map and the waypoints from the log after a crash, losing at
+most the last unwritten chunk (well under a second at 10 Hz).
 
 The files a run writes (its maps, their truth, the waypoint file) are `teaching_files`'.
 """
@@ -22,15 +22,16 @@ from tqdm import tqdm
 from kiseki._support.atomic import check_writable_folder, reworded
 from kiseki._support.real_numbers import check_number
 from kiseki._support.replaced_files import refuse_replacing
+from kiseki.apps.teach.recovery import recover
 from kiseki.apps.teach.teaching_files import (
     TeachResult,
     environment_grid,
     measure_taught_maps,
+    merge_local_maps,
     write_teaching_files,
 )
 from kiseki.control import PurePursuit
-from kiseki.core import Pose2
-from kiseki.io.runlog import RunWriter, read_run
+from kiseki.io.runlog import RunWriter
 from kiseki.sim.collisions import (
     COLLISION_SCHEMA,
     Collision,
@@ -46,7 +47,6 @@ from kiseki.teach.local_maps import BANDS, LocalMapMaker
 from kiseki.teach.scene_identity import (
     TaughtScene,
     recorded_scene_file,
-    resolve_scene_file,
     scene_digest,
 )
 
@@ -201,7 +201,7 @@ class TeachingRun:
                 self._writer.write_depth_image(f"/{c.name}", t, image, c.name)
         except OSError as err:  # a full disk: what was logged before stays readable
             raise self._log_error(err) from err
-        _integrate(self.maps, self.makers, images, odom)
+        merge_local_maps(self.maps, self.makers, images, odom)
         self.truths.append(truth)
         self.steps += 1
 
@@ -322,12 +322,6 @@ def _blocked(scene: Scene, names, run: TeachingRun, contact: Collision) -> str:
     )
 
 
-def _integrate(maps, makers, images, odom) -> None:
-    pose = Pose2(*odom)
-    for band, maker in makers.items():
-        maps[band].merge(maker.builder(images), pose)
-
-
 def _mark(run: TeachingRun, names, controller: PurePursuit, resting: bool) -> None:
     """The operator marks the next route point when the robot reaches it along the route (the
     goal once the robot has come to rest there)."""
@@ -338,61 +332,3 @@ def _mark(run: TeachingRun, names, controller: PurePursuit, resting: bool) -> No
     if (last and not resting) or (not last and controller.progress < controller.cum[i] - 0.05):
         return
     run.mark(names[i])
-
-
-def _check_same_scene(metadata: dict, scene: Scene, log) -> None:
-    """Refuses to rebuild a log in a scene other than the one it was taught in: by the scene
-    file's SHA-1 when the log records it, else by the recorded file when it still exists."""
-    taught = metadata.get("scene_file", "")
-    recorded = metadata.get("scene_sha1")
-    found = resolve_scene_file(taught, Path(log).parent)
-    if recorded is None and found is not None:
-        recorded = scene_digest(found)  # logs from before the digest was recorded
-    if recorded is not None and recorded != scene_digest(scene.path):
-        raise ValueError(
-            f"{log} was taught in {found or taught or 'another scene'}, not in {scene.path} "
-            "(the scene files differ): give the scene it was taught in"
-        )
-
-
-def recover(
-    scene: Scene, log: str | os.PathLike, out: str | os.PathLike, merge: str | None = None
-) -> TeachResult:
-    """Rebuilds the maps and waypoints of a teaching run from its MCAP log (after a crash),
-    with the merge rule the run was taught with (or `merge`)."""
-    check_writable_folder(out, "teaching")
-    run = read_run(log)
-    _check_same_scene(run.metadata, scene, log)
-    topics = run.topics()
-    merge = merge or run.metadata.get("merge", "thesis")
-    if merge not in MERGE_RULES:
-        raise ValueError(f"{log}: unknown merge rule {merge!r} (known: {', '.join(MERGE_RULES)})")
-    setup = build_robot(scene, 0)
-    cameras = [s for s in build_sensors(scene, setup, 0, 0.1) if s.kind == "depth_camera"]
-    missing = [c.name for c in cameras if f"/{c.name}" not in topics]
-    if missing or "/odom" not in topics:
-        raise ValueError(f"{log}: not a teaching log of {scene.path} (missing topics)")
-    odom = {round(t, 6): (m["x"], m["y"], m["theta"]) for t, m in run.messages("/odom")}
-    truth = {}
-    if "/ground_truth" in topics:
-        times, poses = run.poses("/ground_truth")
-        truth = {round(float(t), 6): tuple(p) for t, p in zip(times, poses, strict=True)}
-    images = [dict((round(t, 6), d) for t, d in run.depth_images(f"/{c.name}")) for c in cameras]
-    makers = {b: LocalMapMaker([c.device for c in cameras], b) for b in BANDS}
-    maps = {b: EnvironmentMap(environment_grid(scene), merge) for b in BANDS}
-    steps, truths = 0, []
-    for t in sorted(odom):
-        if all(t in im for im in images):
-            _integrate(
-                maps, makers, [np.asarray(im[t], dtype=np.float32) for im in images], odom[t]
-            )
-            steps += 1
-            if t in truth:
-                truths.append(truth[t])
-    marks = [m for _, m in run.messages("/waypoints")] if "/waypoints" in topics else []
-    Path(out).mkdir(parents=True, exist_ok=True)
-    grids = {b: m.map() for b, m in maps.items()}
-    measured = measure_taught_maps(scene, grids, np.array(truths), cameras) if truths else None
-    scene_id = TaughtScene(recorded_scene_file(scene.path, out), scene_digest(scene.path), str(out))
-    files = (grids, marks, Path(log), steps, merge, measured, scene_id)
-    return write_teaching_files(Path(out), *files)

@@ -24,7 +24,13 @@ from kiseki.teach.local_maps import BANDS
 from kiseki.teach.map_truth import taught_map_truth
 from kiseki.teach.scene_identity import TaughtScene
 
-__all__ = ["TeachResult", "environment_grid", "measure_taught_maps", "write_teaching_files"]
+__all__ = [
+    "TeachResult",
+    "environment_grid",
+    "measure_taught_maps",
+    "merge_local_maps",
+    "write_teaching_files",
+]
 
 
 @dataclass(frozen=True)
@@ -37,6 +43,14 @@ class TeachResult:
     merge: str = "thesis"  # the merge rule the maps were built with
     truth: dict | None = None  # band -> the map against the scene's truth (map_truth.json)
     scene: TaughtScene | None = None  # the scene file taught in and its SHA-1
+
+
+def merge_local_maps(maps: dict, makers: dict, images: list, odom) -> None:
+    """One step of teaching (sec. 3.4): each band's local map from the depth `images`, placed
+    by the odometry pose `odom` (x, y, theta), merged into that band's environment map."""
+    pose = Pose2(*odom)
+    for band, maker in makers.items():
+        maps[band].merge(maker.builder(images), pose)
 
 
 def environment_grid(scene: Scene, resolution: float = 0.1, margin: float = 4.0) -> OccupancyGrid:
