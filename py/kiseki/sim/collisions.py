@@ -25,6 +25,7 @@ __all__ = [
     "Collision",
     "CollisionCheck",
     "FootprintChecker",
+    "ObstacleCells",
     "body_grid",
     "check_free_start",
     "check_route_clear",
@@ -48,8 +49,9 @@ COLLISION_SCHEMA = {
 
 @dataclass(frozen=True)
 class Collision:
-    """The contact that ended a run: at time t (s), robot hit `hit` ("obstacle", another
-    robot's name or a pedestrian's name) at the world point `contact` (x, y)."""
+    """A contact: at time t (s), robot hit `hit` ("obstacle", another robot's name or a
+    pedestrian's name) at the world point `contact` (x, y). It ends a simulated run and a
+    playback; in teaching the move is not made."""
 
     t: float
     robot: str
@@ -125,23 +127,42 @@ def check_free_start(scene, pose, length: float, width: float, height: float) ->
         raise ValueError(f"{scene.path}: the robot's start footprint overlaps an obstacle")
 
 
+class ObstacleCells:
+    """The occupied cells of a grid (a scene's :func:`body_grid`) by their centres, for the
+    distance from a point to the nearest one."""
+
+    def __init__(self, grid) -> None:
+        occupied = np.argwhere(grid.cells == 100)  # (row, col)
+        self.centres = grid.cell_to_world(occupied[:, ::-1].astype(float))
+        self._tree = None
+        if len(occupied):
+            from scipy.spatial import cKDTree  # here: importing the simulator stays fast
+
+            self._tree = cKDTree(self.centres)
+
+    def nearest(self, point) -> tuple[float, tuple[float, float] | None]:
+        """(distance m, (x, y) of the nearest occupied cell's centre); (inf, None) without
+        any."""
+        if self._tree is None:
+            return math.inf, None
+        distance, k = self._tree.query(np.asarray(point, dtype=float)[:2])
+        x, y = self.centres[int(k)]
+        return float(distance), (float(x), float(y))
+
+
 def check_route_clear(scene, waypoints, names, width: float, grid) -> None:
     """ValueError naming the scene and the first route waypoint (x, y) where the robot cannot
     stand in any heading: an obstacle cell of `grid` (the scene's :func:`body_grid` at the
     robot's height) lies within half its `width` of the point, inside the disc every footprint
     centred there covers. Cells are taken by their centres, so an obstacle grazing the disc by
     less than half a cell passes (the run's own contact check finds it)."""
-    occupied = np.argwhere(grid.cells == 100)  # (row, col)
-    if not len(occupied):
-        return
-    centres = grid.cell_to_world(occupied[:, ::-1].astype(float))
+    cells = ObstacleCells(grid)
     for name, point in zip(names, waypoints, strict=True):
-        near = np.hypot(centres[:, 0] - point[0], centres[:, 1] - point[1])
-        k = int(np.argmin(near))
-        if near[k] <= width / 2:
-            x, y = centres[k]
+        distance, centre = cells.nearest(point)
+        if distance <= width / 2:
+            x, y = centre
             raise ValueError(
-                f"{scene.path}: route waypoint {name} {list(point)} lies {near[k]:.2f} m from "
+                f"{scene.path}: route waypoint {name} {list(point)} lies {distance:.2f} m from "
                 f"an obstacle at ({x:.2f}, {y:.2f}) m, within half the robot's width "
                 f"({width / 2:.2f} m): the robot cannot stand there"
             )

@@ -11,10 +11,9 @@ import math
 from collections.abc import Callable
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from kiseki.magnetic.linear_map import NODE_SPACING
-from kiseki.sim.collisions import FootprintChecker, body_grid, footprint_points
+from kiseki.sim.collisions import FootprintChecker, ObstacleCells, body_grid, footprint_points
 from kiseki.sim.setup import build_robot
 
 __all__ = ["OffsetCheck", "check_magnetometer", "check_route_length", "check_taught_run"]
@@ -71,9 +70,7 @@ class OffsetCheck:
         grid = body_grid(scene, robot.height)
         self.checker = FootprintChecker(grid, robot.length, robot.width)
         self.half_width = robot.width / 2
-        occupied = np.argwhere(grid.cells == 100)  # (row, col)
-        centres = grid.cell_to_world(occupied[:, ::-1].astype(float))
-        self.near = cKDTree(centres) if len(occupied) else None
+        self.obstacles = ObstacleCells(grid)
         self.lo, self.hi = (np.asarray(b, dtype=np.float64)[:2] for b in scene.bounds)
         x, y, self.yaw = scene.robot.get("start", [0.0, 0.0, 0.0])
         self.start = np.array([x, y], dtype=np.float64)
@@ -131,7 +128,7 @@ class OffsetCheck:
                         f"{where}, outside the scene's bounds (x {lo[0]:g}..{hi[0]:g}, "
                         f"y {lo[1]:g}..{hi[1]:g})"
                     )
-                gap = math.inf if self.near is None else float(self.near.query(point)[0])
+                gap = self.obstacles.nearest(point)[0]
                 if gap <= self.half_width:
                     return name, (
                         f"{where}, where the robot cannot stand in any heading (an obstacle "
