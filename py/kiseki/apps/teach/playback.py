@@ -253,9 +253,10 @@ class PlaybackRun:
         follower's command for dt, unless the route is over (reached or stopped) and the robot
         at rest. Returns False when the robot rests at the end (that step recorded, no command),
         and from then on. A move that brings the robot into contact (its footprint on the
-        scene's obstacles, :class:`~kiseki.sim.collisions.CollisionCheck`) ends the run as a simulated run ends: the next step records the pose of the contact
-        and returns False; ``collision`` holds the contact (its time counted, as ``steps``,
-        from the start of the current route)."""
+        scene's obstacles, :class:`~kiseki.sim.collisions.CollisionCheck`) ends the run as a
+        simulated run ends: the next step records the pose of the contact and returns False;
+        ``collision`` holds the contact (its time counted, as ``steps``, from the start of the
+        current route)."""
         if self.done:
             return False
         config, setup, writer = self.config, self.setup, self.writer
