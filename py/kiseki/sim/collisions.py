@@ -100,17 +100,27 @@ class FootprintChecker:
     def samples(self, pose) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(points (n, 2), cells (n, 2), inside the grid (n,))."""
         pts = footprint_points(pose, self.length, self.width, self.spacing)
+        return (pts, *self._cells(pts))
+
+    def _cells(self, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         cells = self.grid.world_to_cell(pts)
         inside = (cells[:, 0] >= 0) & (cells[:, 0] < self.grid.width) & (cells[:, 1] >= 0)
         inside &= cells[:, 1] < self.grid.height
-        return pts, cells, inside
+        return cells, inside
+
+    def occupied(self, pts: np.ndarray) -> np.ndarray:
+        """Which world points (n, 2) lie in occupied cells; points beyond the grid touch
+        nothing (an open corridor end)."""
+        cells, inside = self._cells(pts)
+        hit = np.zeros(len(pts), dtype=bool)
+        hit[inside] = self.cells[cells[inside, 1], cells[inside, 0]] == 100
+        return hit
 
     def contact(self, pose) -> tuple[float, float] | None:
         """The centroid of the footprint's samples in occupied cells, or None. Samples beyond
         the scene's bounds touch nothing (an open corridor end)."""
-        pts, cells, inside = self.samples(pose)
-        hit = np.zeros(len(pts), dtype=bool)
-        hit[inside] = self.cells[cells[inside, 1], cells[inside, 0]] == 100
+        pts = footprint_points(pose, self.length, self.width, self.spacing)
+        hit = self.occupied(pts)
         if not hit.any():
             return None
         x, y = pts[hit].mean(axis=0)

@@ -102,10 +102,7 @@ class OffsetCheck:
             )
             at = np.linspace(0.0, 1.0, max(2, math.ceil(length / c.spacing) + 1))
             points = (a + at[:, None] * (b - a))[:, None, :] + body[None]
-            cells = c.grid.world_to_cell(points.reshape(-1, 2))
-            inside = (cells[:, 0] >= 0) & (cells[:, 0] < c.grid.width) & (cells[:, 1] >= 0)
-            inside &= cells[:, 1] < c.grid.height
-            if (c.cells[cells[inside, 1], cells[inside, 0]] == 100).any():
+            if c.occupied(points.reshape(-1, 2)).any():
                 return True
         return False
 
